@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Set up a fresh machine: Debian packages the renderer and the window tests need (only
+# those missing), a virtual environment in .venv, and the project installed editable.
+# Idempotent: a second run installs nothing new.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+need_apt=()
+have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
+# Mesa's EGL + llvmpipe (headless GL 4.5), GLX for windows, Xvfb and xdotool for window tests.
+for pkg in libegl1 libegl-mesa0 libgl1-mesa-dri libglx-mesa0 libgl1 xvfb xauth xdotool; do
+  have_pkg "$pkg" || need_apt+=("$pkg")
+done
+if ((${#need_apt[@]})); then
+  echo "setup: installing Debian packages: ${need_apt[*]}"
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need_apt[@]}" >/dev/null
+fi
+
+PY=${PYTHON:-python3}
+[ -x .venv/bin/python ] || "$PY" -m venv .venv
+.venv/bin/python -m pip install -q --upgrade pip
+.venv/bin/python -m pip install -q -e ".[test${EXTRAS:+,$EXTRAS}]"
+echo "setup: ready (.venv)"
