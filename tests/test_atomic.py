@@ -1,0 +1,33 @@
+"""Atomic writes: the target appears whole or not at all."""
+
+from __future__ import annotations
+
+import pytest
+
+from catalog.atomic import atomic_path, write_text_atomic
+
+
+def test_write_replaces_whole_file(tmp_path):
+    target = tmp_path / "sub" / "preset.toml"
+    write_text_atomic(target, "a = 1\n")
+    write_text_atomic(target, "a = 2\n")
+    assert target.read_text() == "a = 2\n"
+    assert [p.name for p in target.parent.iterdir()] == ["preset.toml"]
+
+
+def test_failure_leaves_no_file_and_keeps_the_old_one(tmp_path):
+    target = tmp_path / "image.png"
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            tmp.write_bytes(b"half")
+            raise RuntimeError("renderer failed")
+    assert list(tmp_path.iterdir()) == []
+
+    target.write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            assert tmp.suffix == ".png"  # writers choose the format from the suffix
+            tmp.write_text("new, half")
+            raise RuntimeError("boom")
+    assert target.read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["image.png"]
