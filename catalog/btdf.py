@@ -61,10 +61,10 @@ import numpy as np
 
 FOUR_PI = 4.0 * math.pi
 
-#: A straight-through point: theta below this (degrees) sees the lamp through the gaps.
-#: The OGM-3 grid has one such direction per light direction (step 80/39 deg), the
-#: lamp and the camera's 40x40 px field subtend well under a degree.
-STRAIGHT_THROUGH_DEG = 0.5
+#: A straight-through point: theta below this (degrees) sees the lamp through the gaps
+#: (the collimated lamp's angular radius). On the OGM-3 grid only light elevation 180 with
+#: camera elevation 90 qualifies; the next nearest grid points are 0.19 deg off.
+STRAIGHT_THROUGH_DEG = 0.1
 
 
 def _check_g(g) -> None:
