@@ -252,6 +252,53 @@ def _sun_direct_light(name: str, path_km: float) -> Light:
     return _make(name, description, direct_beam_w_m2_nm(path_km))
 
 
+def _sun_clear_light(name: str, path_km: float) -> Light:
+    from catalog.sun import Atmosphere, clear_sky  # noqa: PLC0415
+
+    atmosphere = Atmosphere()
+    try:
+        sky = clear_sky(path_km=path_km, atmosphere=atmosphere)
+    except CatalogError as exc:
+        raise InputError(f"{exc} (sun-clear needs a path the sun can have; 'sun:PATH_KM' "
+                         "takes any)", field=f"light {name!r}") from None
+    description = (f"clear sky, sun at zenith {sky.zenith_deg:.1f} deg ({path_km:g} km "
+                   f"through the 22 km shell): direct + skylight + ground on a plane facing "
+                   f"the sun; ozone {atmosphere.ozone_atm_cm:g} atm-cm, aerosol "
+                   f"{atmosphere.aod_500nm:g} at 500 nm, absolute")
+    return _make(name, description, sky.sun_facing(atmosphere.ground_albedo))
+
+
+def _sun_at_light(name: str, spec: str) -> Light:
+    from catalog.sun import Atmosphere, clear_sky, sun_position  # noqa: PLC0415
+
+    parts = [p.strip() for p in spec.split(",")]
+    if len(parts) not in (2, 3):
+        raise InputError("write 'sun@DATE[THH:MM[+HH:MM]],LAT[,LON]', e.g. "
+                         "'sun@2026-06-21T12:00,34.7,135.5' (naive time = local mean solar "
+                         "time)", field=f"light {name!r}")
+    try:
+        lat = float(parts[1])
+        lon = float(parts[2]) if len(parts) == 3 else 0.0
+    except ValueError:
+        raise InputError(f"latitude/longitude {parts[1:]} are not numbers (deg)",
+                         field=f"light {name!r}") from None
+    try:
+        position = sun_position(parts[0], lat, lon)
+    except CatalogError as exc:
+        raise InputError(str(exc), field=f"light {name!r}") from None
+    if position.path_km is None:
+        raise InputError(f"the sun is below the horizon then (zenith "
+                         f"{position.zenith_deg:.1f} deg at {position.when_utc})",
+                         field=f"light {name!r}")
+    atmosphere = Atmosphere()
+    sky = clear_sky(position.zenith_deg, atmosphere=atmosphere,
+                    earth_sun_factor=position.earth_sun_factor)
+    description = (f"clear sky at {position.when_utc} UTC, {lat:g} N {lon:g} E: zenith "
+                   f"{position.zenith_deg:.1f} deg, path {position.path_km:.0f} km; direct + "
+                   "skylight + ground on a plane facing the sun, absolute")
+    return _make(name, description, sky.sun_facing(atmosphere.ground_albedo))
+
+
 # --------------------------------------------------------------------------------------
 # The library
 
@@ -274,13 +321,18 @@ def _base_light(name: str) -> Light:
         return _warm_led_light()
     if name.startswith("sun:"):
         return _sun_direct_light(name, _parse_path(name, name[len("sun:"):]))
+    if name.startswith("sun-clear:"):
+        return _sun_clear_light(name, _parse_path(name, name[len("sun-clear:"):]))
+    if name.startswith("sun@"):
+        return _sun_at_light(name, name[len("sun@"):])
     canonical = _canonical_cie(name)
     if canonical is not None:
         return _cie_light(canonical)
     close = difflib.get_close_matches(name, light_names(), n=4, cutoff=0.5)
     hint = f"; close names: {', '.join(close)}" if close else ""
     raise InputError(f"unknown light{hint} (`catalog lights` lists them all; the sun is "
-                     "'sun:PATH_KM')", field=f"light {name!r}")
+                     "'sun:PATH_KM', 'sun-clear:PATH_KM' or 'sun@DATE,LAT,LON')",
+                     field=f"light {name!r}")
 
 
 def _canonical_cie(name: str) -> str | None:

@@ -170,3 +170,304 @@ def zenith_deg_from_path(path_km: float, layer_km: float = LAYER_KM,
     cos_z = (2.0 * earth_radius_km * layer_km + layer_km ** 2 - length ** 2) / (
         2.0 * length * earth_radius_km)
     return math.degrees(math.acos(min(1.0, max(0.0, cos_z))))
+
+
+# --------------------------------------------------------------------------------------
+# Beyond the paper: a clear sky (ozone, aerosol, skylight)
+
+
+@dataclass(frozen=True)
+class Atmosphere:
+    """A clear, cloudless atmosphere. Defaults: the ASTM G173-03 reference atmosphere
+    (ozone 0.3438 atm-cm, aerosol optical depth 0.084 at 500 nm), rural aerosol after Bird &
+    Riordan (Angstrom exponent 1.14, single-scattering albedo 0.945, asymmetry 0.65), sea
+    level, ground albedo 0.2 (grass, soil). Water vapour and O2 are not modelled: their bands
+    in 300-780 nm are narrow lines at 590, 690-730 and 760 nm.
+    """
+
+    ozone_atm_cm: float = 0.3438
+    aod_500nm: float = 0.084
+    angstrom_alpha: float = 1.14
+    aerosol_albedo: float = 0.945
+    aerosol_asymmetry: float = 0.65
+    pressure_hpa: float = 1013.25
+    ground_albedo: float = 0.2
+    #: Height of the ozone layer (km): its slant factor is that of a thin shell there.
+    ozone_height_km: float = 22.0
+
+    def __post_init__(self):
+        checks = {"ozone_atm_cm": (0.0, 1.0), "aod_500nm": (0.0, 5.0),
+                  "angstrom_alpha": (-1.0, 4.0), "aerosol_albedo": (0.0, 1.0),
+                  "aerosol_asymmetry": (-0.95, 0.95), "pressure_hpa": (1.0, 1100.0),
+                  "ground_albedo": (0.0, 0.99), "ozone_height_km": (1.0, 60.0)}
+        for field_name, (low, high) in checks.items():
+            value = getattr(self, field_name)
+            if not (math.isfinite(value) and low <= value <= high):
+                raise CatalogError(f"atmosphere: {field_name} = {value!r} is outside "
+                                   f"{low:g}-{high:g}")
+
+
+@functools.lru_cache(maxsize=1)
+def _ozone_table() -> tuple[np.ndarray, np.ndarray]:
+    """Ozone absorption coefficients (per atm-cm) of Bird & Riordan (1986) after Leckner (1978),
+    as pvlib's SPECTRL2 carries them (Huggins band below 350 nm, Chappuis 450-780 nm)."""
+    import importlib  # noqa: PLC0415
+
+    # the module, not the function of the same name that pvlib.spectrum re-exports
+    spectrl2_module = importlib.import_module("pvlib.spectrum.spectrl2")
+    try:
+        table = spectrl2_module._SPECTRL2_COEFFS  # noqa: SLF001  (pvlib keeps it module-private)
+    except AttributeError:  # pragma: no cover - a pvlib that moved its table
+        raise CatalogError("pvlib no longer carries the SPECTRL2 ozone table "
+                           "(pvlib.spectrum.spectrl2._SPECTRL2_COEFFS)") from None
+    return (np.asarray(table["wavelength"], dtype=np.float64),
+            np.asarray(table["ozone_absorption"], dtype=np.float64))
+
+
+def ozone_absorption_per_atm_cm(wavelength_nm: np.ndarray = GRID_NM) -> np.ndarray:
+    """k_O3(l) (1/atm-cm): vertical ozone optical depth = k_O3 * ozone column (atm-cm).
+
+    The table is 5-10 nm apart; the Huggins band falls by ~2x every 5 nm, so it is
+    interpolated in log k where both neighbours are positive, linearly elsewhere.
+    """
+    wl_table, k_table = _ozone_table()
+    wl = np.asarray(wavelength_nm, dtype=np.float64)
+    linear = np.interp(wl, wl_table, k_table)
+    positive = k_table > 0
+    with np.errstate(divide="ignore"):
+        log_k = np.where(positive, np.log(np.where(positive, k_table, 1.0)), -np.inf)
+    log_interp = np.exp(np.interp(wl, wl_table, log_k))
+    # log interpolation only between two positive entries (else the -inf pulls it to 0)
+    idx = np.clip(np.searchsorted(wl_table, wl), 1, wl_table.size - 1)
+    both_positive = positive[idx] & positive[idx - 1]
+    return np.where(both_positive, log_interp, linear)
+
+
+def aerosol_optical_depth(atmosphere: Atmosphere,
+                          wavelength_nm: np.ndarray = GRID_NM) -> np.ndarray:
+    """Angstrom's law: tau_a(l) = tau_a(500 nm) * (l / 500 nm)^-alpha (vertical)."""
+    wl = np.asarray(wavelength_nm, dtype=np.float64)
+    return atmosphere.aod_500nm * (wl / 500.0) ** (-atmosphere.angstrom_alpha)
+
+
+def relative_airmass_kasten_young(zenith_deg: float) -> float:
+    """Kasten & Young (1989): m = 1 / (cos z + 0.50572 (96.07995 - z)^-1.6364), z in deg.
+
+    The air mass of the real, exponentially thinning atmosphere (38 at the horizon); used
+    for the aerosol, which sits in the lowest kilometres.
+    """
+    z = float(zenith_deg)
+    return 1.0 / (math.cos(math.radians(z)) + 0.50572 * (96.07995 - z) ** -1.6364)
+
+
+def ozone_slant_factor(zenith_deg: float, height_km: float = 22.0,
+                       earth_radius_km: float = EARTH_RADIUS_KM) -> float:
+    """Slant factor of a thin layer at ``height_km``: 1 / cos z', sin z' = R sin z / (R + h)."""
+    s = EARTH_RADIUS_KM / (earth_radius_km + height_km) * math.sin(math.radians(zenith_deg))
+    return 1.0 / math.sqrt(1.0 - s * s)
+
+
+@functools.lru_cache(maxsize=64)
+def hg_downward_fraction(cos_zenith: float, g: float, nodes: int = 48) -> float:
+    """Fraction of light scattered by a Henyey-Greenstein particle (eq. 6) that goes down,
+    for a beam travelling down at ``cos_zenith`` to the vertical.
+
+    Integral of the phase function over the lower hemisphere (Gauss-Legendre in the cosine,
+    uniform in azimuth). 0.5 for g = 0 at any zenith (Rayleigh's phase function is also
+    symmetric, so its downward fraction is exactly 0.5); -> 1 as g -> 1 for an overhead sun.
+    """
+    from catalog.btdf import hg_phase  # noqa: PLC0415  (eq. 6, one copy in the project)
+
+    mu0 = float(cos_zenith)
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    mu = 0.5 * (x + 1.0)                       # downward direction cosines in (0, 1)
+    w_mu = 0.5 * w
+    phi = (np.arange(4 * nodes) + 0.5) * (2.0 * math.pi / (4 * nodes))
+    sin0 = math.sqrt(max(0.0, 1.0 - mu0 * mu0))
+    cos_theta = mu0 * mu[:, None] + sin0 * np.sqrt(1.0 - mu[:, None] ** 2) * np.cos(phi)[None, :]
+    integrand = hg_phase(np.clip(cos_theta, -1.0, 1.0), g)
+    return float(np.sum(w_mu[:, None] * integrand) * (2.0 * math.pi / (4 * nodes)))
+
+
+#: Diffusivity factor: the mean slant of diffuse light through a plane layer (Elsasser).
+DIFFUSIVITY = 1.66
+
+
+@dataclass(frozen=True, eq=False)
+class ClearSky:
+    """Clear-sky spectra on ``wavelength_nm`` (W m^-2 nm^-1)."""
+
+    wavelength_nm: np.ndarray
+    zenith_deg: float
+    path_km: float
+    direct_normal: np.ndarray
+    diffuse_horizontal: np.ndarray
+    extraterrestrial: np.ndarray
+
+    @property
+    def cos_zenith(self) -> float:
+        return math.cos(math.radians(self.zenith_deg))
+
+    @property
+    def global_horizontal(self) -> np.ndarray:
+        return self.direct_normal * self.cos_zenith + self.diffuse_horizontal
+
+    def sun_facing(self, ground_albedo: float) -> np.ndarray:
+        """Global irradiance on a plane facing the sun (tilted by the zenith angle): the
+        direct beam at normal incidence, the isotropic sky it sees ((1 + cos z) / 2) and
+        the ground it sees ((1 - cos z) / 2 of the ground's reflected global)."""
+        tilt_cos = self.cos_zenith
+        return (self.direct_normal + self.diffuse_horizontal * (1.0 + tilt_cos) / 2.0
+                + ground_albedo * self.global_horizontal * (1.0 - tilt_cos) / 2.0)
+
+
+def clear_sky(zenith_deg: float | None = None, *, path_km: float | None = None,
+              atmosphere: Atmosphere = Atmosphere(), earth_sun_factor: float = 1.0,
+              grid_nm: np.ndarray = GRID_NM) -> ClearSky:
+    """Direct and diffuse clear-sky spectra for a solar zenith (or a path in the 22 km shell).
+
+    Direct normal (Beer-Lambert along the slant paths of each constituent)::
+
+        E_dn = f E0 exp(-tau_R L/22 km - k_O3 U m_O3 - tau_a m_a)
+
+    with the paper's Rayleigh path L (shell geometry), the ozone column U through a thin
+    shell at 22 km, the aerosol along the Kasten-Young air mass m_a, f the Earth-Sun
+    distance factor (1 at 1 AU).
+
+    Diffuse horizontal (single scattering in a mixed layer, then one ground-sky bounce):
+    of the light the beam loses to scattering, (1 - T_ext) * tau_scat / tau_ext, the
+    Rayleigh part goes down with probability 1/2 and the aerosol part with the downward
+    fraction of its HG phase function (:func:`hg_downward_fraction`). The ozone (above the
+    scatterers) attenuates the incident beam first. The sky's albedo for the light the
+    ground reflects is the same single-scattering estimate for diffuse light going up
+    (diffusivity 1.66, upward fractions), and the ground-sky series sums to
+    E_g = (E_dn cos z + E_d) rho_g rho_s / (1 - rho_g rho_s).
+    """
+    from catalog.errors import CatalogError as _Err  # noqa: PLC0415 (same class, local name)
+
+    if (zenith_deg is None) == (path_km is None):
+        raise _Err("clear_sky: give exactly one of zenith_deg and path_km")
+    if path_km is not None:
+        path_km = float(path_km)
+        zenith_deg = zenith_deg_from_path(path_km)
+    else:
+        zenith_deg = float(zenith_deg)
+        path_km = path_km_from_zenith(zenith_deg)
+    grid = np.asarray(grid_nm, dtype=np.float64)
+    cos_z = math.cos(math.radians(zenith_deg))
+    atm = atmosphere
+    e0 = extraterrestrial_w_m2_nm(grid) * float(earth_sun_factor)
+
+    pressure_scale = atm.pressure_hpa / 1013.25
+    tau_r = rayleigh_optical_depth(grid) * pressure_scale          # vertical
+    tau_o3 = ozone_absorption_per_atm_cm(grid) * atm.ozone_atm_cm   # vertical
+    tau_a = aerosol_optical_depth(atm, grid)                        # vertical
+    m_r = path_km / LAYER_KM
+    m_o3 = ozone_slant_factor(zenith_deg, atm.ozone_height_km)
+    m_a = relative_airmass_kasten_young(zenith_deg)
+
+    t_o3 = np.exp(-tau_o3 * m_o3)
+    slant_r = tau_r * m_r
+    slant_a = tau_a * m_a
+    slant_ext = slant_r + slant_a
+    direct_normal = e0 * t_o3 * np.exp(-slant_ext)
+
+    # single scattering in the mixed layer, downward parts
+    f_aer_down = hg_downward_fraction(round(cos_z, 6), atm.aerosol_asymmetry)
+    down_scat = 0.5 * slant_r + f_aer_down * atm.aerosol_albedo * slant_a
+    lost = -np.expm1(-slant_ext)                                   # 1 - T_ext, exact near 0
+    diffuse_sky = e0 * cos_z * t_o3 * lost * down_scat / slant_ext
+
+    # the sky's albedo for diffuse light from the ground (upward fractions at mu = 1/1.66)
+    f_aer_up_back = 1.0 - hg_downward_fraction(round(1.0 / DIFFUSIVITY, 6), atm.aerosol_asymmetry)
+    diff_r = DIFFUSIVITY * tau_r
+    diff_a = DIFFUSIVITY * tau_a
+    diff_ext = diff_r + diff_a
+    sky_albedo = -np.expm1(-diff_ext) * (0.5 * diff_r + f_aer_up_back * atm.aerosol_albedo
+                                         * diff_a) / diff_ext
+    ground_global = direct_normal * cos_z + diffuse_sky
+    rho = atm.ground_albedo * sky_albedo
+    diffuse = diffuse_sky + ground_global * rho / (1.0 - rho)
+
+    return ClearSky(grid, zenith_deg, path_km, direct_normal, diffuse, e0)
+
+
+# --------------------------------------------------------------------------------------
+# Date, time and place -> zenith
+
+
+def solar_zenith_deg(when, latitude_deg: float, longitude_deg: float = 0.0) -> float:
+    """Apparent (refracted) solar zenith (deg) at ``when`` (an aware datetime, or a naive one
+    read as UTC) and the place (latitude north, longitude east, deg), by pvlib's NREL SPA."""
+    import pandas as pd  # noqa: PLC0415
+    from pvlib.solarposition import get_solarposition  # noqa: PLC0415
+
+    stamp = pd.Timestamp(when)
+    stamp = stamp.tz_localize("UTC") if stamp.tzinfo is None else stamp.tz_convert("UTC")
+    position = get_solarposition(pd.DatetimeIndex([stamp]), float(latitude_deg),
+                                 float(longitude_deg))
+    return float(position["apparent_zenith"].iloc[0])
+
+
+def earth_sun_factor(when) -> float:
+    """(1 AU / Earth-Sun distance)^2 on the date of ``when`` (Spencer 1971, via pvlib)."""
+    import pandas as pd  # noqa: PLC0415
+    from pvlib.irradiance import get_extra_radiation  # noqa: PLC0415
+
+    return float(get_extra_radiation(pd.Timestamp(when).dayofyear, method="spencer",
+                                     solar_constant=1.0))
+
+
+def parse_when(text: str, longitude_deg: float = 0.0):
+    """An ISO date-time -> an aware UTC ``pandas.Timestamp``.
+
+    With an offset (``2026-06-21T12:00+09:00``, ``...Z``) the time is taken as written. A
+    naive time is local mean solar time at ``longitude_deg`` (UTC + longitude / 15 h), so
+    ``T12:00`` is about noon wherever you are (within the equation of time, +-16 min). A date
+    alone means 12:00.
+    """
+    import pandas as pd  # noqa: PLC0415
+
+    try:
+        stamp = pd.Timestamp(str(text).strip())
+    except (ValueError, TypeError):
+        raise CatalogError(f"date-time {text!r} is not ISO 8601 "
+                           "(e.g. 2026-06-21T12:00 or 2026-06-21T12:00+09:00)") from None
+    if stamp is pd.NaT:
+        raise CatalogError(f"date-time {text!r} is empty")
+    if "T" not in str(text) and " " not in str(text).strip():
+        stamp = stamp + pd.Timedelta(hours=12)
+    if stamp.tzinfo is None:
+        stamp = (stamp - pd.Timedelta(hours=float(longitude_deg) / 15.0)).tz_localize("UTC")
+    return stamp.tz_convert("UTC")
+
+
+def check_place(latitude_deg: float, longitude_deg: float) -> tuple[float, float]:
+    """Refuse a latitude outside [-90, 90] or a longitude outside [-180, 360] deg."""
+    lat, lon = float(latitude_deg), float(longitude_deg)
+    if not (math.isfinite(lat) and -90.0 <= lat <= 90.0):
+        raise CatalogError(f"latitude {latitude_deg!r} deg is outside -90..90")
+    if not (math.isfinite(lon) and -180.0 <= lon <= 360.0):
+        raise CatalogError(f"longitude {longitude_deg!r} deg is outside -180..360")
+    return lat, lon
+
+
+@dataclass(frozen=True)
+class SunPosition:
+    """Where the sun is for a date, time and place, and the path that gives."""
+
+    when_utc: str
+    latitude_deg: float
+    longitude_deg: float
+    zenith_deg: float
+    path_km: float | None  # None when the sun is below the horizon
+    earth_sun_factor: float
+
+
+def sun_position(when_text: str, latitude_deg: float, longitude_deg: float = 0.0) -> SunPosition:
+    """Date-time text (see :func:`parse_when`) and place -> zenith and shell path."""
+    lat, lon = check_place(latitude_deg, longitude_deg)
+    stamp = parse_when(when_text, lon)
+    zenith = solar_zenith_deg(stamp, lat, lon)
+    path = path_km_from_zenith(zenith) if zenith <= 90.0 else None
+    return SunPosition(stamp.isoformat(), lat, lon, zenith, path, earth_sun_factor(stamp))
