@@ -49,7 +49,7 @@ GRID_STEP_NM = 1.0
 
 #: Default physical-mode parameters (docs/fluorescence.md says where they come from).
 DEFAULT_QUANTUM_YIELD = 0.6
-DEFAULT_PEAK_ABSORPTANCE = 0.7
+DEFAULT_PEAK_ABSORPTANCE = 0.5
 #: Ground-state depletion of a dye with absorption cross-section ~1e-20 m^2 and an excited
 #: lifetime ~1 ns saturates near 1 / (sigma tau) = 1e29 incident photons m^-2 s^-1; with
 #: an absorptance below 1 the absorbed rate at that point is ~1e28. Sunlight brings ~1e20,
@@ -249,6 +249,19 @@ def fluorescence_needed(material: FluorescentMaterial, irradiance_w_m2_nm: np.nd
                                 reflectance_background) > threshold_delta_e
 
 
+def emission_is_photon_spectrum(emission: Spectrum) -> bool:
+    """True when a header comment reads ``quantity: photon...`` (e.g. "quantity: photons per nm").
+
+    Corrected spectrofluorometer output is an energy spectrum, the default; a file that
+    counts photons says so in a ``quantity:`` comment line.
+    """
+    for comment in emission.comments:
+        key, _, value = comment.partition(":")
+        if key.strip().lower() == "quantity" and value.strip().lower().startswith("photon"):
+            return True
+    return False
+
+
 def material_from_spectra(excitation: Spectrum, emission: Spectrum, *,
                           peak_absorptance: float = DEFAULT_PEAK_ABSORPTANCE,
                           quantum_yield: float = DEFAULT_QUANTUM_YIELD,
@@ -259,8 +272,10 @@ def material_from_spectra(excitation: Spectrum, emission: Spectrum, *,
     The excitation is normalised to a peak of 1 over its measured range and scaled by
     ``peak_absorptance`` (in (0, 1]). The emission is read as an energy spectrum (W per nm,
     what spectrofluorometers report once corrected) unless ``emission_in_photons`` is True
-    or, when it is None, a header comment of the emission file mentions "photon"; an energy
-    spectrum S(l) becomes the photon spectrum S(l) l, then normalised to integrate to 1.
+    or, when it is None, the emission file has a header comment ``# quantity: photons ...``
+    (see :func:`emission_is_photon_spectrum`); an energy spectrum S(l) becomes the photon
+    spectrum S(l) l (photons per nm are power per nm divided by h c / l), then normalised to
+    integrate to 1.
     """
     if not 0.0 < float(peak_absorptance) <= 1.0:
         raise CatalogError(f"peak_absorptance must lie in (0, 1], not {peak_absorptance!r}")
@@ -279,7 +294,7 @@ def material_from_spectra(excitation: Spectrum, emission: Spectrum, *,
                          path=excitation.source or None)
 
     if emission_in_photons is None:
-        emission_in_photons = any("photon" in c.lower() for c in emission.comments)
+        emission_in_photons = emission_is_photon_spectrum(emission)
     emission_on_grid = emission.resample(GRID_NM)
     photons = emission_on_grid if emission_in_photons else emission_on_grid * GRID_NM
     area = float(np.sum(photons) * GRID_STEP_NM)
