@@ -238,7 +238,7 @@ def _parse_path(name: str, text: str) -> float:
         raise InputError(f"path length {text!r} is not a number of km "
                          f"(write e.g. 'sun:22' or 'sun:500')", field=f"light {name!r}") from None
     try:
-        return check_path_km(value, name)
+        return check_path_km(value, f"light {name!r}")
     except CatalogError as exc:  # its message already names the light
         raise InputError(str(exc)) from None
 

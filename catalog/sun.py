@@ -96,15 +96,16 @@ def rayleigh_optical_depth(wavelength_nm: np.ndarray | float) -> np.ndarray:
         1.0 + 0.0027059889 * inv2 - 85.968563 * sq)
 
 
-def check_path_km(path_km: float, name: str = "sun") -> float:
-    """Refuse a path length outside [MIN_PATH_KM, MAX_PATH_KM] with a message naming ``name``."""
+def check_path_km(path_km: float, what: str = "light 'sun'") -> float:
+    """Refuse a path length outside [MIN_PATH_KM, MAX_PATH_KM]; the message starts with
+    ``what`` (the light or the option that gave the path)."""
     try:
         value = float(path_km)
     except (TypeError, ValueError):
-        raise CatalogError(f"light {name!r}: path length {path_km!r} is not a number "
+        raise CatalogError(f"{what}: path length {path_km!r} is not a number "
                            f"(km)") from None
     if not math.isfinite(value) or not MIN_PATH_KM <= value <= MAX_PATH_KM:
-        raise CatalogError(f"light {name!r}: path length {path_km!r} km is outside "
+        raise CatalogError(f"{what}: path length {path_km!r} km is outside "
                            f"{MIN_PATH_KM:g}-{MAX_PATH_KM:g} km (22 km = sun at the zenith, "
                            f"about 530 km = the horizon)")
     return value
