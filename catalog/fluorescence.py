@@ -56,6 +56,9 @@ DEFAULT_PEAK_ABSORPTANCE = 0.5
 #: so saturation only matters for lasers and focused lamps; it is kept for completeness
 #: (the paper's future-work note) and can be lowered per material.
 DEFAULT_SATURATION_PHOTON_IRRADIANCE = 1.0e28
+#: Below this colour change (Delta E 2000) the fluorescence pass may be skipped: well under
+#: the ~1 of a just-noticeable difference, so skipping it can never be seen.
+NEEDED_DELTA_E = 0.1
 
 
 def photon_energy_j(wavelength_nm: np.ndarray | float) -> np.ndarray:
@@ -238,7 +241,7 @@ def fluorescence_delta_e(material: FluorescentMaterial, irradiance_w_m2_nm: np.n
 
 def fluorescence_needed(material: FluorescentMaterial, irradiance_w_m2_nm: np.ndarray,
                         reflectance_background: float | np.ndarray = 0.85,
-                        threshold_delta_e: float = 0.1) -> bool:
+                        threshold_delta_e: float = NEEDED_DELTA_E) -> bool:
     """True when the emission changes the colour of the lit cloth by more than
     ``threshold_delta_e`` (Delta E 2000): the renderer skips the fluorescence pass otherwise.
 
