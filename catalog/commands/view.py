@@ -1,0 +1,106 @@
+"""`catalog view`: the interactive viewer in a window (needs a display)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
+
+FLUORESCENCE_CHOICES = ("off", "paper", "physical")
+BAND_CHOICES = (3, 6, 9, 16)
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        width, height = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WxH, e.g. 1280x720, found {text!r}") from None
+    if not (16 <= width <= 16384 and 16 <= height <= 16384):
+        raise argparse.ArgumentTypeError(f"{text}: each side must be 16-16384 px")
+    return width, height
+
+
+def _grid(text: str) -> tuple[int, int]:
+    try:
+        width, height = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WxH, e.g. 48x64, found {text!r}") from None
+    if not (2 <= width <= 1024 and 2 <= height <= 1024):
+        raise argparse.ArgumentTypeError(f"{text}: each side must be 2-1024 particles")
+    return width, height
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, found {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, found {value}")
+    return value
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--fabric", help="fabric to show first (preset name or .toml)")
+    parser.add_argument("--light", help="light to start with: 'sun' (hour slider), a CIE "
+                        "illuminant (D65, A, FL2, LED-B4, ...), UV-A, LED-warm, sun:PATH_KM")
+    parser.add_argument("--compare", metavar="NAME",
+                        help="split screen: this fabric on the right, same light")
+    parser.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",
+                        help="window size in pixels (default 1280x720)")
+    parser.add_argument("--frames", type=_positive_int, metavar="N",
+                        help="run N frames (fixed 1/60 s cloth steps), then exit")
+    parser.add_argument("--screenshot", type=Path, metavar="FILE.png",
+                        help="with --frames: save the window after the last frame")
+    parser.add_argument("--screenshot-dir", type=Path, default=Path("screenshots"),
+                        metavar="DIR", help="where the S key saves EXR + PNG (default "
+                        "./screenshots)")
+    parser.add_argument("--stats", action="store_true",
+                        help="log each frame's time and parts (JSON lines on stdout)")
+    parser.add_argument("--fluorescence", choices=FLUORESCENCE_CHOICES, default="physical",
+                        help="fluorescence mode to start with (default physical)")
+    parser.add_argument("--bands", type=int, choices=BAND_CHOICES, default=3,
+                        help="spectral bands (3 = RGB)")
+    parser.add_argument("--hour", type=float, help="hour of day for the sun (6-18)")
+    parser.add_argument("--wind", type=float, metavar="M_S", help="wind speed, m/s")
+    parser.add_argument("--grid", type=_grid, default=(48, 64), metavar="WxH",
+                        help="cloth particles across x down (default 48x64)")
+    parser.add_argument("--cloth-backend", choices=("numpy", "cpu", "gpu"), default="cpu",
+                        help="cloth simulation backend (default cpu)")
+    parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
+    parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
+    parser.add_argument("--fabric-dir", type=Path, metavar="DIR",
+                        help="folder of presets (default: the catalog's fabrics/)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from catalog import FABRIC_DIR
+    from catalog.errors import CatalogError
+    from catalog.viewer.app import ViewerApp, ViewerOptions
+    from catalog.viewer.window import NO_DISPLAY_HINT, display_available
+
+    if args.screenshot is not None and args.frames is None:
+        raise CatalogError("--screenshot needs --frames N (the S key saves screenshots "
+                           "in interactive use)")
+    if args.hour is not None and not 0.0 <= args.hour <= 24.0:
+        raise CatalogError(f"--hour: {args.hour:g} is not an hour of the day (0-24)")
+    if args.wind is not None and not 0.0 <= args.wind <= 50.0:
+        raise CatalogError(f"--wind: {args.wind:g} m/s is outside 0-50 m/s")
+    if not display_available():  # say so before any heavy import or preset read
+        raise CatalogError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
+                           + NO_DISPLAY_HINT)
+    fabric, fabric_dir = args.fabric, args.fabric_dir
+    if fabric is not None and fabric.endswith(".toml"):  # a preset file: browse its folder
+        path = Path(fabric)
+        if not path.is_file():
+            raise CatalogError(f"--fabric: no such preset file {fabric}")
+        fabric, fabric_dir = path.stem, fabric_dir or path.parent
+    options = ViewerOptions(
+        fabric=fabric, light=args.light, compare=args.compare, size=args.size,
+        frames=args.frames, screenshot=args.screenshot, screenshot_dir=args.screenshot_dir,
+        stats=args.stats, fluorescence=args.fluorescence, bands=args.bands, hour=args.hour,
+        wind_m_s=args.wind, grid=args.grid, cloth_backend=args.cloth_backend,
+        panel=not args.no_panel, paused=args.paused,
+        fabric_dir=fabric_dir if fabric_dir is not None else FABRIC_DIR)
+    return ViewerApp(options).run()

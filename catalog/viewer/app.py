@@ -1,0 +1,437 @@
+"""The viewer's window and main loop.
+
+Per frame: poll events -> apply keys and panel changes -> step the cloth (simulation)
+-> draw the curtain into the window's framebuffer, one renderer per half in split screen
+(shading) -> draw the panel over it (UI) -> copy to the window and swap.
+
+Everything is drawn into a framebuffer of our own and copied to the window: screenshots
+read that framebuffer (``ctx.screen.read()`` on a glfw window raises a GL error, although
+the pixels are right).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from catalog import FABRIC_DIR
+from catalog.errors import CatalogError
+from catalog.viewer.catalog_state import FabricCatalog
+from catalog.viewer.input import Action, MouseOrbit, OrbitCamera, action_for_key
+from catalog.viewer.settings import (SUN, ViewerSettings, next_fluorescence, next_light)
+from catalog.viewer.timing import FrameTimer
+
+#: Simulated time per frame when a frame count is given (reproducible runs), s.
+FIXED_FRAME_DT_S = 1.0 / 60.0
+#: Bounds on the simulated time per frame in interactive use (slow machines run slow motion
+#: rather than let the cloth take huge steps), s.
+MIN_FRAME_DT_S, MAX_FRAME_DT_S = 1.0 / 240.0, 1.0 / 15.0
+
+
+@dataclass
+class ViewerOptions:
+    """The command line's choices (see catalog/commands/view.py)."""
+
+    fabric: str | None = None
+    light: str | None = None
+    compare: str | None = None
+    size: tuple[int, int] = (1280, 720)
+    frames: int | None = None  # run this many frames then exit (None: until closed)
+    screenshot: Path | None = None  # PNG of the window after the last frame
+    screenshot_dir: Path = Path("screenshots")  # where the S key saves
+    stats: bool = False
+    fluorescence: str = "physical"
+    bands: int = 3
+    hour: float | None = None
+    wind_m_s: float | None = None
+    grid: tuple[int, int] = (48, 64)
+    cloth_backend: str = "cpu"
+    panel: bool = True
+    paused: bool = False
+    fabric_dir: Path = FABRIC_DIR
+    extra: dict = field(default_factory=dict)
+
+
+def heavy_modules_loaded() -> dict[str, bool]:
+    """Which of the modules the viewer must not need are in this process."""
+    return {name: name in sys.modules for name in ("scipy", "colour", "matplotlib", "pvlib")}
+
+
+class ViewerApp:
+    """A window, its GL context, the renderers, the cloth, the panel and the loop."""
+
+    def __init__(self, options: ViewerOptions):
+        self.options = options
+        self.catalog = FabricCatalog(options.fabric_dir)
+        if len(self.catalog) == 0:
+            raise CatalogError(f"no presets (*.toml) in {options.fabric_dir}")
+        self.settings = ViewerSettings(fluorescence=options.fluorescence, bands=options.bands,
+                                       show_panel=options.panel, paused=options.paused)
+        if options.hour is not None:
+            self.settings.sun_hour = options.hour
+        if options.wind_m_s is not None:
+            self.settings.wind_m_s = options.wind_m_s
+        self._choose_start(options)
+        self.camera = OrbitCamera()
+        self.timer = FrameTimer()
+        self._actions: list[Action] = []
+        self._quit = False
+        self._screenshot_requested = False
+        self.messages: dict[str, str] = {}  # topic -> one-line error shown in the panel
+        self.last_screenshot: str | None = None
+
+    def _choose_start(self, options: ViewerOptions) -> None:
+        if options.fabric is not None:
+            index = self.catalog.index_of(options.fabric)
+            entry = self.catalog.load(index)
+            if entry.preset is None:
+                raise CatalogError(entry.error or f"cannot load fabric {options.fabric!r}")
+            self.settings.fabric_index = index
+        else:
+            first = self.catalog.first_usable(0)
+            self.settings.fabric_index = 0 if first is None else first
+        if options.compare is not None:
+            index = self.catalog.index_of(options.compare)
+            entry = self.catalog.load(index)
+            if entry.preset is None:
+                raise CatalogError(entry.error or f"cannot load fabric {options.compare!r}")
+            self.settings.compare_index = index
+        if options.light is not None:
+            from catalog.lights import get_light  # noqa: PLC0415
+
+            if options.light != SUN:
+                get_light(options.light)  # an unknown name is refused before a window opens
+            self.settings.light = options.light
+
+    # ------------------------------------------------------------------------------
+    def run(self) -> int:
+        from catalog.viewer.window import open_window  # noqa: PLC0415
+
+        glfw, window = open_window(self.options.size, "catalog view")
+        try:
+            return self._run_in(glfw, window)
+        finally:
+            glfw.destroy_window(window)
+            glfw.terminate()
+
+    def _run_in(self, glfw, window) -> int:
+        import moderngl  # noqa: PLC0415
+        from imgui_bundle import imgui  # noqa: PLC0415
+        from imgui_bundle.python_backends.glfw_backend import GlfwRenderer  # noqa: PLC0415
+
+        from catalog.render.context import wrap_window_context  # noqa: PLC0415
+        from catalog.viewer.panel import Panel, PanelInfo  # noqa: PLC0415
+        from catalog.viewer.scene import CurtainScene  # noqa: PLC0415
+
+        self.glfw = glfw
+        self.window = window
+        self.ctx: moderngl.Context = wrap_window_context()
+        glfw.swap_interval(0 if self.options.frames is not None else 1)
+
+        imgui.create_context()
+        imgui.get_io().set_ini_filename("")  # no imgui.ini left in the user's folder
+        self.gui = GlfwRenderer(window, attach_callbacks=True)
+        self._install_callbacks(imgui)
+        self.panel = Panel()
+        self.panel_info = PanelInfo(cie_lights=self._cie_light_names())
+
+        self.scene = CurtainScene(self.options.grid, backend=self.options.cloth_backend,
+                                  wind_m_s=self.settings.wind_m_s)
+        self._fbo = None
+        self._renderers: list = []
+        self._layout_key = None
+        self._applied: dict[int, dict] = {}
+
+        frame = 0
+        last_time = time.perf_counter()
+        while not glfw.window_should_close(window) and not self._quit:
+            self.timer.begin_frame()
+            glfw.poll_events()
+            self._apply_actions()
+            if self.catalog.refresh():
+                self._applied.clear()  # a preset file changed: apply it again
+            self._ensure_targets()
+            self._sync_renderers()
+
+            now = time.perf_counter()
+            if self.options.frames is not None:
+                frame_dt = FIXED_FRAME_DT_S
+            else:
+                frame_dt = min(MAX_FRAME_DT_S, max(MIN_FRAME_DT_S, now - last_time))
+            last_time = now
+
+            with self.timer.part("simulation"):
+                self.scene.set_wind(self.settings.wind_m_s)
+                self.scene.set_open(self.settings.curtain_open)
+                if not self.settings.paused:
+                    self.scene.step(frame_dt)
+                for renderer in self._renderers:
+                    self.scene.feed(renderer)
+
+            with self.timer.part("shading"):
+                self._fbo.use()
+                self._fbo.clear(0.0, 0.0, 0.0, 1.0)
+                for renderer, viewport in zip(self._renderers, self._viewports()):
+                    renderer.set_camera(self.camera.yaw_deg, self.camera.pitch_deg,
+                                        self.camera.distance_m)
+                    renderer.render(fbo=self._fbo, viewport=viewport)
+                self.ctx.finish()
+
+            with self.timer.part("ui"):
+                self._update_panel_info()
+                self.gui.process_inputs()
+                imgui.new_frame()
+                self.panel.draw(self.settings, self.catalog, self.timer, self.panel_info,
+                                self._fbo.size[1])
+                imgui.render()
+                self._fbo.use()
+                self.gui.render(imgui.get_draw_data())
+                self.ctx.finish()
+
+            frame += 1
+            last_frame = self.options.frames is not None and frame >= self.options.frames
+            if self._screenshot_requested:
+                self._screenshot_requested = False
+                self._save_screenshot_pair()
+            if last_frame and self.options.screenshot is not None:
+                self._save_window_png(self.options.screenshot)
+
+            self.ctx.copy_framebuffer(self.ctx.screen, self._fbo)
+            glfw.swap_buffers(window)
+            self._update_title()
+            times = self.timer.end_frame()
+            if self.options.stats:
+                self._log_stats(times, frame)
+            if last_frame:
+                break
+
+        if self.options.stats:
+            summary = {"summary": True, "frames": frame, "size": list(self._fbo.size),
+                       "grid": list(self.options.grid), "renderer": self.ctx.info["GL_RENDERER"],
+                       **{f"median_{k}_ms": round(v, 3)
+                          for k, v in self.timer.median_ms().items()}}
+            print(json.dumps(summary), flush=True)
+        self.gui.shutdown()
+        return 0
+
+    # -- input ---------------------------------------------------------------------
+    def _install_callbacks(self, imgui) -> None:
+        glfw, gui = self.glfw, self.gui
+        io = imgui.get_io()
+        self.orbit = MouseOrbit(self.camera, ui_wants_mouse=lambda: io.want_capture_mouse)
+
+        def on_key(window, key, scancode, action, mods):
+            gui.keyboard_callback(window, key, scancode, action, mods)
+            if io.want_text_input:
+                return
+            viewer_action = action_for_key(key, action)
+            if viewer_action is not None:
+                self._actions.append(viewer_action)
+
+        def on_button(window, button, action, mods):
+            gui.mouse_button_callback(window, button, action, mods)
+            self.orbit.button(button, action)
+
+        def on_cursor(window, x, y):
+            gui.mouse_callback(window, x, y)
+            self.orbit.moved(x, y)
+
+        def on_scroll(window, x_offset, y_offset):
+            gui.scroll_callback(window, x_offset, y_offset)
+            self.orbit.scrolled(y_offset)
+
+        glfw.set_key_callback(self.window, on_key)
+        glfw.set_mouse_button_callback(self.window, on_button)
+        glfw.set_cursor_pos_callback(self.window, on_cursor)
+        glfw.set_scroll_callback(self.window, on_scroll)
+
+    def _apply_actions(self) -> None:
+        settings = self.settings
+        actions, self._actions = self._actions, []
+        for action in actions:
+            if action is Action.NEXT_FABRIC:
+                settings.fabric_index = self.catalog.step(settings.fabric_index, +1)
+            elif action is Action.PREVIOUS_FABRIC:
+                settings.fabric_index = self.catalog.step(settings.fabric_index, -1)
+            elif action is Action.NEXT_LIGHT:
+                settings.light = next_light(settings.light)
+            elif action is Action.CYCLE_FLUORESCENCE:
+                settings.fluorescence = next_fluorescence(settings.fluorescence)
+            elif action is Action.TOGGLE_PAUSE:
+                settings.paused = not settings.paused
+            elif action is Action.SCREENSHOT:
+                self._screenshot_requested = True
+            elif action is Action.TOGGLE_HELP:
+                settings.show_help = not settings.show_help
+            elif action is Action.TOGGLE_PANEL:
+                settings.show_panel = not settings.show_panel
+            elif action is Action.TOGGLE_CURTAIN:
+                settings.curtain_open = not settings.curtain_open
+            elif action is Action.QUIT:
+                self._quit = True
+
+    # -- renderers -----------------------------------------------------------------
+    def _halves(self) -> int:
+        return 2 if self.settings.compare_index is not None else 1
+
+    def _viewports(self) -> list[tuple[int, int, int, int]]:
+        """The scene's rectangles (x, y, w, h) in the window: right of the panel when it is
+        shown, halved for a comparison."""
+        width, height = self._fbo.size
+        left = min(self.panel.width_px, width // 2) if self.settings.show_panel else 0
+        scene_width = width - left
+        if self._halves() == 1:
+            return [(left, 0, scene_width, height)]
+        half = scene_width // 2
+        return [(left, 0, half, height), (left + half, 0, scene_width - half, height)]
+
+    def _ensure_targets(self) -> None:
+        """(Re)make the window framebuffer and the renderers when the size or split changes."""
+        from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+        size = tuple(self.glfw.get_framebuffer_size(self.window))
+        if size[0] < 2 or size[1] < 2:  # minimised
+            size = self._fbo.size if self._fbo is not None else (2, 2)
+        key = (size, self._halves(), self.settings.show_panel)
+        if key == self._layout_key:
+            return
+        if self._fbo is None or self._fbo.size != size:
+            if self._fbo is not None:
+                self._fbo.release()
+            self._fbo = self.ctx.simple_framebuffer(size, components=4)
+        for renderer in self._renderers:
+            self.scene.forget(renderer)
+            if hasattr(renderer, "release"):
+                renderer.release()
+        self._renderers = []
+        self._applied = {}
+        self._layout_key = key
+        for viewport in self._viewports():
+            self._renderers.append(FrameRenderer(self.ctx, (viewport[2], viewport[3])))
+
+    def _sync_renderers(self) -> None:
+        """Pass the settings to each renderer, only what changed since the last frame."""
+        settings = self.settings
+        fabrics = [settings.fabric_index]
+        if settings.compare_index is not None:
+            fabrics.append(settings.compare_index)
+        for slot, (renderer, fabric_index) in enumerate(zip(self._renderers, fabrics)):
+            applied = self._applied.setdefault(slot, {})
+            entry = self.catalog.load(fabric_index)
+            if entry.preset is not None and applied.get("fabric") != (entry.name, id(entry.preset)):
+                try:
+                    renderer.set_fabric(entry.preset)
+                    if slot == 0:
+                        self.scene.set_fabric(entry.preset)
+                    self.messages.pop(f"fabric{slot}", None)
+                except CatalogError as exc:
+                    self.messages[f"fabric{slot}"] = str(exc)
+                applied["fabric"] = (entry.name, id(entry.preset))
+            light_key = (settings.light, settings.sun_hour if settings.light == SUN else None)
+            if applied.get("light") != light_key:
+                try:
+                    if settings.light == SUN:
+                        renderer.set_sun_hour(settings.sun_hour)
+                    else:
+                        renderer.set_light(settings.light)
+                    self.messages.pop("light", None)
+                except CatalogError as exc:
+                    self.messages["light"] = str(exc)
+                applied["light"] = light_key
+            if applied.get("fluorescence") != settings.fluorescence:
+                renderer.set_fluorescence(settings.fluorescence)
+                applied["fluorescence"] = settings.fluorescence
+            if applied.get("bands") != settings.bands:
+                renderer.set_bands(settings.bands)
+                applied["bands"] = settings.bands
+        if self.scene.preset_name is None:
+            entry = self.catalog.load(settings.fabric_index)
+            if entry.preset is not None:
+                self.scene.set_fabric(entry.preset)
+
+    def _cie_light_names(self) -> list[str]:
+        try:
+            from catalog.lights import cie_names  # noqa: PLC0415
+
+            return list(cie_names())
+        except CatalogError:
+            return []
+
+    def _update_panel_info(self) -> None:
+        info = self.panel_info
+        renderer_info = self._renderers[0].info() if self._renderers else {}
+        info.sun_path_km = renderer_info.get("sun_path_km")
+        info.sun_elevation_deg = renderer_info.get("sun_elevation_deg")
+        info.fluorescence_compiled = renderer_info.get("fluorescence_needed")
+        info.messages = list(self.messages.values())
+        info.last_screenshot = self.last_screenshot
+
+    def _update_title(self) -> None:
+        entry = self.catalog.entries[self.settings.fabric_index] \
+            if self.settings.fabric_index < len(self.catalog) else None
+        fabric = entry.label if entry is not None else "?"
+        title = f"catalog view - {fabric}"
+        if self.settings.compare_index is not None \
+                and self.settings.compare_index < len(self.catalog):
+            title += f" | {self.catalog.entries[self.settings.compare_index].label}"
+        title += (f" - light {self.settings.light_label} - fluorescence "
+                  f"{self.settings.fluorescence}")
+        if self.settings.paused:
+            title += " (paused)"
+        if title != getattr(self, "_title", None):
+            self.glfw.set_window_title(self.window, title)
+            self._title = title
+
+    # -- screenshots and stats -------------------------------------------------------
+    def window_pixels(self) -> np.ndarray:
+        """The window as shown: (H, W, 3) uint8, row 0 at the top, read from our framebuffer."""
+        width, height = self._fbo.size
+        data = self._fbo.read(components=3, alignment=1)
+        return np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1]
+
+    def scene_linear(self) -> np.ndarray:
+        """The curtain's linear radiance without the panel, halves side by side."""
+        halves = [np.asarray(renderer.read_linear(), dtype=np.float32)
+                  for renderer in self._renderers]
+        return np.concatenate(halves, axis=1) if len(halves) > 1 else halves[0]
+
+    def _metadata(self) -> dict[str, str]:
+        entry = self.catalog.entries[self.settings.fabric_index]
+        meta = {"catalog:fabric": entry.name, "catalog:light": self.settings.light_label,
+                "catalog:fluorescence": self.settings.fluorescence,
+                "catalog:bands": str(self.settings.bands), "Software": "catalog view"}
+        if self.settings.compare_index is not None:
+            meta["catalog:compare"] = self.catalog.entries[self.settings.compare_index].name
+        return meta
+
+    def _save_window_png(self, path: Path) -> None:
+        from catalog.viewer.screenshot import write_image  # noqa: PLC0415
+
+        write_image(path, self.window_pixels(), self._metadata())
+
+    def _save_screenshot_pair(self) -> None:
+        from catalog.viewer.screenshot import next_screenshot_stem, write_image  # noqa: PLC0415
+
+        entry = self.catalog.entries[self.settings.fabric_index]
+        stem = next_screenshot_stem(self.options.screenshot_dir, entry.name,
+                                    self.settings.light_label)
+        try:
+            write_image(stem.with_suffix(".exr"), self.scene_linear(), self._metadata())
+            write_image(stem.with_suffix(".png"), self.window_pixels(), self._metadata())
+            self.last_screenshot = str(stem) + ".{exr,png}"
+            self.messages.pop("screenshot", None)
+        except (CatalogError, OSError) as exc:
+            self.messages["screenshot"] = f"screenshot not saved: {exc}"
+
+    def _log_stats(self, times, frame: int) -> None:
+        record = {"frame": frame, "total_ms": round(times.total_ms, 3),
+                  **{f"{part}_ms": round(ms, 3) for part, ms in times.parts_ms.items()},
+                  "other_ms": round(times.other_ms, 3)}
+        if frame == 1:
+            record["heavy_modules"] = heavy_modules_loaded()
+        print(json.dumps(record), flush=True)

@@ -1,0 +1,128 @@
+"""Keyboard shortcuts and the mouse orbit camera.
+
+Keys (glfw key codes -> actions; :data:`KEY_HELP` is the text of the help overlay):
+Left/Right previous/next fabric, L next light, F fluorescence off/paper/physical,
+Space pause, S screenshot (EXR and PNG), H help, Tab panel, C curtain open/close,
+Escape quit. Mouse: drag with the left button to orbit, wheel to zoom.
+
+The glfw module is imported for its key constants only (no window is needed to import it).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+import glfw
+
+
+class Action(enum.Enum):
+    PREVIOUS_FABRIC = "previous fabric"
+    NEXT_FABRIC = "next fabric"
+    NEXT_LIGHT = "next light"
+    CYCLE_FLUORESCENCE = "fluorescence off / paper / physical"
+    TOGGLE_PAUSE = "pause / run the simulation"
+    SCREENSHOT = "screenshot (EXR and PNG)"
+    TOGGLE_HELP = "this help"
+    TOGGLE_PANEL = "show / hide the panel"
+    TOGGLE_CURTAIN = "open / close the curtain"
+    QUIT = "quit"
+
+
+#: glfw key -> action, and the key's name in the help overlay.
+KEY_ACTIONS: dict[int, tuple[Action, str]] = {
+    glfw.KEY_LEFT: (Action.PREVIOUS_FABRIC, "Left"),
+    glfw.KEY_RIGHT: (Action.NEXT_FABRIC, "Right"),
+    glfw.KEY_L: (Action.NEXT_LIGHT, "L"),
+    glfw.KEY_F: (Action.CYCLE_FLUORESCENCE, "F"),
+    glfw.KEY_SPACE: (Action.TOGGLE_PAUSE, "Space"),
+    glfw.KEY_S: (Action.SCREENSHOT, "S"),
+    glfw.KEY_H: (Action.TOGGLE_HELP, "H"),
+    glfw.KEY_TAB: (Action.TOGGLE_PANEL, "Tab"),
+    glfw.KEY_C: (Action.TOGGLE_CURTAIN, "C"),
+    glfw.KEY_ESCAPE: (Action.QUIT, "Esc"),
+}
+
+KEY_HELP: list[tuple[str, str]] = [(name, action.value) for action, name in KEY_ACTIONS.values()]
+KEY_HELP += [("drag", "orbit the camera"), ("wheel", "zoom")]
+
+
+def action_for_key(key: int, action: int) -> Action | None:
+    """The viewer action of a key press (and of its auto-repeat for the arrows), or None."""
+    entry = KEY_ACTIONS.get(key)
+    if entry is None:
+        return None
+    if action == glfw.PRESS:
+        return entry[0]
+    if action == glfw.REPEAT and entry[0] in (Action.PREVIOUS_FABRIC, Action.NEXT_FABRIC):
+        return entry[0]
+    return None
+
+
+@dataclass
+class OrbitCamera:
+    """Yaw and pitch about the curtain's centre and the distance to it (the renderer's camera).
+
+    Yaw 0 looks at the curtain from the room side along its normal; pitch is clamped short
+    of the poles so the view never flips; the distance stays between ``min_distance_m`` and
+    ``max_distance_m``.
+    """
+
+    yaw_deg: float = 0.0
+    pitch_deg: float = 0.0
+    distance_m: float = 2.6
+    degrees_per_pixel: float = 0.25
+    zoom_per_step: float = 0.9  # distance factor per wheel step towards the curtain
+    min_pitch_deg: float = -80.0
+    max_pitch_deg: float = 80.0
+    min_distance_m: float = 0.4
+    max_distance_m: float = 12.0
+
+    def drag(self, dx_px: float, dy_px: float) -> None:
+        """Mouse moved by (dx, dy) pixels with the button held: orbit."""
+        if not (math.isfinite(dx_px) and math.isfinite(dy_px)):
+            return
+        self.yaw_deg = (self.yaw_deg - dx_px * self.degrees_per_pixel + 180.0) % 360.0 - 180.0
+        self.pitch_deg = min(self.max_pitch_deg, max(
+            self.min_pitch_deg, self.pitch_deg + dy_px * self.degrees_per_pixel))
+
+    def zoom(self, steps: float) -> None:
+        """Wheel turned by ``steps`` (positive = towards the curtain)."""
+        if not math.isfinite(steps):
+            return
+        self.distance_m = min(self.max_distance_m, max(
+            self.min_distance_m, self.distance_m * self.zoom_per_step ** steps))
+
+
+class MouseOrbit:
+    """Turns glfw mouse events into :class:`OrbitCamera` moves.
+
+    ``ui_wants_mouse`` is asked on each event: while the pointer is over the panel the
+    panel gets the mouse, not the camera.
+    """
+
+    def __init__(self, camera: OrbitCamera, ui_wants_mouse=lambda: False):
+        self.camera = camera
+        self.ui_wants_mouse = ui_wants_mouse
+        self.dragging = False
+        self._last: tuple[float, float] | None = None
+
+    def button(self, button: int, action: int) -> None:
+        if button != glfw.MOUSE_BUTTON_LEFT:
+            return
+        if action == glfw.PRESS and not self.ui_wants_mouse():
+            self.dragging = True
+            self._last = None
+        elif action == glfw.RELEASE:
+            self.dragging = False
+            self._last = None
+
+    def moved(self, x: float, y: float) -> None:
+        if self.dragging and self._last is not None:
+            self.camera.drag(x - self._last[0], y - self._last[1])
+        self._last = (x, y)
+
+    def scrolled(self, y_offset: float) -> None:
+        if not self.ui_wants_mouse():
+            self.camera.zoom(y_offset)

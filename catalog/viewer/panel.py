@@ -1,0 +1,207 @@
+"""The on-screen panel (imgui-bundle): fabrics, light, fluorescence, bands, wind, curtain,
+frame time; and the help overlay.
+
+Immediate mode: :meth:`Panel.draw` is called once per frame between ``imgui.new_frame()``
+and ``imgui.render()``; it reads and writes a :class:`ViewerSettings` and reads the
+catalog and the frame timer. It never touches GL itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from imgui_bundle import imgui
+
+from catalog.viewer.catalog_state import FabricCatalog
+from catalog.viewer.input import KEY_HELP
+from catalog.viewer.settings import (BAND_COUNTS, FLUORESCENCE_MODES, LED_LIGHTS, SUN,
+                                     SUN_HOUR_RANGE, UVA_LIGHT, WIND_RANGE_M_S,
+                                     ViewerSettings)
+from catalog.viewer.timing import FrameTimer
+
+PANEL_WIDTH_PX = 330
+ERROR_COLOUR = imgui.ImVec4(1.0, 0.42, 0.35, 1.0)
+DIM_COLOUR = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
+
+
+@dataclass
+class PanelInfo:
+    """What the panel shows but does not set: the renderer's view of the scene."""
+
+    sun_path_km: float | None = None
+    sun_elevation_deg: float | None = None
+    fluorescence_compiled: bool | None = None
+    cie_lights: list[str] = field(default_factory=list)  # CIE illuminant names for the combo
+    messages: list[str] = field(default_factory=list)  # errors to show (light, fabric, save)
+    last_screenshot: str | None = None
+
+
+class Panel:
+    """Draws the panel; ``width_px`` is the strip of the window it covers on the left."""
+
+    def __init__(self, width_px: int = PANEL_WIDTH_PX):
+        self.width_px = width_px
+
+    # ------------------------------------------------------------------------------
+    def draw(self, settings: ViewerSettings, catalog: FabricCatalog, timer: FrameTimer,
+             info: PanelInfo, window_height_px: int) -> None:
+        if settings.show_panel:
+            imgui.set_next_window_pos(imgui.ImVec2(0, 0))
+            imgui.set_next_window_size(imgui.ImVec2(self.width_px, window_height_px))
+            flags = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
+                     | imgui.WindowFlags_.no_collapse)
+            imgui.begin("Fabric catalog", None, flags)
+            self._fabrics(settings, catalog)
+            self._light(settings, info)
+            self._fluorescence(settings, info)
+            self._simulation(settings)
+            self._timing(timer)
+            self._messages(info)
+            imgui.end()
+        if settings.show_help:
+            self._help()
+
+    # ------------------------------------------------------------------------------
+    def _fabrics(self, settings: ViewerSettings, catalog: FabricCatalog) -> None:
+        imgui.separator_text("Fabric  (Left / Right)")
+        catalog.load_all()  # swatches for every preset; a file is read once per version
+        for index, entry in enumerate(catalog.entries):
+            imgui.push_id(f"fabric-{entry.name}")
+            if entry.swatch is not None:
+                colour = imgui.ImVec4(*entry.swatch, 1.0)
+                imgui.color_button("swatch", colour, imgui.ColorEditFlags_.no_tooltip,
+                                   imgui.ImVec2(18, 18))
+            else:
+                imgui.text_colored(ERROR_COLOUR, " ! ")
+            imgui.same_line()
+            label = entry.label + ("  [FL]" if entry.fluorescent else "")
+            if entry.error is not None:
+                imgui.text_colored(ERROR_COLOUR, f"{entry.name}: broken preset")
+            else:
+                clicked, _ = imgui.selectable(label, index == settings.fabric_index)
+                if clicked:
+                    settings.fabric_index = index
+            imgui.pop_id()
+        for error in catalog.errors():
+            imgui.push_text_wrap_pos(self.width_px - 10)
+            imgui.text_colored(ERROR_COLOUR, error)
+            imgui.pop_text_wrap_pos()
+
+        names = ["(none)"] + [entry.name for entry in catalog.entries]
+        current = 0 if settings.compare_index is None else settings.compare_index + 1
+        changed, current = imgui.combo("compare", current, names)
+        if changed:
+            settings.compare_index = None if current == 0 else current - 1
+
+    def _light(self, settings: ViewerSettings, info: PanelInfo) -> None:
+        imgui.separator_text("Light  (L)")
+        kind = self._light_kind(settings.light, info)
+        if imgui.radio_button("Sun", kind == "sun"):
+            settings.light = SUN
+        imgui.same_line()
+        if imgui.radio_button("CIE", kind == "cie"):
+            settings.light = "D65" if "D65" in info.cie_lights or not info.cie_lights \
+                else info.cie_lights[0]
+        imgui.same_line()
+        if imgui.radio_button("LED", kind == "led"):
+            settings.light = LED_LIGHTS[0]
+        imgui.same_line()
+        if imgui.radio_button("UV-A lamp", kind == "uva"):
+            settings.light = UVA_LIGHT
+
+        kind = self._light_kind(settings.light, info)
+        if kind == "sun":
+            changed, hour = imgui.slider_float("hour", settings.sun_hour, *SUN_HOUR_RANGE,
+                                               "%.1f h")
+            if changed:
+                settings.sun_hour = hour
+            if info.sun_path_km is not None:
+                elevation = ("" if info.sun_elevation_deg is None
+                             else f", elevation {info.sun_elevation_deg:.0f} deg")
+                imgui.text(f"path through the air {info.sun_path_km:.0f} km{elevation}")
+        elif kind == "cie" and info.cie_lights:
+            names = info.cie_lights
+            current = names.index(settings.light) if settings.light in names else 0
+            changed, current = imgui.combo("illuminant", current, names)
+            if changed:
+                settings.light = names[current]
+        elif kind == "led":
+            current = LED_LIGHTS.index(settings.light) if settings.light in LED_LIGHTS else 0
+            changed, current = imgui.combo("LED", current, list(LED_LIGHTS))
+            if changed:
+                settings.light = LED_LIGHTS[current]
+        elif kind == "other":
+            imgui.text(f"light {settings.light}")
+
+    @staticmethod
+    def _light_kind(light: str, info: PanelInfo) -> str:
+        if light == SUN or light.startswith("sun"):
+            return "sun"
+        if light == UVA_LIGHT:
+            return "uva"
+        if light in LED_LIGHTS:
+            return "led"
+        if light in info.cie_lights:
+            return "cie"
+        return "other"
+
+    def _fluorescence(self, settings: ViewerSettings, info: PanelInfo) -> None:
+        imgui.separator_text("Fluorescence  (F)")
+        for mode in FLUORESCENCE_MODES:
+            if imgui.radio_button(mode, settings.fluorescence == mode):
+                settings.fluorescence = mode
+            imgui.same_line()
+        imgui.new_line()
+        if info.fluorescence_compiled is False and settings.fluorescence != "off":
+            imgui.text_colored(DIM_COLOUR, "below the colour threshold: not compiled")
+        imgui.text("bands")
+        for bands in BAND_COUNTS:
+            imgui.same_line()
+            if imgui.radio_button(f"{bands}##bands", settings.bands == bands):
+                settings.bands = bands
+
+    def _simulation(self, settings: ViewerSettings) -> None:
+        imgui.separator_text("Curtain")
+        changed, wind = imgui.slider_float("wind", settings.wind_m_s, *WIND_RANGE_M_S,
+                                           "%.1f m/s")
+        if changed:
+            settings.wind_m_s = wind
+        if imgui.button("Open curtain" if not settings.curtain_open else "Close curtain"):
+            settings.curtain_open = not settings.curtain_open
+        imgui.same_line()
+        _, settings.paused = imgui.checkbox("pause (Space)", settings.paused)
+
+    def _timing(self, timer: FrameTimer) -> None:
+        imgui.separator_text("Frame time")
+        medians = timer.median_ms()
+        if not medians:
+            imgui.text("(measuring)")
+            return
+        total = medians["total"]
+        fps = 1e3 / total if total > 0 else float("inf")
+        imgui.text(f"{total:6.1f} ms  ({fps:5.1f} fps), median of {len(timer.history)}")
+        imgui.text(f"simulation {medians['simulation']:5.1f} ms")
+        imgui.text(f"shading    {medians['shading']:5.1f} ms")
+        imgui.text(f"UI         {medians['ui']:5.1f} ms")
+        imgui.text(f"other      {medians['other']:5.1f} ms  (swap, events)")
+        totals = np.asarray(timer.totals_ms(), dtype=np.float32)
+        imgui.plot_lines("##frametimes", totals, graph_size=imgui.ImVec2(self.width_px - 20, 40))
+
+    def _messages(self, info: PanelInfo) -> None:
+        if info.last_screenshot:
+            imgui.text_colored(DIM_COLOUR, f"saved {info.last_screenshot}")
+        for message in info.messages:
+            imgui.push_text_wrap_pos(self.width_px - 10)
+            imgui.text_colored(ERROR_COLOUR, message)
+            imgui.pop_text_wrap_pos()
+
+    def _help(self) -> None:
+        io = imgui.get_io()
+        imgui.set_next_window_pos(imgui.ImVec2(io.display_size.x * 0.5, io.display_size.y * 0.5),
+                                  imgui.Cond_.always, imgui.ImVec2(0.5, 0.5))
+        imgui.begin("Keys", None, imgui.WindowFlags_.always_auto_resize
+                    | imgui.WindowFlags_.no_collapse)
+        for key, what in KEY_HELP:
+            imgui.text(f"{key:>6}  {what}")
+        imgui.end()

@@ -1,0 +1,63 @@
+"""What the viewer shows: fabric, light, fluorescence mode, bands, wind, curtain, pause.
+
+Plain data and the small rules the keys and the panel share (the order the L key walks
+the lights in, the F key's cycle of modes). No GL, no window: tested directly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+#: The renderer's fluorescence modes, in the order the F key cycles them.
+FLUORESCENCE_MODES = ("off", "paper", "physical")
+#: Band counts the renderer compiles (3 = RGB).
+BAND_COUNTS = (3, 6, 9, 16)
+#: The lights the L key steps through: the sun (hour slider), CIE daylight and tungsten,
+#: two fluorescent tubes, two LEDs and the UV-A lamp. The panel offers every CIE table too.
+SUN = "sun"
+LIGHT_CYCLE = (SUN, "D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "UV-A")
+#: The LED lights of the panel's LED group.
+LED_LIGHTS = ("LED-B4", "LED-warm")
+UVA_LIGHT = "UV-A"
+
+#: Hour-of-day slider range (local solar time, h) and its default: noon, the paper's scene.
+SUN_HOUR_RANGE = (6.0, 18.0)
+DEFAULT_SUN_HOUR = 12.0
+#: Wind slider range (m/s at the open window).
+WIND_RANGE_M_S = (0.0, 8.0)
+DEFAULT_WIND_M_S = 1.5
+
+
+def next_fluorescence(mode: str) -> str:
+    """The mode after ``mode`` in off -> paper -> physical -> off."""
+    if mode not in FLUORESCENCE_MODES:
+        return FLUORESCENCE_MODES[0]
+    return FLUORESCENCE_MODES[(FLUORESCENCE_MODES.index(mode) + 1) % len(FLUORESCENCE_MODES)]
+
+
+def next_light(light: str) -> str:
+    """The light after ``light`` in :data:`LIGHT_CYCLE` (any other light goes to the first)."""
+    if light not in LIGHT_CYCLE:
+        return LIGHT_CYCLE[0]
+    return LIGHT_CYCLE[(LIGHT_CYCLE.index(light) + 1) % len(LIGHT_CYCLE)]
+
+
+@dataclass
+class ViewerSettings:
+    """The viewer's state as the user set it (the panel and the keys both write here)."""
+
+    fabric_index: int = 0
+    compare_index: int | None = None  # split screen: the right half's fabric
+    light: str = SUN  # SUN (path from ``sun_hour``) or a light name of catalog.lights
+    sun_hour: float = DEFAULT_SUN_HOUR
+    fluorescence: str = "physical"
+    bands: int = 3
+    wind_m_s: float = DEFAULT_WIND_M_S
+    curtain_open: bool = False
+    paused: bool = False
+    show_help: bool = False
+    show_panel: bool = True
+
+    @property
+    def light_label(self) -> str:
+        return f"sun at {self.sun_hour:04.1f} h" if self.light == SUN else self.light
