@@ -1,0 +1,182 @@
+"""ClothSimulation: the one object the viewer, the CLI and the tests drive.
+
+    sim = ClothSimulation(ClothParams(grid_w=64, grid_h=96), backend="cpu")
+    sim.set_wind(2.0)            # m/s from the window; wakes the simulation
+    sim.step(1 / 60)             # one frame (substeps inside); False if it slept
+    mesh = sim.mesh()            # positions, normals, uv, tangents, triangle indices
+
+Backends: ``numpy`` (reference, float64), ``cpu`` (numba, float64, same algorithm),
+``gpu`` (GLSL compute through moderngl, float32; keeps the state on the GPU and writes
+the renderer's vertex buffer directly, see docs/cloth.md).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from catalog.cloth.params import ClothParams
+from catalog.cloth.state import ClothState, ring_positions
+from catalog.cloth.topology import FAMILIES, rest_lengths_m
+from catalog.errors import CatalogError, InputError
+
+BACKENDS = ("numpy", "cpu", "gpu")
+
+
+def make_backend(name: str, params: ClothParams, **options: Any):
+    """The backend object for a name of BACKENDS."""
+    if name == "numpy":
+        from catalog.cloth.backend_numpy import NumpyBackend
+        return NumpyBackend(params)
+    if name == "cpu":
+        from catalog.cloth.backend_numba import NumbaBackend
+        return NumbaBackend(params)
+    if name == "gpu":
+        from catalog.cloth.backend_gpu import GpuBackend
+        return GpuBackend(params, **options)
+    raise InputError(f"unknown backend {name!r}; choose one of {', '.join(BACKENDS)}",
+                     field="backend")
+
+
+def max_spring_strain(positions_m: np.ndarray, params: ClothParams) -> float:
+    """Largest (length - rest) / rest over all springs of all families (float64)."""
+    x = np.asarray(positions_m, dtype=np.float64)
+    rest = rest_lengths_m(params.spacing_x_m, params.spacing_y_m)
+    worst = -math.inf
+    h, w = params.grid_h, params.grid_w
+    for family, (_, di, dj, _, _) in enumerate(FAMILIES):
+        c0 = max(0, -dj)
+        a = x[0:h - di, c0:w - max(dj, 0)]
+        b = x[di:h, c0 + dj:w - max(dj, 0) + dj]
+        if a.size == 0:
+            continue
+        length = np.sqrt(np.sum((b - a) ** 2, axis=-1))
+        # spring between two rings: the rod sets it, not the solver
+        strain = (length - rest[family]) / rest[family]
+        if di == 0:
+            strain = strain[1:]
+        if strain.size:
+            worst = max(worst, float(np.max(strain)))
+    return worst
+
+
+def kinetic_energy_j(velocities_m_s: np.ndarray, params: ClothParams) -> float:
+    """1/2 m sum |v|^2 over the free particles (the rings are driven, not counted)."""
+    v = np.asarray(velocities_m_s, dtype=np.float64)[1:]
+    return 0.5 * params.particle_mass_kg * float(np.sum(v * v))
+
+
+class ClothSimulation:
+    """A curtain on a rod: parameters, state, a backend, sleep and monitoring."""
+
+    def __init__(self, params: ClothParams, backend: str = "numpy",
+                 monitor_every: int | None = None, **backend_options: Any):
+        if not isinstance(params, ClothParams):
+            raise TypeError("params must be a ClothParams")
+        self.params = params
+        self.state = ClothState.at_rest(params)
+        self.backend_name = backend
+        self.backend = make_backend(backend, params, **backend_options)
+        if hasattr(self.backend, "load"):
+            self.backend.load(self.state)
+        # checks (finite, stretch, energy, sleep) need the state on the CPU: every frame
+        # for the CPU backends, every few frames for the GPU one (a small download)
+        self.monitor_every = monitor_every or (30 if backend == "gpu" else 1)
+        self.sleeping = False
+        self.last_substeps = 0
+        self.kinetic_energy = 0.0
+        self.max_stretch = max_spring_strain(self.state.positions_m, params)
+
+    # ---- controls ----------------------------------------------------------------
+    def wake(self) -> None:
+        self.sleeping = False
+        self.state.quiet_frames = 0
+
+    def set_wind(self, speed_m_s: float, direction: tuple[float, float, float] | None = None,
+                 gust_strength: float | None = None) -> None:
+        changes: dict[str, Any] = {"wind_speed_m_s": speed_m_s}
+        if direction is not None:
+            changes["wind_direction"] = direction
+        if gust_strength is not None:
+            changes["gust_strength"] = gust_strength
+        self.set_params(**changes)
+
+    def set_opening(self, fraction: float) -> None:
+        """Slide the rings so they span ``fraction`` of the rest width (1 = closed)."""
+        self.set_params(opening=fraction)
+
+    def set_params(self, **changes: Any) -> None:
+        """Change parameters that keep the grid (wind, stiffness, opening, ...); wakes."""
+        new = self.params.with_changes(**changes)
+        if (new.grid_w, new.grid_h) != (self.params.grid_w, self.params.grid_h):
+            raise CatalogError("the grid size cannot change on a running simulation")
+        self.params = new
+        if hasattr(self.backend, "set_params"):
+            self.backend.set_params(new)
+        else:
+            self.backend = make_backend(self.backend_name, new)
+        self.state.ring_targets_m = ring_positions(new)
+        if hasattr(self.backend, "set_ring_targets"):
+            self.backend.set_ring_targets(self.state.ring_targets_m)
+        self.wake()
+
+    # ---- stepping ----------------------------------------------------------------
+    def step(self, frame_dt_s: float) -> bool:
+        """Advance one frame. Returns False (and does nothing) while asleep."""
+        if self.sleeping:
+            return False
+        n = self.params.substeps_for(frame_dt_s)
+        h = frame_dt_s / n
+        self.backend.advance(self.state, n, h)
+        self.last_substeps = n
+        self.state.frames += 1
+        if self.state.frames % self.monitor_every == 0:
+            self._monitor()
+        return True
+
+    def run(self, frames: int, frame_dt_s: float) -> int:
+        """Step ``frames`` frames; returns how many were actually simulated (not asleep)."""
+        return sum(1 for _ in range(frames) if self.step(frame_dt_s))
+
+    def _monitor(self) -> None:
+        self.backend.sync(self.state)
+        x, v = self.state.positions_m, self.state.velocities_m_s
+        finite = bool(np.isfinite(x).all() and np.isfinite(v).all())
+        self.state.finite = self.state.finite and finite
+        if not finite:
+            self.max_stretch = math.inf
+            self.kinetic_energy = math.inf
+            return
+        self.max_stretch = max_spring_strain(x, self.params)
+        self.state.max_stretch_seen = max(self.state.max_stretch_seen, self.max_stretch)
+        self.kinetic_energy = kinetic_energy_j(v, self.params)
+        rings_done = np.array_equal(self.state.ring_positions_m, self.state.ring_targets_m)
+        speed = float(np.sqrt(np.max(np.sum(v * v, axis=-1))))
+        if self.params.wind_speed_m_s == 0.0 and rings_done \
+                and speed < self.params.sleep_speed_m_s:
+            self.state.quiet_frames += self.monitor_every
+            if self.state.quiet_frames >= self.params.sleep_frames:
+                self.sleeping = True
+        else:
+            self.state.quiet_frames = 0
+
+    # ---- reading -----------------------------------------------------------------
+    def positions(self) -> np.ndarray:
+        """(H, W, 3) float64 positions (downloads from the GPU backend)."""
+        self.backend.sync(self.state)
+        return self.state.positions_m
+
+    def velocities(self) -> np.ndarray:
+        self.backend.sync(self.state)
+        return self.state.velocities_m_s
+
+    @property
+    def finite(self) -> bool:
+        return self.state.finite
+
+    def mesh(self):
+        """The current curtain as a CurtainMesh (positions, normals, uv, tangents, indices)."""
+        from catalog.cloth.mesh import CurtainMesh
+        return CurtainMesh.from_grid(self.positions(), self.params)
