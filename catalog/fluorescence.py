@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from catalog.colorimetry import (M_PAPER_XYZ_TO_RGB, cmfs, delta_e_2000,
-                                 xyz_to_linear_srgb)
+                                 linear_srgb_to_xyz, xyz_to_linear_srgb)
 from catalog.errors import CatalogError, InputError
 from catalog.spectra import GRID_NM, VISIBLE_NM, Spectrum
 
@@ -209,6 +209,40 @@ def emission_relative_srgb(material: FluorescentMaterial,
         raise CatalogError("the light has no visible part (illuminance 0 lx): "
                            "use emission_linear_srgb for the absolute emission")
     return emission_linear_srgb(material, irradiance_w_m2_nm) / illuminance
+
+
+#: How an emission colour outside the sRGB gamut is carried to the shader (docs/fluorescence.md).
+CARRY_METHODS = ("signed", "clip", "desaturate")
+
+
+def carry_emission_rgb(emission_rgb: np.ndarray, method: str = "signed") -> np.ndarray:
+    """The linear-sRGB triple handed to the shader for an emission colour.
+
+    ``signed`` (the project's choice): unchanged, negatives kept; added to the reflected and
+    transmitted light this is exact (XYZ -> RGB is linear), and only a final sum that is
+    itself out of gamut is clipped, at display. ``clip``: negative components set to 0
+    (adds light the emission does not have). ``desaturate``: mixed toward the grey of the
+    same luminance until no component is negative (keeps Y and the hue angle, loses purity).
+    """
+    rgb = np.asarray(emission_rgb, dtype=np.float64)
+    if method == "signed":
+        return rgb.copy()
+    if method == "clip":
+        return np.maximum(rgb, 0.0)
+    if method == "desaturate":
+        luminance = linear_srgb_luminance(rgb)[..., None]
+        lowest = np.min(rgb, axis=-1, keepdims=True)
+        out_of_gamut = lowest < 0
+        with np.errstate(divide="ignore", invalid="ignore"):  # only used where lowest < 0 <= Y
+            keep = np.where(out_of_gamut & (luminance > 0), luminance / (luminance - lowest), 1.0)
+        mapped = luminance + keep * (rgb - luminance)
+        return np.where(out_of_gamut & (luminance <= 0), 0.0, mapped)
+    raise CatalogError(f"unknown carry method {method!r}; one of {', '.join(CARRY_METHODS)}")
+
+
+def linear_srgb_luminance(rgb: np.ndarray) -> np.ndarray:
+    """Y of linear sRGB (colour-science's RGB -> XYZ matrix, second row)."""
+    return linear_srgb_to_xyz(np.asarray(rgb, dtype=np.float64))[..., 1]
 
 
 def _reflectance_on_grid(reflectance_background: float | np.ndarray) -> np.ndarray:

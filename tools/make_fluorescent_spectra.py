@@ -107,7 +107,7 @@ SPECTRA: dict[str, tuple[SyntheticSpectrum, SyntheticSpectrum]] = {
             kind="emission", start_nm=350.0, stop_nm=700.0, step_nm=0.5, peak_nm=430.5,
             origin_nm=428.0,
             bands=(Band(0.0, 620.0, 0.9), Band(-1350.0, 600.0, 0.55),
-                   Band(-2700.0, 900.0, 0.18), Band(-4000.0, 1500.0, 0.05)),
+                   Band(-2700.0, 900.0, 0.10), Band(-4000.0, 1500.0, 0.03)),
             header=("lace-fwa: emission spectrum of the optical brightener (FWA) of a white "
                     "lace-curtain cloth",
                     _SYNTHETIC,

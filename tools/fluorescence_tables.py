@@ -1,0 +1,179 @@
+#!/usr/bin/env python3
+"""Print the tables of docs/fluorescence.md (markdown) and optionally write them as JSON.
+
+    .venv/bin/python tools/fluorescence_tables.py [--json FILE]
+
+1. Which lights need a fluorescence term: the brightened lace under D65, A, FL2, FL11,
+   LED-B4, LED-warm, UV-A and the sun at 22 and 500 km, in paper mode (eq. 4) and
+   physical mode (absorbed photons, emitted luminance, Delta E 2000 of the lit cloth).
+2. The colour error of carrying an out-of-gamut emission to the shader as signed linear
+   sRGB, clipped, or desaturated, against the exact spectral result (Delta E 2000).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from catalog import SHARED_DATA_DIR  # noqa: E402
+from catalog import fluorescence as fl  # noqa: E402
+from catalog.colorimetry import delta_e_2000, xyz_to_linear_srgb  # noqa: E402
+from catalog.lights import get_light  # noqa: E402
+from catalog.spectra import GRID_NM, read_spectrum  # noqa: E402
+
+INTENSITY_LIGHTS = ("D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "UV-A", "sun:22", "sun:500")
+GAMUT_LIGHTS = ("D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "UV-A", "sun:22", "sun:500")
+#: Physical-mode parameters of the catalog's fluorescent fabrics (docs/fluorescence.md).
+FABRIC_PARAMETERS = {
+    "lace-fwa": {"quantum_yield": 0.6, "peak_absorptance": 0.5},
+    "safety-yellow": {"quantum_yield": 0.7, "peak_absorptance": 0.9},
+    "fluoro-pink": {"quantum_yield": 0.5, "peak_absorptance": 0.9},
+}
+#: Reflectance of the white cloth behind/under the emission (a bleached cotton's level).
+WHITE_CLOTH = 0.85
+
+
+def fabric_material(name: str) -> tuple[fl.FluorescentMaterial, object, object]:
+    folder = ROOT / "fabrics" / "measurements" / name
+    excitation = read_spectrum(folder / "excitation.csv", normalise=True)
+    emission = read_spectrum(folder / "emission.csv", normalise=True)
+    return fl.material_from_spectra(excitation, emission, **FABRIC_PARAMETERS[name]), excitation, emission
+
+
+def calcofluor_material() -> fl.FluorescentMaterial:
+    folder = SHARED_DATA_DIR / "brightener"
+    excitation = read_spectrum(folder / "calcofluor_white_excitation.csv", normalise=True)
+    emission = read_spectrum(folder / "calcofluor_white_emission.csv", normalise=True)
+    return fl.material_from_spectra(excitation, emission, **FABRIC_PARAMETERS["lace-fwa"])
+
+
+def intensity_rows() -> list[dict]:
+    material, excitation, _ = fabric_material("lace-fwa")
+    rows = []
+    for name in INTENSITY_LIGHTS:
+        light = get_light(name)
+        e = light.irradiance_w_m2_nm
+        emitted_xyz = fl.emission_xyz(material, e)
+        lux = float(fl.light_xyz(e)[1])
+        rows.append({
+            "light": name,
+            "illuminance_lx": lux,
+            "uva_fraction": light.uva_fraction,
+            "paper_intensity": fl.paper_intensity(e, excitation.resample(GRID_NM)),
+            "absorbed_photons_m2_s": fl.absorbed_photon_irradiance(material, e),
+            "emitted_exitance_w_m2": float(np.sum(fl.emitted_exitance_w_m2_nm(material, e))),
+            "luminance_ratio": float(emitted_xyz[1]) / lux if lux > 0 else float("inf"),
+            "delta_e_2000": fl.fluorescence_delta_e(material, e, WHITE_CLOTH),
+            "needed": fl.fluorescence_needed(material, e, WHITE_CLOTH),
+        })
+    return rows
+
+
+def _rgb_to_xyz_exact(rgb: np.ndarray) -> np.ndarray:
+    """The exact inverse of xyz_to_linear_srgb (colour-science's two sRGB matrices are
+    rounded separately and invert each other only to ~4e-5, which alone costs Delta E ~0.005)."""
+    forward = xyz_to_linear_srgb(np.eye(3)).T  # rgb = forward @ xyz
+    return np.linalg.solve(forward, np.asarray(rgb, dtype=np.float64))
+
+
+def carry_errors(material: fl.FluorescentMaterial, irradiance: np.ndarray,
+                 background: float) -> dict[str, float]:
+    """Delta E 2000 of each carry method against the exact spectral colour.
+
+    The exact colour is the XYZ of (background * E + M). Each method adds its carried
+    emission RGB to the RGB of the reflected light; "scene" errors keep the sum as it is
+    (a linear EXR holds negatives), "display" clips negatives of the final sum (a screen
+    cannot show them). ``display_floor`` is what the display loses on the exact colour
+    itself: no way of carrying the emission can do better on a screen. White: a perfect
+    diffuser under the light (the emission itself for a light with no visible part).
+    """
+    reflected_xyz = fl.exitance_xyz(background * irradiance)
+    emitted_xyz = fl.emission_xyz(material, irradiance)
+    exact_xyz = reflected_xyz + emitted_xyz
+    white = fl.light_xyz(irradiance)
+    if not white[1] > 0:
+        white = emitted_xyz
+    emission_rgb = xyz_to_linear_srgb(emitted_xyz)
+    reflected_rgb = xyz_to_linear_srgb(reflected_xyz)
+    exact_rgb = xyz_to_linear_srgb(exact_xyz)
+    errors: dict[str, object] = {}
+    for method in fl.CARRY_METHODS:
+        carried = reflected_rgb + fl.carry_emission_rgb(emission_rgb, method)
+        errors[method] = float(delta_e_2000(_rgb_to_xyz_exact(carried), exact_xyz, white))
+        errors[f"{method}_display"] = float(delta_e_2000(
+            _rgb_to_xyz_exact(np.maximum(carried, 0.0)), exact_xyz, white))
+    errors["display_floor"] = float(delta_e_2000(
+        _rgb_to_xyz_exact(np.maximum(exact_rgb, 0.0)), exact_xyz, white))
+    errors["signed_display_desaturate"] = float(delta_e_2000(
+        _rgb_to_xyz_exact(fl.carry_emission_rgb(exact_rgb, "desaturate")), exact_xyz, white))
+    errors["sum_in_gamut"] = bool(np.all(exact_rgb >= 0))
+    errors["emission_rgb_relative"] = (emission_rgb / white[1]).tolist()
+    return errors
+
+
+def gamut_rows() -> list[dict]:
+    materials = {"lace-fwa": fabric_material("lace-fwa")[0],
+                 "calcofluor (measured)": calcofluor_material()}
+    rows = []
+    for material_name, material in materials.items():
+        for background_name, background in (("white cloth 0.85", WHITE_CLOTH), ("black", 0.0)):
+            for name in GAMUT_LIGHTS:
+                e = get_light(name).irradiance_w_m2_nm
+                rows.append({"material": material_name, "background": background_name,
+                             "light": name, **carry_errors(material, e, background)})
+    return rows
+
+
+def _cell(value: object, fmt: str) -> str:
+    if isinstance(value, float) and fmt and abs(value) < 1e-9:
+        return "0"  # exact to rounding (the sums differ in the last bits only)
+    return format(value, fmt) if fmt else str(value)
+
+
+def _markdown(rows: list[dict], columns: list[tuple[str, str, str]]) -> str:
+    lines = ["| " + " | ".join(title for _, title, _ in columns) + " |",
+             "|" + "|".join("---" for _ in columns) + "|"]
+    for row in rows:
+        lines.append("| " + " | ".join(_cell(row[key], fmt) for key, _, fmt in columns) + " |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", type=Path, help="also write the rows as JSON here")
+    args = parser.parse_args(argv)
+    intensity = intensity_rows()
+    gamut = gamut_rows()
+    print("## Which lights need a fluorescence term (lace-fwa, QY 0.6, peak absorptance 0.5)\n")
+    print(_markdown(intensity, [
+        ("light", "light", ""), ("illuminance_lx", "lx", ",.0f"),
+        ("uva_fraction", "UV-A share", ".3f"),
+        ("paper_intensity", "paper I (eq. 4)", ".4g"),
+        ("absorbed_photons_m2_s", "absorbed photons m^-2 s^-1", ".3g"),
+        ("emitted_exitance_w_m2", "emitted W m^-2", ".3g"),
+        ("luminance_ratio", "emission / white (Y)", ".3g"),
+        ("delta_e_2000", "Delta E 2000", ".3g"), ("needed", "needed", "")]))
+    print("\n## Carrying the emission colour: Delta E 2000 against the exact spectral colour\n")
+    print(_markdown(gamut, [
+        ("material", "material", ""), ("background", "background", ""), ("light", "light", ""),
+        ("signed", "signed", ".1g"), ("clip", "clip", ".3g"), ("desaturate", "desaturate", ".3g"),
+        ("sum_in_gamut", "sum in gamut", ""), ("display_floor", "display floor", ".3g"),
+        ("signed_display", "signed, display", ".3g"), ("clip_display", "clip, display", ".3g"),
+        ("desaturate_display", "desat., display", ".3g"),
+        ("signed_display_desaturate", "signed, display desat.", ".3g")]))
+    if args.json:
+        from catalog.atomic import write_text_atomic  # noqa: PLC0415
+        write_text_atomic(args.json, json.dumps({"intensity": intensity, "gamut": gamut},
+                                                indent=1, default=float))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
