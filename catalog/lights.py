@@ -182,8 +182,8 @@ def uva_lamp_relative(grid_nm: np.ndarray = GRID_NM) -> np.ndarray:
 #: Warm-white LED: an InGaN blue pump and two phosphors, each a Gaussian (centre nm, FWHM nm):
 #: a broad yellow-green garnet (YAG:Ce-like) and a red nitride, as warm-white LEDs combine
 #: them. The three weights are solved so that the mix has the chromaticity of a Planckian
-#: radiator at WARM_LED_CCT_K (Duv 0). Nothing below 400 nm: the pump's Gaussian tail there
-#: (< 1e-6 of its peak) is cut to exactly zero, as a real LED package has no UV.
+#: radiator at WARM_LED_CCT_K (Duv 0). Nothing at or below 400 nm: the pump's Gaussian
+#: tail there (< 1e-7 of its peak) is cut to exactly zero, as a real LED package has no UV.
 WARM_LED_BANDS = ((450.0, 20.0), (555.0, 110.0), (625.0, 90.0))
 WARM_LED_CCT_K = 2800.0
 WARM_LED_UV_CUTOFF_NM = 400.0
@@ -201,7 +201,7 @@ def warm_led_relative(grid_nm: np.ndarray = GRID_NM) -> np.ndarray:
     from catalog.colorimetry import spectrum_to_xyz  # noqa: PLC0415
 
     bands = np.stack([_gaussian(c, w, grid_nm) for c, w in WARM_LED_BANDS])
-    bands[:, grid_nm < WARM_LED_UV_CUTOFF_NM] = 0.0
+    bands[:, grid_nm <= WARM_LED_UV_CUTOFF_NM] = 0.0
     band_xyz = spectrum_to_xyz(bands, grid_nm)              # (3 bands, XYZ)
     target_xyz = spectrum_to_xyz(planck_w_m2_nm(WARM_LED_CCT_K, grid_nm), grid_nm)
     weights = np.linalg.solve(band_xyz.T, target_xyz)       # sum_i w_i XYZ_i = XYZ_target
@@ -221,7 +221,7 @@ def _warm_led_light() -> Light:
     relative = warm_led_relative()
     description = (f"warm-white LED, {WARM_LED_CCT_K:g} K: 450 nm blue pump + yellow-green "
                    "and red phosphors (Gaussians mixed to the Planckian white), nothing "
-                   f"below 400 nm; scaled to {LAMP_LX:,.0f} lx")
+                   f"at or below 400 nm; scaled to {LAMP_LX:,.0f} lx")
     return _make("LED-warm", description, relative * (LAMP_LX / illuminance_lx(relative)))
 
 
