@@ -1,0 +1,470 @@
+"""FrameRenderer: one frame of the curtain scene into an HDR target, tone-mapped to sRGB.
+
+The viewer and the snapshot command both drive this class (docs/render.md has the API).
+It never creates a GL context: it is handed one (:mod:`catalog.render.context`).
+
+Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
+
+1. background (shaders/fullscreen.vert + background.frag): the outside through the window
+   (sky, ground, the sun's disc) or the room, per camera ray;
+2. room props (room.vert/.frag): walls around the window, the curtain rod;
+3. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling;
+4. tone map (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
+   target): exposure, Reinhard on luminance, the sRGB curve.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from catalog.errors import CatalogError
+from catalog.render import bands as band_lib
+from catalog.render import scene as scene_lib
+from catalog.render.camera import OrbitCamera, gl_bytes
+from catalog.render.shaderlib import create_program
+
+#: Auto exposure: a white diffuser under the key light maps to this (before the curve).
+EXPOSURE_KEY = 5.0
+#: Tone curve white point (after exposure): this luminance maps to display white.
+TONE_WHITE = 6.0
+FLUORESCENCE_MODES = ("off", "paper", "physical")
+#: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
+MAX_SIDE_PX = 16384
+
+
+def check_size(size, ctx=None) -> tuple[int, int]:
+    """(width, height) in pixels, refused with a one-line error when impossible."""
+    try:
+        width, height = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise CatalogError(f"image size {size!r} must be two whole numbers (width, height)") from None
+    limit = MAX_SIDE_PX
+    if ctx is not None:
+        limit = min(limit, int(ctx.info.get("GL_MAX_TEXTURE_SIZE", limit)))
+    if not (1 <= width <= limit and 1 <= height <= limit):
+        raise CatalogError(f"image size {width}x{height} is impossible: each side must lie in "
+                           f"1..{limit} px")
+    return width, height
+
+
+class FrameRenderer:
+    """Renders the curtain scene with a given moderngl context at a given size (w, h)."""
+
+    def __init__(self, ctx, size: tuple[int, int]):
+        import moderngl  # noqa: PLC0415
+
+        self._moderngl = moderngl
+        self.ctx = ctx
+        self.size = check_size(size, ctx)
+        w, h = self.size
+        self._hdr = ctx.texture((w, h), 4, dtype="f4")
+        self._hdr.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self._depth = ctx.depth_renderbuffer((w, h))
+        self._hdr_fbo = ctx.framebuffer([self._hdr], self._depth)
+        self._ldr = ctx.texture((w, h), 4)
+        self._ldr_fbo = ctx.framebuffer([self._ldr])
+        self._gbuffer = None
+        self._programs: dict[tuple, object] = {}
+        self._vaos: dict[tuple, object] = {}
+
+        self.preset = None
+        self.light = None
+        self._key_to_light = scene_lib.key_direction(scene_lib.LAMP_ELEVATION_DEG)
+        self._is_sun = False
+        self.mode = "physical"
+        self.n_bands = 3
+        self.camera = OrbitCamera()
+        self.exposure = 1.0
+        self._inputs = None
+        self._inputs_key = None
+        self._decision = None
+        self._uniforms = None
+        self._uniforms_key = None
+        self._last = None  # (vw, vh, fbo, viewport)
+
+        positions, normals = scene_lib.room_props()
+        self._room_vbo = ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
+        self._room_count = positions.shape[0]
+        self._curtain_buffers = None
+        default = scene_lib.draped_curtain()
+        self.set_mesh(default.positions, default.normals, default.uvs, default.tangents,
+                      default.indices)
+
+    # ------------------------------------------------------------------ state
+    def set_fabric(self, preset) -> None:
+        """A preset object, a preset name (fabrics/NAME.toml) or a path to a .toml."""
+        from catalog.presets import Preset, find_preset, load_preset  # noqa: PLC0415
+
+        if not isinstance(preset, Preset):
+            preset = load_preset(find_preset(preset))
+        scene_lib.dye_transmittance(preset)  # refuse a bad dye file now, not at render
+        scene_lib.fluorescent_material(preset)
+        self.preset = preset
+
+    def set_light(self, light) -> None:
+        """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.lights.Light.
+
+        The sun stands behind the window at the elevation its path length implies; a lamp at
+        scene.LAMP_ELEVATION_DEG. :meth:`set_sun_hour` and :meth:`set_key_direction` move it.
+        """
+        from catalog.lights import get_light  # noqa: PLC0415
+
+        if isinstance(light, str):
+            light = get_light(light)
+        self.light = light
+        self._is_sun = light.name.startswith(("sun:", "sun-clear:", "sun@"))
+        try:
+            elevation = scene_lib.key_elevation_for(light.name)
+        except (ValueError, CatalogError):
+            elevation = scene_lib.LAMP_ELEVATION_DEG
+        self._key_to_light = scene_lib.key_direction(elevation)
+
+    def set_sun_hour(self, hour: float) -> dict:
+        """The sun at ``hour`` (local solar time, summer solstice, 34.7 N) behind the window."""
+        from catalog.lights import get_light  # noqa: PLC0415
+
+        sun = scene_lib.sun_at_hour(hour)
+        self.light = get_light(sun.light_name)
+        self._is_sun = True
+        self._key_to_light = scene_lib.key_direction(90.0 - sun.zenith_deg, sun.azimuth_deg)
+        return {"hour": hour, "zenith_deg": sun.zenith_deg, "path_km": sun.path_km,
+                "light": sun.light_name}
+
+    def set_key_direction(self, elevation_deg: float, azimuth_deg: float = scene_lib.KEY_AZIMUTH_DEG) -> None:
+        """Move the key light: azimuth 0 = straight behind the window, 180 = behind the viewer."""
+        self._key_to_light = scene_lib.key_direction(elevation_deg, azimuth_deg)
+
+    def set_fluorescence(self, mode: str) -> None:
+        if mode not in FLUORESCENCE_MODES:
+            raise CatalogError(f"fluorescence mode {mode!r}: choose one of {', '.join(FLUORESCENCE_MODES)}")
+        self.mode = mode
+
+    def set_bands(self, n_bands: int) -> None:
+        self.n_bands = band_lib.check_band_count(n_bands)
+
+    def set_camera(self, yaw_deg: float, pitch_deg: float, distance_m: float) -> None:
+        self.camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
+                                  distance_m=float(distance_m))
+
+    def set_exposure(self, multiplier: float) -> None:
+        if not (math.isfinite(multiplier) and multiplier > 0):
+            raise CatalogError(f"exposure {multiplier!r} must be a positive number")
+        self.exposure = float(multiplier)
+
+    # ------------------------------------------------------------------ mesh
+    def set_mesh(self, positions, normals, uvs, tangents, indices) -> None:
+        """The curtain: float32 (V, 3) positions, normals, tangents (weft), (V, 2) uvs and
+        int32 triangle indices ((T, 3) or flat)."""
+        positions = np.ascontiguousarray(positions, dtype="f4").reshape(-1, 3)
+        count = positions.shape[0]
+        normals = np.ascontiguousarray(normals, dtype="f4").reshape(-1, 3)
+        tangents = np.ascontiguousarray(tangents, dtype="f4").reshape(-1, 3)
+        uvs = np.ascontiguousarray(uvs, dtype="f4").reshape(-1, 2)
+        indices = np.ascontiguousarray(indices, dtype="i4").ravel()
+        if not (normals.shape[0] == tangents.shape[0] == uvs.shape[0] == count):
+            raise CatalogError("curtain mesh arrays differ in vertex count")
+        if indices.size == 0 or indices.size % 3 or indices.min() < 0 or indices.max() >= count:
+            raise CatalogError("curtain mesh indices must be triangles of existing vertices")
+        if self._curtain_buffers is not None:
+            for buffer in self._curtain_buffers.values():
+                buffer.release()
+        self._curtain_buffers = {
+            "position": self.ctx.buffer(positions.tobytes()),
+            "normal": self.ctx.buffer(normals.tobytes()),
+            "tangent": self.ctx.buffer(tangents.tobytes()),
+            "uv": self.ctx.buffer(uvs.tobytes()),
+            "index": self.ctx.buffer(indices.tobytes()),
+        }
+        self._curtain_format = "3f"
+        self._vertex_count = count
+        self._release_vaos()
+        self.mesh_arrays = (positions, normals, tangents)
+
+    def update_positions(self, positions, normals) -> None:
+        """New positions and normals for the same vertices (a simulation frame)."""
+        positions = np.ascontiguousarray(positions, dtype="f4").reshape(-1, 3)
+        normals = np.ascontiguousarray(normals, dtype="f4").reshape(-1, 3)
+        if positions.shape[0] != self._vertex_count or normals.shape[0] != self._vertex_count:
+            raise CatalogError(f"update_positions: expected {self._vertex_count} vertices, "
+                               f"got {positions.shape[0]}")
+        if self._curtain_format != "3f":
+            raise CatalogError("update_positions after bind_cloth_buffers: the cloth owns the buffers")
+        self._curtain_buffers["position"].write(positions.tobytes())
+        self._curtain_buffers["normal"].write(normals.tobytes())
+        self.mesh_arrays = (positions, normals, self.mesh_arrays[2])
+
+    def bind_cloth_buffers(self, position_buffer, normal_buffer) -> None:
+        """Read positions and normals straight from GPU buffers (vec4 per vertex, xyz used),
+        e.g. written by the cloth's compute shader; same vertex order as :meth:`set_mesh`."""
+        expected = 16 * self._vertex_count
+        if position_buffer.size < expected or normal_buffer.size < expected:
+            raise CatalogError(f"cloth buffers hold fewer than {self._vertex_count} vec4 vertices")
+        self._curtain_buffers["position"] = position_buffer
+        self._curtain_buffers["normal"] = normal_buffer
+        self._curtain_format = "3f 4x"
+        self._release_vaos()
+
+    def _release_vaos(self) -> None:
+        for vao in self._vaos.values():
+            vao.release()
+        self._vaos.clear()
+
+    # ------------------------------------------------------------------ derived state
+    def _require_ready(self) -> None:
+        if self.preset is None:
+            raise CatalogError("no fabric set: call set_fabric first")
+        if self.light is None:
+            raise CatalogError("no light set: call set_light first")
+
+    @property
+    def viewer_inside(self) -> bool:
+        return bool(self.camera.position[2] > scene_lib.WINDOW_Z)
+
+    def shading_inputs(self):
+        """The scene's :class:`catalog.reference.ShadingInputs` (rebuilt only on change)."""
+        self._require_ready()
+        key = (id(self.preset), self.light.name, id(self.light), tuple(self._key_to_light),
+               self.mode, self.viewer_inside, self._is_sun)
+        if key != self._inputs_key:
+            self._inputs, self._decision = scene_lib.build_shading_inputs(
+                self.preset, self.light.irradiance_w_m2_nm, self._key_to_light,
+                is_sun=self._is_sun, fluorescence=self.mode, viewer_inside=self.viewer_inside)
+            self._inputs_key = key
+            self._uniforms_key = None
+        return self._inputs
+
+    def _band_uniforms(self):
+        inputs = self.shading_inputs()
+        key = (self._inputs_key, self.n_bands)
+        if key != self._uniforms_key:
+            self._uniforms = band_lib.band_uniforms(inputs, self.n_bands)
+            self._uniforms_key = key
+        return self._uniforms
+
+    def variant_defines(self, gbuffer: bool = False) -> dict:
+        """The #defines of the curtain program this scene needs."""
+        inputs = self.shading_inputs()
+        defines = {"N_BANDS": self.n_bands, "NV4": band_lib.chunks(self.n_bands),
+                   f"FLUORESCENCE_{inputs.fluorescence_mode.upper()}": True,
+                   "SEE_THROUGH": inputs.direct > 0, "GBUFFER": gbuffer}
+        return defines
+
+    def _program(self, vertex: str, fragment: str, defines: dict | None = None):
+        key = (vertex, fragment, tuple(sorted((defines or {}).items())))
+        if key not in self._programs:
+            self._programs[key] = create_program(self.ctx, vertex, fragment, defines)
+        return self._programs[key]
+
+    def compiled_variants(self) -> list[dict]:
+        """The defines of every curtain program compiled so far (for tests and reports)."""
+        return [dict(k[2]) for k in self._programs if k[1] == "curtain.frag"]
+
+    def _curtain_vao(self, program):
+        key = ("curtain", id(program))
+        if key not in self._vaos:
+            b = self._curtain_buffers
+            content = [(b["position"], self._curtain_format, "in_position")]
+            if "in_normal" in program:
+                content.append((b["normal"], self._curtain_format, "in_normal"))
+            if "in_tangent" in program:
+                content.append((b["tangent"], "3f", "in_tangent"))
+            self._vaos[key] = self.ctx.vertex_array(program, content, index_buffer=b["index"],
+                                                    index_element_size=4)
+        return self._vaos[key]
+
+    def _room_vao(self, program):
+        key = ("room", id(program))
+        if key not in self._vaos:
+            self._vaos[key] = self.ctx.vertex_array(
+                program, [(self._room_vbo, "3f 3f", "in_position", "in_normal")])
+        return self._vaos[key]
+
+    def _fullscreen_vao(self, program):
+        key = ("fullscreen", id(program))
+        if key not in self._vaos:
+            self._vaos[key] = self.ctx.vertex_array(program, [])
+        return self._vaos[key]
+
+    @staticmethod
+    def _set(program, name, value) -> None:
+        if name not in program:
+            return  # optimised away in this variant
+        if isinstance(value, np.ndarray):
+            program[name].write(np.ascontiguousarray(value, dtype="f4").tobytes())
+        elif isinstance(value, bytes):
+            program[name].write(value)
+        else:
+            program[name].value = value
+
+    def exposure_scale(self) -> float:
+        """Linear radiance (cd m^-2) -> tone-curve input: EXPOSURE_KEY over a white diffuser's Y."""
+        illuminance = max(self.light.illuminance_lx, 1e-9)
+        return self.exposure * EXPOSURE_KEY * math.pi / illuminance
+
+    # ------------------------------------------------------------------ passes
+    def _scene_uniforms(self, program, view_proj, inputs) -> None:
+        s = self._set
+        s(program, "u_view_proj", gl_bytes(view_proj))
+        s(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
+        s(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
+        s(program, "u_fill_to_light", tuple(float(v) for v in inputs.fill_to_light))
+        s(program, "u_sun_direction", tuple(float(v) for v in inputs.key_to_light))
+        s(program, "u_sun_chord2", tuple(float(v) for v in inputs.sun_chord2))
+
+    def draw_curtain(self, view_proj, trivial: bool = False, gbuffer: bool = False) -> None:
+        """The curtain pass alone into the bound framebuffer (the benchmark times this)."""
+        if trivial:
+            program = self._program("curtain.vert", "trivial.frag")
+            self._set(program, "u_view_proj", gl_bytes(view_proj))
+        else:
+            inputs = self.shading_inputs()
+            program = self._program("curtain.vert", "curtain.frag", self.variant_defines(gbuffer))
+            self._scene_uniforms(program, view_proj, inputs)
+            for name, value in (("u_direct", inputs.direct), ("u_a_diff", inputs.a_diff),
+                                ("u_g_diff", inputs.g_diff), ("u_a_spec", inputs.a_spec),
+                                ("u_g_spec", inputs.g_spec), ("u_anisotropy", inputs.anisotropy)):
+                self._set(program, name, float(value))
+            for name, value in self._band_uniforms().items():
+                self._set(program, name, value)
+        self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
+        self._curtain_vao(program).render(self._moderngl.TRIANGLES)
+
+    def _draw_background(self, view_proj, inputs) -> None:
+        program = self._program("fullscreen.vert", "background.frag")
+        self._scene_uniforms(program, view_proj, inputs)
+        self._set(program, "u_inverse_view_proj", gl_bytes(np.linalg.inv(view_proj)))
+        for name, spectrum in (("u_sky_rgb", inputs.sky_radiance),
+                               ("u_ground_rgb", inputs.ground_radiance),
+                               ("u_sun_disc_rgb", inputs.sun_disc_radiance),
+                               ("u_room_rgb", inputs.room_radiance)):
+            self._set(program, name, tuple(float(v) for v in band_lib.spectrum_to_display_rgb(spectrum)))
+        self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
+
+    def _draw_room(self, view_proj, inputs) -> None:
+        program = self._program("room.vert", "room.frag")
+        self._scene_uniforms(program, view_proj, inputs)
+        room_rgb = band_lib.spectrum_to_display_rgb(inputs.room_radiance)
+        fill_rgb = band_lib.spectrum_to_display_rgb(
+            scene_lib.ROOM_ALBEDO * inputs.fill_irradiance / math.pi)
+        self._set(program, "u_room_rgb", tuple(float(v) for v in room_rgb))
+        self._set(program, "u_fill_rgb", tuple(float(v) for v in fill_rgb))
+        self._room_vao(program).render(self._moderngl.TRIANGLES)
+
+    def _viewport_size(self, viewport) -> tuple[int, int]:
+        if viewport is None:
+            return self.size
+        vw, vh = int(viewport[2]), int(viewport[3])
+        if not (1 <= vw <= self.size[0] and 1 <= vh <= self.size[1]):
+            raise CatalogError(f"viewport {tuple(viewport)} does not fit the renderer's "
+                               f"{self.size[0]}x{self.size[1]} HDR target")
+        return vw, vh
+
+    def render_hdr(self, viewport=None) -> tuple[int, int]:
+        """Background, room and curtain into the HDR target; returns the size drawn."""
+        mgl = self._moderngl
+        inputs = self.shading_inputs()
+        vw, vh = self._viewport_size(viewport)
+        view_proj = self.camera.view_projection(vw / vh)
+        self._hdr_fbo.use()
+        self.ctx.viewport = (0, 0, vw, vh)
+        self._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
+        self.ctx.disable(mgl.DEPTH_TEST | mgl.BLEND)
+        self._draw_background(view_proj, inputs)
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self._draw_room(view_proj, inputs)
+        self.draw_curtain(view_proj)
+        self.ctx.disable(mgl.DEPTH_TEST)
+        return vw, vh
+
+    def render(self, fbo=None, viewport=None) -> None:
+        """One frame: HDR passes, then the tone map into ``fbo`` (default: our RGBA8 target)
+        at ``viewport`` (x, y, w, h; default the whole renderer size)."""
+        vw, vh = self.render_hdr(viewport)
+        target = fbo if fbo is not None else self._ldr_fbo
+        target.use()
+        self.ctx.viewport = tuple(viewport) if (fbo is not None and viewport is not None) else (0, 0, vw, vh)
+        program = self._program("fullscreen.vert", "tonemap.frag")
+        self._hdr.use(location=0)
+        self._set(program, "u_hdr", 0)
+        self._set(program, "u_hdr_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
+        self._set(program, "u_exposure", self.exposure_scale())
+        self._set(program, "u_white", TONE_WHITE)
+        self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
+        self._last = (vw, vh, fbo, viewport)
+
+    # ------------------------------------------------------------------ read back
+    def read_linear(self) -> np.ndarray:
+        """The last frame's HDR radiance: float32 (H, W, 3), linear sRGB, cd m^-2 scale, row 0 = top."""
+        if self._last is None:
+            raise CatalogError("nothing rendered yet")
+        vw, vh = self._last[:2]
+        data = self._hdr_fbo.read(viewport=(0, 0, vw, vh), components=4, dtype="f4")
+        return np.frombuffer(data, dtype=np.float32).reshape(vh, vw, 4)[::-1, :, :3].copy()
+
+    def read_srgb8(self) -> np.ndarray:
+        """The last frame tone-mapped and sRGB-encoded: uint8 (H, W, 3), row 0 = top."""
+        if self._last is None:
+            raise CatalogError("nothing rendered yet")
+        vw, vh, fbo, viewport = self._last
+        if fbo is None:
+            data = self._ldr_fbo.read(viewport=(0, 0, vw, vh), components=3)
+        else:
+            data = fbo.read(viewport=tuple(viewport) if viewport is not None else (0, 0, vw, vh),
+                            components=3)
+        return np.frombuffer(data, dtype=np.uint8).reshape(vh, vw, 3)[::-1].copy()
+
+    def render_gbuffer(self) -> dict[str, np.ndarray]:
+        """The curtain alone with the G-buffer variant: radiance and the per-pixel geometry the
+        shader used (world position, unit normal, weft tangent), float32 (H, W, 3) each, and a
+        boolean mask of curtain pixels. The reference shades these positions in float64."""
+        mgl = self._moderngl
+        w, h = self.size
+        if self._gbuffer is None:
+            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(4)]
+            depth = self.ctx.depth_renderbuffer((w, h))
+            self._gbuffer = (textures, self.ctx.framebuffer(textures, depth))
+        textures, fbo = self._gbuffer
+        fbo.use()
+        self.ctx.viewport = (0, 0, w, h)
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        self.draw_curtain(self.camera.view_projection(w / h), gbuffer=True)
+        self.ctx.disable(mgl.DEPTH_TEST)
+        out = {}
+        for name, attachment in zip(("radiance", "position", "normal", "tangent"), range(4)):
+            data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
+            out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
+        out["mask"] = out["position"][..., 3] > 0.5
+        for name in ("radiance", "position", "normal", "tangent"):
+            out[name] = out[name][..., :3]
+        return out
+
+    # ------------------------------------------------------------------ report
+    def info(self) -> dict:
+        inputs = self.shading_inputs()
+        decision = self._decision
+        return {
+            "fabric": self.preset.name,
+            "light": self.light.name,
+            "illuminance_lx": round(self.light.illuminance_lx, 3),
+            "mode": decision.requested,
+            "fluorescence_variant": inputs.fluorescence_mode,
+            "fluorescence_needed": decision.needed,
+            "fluorescence_delta_e": decision.delta_e,
+            "bands": self.n_bands,
+            "see_through": inputs.direct > 0,
+            "key_to_light": [round(float(v), 6) for v in inputs.key_to_light],
+            "camera": {"yaw_deg": self.camera.yaw_deg, "pitch_deg": self.camera.pitch_deg,
+                       "distance_m": self.camera.distance_m},
+            "exposure": self.exposure_scale(),
+            "size": list(self.size),
+        }
+
+    def release(self) -> None:
+        self._release_vaos()
+        for program in self._programs.values():
+            program.release()
+        self._programs.clear()

@@ -1,0 +1,350 @@
+"""The scene: a curtain hanging in a window, the sun (or a lamp) behind it, a room around
+the viewer; and the spectral description of its light (:class:`catalog.reference.ShadingInputs`).
+
+Coordinates: metres, y up; the window is in the wall z = WINDOW_Z, the outside lies towards
+-z, the room (and the viewer) towards +z. No GL here: meshes are numpy arrays (props are
+built and merged with trimesh) and the renderer uploads them.
+
+Lighting model (the numbers are scene design, stated once here; the physics is eq. 5-8):
+
+- key: the light the user picks, as a distant source behind the window (the sun's disc
+  size, 0.2666 deg), normal irradiance = the light's spectrum;
+- sky: outside above the horizon, radiance SKY_FRACTION E / pi, tinted (550 / l)^4 for
+  the sun (Rayleigh) and untinted for a lamp (a lit backdrop); ground below: albedo
+  GROUND_ALBEDO under the key light's horizontal irradiance;
+- fill: the light bounced into the room, a directional light on the viewer's side with
+  FILL_FRACTION of the key's spectrum (so a front-lit curtain is not black);
+- room: grey walls of albedo ROOM_ALBEDO under ROOM_FRACTION of the key;
+- ambient: the cloth's radiance under the sky/ground behind it and the room in front,
+  through eq. 7's lobes integrated over each hemisphere (:func:`catalog.reference.hg_hemisphere_factors`).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from catalog.errors import CatalogError, InputError
+from catalog.reference import ShadingInputs, hg_hemisphere_factors
+from catalog.spectra import GRID_NM
+
+WINDOW_Z = -0.2
+#: Window opening in the wall (x from, x to, y from, y to), metres.
+WINDOW_RECT = (-0.95, 0.95, -0.9, 1.35)
+#: The room box (x, y, z extents), metres.
+ROOM_BOX = ((-2.2, 2.2), (-1.3, 1.7), (WINDOW_Z, 4.5))
+CURTAIN_TOP_Y = 1.25
+CURTAIN_Z = -0.08
+CURTAIN_WIDTH_M = 1.7
+CURTAIN_HEIGHT_M = 2.2
+
+SUN_RADIUS_RAD = math.radians(0.2666)
+SKY_FRACTION = 0.12
+GROUND_ALBEDO = 0.2
+FILL_FRACTION = 0.04
+FILL_TO_LIGHT = np.array([0.3, 0.5, 1.0]) / np.linalg.norm([0.3, 0.5, 1.0])
+ROOM_ALBEDO = 0.6
+ROOM_FRACTION = 0.03
+#: A lamp (not the sun) stands this high above the horizon behind the window.
+LAMP_ELEVATION_DEG = 25.0
+#: The key light's azimuth from the window normal (deg, + to the right seen from the room).
+KEY_AZIMUTH_DEG = 15.0
+#: Where and when the hour of day is taken (the paper's setting: Japan, summer solstice).
+SUN_DATE = "2026-06-21"
+SUN_LATITUDE_DEG = 34.7
+SUN_LONGITUDE_DEG = 135.5
+
+
+# --------------------------------------------------------------------------- meshes
+
+@dataclass(frozen=True)
+class Mesh:
+    """Vertex arrays (float32) and triangle indices (int32, (T, 3))."""
+
+    positions: np.ndarray
+    normals: np.ndarray
+    uvs: np.ndarray
+    tangents: np.ndarray
+    indices: np.ndarray
+
+
+def draped_curtain(columns: int = 120, rows: int = 80, folds: float = 5.5,
+                   depth_m: float = 0.07) -> Mesh:
+    """A static draped curtain: sinusoidal folds hanging from a rod, deepest at the top.
+
+    u runs along the weft (across, x), v along the warp (down from the rod, -y). The
+    tangent is dP/du (weft); the normal dP/du x dP/dv' faces the room (+z) on average.
+    """
+    if columns < 2 or rows < 2:
+        raise CatalogError("a curtain mesh needs at least 2 x 2 vertices")
+    u = np.linspace(0.0, 1.0, columns)
+    v = np.linspace(0.0, 1.0, rows)
+    uu, vv = np.meshgrid(u, v)  # (rows, columns)
+    amplitude = depth_m * (1.0 - 0.45 * vv)  # folds open up towards the hem
+    phase = 2 * math.pi * folds * uu
+    x = (uu - 0.5) * CURTAIN_WIDTH_M
+    y = CURTAIN_TOP_Y - vv * CURTAIN_HEIGHT_M
+    z = CURTAIN_Z + amplitude * np.sin(phase)
+    positions = np.stack([x, y, z], axis=-1)
+    # analytic derivatives
+    dp_du = np.stack([np.full_like(uu, CURTAIN_WIDTH_M), np.zeros_like(uu),
+                      amplitude * 2 * math.pi * folds * np.cos(phase)], axis=-1)
+    dp_dv = np.stack([np.zeros_like(uu), np.full_like(uu, -CURTAIN_HEIGHT_M),
+                      -0.45 * depth_m * np.sin(phase)], axis=-1)
+    normals = np.cross(dp_dv, dp_du)  # (0,-1,0) x (1,0,0) = (0,0,1): faces the room
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    tangents = dp_du / np.linalg.norm(dp_du, axis=-1, keepdims=True)
+    index = np.arange(rows * columns).reshape(rows, columns)
+    a, b = index[:-1, :-1].ravel(), index[:-1, 1:].ravel()
+    c, d = index[1:, :-1].ravel(), index[1:, 1:].ravel()
+    triangles = np.concatenate([np.stack([a, c, b], 1), np.stack([b, c, d], 1)])
+    return Mesh(positions.reshape(-1, 3).astype(np.float32),
+                normals.reshape(-1, 3).astype(np.float32),
+                np.stack([uu, vv], -1).reshape(-1, 2).astype(np.float32),
+                tangents.reshape(-1, 3).astype(np.float32),
+                triangles.astype(np.int32))
+
+
+def _slab(x0, x1, y0, y1, z0, z1):
+    import trimesh  # noqa: PLC0415
+
+    extents = [x1 - x0, y1 - y0, z1 - z0]
+    centre = [(x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2]
+    return trimesh.creation.box(extents=extents,
+                                transform=trimesh.transformations.translation_matrix(centre))
+
+
+@functools.lru_cache(maxsize=1)
+def room_props() -> tuple[np.ndarray, np.ndarray]:
+    """The room (walls, floor, ceiling, the window wall with its opening) and the curtain rod,
+    merged through trimesh; returns non-indexed (positions, face normals), float32 (3T, 3)."""
+    import trimesh  # noqa: PLC0415
+
+    (x0, x1), (y0, y1), (z0, z1) = ROOM_BOX
+    wx0, wx1, wy0, wy1 = WINDOW_RECT
+    t = 0.1  # wall thickness
+    parts = [
+        _slab(x0 - t, x1 + t, y0 - t, y0, z0 - t, z1 + t),       # floor
+        _slab(x0 - t, x1 + t, y1, y1 + t, z0 - t, z1 + t),       # ceiling
+        _slab(x0 - t, x0, y0, y1, z0 - t, z1 + t),               # left wall
+        _slab(x1, x1 + t, y0, y1, z0 - t, z1 + t),               # right wall
+        _slab(x0, x1, y0, y1, z1, z1 + t),                       # wall behind the viewer
+        # the window wall, around the opening
+        _slab(x0, wx0, y0, y1, z0 - t, z0),
+        _slab(wx1, x1, y0, y1, z0 - t, z0),
+        _slab(wx0, wx1, y0, wy0, z0 - t, z0),
+        _slab(wx0, wx1, wy1, y1, z0 - t, z0),
+    ]
+    rod = trimesh.creation.cylinder(radius=0.015, height=CURTAIN_WIDTH_M + 0.4, sections=16)
+    rod.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [0, 1, 0]))
+    rod.apply_translation([0.0, CURTAIN_TOP_Y + 0.03, CURTAIN_Z])
+    merged = trimesh.util.concatenate(parts + [rod])
+    triangles = merged.vertices[merged.faces]  # (T, 3, 3)
+    normals = np.repeat(merged.face_normals[:, None, :], 3, axis=1)
+    return (triangles.reshape(-1, 3).astype(np.float32), normals.reshape(-1, 3).astype(np.float32))
+
+
+# --------------------------------------------------------------------------- the sun
+
+def key_direction(elevation_deg: float, azimuth_deg: float = KEY_AZIMUTH_DEG) -> np.ndarray:
+    """Unit vector towards a distant light behind the window (outside is -z)."""
+    el, az = math.radians(elevation_deg), math.radians(azimuth_deg)
+    return np.array([math.sin(az) * math.cos(el), math.sin(el), -math.cos(az) * math.cos(el)])
+
+
+@dataclass(frozen=True)
+class SunAtHour:
+    hour: float
+    zenith_deg: float
+    azimuth_deg: float  # from the window normal (the window faces south)
+    path_km: float
+    light_name: str
+
+
+def sun_at_hour(hour: float) -> SunAtHour:
+    """Hour of local mean solar time on SUN_DATE at SUN_LATITUDE -> the sun through a
+    south-facing window: zenith (pvlib's SPA via catalog.sun), path length through the
+    paper's 22 km shell, and the light name ``sun:PATH_KM`` of the light library."""
+    from catalog.sun import sun_position  # noqa: PLC0415
+
+    if not (math.isfinite(hour) and 0.0 <= hour < 24.0):
+        raise InputError(f"{hour!r} is not an hour of the day (0 <= hour < 24)", field="--hour")
+    minutes = int(round(hour * 60))
+    position = sun_position(f"{SUN_DATE}T{minutes // 60:02d}:{minutes % 60:02d}",
+                            SUN_LATITUDE_DEG, SUN_LONGITUDE_DEG)
+    if position.path_km is None:
+        raise InputError(f"the sun is below the horizon at {hour:g} h "
+                         f"(zenith {position.zenith_deg:.1f} deg)", field="--hour")
+    azimuth = max(-75.0, min(75.0, 15.0 * (hour - 12.0)))  # hour angle, kept inside the window
+    return SunAtHour(hour, position.zenith_deg, azimuth, position.path_km,
+                     f"sun:{position.path_km:.1f}")
+
+
+def key_elevation_for(light_name: str) -> float:
+    """Elevation (deg) of the key light: the sun's from its path length, a lamp's fixed."""
+    if light_name.startswith(("sun:", "sun-clear:")):
+        from catalog.sun import zenith_deg_from_path  # noqa: PLC0415
+
+        path = float(light_name.split(":", 1)[1])
+        return 90.0 - zenith_deg_from_path(path)
+    return LAMP_ELEVATION_DEG
+
+
+# --------------------------------------------------------------------------- fabric spectra
+
+def dye_transmittance(preset) -> np.ndarray:
+    """T(l) of a preset's ``[dye] transmittance`` CSV on GRID_NM (edge values held), or 1."""
+    from catalog.spectra import read_spectrum  # noqa: PLC0415
+
+    rel = preset.table("dye").get("transmittance")
+    if rel is None:
+        return np.ones(GRID_NM.size)
+    spectrum = read_spectrum(preset.resolve(rel))
+    values = np.interp(GRID_NM, spectrum.wavelength_nm, spectrum.values)
+    if np.any(values > 1.0):
+        raise InputError("dye transmittance must lie in [0, 1]", path=spectrum.source,
+                         field="intensity")
+    return values
+
+
+@functools.lru_cache(maxsize=32)
+def _material_cached(excitation_path: str, emission_path: str, peak_absorptance: float,
+                     quantum_yield: float, saturation: float):
+    from catalog.fluorescence import material_from_spectra  # noqa: PLC0415
+    from catalog.spectra import read_spectrum  # noqa: PLC0415
+
+    return material_from_spectra(read_spectrum(excitation_path), read_spectrum(emission_path),
+                                 peak_absorptance=peak_absorptance, quantum_yield=quantum_yield,
+                                 saturation_photon_irradiance=saturation)
+
+
+def fluorescent_material(preset):
+    """The physical-mode material of a preset with a ``[fluorescence]`` table (else None)."""
+    from catalog import fluorescence as fl  # noqa: PLC0415
+
+    if preset.fluorescence is None:
+        return None
+    extra = preset.fluorescence.extra
+    for path in (preset.fluorescence.excitation, preset.fluorescence.emission):
+        if not path.is_file():
+            raise InputError("fluorescence spectrum file not found", path=path)
+    return _material_cached(str(preset.fluorescence.excitation), str(preset.fluorescence.emission),
+                            float(extra.get("peak_absorptance", fl.DEFAULT_PEAK_ABSORPTANCE)),
+                            float(extra.get("quantum_yield", fl.DEFAULT_QUANTUM_YIELD)),
+                            float(extra.get("saturation_photon_irradiance",
+                                            fl.DEFAULT_SATURATION_PHOTON_IRRADIANCE)))
+
+
+def paper_emission_shape(preset) -> np.ndarray:
+    """The emission Le on GRID_NM, 380-780 nm only (eq. 1), scaled so that sum ybar s dl = 1
+    (eq. 3's K / 100): F = 100 sum cmf s is the paper's fluorescence colour."""
+    from catalog.colorimetry import cmfs  # noqa: PLC0415
+    from catalog.spectra import VISIBLE_NM, read_spectrum  # noqa: PLC0415
+
+    emission = read_spectrum(preset.fluorescence.emission).resample(GRID_NM)
+    emission = np.where((GRID_NM >= VISIBLE_NM[0]) & (GRID_NM <= VISIBLE_NM[1]), emission, 0.0)
+    y = float(emission @ cmfs(GRID_NM)[:, 1])
+    if not y > 0:
+        raise InputError("emission has no luminance in 380-780 nm",
+                         path=preset.fluorescence.emission)
+    return emission / y
+
+
+# --------------------------------------------------------------------------- the light
+
+@dataclass(frozen=True)
+class FluorescenceDecision:
+    requested: str        # "off" | "paper" | "physical"
+    used: str             # the variant compiled
+    needed: bool | None   # fluorescence_needed's verdict (None: no brightener / not asked)
+    delta_e: float | None
+
+
+def decide_fluorescence(preset, irradiance: np.ndarray, requested: str) -> FluorescenceDecision:
+    """Which fluorescence variant a scene needs: none for a fabric without brightener, none
+    when the emission changes the lit cloth by less than Delta E 2000 0.1 under this light
+    (:func:`catalog.fluorescence.fluorescence_needed`; the same judgement for both modes)."""
+    from catalog.fluorescence import fluorescence_delta_e  # noqa: PLC0415
+
+    if requested not in ("off", "paper", "physical"):
+        raise CatalogError(f"fluorescence mode {requested!r}: choose off, paper or physical")
+    material = fluorescent_material(preset)
+    if requested == "off" or material is None:
+        return FluorescenceDecision(requested, "off", None, None)
+    delta_e = fluorescence_delta_e(material, irradiance)
+    needed = delta_e > 0.1
+    return FluorescenceDecision(requested, requested if needed else "off", needed, delta_e)
+
+
+def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.ndarray, *,
+                         is_sun: bool, fluorescence: str = "physical",
+                         viewer_inside: bool = True) -> tuple[ShadingInputs, FluorescenceDecision]:
+    """The spectral description of the scene's light on the curtain for a preset."""
+    from catalog.colorimetry import cmfs  # noqa: PLC0415
+    from catalog.fluorescence import absorbed_photon_irradiance, paper_intensity, photon_energy_j  # noqa: PLC0415
+
+    key = np.asarray(key_irradiance, dtype=np.float64)
+    to_light = np.asarray(key_to_light, dtype=np.float64)
+    to_light = to_light / np.linalg.norm(to_light)
+    tint = (550.0 / GRID_NM) ** 4 if is_sun else np.ones(GRID_NM.size)
+    sky = SKY_FRACTION * key * tint / math.pi
+    ground = GROUND_ALBEDO * key * max(to_light[1], 0.0) / math.pi
+    fill = FILL_FRACTION * key
+    room = ROOM_ALBEDO * ROOM_FRACTION * key / math.pi
+    disc = key / (math.pi * SUN_RADIUS_RAD ** 2)
+    chord2 = tuple((2 * math.sin(r / 2)) ** 2 for r in (0.9 * SUN_RADIUS_RAD, 1.1 * SUN_RADIUS_RAD))
+
+    btdf = preset.btdf
+    anisotropy = float(preset.raw.get("btdf", {}).get("anisotropy", 0.0))
+    if not -1.0 < anisotropy < 1.0:
+        raise InputError(f"{anisotropy:g} is out of range (-1, 1)", path=preset.path,
+                         field="btdf.anisotropy")
+    dye = dye_transmittance(preset)
+    behind = 0.5 * (sky + ground)  # mean radiance of the outside half-space
+    front = room
+    if not viewer_inside:
+        behind, front = front, behind
+    fwd_d, back_d = hg_hemisphere_factors(btdf.g_diff)
+    fwd_s, back_s = hg_hemisphere_factors(btdf.g_spec)
+    ambient = dye * (btdf.a_diff * (fwd_d * behind + back_d * front)
+                     + btdf.a_spec * (fwd_s * behind + back_s * front))
+
+    decision = decide_fluorescence(preset, key, fluorescence)
+    paper = None
+    absorbed = (0.0, 0.0, 0.0)
+    saturation = math.inf
+    emission_per_photon = None
+    if decision.used == "paper":
+        excitation = _excitation_on_grid(preset)
+        intensity = paper_intensity(key, excitation)  # eq. 4
+        white_y = float(key @ cmfs(GRID_NM)[:, 1]) / math.pi  # a white diffuser's Y (W-weighted)
+        paper = intensity * paper_emission_shape(preset) * white_y  # eq. 8: I_fluor F
+    elif decision.used == "physical":
+        material = fluorescent_material(preset)
+        ambient_irradiance = math.pi * (0.5 * (sky + ground) + room)  # both sides of the cloth
+        absorbed = (absorbed_photon_irradiance(material, key),
+                    absorbed_photon_irradiance(material, fill),
+                    absorbed_photon_irradiance(material, ambient_irradiance))
+        saturation = material.saturation_photon_irradiance
+        # M / pi shared by the two sides of a thin cloth: M / (2 pi) on each
+        emission_per_photon = (material.quantum_yield * material.emission_pdf_per_nm
+                               * photon_energy_j(GRID_NM) / (2 * math.pi))
+    inputs = ShadingInputs(
+        key_irradiance=key, key_to_light=to_light, fill_irradiance=fill,
+        fill_to_light=FILL_TO_LIGHT.copy(), sky_radiance=sky, ground_radiance=ground,
+        sun_disc_radiance=disc, room_radiance=room, sun_chord2=chord2,
+        direct=btdf.direct, a_diff=btdf.a_diff, g_diff=btdf.g_diff, a_spec=btdf.a_spec,
+        g_spec=btdf.g_spec, anisotropy=anisotropy, dye_transmittance=dye,
+        ambient_radiance=ambient, fluorescence_mode=decision.used, paper_radiance=paper,
+        absorbed_photons=absorbed, saturation_photons=saturation,
+        emission_per_photon=emission_per_photon)
+    return inputs, decision
+
+
+def _excitation_on_grid(preset) -> np.ndarray:
+    from catalog.spectra import read_spectrum  # noqa: PLC0415
+
+    return read_spectrum(preset.fluorescence.excitation, normalise=True).resample(GRID_NM)
