@@ -294,6 +294,87 @@ def hg_downward_fraction(cos_zenith: float, g: float, nodes: int = 48) -> float:
 DIFFUSIVITY = 1.66
 
 
+def eddington_layer(tau, omega, g, mu0, ground_albedo):
+    """Delta-Eddington two-stream solution for one homogeneous layer lit by a beam.
+
+    Joseph, Wiscombe & Weinman (1976), "The delta-Eddington approximation for radiative flux
+    transfer", J. Atmos. Sci. 33, 2452: the intensity is I0 + mu I1 (Eddington), the phase
+    function's forward peak (fraction g^2) is put back into the beam (delta scaling). Inputs
+    broadcast (one value per wavelength): vertical optical depth ``tau``, single-scattering
+    albedo ``omega``, asymmetry ``g``, beam cosine ``mu0``, Lambertian ``ground_albedo``.
+
+    Returns (diffuse down at the ground, diffuse up at the top), both per unit beam flux
+    through a surface normal to the beam, so the beam brings ``mu0`` per unit horizontal area.
+    Without absorption (omega = 1, albedo 0) up + diffuse down + direct mu0 e^(-tau/mu0)
+    = mu0: nothing is created or lost.
+    """
+    tau, omega, g, mu0 = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
+                                               for x in (tau, omega, g, mu0)))
+    # delta scaling (their eq. 2-4): f = g^2
+    f = g * g
+    tau_s = (1.0 - omega * f) * tau
+    omega_s = (1.0 - f) * omega / (1.0 - omega * f)
+    g_s = g / (1.0 + g)
+    # omega = 1 exactly makes k = 0 (a double root): a 1e-9 absorption changes nothing
+    # measurable and keeps the exponential solution
+    omega_s = np.minimum(omega_s, 1.0 - 1e-9)
+    k = np.sqrt(3.0 * (1.0 - omega_s) * (1.0 - omega_s * g_s))
+    p = k / (1.0 - omega_s * g_s)
+    # k mu0 = 1 is a removable singularity of the particular solution: step off it
+    mu0 = np.where(np.abs(1.0 - (k * mu0) ** 2) < 1e-6, mu0 * (1.0 + 1e-4), mu0)
+    f0 = 1.0 / math.pi  # beam flux pi F0 = 1
+    # particular solution I0 = -a e^(-t/mu0), I1 = -b e^(-t/mu0) of
+    # dI1/dt = 3 (1 - w) I0 - 3/4 w F0 e^(-t/mu0),  dI0/dt = (1 - w g) I1 + 3/4 w g mu0 F0 e^(-t/mu0)
+    a = 0.75 * omega_s * f0 * mu0 ** 2 * (1.0 + g_s - omega_s * g_s) / (1.0 - (k * mu0) ** 2)
+    b = -3.0 * (1.0 - omega_s) * mu0 * a - 0.75 * omega_s * f0 * mu0
+    e_k = np.exp(-k * tau_s)
+    e_beam = np.exp(-tau_s / mu0)
+    q = 2.0 * p / 3.0
+    alb = np.asarray(ground_albedo, dtype=np.float64)
+    # homogeneous part C1 e^(-kt) + C2 e^(k(t - tau)); fluxes pi (I0 -+ 2/3 I1)
+    # top: no diffuse light comes down; ground: up = albedo * (diffuse down + beam)
+    m11, m12 = 1.0 + q, e_k * (1.0 - q)
+    m21, m22 = e_k * ((1.0 - q) - alb * (1.0 + q)), (1.0 + q) - alb * (1.0 - q)
+    r1 = a - 2.0 * b / 3.0
+    r2 = (alb * mu0 * f0 + (a + 2.0 * b / 3.0) - alb * (a - 2.0 * b / 3.0)) * e_beam
+    det = m11 * m22 - m12 * m21
+    c1 = (r1 * m22 - m12 * r2) / det
+    c2 = (m11 * r2 - m21 * r1) / det
+    i0_ground = c1 * e_k + c2 - a * e_beam
+    i1_ground = -p * (c1 * e_k - c2) - b * e_beam
+    i0_top = c1 + c2 * e_k - a
+    i1_top = -p * (c1 - c2 * e_k) - b
+    down_scaled = math.pi * (i0_ground - 2.0 * i1_ground / 3.0)
+    up_top = math.pi * (i0_top + 2.0 * i1_top / 3.0)
+    # the scaled beam still carries the forward peak: hand it back to the diffuse light
+    forward_peak = mu0 * (e_beam - np.exp(-tau / mu0))
+    return down_scaled + forward_peak, up_top
+
+
+def _single_scattering_diffuse(slant_r, slant_a, cos_z, atm):
+    """Diffuse horizontal per unit beam flux, single scattering in a mixed layer, plus one
+    ground-sky bounce series (the "single" method of :func:`clear_sky`)."""
+    slant_ext = slant_r + slant_a
+    f_aer_down = hg_downward_fraction(round(cos_z, 6), atm.aerosol_asymmetry)
+    down_scat = 0.5 * slant_r + f_aer_down * atm.aerosol_albedo * slant_a
+    diffuse_sky = cos_z * -np.expm1(-slant_ext) * down_scat / slant_ext
+    return diffuse_sky
+
+
+def _sky_albedo_single(tau_r, tau_a, atm):
+    """The sky's reflectance for light going up from the ground (single scattering at the
+    diffusivity slant 1.66, the HG part scattered back down)."""
+    f_back = 1.0 - hg_downward_fraction(round(1.0 / DIFFUSIVITY, 6), atm.aerosol_asymmetry)
+    diff_r = DIFFUSIVITY * tau_r
+    diff_a = DIFFUSIVITY * tau_a
+    diff_ext = diff_r + diff_a
+    return -np.expm1(-diff_ext) * (0.5 * diff_r + f_back * atm.aerosol_albedo * diff_a) / diff_ext
+
+
+#: Skylight methods of :func:`clear_sky`.
+DIFFUSE_METHODS = ("delta-eddington", "single")
+
+
 @dataclass(frozen=True, eq=False)
 class ClearSky:
     """Clear-sky spectra on ``wavelength_nm`` (W m^-2 nm^-1)."""
@@ -324,6 +405,7 @@ class ClearSky:
 
 def clear_sky(zenith_deg: float | None = None, *, path_km: float | None = None,
               atmosphere: Atmosphere = Atmosphere(), earth_sun_factor: float = 1.0,
+              diffuse_method: str = "delta-eddington",
               grid_nm: np.ndarray = GRID_NM) -> ClearSky:
     """Direct and diffuse clear-sky spectra for a solar zenith (or a path in the 22 km shell).
 
@@ -335,19 +417,27 @@ def clear_sky(zenith_deg: float | None = None, *, path_km: float | None = None,
     shell at 22 km, the aerosol along the Kasten-Young air mass m_a, f the Earth-Sun
     distance factor (1 at 1 AU).
 
-    Diffuse horizontal (single scattering in a mixed layer, then one ground-sky bounce):
-    of the light the beam loses to scattering, (1 - T_ext) * tau_scat / tau_ext, the
-    Rayleigh part goes down with probability 1/2 and the aerosol part with the downward
-    fraction of its HG phase function (:func:`hg_downward_fraction`). The ozone (above the
-    scatterers) attenuates the incident beam first. The sky's albedo for the light the
-    ground reflects is the same single-scattering estimate for diffuse light going up
-    (diffusivity 1.66, upward fractions), and the ground-sky series sums to
-    E_g = (E_dn cos z + E_d) rho_g rho_s / (1 - rho_g rho_s).
-    """
-    from catalog.errors import CatalogError as _Err  # noqa: PLC0415 (same class, local name)
+    Diffuse horizontal: the ozone (stratospheric, above the scatterers) dims the beam
+    first; below it one homogeneous layer of air and aerosol (vertical optical depth
+    tau_R + tau_a, single-scattering albedo (tau_R + w_a tau_a) / tau, asymmetry
+    w_a tau_a g_a / (tau_R + w_a tau_a): Rayleigh's phase function has g = 0) over a
+    Lambertian ground scatters it. ``diffuse_method``:
 
+    - ``"delta-eddington"`` (default): :func:`eddington_layer`, multiple scattering and the
+      ground-sky bounces included. The beam enters at the effective cosine
+      mu = tau / (tau_R L/22 + tau_a m_a), the slant the shell gives it, so the sky stays
+      lit at sunset as a spherical atmosphere's does (pseudo-spherical);
+    - ``"single"``: single scattering in the mixed layer (half of the Rayleigh-scattered
+      light and the downward part of the aerosol's HG phase function reach the ground,
+      :func:`hg_downward_fraction`), and the ground-sky series
+      E_g = (E_dn cos z + E_d) rho_g rho_s / (1 - rho_g rho_s). Too bright in the UV,
+      where the sky is optically thick; kept for comparison.
+    """
     if (zenith_deg is None) == (path_km is None):
-        raise _Err("clear_sky: give exactly one of zenith_deg and path_km")
+        raise CatalogError("clear_sky: give exactly one of zenith_deg and path_km")
+    if diffuse_method not in DIFFUSE_METHODS:
+        raise CatalogError(f"clear_sky: diffuse_method {diffuse_method!r} is not one of "
+                           f"{', '.join(DIFFUSE_METHODS)}")
     if path_km is not None:
         path_km = float(path_km)
         zenith_deg = zenith_deg_from_path(path_km)
@@ -359,37 +449,26 @@ def clear_sky(zenith_deg: float | None = None, *, path_km: float | None = None,
     atm = atmosphere
     e0 = extraterrestrial_w_m2_nm(grid) * float(earth_sun_factor)
 
-    pressure_scale = atm.pressure_hpa / 1013.25
-    tau_r = rayleigh_optical_depth(grid) * pressure_scale          # vertical
-    tau_o3 = ozone_absorption_per_atm_cm(grid) * atm.ozone_atm_cm   # vertical
-    tau_a = aerosol_optical_depth(atm, grid)                        # vertical
-    m_r = path_km / LAYER_KM
-    m_o3 = ozone_slant_factor(zenith_deg, atm.ozone_height_km)
-    m_a = relative_airmass_kasten_young(zenith_deg)
+    tau_r = rayleigh_optical_depth(grid) * (atm.pressure_hpa / 1013.25)  # vertical
+    tau_o3 = ozone_absorption_per_atm_cm(grid) * atm.ozone_atm_cm        # vertical
+    tau_a = aerosol_optical_depth(atm, grid)                             # vertical
+    slant_r = tau_r * (path_km / LAYER_KM)
+    slant_a = tau_a * relative_airmass_kasten_young(zenith_deg)
+    beam_top = e0 * np.exp(-tau_o3 * ozone_slant_factor(zenith_deg, atm.ozone_height_km))
+    direct_normal = beam_top * np.exp(-(slant_r + slant_a))
 
-    t_o3 = np.exp(-tau_o3 * m_o3)
-    slant_r = tau_r * m_r
-    slant_a = tau_a * m_a
-    slant_ext = slant_r + slant_a
-    direct_normal = e0 * t_o3 * np.exp(-slant_ext)
-
-    # single scattering in the mixed layer, downward parts
-    f_aer_down = hg_downward_fraction(round(cos_z, 6), atm.aerosol_asymmetry)
-    down_scat = 0.5 * slant_r + f_aer_down * atm.aerosol_albedo * slant_a
-    lost = -np.expm1(-slant_ext)                                   # 1 - T_ext, exact near 0
-    diffuse_sky = e0 * cos_z * t_o3 * lost * down_scat / slant_ext
-
-    # the sky's albedo for diffuse light from the ground (upward fractions at mu = 1/1.66)
-    f_aer_up_back = 1.0 - hg_downward_fraction(round(1.0 / DIFFUSIVITY, 6), atm.aerosol_asymmetry)
-    diff_r = DIFFUSIVITY * tau_r
-    diff_a = DIFFUSIVITY * tau_a
-    diff_ext = diff_r + diff_a
-    sky_albedo = -np.expm1(-diff_ext) * (0.5 * diff_r + f_aer_up_back * atm.aerosol_albedo
-                                         * diff_a) / diff_ext
-    ground_global = direct_normal * cos_z + diffuse_sky
-    rho = atm.ground_albedo * sky_albedo
-    diffuse = diffuse_sky + ground_global * rho / (1.0 - rho)
-
+    if diffuse_method == "delta-eddington":
+        tau = tau_r + tau_a
+        scattering = tau_r + atm.aerosol_albedo * tau_a
+        mu_eff = tau / (slant_r + slant_a)
+        down, _ = eddington_layer(tau, scattering / tau,
+                                  atm.aerosol_albedo * tau_a * atm.aerosol_asymmetry / scattering,
+                                  mu_eff, atm.ground_albedo)
+        diffuse = beam_top * down
+    else:
+        diffuse_sky = beam_top * _single_scattering_diffuse(slant_r, slant_a, cos_z, atm)
+        rho = atm.ground_albedo * _sky_albedo_single(tau_r, tau_a, atm)
+        diffuse = diffuse_sky + (direct_normal * cos_z + diffuse_sky) * rho / (1.0 - rho)
     return ClearSky(grid, zenith_deg, path_km, direct_normal, diffuse, e0)
 
 
