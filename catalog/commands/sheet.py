@@ -1,0 +1,36 @@
+"""``catalog sheet``: every fabric under a set of lights, one image each and a grid."""
+
+from __future__ import annotations
+
+HELP = "contact sheet: every fabric x light as PNG images and one grid image"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--lights", required=True, help="comma-separated light names, e.g. D65,A,LED-B4,sun:22")
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--size", default="320x240", help="WIDTHxHEIGHT of each image")
+    parser.add_argument("--fabrics", default=None,
+                        help="comma-separated preset names or .toml paths (default: every fabrics/*.toml)")
+    parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
+    parser.add_argument("--mode", choices=("paper", "physical"), default="physical")
+    parser.add_argument("--bands", type=int, default=3)
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def run(args) -> int:
+    from pathlib import Path  # noqa: PLC0415
+
+    from catalog.jsonout import print_json  # noqa: PLC0415
+    from catalog.render.sheet import render_sheet  # noqa: PLC0415
+    from catalog.render.snapshot import parse_size  # noqa: PLC0415
+
+    lights = [name.strip() for name in args.lights.split(",") if name.strip()]
+    fabrics = None if args.fabrics is None else [f.strip() for f in args.fabrics.split(",") if f.strip()]
+    report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=fabrics,
+                          fluorescence="off" if args.no_fluorescence else args.mode,
+                          bands=args.bands, progress=not args.json)
+    if args.json:
+        print_json(report)
+    else:
+        print(f"wrote {len(report['images'])} images and {report['grid']}")
+    return 0

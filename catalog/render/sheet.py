@@ -1,0 +1,94 @@
+"""Contact sheets: every fabric under every light, one PNG per pair and a labelled grid.
+
+Rows are fabrics, columns lights. Everything is checked (fabrics, lights, size) before the
+first render, each image is written atomically, and the grid last.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from catalog.errors import CatalogError, InputError
+
+
+def _fabric_list(fabrics):
+    from catalog.presets import find_preset, list_presets, load_preset  # noqa: PLC0415
+
+    paths = list_presets() if fabrics is None else [find_preset(f) for f in fabrics]
+    if not paths:
+        raise InputError("no fabric presets found (fabrics/*.toml); run `catalog fit` first",
+                         field="--fabrics")
+    return [load_preset(p) for p in paths]
+
+
+def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fabrics=None,
+                 fluorescence: str = "physical", bands: int = 3, progress: bool = True,
+                 ctx=None) -> dict:
+    from catalog.lights import get_light  # noqa: PLC0415
+    from catalog.render import bands as band_lib  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.render.context import create_headless_context  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.snapshot import write_image  # noqa: PLC0415
+
+    if not lights:
+        raise InputError("give at least one light", field="--lights")
+    light_objects = [get_light(name) for name in lights]
+    presets = _fabric_list(fabrics)
+    for preset in presets:
+        scene_lib.dye_transmittance(preset)
+        scene_lib.fluorescent_material(preset)
+    band_lib.check_band_count(bands)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(f"{str(out_dir)!r} exists and is not a folder", field="--out")
+
+    ctx = ctx or create_headless_context()
+    renderer = FrameRenderer(ctx, size)
+    renderer.set_fluorescence(fluorescence)
+    renderer.set_bands(bands)
+    width, height = size
+    grid = np.zeros((height * len(presets), width * len(lights), 3), dtype=np.uint8)
+    images = []
+    pairs = [(i, preset, j, light) for i, preset in enumerate(presets)
+             for j, light in enumerate(light_objects)]
+
+    def work(advance):
+        for i, preset, j, light in pairs:
+            renderer.set_fabric(preset)
+            renderer.set_light(light)
+            renderer.render()
+            pixels = renderer.read_srgb8()
+            safe_light = "".join(c if c.isalnum() or c in "-._" else "_" for c in light.name)
+            path = out_dir / f"{preset.name}__{safe_light}.png"
+            info = renderer.info()
+            write_image(path, pixels, {"catalog:fabric": preset.name, "catalog:light": light.name,
+                                       "catalog:mode": info["mode"],
+                                       "catalog:fluorescence_variant": info["fluorescence_variant"]})
+            grid[i * height:(i + 1) * height, j * width:(j + 1) * width] = pixels
+            images.append({"fabric": preset.name, "light": light.name, "path": str(path),
+                           "fluorescence_variant": info["fluorescence_variant"]})
+            advance()
+
+    try:
+        if progress:
+            from rich.progress import Progress  # noqa: PLC0415
+
+            with Progress(transient=True) as bar:
+                task = bar.add_task("rendering", total=len(pairs))
+                work(lambda: bar.advance(task))
+        else:
+            work(lambda: None)
+    finally:
+        renderer.release()
+    grid_path = out_dir / "grid.png"
+    write_image(grid_path, grid, {
+        "ImageDescription": "rows: " + ", ".join(p.name for p in presets)
+                            + "; columns: " + ", ".join(l.name for l in light_objects),
+        "catalog:fabrics": ",".join(p.name for p in presets),
+        "catalog:lights": ",".join(l.name for l in light_objects)})
+    if not images:
+        raise CatalogError("nothing rendered")
+    return {"images": images, "grid": str(grid_path), "rows": [p.name for p in presets],
+            "columns": [l.name for l in light_objects], "size": list(size)}

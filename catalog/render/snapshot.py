@@ -1,0 +1,192 @@
+"""Headless snapshots: render a fabric under a light through EGL and write EXR or PNG.
+
+EXR holds the linear scene-referred radiance (float32, linear sRGB primaries, Y in
+cd m^-2); PNG the tone-mapped, sRGB-encoded display image (8 bit). Both carry the
+fabric, light and mode in their metadata, and are written atomically (a temporary file
+beside the target, renamed when complete), so an error leaves no partial image.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from catalog.errors import CatalogError, InputError
+
+IMAGE_SUFFIXES = (".exr", ".png")
+#: Frame step of the cloth simulation behind ``--frame N`` (s).
+FRAME_DT_S = 1.0 / 60.0
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``WxH`` -> (width, height), refused unless both are whole numbers >= 1."""
+    match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", str(text))
+    if match is None:
+        raise InputError(f"{text!r} is not WIDTHxHEIGHT in pixels (e.g. 1280x720)", field="--size")
+    width, height = int(match.group(1)), int(match.group(2))
+    from catalog.render.frame import MAX_SIDE_PX  # noqa: PLC0415
+
+    if not (1 <= width <= MAX_SIDE_PX and 1 <= height <= MAX_SIDE_PX):
+        raise InputError(f"{width}x{height} is impossible: each side must lie in 1..{MAX_SIDE_PX} px",
+                         field="--size")
+    return width, height
+
+
+def check_output(path: str | Path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() not in IMAGE_SUFFIXES:
+        raise InputError(f"{str(path)!r}: the image must end in .exr (linear) or .png (sRGB)",
+                         field="--out")
+    if path.exists() and path.is_dir():
+        raise InputError(f"{str(path)!r} is a folder", field="--out")
+    return path
+
+
+@dataclass(frozen=True)
+class SnapshotRequest:
+    fabric: str
+    light: str
+    size: tuple[int, int]
+    out: Path
+    frame: int = 0
+    fluorescence: str = "physical"    # "off" | "paper" | "physical"
+    bands: int = 3
+    hour: float | None = None
+    yaw_deg: float = 0.0
+    pitch_deg: float = 0.0
+    distance_m: float = 2.6
+    exposure: float = 1.0
+
+
+def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
+    """Write (H, W, 3) pixels with OpenImageIO, atomically: float32 -> EXR, uint8 -> PNG."""
+    import OpenImageIO as oiio  # noqa: PLC0415
+
+    from catalog.atomic import atomic_path  # noqa: PLC0415
+
+    height, width, channels = pixels.shape
+    kind = oiio.FLOAT if pixels.dtype == np.float32 else oiio.UINT8
+    spec = oiio.ImageSpec(width, height, channels, kind)
+    spec.channelnames = ("R", "G", "B")
+    for key, value in metadata.items():
+        spec.attribute(key, str(value))
+    with atomic_path(path) as tmp:
+        output = oiio.ImageOutput.create(str(tmp))
+        if output is None:
+            raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
+        ok = output.open(str(tmp), spec) and output.write_image(np.ascontiguousarray(pixels))
+        error = output.geterror()
+        output.close()
+        if not ok:
+            raise CatalogError(f"cannot write {path}: {error}")
+
+
+def read_metadata(path: str | Path) -> dict[str, str]:
+    """The string attributes of an image (to check what a snapshot recorded)."""
+    import OpenImageIO as oiio  # noqa: PLC0415
+
+    image = oiio.ImageInput.open(str(path))
+    if image is None:
+        raise CatalogError(f"cannot read {path}: {oiio.geterror()}")
+    spec = image.spec()
+    image.close()
+    return {attr.name: str(attr.value) for attr in spec.extra_attribs}
+
+
+def simulated_curtain(preset, frames: int):
+    """The cloth simulation after ``frames`` frames, moved onto the scene's rod."""
+    from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
+    from catalog.cloth.params import ClothParams  # noqa: PLC0415
+    from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    params = ClothParams.from_preset(preset)
+    simulation = ClothSimulation(params, backend="numpy")
+    simulation.run(frames, FRAME_DT_S)
+    mesh = CurtainMesh.from_grid(simulation.positions(), params)
+    offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - params.rod_y_m, scene_lib.CURTAIN_Z],
+                      dtype=np.float32)
+    return mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices
+
+
+def validate(request: SnapshotRequest):
+    """Everything that can be refused before a context exists: the preset, the light, the
+    size, the output name. Returns (preset, light)."""
+    from catalog.lights import get_light  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+    from catalog.render import bands as band_lib  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    check_output(request.out)
+    width, height = request.size
+    parse_size(f"{width}x{height}")
+    if request.frame < 0:
+        raise InputError(f"{request.frame} must be >= 0", field="--frame")
+    band_lib.check_band_count(request.bands)
+    preset = load_preset(find_preset(request.fabric))
+    scene_lib.dye_transmittance(preset)
+    scene_lib.fluorescent_material(preset)
+    light = get_light(request.light) if request.hour is None else None
+    return preset, light
+
+
+def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
+    """Render one image as asked and write it; returns a JSON-able report."""
+    import time  # noqa: PLC0415
+
+    from catalog.render.context import create_headless_context, describe  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    preset, light = validate(request)
+    ctx = ctx or create_headless_context()
+    renderer = FrameRenderer(ctx, request.size)
+    try:
+        renderer.set_fabric(preset)
+        sun = None
+        if request.hour is not None:
+            sun = renderer.set_sun_hour(request.hour)
+        else:
+            renderer.set_light(light)
+        renderer.set_fluorescence(request.fluorescence)
+        renderer.set_bands(request.bands)
+        renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
+        renderer.set_exposure(request.exposure)
+        mesh_source = "static drape"
+        if request.frame > 0:
+            renderer.set_mesh(*simulated_curtain(preset, request.frame))
+            mesh_source = f"cloth simulation, frame {request.frame}"
+        start = time.perf_counter()
+        renderer.render()
+        pixels = (renderer.read_linear() if request.out.suffix.lower() == ".exr"
+                  else renderer.read_srgb8())
+        render_s = time.perf_counter() - start
+        info = renderer.info()
+    finally:
+        renderer.release()
+    if not np.all(np.isfinite(pixels)):
+        raise CatalogError("the render has NaN or infinite pixels; nothing written")
+    metadata = {
+        "ImageDescription": f"catalog snapshot: {info['fabric']} under {info['light']}, "
+                            f"fluorescence {info['fluorescence_variant']}",
+        "catalog:fabric": info["fabric"],
+        "catalog:light": info["light"],
+        "catalog:mode": info["mode"],
+        "catalog:fluorescence_variant": info["fluorescence_variant"],
+        "catalog:bands": str(info["bands"]),
+        "catalog:frame": str(request.frame),
+        "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
+                             if request.out.suffix.lower() == ".exr"
+                             else "sRGB, Reinhard luminance tone map"),
+    }
+    write_image(request.out, pixels, metadata)
+    report = dict(info)
+    report.update({"out": str(request.out), "frame": request.frame, "mesh": mesh_source,
+                   "render_s": round(render_s, 4), "gl": describe(ctx),
+                   "mean_linear_rgb" if pixels.dtype == np.float32 else "mean_srgb8":
+                   [round(float(v), 4) for v in pixels.reshape(-1, 3).mean(axis=0)]})
+    if sun is not None:
+        report["sun"] = sun
+    return report
