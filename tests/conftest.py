@@ -27,3 +27,23 @@ def project_root() -> Path:
 @pytest.fixture(scope="session")
 def fabric_dir() -> Path:
     return FABRIC_DIR
+
+
+# --- GL (the renderer's tests; the only place a test creates a context) -----------------
+
+@pytest.fixture(scope="session")
+def gl_context():
+    """One headless OpenGL 4.3 context (EGL, Mesa llvmpipe in CI) shared by the GL tests."""
+    from catalog.render.context import create_headless_context
+
+    ctx = create_headless_context()
+    yield ctx
+    ctx.release()
+
+
+@pytest.fixture
+def gl(gl_context):
+    """The shared context, checked for no pending GL error before and after each test."""
+    assert gl_context.error == "GL_NO_ERROR", f"GL error pending before the test: {gl_context.error}"
+    yield gl_context
+    assert gl_context.error == "GL_NO_ERROR", f"GL error left by the test: {gl_context.error}"
