@@ -376,9 +376,11 @@ def paper_colour(emission: Spectrum) -> tuple[np.ndarray, np.ndarray]:
 def paper_intensity(irradiance_on_grid: np.ndarray, excitation_on_grid: np.ndarray) -> float:
     """Paper eq. 4: I = sum I_light I_exci / sum I_light over l = 380..780 nm at 1 nm.
 
-    Both arguments are sampled on GRID_NM. The excitation is normalised to a peak of 1 over
-    the whole grid first (its scale is arbitrary; model.md section 3). The result is
-    dimensionless and does not change when the light is scaled.
+    Both arguments are sampled on GRID_NM. The excitation must already be normalised to a
+    peak of 1 over its measured range, as ``read_spectrum(path, normalise=True)`` loads it
+    (formats.md), then resampled: its maximum on the grid may be below 1 when the measured
+    peak lies under 300 nm (Calcofluor White peaks at 254 nm), and one above 1 is refused as
+    not normalised. The result is dimensionless and does not change when the light is scaled.
     """
     irradiance = _irradiance_on_grid(irradiance_on_grid)
     excitation = _on_grid("excitation_on_grid", excitation_on_grid)
@@ -386,10 +388,13 @@ def paper_intensity(irradiance_on_grid: np.ndarray, excitation_on_grid: np.ndarr
         raise CatalogError("excitation_on_grid must be >= 0")
     peak = float(np.max(excitation))
     if not peak > 0:
-        raise CatalogError("excitation is zero everywhere; cannot normalise to a peak of 1")
+        raise CatalogError("excitation is zero everywhere on the grid")
+    if peak > 1.0 + 1e-9:
+        raise CatalogError(f"excitation_on_grid peaks at {peak:.6g}: normalise the excitation "
+                           "spectrum to a peak of 1 first (read_spectrum(..., normalise=True))")
     visible = _visible_mask()
     light = irradiance[visible]
     total = float(np.sum(light))
     if not total > 0:
         raise CatalogError("the light is zero over 380-780 nm: eq. 4 divides by zero")
-    return float(np.sum(light * excitation[visible] / peak) / total)  # eq. 4
+    return float(np.sum(light * excitation[visible]) / total)  # eq. 4
