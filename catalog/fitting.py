@@ -1,0 +1,449 @@
+"""Fitting eq. 7 (and the Cook-Torrance baseline) to gonio measurements.
+
+What the data can identify (model.md section 5): k_d, k_s, tau and rho enter eq. 7 only
+as the products a_diff = rho e^-tau k_d and a_spec = rho e^-tau k_s, so the fit is over
+
+    direct, a_diff, a_spec, g_diff, g_spec
+
+and rho (from the weave), tau (from the dye) are supplied, k_d and k_s derived
+(:func:`split_amplitudes`).
+
+Method. The model is linear in (direct, a_diff, a_spec) for fixed g's. A scan over a
+grid of (g_diff, g_spec) pairs solves the linear part exactly for each pair (variable
+projection) and keeps the best few pairs as starts; from each start Levenberg-Marquardt
+(scipy ``least_squares(method="lm")``, analytic Jacobian) first moves the two g's with
+the amplitudes projected out, then polishes all five parameters. The best end point
+wins, so the answer does not depend on an initial guess; a guess passed in is one more
+start. The g's are fitted through u (g = G_MID + G_HALF tanh u keeps
+g in (G_LOW, G_HIGH)), reported as g.
+
+Standard errors: cov = s^2 (J^T J)^-1, J the Jacobian of the weighted residuals at the
+optimum in the reported parameters, s^2 = sum r^2 / (n - p) (the noise level is
+estimated from the residuals).
+
+Weighting. The gonio ratio spans four decades (a peak of tens per steradian, a skirt of
+1e-4), and the two-exposure instrument's error is roughly relative, so the default
+(``"relative"``) weights each point by 1 / (y + floor), floor = 2 % of the median
+value. ``"none"`` is the paper's plain least squares. The reported ``rmse`` is always
+the plain root-mean-square difference on the points fitted (the paper's measure).
+
+scipy is imported inside the functions; the renderer never imports this module.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from catalog.btdf import (beckmann_d, beckmann_d_droughness, ct_geometry, ct_shadowing,
+                          hg_phase_dg, hg_phase_one_minus_cos)
+
+HG_NAMES = ("direct", "a_diff", "a_spec", "g_diff", "g_spec")
+CT_NAMES = ("direct", "k_lambert", "k_spec", "roughness")
+WEIGHTINGS = ("relative", "none")
+
+#: The Cook-Torrance scan's Beckmann roughness grid.
+SCAN_ROUGHNESS = np.geomspace(0.005, 2.0, 32)
+#: Starts taken from the scan.
+SCAN_STARTS = 3
+#: The g's are fitted as g = G_MID + G_HALF tanh(u): a transmitted lobe may lean back a
+#: little (g >= -0.9; further back it only mimics a constant floor with a huge weight)
+#: and be as sharp as g = 0.99999.
+G_LOW, G_HIGH = -0.9, 0.99999
+G_MID, G_HALF = 0.5 * (G_HIGH + G_LOW), 0.5 * (G_HIGH - G_LOW)
+#: Largest |u| the optimiser may reach.
+U_LIMIT = 12.0
+RELATIVE_FLOOR = 0.02
+
+
+def g_of_u(u):
+    return G_MID + G_HALF * np.tanh(u)
+
+
+def dg_du(u):
+    t = np.tanh(u)
+    return G_HALF * (1 - t * t)
+
+
+def u_of_g(g):
+    return np.arctanh(np.clip((np.asarray(g, dtype=np.float64) - G_MID) / G_HALF,
+                              -1 + 1e-12, 1 - 1e-12))
+
+
+#: The scan's g grid: uniform in u from g = -0.6 to g = 0.9995.
+SCAN_G = g_of_u(np.linspace(float(u_of_g(-0.6)), float(u_of_g(0.9995)), 24))
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """A fitted model: parameters with standard errors and the fit's figures."""
+
+    model: str                      # "hg" (eq. 7) or "cook-torrance"
+    params: dict[str, float]
+    stderr: dict[str, float]
+    rmse: float                     # plain RMS of model - data on the points fitted
+    weighted_rms: float             # RMS of the weighted residuals
+    points: int
+    iterations: int                 # residual evaluations of the winning start (LM)
+    evaluations: int                # ... summed over all starts
+    starts: int
+    time_s: float
+    weighting: str
+    predicted: np.ndarray = field(repr=False)
+    covariance: np.ndarray = field(repr=False)
+
+
+def noise_scale(values: np.ndarray, weighting: str = "relative") -> np.ndarray:
+    """Per-point scale s_i of the residuals (residual / s_i is minimised)."""
+    values = np.asarray(values, dtype=np.float64)
+    if weighting == "none":
+        return np.ones_like(values)
+    if weighting == "sqrt":
+        return np.sqrt(values + RELATIVE_FLOOR * float(np.median(values)))
+    if weighting != "relative":
+        raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {weighting!r}")
+    floor = RELATIVE_FLOOR * float(np.median(values))
+    if not floor > 0:
+        floor = RELATIVE_FLOOR * float(np.mean(values))
+    if not floor > 0:
+        raise ValueError("all values are zero: nothing to fit")
+    return values + floor
+
+
+def _covariance(jac: np.ndarray, residual: np.ndarray) -> np.ndarray:
+    n, p = jac.shape
+    dof = max(n - p, 1)
+    s2 = float(residual @ residual) / dof
+    jtj = jac.T @ jac
+    try:
+        return s2 * np.linalg.inv(jtj)
+    except np.linalg.LinAlgError:
+        return s2 * np.linalg.pinv(jtj)
+
+
+def _stderr(cov: np.ndarray) -> np.ndarray:
+    diag = np.diag(cov)
+    return np.sqrt(np.where(diag >= 0, diag, np.nan))
+
+
+# --- eq. 7 ----------------------------------------------------------------------------
+
+class _HGProblem:
+    """Weighted eq. 7 residuals over (direct, a_diff, a_spec, u_diff, u_spec)."""
+
+    def __init__(self, one_minus_cos, straight, values, scale):
+        self.omc = np.asarray(one_minus_cos, dtype=np.float64)
+        self.straight = np.asarray(straight, dtype=np.float64)
+        self.values = np.asarray(values, dtype=np.float64)
+        self.inv_scale = 1.0 / np.asarray(scale, dtype=np.float64)
+        self.target = self.values * self.inv_scale
+        self.evaluations = 0
+
+    def model(self, p):
+        direct, a_d, a_s, u_d, u_s = p
+        g_d, g_s = g_of_u(min(max(u_d, -U_LIMIT), U_LIMIT)), g_of_u(min(max(u_s, -U_LIMIT), U_LIMIT))
+        return (direct * self.straight + a_d * hg_phase_one_minus_cos(self.omc, g_d)
+                + a_s * hg_phase_one_minus_cos(self.omc, g_s))                     # eq. 7
+
+    def residual(self, p):
+        self.evaluations += 1
+        return self.model(p) * self.inv_scale - self.target
+
+    def jacobian(self, p):
+        direct, a_d, a_s, u_d, u_s = p
+        g_d, g_s = g_of_u(u_d), g_of_u(u_s)
+        cols = np.empty((len(self.omc), 5))
+        cols[:, 0] = self.straight
+        cols[:, 1] = hg_phase_one_minus_cos(self.omc, g_d)
+        cols[:, 2] = hg_phase_one_minus_cos(self.omc, g_s)
+        cols[:, 3] = a_d * hg_phase_dg(self.omc, g_d) * dg_du(u_d)
+        cols[:, 4] = a_s * hg_phase_dg(self.omc, g_s) * dg_du(u_s)
+        return cols * self.inv_scale[:, None]
+
+    def basis(self, g_d, g_s):
+        """Weighted columns of the linear part for fixed g's: (n, 3)."""
+        return np.stack([self.straight, hg_phase_one_minus_cos(self.omc, g_d),
+                         hg_phase_one_minus_cos(self.omc, g_s)], axis=1) * self.inv_scale[:, None]
+
+    def projected(self, u):
+        """Amplitudes solved exactly (non-negative least squares) for g(u):
+        (amplitudes, weighted residual)."""
+        self.evaluations += 1
+        u = np.clip(u, -U_LIMIT, U_LIMIT)
+        basis = self.basis(g_of_u(u[0]), g_of_u(u[1]))
+        amps = _nnls_small(basis.T @ basis, basis.T @ self.target)
+        return amps, basis @ amps - self.target
+
+
+def _nnls_small(gram: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Non-negative least squares for a few unknowns from the normal equations: the best
+    of the unconstrained solutions on every subset of free variables that is feasible."""
+    p = len(rhs)
+    best, best_value = np.zeros(p), 0.0          # objective relative to y.y: -2 a.b + a.G.a
+    ridge = 1e-12 * np.trace(gram)
+    for mask in range(1, 1 << p):
+        free = [i for i in range(p) if mask >> i & 1]
+        sub = gram[np.ix_(free, free)] + ridge * np.eye(len(free))
+        try:
+            a_free = np.linalg.solve(sub, rhs[free])
+        except np.linalg.LinAlgError:
+            continue
+        if np.any(a_free < 0):
+            continue
+        value = -float(a_free @ rhs[free])        # at a stationary point a.G.a = a.b
+        if value < best_value:
+            best_value = value
+            best = np.zeros(p)
+            best[free] = a_free
+    return best
+
+
+def _scan_hg(problem: _HGProblem, count: int) -> list[np.ndarray]:
+    """Best (direct, a_d, a_s, u_d, u_s) starts over the SCAN_G pair grid (g_d < g_s)."""
+    phases = hg_phase_one_minus_cos(problem.omc[None, :], SCAN_G[:, None])
+    columns = np.vstack([problem.straight[None, :], phases]) * problem.inv_scale[None, :]
+    gram = columns @ columns.T
+    rhs = columns @ problem.target
+    i, j = np.triu_indices(len(SCAN_G), k=1)
+    idx = np.stack([np.zeros_like(i), i + 1, j + 1], axis=1)          # (pairs, 3)
+    a = gram[idx[:, :, None], idx[:, None, :]]
+    b = rhs[idx]
+    a = a + 1e-12 * np.trace(a, axis1=1, axis2=2)[:, None, None] * np.eye(3)
+    amps = np.linalg.solve(a, b[..., None])[..., 0]
+    sse = problem.target @ problem.target - np.einsum("pi,pi->p", amps, b)
+    physical = np.all(amps >= 0, axis=1)
+    order = np.lexsort((sse, ~physical))                               # physical first
+    starts = []
+    for k in order[:count]:
+        starts.append(np.array([*amps[k], u_of_g(SCAN_G[i[k]]), u_of_g(SCAN_G[j[k]])]))
+    return starts
+
+
+def _lm(fun, x0, jac="2-point"):
+    from scipy.optimize import least_squares
+
+    return least_squares(fun, x0, jac=jac, method="lm", xtol=1e-10, ftol=1e-10, gtol=1e-10,
+                         max_nfev=1000)
+
+
+def _run_hg_start(problem: _HGProblem, start: np.ndarray,
+                  project_first: bool) -> tuple[np.ndarray, int]:
+    """One start: (for a guess from outside) LM on the g's with the amplitudes projected
+    out, then LM on all five parameters, holding at zero any amplitude that would go
+    negative (and the g of a lobe with no weight, which has no shape to fit)."""
+    before = problem.evaluations
+    x = np.array(start, dtype=np.float64)
+    if project_first:
+        u_fit = np.clip(_lm(lambda u: problem.projected(u)[1], x[3:]).x, -U_LIMIT, U_LIMIT)
+        x = np.concatenate([problem.projected(u_fit)[0], u_fit])
+    free = np.ones(5, dtype=bool)
+    for _ in range(4):
+        free[:3] &= x[:3] > 0
+        free[3] &= bool(free[1])
+        free[4] &= bool(free[2])
+        x[:3][~free[:3]] = 0.0
+        fixed = x.copy()
+
+        def residual(q, fixed=fixed, free=free.copy()):
+            full = fixed.copy()
+            full[free] = q
+            return problem.residual(full)
+
+        def jacobian(q, fixed=fixed, free=free.copy()):
+            full = fixed.copy()
+            full[free] = q
+            return problem.jacobian(full)[:, free]
+
+        x = fixed.copy()
+        x[free] = _lm(residual, fixed[free], jac=jacobian).x
+        if np.all(x[:3] >= 0):
+            break
+    x[:3] = np.maximum(x[:3], 0.0)
+    return x, problem.evaluations - before
+
+
+def _hg_start_from_guess(guess) -> np.ndarray:
+    if isinstance(guess, dict):
+        guess = [guess[name] for name in HG_NAMES]
+    guess = np.asarray(guess, dtype=np.float64)
+    if guess.shape != (5,):
+        raise ValueError(f"an eq. 7 start needs {HG_NAMES}, got {guess!r}")
+    return np.concatenate([guess[:3], u_of_g(guess[3:])])
+
+
+def fit_hg(one_minus_cos, straight, values, *, weighting: str = "relative", starts=(),
+           scan: bool = True) -> FitResult:
+    """Fit eq. 7 (direct, a_diff, a_spec, g_diff, g_spec) to ``values``.
+
+    ``one_minus_cos``: 1 - cos theta per point; ``straight``: where the direct
+    see-through reaches the camera; ``starts``: extra initial guesses (dicts keyed by
+    HG_NAMES or 5-sequences); ``scan=False`` uses only those.
+    """
+    t0 = time.perf_counter()
+    values = np.asarray(values, dtype=np.float64)
+    problem = _HGProblem(one_minus_cos, straight, values, noise_scale(values, weighting))
+    start_list = [(_hg_start_from_guess(s), True) for s in starts]
+    if scan:
+        start_list += [(s, False) for s in _scan_hg(problem, SCAN_STARTS)]
+    if not start_list:
+        raise ValueError("no start: pass starts or scan=True")
+    best, best_cost, best_evals = None, math.inf, 0
+    for start, project_first in start_list:
+        x, evals = _run_hg_start(problem, start, project_first)
+        x = _ordered_lobes(x)
+        cost = float(np.sum(problem.residual(x) ** 2))
+        physical = x[1] >= 0 and x[2] >= 0
+        key = (not physical, cost)
+        if best is None or key < best_key:
+            best, best_key, best_cost, best_evals = x, key, cost, evals
+    jac_u = problem.jacobian(best)
+    residual = problem.residual(best)
+    g = g_of_u(best[3:])
+    # Jacobian in the reported parameters: d/dg = d/du / (dg/du)
+    jac = jac_u.copy()
+    jac[:, 3:] /= dg_du(best[3:])[None, :]
+    cov = _covariance(jac, residual)
+    params = dict(zip(HG_NAMES, [float(v) for v in (*best[:3], *g)]))
+    predicted = problem.model(best)
+    return FitResult(model="hg", params=params,
+                     stderr=dict(zip(HG_NAMES, map(float, _stderr(cov)))),
+                     rmse=float(np.sqrt(np.mean((predicted - values) ** 2))),
+                     weighted_rms=float(np.sqrt(np.mean(residual ** 2))),
+                     points=len(values), iterations=best_evals,
+                     evaluations=problem.evaluations, starts=len(start_list),
+                     time_s=time.perf_counter() - t0, weighting=weighting,
+                     predicted=predicted, covariance=cov)
+
+
+def _ordered_lobes(x: np.ndarray) -> np.ndarray:
+    """Name the sharper lobe 'spec' (g_spec >= g_diff): the two lobes are interchangeable."""
+    x = np.array(x, dtype=np.float64)
+    x[3:] = np.clip(x[3:], -U_LIMIT, U_LIMIT)
+    if x[3] > x[4]:
+        x = x[[0, 2, 1, 4, 3]]
+    return x
+
+
+def fit_channels(one_minus_cos, straight, channel_values, g_diff: float, g_spec: float, *,
+                 weighting: str = "relative") -> list[dict[str, dict[str, float]]]:
+    """Per-channel (direct, a_diff, a_spec) with the shape (g's) of the grey fit.
+
+    Linear least squares per channel; returns, per channel, ``{"params": .., "stderr": ..}``.
+    """
+    out = []
+    channel_values = np.asarray(channel_values, dtype=np.float64)
+    for c in range(channel_values.shape[1]):
+        values = channel_values[:, c]
+        problem = _HGProblem(one_minus_cos, straight, values, noise_scale(values, weighting))
+        basis = problem.basis(g_diff, g_spec)
+        amps, *_ = np.linalg.lstsq(basis, problem.target, rcond=None)
+        residual = basis @ amps - problem.target
+        cov = _covariance(basis, residual)
+        predicted = basis @ amps / problem.inv_scale
+        out.append({"params": dict(zip(HG_NAMES[:3], map(float, amps))),
+                    "stderr": dict(zip(HG_NAMES[:3], map(float, _stderr(cov)))),
+                    "rmse": float(np.sqrt(np.mean((predicted - values) ** 2)))})
+    return out
+
+
+def split_amplitudes(a_diff: float, a_spec: float, rho: float, tau: float) -> tuple[float, float]:
+    """k_d, k_s from the identifiable products (a = rho e^-tau k, eq. 7)."""
+    if not (0 < rho <= 1):
+        raise ValueError(f"rho must lie in (0, 1], got {rho}")
+    scale = rho * math.exp(-tau)
+    return a_diff / scale, a_spec / scale
+
+
+# --- Cook-Torrance ----------------------------------------------------------------------
+
+class _CTProblem:
+    """Weighted Cook-Torrance residuals over (direct, k_lambert, k_spec, log m)."""
+
+    def __init__(self, to_light, view, straight, values, scale):
+        self.geometry = ct_geometry(to_light, view)
+        self.shadow = ct_shadowing(self.geometry)
+        self.lambert = self.geometry["cos_i"] / math.pi
+        self.spec_factor = self.shadow / (4 * self.geometry["cos_o"])
+        self.straight = np.asarray(straight, dtype=np.float64)
+        self.values = np.asarray(values, dtype=np.float64)
+        self.inv_scale = 1.0 / np.asarray(scale, dtype=np.float64)
+        self.target = self.values * self.inv_scale
+        self.evaluations = 0
+
+    def model(self, p):
+        direct, k_l, k_s, log_m = p
+        spec = beckmann_d(self.geometry["cos_h"], math.exp(log_m)) * self.spec_factor
+        return direct * self.straight + k_l * self.lambert + k_s * spec
+
+    def residual(self, p):
+        self.evaluations += 1
+        return self.model(p) * self.inv_scale - self.target
+
+    def jacobian(self, p):
+        direct, k_l, k_s, log_m = p
+        m = math.exp(log_m)
+        cols = np.empty((len(self.values), 4))
+        cols[:, 0] = self.straight
+        cols[:, 1] = self.lambert
+        cols[:, 2] = beckmann_d(self.geometry["cos_h"], m) * self.spec_factor
+        cols[:, 3] = k_s * beckmann_d_droughness(self.geometry["cos_h"], m) * self.spec_factor * m
+        return cols * self.inv_scale[:, None]
+
+
+def fit_cook_torrance(to_light, view, straight, values, *,
+                      weighting: str = "relative") -> FitResult:
+    """Fit the Cook-Torrance baseline (btdf module docstring) to the same data."""
+    t0 = time.perf_counter()
+    values = np.asarray(values, dtype=np.float64)
+    problem = _CTProblem(to_light, view, straight, values, noise_scale(values, weighting))
+    scans = []
+    for m in SCAN_ROUGHNESS:
+        p = np.array([0.0, 0.0, 0.0, math.log(m)])
+        basis = problem.jacobian(np.array([0.0, 0.0, 1.0, math.log(m)]))[:, :3]
+        amps, *_ = np.linalg.lstsq(basis, problem.target, rcond=None)
+        p[:3] = amps
+        scans.append((float(np.sum((basis @ amps - problem.target) ** 2)), p))
+    scans.sort(key=lambda item: item[0])
+    best, best_cost, best_evals = None, math.inf, 0
+    for _, start in scans[:SCAN_STARTS]:
+        before = problem.evaluations
+        x = _lm(problem.residual, start, jac=problem.jacobian).x
+        cost = float(np.sum(problem.residual(x) ** 2))
+        if cost < best_cost:
+            best, best_cost, best_evals = x, cost, problem.evaluations - before
+    residual = problem.residual(best)
+    m = math.exp(best[3])
+    jac = problem.jacobian(best)
+    jac[:, 3] /= m                       # d/dm = d/dlog m / m
+    cov = _covariance(jac, residual)
+    predicted = problem.model(best)
+    params = dict(zip(CT_NAMES, [float(best[0]), float(best[1]), float(best[2]), m]))
+    return FitResult(model="cook-torrance", params=params,
+                     stderr=dict(zip(CT_NAMES, map(float, _stderr(cov)))),
+                     rmse=float(np.sqrt(np.mean((predicted - values) ** 2))),
+                     weighted_rms=float(np.sqrt(np.mean(residual ** 2))),
+                     points=len(values), iterations=best_evals,
+                     evaluations=problem.evaluations, starts=min(SCAN_STARTS, len(scans)),
+                     time_s=time.perf_counter() - t0, weighting=weighting,
+                     predicted=predicted, covariance=cov)
+
+
+# --- on GonioData -----------------------------------------------------------------------
+
+def fit_gonio_hg(data, values=None, **kwargs) -> FitResult:
+    """:func:`fit_hg` on a :class:`catalog.gonio.GonioData` (its grey column by default)."""
+    return fit_hg(data.one_minus_cos, data.straight_through,
+                  data.transmittance if values is None else values, **kwargs)
+
+
+def fit_gonio_ct(data, values=None, **kwargs) -> FitResult:
+    return fit_cook_torrance(data.to_light, data.view, data.straight_through,
+                             data.transmittance if values is None else values, **kwargs)
+
+
+__all__ = ["FitResult", "HG_NAMES", "CT_NAMES", "fit_hg", "fit_cook_torrance",
+           "fit_channels", "fit_gonio_hg", "fit_gonio_ct", "split_amplitudes",
+           "noise_scale"]
