@@ -290,7 +290,7 @@ def test_relative_emission_does_not_change_with_the_light_level(lace_material):
     np.testing.assert_allclose(fl.emission_relative_srgb(lace_material, 20 * e),
                                fl.emission_relative_srgb(lace_material, e), rtol=bound)
     with pytest.raises(CatalogError, match="no visible part"):
-        fl.emission_relative_srgb(lace_material, np.where(GRID_NM < 370, 1.0, 0.0))
+        fl.emission_relative_srgb(lace_material, np.where(GRID_NM < 355, 1.0, 0.0))
 
 
 def test_material_validation(lace):
