@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     from catalog import FABRIC_DIR
     from catalog.errors import CatalogError
     from catalog.viewer.app import ViewerApp, ViewerOptions
-    from catalog.viewer.window import NO_DISPLAY_HINT, display_available
+    from catalog.viewer.window import NO_DISPLAY_HINT, display_available, init_glfw
 
     if args.screenshot is not None and args.frames is None:
         raise CatalogError("--screenshot needs --frames N (the S key saves screenshots "
@@ -90,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
     if not display_available():  # say so before any heavy import or preset read
         raise CatalogError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
                            + NO_DISPLAY_HINT)
+    init_glfw()  # a named display that cannot be opened: the same one line, exit 2
     fabric, fabric_dir = args.fabric, args.fabric_dir
     if fabric is not None and fabric.endswith(".toml"):  # a preset file: browse its folder
         path = Path(fabric)

@@ -156,7 +156,6 @@ class ViewerApp:
             if self.catalog.refresh():
                 self._applied.clear()  # a preset file changed: apply it again
             self._ensure_targets()
-            self._sync_renderers()
 
             now = time.perf_counter()
             if self.options.frames is not None:
@@ -164,6 +163,9 @@ class ViewerApp:
             else:
                 frame_dt = min(MAX_FRAME_DT_S, max(MIN_FRAME_DT_S, now - last_time))
             last_time = now
+
+            with self.timer.part("shading"):  # fabric/light/mode changes: band integrals
+                self._sync_renderers()
 
             with self.timer.part("simulation"):
                 self.scene.set_wind(self.settings.wind_m_s)
@@ -336,8 +338,9 @@ class ViewerApp:
             if applied.get("light") != light_key:
                 try:
                     if settings.light == SUN:
-                        renderer.set_sun_hour(settings.sun_hour)
+                        self._sun = renderer.set_sun_hour(settings.sun_hour)
                     else:
+                        self._sun = None
                         renderer.set_light(settings.light)
                     self.messages.pop("light", None)
                 except CatalogError as exc:
@@ -364,9 +367,18 @@ class ViewerApp:
 
     def _update_panel_info(self) -> None:
         info = self.panel_info
-        renderer_info = self._renderers[0].info() if self._renderers else {}
-        info.sun_path_km = renderer_info.get("sun_path_km")
-        info.sun_elevation_deg = renderer_info.get("sun_elevation_deg")
+        try:
+            renderer_info = self._renderers[0].info() if self._renderers else {}
+        except CatalogError:
+            renderer_info = {}
+        sun = getattr(self, "_sun", None)
+        info.sun_path_km = None if sun is None else sun["path_km"]
+        info.sun_elevation_deg = None if sun is None else 90.0 - sun["zenith_deg"]
+        if sun is None and self.settings.light.startswith("sun:"):
+            try:
+                info.sun_path_km = float(self.settings.light[4:])
+            except ValueError:
+                pass
         info.fluorescence_compiled = renderer_info.get("fluorescence_needed")
         info.messages = list(self.messages.values())
         info.last_screenshot = self.last_screenshot
@@ -434,4 +446,7 @@ class ViewerApp:
                   "other_ms": round(times.other_ms, 3)}
         if frame == 1:
             record["heavy_modules"] = heavy_modules_loaded()
+            record["fabric"] = self.catalog.entries[self.settings.fabric_index].name
+            record["light"] = self.settings.light_label
+            record["panel_errors"] = self.catalog.errors() + list(self.messages.values())
         print(json.dumps(record), flush=True)

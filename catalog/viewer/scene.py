@@ -7,6 +7,8 @@ same drape in another fabric, so the two differ by their optics alone.
 
 from __future__ import annotations
 
+import numpy as np
+
 from catalog.presets import Preset
 
 #: Rings' span when the curtain is open (fraction of the rest width; 1 = closed).
@@ -14,43 +16,62 @@ OPEN_FRACTION = 0.35
 
 
 class CurtainScene:
-    """Steps the cloth and hands its mesh to every renderer that draws it."""
+    """Steps the cloth and hands its mesh to every renderer that draws it.
+
+    The simulation starts with the first fabric (its ``[cloth]`` table sets the physics);
+    its coordinates (rod at ``rod_y_m``, curtain plane z = 0) are moved onto the renderer's
+    rod as ``catalog snapshot --frame N`` does, so both show the same curtain.
+    """
 
     def __init__(self, grid: tuple[int, int], backend: str = "cpu", wind_m_s: float = 0.0):
-        from catalog.cloth.params import ClothParams  # noqa: PLC0415
-        from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
-
-        self._params_type = ClothParams
         self.grid = grid
-        params = ClothParams(grid_w=grid[0], grid_h=grid[1], wind_speed_m_s=wind_m_s)
-        self.simulation = ClothSimulation(params, backend=backend)
+        self.backend = backend
+        self.wind_m_s = float(wind_m_s)
+        self.opening = 1.0
+        self.simulation = None
         self.preset_name: str | None = None
         self.mesh_version = 0  # bumped whenever the positions change
         self._uploaded: dict[int, int] = {}  # id(renderer) -> mesh_version it has
+        self._offset = None
 
     # -- controls ------------------------------------------------------------------
     def set_fabric(self, preset: Preset) -> None:
-        """Take the fabric's cloth parameters (keeps the motion: same grid, same state)."""
+        """Take the fabric's cloth parameters (a running cloth keeps its motion)."""
+        from catalog.cloth.params import ClothParams  # noqa: PLC0415
+
         if preset.name == self.preset_name:
             return
-        fabric = self._params_type.from_preset(preset)
-        self.simulation.set_params(areal_density_kg_m2=fabric.areal_density_kg_m2,
-                                   stretch_stiffness_n_m=fabric.stretch_stiffness_n_m,
-                                   bend_stiffness_n_m=fabric.bend_stiffness_n_m)
+        fabric = ClothParams.from_preset(preset, grid_w=self.grid[0], grid_h=self.grid[1],
+                                         wind_speed_m_s=self.wind_m_s, opening=self.opening)
+        if self.simulation is None:
+            from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
+            from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+            self.simulation = ClothSimulation(fabric, backend=self.backend)
+            self._offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - fabric.rod_y_m,
+                                     scene_lib.CURTAIN_Z], dtype=np.float32)
+            self.mesh_version += 1
+        else:
+            self.simulation.set_params(areal_density_kg_m2=fabric.areal_density_kg_m2,
+                                       stretch_stiffness_n_m=fabric.stretch_stiffness_n_m,
+                                       bend_stiffness_n_m=fabric.bend_stiffness_n_m)
         self.preset_name = preset.name
 
     def set_wind(self, speed_m_s: float) -> None:
-        if speed_m_s != self.simulation.params.wind_speed_m_s:
+        self.wind_m_s = float(speed_m_s)
+        if self.simulation is not None and speed_m_s != self.simulation.params.wind_speed_m_s:
             self.simulation.set_wind(speed_m_s)
 
     def set_open(self, is_open: bool) -> None:
-        fraction = OPEN_FRACTION if is_open else 1.0
-        if fraction != self.simulation.params.opening:
-            self.simulation.set_opening(fraction)
+        self.opening = OPEN_FRACTION if is_open else 1.0
+        if self.simulation is not None and self.opening != self.simulation.params.opening:
+            self.simulation.set_opening(self.opening)
 
     # -- per frame -----------------------------------------------------------------
     def step(self, frame_dt_s: float) -> bool:
         """Advance one frame; True when the cloth moved (False while it sleeps)."""
+        if self.simulation is None:
+            return False
         moved = self.simulation.step(frame_dt_s)
         if moved:
             self.mesh_version += 1
@@ -58,15 +79,20 @@ class CurtainScene:
 
     def feed(self, renderer) -> None:
         """Give ``renderer`` the current mesh if it has not got this version yet."""
+        if self.simulation is None:
+            return
         have = self._uploaded.get(id(renderer))
         if have == self.mesh_version:
             return
-        mesh = self.simulation.mesh()
+        from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
+
+        mesh = CurtainMesh.from_grid(self.simulation.positions(), self.simulation.params)
+        positions = mesh.positions + self._offset
         if have is None:
-            renderer.set_mesh(mesh.positions, mesh.normals, mesh.uv, mesh.tangents,
+            renderer.set_mesh(positions, mesh.normals, mesh.uv, mesh.tangents[:, :3],
                               mesh.indices)
         else:
-            renderer.update_positions(mesh.positions, mesh.normals)
+            renderer.update_positions(positions, mesh.normals)
         self._uploaded[id(renderer)] = self.mesh_version
 
     def forget(self, renderer) -> None:

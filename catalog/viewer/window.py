@@ -43,21 +43,32 @@ class GlfwErrors:
         return self.messages[-1] if self.messages else "no reason given"
 
 
-def open_window(size: tuple[int, int], title: str, visible: bool = True):
-    """Initialise glfw and open a window with an OpenGL 4.3 core context made current.
+#: glfw's error messages of this process (the last one explains a failure).
+GLFW_ERRORS = GlfwErrors()
 
-    Returns ``(glfw module, window)``. No display, or glfw failing to start, raises
-    :class:`NoDisplayError` with one line that names the headless commands instead.
-    """
+
+def init_glfw():
+    """Start glfw on the display; the glfw module. Raises :class:`NoDisplayError`
+    (one line naming the headless commands) when there is no display or glfw cannot open it.
+    Calling it again is harmless (glfw.init is idempotent)."""
     if not display_available():
         raise NoDisplayError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
                              + NO_DISPLAY_HINT)
     import glfw  # noqa: PLC0415  (the window's module, imported only by the viewer)
 
-    errors = GlfwErrors()
-    glfw.set_error_callback(errors)
+    glfw.set_error_callback(GLFW_ERRORS)
     if not glfw.init():
-        raise NoDisplayError(f"cannot open the display ({errors.last()}): " + NO_DISPLAY_HINT)
+        raise NoDisplayError(f"cannot open the display ({GLFW_ERRORS.last()}): "
+                             + NO_DISPLAY_HINT)
+    return glfw
+
+
+def open_window(size: tuple[int, int], title: str, visible: bool = True):
+    """Open a window with an OpenGL 4.3 core context made current (glfw started here).
+
+    Returns ``(glfw module, window)``; failures are :class:`NoDisplayError` lines.
+    """
+    glfw = init_glfw()
     glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, GL_VERSION[0])
     glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, GL_VERSION[1])
     glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
@@ -68,6 +79,6 @@ def open_window(size: tuple[int, int], title: str, visible: bool = True):
     if not window:
         glfw.terminate()
         raise NoDisplayError(f"cannot open an OpenGL {GL_VERSION[0]}.{GL_VERSION[1]} window "
-                             f"({errors.last()}): " + NO_DISPLAY_HINT)
+                             f"({GLFW_ERRORS.last()}): " + NO_DISPLAY_HINT)
     glfw.make_context_current(window)
     return glfw, window
