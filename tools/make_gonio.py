@@ -80,7 +80,7 @@ class YarnFabric:
 
     name: str
     display_name: str
-    weave: str
+    weave: str                   # a weave of catalog.cloth.params.WEAVE_DEFAULTS
     warp_diameter_mm: float
     warp_spacing_mm: float
     weft_diameter_mm: float
@@ -126,33 +126,33 @@ DYES = {
 }
 
 CATALOG: tuple[YarnFabric, ...] = (
-    YarnFabric("lace-fwa", "White lace, brightened", "leno", 0.16, 0.40, 0.14, 0.36, 0.22,
+    YarnFabric("lace-fwa", "White lace, brightened", "lace", 0.16, 0.40, 0.14, 0.36, 0.22,
                crossings=3.0, albedo=0.93, sigma_x_deg=7.5, sigma_y_deg=6.0, seed=101),
-    YarnFabric("voile-white", "White voile", "plain", 0.12, 0.26, 0.12, 0.25, 0.16,
+    YarnFabric("voile-white", "White voile", "voile", 0.12, 0.26, 0.12, 0.25, 0.16,
                crossings=2.5, albedo=0.92, sigma_x_deg=7.5, sigma_y_deg=6.5, seed=102),
     YarnFabric("linen-dense", "Dense linen", "plain", 0.42, 0.46, 0.45, 0.48, 0.55,
                crossings=7.0, albedo=0.90, sigma_x_deg=11.0, sigma_y_deg=9.0, back_scale=3.0,
-               seed=103),
-    YarnFabric("sheer-teal", "Teal sheer", "plain", 0.11, 0.25, 0.11, 0.24, 0.15,
+               seed=103, cloth={"areal_density_kg_m2": 0.19}),
+    YarnFabric("sheer-teal", "Teal sheer", "voile", 0.11, 0.25, 0.11, 0.24, 0.15,
                crossings=2.8, albedo=0.95, sigma_x_deg=7.5, sigma_y_deg=6.5, dye="teal",
                seed=104),
-    YarnFabric("safety-yellow", "Fluorescent safety yellow mesh", "leno", 0.20, 0.45, 0.20,
+    YarnFabric("safety-yellow", "Fluorescent safety yellow mesh", "lace", 0.20, 0.45, 0.20,
                0.45, 0.26, crossings=3.5, albedo=0.94, sigma_x_deg=8.0, sigma_y_deg=8.0,
                dye="yellow", seed=105),
-    YarnFabric("fluoro-pink", "Fluorescent pink voile", "plain", 0.13, 0.27, 0.13, 0.26,
+    YarnFabric("fluoro-pink", "Fluorescent pink voile", "voile", 0.13, 0.27, 0.13, 0.26,
                0.17, crossings=2.8, albedo=0.94, sigma_x_deg=8.0, sigma_y_deg=7.0,
                dye="pink", seed=106),
-    YarnFabric("organza-ivory", "Ivory organza", "plain", 0.06, 0.14, 0.06, 0.13, 0.08,
+    YarnFabric("organza-ivory", "Ivory organza", "voile", 0.06, 0.14, 0.06, 0.13, 0.08,
                crossings=1.6, albedo=0.97, sigma_x_deg=7.0, sigma_y_deg=6.0, dye="ivory",
-               seed=107),
+               seed=107, cloth={"areal_density_kg_m2": 0.03}),
     YarnFabric("batiste-cream", "Cream batiste", "plain", 0.14, 0.19, 0.14, 0.19, 0.18,
                crossings=4.5, albedo=0.93, sigma_x_deg=8.5, sigma_y_deg=7.5, seed=108),
-    YarnFabric("net-grey", "Grey net", "net", 0.10, 0.50, 0.10, 0.50, 0.14,
+    YarnFabric("net-grey", "Grey net", "lace", 0.10, 0.50, 0.10, 0.50, 0.14,
                crossings=3.0, albedo=0.95, sigma_x_deg=9.0, sigma_y_deg=9.0, dye="grey",
-               seed=109),
-    YarnFabric("jacquard-white", "White jacquard", "jacquard", 0.30, 0.34, 0.28, 0.31, 0.45,
+               seed=109, cloth={"areal_density_kg_m2": 0.035}),
+    YarnFabric("jacquard-white", "White jacquard", "satin", 0.30, 0.34, 0.28, 0.31, 0.45,
                crossings=6.0, albedo=0.93, sigma_x_deg=10.0, sigma_y_deg=7.0,
-               back_scale=3.5, seed=110),
+               back_scale=3.5, seed=110, cloth={"areal_density_kg_m2": 0.26}),
 )
 
 
@@ -307,7 +307,7 @@ def header_comments(fabric: YarnFabric) -> tuple[str, ...]:
         f"yarn: warp {fabric.warp_diameter_mm} mm at {fabric.warp_spacing_mm} mm, "
         f"weft {fabric.weft_diameter_mm} mm at {fabric.weft_spacing_mm} mm",
         f"seed: {fabric.seed}",
-    ]
+    ] + [f"cloth.{key}: {value}" for key, value in sorted(fabric.cloth.items())]
     if fabric.dye is not None:
         lines.append("dye: dye.csv (spectral transmittance); r,g,b: camera channels")
     return tuple(lines)
