@@ -494,7 +494,7 @@ def earth_sun_factor(when) -> float:
     import pandas as pd  # noqa: PLC0415
     from pvlib.irradiance import get_extra_radiation  # noqa: PLC0415
 
-    return float(get_extra_radiation(pd.Timestamp(when).dayofyear, method="spencer",
+    return float(get_extra_radiation(pd.Timestamp(when).day_of_year, method="spencer",
                                      solar_constant=1.0))
 
 
