@@ -47,3 +47,35 @@ def gl(gl_context):
     assert gl_context.error == "GL_NO_ERROR", f"GL error pending before the test: {gl_context.error}"
     yield gl_context
     assert gl_context.error == "GL_NO_ERROR", f"GL error left by the test: {gl_context.error}"
+
+
+@pytest.fixture
+def make_preset(tmp_path):
+    """Write a hand-made preset TOML into tmp_path (never into fabrics/) and return its path.
+
+    ``fluorescent=True`` points [fluorescence] at fabrics/measurements/lace-fwa's spectra;
+    ``dye`` = a list of (wavelength_nm, transmittance) rows writes a [dye] CSV beside it.
+    """
+    def make(name="lace-test", *, fluorescent=True, dye=None, extra_btdf="", **btdf):
+        values = {"direct": 0.05, "k_d": 0.7, "k_s": 0.5, "tau": 0.25, "rho": 0.8,
+                  "g_diff": 0.2, "g_spec": 0.97}
+        values.update(btdf)
+        lines = ["schema = 1", f'name = "{name}"', f'display_name = "{name}"', "[btdf]"]
+        lines += [f"{k} = {v!r}" for k, v in values.items()]
+        if extra_btdf:
+            lines.append(extra_btdf)
+        if fluorescent:
+            folder = FABRIC_DIR / "measurements" / "lace-fwa"
+            lines += ["[fluorescence]", "xyz = [33.0, 100.0, 1700.0]", "rgb = [39.0, -52.0, 1790.0]",
+                      f'excitation = "{folder / "excitation.csv"}"',
+                      f'emission = "{folder / "emission.csv"}"']
+        if dye is not None:
+            dye_path = tmp_path / f"{name}-dye.csv"
+            dye_path.write_text("wavelength_nm,intensity\n"
+                                + "".join(f"{w},{t}\n" for w, t in dye))
+            lines += ["[dye]", f'transmittance = "{dye_path}"']
+        path = tmp_path / f"{name}.toml"
+        path.write_text("\n".join(lines) + "\n")
+        return path
+
+    return make
