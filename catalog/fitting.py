@@ -328,10 +328,14 @@ def _ordered_lobes(x: np.ndarray) -> np.ndarray:
 
 
 def fit_channels(one_minus_cos, straight, channel_values, g_diff: float, g_spec: float, *,
+                 direct: float | None = None,
                  weighting: str = "relative") -> list[dict[str, dict[str, float]]]:
     """Per-channel (direct, a_diff, a_spec) with the shape (g's) of the grey fit.
 
-    Linear least squares per channel; returns, per channel, ``{"params": .., "stderr": ..}``.
+    ``direct`` given: the see-through of the gaps is colourless, so every channel keeps
+    that value (its standard error reported as 0) and only a_diff, a_spec are fitted.
+    Linear least squares per channel; returns, per channel,
+    ``{"params": .., "stderr": .., "rmse": ..}``.
     """
     out = []
     channel_values = np.asarray(channel_values, dtype=np.float64)
@@ -339,12 +343,18 @@ def fit_channels(one_minus_cos, straight, channel_values, g_diff: float, g_spec:
         values = channel_values[:, c]
         problem = _HGProblem(one_minus_cos, straight, values, noise_scale(values, weighting))
         basis = problem.basis(g_diff, g_spec)
-        amps, *_ = np.linalg.lstsq(basis, problem.target, rcond=None)
-        residual = basis @ amps - problem.target
-        cov = _covariance(basis, residual)
-        predicted = basis @ amps / problem.inv_scale
+        target = problem.target
+        if direct is not None:
+            target = target - direct * basis[:, 0]
+            basis = basis[:, 1:]
+        amps = _nnls_small(basis.T @ basis, basis.T @ target)
+        residual = basis @ amps - target
+        errors = _stderr(_covariance(basis, residual))
+        if direct is not None:
+            amps, errors = np.concatenate([[direct], amps]), np.concatenate([[0.0], errors])
+        predicted = problem.model(np.array([*amps, u_of_g(g_diff), u_of_g(g_spec)]))
         out.append({"params": dict(zip(HG_NAMES[:3], map(float, amps))),
-                    "stderr": dict(zip(HG_NAMES[:3], map(float, _stderr(cov)))),
+                    "stderr": dict(zip(HG_NAMES[:3], map(float, errors))),
                     "rmse": float(np.sqrt(np.mean((predicted - values) ** 2)))})
     return out
 

@@ -126,7 +126,8 @@ def fit_measurement(data, weighting: str) -> dict:
     channels = None
     if data.rgb is not None:
         channels = fit_channels(data.one_minus_cos, data.straight_through, data.rgb,
-                                hg.params["g_diff"], hg.params["g_spec"], weighting=weighting)
+                                hg.params["g_diff"], hg.params["g_spec"],
+                                direct=hg.params["direct"], weighting=weighting)
     return {"hg": hg, "ct": ct, "channels": channels}
 
 

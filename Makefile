@@ -1,0 +1,16 @@
+# Fabric presets from the measurement sets (issue 3). Python from the project's virtualenv.
+PYTHON ?= .venv/bin/python
+
+.PHONY: presets measurements fit-table
+
+# Regenerate every fabrics/*.toml with `catalog fit` (deterministic output).
+presets:
+	$(PYTHON) tools/make_presets.py
+
+# Regenerate the gonio measurement sets (and dye spectra) from the yarn-level model.
+measurements:
+	$(PYTHON) tools/make_gonio.py
+
+# The per-fabric HG vs Cook-Torrance error table of docs/fit.md.
+fit-table:
+	$(PYTHON) tools/make_presets.py --table docs/fit-table.md
