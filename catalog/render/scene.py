@@ -42,6 +42,8 @@ CURTAIN_WIDTH_M = 1.7
 CURTAIN_HEIGHT_M = 2.2
 
 SUN_RADIUS_RAD = math.radians(0.2666)
+#: Paper mode: F (Y = 100) is read in 8-bit levels of a white at 255 (Table 2's units).
+PAPER_F_PER_WHITE = 1.0 / 255.0
 SKY_FRACTION = 0.12
 GROUND_ALBEDO = 0.2
 FILL_FRACTION = 0.04
@@ -321,7 +323,9 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         excitation = _excitation_on_grid(preset)
         intensity = paper_intensity(key, excitation)  # eq. 4
         white_y = float(key @ cmfs(GRID_NM)[:, 1]) / math.pi  # a white diffuser's Y (W-weighted)
-        paper = intensity * paper_emission_shape(preset) * white_y  # eq. 8: I_fluor F
+        # eq. 8: I_fluor F_c. Its scale is arbitrary (model.md section 6); Table 2 reads as
+        # 8-bit levels, so F (Y = 100) is taken in units of a white at 255: F / 255 x white
+        paper = intensity * PAPER_F_PER_WHITE * 100.0 * paper_emission_shape(preset) * white_y
     elif decision.used == "physical":
         material = fluorescent_material(preset)
         ambient_irradiance = math.pi * (0.5 * (sky + ground) + room)  # both sides of the cloth
