@@ -242,19 +242,19 @@ def bin_irradiance(centres_nm: np.ndarray, irradiance_w_m2_nm: np.ndarray,
                    grid_nm: np.ndarray = GRID_NM, width_nm: float = 10.0) -> np.ndarray:
     """Mean spectral irradiance over each bin [c - w/2, c + w/2], W m^-2 nm^-1.
 
-    The integral is the trapezoid rule of the (piecewise-linear) light on ``grid_nm``; a
-    bin that sticks out of the grid (300 and 780 nm on GRID_NM) is averaged over the part
-    the grid covers (the light is unknown, not zero, outside it).
+    The integral is the trapezoid rule of the (piecewise-linear) light on ``grid_nm``,
+    divided by the full bin width. The light is zero outside the grid, as everywhere in
+    the project (spectra.resample), so the bins at 300 and 780 nm, half outside GRID_NM,
+    hold half of what a flat light gives: the exact result then sees the same light as
+    the physical mode, which integrates over the grid only.
     """
     grid_nm = np.asarray(grid_nm, dtype=np.float64)
     light = np.asarray(irradiance_w_m2_nm, dtype=np.float64)
     cumulative = np.concatenate(([0.0], np.cumsum(0.5 * (light[1:] + light[:-1]) * np.diff(grid_nm))))
     lower = np.clip(np.asarray(centres_nm) - width_nm / 2, grid_nm[0], grid_nm[-1])
     upper = np.clip(np.asarray(centres_nm) + width_nm / 2, grid_nm[0], grid_nm[-1])
-    covered = upper - lower
     integral = np.interp(upper, grid_nm, cumulative) - np.interp(lower, grid_nm, cumulative)
-    with np.errstate(invalid="ignore", divide="ignore"):  # empty bins give 0 below
-        return np.where(covered > 0, integral / np.where(covered > 0, covered, 1.0), 0.0)
+    return integral / width_nm
 
 
 def render_exact(matrix: DonaldsonMatrix, irradiance_w_m2_nm: np.ndarray) -> np.ndarray:

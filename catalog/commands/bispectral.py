@@ -1,0 +1,86 @@
+"""``catalog bispectral FILE.BFC``: the separable fit of a measured Donaldson matrix and the
+colour error (Delta E 2000) of each fluorescence model against the exact matrix result.
+
+FILE is a BFC-450 matrix file, or the name of one in ../shared/data/bispectral (``CIBA12``).
+``--export DIR`` writes excitation.csv, emission.csv and reflectance.csv there, so the
+measured material can become a catalog fabric (docs/bispectral.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+HELP = "fit a bispectral (Donaldson) matrix and show the colour error of each fluorescence model"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", metavar="FILE.BFC",
+                        help="a BFC-450 matrix file, or a name in ../shared/data/bispectral (CIBA12)")
+    parser.add_argument("--lights", metavar="NAME,NAME..",
+                        help="lights of the Delta E table (default: D65,A,FL2,FL11,LED-B4,UV-A,"
+                             "sun:22,sun:500)")
+    parser.add_argument("--export", metavar="DIR",
+                        help="write excitation.csv, emission.csv, reflectance.csv into DIR")
+    parser.add_argument("--json", action="store_true", help="print one JSON object instead")
+
+
+def run(args: argparse.Namespace) -> int:
+    from catalog import bispectral, bispectral_study as study
+    from catalog.errors import InputError
+    from catalog.lights import get_light
+
+    path = bispectral.find_bfc(args.file)
+    matrix = bispectral.read_bfc(path)
+    lights = study.STUDY_LIGHTS
+    if args.lights:
+        lights = tuple(name.strip() for name in args.lights.split(",") if name.strip())
+        if not lights:
+            raise InputError("no light named", field="--lights")
+        for name in lights:
+            get_light(name)  # refuses an unknown name, listing close ones
+    fit = bispectral.fit_separable(matrix)
+    models = study.prepare(matrix, fit)
+    # eq. 8's one-k scale is set on the eight reference matrices plus this one
+    reference = [m for m in study.reference_models() if m.matrix.name != matrix.name]
+    models = study.with_global_paper_scale(reference + [models])[-1]
+    rows = study.study_material(models, lights)
+    exported = {}
+    if args.export:
+        exported = {k: str(v) for k, v in bispectral.to_fabric_measurements(matrix, args.export, fit).items()}
+
+    fit_info = {"yield_absorptance": fit.yield_absorptance, "quantum_yield": fit.quantum_yield,
+                "peak_absorptance": fit.peak_absorptance,
+                "excitation_peak_nm": fit.excitation_peak_nm,
+                "emission_peak_nm": fit.emission_peak_nm, "rank1_residual": fit.rank1_residual,
+                "residual_over_noise": fit.residual_over_noise, "noise_sigma": fit.noise_sigma,
+                "notes": list(fit.notes)}
+    if args.json:
+        from catalog.jsonout import print_json
+
+        print_json({"file": str(path), "name": matrix.name, "description": matrix.description,
+                    "shape": list(matrix.values.shape), "fit": fit_info,
+                    "paper_scale": models.paper_scale,
+                    "paper_scale_global": models.paper_scale_global,
+                    "delta_e_2000": rows, "methods": list(study.METHODS),
+                    "diagnostics": list(study.DIAGNOSTICS), "exported": exported})
+        return 0
+
+    print(f"{matrix.name}: {matrix.description} ({path})")
+    print(f"  matrix {matrix.values.shape[0]} emission x {matrix.values.shape[1]} excitation, "
+          f"noise sigma {fit.noise_sigma:.2g}")
+    print(f"  separable fit: phi x a_peak = {fit.yield_absorptance:.3f} "
+          f"(phi = {fit.quantum_yield:.3f}, a_peak = {fit.peak_absorptance:.3f}), "
+          f"excitation peak {fit.excitation_peak_nm:.0f} nm, emission peak "
+          f"{fit.emission_peak_nm:.0f} nm")
+    print(f"  rank-1 residual {fit.rank1_residual:.3f} relative, "
+          f"{fit.residual_over_noise:.2f} x noise sigma")
+    for note in fit.notes:
+        print(f"  note: {note}")
+    columns = study.METHODS + study.DIAGNOSTICS
+    print("\n  Delta E 2000 against the exact matrix result")
+    print("  " + f"{'light':<9}" + "".join(f"{c[:14]:>15}" for c in columns))
+    for row in rows:
+        print("  " + f"{row['light']:<9}" + "".join(f"{row[c]:>15.2f}" for c in columns))
+    for name, file in exported.items():
+        print(f"  wrote {name}: {file}")
+    return 0
