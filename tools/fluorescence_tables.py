@@ -83,6 +83,21 @@ def _rgb_to_xyz_exact(rgb: np.ndarray) -> np.ndarray:
     return np.linalg.solve(forward, np.asarray(rgb, dtype=np.float64))
 
 
+def material_rows() -> list[dict]:
+    """Delta E 2000 of each fluorescent fabric's emission on its own white-lit cloth."""
+    rows = []
+    for fabric in FABRIC_PARAMETERS:
+        material, excitation, emission = fabric_material(fabric)
+        xyz, rgb = fl.paper_colour(emission)
+        row = {"fabric": fabric, **FABRIC_PARAMETERS[fabric],
+               "paper_rgb": "(" + ", ".join(f"{v:.0f}" for v in rgb) + ")"}
+        for name in INTENSITY_LIGHTS:
+            e = get_light(name).irradiance_w_m2_nm
+            row[name] = fl.fluorescence_delta_e(material, e, WHITE_CLOTH)
+        rows.append(row)
+    return rows
+
+
 def carry_errors(material: fl.FluorescentMaterial, irradiance: np.ndarray,
                  background: float) -> dict[str, float]:
     """Delta E 2000 of each carry method against the exact spectral colour.
@@ -153,13 +168,18 @@ def main(argv: list[str] | None = None) -> int:
     gamut = gamut_rows()
     print("## Which lights need a fluorescence term (lace-fwa, QY 0.6, peak absorptance 0.5)\n")
     print(_markdown(intensity, [
-        ("light", "light", ""), ("illuminance_lx", "lx", ",.0f"),
+        ("light", "light", ""), ("illuminance_lx", "lx", ".4g"),
         ("uva_fraction", "UV-A share", ".3f"),
         ("paper_intensity", "paper I (eq. 4)", ".4g"),
         ("absorbed_photons_m2_s", "absorbed photons m^-2 s^-1", ".3g"),
         ("emitted_exitance_w_m2", "emitted W m^-2", ".3g"),
         ("luminance_ratio", "emission / white (Y)", ".3g"),
         ("delta_e_2000", "Delta E 2000", ".3g"), ("needed", "needed", "")]))
+    print("\n## Delta E 2000 of the emission on a white-lit cloth, per fabric and light\n")
+    print(_markdown(material_rows(), [
+        ("fabric", "fabric", ""), ("quantum_yield", "QY", "g"),
+        ("peak_absorptance", "peak absorptance", "g"), ("paper_rgb", "F (eq. 2)", ""),
+        *[(name, name, ".3g") for name in INTENSITY_LIGHTS]]))
     print("\n## Carrying the emission colour: Delta E 2000 against the exact spectral colour\n")
     print(_markdown(gamut, [
         ("material", "material", ""), ("background", "background", ""), ("light", "light", ""),
