@@ -383,3 +383,35 @@ def test_carry_methods():
         np.testing.assert_allclose(fl.carry_emission_rgb(inside, method), inside, rtol=1e-15)
     with pytest.raises(CatalogError, match="unknown carry method"):
         fl.carry_emission_rgb(rgb, "magic")
+
+
+# ------------------------------------------------------------------- property: conservation
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+def _bump(center, width, grid=GRID_NM):
+    return np.exp(-0.5 * ((grid - center) / width) ** 2)
+
+
+@settings(max_examples=60, deadline=None)
+@given(ex_center=st.floats(300, 700), ex_width=st.floats(3, 80),
+       em_center=st.floats(380, 780), em_width=st.floats(3, 80),
+       peak_absorptance=st.floats(0.01, 1.0), quantum_yield=st.floats(0.0, 1.0),
+       log_n_sat=st.floats(14, 30), light_center=st.floats(300, 780),
+       light_width=st.floats(2, 300), log_level=st.floats(-6, 6))
+def test_emitted_photons_never_exceed_absorbed_for_any_material_and_light(
+        ex_center, ex_width, em_center, em_width, peak_absorptance, quantum_yield, log_n_sat,
+        light_center, light_width, log_level):
+    excitation = Spectrum(GRID_NM, _bump(ex_center, ex_width))
+    emission = Spectrum(GRID_NM, _bump(em_center, em_width))
+    material = fl.material_from_spectra(excitation, emission, peak_absorptance=peak_absorptance,
+                                        quantum_yield=quantum_yield,
+                                        saturation_photon_irradiance=10.0 ** log_n_sat)
+    light = 10.0 ** log_level * _bump(light_center, light_width)
+    absorbed = fl.absorbed_photon_irradiance(material, light)
+    emitted = _photons_in(fl.emitted_exitance_w_m2_nm(material, light))
+    assert emitted <= absorbed * (1 + 1e-12)
+    assert emitted <= quantum_yield * material.saturation_photon_irradiance * (1 + 1e-12)
+    assert np.all(material.absorptance <= 1.0)
