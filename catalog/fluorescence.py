@@ -27,7 +27,6 @@ Only numpy is imported here at module level; colour-science comes in lazily thro
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
