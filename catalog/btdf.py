@@ -26,9 +26,13 @@ sum of non-negative terms keeps full relative precision::
     phase = (1 - g) * (1 + g) / (4 * pi * d * sqrt(d))         # eq. 6
 
 For g >= 0 both terms of ``d`` are >= 0, so there is no cancellation at all. For
-g < 0 the mirror case (a backward peak, theta -> pi, g -> -1) would cancel the same way;
-woven cloth scatters forward (fitted g_diff is at most slightly negative), and in float64
-the loss there is ~1e-8 relative at g = -0.9999, so one form serves both signs.
+g < 0 the mirror case (a backward peak, theta -> pi, g -> -1) cancels the same way, and
+the mirrored form keeps it exact (used by :func:`hg_phase_between`, which has the
+vectors; shaders/common.glsl does the same)::
+
+    one_plus_cos = 0.5 * dot(travel + view, travel + view)    # = 1 + cos theta, exact
+    d = (1 + g) * (1 + g) - 2 * g * one_plus_cos               # g < 0
+
 ``d * sqrt(d)`` replaces ``pow(d, 1.5)``
 (one rounding instead of exp/log). ``1 - cos theta`` must come from the vectors: taking
 it as ``1 - dot(travel, view)`` re-introduces the cancellation.
@@ -107,8 +111,17 @@ def hg_phase(cos_theta, g):
 
 
 def hg_phase_between(travel: np.ndarray, view: np.ndarray, g):
-    """Eq. 6 for the light's direction of travel and the view direction (unit vectors)."""
-    return hg_phase_one_minus_cos(one_minus_cos_between(travel, view), g)
+    """Eq. 6 for the light's direction of travel and the view direction (unit vectors,
+    last axis 3): the forward robust form for g >= 0, the mirrored one for g < 0."""
+    _check_g(g)
+    travel, view = np.asarray(travel), np.asarray(view)
+    one_minus_cos = one_minus_cos_between(travel, view)
+    total = travel + view
+    one_plus_cos = 0.5 * np.einsum("...i,...i->...", total, total)
+    one_plus_g = 1 + g
+    d = np.where(np.asarray(g) >= 0, hg_denominator(one_minus_cos, g),
+                 one_plus_g * one_plus_g - 2 * g * one_plus_cos)
+    return (1 - g) * (1 + g) / (FOUR_PI * d * np.sqrt(d))  # eq. 6
 
 
 def hg_phase_printed(cos_theta, g):
