@@ -369,7 +369,7 @@ def test_table_tool_prints_markdown_and_json(tmp_path):
     doc = tmp_path / "doc.md"
     doc.write_text("intro\n<!-- bispectral-table:begin -->\nold\n<!-- bispectral-table:end -->\nend\n")
     result = subprocess.run([sys.executable, str(PROJECT_ROOT / "tools" / "bispectral_table.py"),
-                             "--json", str(out), "--update-doc", str(doc)],
+                             "--json", str(out), "--update-doc", str(doc), "--noise-draws", "2"],
                             capture_output=True, text=True, check=True)
     assert "| (c) physical |" in result.stdout
     payload = json.loads(out.read_text())
@@ -377,6 +377,7 @@ def test_table_tool_prints_markdown_and_json(tmp_path):
     text = doc.read_text()
     assert text.startswith("intro\n") and text.endswith("end\n") and "old" not in text
     assert "### Per matrix and light" in text
+    assert set(payload["noise_floor"]) == set(study.STUDY_LIGHTS)
 
 
 def test_command_json_and_export(tmp_path, capsys):

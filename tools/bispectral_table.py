@@ -89,10 +89,30 @@ def _rows_table(rows, study) -> list[str]:
     return lines
 
 
-def build_markdown(models, rows, study) -> str:
+def _noise_table(models, study, draws: int) -> tuple[list[str], dict]:
+    import numpy as np
+
+    lines = [f"Noise floor of the data: the exact colour's Delta E 2000 when the off-diagonal "
+             f"noise (each matrix's own sigma) is re-drawn, {draws} draws x 8 matrices per light:",
+             "", "| light | median | 95th percentile | max |", "|---|---|---|---|"]
+    result = {}
+    for light_name in study.STUDY_LIGHTS:
+        light = study.light_irradiance(light_name)
+        values = np.concatenate([study.noise_floor(m.matrix, light, m.fit.noise_sigma, draws,
+                                                   seed=i) for i, m in enumerate(models)])
+        result[light_name] = {"median": float(np.median(values)),
+                              "p95": float(np.percentile(values, 95)), "max": float(values.max())}
+        r = result[light_name]
+        lines.append(f"| {light_name} | {r['median']:.2f} | {r['p95']:.2f} | {r['max']:.2f} |")
+    return lines, result
+
+
+def build_markdown(models, rows, study, noise_lines=()) -> str:
     parts = ["### Separable fit of each matrix", ""] + _fit_table(models)
     parts += ["", "### Delta E 2000 against the exact matrix result: summary", ""]
     parts += _summary_table(rows, study) + [""] + _goal_lines(rows, study)
+    if noise_lines:
+        parts += [""] + list(noise_lines)
     parts += ["", "### Per matrix and light", ""] + _rows_table(rows, study)
     return "\n".join(parts) + "\n"
 
@@ -101,6 +121,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", metavar="FILE", help="also write the rows and summaries as JSON")
     parser.add_argument("--update-doc", metavar="MD", help="replace the generated part of this file")
+    parser.add_argument("--noise-draws", type=int, default=30, metavar="N",
+                        help="draws per matrix and light of the noise-floor table (0: skip)")
     args = parser.parse_args(argv)
 
     from catalog import bispectral_study as study
@@ -108,7 +130,8 @@ def main(argv: list[str] | None = None) -> int:
 
     models = study.reference_models()
     rows = [row for m in models for row in study.study_material(m, study.STUDY_LIGHTS)]
-    markdown = build_markdown(models, rows, study)
+    noise_lines, noise = _noise_table(models, study, args.noise_draws) if args.noise_draws > 0 else ([], {})
+    markdown = build_markdown(models, rows, study, noise_lines)
     sys.stdout.write(markdown)
     if args.json:
         payload = {"rows": rows,
@@ -124,6 +147,7 @@ def main(argv: list[str] | None = None) -> int:
                              "residual_over_noise": m.fit.residual_over_noise,
                              "paper_scale": m.paper_scale,
                              "paper_scale_global": m.paper_scale_global} for m in models],
+                   "noise_floor": noise,
                    "goal": {"mean": study.GOAL_MEAN, "max": study.GOAL_MAX},
                    "state_of_the_art": study.STATE_OF_THE_ART}
         write_text_atomic(args.json, json.dumps(payload, indent=1) + "\n")
