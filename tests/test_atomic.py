@@ -31,3 +31,14 @@ def test_failure_leaves_no_file_and_keeps_the_old_one(tmp_path):
             raise RuntimeError("boom")
     assert target.read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["image.png"]
+
+
+def test_written_file_is_readable_by_others(tmp_path):
+    import os
+    import stat
+
+    target = tmp_path / "preset.toml"
+    write_text_atomic(target, "x = 1\n")
+    umask = os.umask(0)
+    os.umask(umask)
+    assert stat.S_IMODE(target.stat().st_mode) == 0o666 & ~umask
