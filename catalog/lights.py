@@ -262,8 +262,8 @@ def _sun_clear_light(name: str, path_km: float) -> Light:
         raise InputError(f"{exc} (sun-clear needs a path the sun can have; 'sun:PATH_KM' "
                          "takes any)", field=f"light {name!r}") from None
     description = (f"clear sky, sun at zenith {sky.zenith_deg:.1f} deg ({path_km:g} km "
-                   f"through the 22 km shell): direct + skylight + ground on a plane facing "
-                   f"the sun; ozone {atmosphere.ozone_atm_cm:g} atm-cm, aerosol "
+                   f"through the 22 km shell): direct + skylight (delta-Eddington) + ground "
+                   f"on a plane facing the sun; ozone {atmosphere.ozone_atm_cm:g} atm-cm, aerosol "
                    f"{atmosphere.aod_500nm:g} at 500 nm, absolute")
     return _make(name, description, sky.sun_facing(atmosphere.ground_albedo))
 
@@ -295,7 +295,7 @@ def _sun_at_light(name: str, spec: str) -> Light:
                     earth_sun_factor=position.earth_sun_factor)
     description = (f"clear sky at {position.when_utc} UTC, {lat:g} N {lon:g} E: zenith "
                    f"{position.zenith_deg:.1f} deg, path {position.path_km:.0f} km; direct + "
-                   "skylight + ground on a plane facing the sun, absolute")
+                   "skylight (delta-Eddington) + ground on a plane facing the sun, absolute")
     return _make(name, description, sky.sun_facing(atmosphere.ground_albedo))
 
 

@@ -28,7 +28,7 @@ import math
 import numpy as np
 
 from catalog.spectra import GRID_NM
-from catalog.sun import Atmosphere, clear_sky, relative_airmass_kasten_young
+from catalog.sun import LAYER_KM, Atmosphere, clear_sky, relative_airmass_kasten_young
 
 #: The zenith angles of the comparison (deg).
 ZENITHS_DEG = (0.0, 30.0, 60.0, 75.0, 85.0)
@@ -50,8 +50,11 @@ def _band_average(values_on_grid: np.ndarray, centres_nm: np.ndarray) -> np.ndar
     return out
 
 
-def spectrl2_clear_sky(zenith_deg: float, atmosphere: Atmosphere) -> dict[str, np.ndarray]:
+def spectrl2_clear_sky(zenith_deg: float, atmosphere: Atmosphere,
+                       relative_airmass: float | None = None) -> dict[str, np.ndarray]:
     """pvlib's SPECTRL2 at ``zenith_deg`` for a horizontal plane, 1 AU, no water vapour.
+
+    ``relative_airmass``: Kasten & Young's (as the NREL code uses) unless given.
 
     Returns ``wavelength`` (nm), ``dni``, ``ghi``, ``dhi``, ``et`` (W m^-2 nm^-1) in 300-780 nm.
     """
@@ -61,7 +64,8 @@ def spectrl2_clear_sky(zenith_deg: float, atmosphere: Atmosphere) -> dict[str, n
         apparent_zenith=np.array([zenith_deg]), aoi=np.array([zenith_deg]),
         surface_tilt=np.array([0.0]), ground_albedo=atmosphere.ground_albedo,
         surface_pressure=atmosphere.pressure_hpa * 100.0,
-        relative_airmass=np.array([relative_airmass_kasten_young(zenith_deg)]),
+        relative_airmass=np.array([relative_airmass_kasten_young(zenith_deg)
+                                   if relative_airmass is None else relative_airmass]),
         precipitable_water=np.array([0.0]), ozone=np.array([atmosphere.ozone_atm_cm]),
         aerosol_turbidity_500nm=np.array([atmosphere.aod_500nm]),
         dayofyear=np.array([1]), scattering_albedo_400nm=atmosphere.aerosol_albedo,
@@ -89,10 +93,19 @@ def _rel_rms(ours: np.ndarray, ref: np.ndarray) -> float:
     return float(np.sqrt(np.mean(((ours - ref) / ref) ** 2)))
 
 
-def compare_at_zenith(zenith_deg: float, atmosphere: Atmosphere = Atmosphere()) -> dict:
-    """One row of the comparison (see the module docstring for the measures)."""
-    ref = spectrl2_clear_sky(zenith_deg, atmosphere)
-    ours = clear_sky(zenith_deg, atmosphere=atmosphere)
+def compare_at_zenith(zenith_deg: float, atmosphere: Atmosphere = Atmosphere(),
+                      diffuse_method: str = "delta-eddington",
+                      spectrl2_airmass: str = "kasten-young") -> dict:
+    """One row of the comparison (see the module docstring for the measures).
+
+    ``spectrl2_airmass="shell"`` runs SPECTRL2 with our air mass (path / 22 km) instead of
+    Kasten & Young's, to separate the geometry from the rest of the model.
+    """
+    ours = clear_sky(zenith_deg, atmosphere=atmosphere, diffuse_method=diffuse_method)
+    if spectrl2_airmass not in ("kasten-young", "shell"):
+        raise ValueError(f"spectrl2_airmass {spectrl2_airmass!r}: 'kasten-young' or 'shell'")
+    airmass = ours.path_km / LAYER_KM if spectrl2_airmass == "shell" else None
+    ref = spectrl2_clear_sky(zenith_deg, atmosphere, airmass)
     wl = ref["wavelength"]
     keep = ~np.isin(wl, MIXED_GAS_NM)
     wl = wl[keep]
@@ -115,6 +128,7 @@ def compare_at_zenith(zenith_deg: float, atmosphere: Atmosphere = Atmosphere()) 
     }
 
 
-def comparison_table(zeniths_deg=ZENITHS_DEG, atmosphere: Atmosphere = Atmosphere()) -> list[dict]:
+def comparison_table(zeniths_deg=ZENITHS_DEG, atmosphere: Atmosphere = Atmosphere(),
+                     diffuse_method: str = "delta-eddington") -> list[dict]:
     """:func:`compare_at_zenith` for each zenith angle."""
-    return [compare_at_zenith(z, atmosphere) for z in zeniths_deg]
+    return [compare_at_zenith(z, atmosphere, diffuse_method) for z in zeniths_deg]

@@ -106,8 +106,10 @@ def _plot(path: str, lights: list, model: str) -> None:
     ax.set_ylim(bottom=0.0)
     ax.grid(alpha=0.3)
     ax.legend(title="path", fontsize=8)
-    fig.text(0.01, 0.01, "ASTM G173 extraterrestrial (pvlib); Rayleigh tau from Bodhaine "
-             "et al. 1999 over L / 22 km", fontsize=6, color="0.4")
+    source = "ASTM G173 extraterrestrial (pvlib); Rayleigh tau (Bodhaine et al. 1999) x L / 22 km"
+    if model == "clear":
+        source += "; ozone, aerosol (Angstrom), delta-Eddington skylight"
+    fig.text(0.01, 0.01, source, fontsize=6, color="0.4")
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp)
