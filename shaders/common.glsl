@@ -1,7 +1,7 @@
 // common.glsl: the physical terms of model.md, one small function per term.
 // Included by every pass (catalog/render/shaderlib.py resolves #include and injects
 // #defines: N_BANDS, NV4 = ceil(N_BANDS / 4), FLUORESCENCE_OFF | FLUORESCENCE_PAPER |
-// FLUORESCENCE_PHYSICAL, SEE_THROUGH, GBUFFER). Band quantities travel as vec4 chunks.
+// FLUORESCENCE_PHYSICAL, SEE_THROUGH, ANISOTROPIC, GBUFFER). Band quantities travel as vec4 chunks.
 // The float64 twin of every function is in catalog/reference.py.
 
 #ifndef CATALOG_COMMON_GLSL
@@ -43,7 +43,11 @@ float woven_transmission(vec3 to_light, vec3 to_viewer, vec3 t, vec3 b, vec3 n,
     float chord2 = dot(delta, delta);
     float anti2 = dot(sum, sum);
     float ph_diff = hg_phase_robust(chord2, anti2, g_diff);                       // eq. 6
+#ifdef ANISOTROPIC
     float ph_spec = hg_phase_robust(woven_chord2(delta, t, b, n, anisotropy), anti2, g_spec);
+#else
+    float ph_spec = hg_phase_robust(chord2, anti2, g_spec);                       // eq. 6
+#endif
     return abs(dot(n, to_light)) * (a_diff * ph_diff + a_spec * ph_spec);      // eq. 5, 7
 }
 
@@ -68,12 +72,14 @@ vec4 fluorescence_physical(float effective_photons, vec4 emission_band) {
 // (sky, ground, sun disc, room) for a ray direction; the outside lies towards -z.
 // The disc edge uses the chord |dir - sun|^2, not 1 - cos (float32 resolves it).
 vec4 background_weights(vec3 dir, vec3 to_sun, float sun_chord2_inner, float sun_chord2_outer) {
-    if (dir.z >= 0.0) {
-        return vec4(0.0, 0.0, 0.0, 1.0);
-    }
+    // branch-free (a CPU rasteriser runs fragments in SIMD lanes): outside = dir.z < 0,
+    // above = dir.y >= 0
+    float outside = 1.0 - step(0.0, dir.z);
+    float above = step(0.0, dir.y);
     vec3 d = dir - to_sun;
     float disc = 1.0 - smoothstep(sun_chord2_inner, sun_chord2_outer, dot(d, d));
-    return (dir.y >= 0.0) ? vec4(1.0, 0.0, disc, 0.0) : vec4(0.0, 1.0, 0.0, 0.0);
+    float sky = outside * above;
+    return vec4(sky, outside - sky, sky * disc, 1.0 - outside);
 }
 
 // Reinhard, Stark, Shirley, Ferwerda 2002, "Photographic tone reproduction", eq. 4 (extended,

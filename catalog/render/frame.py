@@ -248,7 +248,8 @@ class FrameRenderer:
         inputs = self.shading_inputs()
         defines = {"N_BANDS": self.n_bands, "NV4": band_lib.chunks(self.n_bands),
                    f"FLUORESCENCE_{inputs.fluorescence_mode.upper()}": True,
-                   "SEE_THROUGH": inputs.direct > 0, "GBUFFER": gbuffer}
+                   "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
+                   "GBUFFER": gbuffer}
         return defines
 
     def _program(self, vertex: str, fragment: str, defines: dict | None = None):

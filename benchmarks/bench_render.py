@@ -1,0 +1,202 @@
+"""Frame time of the curtain shader variants against a trivial shader on the same mesh.
+
+    .venv/bin/python benchmarks/bench_render.py [--size 1280x720] [--repeats 7] [--draws 5]
+        [--fabric NAME_OR_TOML] [--json OUT.json] [--quick]
+
+For each variant (fluorescence off/paper/physical, see-through on/off, 3/6/9/16 bands) the
+curtain pass is drawn ``draws`` times into the 1280x720 RGBA32F target (clear + draw, then
+glFinish), ``repeats`` times; the table gives the median time per draw and its ratio to the
+trivial shader (same vertex shader, mesh, target and depth test: the rasteriser's floor),
+then the whole frame (background, room, curtain, tone map). It also reports the Delta E 2000
+of each band count against the 1 nm float64 reference (catalog.reference) on a small frame.
+The goal of issue 4: the full RGB shader at most 1.3x the trivial one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from catalog import FABRIC_DIR  # noqa: E402
+
+FALLBACK_PRESET = """schema = 1
+name = "bench-lace"
+display_name = "bench lace (hand-written)"
+[btdf]
+direct = 0.012
+k_d = 0.7
+k_s = 0.5
+tau = 0.25
+rho = 0.8
+g_diff = 0.2
+g_spec = 0.97
+[fluorescence]
+xyz = [33.0, 100.0, 1700.0]
+rgb = [39.0, -52.0, 1790.0]
+excitation = "{folder}/excitation.csv"
+emission = "{folder}/emission.csv"
+"""
+
+
+def bench_preset(name: str | None) -> str:
+    if name is not None:
+        return name
+    real = FABRIC_DIR / "lace-fwa.toml"
+    if real.exists():
+        return str(real)
+    path = Path(tempfile.mkdtemp()) / "bench-lace.toml"
+    path.write_text(FALLBACK_PRESET.format(folder=FABRIC_DIR / "measurements" / "lace-fwa"))
+    return str(path)
+
+
+def time_draws(ctx, draw, repeats: int, draws: int) -> float:
+    """Median seconds per draw over ``repeats`` batches of ``draws`` (each batch finished)."""
+    draw()
+    ctx.finish()
+    samples = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(draws):
+            draw()
+        ctx.finish()
+        samples.append((time.perf_counter() - start) / draws)
+    return statistics.median(samples)
+
+
+def curtain_timer(renderer, trivial: bool):
+    import moderngl
+
+    ctx = renderer.ctx
+    view_proj = renderer.camera.view_projection(renderer.size[0] / renderer.size[1])
+
+    def draw():
+        renderer._hdr_fbo.use()
+        ctx.viewport = (0, 0, *renderer.size)
+        renderer._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        renderer.draw_curtain(view_proj, trivial=trivial)
+
+    return draw
+
+
+def band_errors(ctx, preset) -> dict:
+    from catalog import reference as ref
+    from catalog.colorimetry import delta_e_2000, linear_srgb_to_xyz
+    from catalog.render.frame import FrameRenderer
+
+    rows = {}
+    renderer = FrameRenderer(ctx, (96, 64))
+    renderer.set_fabric(preset)
+    for light in ("D65", "A", "sun:100"):
+        renderer.set_light(light)
+        for mode in ("off", "physical", "paper"):
+            renderer.set_fluorescence(mode)
+            for n in (3, 6, 9, 16):
+                renderer.set_bands(n)
+                gb = renderer.render_gbuffer()
+                m = gb["mask"]
+                inputs = renderer.shading_inputs()
+                reference = ref.reference_linear_srgb(inputs, gb["position"][m], gb["normal"][m],
+                                                      gb["tangent"][m], renderer.camera.position)
+                de = delta_e_2000(linear_srgb_to_xyz(gb["radiance"][m].astype(np.float64)),
+                                  linear_srgb_to_xyz(reference), ref.white_xyz(inputs))
+                rows[f"{light}|{inputs.fluorescence_mode}|{n}"] = (float(de.mean()), float(de.max()))
+    renderer.release()
+    return rows
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", default="1280x720")
+    parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--draws", type=int, default=5)
+    parser.add_argument("--fabric", default=None)
+    parser.add_argument("--json", default=str(ROOT / "benchmarks" / "bench_render.json"))
+    parser.add_argument("--quick", action="store_true", help="3 repeats of 2 draws, no Delta E table")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.repeats, args.draws = 3, 2
+
+    from catalog.render.context import create_headless_context, describe
+    from catalog.render.frame import FrameRenderer
+    from catalog.render.snapshot import parse_size
+
+    size = parse_size(args.size)
+    preset = bench_preset(args.fabric)
+    ctx = create_headless_context()
+    renderer = FrameRenderer(ctx, size)
+    renderer.set_fabric(preset)
+    renderer.set_light("D65")
+
+    variants = [("trivial", None, None, None)]
+    for mode in ("off", "paper", "physical"):
+        variants.append((f"rgb {mode}", mode, 3, True))
+    variants.append(("rgb off, no see-through", "off", 3, False))
+    for n in (6, 9, 16):
+        variants.append((f"{n} bands physical", "physical", n, True))
+
+    base_direct = renderer.preset.btdf.direct
+    rows = []
+    floor = None
+    for label, mode, n_bands, see_through in variants:
+        if mode is None:
+            seconds = time_draws(ctx, curtain_timer(renderer, trivial=True), args.repeats, args.draws)
+            floor = seconds
+            rows.append({"variant": label, "ms": seconds * 1e3, "ratio": 1.0, "defines": {}})
+            continue
+        from dataclasses import replace
+
+        preset_obj = renderer.preset
+        direct = base_direct if see_through else 0.0
+        if see_through and direct == 0.0:
+            direct = 0.01
+        renderer.set_fabric(replace(preset_obj, btdf=replace(preset_obj.btdf, direct=direct)))
+        renderer.set_fluorescence(mode)
+        renderer.set_bands(n_bands)
+        defines = renderer.variant_defines()
+        seconds = time_draws(ctx, curtain_timer(renderer, trivial=False), args.repeats, args.draws)
+        rows.append({"variant": label, "ms": seconds * 1e3, "ratio": seconds / floor,
+                     "defines": {k: v for k, v in defines.items() if v}})
+        renderer.set_fabric(preset_obj)
+
+    renderer.set_fluorescence("physical")
+    renderer.set_bands(3)
+    frame_s = time_draws(ctx, renderer.render, args.repeats, args.draws)
+    rows.append({"variant": "whole frame (rgb physical: background, room, curtain, tone map)",
+                 "ms": frame_s * 1e3, "ratio": frame_s / floor, "defines": {}})
+
+    print(f"{describe(ctx)['renderer']}, {size[0]}x{size[1]}, median of {args.repeats} x {args.draws} draws")
+    print(f"{'variant':<66} {'ms':>8} {'x trivial':>10}")
+    for row in rows:
+        print(f"{row['variant']:<66} {row['ms']:8.2f} {row['ratio']:10.2f}")
+    full = next(r for r in rows if r["variant"] == "rgb physical")
+    goal_met = full["ratio"] <= 1.3
+    print(f"full RGB shader / trivial = {full['ratio']:.2f} (goal <= 1.3: {'met' if goal_met else 'NOT met'})")
+
+    result = {"device": describe(ctx), "size": list(size), "repeats": args.repeats,
+              "draws": args.draws, "fabric": renderer.preset.name, "rows": rows,
+              "full_rgb_ratio": full["ratio"], "goal_met": goal_met}
+    if not args.quick:
+        errors = band_errors(ctx, renderer.preset)
+        result["delta_e_2000_vs_spectral"] = {k: {"mean": m, "max": x} for k, (m, x) in errors.items()}
+        print(f"\n{'light|fluorescence|bands':<28} {'mean dE00':>10} {'max dE00':>10}")
+        for key, (mean, worst) in errors.items():
+            print(f"{key:<28} {mean:10.4f} {worst:10.4f}")
+    Path(args.json).write_text(json.dumps(result, indent=1))
+    print(f"wrote {args.json}")
+    renderer.release()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
