@@ -66,7 +66,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--wind", type=float, metavar="M_S", help="wind speed, m/s")
     parser.add_argument("--grid", type=_grid, default=(48, 64), metavar="WxH",
                         help="cloth particles across x down (default 48x64)")
-    parser.add_argument("--cloth-backend", choices=("numpy", "cpu", "gpu"), default="cpu",
+    parser.add_argument("--cloth-backend", choices=("numpy", "cpu"), default="cpu",
                         help="cloth simulation backend (default cpu)")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")

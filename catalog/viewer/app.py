@@ -178,10 +178,15 @@ class ViewerApp:
             with self.timer.part("shading"):
                 self._fbo.use()
                 self._fbo.clear(0.0, 0.0, 0.0, 1.0)
-                for renderer, viewport in zip(self._renderers, self._viewports()):
+                for slot, (renderer, viewport) in enumerate(zip(self._renderers,
+                                                                self._viewports())):
                     renderer.set_camera(self.camera.yaw_deg, self.camera.pitch_deg,
                                         self.camera.distance_m)
-                    renderer.render(fbo=self._fbo, viewport=viewport)
+                    try:
+                        renderer.render(fbo=self._fbo, viewport=viewport)
+                        self.messages.pop(f"render{slot}", None)
+                    except CatalogError as exc:  # e.g. no fabric loads: say so, keep running
+                        self.messages[f"render{slot}"] = str(exc)
                 self.ctx.finish()
 
             with self.timer.part("ui"):

@@ -1,7 +1,7 @@
 """Screenshots: the window as shown (PNG, sRGB 8-bit) and the scene's linear radiance (EXR).
 
-Written with OpenImageIO through :func:`catalog.atomic.atomic_path`, so a crash never
-leaves half an image; the fabric, light and mode go into the file's metadata.
+Written by the renderer's image writer (OpenImageIO, atomically: a crash never leaves half
+an image); the fabric, light and mode go into the file's metadata.
 """
 
 from __future__ import annotations
@@ -11,38 +11,21 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.atomic import atomic_path
 from catalog.errors import CatalogError
 
 
-def write_image(path: str | Path, pixels: np.ndarray, metadata: dict[str, str] | None = None
-                ) -> Path:
-    """Write ``pixels`` (H, W, C), row 0 at the top: uint8 -> 8-bit, float -> half EXR."""
-    import OpenImageIO as oiio  # noqa: PLC0415  (heavy-ish; only when saving)
+def write_image(path: str | Path, pixels: np.ndarray, metadata: dict[str, str]) -> Path:
+    """Write (H, W, 3) pixels, row 0 at the top: float32 -> 32-bit float EXR (the sun's disc
+    is far above half-float range), uint8 -> 8-bit PNG. The renderer's writer does it."""
+    from catalog.render.snapshot import write_image as write  # noqa: PLC0415
 
     path = Path(path)
     pixels = np.ascontiguousarray(pixels)
-    if pixels.ndim != 3 or pixels.shape[2] not in (3, 4):
-        raise CatalogError(f"{path}: expected an (H, W, 3|4) image, got shape {pixels.shape}")
-    if pixels.dtype == np.uint8:
-        pixel_type = oiio.UINT8
-    else:
+    if pixels.ndim != 3 or pixels.shape[2] != 3:
+        raise CatalogError(f"{path}: expected an (H, W, 3) image, got shape {pixels.shape}")
+    if pixels.dtype != np.uint8:
         pixels = pixels.astype(np.float32)
-        pixel_type = oiio.HALF if path.suffix.lower() == ".exr" else oiio.FLOAT
-    height, width, channels = pixels.shape
-    spec = oiio.ImageSpec(width, height, channels, pixel_type)
-    for key, value in (metadata or {}).items():
-        spec.attribute(key, str(value))
-    with atomic_path(path) as tmp:
-        out = oiio.ImageOutput.create(str(tmp))
-        if out is None:
-            raise CatalogError(f"{path}: no image writer for this suffix ({oiio.geterror()})")
-        if not out.open(str(tmp), spec):
-            raise CatalogError(f"{path}: cannot write: {out.geterror()}")
-        ok = out.write_image(pixels)
-        out.close()
-        if not ok:
-            raise CatalogError(f"{path}: cannot write: {out.geterror()}")
+    write(path, pixels, metadata)
     return path
 
 
