@@ -264,7 +264,7 @@ def relative_airmass_kasten_young(zenith_deg: float) -> float:
 def ozone_slant_factor(zenith_deg: float, height_km: float = 22.0,
                        earth_radius_km: float = EARTH_RADIUS_KM) -> float:
     """Slant factor of a thin layer at ``height_km``: 1 / cos z', sin z' = R sin z / (R + h)."""
-    s = EARTH_RADIUS_KM / (earth_radius_km + height_km) * math.sin(math.radians(zenith_deg))
+    s = earth_radius_km / (earth_radius_km + height_km) * math.sin(math.radians(zenith_deg))
     return 1.0 / math.sqrt(1.0 - s * s)
 
 
@@ -310,7 +310,7 @@ def eddington_layer(tau, omega, g, mu0, ground_albedo):
     """
     tau, omega, g, mu0 = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
                                                for x in (tau, omega, g, mu0)))
-    # delta scaling (their eq. 2-4): f = g^2
+    # delta scaling: the forward peak f = g^2 goes back into the beam
     f = g * g
     tau_s = (1.0 - omega * f) * tau
     omega_s = (1.0 - f) * omega / (1.0 - omega * f)
