@@ -27,6 +27,8 @@ from catalog.render.shaderlib import create_program
 
 #: Auto exposure: a white diffuser under the key light maps to this (before the curve).
 EXPOSURE_KEY = 5.0
+#: The least illuminance (lx) the auto exposure assumes.
+EXPOSURE_FLOOR_LX = 200.0
 #: Tone curve white point (after exposure): this luminance maps to display white.
 TONE_WHITE = 6.0
 FLUORESCENCE_MODES = ("off", "paper", "physical")
@@ -301,7 +303,9 @@ class FrameRenderer:
 
     def exposure_scale(self) -> float:
         """Linear radiance (cd m^-2) -> tone-curve input: EXPOSURE_KEY over a white diffuser's Y."""
-        illuminance = max(self.light.illuminance_lx, 1e-9)
+        # a UV lamp has almost no illuminance: expose as for EXPOSURE_FLOOR_LX instead, so what
+        # shows is the fluorescence it excites, not a blown-out violet tail
+        illuminance = max(self.light.illuminance_lx, EXPOSURE_FLOOR_LX)
         return self.exposure * EXPOSURE_KEY * math.pi / illuminance
 
     # ------------------------------------------------------------------ passes

@@ -212,6 +212,22 @@ def dye_transmittance(preset) -> np.ndarray:
     return values
 
 
+def relative_dye(transmittance: np.ndarray) -> np.ndarray:
+    """The dye's spectral shape around the grey fit: T(l) / T_mean, T_mean weighted by ybar.
+
+    The preset's grey [btdf] lobes are fitted to the luminance-like gonio column, so they
+    already hold the dye's mean absorption; the spectral factor only redistributes it
+    (a cloth with no dye, T = 1, gets exactly 1).
+    """
+    from catalog.colorimetry import cmfs  # noqa: PLC0415
+
+    ybar = cmfs(GRID_NM)[:, 1]
+    mean = float(transmittance @ ybar) / float(np.sum(ybar))
+    if not mean > 0:
+        raise InputError("dye transmittance is zero over the visible range", field="dye.transmittance")
+    return transmittance / mean
+
+
 @functools.lru_cache(maxsize=32)
 def _material_cached(excitation_path: str, emission_path: str, peak_absorptance: float,
                      quantum_yield: float, saturation: float):
@@ -304,7 +320,7 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
     if not -1.0 < anisotropy < 1.0:
         raise InputError(f"{anisotropy:g} is out of range (-1, 1)", path=preset.path,
                          field="btdf.anisotropy")
-    dye = dye_transmittance(preset)
+    dye = relative_dye(dye_transmittance(preset))
     behind = 0.5 * (sky + ground)  # mean radiance of the outside half-space
     front = room
     if not viewer_inside:
