@@ -32,6 +32,14 @@ Methods (model.md sections 6 and 8):
   under D65) times the light's RGB, plus the emission's exact RGB per pair: what
   the pre-integration saves (and what remains wherever two spectra meet at run time).
 
+- ``reduced_3x3`` (e): a reduced re-radiation matrix in the colour-matching space, after
+  Fichet, Belcour and Barla 2024 as we read them (our code, not theirs): the light's XYZ
+  c is upsampled with the dual basis S~ = S (S^T S)^-1 of the CMFs S, the whole matrix
+  (reflectance and re-radiation) applied exactly, and the result projected back:
+  XYZ_out = S^T P S~ c, a 3x3 per material, independent of the light.
+  ``reduced_3x3_uv``: the same with a fourth input band, a box over 300-379 nm that
+  carries the light's UV (3x4).
+
 Diagnostics: ``data_antistokes`` is the colour difference the matrix's anti-Stokes entries
 beyond the reflectance band make (emission at a wavelength 20 nm or more SHORTER than the
 excitation: physically nothing for these materials, so measurement noise and instrument
@@ -58,7 +66,10 @@ GOAL_LIGHTS = ("D65", "A", "FL2", "FL11", "LED-B4")
 #: All lights of the study: the goal's plus a UV-A lamp and the sun at 22 and 500 km.
 STUDY_LIGHTS = GOAL_LIGHTS + ("UV-A", "sun:22", "sun:500")
 #: Model methods, in table order; then the data diagnostics.
-METHODS = ("ignore", "paper", "paper_global", "physical", "physical_rgb", "rgb_product")
+METHODS = ("ignore", "paper", "paper_global", "physical", "physical_rgb", "rgb_product",
+           "reduced_3x3", "reduced_3x3_uv")
+#: The UV band of ``reduced_3x3_uv``, nm (a box below the visible).
+UV_BAND_NM = (300.0, 379.0)
 DIAGNOSTICS = ("physical_no_antistokes", "data_antistokes", "data_10nm")
 #: model.md section 8: the state of the art on the same 8 matrices x GOAL_LIGHTS, Delta E
 #: 2000 (mean, max).
@@ -109,6 +120,8 @@ class MaterialModels:
     paper_scale: float                 # k of eq. 8's fluorescence term, this material
     paper_target_d65: np.ndarray       # what k x paper_term_d65 should match under D65
     paper_term_d65: np.ndarray         # I_fluor F_c under D65
+    reduced_3x3: np.ndarray            # XYZ_out = reduced_3x3 @ (S^T E), (3, 3)
+    reduced_3x3_uv: np.ndarray         # XYZ_out = reduced_3x3_uv @ (S4^T E), (3, 4)
     paper_scale_global: float = float("nan")  # one k for a set of materials
 
 
@@ -118,6 +131,25 @@ def _albedo(reflectance: np.ndarray, light: np.ndarray, matrix_xyz_to_rgb) -> np
 
 def _paper_rgb(xyz):
     return M_PAPER_XYZ_TO_RGB @ np.asarray(xyz)
+
+
+def _sensors(with_uv: bool) -> np.ndarray:
+    """S: the CIE 1931 CMFs on GRID_NM as columns, plus a UV box when asked."""
+    sensors = np.asarray(cmfs(GRID_NM))
+    if with_uv:
+        uv = ((GRID_NM >= UV_BAND_NM[0]) & (GRID_NM <= UV_BAND_NM[1])).astype(np.float64)
+        sensors = np.hstack([sensors, uv[:, None]])
+    return sensors
+
+
+def reduced_matrix(matrix: DonaldsonMatrix, with_uv: bool = False) -> np.ndarray:
+    """S^T P S~ with S~ = S (S^T S)^-1: column j is the XYZ the matrix returns for the
+    (signed) basis light S~_j. Apply it to S^T E (sums over GRID_NM, dl = 1 nm) and
+    multiply by 683 for the absolute XYZ of :func:`_xyz`."""
+    sensors = _sensors(with_uv)
+    dual = sensors @ np.linalg.inv(sensors.T @ sensors)
+    return np.stack([_xyz(exact_exitance_on_grid(matrix, dual[:, j])) / LM_PER_W
+                     for j in range(dual.shape[1])], axis=1)
 
 
 def prepare(matrix: DonaldsonMatrix, fit: SeparableFit | None = None) -> MaterialModels:
@@ -141,7 +173,8 @@ def prepare(matrix: DonaldsonMatrix, fit: SeparableFit | None = None) -> Materia
     term = paper_intensity(d65, excitation) * f_rgb
     k = float(target @ term / (term @ term))
     return MaterialModels(matrix, fit, r_diag, r_fit, f_rgb, excitation, albedo_paper,
-                          albedo_srgb, k, target, term)
+                          albedo_srgb, k, target, term, reduced_matrix(matrix, False),
+                          reduced_matrix(matrix, True))
 
 
 def with_global_paper_scale(models: list[MaterialModels]) -> list[MaterialModels]:
@@ -171,6 +204,10 @@ def method_xyz(models: MaterialModels, method: str, light: np.ndarray) -> np.nda
             * models.paper_rgb_unit  # eq. 4 x eq. 1-3
         rgb = models.albedo_rgb_paper * light_rgb + fluorescence  # eq. 8
         return np.linalg.solve(M_PAPER_XYZ_TO_RGB, rgb) / relative
+    if method in ("reduced_3x3", "reduced_3x3_uv"):
+        with_uv = method == "reduced_3x3_uv"
+        reduced = models.reduced_3x3_uv if with_uv else models.reduced_3x3
+        return LM_PER_W * reduced @ (_sensors(with_uv).T @ light)
     material = models.fit.material()
     emitted = emitted_exitance_w_m2_nm(material, light)
     if method == "physical":

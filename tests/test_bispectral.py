@@ -353,6 +353,32 @@ def test_issue_materials_all_lights(study_rows, name):
         assert abs(r["physical_rgb"] - r["physical"]) < 0.02, r
 
 
+def test_reduced_matrix_of_a_grey_reflector_is_the_identity_times_its_reflectance():
+    lo, li = EMISSION_NM, EXCITATION_NM
+    values = np.where(lo[:, None] == li[None, :], 0.6, 0.0)
+    grey = bispectral.DonaldsonMatrix(lo, li, values, "GREY", "flat 0.6")
+    reduced = study.reduced_matrix(grey)
+    # the CMFs are zero below 360 nm, where the grey reflector (from 380 nm) is not defined,
+    # so only the 360-380 nm tail of the basis lights makes it differ from 0.6 I
+    np.testing.assert_allclose(reduced, 0.6 * np.eye(3), atol=2e-3)
+
+
+def test_reduced_3x3_reproduces_the_published_figures(study_rows):
+    """Our reading of Fichet et al.'s reduction against their figures on the same set
+    (model.md section 8): 3.0 / 13.0, and 3.3 / 8.0 with a UV band (their UV band is not
+    ours, so a wider tolerance there)."""
+    goal = [r for r in study_rows if r["light"] in study.GOAL_LIGHTS]
+    reduced = np.array([r["reduced_3x3"] for r in goal])
+    assert reduced.mean() == pytest.approx(3.0, abs=0.3)
+    assert reduced.max() == pytest.approx(13.0, abs=1.0)
+    with_uv = np.array([r["reduced_3x3_uv"] for r in goal])
+    assert with_uv.mean() == pytest.approx(3.3, abs=0.8)
+    assert with_uv.max() == pytest.approx(8.0, abs=1.0)
+    # the separable fit in physical mode: several times lower on the mean and the max
+    physical = np.array([r["physical"] for r in goal])
+    assert physical.mean() < with_uv.mean() / 5 and physical.max() < with_uv.max() / 5
+
+
 def test_rgb_product_is_worse_than_pre_integration(study_rows):
     goal = [r for r in study_rows if r["light"] in study.GOAL_LIGHTS]
     assert np.mean([r["rgb_product"] for r in goal]) > 3 * np.mean([r["physical"] for r in goal])
