@@ -149,7 +149,7 @@ def _cie_light(name: str) -> Light:
                     f"(no data there, so no UV)")
     else:
         coverage = f"tabulated from {first_nm:g} nm"
-    description = (f"CIE/colour-science {kind} {name} ({coverage}; linear interpolation), "
+    description = (f"colour-science {kind} {name} ({coverage}; linear interpolation), "
                    f"scaled to {level:,.0f} lx")
     relative_lx = illuminance_lx(relative)
     return _make(name, description, relative * (level / relative_lx))

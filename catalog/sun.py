@@ -508,14 +508,18 @@ def parse_when(text: str, longitude_deg: float = 0.0):
     """
     import pandas as pd  # noqa: PLC0415
 
+    text = str(text).strip()
+    if not text[:4].isdigit():  # pandas would also take "now" and "today": not reproducible
+        raise CatalogError(f"date-time {text!r} is not ISO 8601 "
+                           "(e.g. 2026-06-21T12:00 or 2026-06-21T12:00+09:00)")
     try:
-        stamp = pd.Timestamp(str(text).strip())
+        stamp = pd.Timestamp(text)
     except (ValueError, TypeError):
         raise CatalogError(f"date-time {text!r} is not ISO 8601 "
                            "(e.g. 2026-06-21T12:00 or 2026-06-21T12:00+09:00)") from None
     if stamp is pd.NaT:
         raise CatalogError(f"date-time {text!r} is empty")
-    if "T" not in str(text) and " " not in str(text).strip():
+    if "T" not in text and " " not in text:
         stamp = stamp + pd.Timedelta(hours=12)
     if stamp.tzinfo is None:
         stamp = (stamp - pd.Timedelta(hours=float(longitude_deg) / 15.0)).tz_localize("UTC")

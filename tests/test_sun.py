@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from catalog.errors import CatalogError, InputError
 from catalog.lights import get_light
@@ -128,7 +130,25 @@ def test_sun_is_absolute_and_rescalable():
     assert get_light("sun:22", illuminance_lx=1000).illuminance_lx == pytest.approx(1000)
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.floats(1.0, 2000.0), st.floats(1.0, 2000.0))
+def test_any_longer_path_is_darker_and_redder(path_a, path_b):
+    short, long_ = sorted((path_a, path_b))
+    e_short, e_long = direct_beam_w_m2_nm(short), direct_beam_w_m2_nm(long_)
+    assert np.all(e_long <= e_short)
+    blue, red = GRID_NM == 450.0, GRID_NM == 650.0
+    assert (e_long[blue] / e_long[red])[0] <= (e_short[blue] / e_short[red])[0]
+
+
 # ------------------------------------------------------------------ geometry
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(0.0, 90.0))
+def test_zenith_path_round_trip_any_angle(zenith):
+    length = path_km_from_zenith(zenith)
+    assert LAYER_KM - 1e-9 <= length <= horizon_path_km() + 1e-9
+    assert zenith_deg_from_path(length) == pytest.approx(zenith, abs=1e-5)
 
 
 def test_shell_path_at_zenith_and_horizon():
@@ -365,6 +385,8 @@ def test_sun_at_a_date_is_the_clear_sky_at_its_zenith():
 @pytest.mark.parametrize("bad, pattern", [
     ("sun@2026-06-21", "write 'sun@DATE"),
     ("sun@yesterday,34,135", "ISO 8601"),
+    ("sun@now,34,135", "ISO 8601"),
+    ("sun@2026-13-45,34,135", "ISO 8601"),
     ("sun@2026-06-21,95,0", "latitude"),
     ("sun@2026-06-21,34,north", "not numbers"),
 ])
