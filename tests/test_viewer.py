@@ -271,6 +271,23 @@ class Viewer:
             time.sleep(0.2)
         raise AssertionError(f"title {title!r} never showed {text!r}")
 
+    def drag(self, x: int, y: int, dx: int) -> None:
+        """Press the left button at (x, y) in the window, move right by dx, release."""
+        self._xdotool("mousemove", "--window", self.window, str(x), str(y))
+        self._xdotool("mousedown", "1")
+        time.sleep(0.2)
+        for _ in range(5):
+            self._xdotool("mousemove_relative", "--", str(dx // 5), "0")
+            time.sleep(0.1)
+        self._xdotool("mouseup", "1")
+        time.sleep(0.2)
+
+    def wheel(self, x: int, y: int, clicks: int) -> None:
+        """Turn the wheel towards the scene (X button 4) ``clicks`` times at (x, y)."""
+        self._xdotool("mousemove", "--window", self.window, str(x), str(y))
+        self._xdotool("click", "--repeat", str(clicks), "--delay", "80", "4")
+        time.sleep(0.3)
+
     def quit(self) -> int:
         self.keys("Escape")
         try:
@@ -333,7 +350,7 @@ def test_keys_switch_fabric_light_and_fluorescence(xdisplay, tmp_path):
 
         # the plain voile: fluorescence on or off renders the same pixels
         steps = (names.index(VOILE) - names.index(LACE)) % len(names)
-        viewer.keys(*(["Right"] * steps), "l")  # back to D65 order: A -> FL2 is fine too
+        viewer.keys(*(["Right"] * steps))
         viewer.wait_title(VOILE)
         voile_off, _ = viewer.screenshot()
         viewer.keys("f", "f")  # off -> paper -> physical
@@ -341,6 +358,19 @@ def test_keys_switch_fabric_light_and_fluorescence(xdisplay, tmp_path):
         voile_physical, _ = viewer.screenshot()
         np.testing.assert_allclose(voile_physical, voile_off, rtol=1e-5,
                                    atol=1e-6 * float(voile_off.max()))
+
+        # the mouse: a drag over the panel leaves the camera alone (the panel has the
+        # mouse there); a drag over the scene orbits it; the wheel zooms
+        viewer.drag(100, 8, dx=100)
+        same, _ = viewer.screenshot()
+        np.testing.assert_allclose(same, voile_physical, rtol=1e-5,
+                                   atol=1e-6 * float(voile_off.max()))
+        viewer.drag(300, 160, dx=100)
+        orbited, _ = viewer.screenshot()
+        assert np.abs(orbited - same).mean() > 0.05 * same.mean()
+        viewer.wheel(300, 160, 3)
+        zoomed, _ = viewer.screenshot()
+        assert np.abs(zoomed - orbited).mean() > 0.05 * orbited.mean()
         assert viewer.quit() == 0
     finally:
         viewer.close()

@@ -136,8 +136,8 @@ class ViewerApp:
         imgui.create_context()
         imgui.get_io().set_ini_filename("")  # no imgui.ini left in the user's folder
         self.gui = GlfwRenderer(window, attach_callbacks=True)
-        self._install_callbacks(imgui)
         self.panel = Panel()
+        self._install_callbacks(imgui)
         self.panel_info = PanelInfo(cie_lights=self._cie_light_names())
 
         self.scene = CurtainScene(self.options.grid, backend=self.options.cloth_backend,
@@ -194,7 +194,7 @@ class ViewerApp:
                 self.gui.process_inputs()
                 imgui.new_frame()
                 self.panel.draw(self.settings, self.catalog, self.timer, self.panel_info,
-                                self._fbo.size[1])
+                                tuple(self.glfw.get_window_size(self.window)))
                 imgui.render()
                 self._fbo.use()
                 self.gui.render(imgui.get_draw_data())
@@ -230,7 +230,13 @@ class ViewerApp:
     def _install_callbacks(self, imgui) -> None:
         glfw, gui = self.glfw, self.gui
         io = imgui.get_io()
-        self.orbit = MouseOrbit(self.camera, ui_wants_mouse=lambda: io.want_capture_mouse)
+        def ui_wants_mouse(x: float, y: float) -> bool:
+            # the panel's strip is the panel's; elsewhere only the help window (imgui's
+            # flag, which lags a frame) takes the mouse
+            over_panel = self.settings.show_panel and 0 <= x < self.panel.width_px
+            return over_panel or (self.settings.show_help and io.want_capture_mouse)
+
+        self.orbit = MouseOrbit(self.camera, ui_wants_mouse=ui_wants_mouse)
 
         def on_key(window, key, scancode, action, mods):
             gui.keyboard_callback(window, key, scancode, action, mods)
@@ -290,7 +296,7 @@ class ViewerApp:
         """The scene's rectangles (x, y, w, h) in the window: right of the panel when it is
         shown, halved for a comparison."""
         width, height = self._fbo.size
-        left = min(self.panel.width_px, width // 2) if self.settings.show_panel else 0
+        left = self.panel.width_for(width) if self.settings.show_panel else 0
         scene_width = width - left
         if self._halves() == 1:
             return [(left, 0, scene_width, height)]

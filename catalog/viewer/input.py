@@ -98,31 +98,38 @@ class OrbitCamera:
 class MouseOrbit:
     """Turns glfw mouse events into :class:`OrbitCamera` moves.
 
-    ``ui_wants_mouse`` is asked on each event: while the pointer is over the panel the
-    panel gets the mouse, not the camera.
+    ``ui_wants_mouse(x, y)`` is asked on a press and a wheel turn with the pointer's
+    window position: over the panel the panel gets the mouse, not the camera. (imgui's own
+    ``want_capture_mouse`` alone lags a frame behind a pointer that jumps, so the viewer
+    also checks the panel's rectangle.)
     """
 
-    def __init__(self, camera: OrbitCamera, ui_wants_mouse=lambda: False):
+    def __init__(self, camera: OrbitCamera, ui_wants_mouse=lambda x, y: False):
         self.camera = camera
         self.ui_wants_mouse = ui_wants_mouse
         self.dragging = False
+        self.pointer: tuple[float, float] | None = None
         self._last: tuple[float, float] | None = None
 
     def button(self, button: int, action: int) -> None:
         if button != glfw.MOUSE_BUTTON_LEFT:
             return
-        if action == glfw.PRESS and not self.ui_wants_mouse():
+        if action == glfw.PRESS and not self._ui_has_pointer():
             self.dragging = True
-            self._last = None
+            self._last = self.pointer
         elif action == glfw.RELEASE:
             self.dragging = False
-            self._last = None
 
     def moved(self, x: float, y: float) -> None:
         if self.dragging and self._last is not None:
             self.camera.drag(x - self._last[0], y - self._last[1])
         self._last = (x, y)
+        self.pointer = (x, y)
 
     def scrolled(self, y_offset: float) -> None:
-        if not self.ui_wants_mouse():
+        if not self._ui_has_pointer():
             self.camera.zoom(y_offset)
+
+    def _ui_has_pointer(self) -> bool:
+        x, y = self.pointer if self.pointer is not None else (-1.0, -1.0)
+        return bool(self.ui_wants_mouse(x, y))

@@ -41,11 +41,18 @@ class Panel:
     """Draws the panel; ``width_px`` is the strip of the window it covers on the left."""
 
     def __init__(self, width_px: int = PANEL_WIDTH_PX):
+        self.preferred_width_px = width_px
         self.width_px = width_px
+
+    def width_for(self, window_width_px: int) -> int:
+        """The strip the panel takes in a window this wide: at most half of it."""
+        return min(self.preferred_width_px, window_width_px // 2)
 
     # ------------------------------------------------------------------------------
     def draw(self, settings: ViewerSettings, catalog: FabricCatalog, timer: FrameTimer,
-             info: PanelInfo, window_height_px: int) -> None:
+             info: PanelInfo, window_size_px: tuple[int, int]) -> None:
+        self.width_px = self.width_for(window_size_px[0])
+        window_height_px = window_size_px[1]
         if settings.show_panel:
             imgui.set_next_window_pos(imgui.ImVec2(0, 0))
             imgui.set_next_window_size(imgui.ImVec2(self.width_px, window_height_px))
