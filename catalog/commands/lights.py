@@ -48,7 +48,9 @@ def _plot(path: str, lights: list, normalise: bool) -> None:
         if normalise:
             peak = float(np.max(values))
             values = values / peak if peak > 0 else values
-        ax.plot(GRID_NM, values, lw=1.0, label=f"{light.name} ({light.illuminance_lx:,.0f} lx)")
+        lx = light.illuminance_lx
+        level = f"{lx:,.0f} lx" if lx >= 10 else f"{lx:.2g} lx, {light.total_w_m2:.3g} W/m2"
+        ax.plot(GRID_NM, values, lw=1.0, label=f"{light.name} ({level})")
     ax.set_xlabel("wavelength (nm)")
     ax.set_ylabel("relative (peak 1)" if normalise
                   else "spectral irradiance (W m$^{-2}$ nm$^{-1}$)")
@@ -59,7 +61,7 @@ def _plot(path: str, lights: list, normalise: bool) -> None:
     ax.set_xlim(float(GRID_NM[0]), float(GRID_NM[-1]))
     ax.axvspan(315, 400, color="violet", alpha=0.08, lw=0)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="best")
     ax.set_title("Light library (UV-A band 315-400 nm shaded)", fontsize=10)
     fig.tight_layout()
     with atomic_path(path) as tmp:
