@@ -140,6 +140,17 @@ def hg_phase_dg(one_minus_cos, g):
             - 1.5 * (1 - g) * (1 + g) * dd_dg / (FOUR_PI * d * d * sqrt_d))
 
 
+def hg_phase_and_dg(one_minus_cos, g: float):
+    """Eq. 6 and its derivative in g together, sharing d and sqrt(d) (the fit's inner
+    loop; ``g`` a float in (-1, 1), not checked)."""
+    d = hg_denominator(one_minus_cos, g)
+    d_sqrt_d = d * np.sqrt(d)
+    one_minus_g2 = (1 - g) * (1 + g)
+    phase = one_minus_g2 / (FOUR_PI * d_sqrt_d)
+    dd_dg = 2 * (one_minus_cos - (1 - g))
+    return phase, phase * (-2 * g / one_minus_g2 - 1.5 * dd_dg / d)
+
+
 def eq7_scattered(one_minus_cos, a_diff, a_spec, g_diff, g_spec):
     """The two HG lobes of eq. 7 with Lin = 1 (per steradian):
     ``a_diff ph(theta; g_diff) + a_spec ph(theta; g_spec)``, ``a = rho e^-tau k``."""
@@ -245,6 +256,6 @@ def cook_torrance_transmittance(to_light: np.ndarray, view: np.ndarray, direct, 
 
 __all__ = ["STRAIGHT_THROUGH_DEG", "one_minus_cos_between", "hg_denominator",
            "hg_phase", "hg_phase_between", "hg_phase_one_minus_cos", "hg_phase_printed",
-           "hg_phase_dg", "eq7_scattered", "eq7_transmittance", "is_straight_through",
+           "hg_phase_dg", "hg_phase_and_dg", "eq7_scattered", "eq7_transmittance", "is_straight_through",
            "woven_btdf", "cook_torrance_transmittance", "ct_geometry", "ct_lobes",
            "beckmann_d", "beckmann_d_droughness", "ct_shadowing", "mirror_view"]

@@ -22,6 +22,7 @@ same direction seen from both azimuths).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -70,7 +71,11 @@ def light_direction(light_elevation_deg, light_azimuth_deg) -> np.ndarray:
 
 @dataclass(frozen=True)
 class GonioData:
-    """One gonio measurement set: angles (degrees), the grey ratio and optional r,g,b."""
+    """One gonio measurement set: angles (degrees), the grey ratio and optional r,g,b.
+
+    The directions and angles derived from the angles are computed once and cached
+    (the arrays are not to be modified in place; :meth:`subset` and :meth:`with_values`
+    make new sets)."""
 
     light_elevation_deg: np.ndarray
     light_azimuth_deg: np.ndarray
@@ -85,7 +90,7 @@ class GonioData:
     def __len__(self) -> int:
         return len(self.transmittance)
 
-    @property
+    @cached_property
     def to_light(self) -> np.ndarray:
         return light_direction(self.light_elevation_deg, self.light_azimuth_deg)
 
@@ -94,11 +99,11 @@ class GonioData:
         """The light's direction of travel (minus the direction to the light)."""
         return -self.to_light
 
-    @property
+    @cached_property
     def view(self) -> np.ndarray:
         return view_direction(self.camera_elevation_deg, self.camera_azimuth_deg)
 
-    @property
+    @cached_property
     def one_minus_cos(self) -> np.ndarray:
         """1 - cos theta, from the vectors (exact near straight through)."""
         return one_minus_cos_between(self.travel, self.view)
@@ -109,7 +114,7 @@ class GonioData:
         chord = np.sqrt(2.0 * self.one_minus_cos)
         return np.degrees(2.0 * np.arcsin(np.clip(chord / 2.0, 0.0, 1.0)))
 
-    @property
+    @cached_property
     def straight_through(self) -> np.ndarray:
         return is_straight_through(self.one_minus_cos)
 

@@ -78,6 +78,8 @@ GUESSES = [
 
 @pytest.mark.parametrize("measured", [False, True])
 def test_fit_does_not_depend_on_the_initial_guess(measured):
+    """Far-off guesses, alone (no scan) or with the scan, end where the scan's starts do
+    (to 1e-5: LM's stopping tolerance; the standard errors are ~1e-3)."""
     if measured:
         data = gonio.read_gonio(_measurement("lace-fwa"))
         values = data.transmittance
@@ -90,8 +92,8 @@ def test_fit_does_not_depend_on_the_initial_guess(measured):
         for name in fitting.HG_NAMES:
             assert alone.params[name] == pytest.approx(reference.params[name], rel=1e-5,
                                                        abs=1e-6), (guess, name)
-            assert with_scan.params[name] == pytest.approx(reference.params[name], rel=1e-6,
-                                                           abs=1e-7)
+            assert with_scan.params[name] == pytest.approx(reference.params[name], rel=1e-5,
+                                                           abs=1e-6)
 
 
 def test_lobes_are_named_by_sharpness():
