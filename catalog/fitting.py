@@ -262,7 +262,7 @@ def _scan_hg(problem: _HGProblem, count: int) -> list[np.ndarray]:
 def _lm(fun, x0, jac="2-point"):
     from scipy.optimize import least_squares
 
-    return least_squares(fun, x0, jac=jac, method="lm", xtol=1e-10, ftol=1e-10, gtol=1e-10,
+    return least_squares(fun, x0, jac=jac, method="lm", xtol=1e-12, ftol=1e-12, gtol=1e-12,
                          max_nfev=1000)
 
 
