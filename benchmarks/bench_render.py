@@ -61,7 +61,6 @@ def bench_preset(name: str | None) -> str:
 
 def time_draws(ctx, draw, repeats: int, draws: int) -> float:
     """Median seconds per draw over ``repeats`` batches of ``draws`` (each batch finished)."""
-    draw()
     ctx.finish()
     samples = []
     for _ in range(repeats):
@@ -145,37 +144,47 @@ def main(argv=None) -> int:
     for n in (6, 9, 16):
         variants.append((f"{n} bands physical", "physical", n, True))
 
-    base_direct = renderer.preset.btdf.direct
-    rows = []
-    floor = None
+    # every variant gets its own renderer state; rounds interleave the variants so that a
+    # change of machine load hits them all alike; the median of the rounds is reported
+    from dataclasses import replace
+
+    base = renderer.preset
+    drawers = {}
+    defines_of = {}
     for label, mode, n_bands, see_through in variants:
         if mode is None:
-            seconds = time_draws(ctx, curtain_timer(renderer, trivial=True), args.repeats, args.draws)
-            floor = seconds
-            rows.append({"variant": label, "ms": seconds * 1e3, "ratio": 1.0, "defines": {}})
+            drawers[label] = curtain_timer(renderer, trivial=True)
             continue
-        from dataclasses import replace
-
-        preset_obj = renderer.preset
-        direct = base_direct if see_through else 0.0
+        direct = base.btdf.direct if see_through else 0.0
         if see_through and direct == 0.0:
             direct = 0.01
-        renderer.set_fabric(replace(preset_obj, btdf=replace(preset_obj.btdf, direct=direct)))
-        renderer.set_fluorescence(mode)
-        renderer.set_bands(n_bands)
-        defines = renderer.variant_defines()
-        seconds = time_draws(ctx, curtain_timer(renderer, trivial=False), args.repeats, args.draws)
-        rows.append({"variant": label, "ms": seconds * 1e3, "ratio": seconds / floor,
-                     "defines": {k: v for k, v in defines.items() if v}})
-        renderer.set_fabric(preset_obj)
-
+        variant_renderer = FrameRenderer(ctx, size)
+        variant_renderer.set_fabric(replace(base, btdf=replace(base.btdf, direct=direct)))
+        variant_renderer.set_light("D65")
+        variant_renderer.set_fluorescence(mode)
+        variant_renderer.set_bands(n_bands)
+        defines_of[label] = {k: v for k, v in variant_renderer.variant_defines().items() if v}
+        drawers[label] = curtain_timer(variant_renderer, trivial=False)
     renderer.set_fluorescence("physical")
     renderer.set_bands(3)
-    frame_s = time_draws(ctx, renderer.render, args.repeats, args.draws)
-    rows.append({"variant": "whole frame (rgb physical: background, room, curtain, tone map)",
-                 "ms": frame_s * 1e3, "ratio": frame_s / floor, "defines": {}})
+    frame_label = "whole frame (rgb physical: background, room, curtain, tone map)"
+    drawers[frame_label] = renderer.render
+    for draw in drawers.values():  # compile and warm up
+        draw()
+    ctx.finish()
+    samples = {label: [] for label in drawers}
+    for _ in range(args.repeats):
+        for label, draw in drawers.items():
+            samples[label].append(time_draws(ctx, draw, 1, args.draws))
+    floor = statistics.median(samples["trivial"])
+    rows = []
+    for label in drawers:
+        seconds = statistics.median(samples[label])
+        rows.append({"variant": label, "ms": seconds * 1e3, "ratio": seconds / floor,
+                     "defines": defines_of.get(label, {}),
+                     "ms_rounds": [round(v * 1e3, 2) for v in samples[label]]})
 
-    print(f"{describe(ctx)['renderer']}, {size[0]}x{size[1]}, median of {args.repeats} x {args.draws} draws")
+    print(f"{describe(ctx)['renderer']}, {size[0]}x{size[1]}, median of {args.repeats} interleaved rounds of {args.draws} draws")
     print(f"{'variant':<66} {'ms':>8} {'x trivial':>10}")
     for row in rows:
         print(f"{row['variant']:<66} {row['ms']:8.2f} {row['ratio']:10.2f}")

@@ -54,7 +54,11 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec4 w_bg, float effective) {
 #ifdef FLUORESCENCE_PHYSICAL
     band += fluorescence_physical(effective, u_fluorescence[k]);
 #endif
+#if N_BANDS == 3
+    return band.rgb;  // RGB: the bands are linear sRGB already (bands.py: band_to_rgb = identity)
+#else
     return vec3(dot(band, u_band_to_r[k]), dot(band, u_band_to_g[k]), dot(band, u_band_to_b[k]));
+#endif
 }
 
 void main() {

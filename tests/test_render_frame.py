@@ -190,3 +190,26 @@ def test_tone_map_and_srgb_encoding_match_numpy(gl, make_preset):
     expected = np.round(255 * srgb_encode(np.clip(mapped, 0, 1)))
     assert np.abs(renderer.read_srgb8().astype(int) - expected).max() <= 1
     renderer.release()
+
+
+def test_paper_mode_colour_is_eq_1_to_3_of_the_emission(gl, make_preset):
+    """Paper mode's added radiance has the chromaticity of F (eq. 1-3, catalog.fluorescence)
+    and the size I_fluor F / 255 of a white diffuser (eq. 4, 8; docs/render.md)."""
+    import math
+
+    from catalog.colorimetry import spectrum_to_xyz
+    from catalog.fluorescence import paper_colour, paper_intensity
+    from catalog.spectra import GRID_NM, read_spectrum
+
+    path = make_preset()
+    renderer = _renderer(gl, path, "D65", "paper")
+    inputs = renderer.shading_inputs()
+    preset = renderer.preset
+    xyz_paper, _ = paper_colour(read_spectrum(preset.fluorescence.emission))
+    intensity = paper_intensity(inputs.key_irradiance,
+                                read_spectrum(preset.fluorescence.excitation).resample(GRID_NM))
+    white_y = float(spectrum_to_xyz(inputs.key_irradiance / math.pi)[1])
+    added = spectrum_to_xyz(inputs.paper_radiance)
+    expected = intensity * xyz_paper / 255.0 * white_y
+    assert np.allclose(added, expected, rtol=1e-9)
+    renderer.release()

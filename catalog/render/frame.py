@@ -336,25 +336,33 @@ class FrameRenderer:
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program).render(self._moderngl.TRIANGLES)
 
+    def _display_colours(self, inputs) -> dict[str, tuple]:
+        """Exact linear sRGB of the background and room radiances (once per scene change)."""
+        if getattr(self, "_display_key", None) != self._inputs_key:
+            spectra = {"u_sky_rgb": inputs.sky_radiance, "u_ground_rgb": inputs.ground_radiance,
+                       "u_sun_disc_rgb": inputs.sun_disc_radiance,
+                       "u_room_rgb": inputs.room_radiance,
+                       "u_fill_rgb": scene_lib.ROOM_ALBEDO * inputs.fill_irradiance / math.pi}
+            self._display = {name: tuple(float(v) for v in band_lib.spectrum_to_display_rgb(s))
+                             for name, s in spectra.items()}
+            self._display_key = self._inputs_key
+        return self._display
+
     def _draw_background(self, view_proj, inputs) -> None:
         program = self._program("fullscreen.vert", "background.frag")
         self._scene_uniforms(program, view_proj, inputs)
         self._set(program, "u_inverse_view_proj", gl_bytes(np.linalg.inv(view_proj)))
-        for name, spectrum in (("u_sky_rgb", inputs.sky_radiance),
-                               ("u_ground_rgb", inputs.ground_radiance),
-                               ("u_sun_disc_rgb", inputs.sun_disc_radiance),
-                               ("u_room_rgb", inputs.room_radiance)):
-            self._set(program, name, tuple(float(v) for v in band_lib.spectrum_to_display_rgb(spectrum)))
+        colours = self._display_colours(inputs)
+        for name in ("u_sky_rgb", "u_ground_rgb", "u_sun_disc_rgb", "u_room_rgb"):
+            self._set(program, name, colours[name])
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
 
     def _draw_room(self, view_proj, inputs) -> None:
         program = self._program("room.vert", "room.frag")
         self._scene_uniforms(program, view_proj, inputs)
-        room_rgb = band_lib.spectrum_to_display_rgb(inputs.room_radiance)
-        fill_rgb = band_lib.spectrum_to_display_rgb(
-            scene_lib.ROOM_ALBEDO * inputs.fill_irradiance / math.pi)
-        self._set(program, "u_room_rgb", tuple(float(v) for v in room_rgb))
-        self._set(program, "u_fill_rgb", tuple(float(v) for v in fill_rgb))
+        colours = self._display_colours(inputs)
+        self._set(program, "u_room_rgb", colours["u_room_rgb"])
+        self._set(program, "u_fill_rgb", colours["u_fill_rgb"])
         self._room_vao(program).render(self._moderngl.TRIANGLES)
 
     def _viewport_size(self, viewport) -> tuple[int, int]:
