@@ -421,8 +421,8 @@ def _alternating_nnls(values: np.ndarray, weight: np.ndarray, energy: np.ndarray
 
 
 def fit_separable(matrix: DonaldsonMatrix, *, noise_sigmas: float = NOISE_SIGMAS,
-                  band_nm: float = REFLECTANCE_BAND_NM, max_iterations: int = 5000,
-                  tolerance: float = 1e-9) -> SeparableFit:
+                  band_nm: float = REFLECTANCE_BAND_NM, single_band: bool = True,
+                  max_iterations: int = 5000, tolerance: float = 1e-9) -> SeparableFit:
     """Fit reflectance + rank-1 photon-conserving re-radiation to ``matrix``.
 
     1. The rank-1 part u(lo) v(li) (li / lo) dli is fitted by alternating nonnegative least
@@ -433,9 +433,11 @@ def fit_separable(matrix: DonaldsonMatrix, *, noise_sigmas: float = NOISE_SIGMAS
     2. Noise: sigma is the robust (median absolute deviation) spread of the entries at
        least 30 nm on the anti-Stokes side, where nothing is emitted. An excitation or
        emission sample whose predicted entries stay below ``noise_sigmas`` x sigma is set
-       to 0, and only the contiguous run around the peak is kept (so a white plastic does
-       not "absorb" at 700 nm because the noise there is slightly positive); the fit is
-       repeated on that support until it stops changing.
+       to 0, and (``single_band``, the default: one fluorophore, one absorption and one
+       emission band) only the contiguous run around the peak is kept, so a white
+       plastic does not "absorb" at 490-620 nm because the anti-Stokes entries there are
+       slightly positive (an instrument artefact: such islands would make it turn red
+       light into blue); the fit is repeated on that support until it stops changing.
     3. Reflectance: R(lo) = sum over the band |lo - li| <= ``band_nm`` of (D - fit), i.e.
        the diagonal plus the reflectance the 10 nm bandpass spilled into its neighbours,
        minus the re-radiation the rank-1 part already gives there; clipped at 0.
@@ -462,8 +464,11 @@ def fit_separable(matrix: DonaldsonMatrix, *, noise_sigmas: float = NOISE_SIGMAS
                                     max_iterations, tolerance)
         total_iterations += n
         fitted = np.outer(u, v) * energy
-        new_keep_v = _keep_peak_run(fitted.max(axis=0) > noise_sigmas * sigma, v)
-        new_keep_u = _keep_peak_run(fitted.max(axis=1) > noise_sigmas * sigma, u)
+        new_keep_v = fitted.max(axis=0) > noise_sigmas * sigma
+        new_keep_u = fitted.max(axis=1) > noise_sigmas * sigma
+        if single_band:
+            new_keep_v = _keep_peak_run(new_keep_v, v)
+            new_keep_u = _keep_peak_run(new_keep_u, u)
         if np.array_equal(new_keep_u, keep_u) and np.array_equal(new_keep_v, keep_v):
             break
         keep_u, keep_v = new_keep_u, new_keep_v
