@@ -5,10 +5,11 @@ It never creates a GL context: it is handed one (:mod:`catalog.render.context`).
 
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
-1. background (shaders/fullscreen.vert + background.frag): the outside through the window
-   (sky, ground, the sun's disc) or the room, per camera ray;
-2. room props (room.vert/.frag): walls around the window, the curtain rod;
-3. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling;
+1. room props (room.vert/.frag): walls around the window, the curtain rod;
+2. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling;
+3. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
+   shades only the pixels nothing covers: the outside through the window (sky, ground, the
+   sun's disc) or the room, per camera ray;
 4. tone map (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
    target): exposure, Reinhard on luminance, the sRGB curve.
 """
@@ -383,11 +384,14 @@ class FrameRenderer:
         self._hdr_fbo.use()
         self.ctx.viewport = (0, 0, vw, vh)
         self._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
-        self.ctx.disable(mgl.DEPTH_TEST | mgl.BLEND)
-        self._draw_background(view_proj, inputs)
+        self.ctx.disable(mgl.BLEND)
         self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<="
         self._draw_room(view_proj, inputs)
         self.draw_curtain(view_proj)
+        # last, on the far plane: the depth test leaves only the pixels nothing covers
+        self._draw_background(view_proj, inputs)
+        self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
 
