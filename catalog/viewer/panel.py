@@ -121,8 +121,9 @@ class Panel:
         if kind == "sun":
             changed, hour = imgui.slider_float("hour", settings.sun_hour, *SUN_HOUR_RANGE,
                                                "%.1f h")
-            if changed:
+            if changed:  # the slider drives the sun (also after --light sun:PATH_KM)
                 settings.sun_hour = hour
+                settings.light = SUN
             if info.sun_path_km is not None:
                 elevation = ("" if info.sun_elevation_deg is None
                              else f", elevation {info.sun_elevation_deg:.0f} deg")
