@@ -347,8 +347,9 @@ class SeparableFit:
         return float(self.emission_nm[int(np.argmax(self.emission_weight))])
 
     def reflectance_on_grid(self) -> np.ndarray:
-        """R on GRID_NM: linear interpolation, constant below the first emission sample."""
-        return np.interp(GRID_NM, self.emission_nm, self.reflectance)
+        """R on GRID_NM: linear interpolation, zero outside the emission range (380-780 nm),
+        as the exported reflectance.csv reads back and as the exact result treats it."""
+        return np.interp(GRID_NM, self.emission_nm, self.reflectance, left=0.0, right=0.0)
 
     def excitation_on_grid(self) -> np.ndarray:
         """The excitation (absorption) spectrum on GRID_NM, peak 1, zero outside the fit."""
