@@ -25,6 +25,9 @@ from catalog.cloth.state import ClothState, SolverConstants
 from catalog.cloth.topology import SELECTORS
 from catalog.cloth.wind import wind_velocity
 
+#: Strain above the limit that the last substep's sweeps accept before stopping.
+STRAIN_TOLERANCE = 5e-4
+
 
 def grid_normals(x: np.ndarray) -> np.ndarray:
     """Unit normals (H, W, 3) by central differences (one-sided at the edges).
@@ -63,74 +66,91 @@ class NumpyBackend:
         self.params = params
         self.constants = SolverConstants.from_params(params)
         w, h = params.grid_w, params.grid_h
-        self._inv_mass = np.full((h, w), self.constants.inv_mass_per_kg)
-        self._inv_mass[0] = 0.0
+        self._inv_mass = self.constants.inv_mass_per_kg
+        self._free = (self._inv_mass > 0.0)[..., None]
+        self._ring_cols = self.constants.ring_cols
         self._slices = [sel.slices(w, h) for sel in SELECTORS]
-        self._lra_limit = (np.arange(1, h) * self.constants.lra_step_m)[:, None, None]
+        self._lra_limit = self.constants.lra_limit_m[..., None]
 
     def advance(self, state: ClothState, substeps: int, h: float) -> None:
-        for _ in range(substeps):
-            self._substep(state, h)
+        """One frame. The wind field is taken once per frame, at its start."""
+        p = self.params
+        wind = wind_velocity(state.positions_m, state.time_s, p.wind_speed_m_s,
+                             p.wind_direction, p.gust_strength, p.gust_length_m,
+                             p.gust_period_s)
+        for step in range(substeps):
+            self._substep(state, h, wind, last=step == substeps - 1)
 
     def sync(self, state: ClothState) -> None:
         """Nothing to do: the state's arrays are the working arrays."""
 
-    def _substep(self, state: ClothState, h: float) -> None:
+    def _substep(self, state: ClothState, h: float, wind: np.ndarray, last: bool) -> None:
         p, c = self.params, self.constants
         x, v = state.positions_m, state.velocities_m_s
+        ring_cols = self._ring_cols
         # 1. rings
         rings_before = state.ring_positions_m
         rings = move_rings(rings_before, state.ring_targets_m, p.ring_speed_m_s * h)
         state.ring_positions_m = rings
         # 2. normals at the start of the substep
         n = grid_normals(x)
-        # 3. predict the free particles (rows 1..)
-        vf = v[1:]
-        vf *= 1.0 / (1.0 + p.damping_per_s * h)
-        vf[..., 1] -= h * p.gravity_m_s2
-        wind = wind_velocity(x[1:], state.time_s, p.wind_speed_m_s, p.wind_direction,
-                             p.gust_strength, p.gust_length_m, p.gust_period_s)
-        nf = n[1:]
-        vn = np.sum((vf - wind) * nf, axis=-1, keepdims=True)
+        # 3. predict (the rings are overwritten below: they only follow the rod)
+        v *= 1.0 / (1.0 + p.damping_per_s * h)
+        v[..., 1] -= h * p.gravity_m_s2
+        vn = np.sum((v - wind) * n, axis=-1, keepdims=True)
         # dv_n/dt = -c |v_n| v_n, taken semi-implicitly: v_n' = v_n / (1 + c |v_n| h)
-        vf += nf * (vn / (1.0 + c.aero_per_m * np.abs(vn) * h) - vn)
+        v += n * (vn / (1.0 + c.aero_per_m * np.abs(vn) * h) - vn)
         x_prev = x.copy()
-        x_prev[0] = rings_before
-        x[1:] += h * vf
-        x[0] = rings
+        x_prev[0, ring_cols] = rings_before
+        x += h * v
+        x[0, ring_cols] = rings
         # 4. XPBD, colour by colour
         for sel, (sa, sb) in zip(SELECTORS, self._slices):
             self._project(x, sa, sb, sel.family, h)
         # 5. long-range attachments
-        d = x[1:] - x[0][None]
+        d = x - rings[c.lra_ring]
         dist = np.sqrt(np.sum(d * d, axis=-1, keepdims=True))
-        over = dist > self._lra_limit
-        x[1:] = np.where(over, x[0][None] + d * (self._lra_limit / np.where(over, dist, 1.0)),
-                         x[1:])
-        # 5b. strain limiting sweep: stretch and shear springs beyond the limit, hard
-        for _ in range(p.strain_passes):
-            for sel, (sa, sb) in zip(SELECTORS, self._slices):
-                if c.strain_limited[sel.family]:
-                    self._project(x, sa, sb, sel.family, h, limit_only=True)
-        # 6. collisions (rings excepted)
+        over = (dist > self._lra_limit) & self._free
+        x[...] = np.where(over, rings[c.lra_ring] + d * (self._lra_limit
+                                                        / np.where(over, dist, 1.0)), x)
+        # 6. collisions (the rings are on the rod, above the floor, in front of the wall)
         floor = p.thickness_m
         wall = -p.wall_gap_m + p.thickness_m
-        xf = x[1:]
-        np.maximum(xf[..., 1], floor, out=xf[..., 1])
-        np.maximum(xf[..., 2], wall, out=xf[..., 2])
+        np.maximum(x[..., 1], floor, out=x[..., 1])
+        np.maximum(x[..., 2], wall, out=x[..., 2])
+        # 6b. strain limiting sweeps (Provot): stretch and shear springs beyond the limit,
+        # hard, alternately forward and backward; the frame's last substep repeats them
+        # until no spring is more than STRAIN_TOLERANCE over (at most final_strain_passes)
+        passes = max(p.strain_passes, p.final_strain_passes) if last else p.strain_passes
+        for k in range(passes):
+            worst = self._strain_sweep(x, h, backward=k % 2 == 1)
+            if last and k + 1 >= p.strain_passes and worst <= STRAIN_TOLERANCE:
+                break
+        # the sweeps may have nudged a particle into a plane: clamp again
+        np.maximum(x[..., 1], floor, out=x[..., 1])
+        np.maximum(x[..., 2], wall, out=x[..., 2])
         # 7. velocities, friction in contact
         v[...] = (x - x_prev) / h
         keep = 1.0 - p.friction
-        on_floor = xf[..., 1] <= floor
-        on_wall = xf[..., 2] <= wall
-        vf = v[1:]
-        vf[..., 0] *= np.where(on_floor | on_wall, keep, 1.0)
-        vf[..., 2] *= np.where(on_floor, keep, 1.0)
-        vf[..., 1] *= np.where(on_wall, keep, 1.0)
+        on_floor = x[..., 1] <= floor
+        on_wall = x[..., 2] <= wall
+        v[..., 0] *= np.where(on_floor | on_wall, keep, 1.0)
+        v[..., 2] *= np.where(on_floor, keep, 1.0)
+        v[..., 1] *= np.where(on_wall, keep, 1.0)
         state.time_s += h
 
+    def _strain_sweep(self, x: np.ndarray, h: float, backward: bool) -> float:
+        worst = -1.0
+        order = list(zip(SELECTORS, self._slices))
+        for sel, (sa, sb) in (reversed(order) if backward else order):
+            if self.constants.strain_limited[sel.family]:
+                worst = max(worst, self._project(x, sa, sb, sel.family, h, limit_only=True))
+        return worst
+
     def _project(self, x: np.ndarray, sa, sb, family: int, h: float,
-                 limit_only: bool = False) -> None:
+                 limit_only: bool = False) -> float:
+        """One selector's XPBD constraints; returns the worst strain beyond the limit
+        (before correction) among springs with a movable end."""
         c = self.constants
         a = x[sa]
         b = x[sb]
@@ -154,3 +174,5 @@ class NumpyBackend:
         scale = np.where(safe, shorten / np.where(safe, wsum * length, 1.0), 0.0)
         x[sa] = a + (wa * scale) * d
         x[sb] = b - (wb * scale) * d
+        excess = np.where(safe, (length - limit) / rest, -1.0)
+        return float(excess.max()) if excess.size else -1.0

@@ -85,7 +85,7 @@ class ClothParams:
     stretch_stiffness_n_m: float = WEAVE_DEFAULTS[DEFAULT_WEAVE][1]
     shear_stiffness_n_m: float | None = None  # None: 10% of the stretch stiffness
     bend_stiffness_n_m: float = WEAVE_DEFAULTS[DEFAULT_WEAVE][2]
-    damping_per_s: float = 0.3  # mass-proportional velocity damping (light: not syrup)
+    damping_per_s: float = 0.5  # mass-proportional velocity damping (halves in 1.4 s)
     drag_coefficient: float = 1.2  # C_d of a flat plate, on the normal relative velocity
     air_density_kg_m3: float = AIR_DENSITY_KG_M3
     gravity_m_s2: float = GRAVITY_M_S2
@@ -96,14 +96,16 @@ class ClothParams:
     gust_period_s: float = 2.5  # time scale of the gust noise
     max_stretch: float = 0.10  # Provot's strain limit on stretch and shear springs
     opening: float = 1.0  # fraction of the rest width the rings span (1 = closed)
+    ring_spacing_m: float = 0.10  # rest fabric between two rings (a ring every k columns)
     ring_speed_m_s: float = 0.6  # how fast the rings slide to a new opening
     rod_height_m: float | None = None  # None: height_m + 0.05 (hem just above the floor)
     wall_gap_m: float = 0.12  # the window wall is the plane z = -wall_gap_m
     thickness_m: float = 0.004  # collision offset from the wall and floor planes
     friction: float = 0.4  # fraction of tangential velocity lost in a contact substep
-    strain_passes: int = 1  # extra strain-limiting sweeps per substep (after the LRA)
+    strain_passes: int = 1  # strain-limiting sweeps per substep (after the LRA)
+    final_strain_passes: int = 16  # at most this many in a frame's last substep (adaptive)
     max_substep_s: float = 1.0 / 600.0  # substeps per frame = ceil(frame_dt / this)
-    sleep_speed_m_s: float = 2.0e-3  # below this everywhere, for sleep_frames, it sleeps
+    sleep_speed_m_s: float = 5.0e-3  # below this everywhere, for sleep_frames, it sleeps
     sleep_frames: int = 20
     extra: Mapping[str, Any] = field(default_factory=dict, compare=False)
 
@@ -118,7 +120,7 @@ class ClothParams:
                 raise InputError(f"at most 4096 particles a side, found {value}", field=name)
         for name in ("width_m", "height_m", "areal_density_kg_m2", "stretch_stiffness_n_m",
                      "gust_length_m", "gust_period_s", "max_stretch", "max_substep_s",
-                     "ring_speed_m_s", "thickness_m"):
+                     "ring_speed_m_s", "ring_spacing_m", "thickness_m"):
             _positive(name, getattr(self, name))
         for name in ("bend_stiffness_n_m", "damping_per_s", "drag_coefficient",
                      "air_density_kg_m3", "gravity_m_s2", "wind_speed_m_s", "gust_strength",
@@ -136,6 +138,11 @@ class ClothParams:
                 or not 0 <= self.strain_passes <= 8:
             raise InputError(f"must be an integer in 0..8, found {self.strain_passes!r}",
                              field="strain_passes")
+        if isinstance(self.final_strain_passes, bool) \
+                or not isinstance(self.final_strain_passes, int) \
+                or not 0 <= self.final_strain_passes <= 256:
+            raise InputError(f"must be an integer in 0..256, found "
+                             f"{self.final_strain_passes!r}", field="final_strain_passes")
         if isinstance(self.sleep_frames, bool) or not isinstance(self.sleep_frames, int) \
                 or self.sleep_frames < 1:
             raise InputError(f"must be an integer >= 1, found {self.sleep_frames!r}",
@@ -171,6 +178,11 @@ class ClothParams:
     def particle_mass_kg(self) -> float:
         """Mass of one particle: the areal density times its share of the fabric."""
         return self.areal_density_kg_m2 * self.spacing_x_m * self.spacing_y_m
+
+    @property
+    def ring_every(self) -> int:
+        """Columns from one ring to the next (at least 1)."""
+        return max(1, round(self.ring_spacing_m / self.spacing_x_m))
 
     @property
     def rod_y_m(self) -> float:

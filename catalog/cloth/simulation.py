@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from catalog.cloth.params import ClothParams
-from catalog.cloth.state import ClothState, ring_positions
+from catalog.cloth.state import ClothState, inverse_mass, ring_positions
 from catalog.cloth.topology import FAMILIES, rest_lengths_m
 from catalog.errors import CatalogError, InputError
 
@@ -44,6 +44,7 @@ def max_spring_strain(positions_m: np.ndarray, params: ClothParams) -> float:
     """Largest (length - rest) / rest over all springs of all families (float64)."""
     x = np.asarray(positions_m, dtype=np.float64)
     rest = rest_lengths_m(params.spacing_x_m, params.spacing_y_m)
+    free = inverse_mass(params) > 0.0
     worst = -math.inf
     h, w = params.grid_h, params.grid_w
     for family, (_, di, dj, _, _) in enumerate(FAMILIES):
@@ -53,10 +54,10 @@ def max_spring_strain(positions_m: np.ndarray, params: ClothParams) -> float:
         if a.size == 0:
             continue
         length = np.sqrt(np.sum((b - a) ** 2, axis=-1))
-        # spring between two rings: the rod sets it, not the solver
         strain = (length - rest[family]) / rest[family]
-        if di == 0:
-            strain = strain[1:]
+        # a spring between two rings: the rod sets it, not the solver
+        movable = free[0:h - di, c0:w - max(dj, 0)] | free[di:h, c0 + dj:w - max(dj, 0) + dj]
+        strain = strain[movable]
         if strain.size:
             worst = max(worst, float(np.max(strain)))
     return worst
@@ -64,7 +65,7 @@ def max_spring_strain(positions_m: np.ndarray, params: ClothParams) -> float:
 
 def kinetic_energy_j(velocities_m_s: np.ndarray, params: ClothParams) -> float:
     """1/2 m sum |v|^2 over the free particles (the rings are driven, not counted)."""
-    v = np.asarray(velocities_m_s, dtype=np.float64)[1:]
+    v = np.asarray(velocities_m_s, dtype=np.float64)[inverse_mass(params) > 0.0]
     return 0.5 * params.particle_mass_kg * float(np.sum(v * v))
 
 

@@ -1,11 +1,12 @@
 """The simulation state and its rest pose: rings on the rod, pleats, the fabric below.
 
-The top row (row 0) is the row of rings. Ring c sits at x = -width/2 + c dx o (o the
-opening: the fraction of the rest width the rings span), alternately in front of and
-behind the rod's line by a pleat depth p = 1/2 sqrt(dx^2 - (o dx)^2), so neighbouring
-rings stay exactly one rest spacing apart along the zig-zag, as a ring tape folds.
-The rings are kinematic (inverse mass 0): they slide to new targets at
-``ring_speed_m_s`` and drag the fabric along.
+The top row (row 0) carries the heading. Every ``ring_every`` columns (and at both
+ends) a particle is held by a ring on the rod: kinematic (inverse mass 0), it slides to
+its target at ``ring_speed_m_s`` and drags the fabric along. Ring j sits at
+x = -width/2 + c_j dx o (o the opening: the fraction of the rest width the rings span),
+on the rod (z = 0). The fabric between two rings folds into a pleat, alternately
+towards the room and towards the window: in the rest pose each span is a V whose two
+straight legs keep the fabric's rest length, and every column hangs straight down.
 """
 
 from __future__ import annotations
@@ -18,28 +19,76 @@ import numpy as np
 from catalog.cloth.params import ClothParams
 
 
+def ring_columns(params: ClothParams) -> np.ndarray:
+    """Columns of row 0 held by rings (int64, sorted): every ring_every, and the last."""
+    cols = list(range(0, params.grid_w, params.ring_every))
+    if cols[-1] != params.grid_w - 1:
+        cols.append(params.grid_w - 1)
+    return np.array(cols, dtype=np.int64)
+
+
 def ring_positions(params: ClothParams, opening: float | None = None) -> np.ndarray:
-    """(W, 3) ring positions on the rod for an opening (default: the params' opening)."""
+    """(R, 3) positions of the rings on the rod for an opening (default: the params')."""
     o = params.opening if opening is None else opening
-    dx = params.spacing_x_m
-    cols = np.arange(params.grid_w)
-    pleat = 0.5 * math.sqrt(max(dx * dx - (o * dx) ** 2, 0.0))
-    # keep the pleats clear of the window wall (the rings are not collided)
-    pleat = min(pleat, 0.5 * (params.wall_gap_m - params.thickness_m))
-    rings = np.empty((params.grid_w, 3))
-    rings[:, 0] = -0.5 * params.width_m + cols * dx * o
+    cols = ring_columns(params)
+    rings = np.zeros((cols.size, 3))
+    rings[:, 0] = -0.5 * params.width_m + cols * params.spacing_x_m * o
     rings[:, 1] = params.rod_y_m
-    rings[:, 2] = np.where(cols % 2 == 0, -pleat, pleat)
     return rings
 
 
+def top_row(params: ClothParams, opening: float | None = None) -> np.ndarray:
+    """(W, 3) heading: rings on the rod, V-shaped pleats of rest length between them."""
+    o = params.opening if opening is None else opening
+    dx = params.spacing_x_m
+    cols = ring_columns(params)
+    rings = ring_positions(params, o)
+    row = np.zeros((params.grid_w, 3))
+    row[:, 1] = params.rod_y_m
+    # pleats clear of the window wall (depth at most half the gap)
+    max_depth = 0.5 * (params.wall_gap_m - params.thickness_m)
+    for j in range(cols.size - 1):
+        c0, c1 = int(cols[j]), int(cols[j + 1])
+        k = c1 - c0
+        span = rings[j + 1, 0] - rings[j, 0]
+        half_leg = 0.5 * k * dx
+        depth = min(math.sqrt(max(half_leg ** 2 - (0.5 * span) ** 2, 0.0)), max_depth)
+        sign = 1.0 if j % 2 == 0 else -1.0
+        for c in range(c0, c1 + 1):
+            s = (c - c0) / k  # 0..1 along the span
+            row[c, 0] = rings[j, 0] + s * span
+            row[c, 2] = sign * depth * (1.0 - abs(2.0 * s - 1.0))
+    return row
+
+
 def rest_pose(params: ClothParams, opening: float | None = None) -> np.ndarray:
-    """(H, W, 3) positions: each column hangs straight down from its ring."""
-    rings = ring_positions(params, opening)
+    """(H, W, 3) positions: every column hangs straight down from the heading."""
+    row = top_row(params, opening)
     rows = np.arange(params.grid_h)
-    x = np.repeat(rings[None, :, :], params.grid_h, axis=0)
+    x = np.repeat(row[None, :, :], params.grid_h, axis=0)
     x[:, :, 1] = params.rod_y_m - rows[:, None] * params.spacing_y_m
     return x
+
+
+def inverse_mass(params: ClothParams) -> np.ndarray:
+    """(H, W) 1/m per particle (1/kg); 0 for the particles held by rings."""
+    w = np.full((params.grid_h, params.grid_w), 1.0 / params.particle_mass_kg)
+    w[0, ring_columns(params)] = 0.0
+    return w
+
+
+def attachments(params: ClothParams) -> tuple[np.ndarray, np.ndarray]:
+    """Long-range attachments (Kim, Chentanez, Mueller 2012): for each particle the
+    index (into the rings) of its nearest ring in the rest fabric, and its rest distance
+    from it (m), which its distance from that ring may never exceed. (H, W) each."""
+    cols = ring_columns(params)
+    c = np.arange(params.grid_w)
+    nearest = np.argmin(np.abs(c[:, None] - cols[None, :]), axis=1)
+    dc = (c - cols[nearest]) * params.spacing_x_m
+    dr = np.arange(params.grid_h) * params.spacing_y_m
+    limit = np.sqrt(dr[:, None] ** 2 + dc[None, :] ** 2)
+    ring_index = np.broadcast_to(nearest[None, :], limit.shape).copy()
+    return ring_index, limit
 
 
 @dataclass
@@ -60,7 +109,7 @@ class ClothState:
     @classmethod
     def at_rest(cls, params: ClothParams) -> "ClothState":
         x = rest_pose(params)
-        rings = x[0].copy()
+        rings = ring_positions(params)
         return cls(positions_m=x, velocities_m_s=np.zeros_like(x),
                    ring_positions_m=rings, ring_targets_m=rings.copy())
 
@@ -73,27 +122,31 @@ class ClothState:
 
 @dataclass(frozen=True)
 class SolverConstants:
-    """Numbers every backend needs, derived once from the parameters."""
+    """Numbers and tables every backend needs, derived once from the parameters."""
 
-    inv_mass_per_kg: float  # 1/m of a free particle (the rings have 0)
+    inv_mass_per_kg: np.ndarray  # (H, W) 1/m; 0 where a ring holds the particle
+    ring_cols: np.ndarray  # (R,) columns of row 0 held by rings
     rest_m: np.ndarray  # (6,) rest length per family
     stiffness_n_m: np.ndarray  # (6,) k per family; the XPBD compliance is alpha = 1/k
     strain_limited: np.ndarray  # (6,) bool
     aero_per_m: float  # 1/2 rho C_d A / m = 1/2 rho C_d / areal density, 1/m
-    lra_step_m: float  # rest distance between rows (the LRA limit of row r is r * this)
+    lra_ring: np.ndarray  # (H, W) index of the attached ring
+    lra_limit_m: np.ndarray  # (H, W) rest distance from it
 
     @classmethod
     def from_params(cls, params: ClothParams) -> "SolverConstants":
         from catalog.cloth.topology import FAMILIES, rest_lengths_m
 
         k = params.spring_stiffness_n_m()
-        stiff = np.array([k[fam[3]] for fam in FAMILIES])
+        lra_ring, lra_limit = attachments(params)
         return cls(
-            inv_mass_per_kg=1.0 / params.particle_mass_kg,
+            inv_mass_per_kg=inverse_mass(params),
+            ring_cols=ring_columns(params),
             rest_m=rest_lengths_m(params.spacing_x_m, params.spacing_y_m),
-            stiffness_n_m=stiff,
+            stiffness_n_m=np.array([k[fam[3]] for fam in FAMILIES]),
             strain_limited=np.array([fam[4] for fam in FAMILIES]),
             aero_per_m=0.5 * params.air_density_kg_m3 * params.drag_coefficient
             / params.areal_density_kg_m2,
-            lra_step_m=params.spacing_y_m,
+            lra_ring=lra_ring,
+            lra_limit_m=lra_limit,
         )
