@@ -160,26 +160,38 @@ def test_screenshot_is_the_curtain_in_the_fabrics_colour(xdisplay, tmp_path):
     assert lace_rgb.max() / max(lace_rgb.min(), 1e-6) < 1.35, lace_rgb
 
 
-def test_stats_log_frame_parts_and_no_scipy(xdisplay, tmp_path):
-    """--stats: one JSON line per frame with its parts, and scipy never imported."""
+@pytest.fixture(scope="module")
+def stats_run(xdisplay, tmp_path_factory):
+    """One `catalog view --frames 6 --stats` run (the noon sun on the brightened lace)."""
     _need_presets(LACE)
-    out = tmp_path / "shot.png"
+    cwd = tmp_path_factory.mktemp("stats")
+    out = cwd / "shot.png"
     result = _catalog(["view", *QUICK, "--fabric", LACE, "--light", "sun:22", "--frames", "6",
-                       "--screenshot", str(out), "--stats"], xdisplay, tmp_path)
+                       "--screenshot", str(out), "--stats"], xdisplay, cwd)
     assert result.returncode == 0, result.stderr
-    records = _stats_records(result.stdout)
-    frames = [r for r in records if "frame" in r]
+    return _stats_records(result.stdout)
+
+
+def test_stats_log_frame_time_and_its_parts(stats_run):
+    """--stats: one JSON line per frame with its parts, then a summary."""
+    frames = [r for r in stats_run if "frame" in r]
     assert [r["frame"] for r in frames] == list(range(1, 7))
     for record in frames:
         parts = record["simulation_ms"] + record["shading_ms"] + record["ui_ms"]
         assert 0 < parts <= record["total_ms"] + 1e-6
         assert record["other_ms"] >= 0
-    heavy = frames[0]["heavy_modules"]
-    assert heavy["scipy"] is False, "the viewer imported scipy before its first frame"
-    assert heavy["matplotlib"] is False
-    summary = [r for r in records if r.get("summary")]
+    assert frames[0]["fabric"] == LACE and frames[0]["light"] == "sun:22"
+    summary = [r for r in stats_run if r.get("summary")]
     assert len(summary) == 1 and summary[0]["frames"] == 6
     assert summary[0]["size"] == [480, 320]
+    assert summary[0]["median_total_ms"] >= summary[0]["median_shading_ms"] > 0
+
+
+def test_viewer_imports_no_scipy_by_its_first_frame(stats_run):
+    """The viewer (window, renderer, cloth, panel) must not pull in scipy or matplotlib."""
+    heavy = stats_run[0]["heavy_modules"]
+    assert heavy["matplotlib"] is False, "the viewer imported matplotlib"
+    assert heavy["scipy"] is False, "the viewer imported scipy before its first frame"
 
 
 def test_split_screen_shows_two_fabrics(xdisplay, tmp_path):
