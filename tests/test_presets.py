@@ -70,6 +70,7 @@ def test_cloth_table_is_what_the_simulator_reads(path):
     assert params.areal_density_kg_m2 == pytest.approx(preset.table("cloth")["areal_density_kg_m2"])
 
 
+@pytest.mark.filterwarnings("ignore:Aligning")   # colour-science reshaping E and the dye to its CMFs
 def test_dyed_sheer_is_coloured_per_channel_and_spectrally():
     from catalog.spectra import read_spectrum
 
