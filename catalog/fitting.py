@@ -10,12 +10,14 @@ and rho (from the weave), tau (from the dye) are supplied, k_d and k_s derived
 
 Method. The model is linear in (direct, a_diff, a_spec) for fixed g's. A scan over a
 grid of (g_diff, g_spec) pairs solves the linear part exactly for each pair (variable
-projection) and keeps the best few pairs as starts; from each start Levenberg-Marquardt
-(scipy ``least_squares(method="lm")``, analytic Jacobian) first moves the two g's with
-the amplitudes projected out, then polishes all five parameters. The best end point
-wins, so the answer does not depend on an initial guess; a guess passed in is one more
-start. The g's are fitted through u (g = G_MID + G_HALF tanh u keeps
-g in (G_LOW, G_HIGH)), reported as g.
+projection, on at most SCAN_POINTS points) and keeps the best SCAN_STARTS pairs as
+starts; from each, Levenberg-Marquardt (scipy ``least_squares(method="lm")``, analytic
+Jacobian) fits all five parameters, holding at zero an amplitude that would go negative
+(and then the g of that lobe). The best end point wins, so no initial guess is needed.
+A guess passed in is one more start: LM first moves its two g's with the amplitudes
+solved by non-negative least squares at every step (robust from far away), then
+polishes all five. The g's are fitted through u (g = G_MID + G_HALF tanh u keeps g in
+(G_LOW, G_HIGH)), reported as g; the lobe with the larger g is called ``spec``.
 
 Standard errors: cov = s^2 (J^T J)^-1, J the Jacobian of the weighted residuals at the
 optimum in the reported parameters, s^2 = sum r^2 / (n - p) (the noise level is
@@ -103,8 +105,6 @@ def noise_scale(values: np.ndarray, weighting: str = "relative") -> np.ndarray:
     values = np.asarray(values, dtype=np.float64)
     if weighting == "none":
         return np.ones_like(values)
-    if weighting == "sqrt":
-        return np.sqrt(values + RELATIVE_FLOOR * float(np.median(values)))
     if weighting != "relative":
         raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {weighting!r}")
     floor = RELATIVE_FLOOR * float(np.median(values))
