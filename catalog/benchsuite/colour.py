@@ -98,20 +98,28 @@ def frame_seconds(renderer, mode: str, bands: int, repeats: int) -> float:
     return median_seconds(renderer.render, repeats, warmup=1, finish=renderer.ctx.finish)
 
 
-def run(quick: bool = False, ctx=None) -> dict:
-    """Rows: one per (fabric, light, variant); summary: per variant, and the default chosen."""
-    from catalog.presets import list_presets, load_preset  # noqa: PLC0415
+def run(quick: bool = False, ctx=None, *, fabrics=None, lights=None, error_size=None,
+        time_size=None, repeats=None) -> dict:
+    """Rows: one per (fabric, light, variant); summary: per variant, and the default chosen.
+
+    The keywords override the (quick or full) choice of fabrics (names), lights, sizes
+    (width, height) and timing repeats.
+    """
+    from catalog.presets import find_preset, list_presets, load_preset  # noqa: PLC0415
     from catalog.render.context import create_headless_context, describe  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
     ctx = ctx or create_headless_context()
-    presets = [load_preset(p) for p in list_presets()]
-    if quick:
-        presets = [p for p in presets if p.name in QUICK_FABRICS] or presets[:2]
-    lights = QUICK_LIGHTS if quick else LIGHTS
-    error_size = QUICK_ERROR_SIZE if quick else ERROR_SIZE
-    time_size = QUICK_TIME_SIZE if quick else TIME_SIZE
-    repeats = 3 if quick else 5
+    if fabrics is not None:
+        presets = [load_preset(find_preset(name)) for name in fabrics]
+    else:
+        presets = [load_preset(p) for p in list_presets()]
+        if quick:
+            presets = [p for p in presets if p.name in QUICK_FABRICS] or presets[:2]
+    lights = tuple(lights) if lights is not None else (QUICK_LIGHTS if quick else LIGHTS)
+    error_size = error_size or (QUICK_ERROR_SIZE if quick else ERROR_SIZE)
+    time_size = time_size or (QUICK_TIME_SIZE if quick else TIME_SIZE)
+    repeats = repeats or (3 if quick else 5)
 
     error_renderer = FrameRenderer(ctx, error_size)
     time_renderer = FrameRenderer(ctx, time_size)
@@ -176,7 +184,13 @@ def summarise(rows: list[dict]) -> dict:
     default = min(meeting)[1] if meeting else None
     pareto = pareto_front([(v["median_time_ratio"], v["mean_delta_e"], label)
                            for label, v in per_variant.items()])
-    return {"per_variant": per_variant, "default": default, "goal_met": default is not None,
+    per_light = {}
+    for light in sorted({r["light"] for r in rows}, key=[r["light"] for r in rows].index):
+        per_light[light] = {label: float(np.mean([r["mean_delta_e"] for r in rows
+                                                  if r["light"] == light and r["variant"] == label]))
+                            for label in per_variant}
+    return {"per_variant": per_variant, "per_light_mean_delta_e": per_light,
+            "default": default, "goal_met": default is not None,
             "pareto_front": pareto,
             "goal": {"mean_delta_e_below": GOAL_MEAN_DELTA_E, "time_ratio_at_most": GOAL_TIME_RATIO}}
 
@@ -193,12 +207,11 @@ def pareto_front(points: list[tuple[float, float, str]]) -> list[str]:
 
 def plot(result: dict, folder) -> list:
     """The Pareto plot: frame time ratio against mean Delta E, per case and per variant."""
-    import matplotlib  # noqa: PLC0415
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
     from pathlib import Path  # noqa: PLC0415
 
+    from catalog.benchsuite.plots import pyplot, save_figure  # noqa: PLC0415
+
+    plt = pyplot()
     rows = result["rows"]
     summary = result["summary"]["per_variant"]
     fig, ax = plt.subplots(figsize=(7.5, 5))
@@ -223,7 +236,4 @@ def plot(result: dict, folder) -> list:
     ax.set_title(f"Colour error against frame time (default: {default or 'none meets the goal'})")
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
-    path = Path(folder) / "bench_colour_pareto.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return [path]
+    return [save_figure(fig, Path(folder) / "bench_colour_pareto.png")]

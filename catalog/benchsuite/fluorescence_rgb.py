@@ -152,12 +152,11 @@ def summarise(rows: list[dict], cpu_ms: dict, goal_lights) -> dict:
 
 def plot(result: dict, folder) -> list:
     """Mean Delta E over all lights per representation, against the numbers it carries."""
-    import matplotlib  # noqa: PLC0415
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
     from pathlib import Path  # noqa: PLC0415
 
+    from catalog.benchsuite.plots import pyplot, save_figure  # noqa: PLC0415
+
+    plt = pyplot()
     per = result["summary"]["per_method"]
     names = list(per)
     fig, ax = plt.subplots(figsize=(8, 4.5))
@@ -172,7 +171,4 @@ def plot(result: dict, folder) -> list:
     ax.set_title(f"Fluorescence in an RGB engine (choice: {result['summary']['choice']})")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    path = Path(folder) / "bench_fluorescence_rgb.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return [path]
+    return [save_figure(fig, Path(folder) / "bench_fluorescence_rgb.png")]

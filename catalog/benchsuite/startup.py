@@ -1,0 +1,119 @@
+"""Start-up: import time, `catalog --help`, and time from the command to its first frame.
+
+Reuses benchmarks/bench_startup.py (import and --help cases, the heavy modules a module
+pulls in) and benchmarks/bench_viewer.py (a private Xvfb). Added here: the wall time of a
+fresh process ``catalog snapshot ... --size 640x360`` (EGL, one frame written) and
+``catalog view --frames 1`` in a 640x360 window under Xvfb (one frame shown), each from
+process start to exit after the first frame, median of repeats; and which heavy modules
+the viewer process had loaded at its first frame (it must not load scipy).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from catalog import PROJECT_ROOT
+
+BENCH_DIR = PROJECT_ROOT / "benchmarks"
+
+
+def load_script(name: str):
+    """A benchmark script of benchmarks/ as a module (they are scripts, not a package)."""
+    path = BENCH_DIR / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"_bench_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def wall_seconds(cmd: list[str], repeats: int, env: dict | None = None) -> tuple[float, str]:
+    """Median wall time of a fresh process; raises with its stderr if it fails."""
+    samples, out = [], ""
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = subprocess.run(cmd, capture_output=True, text=True, cwd=PROJECT_ROOT, env=env)
+        samples.append(time.perf_counter() - start)
+        if result.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} failed: {result.stderr.strip()[-400:]}")
+        out = result.stdout
+    return statistics.median(samples), out
+
+
+def run(quick: bool = False, ctx=None, *, first_frames: bool = True, repeats=None) -> dict:
+    """Import and --help times, heavy imports; with ``first_frames`` also the snapshot and
+    viewer processes to their first frame."""
+    startup = load_script("bench_startup")
+    repeats = repeats or (3 if quick else 7)
+    rows = []
+    floor = None
+    for name, cmd in startup.CASES.items():
+        seconds = startup.time_command(cmd, repeats)
+        floor = seconds if floor is None else floor
+        rows.append({"case": name, "median_s": seconds, "ratio_to_python": seconds / floor})
+    # colour-science: every light and CMF comes through it, and it loads scipy and matplotlib
+    seconds = startup.time_command([sys.executable, "-c", "import colour"], repeats)
+    rows.append({"case": "import colour (colour-science)", "median_s": seconds,
+                 "ratio_to_python": seconds / floor})
+    imports = {name: startup.heavy_imports_of(module) for name, module in startup.IMPORT_PROBES.items()}
+    imports["colour"] = startup.heavy_imports_of("colour")
+
+    frame_repeats = 1 if quick else 3
+    viewer_heavy = None
+    rows_note = None if first_frames else "first frames not timed (first_frames=False)"
+    if first_frames:
+        viewer_heavy, rows_note = first_frame_rows(rows, floor, frame_repeats)
+    viewer_imports_scipy = ("scipy" in (imports.get("catalog.viewer") or [])
+                            or "scipy" in (viewer_heavy or []))
+    return {"rows": rows,
+            "summary": {"import_catalog_s": next(r["median_s"] for r in rows if r["case"] == "import catalog"),
+                        "help_s": next(r["median_s"] for r in rows if r["case"] == "catalog --help"),
+                        "viewer_imports_scipy": viewer_imports_scipy,
+                        "heavy_imports": imports, "viewer_heavy_at_first_frame": viewer_heavy},
+            "settings": {"repeats": repeats, "frame_repeats": frame_repeats,
+                         **({"note": rows_note} if rows_note else {})}}
+
+
+def first_frame_rows(rows: list[dict], floor: float, frame_repeats: int):
+    """Append the snapshot and viewer first-frame rows; returns (the viewer's heavy modules
+    at its first frame, a note when the viewer could not be timed)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "first.png"
+        snapshot_cmd = [sys.executable, "-m", "catalog", "snapshot", "--fabric", "lace-fwa",
+                        "--light", "D65", "--size", "640x360", "--out", str(out), "--json"]
+        seconds, stdout = wall_seconds(snapshot_cmd, frame_repeats)
+        report = json.loads(stdout)
+        rows.append({"case": "catalog snapshot 640x360 (start to written frame)",
+                     "median_s": seconds, "ratio_to_python": seconds / floor,
+                     "render_s": float(report.get("render_s", 0.0))})
+    viewer_heavy = None
+    try:
+        viewer = load_script("bench_viewer")
+        xvfb, display = viewer.start_xvfb()
+    except (SystemExit, OSError) as exc:
+        rows_note = f"catalog view not timed: {exc}"
+    else:
+        rows_note = None
+        try:
+            env = dict(os.environ, DISPLAY=display)
+            env.pop("WAYLAND_DISPLAY", None)
+            view_cmd = [sys.executable, "-m", "catalog", "view", "--size", "640x360",
+                        "--frames", "1", "--stats", "--fabric", "lace-fwa", "--light", "D65"]
+            seconds, stdout = wall_seconds(view_cmd, frame_repeats, env)
+            records = [json.loads(line) for line in stdout.splitlines() if line.startswith("{")]
+            first = next((r for r in records if "heavy_modules" in r), {})
+            viewer_heavy = sorted(k for k, v in first.get("heavy_modules", {}).items() if v)
+            rows.append({"case": "catalog view 640x360, Xvfb (start to first frame, exit)",
+                         "median_s": seconds, "ratio_to_python": seconds / floor,
+                         "first_frame_ms": float(first.get("total_ms", 0.0))})
+        finally:
+            xvfb.terminate()
+            xvfb.wait()
+    return viewer_heavy, rows_note

@@ -1,0 +1,105 @@
+"""``catalog bench``: run time against error, every benchmark side by side.
+
+    catalog bench [--quick] [--json] [--out DIR] [--sections colour,fluorescence,...]
+
+Runs the sections of :mod:`catalog.benchsuite` (colour accuracy against frame time,
+fluorescence representations on measured matrices, fit, cloth, numerical stability,
+start-up) and writes ``bench.md`` (tables), ``bench.json`` and PNG plots into DIR
+(default ``bench-out``). ``--json`` prints the same report as one JSON object on stdout;
+progress goes to stderr. ``--quick`` runs a reduced set (a few minutes on two cores).
+docs/bench.md has the latest figures.
+"""
+
+from __future__ import annotations
+
+HELP = "benchmarks: colour error against frame time, fluorescence, fit, cloth, stability, start-up"
+
+DEFAULT_OUT = "bench-out"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--quick", action="store_true",
+                        help="reduced cases and repeats (a few minutes; for CI)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    parser.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
+                        help=f"folder for bench.md, bench.json and the plots (default {DEFAULT_OUT})")
+    parser.add_argument("--sections", metavar="NAME,NAME",
+                        help="run only these sections (default: all): colour, fluorescence, "
+                             "fit, cloth, stability, startup")
+
+
+def parse_sections(text: str | None) -> list[str]:
+    from catalog.benchsuite import SECTIONS  # noqa: PLC0415
+    from catalog.errors import InputError  # noqa: PLC0415
+
+    if text is None:
+        return list(SECTIONS)
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    unknown = [n for n in names if n not in SECTIONS]
+    if unknown or not names:
+        raise InputError(f"unknown section {', '.join(unknown) or '(none given)'}; choose from "
+                         f"{', '.join(SECTIONS)}", field="--sections")
+    return [n for n in SECTIONS if n in names]
+
+
+def run(args) -> int:
+    import importlib  # noqa: PLC0415
+    import os  # noqa: PLC0415
+    import platform  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+    import time  # noqa: PLC0415
+    import traceback  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    from catalog.benchsuite import SECTIONS  # noqa: PLC0415
+    from catalog.benchsuite.report import write_report  # noqa: PLC0415
+    from catalog.errors import InputError  # noqa: PLC0415
+    from catalog.jsonout import print_json  # noqa: PLC0415
+
+    names = parse_sections(args.sections)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{str(out)!r} exists and is not a folder", field="--out")
+
+    def say(text: str) -> None:
+        print(f"catalog bench: {text}", file=sys.stderr, flush=True)
+
+    ctx = None
+    machine = {"cpu_count": os.cpu_count(), "platform": platform.platform(),
+               "python": platform.python_version()}
+    if any(n in ("colour", "stability") for n in names):
+        from catalog.render.context import create_headless_context, describe  # noqa: PLC0415
+
+        ctx = create_headless_context()
+        machine["gl_renderer"] = describe(ctx)["renderer"]
+    report = {"benchmark": "catalog bench", "quick": bool(args.quick), "machine": machine,
+              "sections": {}, "failed": {}}
+    start_all = time.perf_counter()
+    plotters = {}
+    for name in names:
+        module = importlib.import_module(SECTIONS[name])
+        say(f"{name} ...")
+        start = time.perf_counter()
+        try:
+            result = module.run(quick=bool(args.quick), ctx=ctx)
+        except Exception as exc:  # noqa: BLE001 - one broken section must not lose the others
+            report["failed"][name] = f"{type(exc).__name__}: {exc}"
+            say(f"{name} FAILED: {type(exc).__name__}: {exc}")
+            traceback.print_exc(file=sys.stderr)
+            continue
+        result["seconds"] = time.perf_counter() - start
+        report["sections"][name] = result
+        if hasattr(module, "plot"):
+            plotters[name] = module.plot
+        say(f"{name} done in {result['seconds']:.1f} s")
+    report["total_seconds"] = time.perf_counter() - start_all
+    written = write_report(report, out, plotters)
+    report["written"] = [str(p) for p in written]
+    if ctx is not None:
+        ctx.release()
+    say(f"wrote {', '.join(str(p) for p in written)}")
+    if args.json:
+        print_json(report)
+    else:
+        print((out / "bench.md").read_text(encoding="utf-8"))
+    return 1 if report["failed"] else 0
