@@ -422,11 +422,26 @@ class _CTProblem:
         self.inv_scale = 1.0 / np.asarray(scale, dtype=np.float64)
         self.target = self.values * self.inv_scale
         self.evaluations = 0
+        self._spec: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+
+    def spec(self, log_m: float):
+        """(D G / (4 cos_o), its derivative in log m) at roughness e^log_m, cached:
+        LM asks for the residual and the Jacobian at the same point."""
+        log_m = float(log_m)
+        cached = self._spec.get(log_m)
+        if cached is None:
+            m = math.exp(log_m)
+            cos_h = self.geometry["cos_h"]
+            spec = beckmann_d(cos_h, m) * self.spec_factor
+            dspec = beckmann_d_droughness(cos_h, m) * self.spec_factor * m
+            if len(self._spec) > 8:
+                self._spec.clear()
+            cached = self._spec[log_m] = (spec, dspec)
+        return cached
 
     def model(self, p):
         direct, k_l, k_s, log_m = p
-        spec = beckmann_d(self.geometry["cos_h"], math.exp(log_m)) * self.spec_factor
-        return direct * self.straight + k_l * self.lambert + k_s * spec
+        return direct * self.straight + k_l * self.lambert + k_s * self.spec(log_m)[0]
 
     def residual(self, p):
         self.evaluations += 1
@@ -434,12 +449,12 @@ class _CTProblem:
 
     def jacobian(self, p):
         direct, k_l, k_s, log_m = p
-        m = math.exp(log_m)
+        spec, dspec = self.spec(log_m)
         cols = np.empty((len(self.values), 4))
         cols[:, 0] = self.straight
         cols[:, 1] = self.lambert
-        cols[:, 2] = beckmann_d(self.geometry["cos_h"], m) * self.spec_factor
-        cols[:, 3] = k_s * beckmann_d_droughness(self.geometry["cos_h"], m) * self.spec_factor * m
+        cols[:, 2] = spec
+        cols[:, 3] = k_s * dspec
         return cols * self.inv_scale[:, None]
 
 
