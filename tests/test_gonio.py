@@ -170,3 +170,105 @@ def test_broken_files_are_refused_with_file_and_line(tmp_path, case):
 def test_missing_file_is_named(tmp_path):
     with pytest.raises(InputError, match="no such file"):
         gonio.read_gonio(tmp_path / "absent.csv")
+
+
+# --- the yarn-level generator (tools/make_gonio.py) ------------------------------------------
+
+def _make_gonio_module():
+    import importlib.util
+    import sys
+
+    from catalog import PROJECT_ROOT
+
+    if "make_gonio" not in sys.modules:
+        spec = importlib.util.spec_from_file_location("make_gonio",
+                                                      PROJECT_ROOT / "tools" / "make_gonio.py")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["make_gonio"] = module          # dataclasses look their module up
+        spec.loader.exec_module(module)
+    return sys.modules["make_gonio"]
+
+
+def test_generator_reproduces_the_committed_measurement(tmp_path):
+    from catalog import FABRIC_DIR
+
+    make_gonio = _make_gonio_module()
+    fabric = next(f for f in make_gonio.CATALOG if f.name == "sheer-teal")
+    make_gonio.write_fabric(fabric, tmp_path)
+    for name in ("gonio.csv", "dye.csv"):
+        assert (tmp_path / "sheer-teal" / name).read_text() == \
+            (FABRIC_DIR / "measurements" / "sheer-teal" / name).read_text(), name
+
+
+def test_open_area_of_cylinders_with_gaps():
+    make_gonio = _make_gonio_module()
+    fabric = next(f for f in make_gonio.CATALOG if f.name == "voile-white")
+    normal = np.array([[0.0, 0.0, 1.0]])
+    expected = ((1 - fabric.warp_diameter_mm / fabric.warp_spacing_mm)
+                * (1 - fabric.weft_diameter_mm / fabric.weft_spacing_mm))
+    assert make_gonio.open_fraction(normal, fabric)[0] == pytest.approx(expected, rel=1e-12)
+    # tilting towards x closes the gaps between warp threads only: the weft factor stays
+    angles = np.radians([10.0, 30.0, 50.0])
+    tilted = np.stack([np.sin(angles), np.zeros(3), np.cos(angles)], axis=1)
+    opening = make_gonio.open_fraction(tilted, fabric)
+    assert np.all(np.diff(opening) < 0) and opening[0] < expected
+    h = fabric.layer_thickness_mm - 0.5 * (fabric.warp_diameter_mm + fabric.weft_diameter_mm)
+    gap = (fabric.warp_spacing_mm - fabric.warp_diameter_mm / np.cos(angles[1])
+           - h * np.tan(angles[1]))
+    assert opening[1] == pytest.approx(gap / fabric.warp_spacing_mm
+                                       * (1 - fabric.weft_diameter_mm / fabric.weft_spacing_mm))
+
+
+@pytest.mark.parametrize("nu", [None, 2.0])
+def test_fibre_deflection_density_has_unit_weight(nu):
+    """Over the sphere (Gauss-Legendre in cos theta x uniform azimuth), a narrow lobe
+    around an oblique direction of travel integrates to 1 (Student-t: minus its tail
+    beyond pi, (1 + (pi/sigma)^2/nu)^(-nu/2) < 0.2 %)."""
+    make_gonio = _make_gonio_module()
+    travel = np.array([math.sin(0.4), 0.0, math.cos(0.4)])
+    x, w = np.polynomial.legendre.leggauss(400)
+    # cos theta about the travel direction, from 1 down to -1, denser near 1
+    t = 0.5 * (x + 1)
+    cos_t = 1 - 2 * t ** 3
+    weight_t = w * 0.5 * 6 * t ** 2
+    phi = np.linspace(0, 2 * math.pi, 256, endpoint=False)
+    e1 = np.array([math.cos(0.4), 0.0, -math.sin(0.4)])
+    e2 = np.cross(travel, e1)
+    sin_t = np.sqrt(1 - cos_t ** 2)
+    view = (cos_t[:, None, None] * travel
+            + sin_t[:, None, None] * (np.cos(phi)[None, :, None] * e1
+                                      + np.sin(phi)[None, :, None] * e2))
+    density = make_gonio.deflection_density(np.broadcast_to(travel, view.shape), view,
+                                            math.radians(6.0), math.radians(4.0), nu)
+    total = float(np.sum(density * weight_t[:, None]) * (2 * math.pi / len(phi)))
+    assert total == pytest.approx(1.0, abs=0.01)
+
+
+def test_two_exposure_measurement_keeps_peak_and_skirt():
+    """From the skirt (3e-4) to far above the long exposure's saturation: unbiased, within
+    ~1 % where the signal is well above the read noise, and at the read-noise floor
+    (2 DN per pixel over 40x40 pixels) below that."""
+    make_gonio = _make_gonio_module()
+    values = np.geomspace(3e-4, 50.0, 200)
+    rng = np.random.default_rng(0)
+    measured = np.stack([make_gonio.measure(values, rng) for _ in range(40)])
+    # the noise model written out: per-pixel read, photon and rounding noise averaged
+    # over the patch, in the exposure that does not saturate; lamp flicker; the reference
+    def exposure_sigma(gain):
+        mean_dn = values * gain
+        per_pixel = make_gonio.READ_NOISE_DN ** 2 + mean_dn / make_gonio.ELECTRONS_PER_DN
+        return np.sqrt((per_pixel + 1 / 12) / make_gonio.PIXELS) / gain, \
+            mean_dn + 4 * np.sqrt(per_pixel) >= make_gonio.FULL_WELL_DN
+    long_sigma, long_saturated = exposure_sigma(make_gonio.LONG_GAIN_DN)
+    short_sigma, _ = exposure_sigma(make_gonio.SHORT_GAIN_DN)
+    expected_sigma = np.sqrt(np.where(long_saturated, short_sigma, long_sigma) ** 2
+                             + ((make_gonio.FLICKER ** 2 + make_gonio.REFERENCE_NOISE ** 2)
+                                * values ** 2))
+    spread = np.std(measured, axis=0)
+    bias = np.mean(measured, axis=0) - values
+    assert np.all(spread < 1.5 * expected_sigma) and np.all(spread > 0.5 * expected_sigma)
+    assert np.all(np.abs(bias) < 4 * expected_sigma / math.sqrt(40))
+    strong = values > 1e-2
+    assert np.all(spread[strong] / values[strong] < 0.015)
+    saturating = values * make_gonio.LONG_GAIN_DN > make_gonio.FULL_WELL_DN
+    assert saturating.any() and not saturating.all()
