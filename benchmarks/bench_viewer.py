@@ -5,7 +5,7 @@ for each case, takes the median of the per-frame parts after a warm-up (the firs
 pay for imports, shader compiles and the cloth's JIT), prints a table and writes JSON.
 
     .venv/bin/python benchmarks/bench_viewer.py [--frames 60] [--warmup 10] [--json-out FILE]
-        [--cases 1280x720:48x64,1920x1080:128x128]
+        [--cases 1280x720:48x64,1920x1080:128x128] [--render-scale auto|S]
 
 On a machine with a display of its own, --display :0 uses it instead of Xvfb.
 """
@@ -48,12 +48,12 @@ def start_xvfb() -> tuple[subprocess.Popen, str]:
 
 
 def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backend: str,
-             fabric: str, light: str) -> dict:
+             fabric: str, light: str, render_scale: str) -> dict:
     env = dict(os.environ, DISPLAY=display)
     env.pop("WAYLAND_DISPLAY", None)
     cmd = [sys.executable, "-m", "catalog", "view", "--size", size, "--grid", grid,
            "--cloth-backend", backend, "--frames", str(frames + warmup), "--stats",
-           "--wind", "2.0", "--fabric", fabric, "--light", light]
+           "--wind", "2.0", "--fabric", fabric, "--light", light, "--render-scale", render_scale]
     start = time.perf_counter()
     result = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=ROOT)
     wall = time.perf_counter() - start
@@ -61,9 +61,11 @@ def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backe
         raise SystemExit(f"bench_viewer: {' '.join(cmd)} failed:\n{result.stderr}")
     records = [json.loads(line) for line in result.stdout.splitlines() if line.startswith("{")]
     frames_rec = [r for r in records if "frame" in r and not r.get("summary")]
+    summary = next(r for r in records if r.get("summary"))
     first = frames_rec[0]
     steady = frames_rec[warmup:]
     row = {"size": size, "grid": grid, "backend": backend, "frames": len(steady),
+           "render_scale": summary["render_scale"],
            "first_frame_ms": round(first["total_ms"], 1), "wall_s": round(wall, 1),
            "scipy_imported": first["heavy_modules"]["scipy"]}
     for part in PARTS:
@@ -82,6 +84,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backend", default="cpu", choices=("cpu", "numpy"))
     parser.add_argument("--fabric", default="lace-fwa")
     parser.add_argument("--light", default="D65")
+    parser.add_argument("--render-scale", default="auto",
+                        help="scene resolution / window resolution, or auto (the viewer's default)")
     parser.add_argument("--display", help="use this X display instead of a private Xvfb")
     parser.add_argument("--json-out", type=Path, default=ROOT / "benchmarks" / "viewer.json")
     args = parser.parse_args(argv)
@@ -95,9 +99,9 @@ def main(argv: list[str] | None = None) -> int:
         for case in args.cases.split(","):
             size, grid = case.split(":")
             rows.append(run_case(display, size, grid, args.frames, args.warmup, args.backend,
-                                 args.fabric, args.light))
+                                 args.fabric, args.light, args.render_scale))
             row = rows[-1]
-            print(f"{row['size']:>10} grid {row['grid']:>8}: total {row['total_ms']:7.1f} ms "
+            print(f"{row['size']:>10} x{row['render_scale']} grid {row['grid']:>8}: total {row['total_ms']:7.1f} ms "
                   f"({row['fps']} fps) = simulation {row['simulation_ms']:6.1f} + shading "
                   f"{row['shading_ms']:6.1f} + UI {row['ui_ms']:5.1f} + other "
                   f"{row['other_ms']:5.1f}; first frame {row['first_frame_ms']} ms",

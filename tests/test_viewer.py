@@ -159,6 +159,17 @@ def test_screenshot_is_the_curtain_in_the_fabrics_colour(xdisplay, tmp_path):
     # the white lace under D65 with no fluorescence is near neutral where the cloth is
     assert lace_rgb.max() / max(lace_rgb.min(), 1e-6) < 1.35, lace_rgb
 
+    # full resolution (the runs above are at the software rasteriser's auto 0.5, upscaled
+    # into the window): the same picture in the same place, only sharper
+    out = tmp_path / "full.png"
+    result = _catalog(["view", *QUICK, "--fabric", LACE, "--light", "D65", "--fluorescence",
+                       "off", "--paused", "--no-panel", "--frames", "3", "--render-scale", "1",
+                       "--screenshot", str(out)], xdisplay, tmp_path)
+    assert result.returncode == 0, result.stderr
+    full = _read_image(out)
+    assert float(np.abs(full - lace).mean()) < 0.03
+    np.testing.assert_allclose(full[mask].mean(axis=0), lace_rgb, atol=0.03)
+
 
 @pytest.fixture(scope="module")
 def stats_run(xdisplay, tmp_path_factory):

@@ -41,6 +41,18 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _render_scale(text: str) -> float | None:
+    if text == "auto":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number or 'auto', found {text!r}") from None
+    if not 0.25 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"must be within 0.25-1, found {value:g}")
+    return value
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fabric", help="fabric to show first (preset name or .toml)")
     parser.add_argument("--light", help="light to start with: 'sun' (hour slider), a CIE "
@@ -68,6 +80,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="cloth particles across x down (default 48x64)")
     parser.add_argument("--cloth-backend", choices=("numpy", "cpu"), default="cpu",
                         help="cloth simulation backend (default cpu)")
+    parser.add_argument("--render-scale", type=_render_scale, metavar="S|auto", default=None,
+                        help="scene resolution relative to the window, 0.25-1 (default auto: "
+                        "0.5 on a software rasteriser such as llvmpipe, else 1)")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
     parser.add_argument("--fabric-dir", type=Path, metavar="DIR",
@@ -102,6 +117,6 @@ def run(args: argparse.Namespace) -> int:
         frames=args.frames, screenshot=args.screenshot, screenshot_dir=args.screenshot_dir,
         stats=args.stats, fluorescence=args.fluorescence, bands=args.bands, hour=args.hour,
         wind_m_s=args.wind, grid=args.grid, cloth_backend=args.cloth_backend,
-        panel=not args.no_panel, paused=args.paused,
+        panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
         fabric_dir=fabric_dir if fabric_dir is not None else FABRIC_DIR)
     return ViewerApp(options).run()

@@ -28,6 +28,9 @@ from catalog.viewer.timing import FrameTimer
 
 #: Simulated time per frame when a frame count is given (reproducible runs), s.
 FIXED_FRAME_DT_S = 1.0 / 60.0
+#: Scene resolution on a software rasteriser (llvmpipe): a quarter of the pixels, upscaled.
+SOFTWARE_RENDER_SCALE = 0.5
+SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "SWR")
 #: Bounds on the simulated time per frame in interactive use (slow machines run slow motion
 #: rather than let the cloth take huge steps), s.
 MIN_FRAME_DT_S, MAX_FRAME_DT_S = 1.0 / 240.0, 1.0 / 15.0
@@ -53,6 +56,7 @@ class ViewerOptions:
     cloth_backend: str = "cpu"
     panel: bool = True
     paused: bool = False
+    render_scale: float | None = None  # scene resolution / window resolution; None: auto
     fabric_dir: Path = FABRIC_DIR
     extra: dict = field(default_factory=dict)
 
@@ -131,6 +135,7 @@ class ViewerApp:
         self.glfw = glfw
         self.window = window
         self.ctx: moderngl.Context = wrap_window_context()
+        self.render_scale = self._choose_render_scale()
         glfw.swap_interval(0 if self.options.frames is not None else 1)
 
         imgui.create_context()
@@ -144,6 +149,7 @@ class ViewerApp:
                                   wind_m_s=self.settings.wind_m_s)
         self._fbo = None
         self._renderers: list = []
+        self._scaled_fbos: list = []  # one per renderer when render_scale < 1
         self._layout_key = None
         self._applied: dict[int, dict] = {}
 
@@ -183,7 +189,12 @@ class ViewerApp:
                     renderer.set_camera(self.camera.yaw_deg, self.camera.pitch_deg,
                                         self.camera.distance_m)
                     try:
-                        renderer.render(fbo=self._fbo, viewport=viewport)
+                        if self._scaled_fbos:
+                            small = self._scaled_fbos[slot]
+                            renderer.render(fbo=small, viewport=(0, 0, *small.size))
+                            self._blit(small, viewport)
+                        else:
+                            renderer.render(fbo=self._fbo, viewport=viewport)
                         self.messages.pop(f"render{slot}", None)
                     except CatalogError as exc:  # e.g. no fabric loads: say so, keep running
                         self.messages[f"render{slot}"] = str(exc)
@@ -220,6 +231,7 @@ class ViewerApp:
         if self.options.stats:
             summary = {"summary": True, "frames": frame, "size": list(self._fbo.size),
                        "grid": list(self.options.grid), "renderer": self.ctx.info["GL_RENDERER"],
+                       "render_scale": self.render_scale,
                        **{f"median_{k}_ms": round(v, 3)
                           for k, v in self.timer.median_ms().items()}}
             print(json.dumps(summary), flush=True)
@@ -319,13 +331,39 @@ class ViewerApp:
             self._fbo = self.ctx.simple_framebuffer(size, components=4)
         for renderer in self._renderers:
             self.scene.forget(renderer)
-            if hasattr(renderer, "release"):
-                renderer.release()
-        self._renderers = []
+            renderer.release()
+        for small in self._scaled_fbos:
+            small.release()
+        self._renderers, self._scaled_fbos = [], []
         self._applied = {}
         self._layout_key = key
         for viewport in self._viewports():
-            self._renderers.append(FrameRenderer(self.ctx, (viewport[2], viewport[3])))
+            size = (viewport[2], viewport[3])
+            if self.render_scale < 1.0:
+                size = (max(1, round(size[0] * self.render_scale)),
+                        max(1, round(size[1] * self.render_scale)))
+                self._scaled_fbos.append(self.ctx.simple_framebuffer(size, components=4))
+            self._renderers.append(FrameRenderer(self.ctx, size))
+
+    def _choose_render_scale(self) -> float:
+        """The option's scale, or on a software rasteriser SOFTWARE_RENDER_SCALE, else 1."""
+        if self.options.render_scale is not None:
+            return float(self.options.render_scale)
+        renderer = self.ctx.info.get("GL_RENDERER", "")
+        return SOFTWARE_RENDER_SCALE if any(name in renderer for name in SOFTWARE_RENDERERS) \
+            else 1.0
+
+    def _blit(self, small, viewport: tuple[int, int, int, int]) -> None:
+        """Scale a reduced-resolution scene up into its viewport of the window framebuffer
+        (glBlitFramebuffer, linear filter; moderngl's copy_framebuffer does not scale)."""
+        from OpenGL import GL as gl  # noqa: PLC0415  (PyOpenGL: imgui's backend needs it anyway)
+
+        x, y, width, height = viewport
+        gl.glBindFramebuffer(gl.GL_READ_FRAMEBUFFER, small.glo)
+        gl.glBindFramebuffer(gl.GL_DRAW_FRAMEBUFFER, self._fbo.glo)
+        gl.glBlitFramebuffer(0, 0, small.size[0], small.size[1], x, y, x + width, y + height,
+                             gl.GL_COLOR_BUFFER_BIT, gl.GL_LINEAR)
+        self._fbo.use()
 
     def _sync_renderers(self) -> None:
         """Pass the settings to each renderer, only what changed since the last frame."""
