@@ -213,3 +213,26 @@ def test_paper_mode_colour_is_eq_1_to_3_of_the_emission(gl, make_preset):
     expected = intensity * xyz_paper / 255.0 * white_y
     assert np.allclose(added, expected, rtol=1e-9)
     renderer.release()
+
+
+def test_cloth_interleaved_vertex_buffer_draws_like_set_mesh(gl, make_preset):
+    """The cloth's dynamic layout (docs/cloth.md, 48 bytes a vertex) bound directly, moved by an
+    offset in the vertex shader, gives the frame that uploading the same arrays gives."""
+    from catalog.cloth.mesh import curtain_mesh
+    from catalog.render import scene
+
+    mesh = curtain_mesh()
+    offset = np.array([0.0, scene.CURTAIN_TOP_Y - 2.25, scene.CURTAIN_Z], dtype=np.float32)
+    renderer = _renderer(gl, make_preset(), "sun:100")
+    renderer.set_mesh(mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3],
+                      mesh.indices.astype(np.int32))
+    renderer.render()
+    uploaded = renderer.read_linear()
+    assert uploaded.max() > 0
+    vertex_buffer = gl.buffer(mesh.vertex_data().tobytes())
+    renderer.bind_cloth_vertex_buffer(vertex_buffer, offset_m=offset)
+    renderer.render()
+    bound = renderer.read_linear()
+    assert np.allclose(bound, uploaded, rtol=1e-5, atol=1e-5 * uploaded.max())
+    renderer.release()
+    vertex_buffer.release()

@@ -170,9 +170,7 @@ class FrameRenderer:
             raise CatalogError("curtain mesh arrays differ in vertex count")
         if indices.size == 0 or indices.size % 3 or indices.min() < 0 or indices.max() >= count:
             raise CatalogError("curtain mesh indices must be triangles of existing vertices")
-        if self._curtain_buffers is not None:
-            for buffer in self._curtain_buffers.values():
-                buffer.release()
+        self._release_own_buffers()
         self._curtain_buffers = {
             "position": self.ctx.buffer(positions.tobytes()),
             "normal": self.ctx.buffer(normals.tobytes()),
@@ -180,7 +178,9 @@ class FrameRenderer:
             "uv": self.ctx.buffer(uvs.tobytes()),
             "index": self.ctx.buffer(indices.tobytes()),
         }
+        self._own_buffers = list(self._curtain_buffers.values())  # the cloth's are not ours
         self._curtain_format = "3f"
+        self._mesh_offset = (0.0, 0.0, 0.0)
         self._vertex_count = count
         self._release_vaos()
         self.mesh_arrays = (positions, normals, tangents)
@@ -193,7 +193,8 @@ class FrameRenderer:
             raise CatalogError(f"update_positions: expected {self._vertex_count} vertices, "
                                f"got {positions.shape[0]}")
         if self._curtain_format != "3f":
-            raise CatalogError("update_positions after bind_cloth_buffers: the cloth owns the buffers")
+            raise CatalogError("update_positions after bind_cloth_buffers / bind_cloth_vertex_buffer: "
+                               "the cloth owns the buffers")
         self._curtain_buffers["position"].write(positions.tobytes())
         self._curtain_buffers["normal"].write(normals.tobytes())
         self.mesh_arrays = (positions, normals, self.mesh_arrays[2])
@@ -206,8 +207,42 @@ class FrameRenderer:
             raise CatalogError(f"cloth buffers hold fewer than {self._vertex_count} vec4 vertices")
         self._curtain_buffers["position"] = position_buffer
         self._curtain_buffers["normal"] = normal_buffer
+        self._curtain_buffers.pop("interleaved", None)
         self._curtain_format = "3f 4x"
         self._release_vaos()
+
+    def bind_cloth_vertex_buffer(self, vertex_buffer, index_buffer=None,
+                                 offset_m=(0.0, 0.0, 0.0)) -> None:
+        """Draw the cloth's interleaved dynamic buffer directly (docs/cloth.md: 48 bytes per
+        vertex, [x y z 1 | nx ny nz 0 | tx ty tz w]), as the GPU backend writes it.
+
+        ``index_buffer``: its uint32 triangles (default: those of the last :meth:`set_mesh`,
+        which must then have the same vertex count). ``offset_m`` moves the cloth's frame into
+        the scene (e.g. ``(0, scene.CURTAIN_TOP_Y - params.rod_y_m, scene.CURTAIN_Z)``).
+        """
+        count = vertex_buffer.size // 48
+        if index_buffer is None and count != self._vertex_count:
+            raise CatalogError(f"cloth vertex buffer holds {count} vertices, the mesh "
+                               f"{self._vertex_count}: pass its index_buffer")
+        self._curtain_buffers["interleaved"] = vertex_buffer
+        if index_buffer is not None:
+            self._curtain_buffers["index"] = index_buffer
+        self._vertex_count = count
+        self._curtain_format = "interleaved"
+        self.set_mesh_offset(offset_m)
+        self._release_vaos()
+
+    def set_mesh_offset(self, offset_m) -> None:
+        """Translate the curtain mesh (metres) in the vertex shader."""
+        offset = tuple(float(v) for v in offset_m)
+        if len(offset) != 3 or not all(math.isfinite(v) for v in offset):
+            raise CatalogError(f"mesh offset {offset_m!r} must be three finite numbers (m)")
+        self._mesh_offset = offset
+
+    def _release_own_buffers(self) -> None:
+        for buffer in getattr(self, "_own_buffers", []):
+            buffer.release()
+        self._own_buffers = []
 
     def _release_vaos(self) -> None:
         for vao in self._vaos.values():
@@ -269,11 +304,17 @@ class FrameRenderer:
         key = ("curtain", id(program))
         if key not in self._vaos:
             b = self._curtain_buffers
-            content = [(b["position"], self._curtain_format, "in_position")]
-            if "in_normal" in program:
-                content.append((b["normal"], self._curtain_format, "in_normal"))
-            if "in_tangent" in program:
-                content.append((b["tangent"], "3f", "in_tangent"))
+            if self._curtain_format == "interleaved":
+                names = [n for n in ("in_position", "in_normal", "in_tangent") if n in program]
+                layout = " ".join("3f 4x" if n in program else "16x"
+                                  for n in ("in_position", "in_normal", "in_tangent"))
+                content = [(b["interleaved"], layout, *names)]
+            else:
+                content = [(b["position"], self._curtain_format, "in_position")]
+                if "in_normal" in program:
+                    content.append((b["normal"], self._curtain_format, "in_normal"))
+                if "in_tangent" in program:
+                    content.append((b["tangent"], "3f", "in_tangent"))
             self._vaos[key] = self.ctx.vertex_array(program, content, index_buffer=b["index"],
                                                     index_element_size=4)
         return self._vaos[key]
@@ -324,10 +365,12 @@ class FrameRenderer:
         if trivial:
             program = self._program("curtain.vert", "trivial.frag")
             self._set(program, "u_view_proj", gl_bytes(view_proj))
+            self._set(program, "u_mesh_offset", self._mesh_offset)
         else:
             inputs = self.shading_inputs()
             program = self._program("curtain.vert", "curtain.frag", self.variant_defines(gbuffer))
             self._scene_uniforms(program, view_proj, inputs)
+            self._set(program, "u_mesh_offset", self._mesh_offset)
             for name, value in (("u_direct", inputs.direct), ("u_a_diff", inputs.a_diff),
                                 ("u_g_diff", inputs.g_diff), ("u_a_spec", inputs.a_spec),
                                 ("u_g_spec", inputs.g_spec), ("u_anisotropy", inputs.anisotropy)):
@@ -481,7 +524,19 @@ class FrameRenderer:
         }
 
     def release(self) -> None:
+        """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
+        ours = [self._hdr_fbo, self._ldr_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
+        if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
+            (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._release_vaos()
+        self._release_own_buffers()
+        for obj in (self._hdr_fbo, self._hdr, self._depth, self._ldr_fbo, self._ldr, self._room_vbo):
+            obj.release()
+        if self._gbuffer is not None:
+            for texture in self._gbuffer[0]:
+                texture.release()
+            self._gbuffer[1].release()
+            self._gbuffer = None
         for program in self._programs.values():
             program.release()
         self._programs.clear()
