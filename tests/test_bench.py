@@ -121,6 +121,29 @@ def test_colour_section_on_one_fabric_and_light(gl, tmp_path):
     assert all(p.stat().st_size > 0 for p in paths)
 
 
+@pytest.mark.gl
+def test_truth_switches_on_the_emission_as_the_renderer_does(gl):
+    from catalog.benchsuite import colour
+    from catalog.render.frame import FrameRenderer
+    from catalog.render.scene import fluorescent_material
+
+    renderer = FrameRenderer(gl, (16, 16))
+    try:
+        renderer.set_fabric("lace-fwa")
+        renderer.set_light("D65")
+        renderer.set_fluorescence("physical")
+        kept = renderer.shading_inputs()
+        assert kept.fluorescence_mode == "physical"
+        renderer.set_fluorescence("off")
+        forced = colour.with_emission(renderer.shading_inputs(),
+                                      fluorescent_material(renderer.preset))
+    finally:
+        renderer.release()
+    np.testing.assert_allclose(forced.absorbed_photons, kept.absorbed_photons, rtol=1e-12)
+    np.testing.assert_allclose(forced.emission_per_photon, kept.emission_per_photon, rtol=1e-12)
+    assert forced.saturation_photons == kept.saturation_photons
+
+
 def test_pareto_front_and_default_choice():
     from catalog.benchsuite import colour
 

@@ -5,7 +5,8 @@ variant of :data:`VARIANTS` (paper-mode RGB, physical-mode RGB, physical-mode 6,
 bands, and RGB without fluorescence as the baseline) through the renderer's G-buffer pass;
 every curtain pixel is compared, by CIEDE2000, with the full-spectral float64 reference
 (:mod:`catalog.reference`) of the **physical** model at the same world position, normal
-and tangent: the truth every variant is judged against. Paper mode is therefore measured
+and tangent, with the brightener's emission always included (:func:`truth_inputs`): the
+truth every variant is judged against. Paper mode is therefore measured
 as a model (eq. 8's constant glow), not only as an RGB split of itself.
 
 "Lit cloth": the curtain pixels whose reference luminance is above 1e-6 of the white's
@@ -23,6 +24,7 @@ of the same fabric and light.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -58,6 +60,39 @@ def adapted_white(white: np.ndarray, cloth_xyz: np.ndarray) -> np.ndarray:
     if y95 <= white[1] or not white[1] > 0:
         return white
     return white * (y95 / white[1])
+
+
+def truth_inputs(renderer):
+    """The physical-mode ShadingInputs of the renderer's scene with the brightener's emission
+    always on: the renderer leaves it out where it judges it invisible (Delta E < 0.1, on its
+    own test background); the truth does not."""
+    from catalog.render.scene import fluorescent_material  # noqa: PLC0415
+
+    renderer.set_fluorescence("physical")
+    inputs = renderer.shading_inputs()
+    material = fluorescent_material(renderer.preset)
+    if material is None or inputs.fluorescence_mode == "physical":
+        return inputs
+    return with_emission(inputs, material)
+
+
+def with_emission(inputs, material):
+    """``inputs`` with the physical-mode emission of ``material`` switched on, its terms as
+    catalog.render.scene.build_shading_inputs makes them (a test checks they agree)."""
+    from catalog.fluorescence import absorbed_photon_irradiance, photon_energy_j  # noqa: PLC0415
+    from catalog.spectra import GRID_NM  # noqa: PLC0415
+
+    # both sides of the cloth see the outside half-space and the room
+    ambient_irradiance = math.pi * (0.5 * (inputs.sky_radiance + inputs.ground_radiance)
+                                    + inputs.room_radiance)
+    absorbed = (absorbed_photon_irradiance(material, inputs.key_irradiance),
+                absorbed_photon_irradiance(material, inputs.fill_irradiance),
+                absorbed_photon_irradiance(material, ambient_irradiance))
+    emission = (material.quantum_yield * material.emission_pdf_per_nm
+                * photon_energy_j(GRID_NM) / (2 * math.pi))  # M / pi shared by two sides
+    return replace(inputs, fluorescence_mode="physical", absorbed_photons=absorbed,
+                   saturation_photons=material.saturation_photon_irradiance,
+                   emission_per_photon=emission)
 
 
 def case_errors(renderer, reference_inputs) -> tuple[dict[str, np.ndarray], dict]:
@@ -131,9 +166,7 @@ def run(quick: bool = False, ctx=None, *, fabrics=None, lights=None, error_size=
             for light in lights:
                 for renderer in (error_renderer, time_renderer):
                     renderer.set_light(light)
-                error_renderer.set_fluorescence("physical")
-                reference_inputs = error_renderer.shading_inputs()
-                errors, info = case_errors(error_renderer, reference_inputs)
+                errors, info = case_errors(error_renderer, truth_inputs(error_renderer))
                 times = {label: frame_seconds(time_renderer, mode, bands, repeats)
                          for label, mode, bands in VARIANTS}
                 for label, mode, bands in VARIANTS:
