@@ -467,6 +467,14 @@ def test_preset_reloads_when_its_file_changes(xdisplay, tmp_path):
         viewer.wait_title("Edited voile")
         after, _ = viewer.screenshot()
         assert not np.allclose(after, before), "a changed preset should render differently"
+        # a new file sorting first shifts the list: the viewer keeps showing the voile
+        lace = (fabrics / f"{LACE}.toml").read_text()
+        (fabrics / "aaa-new.toml").write_text(lace.replace(f'name = "{LACE}"',
+                                                           'name = "aaa-new"'))
+        time.sleep(1.5)  # > the 0.5 s rescan interval, several frames
+        again, _ = viewer.screenshot()
+        assert "Edited voile" in viewer.title()
+        np.testing.assert_allclose(again, after, rtol=1e-6)
         path.write_text(original.replace("\nk_d = ", "\nk_d = -1 # was ", 1))
         title = viewer.wait_title(f"- {VOILE} -")  # the name alone: it no longer loads
         assert "Edited" not in title

@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -58,7 +58,6 @@ class ViewerOptions:
     paused: bool = False
     render_scale: float | None = None  # scene resolution / window resolution; None: auto
     fabric_dir: Path = FABRIC_DIR
-    extra: dict = field(default_factory=dict)
 
 
 def heavy_modules_loaded() -> dict[str, bool]:
@@ -159,8 +158,7 @@ class ViewerApp:
             self.timer.begin_frame()
             glfw.poll_events()
             self._apply_actions()
-            if self.catalog.refresh():
-                self._applied.clear()  # a preset file changed: apply it again
+            self._refresh_catalog()
             self._ensure_targets()
 
             now = time.perf_counter()
@@ -237,6 +235,26 @@ class ViewerApp:
             print(json.dumps(summary), flush=True)
         self.gui.shutdown()
         return 0
+
+    def _refresh_catalog(self) -> None:
+        """Pick up changed, added and removed preset files; keep showing the same fabrics
+        (by name: an added file shifts the indices)."""
+        names = self.catalog.names
+        shown = names[self.settings.fabric_index] if self.settings.fabric_index < len(names) \
+            else None
+        compared = names[self.settings.compare_index] \
+            if self.settings.compare_index is not None \
+            and self.settings.compare_index < len(names) else None
+        if not self.catalog.refresh():
+            return
+        self._applied.clear()  # a preset file changed: apply the presets again
+        names = self.catalog.names
+        if shown in names:
+            self.settings.fabric_index = names.index(shown)
+        else:
+            first = self.catalog.first_usable(0)
+            self.settings.fabric_index = 0 if first is None else first
+        self.settings.compare_index = names.index(compared) if compared in names else None
 
     # -- input ---------------------------------------------------------------------
     def _install_callbacks(self, imgui) -> None:
@@ -368,6 +386,10 @@ class ViewerApp:
     def _sync_renderers(self) -> None:
         """Pass the settings to each renderer, only what changed since the last frame."""
         settings = self.settings
+        if len(self.catalog) == 0:
+            self.messages["catalog"] = f"no presets (*.toml) in {self.catalog.fabric_dir}"
+            return
+        self.messages.pop("catalog", None)
         fabrics = [settings.fabric_index]
         if settings.compare_index is not None:
             fabrics.append(settings.compare_index)
@@ -461,13 +483,17 @@ class ViewerApp:
                   for renderer in self._renderers]
         return np.concatenate(halves, axis=1) if len(halves) > 1 else halves[0]
 
+    def _shown_name(self) -> str:
+        index = self.settings.fabric_index
+        return self.catalog.entries[index].name if index < len(self.catalog) else "none"
+
     def _metadata(self) -> dict[str, str]:
-        entry = self.catalog.entries[self.settings.fabric_index]
-        meta = {"catalog:fabric": entry.name, "catalog:light": self.settings.light_label,
+        meta = {"catalog:fabric": self._shown_name(), "catalog:light": self.settings.light_label,
                 "catalog:fluorescence": self.settings.fluorescence,
                 "catalog:bands": str(self.settings.bands), "Software": "catalog view"}
-        if self.settings.compare_index is not None:
-            meta["catalog:compare"] = self.catalog.entries[self.settings.compare_index].name
+        compare = self.settings.compare_index
+        if compare is not None and compare < len(self.catalog):
+            meta["catalog:compare"] = self.catalog.entries[compare].name
         return meta
 
     def _save_window_png(self, path: Path) -> None:
@@ -478,8 +504,7 @@ class ViewerApp:
     def _save_screenshot_pair(self) -> None:
         from catalog.viewer.screenshot import next_screenshot_stem, write_image  # noqa: PLC0415
 
-        entry = self.catalog.entries[self.settings.fabric_index]
-        stem = next_screenshot_stem(self.options.screenshot_dir, entry.name,
+        stem = next_screenshot_stem(self.options.screenshot_dir, self._shown_name(),
                                     self.settings.light_label)
         try:
             write_image(stem.with_suffix(".exr"), self.scene_linear(), self._metadata())
@@ -495,7 +520,7 @@ class ViewerApp:
                   "other_ms": round(times.other_ms, 3)}
         if frame == 1:
             record["heavy_modules"] = heavy_modules_loaded()
-            record["fabric"] = self.catalog.entries[self.settings.fabric_index].name
+            record["fabric"] = self._shown_name()
             record["light"] = self.settings.light_label
             record["panel_errors"] = self.catalog.errors() + list(self.messages.values())
         print(json.dumps(record), flush=True)
