@@ -302,7 +302,7 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
                          viewer_inside: bool = True) -> tuple[ShadingInputs, FluorescenceDecision]:
     """The spectral description of the scene's light on the curtain for a preset."""
     from catalog.colorimetry import cmfs  # noqa: PLC0415
-    from catalog.fluorescence import absorbed_photon_irradiance, paper_intensity, photon_energy_j  # noqa: PLC0415
+    from catalog.fluorescence import paper_intensity  # noqa: PLC0415
 
     key = np.asarray(key_irradiance, dtype=np.float64)
     to_light = np.asarray(key_to_light, dtype=np.float64)
@@ -342,16 +342,6 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         # eq. 8: I_fluor F_c. Its scale is arbitrary (model.md section 6); Table 2 reads as
         # 8-bit levels, so F (Y = 100) is taken in units of a white at 255: F / 255 x white
         paper = intensity * PAPER_F_PER_WHITE * 100.0 * paper_emission_shape(preset) * white_y
-    elif decision.used == "physical":
-        material = fluorescent_material(preset)
-        ambient_irradiance = math.pi * (0.5 * (sky + ground) + room)  # both sides of the cloth
-        absorbed = (absorbed_photon_irradiance(material, key),
-                    absorbed_photon_irradiance(material, fill),
-                    absorbed_photon_irradiance(material, ambient_irradiance))
-        saturation = material.saturation_photon_irradiance
-        # M / pi shared by the two sides of a thin cloth: M / (2 pi) on each
-        emission_per_photon = (material.quantum_yield * material.emission_pdf_per_nm
-                               * photon_energy_j(GRID_NM) / (2 * math.pi))
     inputs = ShadingInputs(
         key_irradiance=key, key_to_light=to_light, fill_irradiance=fill,
         fill_to_light=FILL_TO_LIGHT.copy(), sky_radiance=sky, ground_radiance=ground,
@@ -361,7 +351,31 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         ambient_radiance=ambient, fluorescence_mode=decision.used, paper_radiance=paper,
         absorbed_photons=absorbed, saturation_photons=saturation,
         emission_per_photon=emission_per_photon)
+    if decision.used == "physical":
+        inputs = with_physical_emission(inputs, fluorescent_material(preset))
     return inputs, decision
+
+
+def with_physical_emission(inputs: ShadingInputs, material) -> ShadingInputs:
+    """``inputs`` with physical-mode fluorescence of ``material`` switched on (the one place
+    these terms are made): absorbed photons at normal incidence for the key and fill lights
+    and, from both sides of the cloth, the outside half-space and the room; the emission
+    ``quantum_yield p(l) h c / l`` per effective photon as a radiance, M / pi shared by the
+    two sides of a thin cloth (M / (2 pi) on each)."""
+    from dataclasses import replace  # noqa: PLC0415
+
+    from catalog.fluorescence import absorbed_photon_irradiance, photon_energy_j  # noqa: PLC0415
+
+    ambient_irradiance = math.pi * (0.5 * (inputs.sky_radiance + inputs.ground_radiance)
+                                    + inputs.room_radiance)
+    absorbed = (absorbed_photon_irradiance(material, inputs.key_irradiance),
+                absorbed_photon_irradiance(material, inputs.fill_irradiance),
+                absorbed_photon_irradiance(material, ambient_irradiance))
+    emission = (material.quantum_yield * material.emission_pdf_per_nm
+                * photon_energy_j(GRID_NM) / (2 * math.pi))
+    return replace(inputs, fluorescence_mode="physical", absorbed_photons=absorbed,
+                   saturation_photons=material.saturation_photon_irradiance,
+                   emission_per_photon=emission)
 
 
 def _excitation_on_grid(preset) -> np.ndarray:
