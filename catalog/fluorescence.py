@@ -229,13 +229,15 @@ def carry_emission_rgb(emission_rgb: np.ndarray, method: str = "signed") -> np.n
     if method == "clip":
         return np.maximum(rgb, 0.0)
     if method == "desaturate":
-        luminance = linear_srgb_luminance(rgb)[..., None]
+        # the grey of the same luminance: (g, g, g) with Y(g, g, g) = Y(rgb); the white's Y
+        # is 1 only to the rounding of the sRGB matrices, so divide by it
+        grey = (linear_srgb_luminance(rgb) / linear_srgb_luminance(np.ones(3)))[..., None]
         lowest = np.min(rgb, axis=-1, keepdims=True)
         out_of_gamut = lowest < 0
         with np.errstate(divide="ignore", invalid="ignore"):  # only used where lowest < 0 <= Y
-            keep = np.where(out_of_gamut & (luminance > 0), luminance / (luminance - lowest), 1.0)
-        mapped = luminance + keep * (rgb - luminance)
-        return np.where(out_of_gamut & (luminance <= 0), 0.0, mapped)
+            keep = np.where(out_of_gamut & (grey > 0), grey / (grey - lowest), 1.0)
+        mapped = grey + keep * (rgb - grey)
+        return np.where(out_of_gamut & (grey <= 0), 0.0, mapped)
     raise CatalogError(f"unknown carry method {method!r}; one of {', '.join(CARRY_METHODS)}")
 
 
