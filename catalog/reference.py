@@ -128,19 +128,26 @@ def background_weights(ray, to_sun, chord2_inner, chord2_outer):
     return w
 
 
-def hg_hemisphere_factors(g: float, nodes: int = 20000) -> tuple[float, float]:
+def hg_hemisphere_factors(g: float) -> tuple[float, float]:
     """Cloth radiance per unit radiance of a uniform hemisphere, for a view along the normal.
 
-    forward: the lit hemisphere behind the cloth (transmission), integral of
-    ph(theta; g) cos(theta_i) d omega with theta = theta_i; backward: the hemisphere on the
-    viewer's side (the thin layer scattering back), theta = pi - theta_i. Their sum is
-    the integral of ph |cos| over the sphere, at most 1. Midpoint rule in cos(theta_i).
+    forward: the lit hemisphere behind the cloth (transmission),
+    2 pi integral_0^1 ph(mu; g) mu d mu with cos(theta) = mu; backward: the hemisphere on the
+    viewer's side (the thin layer scattering back), the same with cos(theta) = -mu, which by
+    HG's mirror symmetry is forward(-g). In closed form (eq. 6 integrated; written without
+    the cancellation of the textbook form at small g):
+
+        forward(g) = (1 + g) / 2 - (1 - g^2) / (2 (1 + sqrt(1 + g^2)))
+
+    forward(0) = backward(0) = 1/4; forward + backward = 1 - (1 - g^2) / (1 + sqrt(1 + g^2)),
+    the integral of ph |cos| over the sphere. (A quadrature would need nodes finer than the
+    peak, (1 - g)^2 / 2g in cos theta: a 20 000-node midpoint rule is 4e-4 off at g = 0.97
+    and 75 % off at g = 0.999.)
     """
-    mu = (np.arange(nodes) + 0.5) / nodes  # cos(theta_i) in (0, 1)
-    forward = hg_phase_one_minus_cos(1.0 - mu, g)
-    backward = hg_phase_one_minus_cos(1.0 + mu, g)
-    weight = 2 * math.pi * mu / nodes  # 2 pi cos d(cos)
-    return float(np.sum(forward * weight)), float(np.sum(backward * weight))
+    if not -1.0 < g < 1.0:
+        raise ValueError(f"HG g must lie in (-1, 1), got {g!r}")
+    shared = (1.0 - g * g) / (2.0 * (1.0 + math.sqrt(1.0 + g * g)))
+    return (1.0 + g) / 2.0 - shared, (1.0 - g) / 2.0 - shared
 
 
 # --------------------------------------------------------------------------- shading
