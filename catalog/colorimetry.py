@@ -1,7 +1,11 @@
-"""Colorimetry through colour-science: CIE 1931 2 deg CMFs, XYZ, sRGB, Delta E 2000.
+"""Colorimetry: CIE 1931 2 deg CMFs, XYZ, sRGB, CIELAB and Delta E 2000.
 
-colour-science is imported lazily (it takes about a second); nothing here copies a colour
-table by hand. The only matrix written out is the paper's eq. 2, kept for paper mode.
+The tables (CMFs, the sRGB matrix and white) are colour-science's own, read from the cache
+of :mod:`catalog.reference_tables` so that drawing a frame never imports colour (which takes
+seconds and pulls in scipy). The few formulas here (the sRGB transfer curve, CIELAB,
+CIEDE2000) are short closed forms; tests/test_colorimetry.py checks each against
+colour-science's implementation. The only matrix written out is the paper's eq. 2, kept
+for paper mode.
 """
 
 from __future__ import annotations
@@ -10,6 +14,7 @@ import functools
 
 import numpy as np
 
+from catalog import reference_tables
 from catalog.spectra import GRID_NM
 
 #: Paper eq. 2: XYZ -> linear sRGB, as printed (4 significant digits).
@@ -17,21 +22,14 @@ M_PAPER_XYZ_TO_RGB = np.array([[3.241, -1.537, -0.499],
                                [-0.969, 1.876, 0.042],
                                [0.056, -0.204, 1.057]])
 
-OBSERVER = "CIE 1931 2 Degree Standard Observer"
-
-
-def _colour():
-    import colour  # noqa: PLC0415  (lazy: heavy import)
-    return colour
+OBSERVER = reference_tables.CMFS_NAME
 
 
 @functools.lru_cache(maxsize=8)
 def _cmfs_cached(grid_key: tuple[float, float, int]) -> np.ndarray:
     start, stop, count = grid_key
     grid = np.linspace(start, stop, count)
-    cmfs = _colour().MSDS_CMFS[OBSERVER]
-    wl = np.asarray(cmfs.wavelengths, dtype=np.float64)
-    values = np.asarray(cmfs.values, dtype=np.float64)
+    wl, values = reference_tables.cmfs_table()
     out = np.stack([np.interp(grid, wl, values[:, i], left=0.0, right=0.0)
                     for i in range(3)], axis=1)
     out.setflags(write=False)
@@ -62,12 +60,10 @@ def spectrum_to_xyz(spectral: np.ndarray, grid_nm: np.ndarray = GRID_NM,
 
 @functools.lru_cache(maxsize=1)
 def _srgb():
-    colour = _colour()
-    space = colour.RGB_COLOURSPACES["sRGB"]
-    to_rgb = np.asarray(space.matrix_XYZ_to_RGB, dtype=np.float64)
+    to_rgb = np.array(reference_tables.srgb_xyz_to_rgb(), dtype=np.float64)
     # colour rounds its two sRGB matrices separately (a round trip costs ~0.005 Delta E);
     # the exact inverse keeps XYZ -> RGB -> XYZ the identity.
-    return (to_rgb, np.linalg.inv(to_rgb), np.asarray(space.whitepoint, dtype=np.float64))
+    return to_rgb, np.linalg.inv(to_rgb), np.array(reference_tables.srgb_whitepoint_xy())
 
 
 def xyz_to_linear_srgb(xyz: np.ndarray) -> np.ndarray:
@@ -76,7 +72,7 @@ def xyz_to_linear_srgb(xyz: np.ndarray) -> np.ndarray:
 
 
 def linear_srgb_to_xyz(rgb: np.ndarray) -> np.ndarray:
-    """Linear sRGB -> XYZ (colour-science's matrix)."""
+    """Linear sRGB -> XYZ (the exact inverse of :func:`xyz_to_linear_srgb`)."""
     return np.asarray(rgb, dtype=np.float64) @ _srgb()[1].T
 
 
@@ -87,32 +83,71 @@ def srgb_whitepoint_xy() -> np.ndarray:
 
 def srgb_encode(linear: np.ndarray) -> np.ndarray:
     """The sRGB transfer function (IEC 61966-2-1, piecewise), not a 2.2 power."""
-    return np.asarray(_colour().cctf_encoding(np.asarray(linear, dtype=np.float64),
-                                              function="sRGB"))
+    x = np.asarray(linear, dtype=np.float64)
+    with np.errstate(invalid="ignore"):  # the power branch is only kept where x > 0.0031308
+        return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.abs(x) ** (1 / 2.4) - 0.055)
 
 
 def srgb_decode(encoded: np.ndarray) -> np.ndarray:
     """Inverse of :func:`srgb_encode`."""
-    return np.asarray(_colour().cctf_decoding(np.asarray(encoded, dtype=np.float64),
-                                              function="sRGB"))
+    v = np.asarray(encoded, dtype=np.float64)
+    return np.where(v <= 0.04045, v / 12.92, ((np.abs(v) + 0.055) / 1.055) ** 2.4)
+
+
+def xy_to_xyz(xy: np.ndarray) -> np.ndarray:
+    """Chromaticity xy -> XYZ with Y = 1."""
+    x, y = np.asarray(xy, dtype=np.float64)[..., 0], np.asarray(xy, dtype=np.float64)[..., 1]
+    return np.stack([x / y, np.ones_like(x), (1 - x - y) / y], axis=-1)
 
 
 def xyz_to_lab(xyz: np.ndarray, white_xyz: np.ndarray) -> np.ndarray:
-    """CIELAB of ``xyz`` relative to the reference white ``white_xyz`` (same scale)."""
-    colour = _colour()
-    white_xyz = np.asarray(white_xyz, dtype=np.float64)
-    xy = colour.XYZ_to_xy(white_xyz)
-    scale = white_xyz[..., 1:2] if white_xyz.ndim else 1.0
-    return np.asarray(colour.XYZ_to_Lab(np.asarray(xyz, dtype=np.float64) / scale, xy))
+    """CIELAB (CIE 15:2004) of ``xyz`` relative to the reference white ``white_xyz`` (same scale)."""
+    ratio = np.asarray(xyz, dtype=np.float64) / np.asarray(white_xyz, dtype=np.float64)
+    epsilon, kappa = 216 / 24389, 24389 / 27
+    f = np.where(ratio > epsilon, np.cbrt(ratio), (kappa * ratio + 16) / 116)
+    return np.stack([116 * f[..., 1] - 16, 500 * (f[..., 0] - f[..., 1]),
+                     200 * (f[..., 1] - f[..., 2])], axis=-1)
+
+
+def delta_e_2000_lab(lab_a: np.ndarray, lab_b: np.ndarray) -> np.ndarray:
+    """CIEDE2000 (Sharma, Wu and Dalal 2005, with kL = kC = kH = 1) between CIELAB colours."""
+    L1, a1, b1 = np.moveaxis(np.asarray(lab_a, dtype=np.float64), -1, 0)
+    L2, a2, b2 = np.moveaxis(np.asarray(lab_b, dtype=np.float64), -1, 0)
+    c_mean = (np.hypot(a1, b1) + np.hypot(a2, b2)) / 2
+    g = 0.5 * (1 - np.sqrt(c_mean ** 7 / (c_mean ** 7 + 25.0 ** 7)))
+    a1p, a2p = (1 + g) * a1, (1 + g) * a2
+    c1p, c2p = np.hypot(a1p, b1), np.hypot(a2p, b2)
+    h1p = np.degrees(np.arctan2(b1, a1p)) % 360  # atan2(0, 0) = 0, as the paper defines
+    h2p = np.degrees(np.arctan2(b2, a2p)) % 360
+    dLp = L2 - L1
+    dCp = c2p - c1p
+    dh = h2p - h1p
+    dh = np.where(dh > 180, dh - 360, np.where(dh < -180, dh + 360, dh))
+    dh = np.where(c1p * c2p == 0, 0.0, dh)
+    dHp = 2 * np.sqrt(c1p * c2p) * np.sin(np.radians(dh) / 2)
+    Lp_mean = (L1 + L2) / 2
+    Cp_mean = (c1p + c2p) / 2
+    h_sum = h1p + h2p
+    hp_mean = np.where(np.abs(h1p - h2p) <= 180, h_sum / 2,
+                       np.where(h_sum < 360, (h_sum + 360) / 2, (h_sum - 360) / 2))
+    hp_mean = np.where(c1p * c2p == 0, h_sum, hp_mean)
+    t = (1 - 0.17 * np.cos(np.radians(hp_mean - 30)) + 0.24 * np.cos(np.radians(2 * hp_mean))
+         + 0.32 * np.cos(np.radians(3 * hp_mean + 6))
+         - 0.20 * np.cos(np.radians(4 * hp_mean - 63)))
+    d_theta = 30 * np.exp(-(((hp_mean - 275) / 25) ** 2))
+    r_c = 2 * np.sqrt(Cp_mean ** 7 / (Cp_mean ** 7 + 25.0 ** 7))
+    s_l = 1 + 0.015 * (Lp_mean - 50) ** 2 / np.sqrt(20 + (Lp_mean - 50) ** 2)
+    s_c = 1 + 0.045 * Cp_mean
+    s_h = 1 + 0.015 * Cp_mean * t
+    r_t = -np.sin(np.radians(2 * d_theta)) * r_c
+    return np.sqrt((dLp / s_l) ** 2 + (dCp / s_c) ** 2 + (dHp / s_h) ** 2
+                   + r_t * (dCp / s_c) * (dHp / s_h))
 
 
 def delta_e_2000(xyz_a: np.ndarray, xyz_b: np.ndarray, white_xyz: np.ndarray) -> np.ndarray:
     """CIEDE2000 colour difference between two XYZ colours seen against ``white_xyz``.
 
-    All three on the same absolute scale; the white sets Y = 100 (L* = 100).
+    All three on the same absolute scale; the white has L* = 100.
     """
-    colour = _colour()
     white_xyz = np.asarray(white_xyz, dtype=np.float64)
-    lab_a = xyz_to_lab(xyz_a, white_xyz)
-    lab_b = xyz_to_lab(xyz_b, white_xyz)
-    return np.asarray(colour.delta_E(lab_a, lab_b, method="CIE 2000"))
+    return delta_e_2000_lab(xyz_to_lab(xyz_a, white_xyz), xyz_to_lab(xyz_b, white_xyz))

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from catalog import reference_tables
 from catalog.errors import CatalogError, InputError
 from catalog.spectra import GRID_NM
 
@@ -114,15 +115,11 @@ def illuminance_lx(irradiance_w_m2_nm: np.ndarray, grid_nm: np.ndarray = GRID_NM
 # CIE (colour-science) illuminants
 
 
-def _colour():
-    import colour  # noqa: PLC0415  (lazy: heavy import)
-    return colour
-
-
 @functools.lru_cache(maxsize=1)
 def cie_names() -> tuple[str, ...]:
-    """Every illuminant name in colour-science's SDS_ILLUMINANTS, in colour's order."""
-    return tuple(str(k) for k in _colour().SDS_ILLUMINANTS.keys())
+    """Every illuminant name in colour-science's SDS_ILLUMINANTS, in colour's order
+    (read from catalog.reference_tables' cache: no colour import at run time)."""
+    return reference_tables.illuminant_names()
 
 
 def _is_daylight(name: str) -> bool:
@@ -133,9 +130,7 @@ def _is_daylight(name: str) -> bool:
 
 def cie_relative(name: str) -> tuple[np.ndarray, float, float]:
     """colour-science's table for ``name`` on GRID_NM (linear, 0 outside), and its range (nm)."""
-    sd = _colour().SDS_ILLUMINANTS[name]
-    wl = np.asarray(sd.wavelengths, dtype=np.float64)
-    values = np.asarray(sd.values, dtype=np.float64)
+    wl, values = reference_tables.illuminant_table(name)
     on_grid = np.interp(GRID_NM, wl, values, left=0.0, right=0.0)
     return on_grid, float(wl[0]), float(wl[-1])
 

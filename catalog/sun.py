@@ -16,8 +16,9 @@ Three models, from the paper's to a clear-sky one:
 
 Sources: the extraterrestrial spectrum is ASTM G173-03 as pvlib ships it; the Rayleigh
 optical depth is Bodhaine et al. (1999) eq. 30; the ozone absorption coefficients are the
-table of Bird & Riordan (1986, after Leckner 1978) that pvlib's SPECTRL2 carries. pvlib and
-pandas are imported lazily: only the sun needs them.
+table of Bird & Riordan (1986, after Leckner 1978) that pvlib's SPECTRL2 carries; both tables
+are read from the cache of :mod:`catalog.reference_tables`. pvlib and pandas are imported
+lazily, only for a date and time (solar position) and the SPECTRL2 comparison.
 
 All spectra are on :data:`catalog.spectra.GRID_NM` (300-780 nm, 1 nm) in W m^-2 nm^-1.
 """
@@ -30,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from catalog import reference_tables
 from catalog.errors import CatalogError
 from catalog.spectra import GRID_NM
 
@@ -48,15 +50,10 @@ MAX_PATH_KM = 2000.0
 # The extraterrestrial spectrum
 
 
-@functools.lru_cache(maxsize=1)
 def _g173_extraterrestrial() -> tuple[np.ndarray, np.ndarray]:
-    """ASTM G173-03 extraterrestrial spectrum (280-4000 nm, W m^-2 nm^-1) from pvlib."""
-    from pvlib.spectrum import get_reference_spectra  # noqa: PLC0415  (lazy: pandas)
-
-    table = get_reference_spectra(standard="ASTM G173-03")
-    wavelength_nm = np.asarray(table.index, dtype=np.float64)
-    values = np.asarray(table["extraterrestrial"], dtype=np.float64)
-    return wavelength_nm, values
+    """ASTM G173-03 extraterrestrial spectrum (280-4000 nm, W m^-2 nm^-1) as pvlib ships it,
+    read from catalog.reference_tables' cache (no pvlib/pandas import at run time)."""
+    return reference_tables.g173_extraterrestrial()
 
 
 @functools.lru_cache(maxsize=4)
@@ -208,21 +205,11 @@ class Atmosphere:
                                    f"{low:g}-{high:g}")
 
 
-@functools.lru_cache(maxsize=1)
 def _ozone_table() -> tuple[np.ndarray, np.ndarray]:
     """Ozone absorption coefficients (per atm-cm) of Bird & Riordan (1986) after Leckner (1978),
-    as pvlib's SPECTRL2 carries them (Huggins band below 350 nm, Chappuis 450-780 nm)."""
-    import importlib  # noqa: PLC0415
-
-    # the module, not the function of the same name that pvlib.spectrum re-exports
-    spectrl2_module = importlib.import_module("pvlib.spectrum.spectrl2")
-    try:
-        table = spectrl2_module._SPECTRL2_COEFFS  # noqa: SLF001  (pvlib keeps it module-private)
-    except AttributeError:  # pragma: no cover - a pvlib that moved its table
-        raise CatalogError("pvlib no longer carries the SPECTRL2 ozone table "
-                           "(pvlib.spectrum.spectrl2._SPECTRL2_COEFFS)") from None
-    return (np.asarray(table["wavelength"], dtype=np.float64),
-            np.asarray(table["ozone_absorption"], dtype=np.float64))
+    as pvlib's SPECTRL2 carries them (Huggins band below 350 nm, Chappuis 450-780 nm); read
+    from catalog.reference_tables' cache."""
+    return reference_tables.ozone_table()
 
 
 def ozone_absorption_per_atm_cm(wavelength_nm: np.ndarray = GRID_NM) -> np.ndarray:

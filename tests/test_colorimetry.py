@@ -55,3 +55,39 @@ def test_delta_e_2000_on_sharma_pairs(pair, expected):
     xyz_a = colour.Lab_to_XYZ(np.array(pair[0]), xy) * 100
     xyz_b = colour.Lab_to_XYZ(np.array(pair[1]), xy) * 100
     assert cm.delta_e_2000(xyz_a, xyz_b, white) == pytest.approx(expected, abs=1e-4)
+
+
+def test_lab_matches_colour_science():
+    rng = np.random.default_rng(7)
+    white = np.array([95.047, 100.0, 108.883])
+    xyz = rng.uniform(0, 120, (200, 3))
+    xyz[:5] *= 1e-4  # the linear segment near black
+    ref = colour.XYZ_to_Lab(xyz / 100, colour.XYZ_to_xy(white))
+    np.testing.assert_allclose(cm.xyz_to_lab(xyz, white), ref, atol=1e-9)
+
+
+def test_delta_e_2000_matches_colour_science_on_random_and_edge_pairs():
+    rng = np.random.default_rng(11)
+    lab_a = np.column_stack([rng.uniform(0, 100, 2000), rng.uniform(-120, 120, (2000, 2))])
+    lab_b = lab_a + rng.normal(0, 8, (2000, 3))
+    # edges: neutral greys (C = 0, hue undefined), hues across 0/360, identical colours
+    edges_a = np.array([[50, 0, 0], [50, 0, 0], [60, 10, -0.01], [40, 3, 4], [70, -5, 0]])
+    edges_b = np.array([[60, 0, 0], [50, 5, 5], [60, 10, 0.01], [40, 3, 4], [70, 5, 0]])
+    lab_a = np.vstack([lab_a, edges_a])
+    lab_b = np.vstack([lab_b, edges_b])
+    ref = colour.delta_E(lab_a, lab_b, method="CIE 2000")
+    np.testing.assert_allclose(cm.delta_e_2000_lab(lab_a, lab_b), ref, atol=1e-9)
+
+
+def test_colorimetry_does_not_import_colour_or_scipy():
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np\n"
+            "from catalog import colorimetry as cm\n"
+            "cm.delta_e_2000(np.ones(3), np.ones(3) * 2, np.ones(3) * 3)\n"
+            "cm.spectrum_to_xyz(np.ones(481)); cm.xyz_to_linear_srgb(np.ones(3))\n"
+            "print(sorted({'colour', 'scipy'} & {m.split('.')[0] for m in sys.modules}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip() == "[]"
