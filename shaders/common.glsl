@@ -9,7 +9,8 @@
 
 const float PI = 3.14159265358979;
 
-// Henyey & Greenstein 1941, "Diffuse radiation in the galaxy"; model.md eq. 6 in the robust form:
+// Henyey & Greenstein 1941, "Diffuse radiation in the galaxy"; model.md eq. 6 in the robust form of
+// catalog/btdf.py (unchanged for g >= 0):
 // 1 + g^2 - 2 g cos(theta) = (1 - g)^2 + 2 g (1 - cos theta) with 1 - cos theta = chord2 / 2, and
 // = (1 + g)^2 - 2 g (1 + cos theta) with 1 + cos theta = anti2 / 2 for g < 0 (no cancellation
 // near g = -1); the power 1.5 as d * sqrt(d). chord2 = |w_view - w_travel|^2, anti2 = |w_view + w_travel|^2.

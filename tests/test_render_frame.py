@@ -236,3 +236,24 @@ def test_cloth_interleaved_vertex_buffer_draws_like_set_mesh(gl, make_preset):
     assert np.allclose(bound, uploaded, rtol=1e-5, atol=1e-5 * uploaded.max())
     renderer.release()
     vertex_buffer.release()
+
+
+@pytest.mark.parametrize("illuminance_lx", [0.0, 1e9])
+def test_zero_and_huge_light_stay_finite_and_match_the_reference(gl, make_preset, illuminance_lx):
+    from catalog.lights import Light, get_light
+    from catalog.spectra import GRID_NM
+
+    if illuminance_lx == 0.0:
+        light = Light("dark", "no light at all", np.zeros(GRID_NM.size))
+    else:
+        light = get_light("D65", illuminance_lx=illuminance_lx)
+    renderer = _renderer(gl, make_preset(), light, "physical")
+    renderer.render()
+    assert np.all(np.isfinite(renderer.read_linear()))
+    gl_rgb, reference = _compare(renderer)
+    if illuminance_lx == 0.0:
+        assert np.all(gl_rgb == 0.0) and np.all(reference == 0.0)
+        assert renderer.shading_inputs().fluorescence_mode == "off"
+    else:
+        assert _relative_error(gl_rgb, reference).max() < 1e-3
+    renderer.release()
