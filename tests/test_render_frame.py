@@ -257,3 +257,24 @@ def test_zero_and_huge_light_stay_finite_and_match_the_reference(gl, make_preset
     else:
         assert _relative_error(gl_rgb, reference).max() < 1e-3
     renderer.release()
+
+
+@pytest.mark.parametrize("n_bands", [6, 9, 16])
+def test_band_shader_arithmetic_matches_float64_bands(gl, make_preset, n_bands):
+    """The N-band shader against the same bands taken in float64 from the 1 nm radiance:
+    display = to_rgb . (W . L(l)). This isolates the shader's arithmetic (chunks, indices,
+    projection) from the band approximation, which the Delta E test measures."""
+    from catalog.render.bands import band_weights
+
+    renderer = _renderer(gl, make_preset(dye=YELLOW_DYE, extra_btdf="anisotropy = -0.3"),
+                         "sun:150", "physical", n_bands)
+    gbuffer = renderer.render_gbuffer()
+    mask = gbuffer["mask"]
+    inputs = renderer.shading_inputs()
+    spectral = ref.shade_spectral(inputs, gbuffer["position"][mask], gbuffer["normal"][mask],
+                                  gbuffer["tangent"][mask], renderer.camera.position)
+    weights, to_rgb = band_weights(n_bands, inputs.key_irradiance)
+    expected = (spectral @ weights.T) @ to_rgb.T
+    error = _relative_error(gbuffer["radiance"][mask].astype(np.float64), expected)
+    assert error.max() < 1e-3, float(error.max())
+    renderer.release()
