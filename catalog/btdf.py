@@ -179,14 +179,27 @@ def is_straight_through(one_minus_cos, limit_deg: float = STRAIGHT_THROUGH_DEG):
     return np.asarray(one_minus_cos) < 1.0 - math.cos(math.radians(limit_deg))
 
 
-def woven_btdf(params, travel: np.ndarray, view: np.ndarray):
-    """Eq. 7's scattered part (the two lobes) for a :class:`catalog.presets.BTDFParams`.
+def woven_one_minus_cos(travel: np.ndarray, view: np.ndarray, anisotropy: float = 0.0):
+    """The directional lobe's 1 - cos theta with the warp/weft anisotropy A (our extension,
+    shaders/common.glsl ``woven_chord2`` / 2): delta = view - travel in the cloth frame
+    (x along the weft, y along the warp, z the normal),
+    ``(dx^2 (1 - A) + dy^2 (1 + A) + dz^2) / 2``; A = 0 is eq. 6's."""
+    delta = np.asarray(view) - np.asarray(travel)
+    return 0.5 * (delta[..., 0] ** 2 * (1 - anisotropy) + delta[..., 1] ** 2 * (1 + anisotropy)
+                  + delta[..., 2] ** 2)
+
+
+def woven_btdf(params, travel: np.ndarray, view: np.ndarray, anisotropy: float = 0.0):
+    """Eq. 7's scattered part (the two lobes) for a :class:`catalog.presets.BTDFParams`,
+    the directional lobe with the preset's ``btdf.anisotropy`` (default 0).
 
     The direct see-through (``params.direct``) is a delta in the straight-through
     direction: a renderer adds it as the background seen through the gaps.
     """
-    return eq7_scattered(one_minus_cos_between(travel, view), params.a_diff, params.a_spec,
-                         params.g_diff, params.g_spec)
+    return (params.a_diff * hg_phase_one_minus_cos(one_minus_cos_between(travel, view),
+                                                   params.g_diff)
+            + params.a_spec * hg_phase_one_minus_cos(woven_one_minus_cos(travel, view, anisotropy),
+                                                     params.g_spec))
 
 
 # --- Cook-Torrance (the paper's baseline) -----------------------------------------------
@@ -257,5 +270,5 @@ def cook_torrance_transmittance(to_light: np.ndarray, view: np.ndarray, direct, 
 __all__ = ["STRAIGHT_THROUGH_DEG", "one_minus_cos_between", "hg_denominator",
            "hg_phase", "hg_phase_between", "hg_phase_one_minus_cos", "hg_phase_printed",
            "hg_phase_dg", "hg_phase_and_dg", "eq7_scattered", "eq7_transmittance", "is_straight_through",
-           "woven_btdf", "cook_torrance_transmittance", "ct_geometry", "ct_lobes",
+           "woven_btdf", "woven_one_minus_cos", "cook_torrance_transmittance", "ct_geometry", "ct_lobes",
            "beckmann_d", "beckmann_d_droughness", "ct_shadowing", "mirror_view"]

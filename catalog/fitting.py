@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from catalog.btdf import (beckmann_d, beckmann_d_droughness, ct_geometry, ct_shadowing,
-                          hg_phase_and_dg, hg_phase_one_minus_cos)
+                          hg_denominator, hg_phase_and_dg, hg_phase_one_minus_cos)
 
 HG_NAMES = ("direct", "a_diff", "a_spec", "g_diff", "g_spec")
 CT_NAMES = ("direct", "k_lambert", "k_spec", "roughness")
@@ -61,6 +61,19 @@ G_MID, G_HALF = 0.5 * (G_HIGH + G_LOW), 0.5 * (G_HIGH - G_LOW)
 #: Largest |u| the optimiser may reach.
 U_LIMIT = 12.0
 RELATIVE_FLOOR = 0.02
+
+
+#: |anisotropy| stays below this (the renderer accepts (-1, 1)).
+A_LIMIT = 0.95
+
+
+def anisotropy_of_w(w):
+    return A_LIMIT * np.tanh(w)
+
+
+def dA_dw(w):
+    t = np.tanh(w)
+    return A_LIMIT * (1 - t * t)
 
 
 def g_of_u(u):
@@ -150,54 +163,78 @@ def _stderr(cov: np.ndarray) -> np.ndarray:
 # --- eq. 7 ----------------------------------------------------------------------------
 
 class _HGProblem:
-    """Weighted eq. 7 residuals over (direct, a_diff, a_spec, u_diff, u_spec)."""
+    """Weighted eq. 7 residuals over (direct, a_diff, a_spec, u_diff, u_spec[, w]).
 
-    def __init__(self, one_minus_cos, straight, values, scale):
+    With ``spread`` (per point, ``(delta_y^2 - delta_x^2) / 2`` of delta = view - travel
+    in the cloth frame, x along the weft, y along the warp) the directional lobe takes
+    the renderer's anisotropic chord (shaders/common.glsl ``woven_chord2``):
+    1 - cos theta becomes ``one_minus_cos + A spread``, A = A_LIMIT tanh(w), the sixth
+    parameter.
+    """
+
+    def __init__(self, one_minus_cos, straight, values, scale, spread=None):
         self.omc = np.asarray(one_minus_cos, dtype=np.float64)
         self.straight = np.asarray(straight, dtype=np.float64)
         self.values = np.asarray(values, dtype=np.float64)
         self.inv_scale = 1.0 / np.asarray(scale, dtype=np.float64)
         self.target = self.values * self.inv_scale
+        self.spread = None if spread is None else np.asarray(spread, dtype=np.float64)
+        self.size = 5 if spread is None else 6
         self.evaluations = 0
-        self._lobes: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        self._lobes: dict[tuple[float, float], tuple[np.ndarray, ...]] = {}
 
-    def lobe(self, u: float):
-        """(phase, d phase / du) of one HG lobe at g(u), cached: LM asks for the
-        residual and the Jacobian at the same point."""
+    def lobe(self, u: float, w: float | None = None):
+        """(phase, d phase / du, d phase / dw) of one HG lobe at g(u) (and anisotropy
+        A(w) when w is given), cached: LM asks for the residual and the Jacobian at the
+        same point."""
         u = min(max(float(u), -U_LIMIT), U_LIMIT)
-        cached = self._lobes.get(u)
+        key = (u, math.nan if w is None else float(w))
+        cached = self._lobes.get(key)
         if cached is None:
-            phase, dphase_dg = hg_phase_and_dg(self.omc, float(g_of_u(u)))
-            cached = (phase, dphase_dg * float(dg_du(u)))
+            g = float(g_of_u(u))
+            if w is None:
+                phase, dphase_dg = hg_phase_and_dg(self.omc, g)
+                dphase_dw = None
+            else:
+                omc = self.omc + float(anisotropy_of_w(w)) * self.spread
+                phase, dphase_dg = hg_phase_and_dg(omc, g)
+                # d ph / d(1 - cos) = -3 g ph / d (eq. 6)
+                dphase_dw = (-3.0 * g * phase / hg_denominator(omc, g)
+                             * self.spread * float(dA_dw(w)))
+            cached = (phase, dphase_dg * float(dg_du(u)), dphase_dw)
             if len(self._lobes) > 8:
                 self._lobes.clear()
-            self._lobes[u] = cached
+            self._lobes[key] = cached
         return cached
 
+    def _spec(self, p):
+        return self.lobe(p[4], p[5] if self.size == 6 else None)
+
     def model(self, p):
-        direct, a_d, a_s, u_d, u_s = p
-        return (direct * self.straight + a_d * self.lobe(u_d)[0]
-                + a_s * self.lobe(u_s)[0])                                          # eq. 7
+        return (p[0] * self.straight + p[1] * self.lobe(p[3])[0]
+                + p[2] * self._spec(p)[0])                                          # eq. 7
 
     def residual(self, p):
         self.evaluations += 1
         return self.model(p) * self.inv_scale - self.target
 
     def jacobian(self, p):
-        direct, a_d, a_s, u_d, u_s = p
-        (ph_d, dph_d), (ph_s, dph_s) = self.lobe(u_d), self.lobe(u_s)
-        cols = np.empty((len(self.omc), 5))
+        (ph_d, dph_d, _), (ph_s, dph_s, dph_w) = self.lobe(p[3]), self._spec(p)
+        cols = np.empty((len(self.omc), self.size))
         cols[:, 0] = self.straight
         cols[:, 1] = ph_d
         cols[:, 2] = ph_s
-        cols[:, 3] = a_d * dph_d
-        cols[:, 4] = a_s * dph_s
+        cols[:, 3] = p[1] * dph_d
+        cols[:, 4] = p[2] * dph_s
+        if self.size == 6:
+            cols[:, 5] = p[2] * dph_w
         return cols * self.inv_scale[:, None]
 
-    def basis(self, g_d, g_s):
-        """Weighted columns of the linear part for fixed g's: (n, 3)."""
+    def basis(self, g_d, g_s, anisotropy: float = 0.0):
+        """Weighted columns of the linear part for fixed shapes: (n, 3)."""
+        omc_s = self.omc if not anisotropy else self.omc + anisotropy * self.spread
         return np.stack([self.straight, hg_phase_one_minus_cos(self.omc, g_d),
-                         hg_phase_one_minus_cos(self.omc, g_s)], axis=1) * self.inv_scale[:, None]
+                         hg_phase_one_minus_cos(omc_s, g_s)], axis=1) * self.inv_scale[:, None]
 
     def projected(self, u):
         """Amplitudes solved exactly (non-negative least squares) for g(u):
@@ -269,18 +306,18 @@ def _lm(fun, x0, jac="2-point"):
 def _run_hg_start(problem: _HGProblem, start: np.ndarray,
                   project_first: bool) -> tuple[np.ndarray, int]:
     """One start: (for a guess from outside) LM on the g's with the amplitudes projected
-    out, then LM on all five parameters, holding at zero any amplitude that would go
-    negative (and the g of a lobe with no weight, which has no shape to fit)."""
+    out, then LM on all the parameters, holding at zero any amplitude that would go
+    negative (and the shape of a lobe with no weight, which has none to fit)."""
     before = problem.evaluations
     x = np.array(start, dtype=np.float64)
     if project_first:
-        u_fit = np.clip(_lm(lambda u: problem.projected(u)[1], x[3:]).x, -U_LIMIT, U_LIMIT)
-        x = np.concatenate([problem.projected(u_fit)[0], u_fit])
-    free = np.ones(5, dtype=bool)
+        u_fit = np.clip(_lm(lambda u: problem.projected(u)[1], x[3:5]).x, -U_LIMIT, U_LIMIT)
+        x[:5] = np.concatenate([problem.projected(u_fit)[0], u_fit])
+    free = np.ones(problem.size, dtype=bool)
     for _ in range(4):
         free[:3] &= x[:3] > 0
         free[3] &= bool(free[1])
-        free[4] &= bool(free[2])
+        free[4:] &= bool(free[2])
         x[:3][~free[:3]] = 0.0
         fixed = x.copy()
 
@@ -302,54 +339,72 @@ def _run_hg_start(problem: _HGProblem, start: np.ndarray,
     return x, problem.evaluations - before
 
 
-def _hg_start_from_guess(guess) -> np.ndarray:
+def _hg_start_from_guess(guess, size: int = 5) -> np.ndarray:
+    anisotropy = 0.0
     if isinstance(guess, dict):
+        anisotropy = float(guess.get("anisotropy", 0.0))
         guess = [guess[name] for name in HG_NAMES]
     guess = np.asarray(guess, dtype=np.float64)
     if guess.shape != (5,):
         raise ValueError(f"an eq. 7 start needs {HG_NAMES}, got {guess!r}")
-    return np.concatenate([guess[:3], u_of_g(guess[3:])])
+    start = np.concatenate([guess[:3], u_of_g(guess[3:])])
+    if size == 6:
+        start = np.append(start, np.arctanh(np.clip(anisotropy / A_LIMIT, -0.999, 0.999)))
+    return start
 
 
 def fit_hg(one_minus_cos, straight, values, *, weighting: str = "relative", starts=(),
-           scan: bool = True) -> FitResult:
+           scan: bool = True, spread=None) -> FitResult:
     """Fit eq. 7 (direct, a_diff, a_spec, g_diff, g_spec) to ``values``.
 
     ``one_minus_cos``: 1 - cos theta per point; ``straight``: where the direct
     see-through reaches the camera; ``starts``: extra initial guesses (dicts keyed by
-    HG_NAMES or 5-sequences); ``scan=False`` uses only those. ``time_s`` of the result
-    excludes importing scipy.
+    HG_NAMES or 5-sequences); ``scan=False`` uses only those; ``spread``: also fit the
+    directional lobe's warp/weft ``anisotropy`` (see :class:`_HGProblem`). ``time_s``
+    of the result excludes importing scipy.
     """
     import scipy.optimize  # noqa: F401  (lazily, and outside the timing)
 
     t0 = time.perf_counter()
     values = np.asarray(values, dtype=np.float64)
-    problem = _HGProblem(one_minus_cos, straight, values, noise_scale(values, weighting))
-    start_list = [(_hg_start_from_guess(s), True) for s in starts]
+    problem = _HGProblem(one_minus_cos, straight, values, noise_scale(values, weighting),
+                         spread)
+    start_list = [(_hg_start_from_guess(s, problem.size), True) for s in starts]
     if scan:
-        start_list += [(s, False) for s in _scan_hg(problem, SCAN_STARTS)]
+        start_list += [(np.append(s, [0.0] * (problem.size - 5)), False)
+                       for s in _scan_hg(problem, SCAN_STARTS)]
     if not start_list:
         raise ValueError("no start: pass starts or scan=True")
-    best, best_cost, best_evals = None, math.inf, 0
+    best, best_key, best_evals = None, None, 0
     for start, project_first in start_list:
         x, evals = _run_hg_start(problem, start, project_first)
-        x = _ordered_lobes(x)
+        if x[3] > x[4]:
+            # the sharper lobe is called 'spec'; with anisotropy (which belongs to that
+            # lobe) the swapped point is polished again
+            x = _ordered_lobes(x)
+            if problem.size == 6:
+                x[5] = 0.0
+                x, more = _run_hg_start(problem, x, False)
+                evals += more
         cost = float(np.sum(problem.residual(x) ** 2))
-        physical = x[1] >= 0 and x[2] >= 0
-        key = (not physical, cost)
+        key = (not (x[1] >= 0 and x[2] >= 0), cost)
         if best is None or key < best_key:
-            best, best_key, best_cost, best_evals = x, key, cost, evals
-    jac_u = problem.jacobian(best)
+            best, best_key, best_evals = x, key, evals
     residual = problem.residual(best)
-    g = g_of_u(best[3:])
-    # Jacobian in the reported parameters: d/dg = d/du / (dg/du)
-    jac = jac_u.copy()
-    jac[:, 3:] /= dg_du(best[3:])[None, :]
+    # Jacobian in the reported parameters: d/dg = d/du / (dg/du), d/dA = d/dw / (dA/dw)
+    jac = problem.jacobian(best)
+    jac[:, 3:5] /= dg_du(best[3:5])[None, :]
+    names = list(HG_NAMES)
+    values_out = [*best[:3], *g_of_u(best[3:5])]
+    if problem.size == 6:
+        jac[:, 5] /= float(dA_dw(best[5]))
+        names.append("anisotropy")
+        values_out.append(anisotropy_of_w(best[5]))
     cov = _covariance(jac, residual)
-    params = dict(zip(HG_NAMES, [float(v) for v in (*best[:3], *g)]))
+    params = dict(zip(names, [float(v) for v in values_out]))
     predicted = problem.model(best)
     return FitResult(model="hg", params=params,
-                     stderr=dict(zip(HG_NAMES, map(float, _stderr(cov)))),
+                     stderr=dict(zip(names, map(float, _stderr(cov)))),
                      rmse=float(np.sqrt(np.mean((predicted - values) ** 2))),
                      weighted_rms=float(np.sqrt(np.mean(residual ** 2))),
                      points=len(values), iterations=best_evals,
@@ -361,16 +416,16 @@ def fit_hg(one_minus_cos, straight, values, *, weighting: str = "relative", star
 def _ordered_lobes(x: np.ndarray) -> np.ndarray:
     """Name the sharper lobe 'spec' (g_spec >= g_diff): the two lobes are interchangeable."""
     x = np.array(x, dtype=np.float64)
-    x[3:] = np.clip(x[3:], -U_LIMIT, U_LIMIT)
+    x[3:5] = np.clip(x[3:5], -U_LIMIT, U_LIMIT)
     if x[3] > x[4]:
-        x = x[[0, 2, 1, 4, 3]]
+        x[[1, 2, 3, 4]] = x[[2, 1, 4, 3]]
     return x
 
 
 def fit_channels(one_minus_cos, straight, channel_values, g_diff: float, g_spec: float, *,
-                 direct: float | None = None,
+                 direct: float | None = None, spread=None, anisotropy: float = 0.0,
                  weighting: str = "relative") -> list[dict[str, dict[str, float]]]:
-    """Per-channel (direct, a_diff, a_spec) with the shape (g's) of the grey fit.
+    """Per-channel (direct, a_diff, a_spec) with the shape (g's, anisotropy) of the grey fit.
 
     ``direct`` given: the see-through of the gaps is colourless, so every channel keeps
     that value (its standard error reported as 0) and only a_diff, a_spec are fitted.
@@ -381,9 +436,10 @@ def fit_channels(one_minus_cos, straight, channel_values, g_diff: float, g_spec:
     channel_values = np.asarray(channel_values, dtype=np.float64)
     for c in range(channel_values.shape[1]):
         values = channel_values[:, c]
-        problem = _HGProblem(one_minus_cos, straight, values, noise_scale(values, weighting))
-        basis = problem.basis(g_diff, g_spec)
-        target = problem.target
+        problem = _HGProblem(one_minus_cos, straight, values, noise_scale(values, weighting),
+                             spread)
+        full_basis = problem.basis(g_diff, g_spec, anisotropy)
+        basis, target = full_basis, problem.target
         if direct is not None:
             target = target - direct * basis[:, 0]
             basis = basis[:, 1:]
@@ -392,7 +448,7 @@ def fit_channels(one_minus_cos, straight, channel_values, g_diff: float, g_spec:
         errors = _stderr(_covariance(basis, residual))
         if direct is not None:
             amps, errors = np.concatenate([[direct], amps]), np.concatenate([[0.0], errors])
-        predicted = problem.model(np.array([*amps, u_of_g(g_diff), u_of_g(g_spec)]))
+        predicted = _combine(full_basis, amps) / problem.inv_scale
         out.append({"params": dict(zip(HG_NAMES[:3], map(float, amps))),
                     "stderr": dict(zip(HG_NAMES[:3], map(float, errors))),
                     "rmse": float(np.sqrt(np.mean((predicted - values) ** 2)))})
@@ -502,10 +558,26 @@ def fit_cook_torrance(to_light, view, straight, values, *,
 
 # --- on GonioData -----------------------------------------------------------------------
 
-def fit_gonio_hg(data, values=None, **kwargs) -> FitResult:
-    """:func:`fit_hg` on a :class:`catalog.gonio.GonioData` (its grey column by default)."""
+def anisotropy_identifiable(data) -> bool:
+    """Whether a gonio set constrains the warp/weft anisotropy: it needs views whose offset
+    from the light's travel has both an x (weft) and a y (warp) part. The paper's 79
+    points lie in one plane and do not; the OGM-3 grid does."""
+    delta = data.view - data.travel
+    return bool(np.any(np.abs(delta[:, 0]) > 0.05) and np.any(np.abs(delta[:, 1]) > 0.05))
+
+
+def fit_gonio_hg(data, values=None, *, anisotropy="auto", **kwargs) -> FitResult:
+    """:func:`fit_hg` on a :class:`catalog.gonio.GonioData` (its grey column by default).
+
+    ``anisotropy``: True fits the directional lobe's warp/weft anisotropy (our extension
+    of eq. 7, the renderer's ``btdf.anisotropy``), False does not, "auto" fits it when
+    :func:`anisotropy_identifiable`.
+    """
+    if anisotropy == "auto":
+        anisotropy = anisotropy_identifiable(data)
     return fit_hg(data.one_minus_cos, data.straight_through,
-                  data.transmittance if values is None else values, **kwargs)
+                  data.transmittance if values is None else values,
+                  spread=data.anisotropy_spread if anisotropy else None, **kwargs)
 
 
 def fit_gonio_ct(data, values=None, **kwargs) -> FitResult:
@@ -515,4 +587,5 @@ def fit_gonio_ct(data, values=None, **kwargs) -> FitResult:
 
 __all__ = ["FitResult", "HG_NAMES", "CT_NAMES", "fit_hg", "fit_cook_torrance",
            "fit_channels", "fit_gonio_hg", "fit_gonio_ct", "split_amplitudes",
+           "anisotropy_identifiable",
            "noise_scale"]

@@ -9,6 +9,8 @@ Angle convention (model.md section 1, formats.md), all in degrees:
   light* has polar angle ``180 - light_elevation`` from -Z and azimuth ``light_azimuth``;
 - theta: between the light's direction of travel (minus the direction to the light)
   and the view direction; theta = 0 is straight through.
+- the sample's weft runs along x (azimuth 0), its warp along y (azimuth 90): the
+  renderer's tangent t and bitangent b.
 
 The OGM-3 grid (4800 points): "X-Y in N steps" read as N values from X to Y inclusive,
 the only reading that makes the paper's count: camera elevation 10-90 in 40 values
@@ -107,6 +109,14 @@ class GonioData:
     def one_minus_cos(self) -> np.ndarray:
         """1 - cos theta, from the vectors (exact near straight through)."""
         return one_minus_cos_between(self.travel, self.view)
+
+    @cached_property
+    def anisotropy_spread(self) -> np.ndarray:
+        """(delta_y^2 - delta_x^2) / 2 of delta = view - travel: how a warp/weft
+        anisotropy A changes the directional lobe's 1 - cos theta (by + A spread; the
+        renderer's ``woven_chord2`` / 2 with the weft along x and the warp along y)."""
+        delta = self.view - self.travel
+        return 0.5 * (delta[:, 1] ** 2 - delta[:, 0] ** 2)
 
     @property
     def theta_deg(self) -> np.ndarray:

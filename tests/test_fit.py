@@ -160,10 +160,48 @@ def test_hg_beats_cook_torrance_on_yarn_level_data(name):
     data = gonio.read_gonio(_measurement(name))
     for part in (data, data.subset(gonio.paper_subset_mask(data))):
         for weighting in ("relative", "none"):
-            hg = fitting.fit_gonio_hg(part, weighting=weighting)
+            hg = fitting.fit_gonio_hg(part, weighting=weighting, anisotropy=False)  # eq. 7
             ct = fitting.fit_gonio_ct(part, weighting=weighting)
             assert hg.rmse < ct.rmse, (len(part), weighting, hg.rmse, ct.rmse)
             assert hg.weighted_rms < ct.weighted_rms
+
+
+def test_anisotropy_is_recovered_from_anisotropic_eq7_data():
+    truth = dict(TRUTHS[0])
+    for anisotropy in (0.0, 0.15, -0.3):
+        omc_spec = GRID.one_minus_cos + anisotropy * GRID.anisotropy_spread
+        clean = (truth["direct"] * GRID.straight_through
+                 + truth["a_diff"] * btdf.hg_phase_one_minus_cos(GRID.one_minus_cos, truth["g_diff"])
+                 + truth["a_spec"] * btdf.hg_phase_one_minus_cos(omc_spec, truth["g_spec"]))
+        values = clean * (1 + 0.02 * np.random.default_rng(21).standard_normal(len(clean)))
+        result = fitting.fit_gonio_hg(GRID, values)
+        assert "anisotropy" in result.params
+        assert abs(result.params["anisotropy"] - anisotropy) < 3 * result.stderr["anisotropy"]
+        for name, value in truth.items():
+            assert abs(result.params[name] - value) < 3 * result.stderr[name], name
+
+
+def test_anisotropy_matches_the_renderer_chord():
+    """GonioData's spread is the renderer's woven_chord2 / 2 minus the isotropic part."""
+    travel, view = GRID.travel, GRID.view
+    for anisotropy in (-0.4, 0.25):
+        assert np.allclose(GRID.one_minus_cos + anisotropy * GRID.anisotropy_spread,
+                           btdf.woven_one_minus_cos(travel, view, anisotropy), atol=1e-14)
+
+
+def test_anisotropy_is_left_out_where_the_data_cannot_tell():
+    assert fitting.anisotropy_identifiable(GRID)
+    assert not fitting.anisotropy_identifiable(GRID.subset(SUBSET))
+    result = fitting.fit_gonio_hg(GRID.subset(SUBSET), eq7_data(TRUTHS[0], GRID.subset(SUBSET)))
+    assert "anisotropy" not in result.params
+
+
+def test_yarn_level_anisotropy_has_the_generator_sign():
+    """The generator spreads more across the warp (sigma_x > sigma_y): a positive A,
+    larger for linen (11 vs 9 deg) than for voile (7.5 vs 6.5)."""
+    fits = {name: fitting.fit_gonio_hg(gonio.read_gonio(_measurement(name)))
+            for name in ("voile-white", "linen-dense")}
+    assert 0 < fits["voile-white"].params["anisotropy"] < fits["linen-dense"].params["anisotropy"]
 
 
 def test_yarn_level_data_is_not_eq7_itself():

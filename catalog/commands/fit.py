@@ -24,6 +24,8 @@ DEFAULT_TAU_UNDYED = 0.05
 MIN_RHO = 0.01
 #: Significant digits written to the preset (deterministic, diff-friendly files).
 DIGITS = 6
+#: formats.md's identifiable set (the anisotropy, when fitted, is reported beside it).
+IDENTIFIABLE = ("direct", "a_diff", "a_spec", "g_diff", "g_spec")
 
 
 def add_arguments(parser) -> None:
@@ -125,9 +127,12 @@ def fit_measurement(data, weighting: str) -> dict:
     ct = fit_gonio_ct(data, weighting=weighting)
     channels = None
     if data.rgb is not None:
+        anisotropy = hg.params.get("anisotropy")
         channels = fit_channels(data.one_minus_cos, data.straight_through, data.rgb,
                                 hg.params["g_diff"], hg.params["g_spec"],
-                                direct=hg.params["direct"], weighting=weighting)
+                                direct=hg.params["direct"],
+                                spread=None if anisotropy is None else data.anisotropy_spread,
+                                anisotropy=anisotropy or 0.0, weighting=weighting)
     return {"hg": hg, "ct": ct, "channels": channels}
 
 
@@ -193,6 +198,8 @@ def preset_document(args, out, data, header, result, rho, tau, dye_path) -> dict
     btdf = {"direct": _round(min(max(p["direct"], 0.0), 1.0)), "k_d": _round(k_d),
             "k_s": _round(k_s), "tau": _round(tau), "rho": _round(rho),
             "g_diff": _round(p["g_diff"]), "g_spec": _round(p["g_spec"])}
+    if "anisotropy" in p:       # our extension: the directional lobe's warp/weft spread
+        btdf["anisotropy"] = _round(p["anisotropy"])
     if channels is not None:
         btdf["rgb"] = {key: [_round(c["params"][key]) for c in channels]
                        for key in ("direct", "a_diff", "a_spec")}
@@ -203,7 +210,7 @@ def preset_document(args, out, data, header, result, rho, tau, dye_path) -> dict
         "source": _relative(args.gonio, folder),
         "weighting": hg.weighting,
         "subset": args.points,
-        "identifiable": {k: _round(v) for k, v in p.items()},
+        "identifiable": {k: _round(p[k]) for k in IDENTIFIABLE},
         "stderr": {k: _round(v) for k, v in hg.stderr.items()},
         "weighted_rms": _round(hg.weighted_rms),
         "cook_torrance": {"rmse": _round(ct.rmse), "weighted_rms": _round(ct.weighted_rms),
@@ -272,7 +279,7 @@ def json_summary(doc, result, out, elapsed) -> dict:
     summary = {
         "name": doc["name"], "out": str(out),
         **{k: v for k, v in doc["btdf"].items() if k != "rgb"},
-        "identifiable": {k: float(v) for k, v in hg.params.items()},
+        "identifiable": {k: float(hg.params[k]) for k in IDENTIFIABLE},
         "stderr": {k: float(v) for k, v in hg.stderr.items()},
         "rmse": hg.rmse, "weighted_rms": hg.weighted_rms, "points": hg.points,
         "weighting": hg.weighting,
@@ -297,6 +304,9 @@ def _print_summary(s: dict) -> None:
           f"{s['starts']} starts, {s['iterations']} LM evaluations, {s['fit_time_s'] * 1e3:.1f} ms")
     for key in ident:
         print(f"  {key:7s} = {ident[key]:.6g} +- {err[key]:.2g}")
+    if "anisotropy" in s:
+        print(f"  anisotropy = {s['anisotropy']:.4g} +- {err['anisotropy']:.2g} (warp/weft, "
+              "directional lobe)")
     print(f"  rho = {s['rho']:g}, tau = {s['tau']:g} -> k_d = {s['k_d']:.6g}, k_s = {s['k_s']:.6g}")
     if "rgb" in s:
         for key, values in s["rgb"].items():
@@ -317,7 +327,8 @@ def plot_fit(data, hg, ct, path, title: str = "") -> None:
     import numpy as np
 
     from catalog.atomic import atomic_path
-    from catalog.btdf import cook_torrance_transmittance, eq7_scattered, one_minus_cos_between
+    from catalog.btdf import (cook_torrance_transmittance, hg_phase_one_minus_cos,
+                              one_minus_cos_between, woven_one_minus_cos)
     from catalog.errors import InputError
     from catalog.gonio import light_direction, view_direction
 
@@ -347,16 +358,18 @@ def plot_fit(data, hg, ct, path, title: str = "") -> None:
         to_light = np.broadcast_to(light_direction(elevation, 0.0), (len(signed_fine), 3))
         view = view_direction(cam_el, cam_az)
         omc = one_minus_cos_between(-to_light, view)
-        hg_curve = eq7_scattered(omc, p["a_diff"], p["a_spec"], p["g_diff"], p["g_spec"])
+        omc_spec = woven_one_minus_cos(-to_light, view, p.get("anisotropy", 0.0))
+        hg_curve = (p["a_diff"] * hg_phase_one_minus_cos(omc, p["g_diff"])
+                    + p["a_spec"] * hg_phase_one_minus_cos(omc_spec, p["g_spec"]))
         ct_curve = cook_torrance_transmittance(to_light, view, 0.0, q["k_lambert"],
                                                q["k_spec"], q["roughness"],
                                                straight_through=np.zeros(len(omc), bool))
         ax.semilogy(signed_fine, hg_curve, "C0-", label=f"HG (eq. 7), rmse {hg.rmse:.3g}")
         ax.semilogy(signed_fine, ct_curve, "C3--", label=f"Cook-Torrance, rmse {ct.rmse:.3g}")
         if straight.any():
-            ax.semilogy([0.0], [p["direct"] + float(eq7_scattered(
-                0.0, p["a_diff"], p["a_spec"], p["g_diff"], p["g_spec"]))], "C0o", mfc="none",
-                ms=9, label="HG with direct")
+            peak = p["direct"] + p["a_diff"] * float(hg_phase_one_minus_cos(0.0, p["g_diff"])) \
+                + p["a_spec"] * float(hg_phase_one_minus_cos(0.0, p["g_spec"]))
+            ax.semilogy([0.0], [peak], "C0o", mfc="none", ms=9, label="HG with direct")
         ax.set_xlabel("view angle from the normal (deg; camera azimuth 0: +, 180: -)")
         ax.set_ylabel("transmittance ratio (per sr)")
         ax.set_title(f"{title}: light elevation {elevation:g} deg, azimuth 0")
