@@ -336,7 +336,8 @@ def test_keys_switch_fabric_light_and_fluorescence(xdisplay, tmp_path):
 
     Space pauses the cloth, so every screenshot shows the same mesh. Right: another fabric,
     other colours. L (D65 -> A, tungsten): the cloth turns warmer. F (physical -> off): the
-    brightened lace loses blue; the plain voile does not change at all.
+    brightened lace loses blue; the plain voile does not change at all. Then the mouse
+    (orbit, zoom, not over the panel), H (help overlay) and Tab (panel hidden).
     """
     _need_presets(LACE, VOILE)
     names = sorted(p.stem for p in FABRIC_DIR.glob("*.toml"))
@@ -392,8 +393,18 @@ def test_keys_switch_fabric_light_and_fluorescence(xdisplay, tmp_path):
         orbited, _ = viewer.screenshot()
         assert np.abs(orbited - same).mean() > 0.05 * same.mean()
         viewer.wheel(300, 160, 3)
-        zoomed, _ = viewer.screenshot()
+        zoomed, window_before = viewer.screenshot()
         assert np.abs(zoomed - orbited).mean() > 0.05 * orbited.mean()
+
+        # H: the help overlay is drawn over the window, the scene (EXR) is untouched
+        viewer.keys("h")
+        scene, window_help = viewer.screenshot()
+        np.testing.assert_allclose(scene, zoomed, rtol=1e-6)
+        assert np.abs(window_help - window_before).mean() > 0.01
+        # Tab: the panel goes, the scene takes the whole width
+        viewer.keys("h", "Tab")
+        wide, _ = viewer.screenshot()
+        assert wide.shape[1] > zoomed.shape[1] and wide.shape[0] == zoomed.shape[0]
         assert viewer.quit() == 0
     finally:
         viewer.close()
