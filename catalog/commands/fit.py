@@ -364,7 +364,8 @@ def plot_fit(data, hg, ct, path, title: str = "") -> None:
         ct_curve = cook_torrance_transmittance(to_light, view, 0.0, q["k_lambert"],
                                                q["k_spec"], q["roughness"],
                                                straight_through=np.zeros(len(omc), bool))
-        ax.semilogy(signed_fine, hg_curve, "C0-", label=f"HG (eq. 7), rmse {hg.rmse:.3g}")
+        hg_name = "HG (eq. 7 + anisotropy)" if "anisotropy" in p else "HG (eq. 7)"
+        ax.semilogy(signed_fine, hg_curve, "C0-", label=f"{hg_name}, rmse {hg.rmse:.3g}")
         ax.semilogy(signed_fine, ct_curve, "C3--", label=f"Cook-Torrance, rmse {ct.rmse:.3g}")
         if straight.any():
             peak = p["direct"] + p["a_diff"] * float(hg_phase_one_minus_cos(0.0, p["g_diff"])) \
