@@ -101,8 +101,8 @@ def main(argv: list[str] | None = None) -> int:
             rows.append(run_case(display, size, grid, args.frames, args.warmup, args.backend,
                                  args.fabric, args.light, args.render_scale))
             row = rows[-1]
-            print(f"{row['size']:>10} x{row['render_scale']} grid {row['grid']:>8}: total {row['total_ms']:7.1f} ms "
-                  f"({row['fps']} fps) = simulation {row['simulation_ms']:6.1f} + shading "
+            print(f"{row['size']:>10} x{row['render_scale']} grid {row['grid']:>8}: "
+                  f"total {row['total_ms']:7.1f} ms ({row['fps']} fps) = simulation {row['simulation_ms']:6.1f} + shading "
                   f"{row['shading_ms']:6.1f} + UI {row['ui_ms']:5.1f} + other "
                   f"{row['other_ms']:5.1f}; first frame {row['first_frame_ms']} ms",
                   flush=True)

@@ -234,6 +234,8 @@ class Viewer:
     """A running `catalog view` and the X tools that drive it."""
 
     def __init__(self, display: str, cwd: Path, args: list[str]):
+        if shutil.which("xdotool") is None:
+            pytest.fail("xdotool is not installed (tools/setup.sh installs it)")
         self.display = display
         self.shots = cwd / "shots"
         self.proc = subprocess.Popen(
