@@ -78,8 +78,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--wind", type=float, metavar="M_S", help="wind speed, m/s")
     parser.add_argument("--grid", type=_grid, default=(48, 64), metavar="WxH",
                         help="cloth particles across x down (default 48x64)")
-    parser.add_argument("--cloth-backend", choices=("numpy", "cpu"), default="cpu",
-                        help="cloth simulation backend (default cpu)")
+    parser.add_argument("--cloth-backend", choices=("numpy", "cpu", "gpu"), default="cpu",
+                        help="cloth simulation backend (default cpu; gpu: compute shaders "
+                        "writing the vertex buffer, for a real GPU)")
     parser.add_argument("--render-scale", type=_render_scale, metavar="S|auto", default=None,
                         help="scene resolution relative to the window, 0.25-1 (default auto: "
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")

@@ -145,7 +145,7 @@ class ViewerApp:
         self.panel_info = PanelInfo(cie_lights=self._cie_light_names())
 
         self.scene = CurtainScene(self.options.grid, backend=self.options.cloth_backend,
-                                  wind_m_s=self.settings.wind_m_s)
+                                  wind_m_s=self.settings.wind_m_s, ctx=self.ctx)
         self._fbo = None
         self._renderers: list = []
         self._scaled_fbos: list = []  # one per renderer when render_scale < 1

@@ -1,5 +1,8 @@
 """The animated curtain behind the viewer: one cloth simulation feeding the renderer(s).
 
+CPU backends (numpy, cpu) upload positions and normals when the cloth moved; the gpu
+backend's compute shader writes the vertex buffer the renderer draws (no copy).
+
 The simulation takes the physical parameters of the fabric on the left (areal density,
 stiffness from its preset's ``[cloth]`` table); in split screen the right half shows the
 same drape in another fabric, so the two differ by their optics alone.
@@ -23,9 +26,11 @@ class CurtainScene:
     rod as ``catalog snapshot --frame N`` does, so both show the same curtain.
     """
 
-    def __init__(self, grid: tuple[int, int], backend: str = "cpu", wind_m_s: float = 0.0):
+    def __init__(self, grid: tuple[int, int], backend: str = "cpu", wind_m_s: float = 0.0,
+                 ctx=None):
         self.grid = grid
         self.backend = backend
+        self.ctx = ctx  # the window's context: the gpu backend computes in it
         self.wind_m_s = float(wind_m_s)
         self.opening = 1.0
         self.simulation = None
@@ -47,7 +52,8 @@ class CurtainScene:
             from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
             from catalog.render import scene as scene_lib  # noqa: PLC0415
 
-            self.simulation = ClothSimulation(fabric, backend=self.backend)
+            options = {"ctx": self.ctx} if self.backend == "gpu" else {}
+            self.simulation = ClothSimulation(fabric, backend=self.backend, **options)
             self._offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - fabric.rod_y_m,
                                      scene_lib.CURTAIN_Z], dtype=np.float32)
             self.mesh_version += 1
@@ -82,11 +88,20 @@ class CurtainScene:
         if self.simulation is None:
             return
         have = self._uploaded.get(id(renderer))
-        if have == self.mesh_version:
-            return
+        if have == self.mesh_version or (have is not None and self.backend == "gpu"):
+            return  # up to date; or the compute shader writes the buffer the renderer draws
         from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
 
         mesh = CurtainMesh.from_grid(self.simulation.positions(), self.simulation.params)
+        if self.backend == "gpu":
+            # the mesh once (triangles, uvs), then the cloth's interleaved vertex buffer
+            # drawn in place, moved onto the scene's rod in the vertex shader
+            renderer.set_mesh(mesh.positions, mesh.normals, mesh.uv, mesh.tangents[:, :3],
+                              mesh.indices)
+            renderer.bind_cloth_vertex_buffer(self.simulation.backend.vertex_buffer,
+                                              offset_m=tuple(float(v) for v in self._offset))
+            self._uploaded[id(renderer)] = self.mesh_version
+            return
         positions = mesh.positions + self._offset
         if have is None:
             renderer.set_mesh(positions, mesh.normals, mesh.uv, mesh.tangents[:, :3],
