@@ -81,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--warmup", type=int, default=10)
     parser.add_argument("--cases", default=",".join(DEFAULT_CASES),
                         help="comma-separated SIZE:GRID, e.g. 1920x1080:128x128")
-    parser.add_argument("--backend", default="cpu", choices=("cpu", "numpy"))
+    parser.add_argument("--backend", default="cpu", choices=("cpu", "numpy", "gpu"))
     parser.add_argument("--fabric", default="lace-fwa")
     parser.add_argument("--light", default="D65")
     parser.add_argument("--render-scale", default="auto",
