@@ -123,3 +123,38 @@ def test_relative_dye_keeps_the_grey_fit_on_average():
     ybar = cmfs(GRID_NM)[:, 1]
     assert float(shape @ ybar) / float(ybar.sum()) == pytest.approx(1.0, rel=1e-12)
     assert np.allclose(scene.relative_dye(np.ones(GRID_NM.size)), 1.0)
+
+
+def test_room_solids_match_trimesh_and_face_outwards():
+    """The numpy boxes and rod against trimesh's own solids: same volume and area, closed,
+    normals pointing out (trimesh is the independent reference; the renderer avoids importing
+    it because it imports scipy)."""
+    import trimesh
+
+    for solid in scene._room_parts():
+        vertices = solid.reshape(-1, 3)
+        faces = np.arange(vertices.shape[0]).reshape(-1, 3)
+        mesh = trimesh.Trimesh(vertices, faces, process=True)
+        assert mesh.is_watertight and mesh.is_winding_consistent
+        assert mesh.volume > 0  # positive volume: counter-clockwise seen from outside
+        lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+        if len(solid) == 12:  # a box
+            reference = trimesh.creation.box(extents=hi - lo)
+        else:  # the rod
+            reference = trimesh.creation.cylinder(radius=0.015, height=hi[0] - lo[0], sections=16)
+        assert mesh.volume == pytest.approx(reference.volume, rel=1e-9)
+        assert mesh.area == pytest.approx(reference.area, rel=1e-9)
+
+
+def test_frame_setup_imports_no_scipy():
+    """Drawing a frame must not import scipy (the viewer's rule): checked in a fresh process."""
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "from catalog.render import scene, bands, frame, camera, shaderlib, snapshot\n"
+            "scene.room_props(); scene.draped_curtain()\n"
+            "print('scipy' in sys.modules, 'trimesh' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["False", "False"]

@@ -2,8 +2,9 @@
 the viewer; and the spectral description of its light (:class:`catalog.reference.ShadingInputs`).
 
 Coordinates: metres, y up; the window is in the wall z = WINDOW_Z, the outside lies towards
--z, the room (and the viewer) towards +z. No GL here: meshes are numpy arrays (props are
-built and merged with trimesh) and the renderer uploads them.
+-z, the room (and the viewer) towards +z. No GL here: meshes are numpy arrays and the
+renderer uploads them. The room's boxes and rod are built in numpy (importing trimesh would
+import scipy, which drawing a frame must not); prop files load through trimesh on demand.
 
 Lighting model (the numbers are scene design, stated once here; the physics is eq. 5-8):
 
@@ -110,43 +111,80 @@ def draped_curtain(columns: int = 120, rows: int = 80, folds: float = 5.5,
                 triangles.astype(np.int32))
 
 
-def _slab(x0, x1, y0, y1, z0, z1):
-    import trimesh  # noqa: PLC0415
+def box_triangles(x0, x1, y0, y1, z0, z1) -> np.ndarray:
+    """An axis-aligned box as 12 triangles (12, 3, 3), counter-clockwise seen from outside."""
+    c = np.array([[x, y, z] for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)], dtype=np.float64)
+    # corner index = 4 ix + 2 iy + iz; each face as a quad (a, b, c, d) counter-clockwise from outside
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5),   # -x, +x
+             (0, 4, 5, 1), (2, 3, 7, 6),   # -y, +y
+             (0, 2, 6, 4), (1, 5, 7, 3)]   # -z, +z
+    return np.array([tri for a, b, cc, d in quads for tri in ((c[a], c[b], c[cc]), (c[a], c[cc], c[d]))])
 
-    extents = [x1 - x0, y1 - y0, z1 - z0]
-    centre = [(x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2]
-    return trimesh.creation.box(extents=extents,
-                                transform=trimesh.transformations.translation_matrix(centre))
+
+def rod_triangles(radius_m: float, length_m: float, centre, sections: int = 16) -> np.ndarray:
+    """A closed cylinder along x (the curtain rod) as triangles, counter-clockwise from outside."""
+    angle = np.linspace(0.0, 2 * math.pi, sections + 1)
+    ring = np.stack([np.zeros_like(angle), radius_m * np.cos(angle), radius_m * np.sin(angle)], 1)
+    left = ring + [-length_m / 2, 0, 0] + np.asarray(centre)
+    right = ring + [length_m / 2, 0, 0] + np.asarray(centre)
+    tris = []
+    for i in range(sections):
+        tris += [(left[i], left[i + 1], right[i + 1]), (left[i], right[i + 1], right[i])]
+        tris += [(np.asarray(centre) + [-length_m / 2, 0, 0], left[i + 1], left[i]),
+                 (np.asarray(centre) + [length_m / 2, 0, 0], right[i], right[i + 1])]
+    return np.array(tris)
+
+
+def _room_parts() -> list[np.ndarray]:
+    (x0, x1), (y0, y1), (z0, z1) = ROOM_BOX
+    wx0, wx1, wy0, wy1 = WINDOW_RECT
+    t = 0.1  # wall thickness
+    return [
+        box_triangles(x0 - t, x1 + t, y0 - t, y0, z0 - t, z1 + t),       # floor
+        box_triangles(x0 - t, x1 + t, y1, y1 + t, z0 - t, z1 + t),       # ceiling
+        box_triangles(x0 - t, x0, y0, y1, z0 - t, z1 + t),               # left wall
+        box_triangles(x1, x1 + t, y0, y1, z0 - t, z1 + t),               # right wall
+        box_triangles(x0, x1, y0, y1, z1, z1 + t),                       # wall behind the viewer
+        # the window wall, around the opening
+        box_triangles(x0, wx0, y0, y1, z0 - t, z0),
+        box_triangles(wx1, x1, y0, y1, z0 - t, z0),
+        box_triangles(wx0, wx1, y0, wy0, z0 - t, z0),
+        box_triangles(wx0, wx1, wy1, y1, z0 - t, z0),
+        rod_triangles(0.015, CURTAIN_WIDTH_M + 0.4, (0.0, CURTAIN_TOP_Y + 0.03, CURTAIN_Z)),
+    ]
 
 
 @functools.lru_cache(maxsize=1)
 def room_props() -> tuple[np.ndarray, np.ndarray]:
-    """The room (walls, floor, ceiling, the window wall with its opening) and the curtain rod,
-    merged through trimesh; returns non-indexed (positions, face normals), float32 (3T, 3)."""
-    import trimesh  # noqa: PLC0415
+    """The room (walls, floor, ceiling, the window wall with its opening) and the curtain rod;
+    returns non-indexed (positions, face normals), float32 (3T, 3).
 
-    (x0, x1), (y0, y1), (z0, z1) = ROOM_BOX
-    wx0, wx1, wy0, wy1 = WINDOW_RECT
-    t = 0.1  # wall thickness
-    parts = [
-        _slab(x0 - t, x1 + t, y0 - t, y0, z0 - t, z1 + t),       # floor
-        _slab(x0 - t, x1 + t, y1, y1 + t, z0 - t, z1 + t),       # ceiling
-        _slab(x0 - t, x0, y0, y1, z0 - t, z1 + t),               # left wall
-        _slab(x1, x1 + t, y0, y1, z0 - t, z1 + t),               # right wall
-        _slab(x0, x1, y0, y1, z1, z1 + t),                       # wall behind the viewer
-        # the window wall, around the opening
-        _slab(x0, wx0, y0, y1, z0 - t, z0),
-        _slab(wx1, x1, y0, y1, z0 - t, z0),
-        _slab(wx0, wx1, y0, wy0, z0 - t, z0),
-        _slab(wx0, wx1, wy1, y1, z0 - t, z0),
-    ]
-    rod = trimesh.creation.cylinder(radius=0.015, height=CURTAIN_WIDTH_M + 0.4, sections=16)
-    rod.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [0, 1, 0]))
-    rod.apply_translation([0.0, CURTAIN_TOP_Y + 0.03, CURTAIN_Z])
-    merged = trimesh.util.concatenate(parts + [rod])
-    triangles = merged.vertices[merged.faces]  # (T, 3, 3)
-    normals = np.repeat(merged.face_normals[:, None, :], 3, axis=1)
+    Built with numpy, not trimesh: importing trimesh imports scipy, which a frame must not
+    (the viewer's rule); tests/test_render_scene.py checks these solids against trimesh's.
+    Extra props from a mesh file go through :func:`load_props` (trimesh, on demand).
+    """
+    triangles = np.concatenate(_room_parts())
+    return _flat_shaded(triangles)
+
+
+def _flat_shaded(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    normals = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = np.repeat(normals[:, None, :], 3, axis=1)
     return (triangles.reshape(-1, 3).astype(np.float32), normals.reshape(-1, 3).astype(np.float32))
+
+
+def load_props(path) -> tuple[np.ndarray, np.ndarray]:
+    """Props from a mesh file (OBJ, PLY, GLB, ... through trimesh), flat-shaded like the room."""
+    import trimesh  # noqa: PLC0415  (imports scipy: only when a prop file is asked for)
+
+    try:
+        mesh = trimesh.load(str(path), force="mesh")
+    except (ValueError, OSError) as exc:
+        raise InputError(f"cannot read the mesh: {exc}", path=path) from None
+    if len(mesh.faces) == 0:
+        raise InputError("the mesh has no triangles", path=path)
+    return _flat_shaded(np.asarray(mesh.vertices, dtype=np.float64)[np.asarray(mesh.faces)])
 
 
 # --------------------------------------------------------------------------- the sun
