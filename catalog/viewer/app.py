@@ -178,6 +178,7 @@ class ViewerApp:
                     self.scene.step(frame_dt)
                 for renderer in self._renderers:
                     self.scene.feed(renderer)
+                self.ctx.finish()  # the gpu cloth's compute passes are simulation time
 
             with self.timer.part("shading"):
                 self._fbo.use()
