@@ -8,7 +8,7 @@
 //   PASS_SPRINGS   XPBD distance constraints of one selector (Macklin, Mueller, Chentanez
 //                  2016), with Provot's strain limit; or the strain-limit sweep alone
 //   PASS_ATTACH    long-range attachments (Kim, Chentanez, Mueller 2012), floor and wall
-//   PASS_UPDATE    clamp again, v = (x - x_prev) / h, friction in contact
+//   PASS_UPDATE    clamp again, v = (x - x_prev) / h, contact damping
 //   PASS_VERTICES  positions, normals, tangents into the renderer's vertex buffer
 // Positions are vec4 (w unused) in std430 buffers; particle index = row * W + col.
 
@@ -170,7 +170,7 @@ void main() {
 #ifdef PASS_UPDATE
 uniform float u_floor;
 uniform float u_wall;
-uniform float u_keep;  // 1 - friction
+uniform float u_contact_damping;  // tangential velocity lost per second in contact
 void main() {
     int i = int(gl_GlobalInvocationID.x);
     if (i >= u_grid.x * u_grid.y) return;
@@ -181,9 +181,10 @@ void main() {
     p.z = max(p.z, u_wall);
     x[i] = vec4(p, 0.0);
     vec3 vel = (p - x_prev[i].xyz) / u_h;
-    if (on_floor || on_wall) vel.x *= u_keep;
-    if (on_floor) vel.z *= u_keep;
-    if (on_wall) vel.y *= u_keep;
+    float keep = 1.0 / (1.0 + u_contact_damping * u_h);
+    if (on_floor || on_wall) vel.x *= keep;
+    if (on_floor) vel.z *= keep;
+    if (on_wall) vel.y *= keep;
     v[i] = vec4(vel, 0.0);
 }
 #endif

@@ -109,7 +109,7 @@ class GpuBackend:
         for name in ("ATTACH", "UPDATE"):
             self._uniform(name, "u_floor", p.thickness_m)
             self._uniform(name, "u_wall", -p.wall_gap_m + p.thickness_m)
-        self._uniform("UPDATE", "u_keep", 1.0 - p.friction)
+        self._uniform("UPDATE", "u_contact_damping", p.contact_damping_per_s)
         w, h = p.grid_w, p.grid_h
         self._selectors = []
         for sel in SELECTORS:

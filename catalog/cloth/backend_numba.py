@@ -31,7 +31,7 @@ def pack_params(params: ClothParams, constants: SolverConstants) -> np.ndarray:
     fp[k.MAX_STRETCH] = params.max_stretch
     fp[k.FLOOR] = params.thickness_m
     fp[k.WALL] = -params.wall_gap_m + params.thickness_m
-    fp[k.FRICTION] = params.friction
+    fp[k.CONTACT_DAMPING] = params.contact_damping_per_s
     fp[k.RING_SPEED] = params.ring_speed_m_s
     fp[k.STRAIN_PASSES] = params.strain_passes
     return fp

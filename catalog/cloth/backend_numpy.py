@@ -13,7 +13,7 @@ physics simulation": many substeps, one constraint iteration each):
 5. long-range attachments to the ring above (Kim, Chentanez, Mueller 2012): no particle
    further from its ring than its rest distance down the fabric;
 6. collision with the floor (y = 0) and the window wall (z = -wall_gap);
-7. v = (x - x_prev) / h, with friction on the particles in contact.
+7. v = (x - x_prev) / h, with contact damping of the tangential velocity.
 """
 
 from __future__ import annotations
@@ -129,9 +129,9 @@ class NumpyBackend:
         # the sweeps may have nudged a particle into a plane: clamp again
         np.maximum(x[..., 1], floor, out=x[..., 1])
         np.maximum(x[..., 2], wall, out=x[..., 2])
-        # 7. velocities, friction in contact
+        # 7. velocities, contact damping (tangential)
         v[...] = (x - x_prev) / h
-        keep = 1.0 - p.friction
+        keep = 1.0 / (1.0 + p.contact_damping_per_s * h)
         on_floor = x[..., 1] <= floor
         on_wall = x[..., 2] <= wall
         v[..., 0] *= np.where(on_floor | on_wall, keep, 1.0)

@@ -127,8 +127,20 @@ def export_mesh(mesh: CurtainMesh, path: str | Path) -> Path:
     if path.suffix.lower() not in EXPORT_SUFFIXES:
         raise InputError(f"unsupported mesh format {path.suffix!r}; use one of "
                          f"{', '.join(EXPORT_SUFFIXES)}", path=path)
+    suffix = path.suffix.lower()
+    if suffix == ".obj":
+        # positions, normals and uv only: no material file beside it (it has no texture)
+        from trimesh.exchange.obj import export_obj
+
+        text = export_obj(mesh.to_trimesh(), include_normals=True, include_texture=True,
+                          write_texture=False)
+        text = "\n".join(line for line in text.splitlines()
+                         if not line.startswith(("mtllib", "usemtl"))) + "\n"
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+        return path
     with atomic_path(path) as tmp:
-        mesh.to_trimesh().export(tmp, file_type=path.suffix.lower().lstrip("."))
+        mesh.to_trimesh().export(tmp, file_type=suffix.lstrip("."))
     return path
 
 

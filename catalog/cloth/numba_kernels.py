@@ -16,7 +16,7 @@ from numba import njit
 
 # fp indices
 DAMPING, GRAVITY, AERO, WIND_SPEED, WIND_X, WIND_Y, WIND_Z, GUST, GUST_LENGTH, GUST_PERIOD, \
-    MAX_STRETCH, FLOOR, WALL, FRICTION, RING_SPEED, STRAIN_PASSES = range(16)
+    MAX_STRETCH, FLOOR, WALL, CONTACT_DAMPING, RING_SPEED, STRAIN_PASSES = range(16)
 FP_SIZE = 16
 #: Strain above the limit that the last substep's sweeps accept before stopping.
 STRAIN_TOLERANCE = 5e-4
@@ -203,7 +203,7 @@ def _collide_update(x, v, xp, fp, h):
     height, width = x.shape[0], x.shape[1]
     floor = fp[FLOOR]
     wall = fp[WALL]
-    keep = 1.0 - fp[FRICTION]
+    keep = 1.0 / (1.0 + fp[CONTACT_DAMPING] * h)  # contact damping
     for r in range(height):
         for c in range(width):
             on_floor = False

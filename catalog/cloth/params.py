@@ -101,9 +101,9 @@ class ClothParams:
     rod_height_m: float | None = None  # None: height_m + 0.05 (hem just above the floor)
     wall_gap_m: float = 0.12  # the window wall is the plane z = -wall_gap_m
     thickness_m: float = 0.004  # collision offset from the wall and floor planes
-    friction: float = 0.4  # fraction of tangential velocity lost in a contact substep
+    contact_damping_per_s: float = 5.0  # tangential velocity lost per second in contact
     strain_passes: int = 1  # strain-limiting sweeps per substep (after the LRA)
-    final_strain_passes: int = 16  # at most this many in a frame's last substep (adaptive)
+    final_strain_passes: int = 64  # at most this many in a frame's last substep (adaptive)
     max_substep_s: float = 1.0 / 600.0  # substeps per frame = ceil(frame_dt / this)
     sleep_speed_m_s: float = 5.0e-3  # below this everywhere, for sleep_frames, it sleeps
     sleep_frames: int = 20
@@ -124,14 +124,13 @@ class ClothParams:
             _positive(name, getattr(self, name))
         for name in ("bend_stiffness_n_m", "damping_per_s", "drag_coefficient",
                      "air_density_kg_m3", "gravity_m_s2", "wind_speed_m_s", "gust_strength",
-                     "wall_gap_m", "sleep_speed_m_s"):
+                     "wall_gap_m", "sleep_speed_m_s", "contact_damping_per_s"):
             _non_negative(name, getattr(self, name))
         if self.shear_stiffness_n_m is not None:
             _non_negative("shear_stiffness_n_m", self.shear_stiffness_n_m)
         if self.rod_height_m is not None:
             _positive("rod_height_m", self.rod_height_m)
         _fraction("opening", self.opening, low_exclusive=True)
-        _fraction("friction", self.friction)
         if self.max_stretch > 1.0:
             raise InputError(f"must be <= 1, found {self.max_stretch:g}", field="max_stretch")
         if isinstance(self.strain_passes, bool) or not isinstance(self.strain_passes, int) \

@@ -27,13 +27,27 @@ def ring_columns(params: ClothParams) -> np.ndarray:
     return np.array(cols, dtype=np.int64)
 
 
+def _max_pleat_depth(params: ClothParams) -> float:
+    """Pleats stay clear of the window wall: at most half the gap deep."""
+    return 0.5 * (params.wall_gap_m - params.thickness_m)
+
+
 def ring_positions(params: ClothParams, opening: float | None = None) -> np.ndarray:
-    """(R, 3) positions of the rings on the rod for an opening (default: the params')."""
+    """(R, 3) positions of the rings on the rod for an opening (default: the params').
+
+    On a grid so coarse that every column has a ring (ring_every = 1) there is no fabric
+    between rings to fold, so the rings themselves zig-zag about the rod's line by
+    1/2 sqrt(dx^2 - (o dx)^2), keeping one rest spacing between neighbours.
+    """
     o = params.opening if opening is None else opening
     cols = ring_columns(params)
+    dx = params.spacing_x_m
     rings = np.zeros((cols.size, 3))
-    rings[:, 0] = -0.5 * params.width_m + cols * params.spacing_x_m * o
+    rings[:, 0] = -0.5 * params.width_m + cols * dx * o
     rings[:, 1] = params.rod_y_m
+    if params.ring_every == 1:
+        depth = min(0.5 * math.sqrt(max(dx * dx - (o * dx) ** 2, 0.0)), _max_pleat_depth(params))
+        rings[:, 2] = np.where(cols % 2 == 0, -depth, depth)
     return rings
 
 
@@ -45,11 +59,13 @@ def top_row(params: ClothParams, opening: float | None = None) -> np.ndarray:
     rings = ring_positions(params, o)
     row = np.zeros((params.grid_w, 3))
     row[:, 1] = params.rod_y_m
-    # pleats clear of the window wall (depth at most half the gap)
-    max_depth = 0.5 * (params.wall_gap_m - params.thickness_m)
+    row[cols] = rings
+    max_depth = _max_pleat_depth(params)
     for j in range(cols.size - 1):
         c0, c1 = int(cols[j]), int(cols[j + 1])
         k = c1 - c0
+        if k == 1:
+            continue
         span = rings[j + 1, 0] - rings[j, 0]
         half_leg = 0.5 * k * dx
         depth = min(math.sqrt(max(half_leg ** 2 - (0.5 * span) ** 2, 0.0)), max_depth)
