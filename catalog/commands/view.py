@@ -78,9 +78,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--wind", type=float, metavar="M_S", help="wind speed, m/s")
     parser.add_argument("--grid", type=_grid, default=(48, 64), metavar="WxH",
                         help="cloth particles across x down (default 48x64)")
-    parser.add_argument("--cloth-backend", choices=("numpy", "cpu", "gpu"), default="cpu",
-                        help="cloth simulation backend (default cpu; gpu: compute shaders "
-                        "writing the vertex buffer, for a real GPU)")
+    parser.add_argument("--cloth-backend", choices=("auto", "numpy", "cpu", "gpu"),
+                        default="auto",
+                        help="cloth simulation backend: gpu (compute shaders writing the "
+                        "vertex buffer), numpy, cpu (numba: fastest on a CPU, but it imports "
+                        "scipy); default auto: gpu on a GPU, numpy on a software rasteriser")
     parser.add_argument("--render-scale", type=_render_scale, metavar="S|auto", default=None,
                         help="scene resolution relative to the window, 0.25-1 (default auto: "
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")
@@ -117,7 +119,8 @@ def run(args: argparse.Namespace) -> int:
         fabric=fabric, light=args.light, compare=args.compare, size=args.size,
         frames=args.frames, screenshot=args.screenshot, screenshot_dir=args.screenshot_dir,
         stats=args.stats, fluorescence=args.fluorescence, bands=args.bands, hour=args.hour,
-        wind_m_s=args.wind, grid=args.grid, cloth_backend=args.cloth_backend,
+        wind_m_s=args.wind, grid=args.grid,
+        cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
         fabric_dir=fabric_dir if fabric_dir is not None else FABRIC_DIR)
     return ViewerApp(options).run()

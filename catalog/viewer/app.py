@@ -53,7 +53,7 @@ class ViewerOptions:
     hour: float | None = None
     wind_m_s: float | None = None
     grid: tuple[int, int] = (48, 64)
-    cloth_backend: str = "cpu"
+    cloth_backend: str | None = None  # None: auto (see ViewerApp._choose_cloth_backend)
     panel: bool = True
     paused: bool = False
     render_scale: float | None = None  # scene resolution / window resolution; None: auto
@@ -135,6 +135,7 @@ class ViewerApp:
         self.window = window
         self.ctx: moderngl.Context = wrap_window_context()
         self.render_scale = self._choose_render_scale()
+        self.cloth_backend = self._choose_cloth_backend()
         glfw.swap_interval(0 if self.options.frames is not None else 1)
 
         imgui.create_context()
@@ -144,7 +145,7 @@ class ViewerApp:
         self._install_callbacks(imgui)
         self.panel_info = PanelInfo(cie_lights=self._cie_light_names())
 
-        self.scene = CurtainScene(self.options.grid, backend=self.options.cloth_backend,
+        self.scene = CurtainScene(self.options.grid, backend=self.cloth_backend,
                                   wind_m_s=self.settings.wind_m_s, ctx=self.ctx)
         self._fbo = None
         self._renderers: list = []
@@ -230,7 +231,7 @@ class ViewerApp:
         if self.options.stats:
             summary = {"summary": True, "frames": frame, "size": list(self._fbo.size),
                        "grid": list(self.options.grid), "renderer": self.ctx.info["GL_RENDERER"],
-                       "render_scale": self.render_scale,
+                       "render_scale": self.render_scale, "cloth_backend": self.cloth_backend,
                        **{f"median_{k}_ms": round(v, 3)
                           for k, v in self.timer.median_ms().items()}}
             print(json.dumps(summary), flush=True)
@@ -368,9 +369,21 @@ class ViewerApp:
         """The option's scale, or on a software rasteriser SOFTWARE_RENDER_SCALE, else 1."""
         if self.options.render_scale is not None:
             return float(self.options.render_scale)
+        return SOFTWARE_RENDER_SCALE if self._software_gl() else 1.0
+
+    def _software_gl(self) -> bool:
         renderer = self.ctx.info.get("GL_RENDERER", "")
-        return SOFTWARE_RENDER_SCALE if any(name in renderer for name in SOFTWARE_RENDERERS) \
-            else 1.0
+        return any(name in renderer for name in SOFTWARE_RENDERERS)
+
+    def _choose_cloth_backend(self) -> str:
+        """The option's backend, or: the GLSL compute cloth on a GPU (it writes the vertex
+        buffer the renderer draws), the numpy cloth on a software rasteriser (where compute
+        shaders run on the same CPU, slower than numpy). Not numba by default: numba's CPU
+        target imports scipy.linalg's BLAS bindings whenever scipy is installed, and the
+        viewer must not import scipy."""
+        if self.options.cloth_backend is not None:
+            return self.options.cloth_backend
+        return "numpy" if self._software_gl() else "gpu"
 
     def _blit(self, small, viewport: tuple[int, int, int, int]) -> None:
         """Scale a reduced-resolution scene up into its viewport of the window framebuffer
