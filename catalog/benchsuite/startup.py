@@ -5,7 +5,8 @@ pulls in) and benchmarks/bench_viewer.py (a private Xvfb). Added here: the wall 
 fresh process ``catalog snapshot ... --size 640x360`` (EGL, one frame written) and
 ``catalog view --frames 1`` in a 640x360 window under Xvfb (one frame shown), each from
 process start to exit after the first frame, median of repeats; and which heavy modules
-the viewer process had loaded at its first frame (it must not load scipy).
+the viewer process had loaded at its first frame (it must not load scipy), beside the
+import cost of colour-science and numba (which loads scipy itself when it is installed).
 """
 
 from __future__ import annotations
@@ -62,8 +63,13 @@ def run(quick: bool = False, ctx=None, *, first_frames: bool = True, repeats=Non
     seconds = startup.time_command([sys.executable, "-c", "import colour"], repeats)
     rows.append({"case": "import colour (colour-science)", "median_s": seconds,
                  "ratio_to_python": seconds / floor})
+    # numba: the viewer's default cloth backend; importing it loads scipy when installed
+    seconds = startup.time_command([sys.executable, "-c", "import numba"], repeats)
+    rows.append({"case": "import numba (cpu cloth backend)", "median_s": seconds,
+                 "ratio_to_python": seconds / floor})
     imports = {name: startup.heavy_imports_of(module) for name, module in startup.IMPORT_PROBES.items()}
-    imports["colour"] = startup.heavy_imports_of("colour")
+    for module in ("colour", "numba", "catalog.cloth.backend_numba"):
+        imports[module] = startup.heavy_imports_of(module)
 
     frame_repeats = 1 if quick else 3
     viewer_heavy = None
