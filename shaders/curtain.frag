@@ -3,36 +3,50 @@
 // (683 * integral of the sRGB matching functions times radiance: cd m^-2 scale) at the end.
 #include "common.glsl"
 
-in vec3 v_position;
+in vec3 v_view_ray;                // position - camera, world space
 in vec3 v_normal;
+#if defined(ANISOTROPIC) || defined(GBUFFER)
 in vec3 v_tangent;
+#endif
+#ifdef GBUFFER
+in vec3 v_position;
+#endif
 
-uniform vec3 u_camera_position;
-uniform vec3 u_key_to_light;
-uniform vec3 u_fill_to_light;
-uniform vec3 u_sun_direction;      // to the sun's disc (the key light)
-uniform vec2 u_sun_chord2;         // disc edge: inner, outer chord^2
-uniform float u_direct;            // LD: the open-area see-through fraction
-uniform float u_a_diff;
-uniform float u_g_diff;
-uniform float u_a_spec;
-uniform float u_g_spec;
-uniform float u_anisotropy;
+// The scene's values, fixed until the light, fabric, mode or band count changes. SPECIALISED:
+// compiled in as constants (catalog/render/frame.py injects S_<NAME> #defines with their
+// values), so the compiler folds them (HG's (1 - g)^2, the sign of g) and a CPU rasteriser
+// loads no uniforms per fragment; otherwise ordinary uniforms.
+#ifdef SPECIALISED
+#define SCENE_VALUE(type, name, value) const type name = value
+#else
+#define SCENE_VALUE(type, name, value) uniform type name
+#endif
+
+SCENE_VALUE(vec3, u_key_to_light, S_KEY_TO_LIGHT);
+SCENE_VALUE(vec3, u_fill_to_light, S_FILL_TO_LIGHT);
+SCENE_VALUE(vec3, u_sun_direction, S_SUN_DIRECTION);        // to the sun's disc (the key light)
+SCENE_VALUE(vec2, u_sun_chord2, S_SUN_CHORD2);              // disc edge: inner, outer chord^2
+SCENE_VALUE(float, u_direct, S_DIRECT);                     // LD: the open-area see-through fraction
+SCENE_VALUE(float, u_a_diff, S_A_DIFF);
+SCENE_VALUE(float, u_g_diff, S_G_DIFF);
+SCENE_VALUE(float, u_a_spec, S_A_SPEC);
+SCENE_VALUE(float, u_g_spec, S_G_SPEC);
+SCENE_VALUE(float, u_anisotropy, S_ANISOTROPY);
 
 // per band, NV4 chunks of 4 bands
-uniform vec4 u_key_dyed[NV4];      // key light normal irradiance x dye transmittance
-uniform vec4 u_fill_dyed[NV4];     // fill light (viewer side) x dye
-uniform vec4 u_ambient[NV4];       // cloth radiance from the diffuse surroundings (both sides)
-uniform vec4 u_sky[NV4];
-uniform vec4 u_ground[NV4];
-uniform vec4 u_sun_disc[NV4];
-uniform vec4 u_room[NV4];
-uniform vec4 u_fluorescence[NV4];  // paper: radiance; physical: radiance per 1e18 effective photons
-uniform vec3 u_absorbed_photons;   // physical: (key, fill, ambient) absorbed photons at normal incidence, 1e18 m^-2 s^-1
-uniform float u_inv_saturation;    // 1e18 / N_sat (0: no saturation)
-uniform vec4 u_band_to_r[NV4];
-uniform vec4 u_band_to_g[NV4];
-uniform vec4 u_band_to_b[NV4];
+SCENE_VALUE(vec4, u_key_dyed[NV4], S_KEY_DYED);             // key light normal irradiance x dye
+SCENE_VALUE(vec4, u_fill_dyed[NV4], S_FILL_DYED);           // fill light (viewer side) x dye
+SCENE_VALUE(vec4, u_ambient[NV4], S_AMBIENT);               // cloth radiance from the diffuse surroundings
+SCENE_VALUE(vec4, u_sky[NV4], S_SKY);
+SCENE_VALUE(vec4, u_ground[NV4], S_GROUND);
+SCENE_VALUE(vec4, u_sun_disc[NV4], S_SUN_DISC);
+SCENE_VALUE(vec4, u_room[NV4], S_ROOM);
+SCENE_VALUE(vec4, u_fluorescence[NV4], S_FLUORESCENCE);     // paper: radiance; physical: per 1e18 effective photons
+SCENE_VALUE(vec3, u_absorbed_photons, S_ABSORBED_PHOTONS);  // physical: key, fill, ambient at normal incidence, 1e18 m^-2 s^-1
+SCENE_VALUE(float, u_inv_saturation, S_INV_SATURATION);     // 1e18 / N_sat (0: no saturation)
+SCENE_VALUE(vec4, u_band_to_r[NV4], S_BAND_TO_R);
+SCENE_VALUE(vec4, u_band_to_g[NV4], S_BAND_TO_G);
+SCENE_VALUE(vec4, u_band_to_b[NV4], S_BAND_TO_B);
 
 layout(location = 0) out vec4 out_radiance;
 #ifdef GBUFFER
@@ -70,7 +84,7 @@ void main() {
     vec3 t = vec3(0.0);                                       // isotropic: the frame is not needed
     vec3 b = vec3(0.0);
 #endif
-    vec3 ray = normalize(v_position - u_camera_position);
+    vec3 ray = normalize(v_view_ray);
     vec3 to_viewer = -ray;
 
     float g_key = woven_transmission(u_key_to_light, to_viewer, t, b, n,

@@ -1,21 +1,35 @@
 #version 430
 // The curtain mesh: positions (moved into the scene by u_mesh_offset: the cloth simulation's
 // own frame has the rod elsewhere), normals and the weft tangent; shared by the shading pass,
-// the G-buffer variant and the trivial floor shader.
+// the G-buffer variant and the trivial floor shader. The view ray (position - camera) is
+// linear in the position, so it is formed here and interpolated exactly: the fragment shader
+// then needs no per-frame uniform. The tangent travels only where it is used.
 in vec3 in_position;
 in vec3 in_normal;
 in vec3 in_tangent;
 
 uniform mat4 u_view_proj;
 uniform vec3 u_mesh_offset;
+uniform vec3 u_camera_position;
 
-out vec3 v_position;
+out vec3 v_view_ray;
 out vec3 v_normal;
+#if defined(ANISOTROPIC) || defined(GBUFFER)
 out vec3 v_tangent;
+#endif
+#ifdef GBUFFER
+out vec3 v_position;
+#endif
 
 void main() {
-    v_position = in_position + u_mesh_offset;
+    vec3 position = in_position + u_mesh_offset;
+    v_view_ray = position - u_camera_position;
     v_normal = in_normal;
+#if defined(ANISOTROPIC) || defined(GBUFFER)
     v_tangent = in_tangent;
-    gl_Position = u_view_proj * vec4(v_position, 1.0);
+#endif
+#ifdef GBUFFER
+    v_position = position;
+#endif
+    gl_Position = u_view_proj * vec4(position, 1.0);
 }

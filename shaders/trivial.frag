@@ -1,10 +1,6 @@
 #version 430
 // The rasteriser's floor for the benchmark: the same mesh and vertex shader, a constant colour
 // written to the same float target.
-in vec3 v_position;
-in vec3 v_normal;
-in vec3 v_tangent;
-
 layout(location = 0) out vec4 out_radiance;
 
 void main() {

@@ -278,3 +278,28 @@ def test_band_shader_arithmetic_matches_float64_bands(gl, make_preset, n_bands):
     error = _relative_error(gbuffer["radiance"][mask].astype(np.float64), expected)
     assert error.max() < 1e-3, float(error.max())
     renderer.release()
+
+
+def test_specialised_and_uniform_programs_agree(gl, make_preset):
+    """Scene values compiled in as constants (the default) or passed as uniforms: the same
+    frame up to float32 constant folding; and old specialised programs are released."""
+    from catalog.render.frame import MAX_SPECIALISED
+
+    path = make_preset(dye=YELLOW_DYE, extra_btdf="anisotropy = 0.2")
+    frames = []
+    for specialise in (True, False):
+        renderer = FrameRenderer(gl, SIZE, specialise=specialise)
+        renderer.set_fabric(path)
+        renderer.set_light("sun:120")
+        renderer.set_bands(6)
+        renderer.render()
+        frames.append(renderer.read_linear())
+        if specialise:
+            for n_lights, light in enumerate(["D65", "A", "FL2", "FL11", "LED-B4", "D50",
+                                              "sun:30", "sun:300", "UV-A", "D75"]):
+                renderer.set_light(light)
+                renderer.render()
+            kept = [v for v in renderer.compiled_variants() if v.get("SPECIALISED")]
+            assert len(kept) <= MAX_SPECIALISED
+        renderer.release()
+    assert np.allclose(frames[0], frames[1], rtol=1e-5, atol=1e-6 * frames[1].max())

@@ -24,7 +24,7 @@ from catalog.errors import CatalogError
 from catalog.render import bands as band_lib
 from catalog.render import scene as scene_lib
 from catalog.render.camera import OrbitCamera, gl_bytes
-from catalog.render.shaderlib import create_program
+from catalog.render.shaderlib import create_program, glsl_literal
 
 #: Auto exposure: a white diffuser under the key light maps to this (before the curve).
 EXPOSURE_KEY = 5.0
@@ -33,6 +33,8 @@ EXPOSURE_FLOOR_LX = 200.0
 #: Tone curve white point (after exposure): this luminance maps to display white.
 TONE_WHITE = 6.0
 FLUORESCENCE_MODES = ("off", "paper", "physical")
+#: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
+MAX_SPECIALISED = 8
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
 
@@ -55,7 +57,10 @@ def check_size(size, ctx=None) -> tuple[int, int]:
 class FrameRenderer:
     """Renders the curtain scene with a given moderngl context at a given size (w, h)."""
 
-    def __init__(self, ctx, size: tuple[int, int]):
+    def __init__(self, ctx, size: tuple[int, int], specialise: bool = True):
+        """``specialise``: compile the scene's values into the curtain shader as constants
+        (recompiled when the light, fabric, mode or band count changes; a CPU rasteriser then
+        loads no uniforms per fragment) rather than passing them as uniforms."""
         import moderngl  # noqa: PLC0415
 
         self._moderngl = moderngl
@@ -70,6 +75,7 @@ class FrameRenderer:
         self._ldr_fbo = ctx.framebuffer([self._ldr])
         self._gbuffer = None
         self._programs: dict[tuple, object] = {}
+        self.specialise = bool(specialise)
         self._vaos: dict[tuple, object] = {}
 
         self.preset = None
@@ -282,23 +288,58 @@ class FrameRenderer:
         return self._uniforms
 
     def variant_defines(self, gbuffer: bool = False) -> dict:
-        """The #defines of the curtain program this scene needs."""
+        """The switches of the curtain program this scene needs (not the specialised values)."""
         inputs = self.shading_inputs()
         defines = {"N_BANDS": self.n_bands, "NV4": band_lib.chunks(self.n_bands),
                    f"FLUORESCENCE_{inputs.fluorescence_mode.upper()}": True,
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
-                   "GBUFFER": gbuffer}
+                   "GBUFFER": gbuffer, "SPECIALISED": self.specialise}
         return defines
+
+    def scene_values(self) -> dict:
+        """The curtain shader's per-scene values (uniform name -> value), float32-exact."""
+        inputs = self.shading_inputs()
+        values = {
+            "u_key_to_light": tuple(float(v) for v in inputs.key_to_light),
+            "u_fill_to_light": tuple(float(v) for v in inputs.fill_to_light),
+            "u_sun_direction": tuple(float(v) for v in inputs.key_to_light),
+            "u_sun_chord2": tuple(float(v) for v in inputs.sun_chord2),
+            "u_direct": float(inputs.direct), "u_a_diff": float(inputs.a_diff),
+            "u_g_diff": float(inputs.g_diff), "u_a_spec": float(inputs.a_spec),
+            "u_g_spec": float(inputs.g_spec), "u_anisotropy": float(inputs.anisotropy),
+        }
+        for name, value in self._band_uniforms().items():
+            values[name] = tuple(float(v) for v in value) if isinstance(value, tuple) else value
+        return values
+
+    def _curtain_program(self, gbuffer: bool):
+        defines = self.variant_defines(gbuffer)
+        if self.specialise:
+            for name, value in self.scene_values().items():
+                defines["S_" + name[2:].upper()] = glsl_literal(value)
+        return self._program("curtain.vert", "curtain.frag", defines)
 
     def _program(self, vertex: str, fragment: str, defines: dict | None = None):
         key = (vertex, fragment, tuple(sorted((defines or {}).items())))
         if key not in self._programs:
+            self._evict_specialised()
             self._programs[key] = create_program(self.ctx, vertex, fragment, defines)
         return self._programs[key]
 
+    def _evict_specialised(self) -> None:
+        """Keep at most MAX_SPECIALISED specialised programs (oldest released first)."""
+        specialised = [k for k in self._programs if dict(k[2]).get("SPECIALISED")]
+        for key in specialised[:max(0, len(specialised) - MAX_SPECIALISED + 1)]:
+            program = self._programs.pop(key)
+            vao = self._vaos.pop(("curtain", id(program)), None)
+            if vao is not None:
+                vao.release()
+            program.release()
+
     def compiled_variants(self) -> list[dict]:
-        """The defines of every curtain program compiled so far (for tests and reports)."""
-        return [dict(k[2]) for k in self._programs if k[1] == "curtain.frag"]
+        """The switches of every curtain program compiled so far (for tests and reports)."""
+        return [{k: v for k, v in k2[2] if not k.startswith("S_")}
+                for k2 in self._programs if k2[1] == "curtain.frag"]
 
     def _curtain_vao(self, program):
         key = ("curtain", id(program))
@@ -366,17 +407,15 @@ class FrameRenderer:
             program = self._program("curtain.vert", "trivial.frag")
             self._set(program, "u_view_proj", gl_bytes(view_proj))
             self._set(program, "u_mesh_offset", self._mesh_offset)
+            self._set(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
         else:
-            inputs = self.shading_inputs()
-            program = self._program("curtain.vert", "curtain.frag", self.variant_defines(gbuffer))
-            self._scene_uniforms(program, view_proj, inputs)
+            program = self._curtain_program(gbuffer)
+            self._set(program, "u_view_proj", gl_bytes(view_proj))
+            self._set(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
             self._set(program, "u_mesh_offset", self._mesh_offset)
-            for name, value in (("u_direct", inputs.direct), ("u_a_diff", inputs.a_diff),
-                                ("u_g_diff", inputs.g_diff), ("u_a_spec", inputs.a_spec),
-                                ("u_g_spec", inputs.g_spec), ("u_anisotropy", inputs.anisotropy)):
-                self._set(program, name, float(value))
-            for name, value in self._band_uniforms().items():
-                self._set(program, name, value)
+            if not self.specialise:
+                for name, value in self.scene_values().items():
+                    self._set(program, name, value)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program).render(self._moderngl.TRIANGLES)
 

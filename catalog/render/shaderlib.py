@@ -90,6 +90,32 @@ def load_source(name: str, defines: Mapping[str, object] | None = None) -> str:
     raise CatalogError(f"shader file {path} has no #version line")
 
 
+def glsl_literal(value) -> str:
+    """A value as a GLSL constant expression for a #define: a float, a vec2/vec3/vec4 tuple, or
+    a float array of 4k values as ``vec4[k](...)``. Floats keep 9 significant digits, which
+    round-trips float32 exactly."""
+    import numpy as np  # noqa: PLC0415
+
+    def number(x) -> str:
+        x = float(np.float32(x))
+        if not np.isfinite(x):
+            raise CatalogError(f"a shader constant must be finite, got {x}")
+        return f"{x:.9e}"
+
+    if isinstance(value, np.ndarray):
+        flat = value.astype(np.float32).ravel()
+        if flat.size == 0 or flat.size % 4:
+            raise CatalogError(f"a vec4 array constant needs 4k values, got {flat.size}")
+        chunks = [f"vec4({', '.join(number(v) for v in flat[i:i + 4])})"
+                  for i in range(0, flat.size, 4)]
+        return f"vec4[{len(chunks)}]({', '.join(chunks)})"
+    if isinstance(value, (tuple, list)):
+        if len(value) not in (2, 3, 4):
+            raise CatalogError(f"a vector constant needs 2 to 4 values, got {len(value)}")
+        return f"vec{len(value)}({', '.join(number(v) for v in value)})"
+    return number(value)
+
+
 def create_program(ctx, vertex: str, fragment: str | None = None,
                    defines: Mapping[str, object] | None = None, fragment_outputs=None):
     """A moderngl program from shader files; compile errors become one-line CatalogErrors."""
