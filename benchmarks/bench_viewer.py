@@ -64,7 +64,7 @@ def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backe
     summary = next(r for r in records if r.get("summary"))
     first = frames_rec[0]
     steady = frames_rec[warmup:]
-    row = {"size": size, "grid": grid, "backend": backend, "frames": len(steady),
+    row = {"size": size, "grid": grid, "backend": summary["cloth_backend"], "frames": len(steady),
            "render_scale": summary["render_scale"],
            "first_frame_ms": round(first["total_ms"], 1), "wall_s": round(wall, 1),
            "scipy_imported": first["heavy_modules"]["scipy"]}
@@ -81,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--warmup", type=int, default=10)
     parser.add_argument("--cases", default=",".join(DEFAULT_CASES),
                         help="comma-separated SIZE:GRID, e.g. 1920x1080:128x128")
-    parser.add_argument("--backend", default="cpu", choices=("cpu", "numpy", "gpu"))
+    parser.add_argument("--backend", default="auto", choices=("auto", "cpu", "numpy", "gpu"))
     parser.add_argument("--fabric", default="lace-fwa")
     parser.add_argument("--light", default="D65")
     parser.add_argument("--render-scale", default="auto",
