@@ -45,6 +45,21 @@ def test_room_props_have_the_window_open():
         assert not (u >= 0 and v >= 0 and u + v <= 1)
 
 
+@pytest.mark.parametrize("hour", [6.0, 9.0, 12.0, 15.5, 18.5])
+def test_solar_zenith_matches_pvlib_spa(hour):
+    """The renderer's closed-form sun (no pvlib at draw time) against pvlib's NREL SPA
+    through catalog.sun, at the same date, local mean solar time and latitude."""
+    from catalog.sun import sun_position
+
+    minutes = int(round(hour * 60))
+    lon = 135.5
+    spa = sun_position(f"{scene.SUN_DATE}T{minutes // 60:02d}:{minutes % 60:02d}",
+                       scene.SUN_LATITUDE_DEG, lon)
+    ours = scene.solar_zenith_deg(hour)
+    # pvlib's apparent zenith includes refraction (up to ~0.5 deg near the horizon)
+    assert abs(ours - spa.zenith_deg) < (0.6 if spa.zenith_deg > 85 else 0.3)
+
+
 def test_sun_by_the_hour():
     noon = scene.sun_at_hour(12.0)
     assert 10 < noon.zenith_deg < 13  # 34.7 N at the solstice: ~11 deg
@@ -153,8 +168,9 @@ def test_frame_setup_imports_no_scipy():
 
     code = ("import sys\n"
             "from catalog.render import scene, bands, frame, camera, shaderlib, snapshot\n"
-            "scene.room_props(); scene.draped_curtain()\n"
-            "print('scipy' in sys.modules, 'trimesh' in sys.modules)\n")
+            "scene.room_props(); scene.draped_curtain(); scene.sun_at_hour(12.0)\n"
+            "from catalog.lights import get_light; get_light(scene.sun_at_hour(17.0).light_name)\n"
+            "print('scipy' in sys.modules, 'trimesh' in sys.modules, 'pvlib' in sys.modules)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.split() == ["False", "False"]
+    assert out.stdout.split() == ["False", "False", "False"]

@@ -95,7 +95,6 @@ class FrameRenderer:
 
         positions, normals = scene_lib.room_props()
         self._room_vbo = ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
-        self._room_count = positions.shape[0]
         self._curtain_buffers = None
         default = scene_lib.draped_curtain()
         self.set_mesh(default.positions, default.normals, default.uvs, default.tangents,

@@ -58,7 +58,6 @@ KEY_AZIMUTH_DEG = 15.0
 #: Where and when the hour of day is taken (the paper's setting: Japan, summer solstice).
 SUN_DATE = "2026-06-21"
 SUN_LATITUDE_DEG = 34.7
-SUN_LONGITUDE_DEG = 135.5
 
 
 # --------------------------------------------------------------------------- meshes
@@ -204,23 +203,52 @@ class SunAtHour:
     light_name: str
 
 
+#: Day of the year of SUN_DATE (the June solstice).
+SUN_DAY_OF_YEAR = 172
+
+
+def solar_declination_and_equation_of_time(day_of_year: int) -> tuple[float, float]:
+    """Spencer (1971), "Fourier series representation of the position of the sun": the
+    declination (rad) and the equation of time (minutes) for a day of the year."""
+    g = 2 * math.pi * (day_of_year - 1) / 365.0
+    declination = (0.006918 - 0.399912 * math.cos(g) + 0.070257 * math.sin(g)
+                   - 0.006758 * math.cos(2 * g) + 0.000907 * math.sin(2 * g)
+                   - 0.002697 * math.cos(3 * g) + 0.00148 * math.sin(3 * g))
+    equation_of_time_min = 229.18 * (0.000075 + 0.001868 * math.cos(g) - 0.032077 * math.sin(g)
+                                     - 0.014615 * math.cos(2 * g) - 0.040849 * math.sin(2 * g))
+    return declination, equation_of_time_min
+
+
+def solar_zenith_deg(hour: float, day_of_year: int = SUN_DAY_OF_YEAR,
+                     latitude_deg: float = SUN_LATITUDE_DEG) -> float:
+    """Geometric solar zenith (deg) at ``hour`` of local mean solar time: hour angle from the
+    apparent solar time (mean time + equation of time), cos z = sin(phi) sin(delta) +
+    cos(phi) cos(delta) cos(h). Within a few tenths of a degree of pvlib's NREL SPA above
+    the horizon (tests/test_render_scene.py checks it), without importing pvlib and scipy,
+    which drawing a frame must not."""
+    declination, eot_min = solar_declination_and_equation_of_time(day_of_year)
+    hour_angle = math.radians(15.0 * (hour + eot_min / 60.0 - 12.0))
+    lat = math.radians(latitude_deg)
+    cos_z = (math.sin(lat) * math.sin(declination)
+             + math.cos(lat) * math.cos(declination) * math.cos(hour_angle))
+    return math.degrees(math.acos(max(-1.0, min(1.0, cos_z))))
+
+
 def sun_at_hour(hour: float) -> SunAtHour:
     """Hour of local mean solar time on SUN_DATE at SUN_LATITUDE -> the sun through a
-    south-facing window: zenith (pvlib's SPA via catalog.sun), path length through the
-    paper's 22 km shell, and the light name ``sun:PATH_KM`` of the light library."""
-    from catalog.sun import sun_position  # noqa: PLC0415
+    south-facing window: zenith (:func:`solar_zenith_deg`), path length through the paper's
+    22 km shell (catalog.sun), and the light name ``sun:PATH_KM`` of the light library."""
+    from catalog.sun import path_km_from_zenith  # noqa: PLC0415
 
     if not (math.isfinite(hour) and 0.0 <= hour < 24.0):
         raise InputError(f"{hour!r} is not an hour of the day (0 <= hour < 24)", field="--hour")
-    minutes = int(round(hour * 60))
-    position = sun_position(f"{SUN_DATE}T{minutes // 60:02d}:{minutes % 60:02d}",
-                            SUN_LATITUDE_DEG, SUN_LONGITUDE_DEG)
-    if position.path_km is None:
-        raise InputError(f"the sun is below the horizon at {hour:g} h "
-                         f"(zenith {position.zenith_deg:.1f} deg)", field="--hour")
+    zenith = solar_zenith_deg(hour)
+    if zenith >= 90.0:
+        raise InputError(f"the sun is below the horizon at {hour:g} h (zenith {zenith:.1f} deg)",
+                         field="--hour")
+    path = path_km_from_zenith(zenith)
     azimuth = max(-75.0, min(75.0, 15.0 * (hour - 12.0)))  # hour angle, kept inside the window
-    return SunAtHour(hour, position.zenith_deg, azimuth, position.path_km,
-                     f"sun:{position.path_km:.1f}")
+    return SunAtHour(hour, zenith, azimuth, path, f"sun:{path:.1f}")
 
 
 def key_elevation_for(light_name: str) -> float:
