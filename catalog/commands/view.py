@@ -92,7 +92,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="folder of presets (default: the catalog's fabrics/)")
 
 
+def _forbid_scipy() -> None:
+    """Mark scipy absent in the viewer's process.
+
+    Drawing a frame never needs scipy (architecture.md: render and viewer never import the
+    tools' fitting code). numba's own import probes for scipy (a version check) and its CPU
+    target then loads scipy.linalg's BLAS bindings, a few hundred ms of start-up for nothing;
+    with scipy marked absent numba skips both, and an accidental scipy import anywhere in the
+    viewer fails loudly instead of silently slowing the start.
+    """
+    import sys
+
+    sys.modules.setdefault("scipy", None)  # type: ignore[arg-type]
+
+
 def run(args: argparse.Namespace) -> int:
+    _forbid_scipy()
     from catalog import FABRIC_DIR
     from catalog.errors import CatalogError
     from catalog.viewer.app import ViewerApp, ViewerOptions

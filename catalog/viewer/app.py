@@ -62,7 +62,9 @@ class ViewerOptions:
 
 def heavy_modules_loaded() -> dict[str, bool]:
     """Which of the modules the viewer must not need are in this process."""
-    return {name: name in sys.modules for name in ("scipy", "colour", "matplotlib", "pvlib")}
+    # a None entry is a module marked absent (catalog view marks scipy so), not a loaded one
+    return {name: sys.modules.get(name) is not None
+            for name in ("scipy", "colour", "matplotlib", "pvlib", "pandas")}
 
 
 class ViewerApp:
@@ -377,13 +379,13 @@ class ViewerApp:
 
     def _choose_cloth_backend(self) -> str:
         """The option's backend, or: the GLSL compute cloth on a GPU (it writes the vertex
-        buffer the renderer draws), the numpy cloth on a software rasteriser (where compute
-        shaders run on the same CPU, slower than numpy). Not numba by default: numba's CPU
-        target imports scipy.linalg's BLAS bindings whenever scipy is installed, and the
-        viewer must not import scipy."""
+        buffer the renderer draws), the numba CPU cloth on a software rasteriser (where compute
+        shaders run on the same CPU, slower than numba: 75 vs 496 ms a frame at 128x128).
+        `catalog view` marks scipy absent before numba is imported, so numba does not pull
+        scipy in (catalog/commands/view.py)."""
         if self.options.cloth_backend is not None:
             return self.options.cloth_backend
-        return "numpy" if self._software_gl() else "gpu"
+        return "cpu" if self._software_gl() else "gpu"
 
     def _blit(self, small, viewport: tuple[int, int, int, int]) -> None:
         """Scale a reduced-resolution scene up into its viewport of the window framebuffer
