@@ -111,35 +111,41 @@ void main() {
 #endif
 
 #ifdef PASS_SPRINGS
-uniform ivec2 u_offset;     // (di, dj): spring from (r, c) to (r + di, c + dj)
-uniform ivec2 u_first;      // first (row, col) of this selector
-uniform ivec2 u_step;       // (row step, col step)
-uniform ivec2 u_count;      // springs (rows, cols) in this selector
-uniform float u_rest;       // m
-uniform float u_kh2;        // k h^2 (the XPBD compliance is 1/k)
-uniform float u_limit;      // (1 + max_stretch) rest, m
-uniform bool u_limited;     // stretch or shear: strain-limited
+// One selector of springs (catalog/cloth/topology.py), a spring from (r, c) to
+// (r + di, c + dj) per invocation; the selectors' numbers sit in a buffer so a dispatch
+// only sets u_selector.
+struct Selector {
+    ivec4 offset_first;   // di, dj, first row, first col
+    ivec4 step_count;     // row step, col step, rows, cols
+    vec4 rest_k_limit;    // rest (m), k (N/m), (1 + max_stretch) rest (m), strain-limited
+};
+layout(std430, binding = 10) readonly buffer Selectors { Selector selector[]; };
+uniform int u_selector;
 uniform bool u_limit_only;  // the strain-limit sweep: only what exceeds the limit
 void main() {
+    Selector s = selector[u_selector];
     ivec2 id = ivec2(gl_GlobalInvocationID.y, gl_GlobalInvocationID.x);  // (row k, col m)
-    if (id.x >= u_count.x || id.y >= u_count.y) return;
-    int r = u_first.x + id.x * u_step.x;
-    int c = u_first.y + id.y * u_step.y;
+    if (id.x >= s.step_count.z || id.y >= s.step_count.w) return;
+    int r = s.offset_first.z + id.x * s.step_count.x;
+    int c = s.offset_first.w + id.y * s.step_count.y;
     int a = r * u_grid.x + c;
-    int b = (r + u_offset.x) * u_grid.x + (c + u_offset.y);
+    int b = (r + s.offset_first.x) * u_grid.x + (c + s.offset_first.y);
     float wa = particle[a].x;
     float wb = particle[b].x;
     float wsum = wa + wb;
     vec3 d = x[b].xyz - x[a].xyz;
     float len = length(d);
     if (wsum <= 0.0 || len <= 0.0) return;
+    float rest = s.rest_k_limit.x;
+    float limit = s.rest_k_limit.z;
     float shorten;
     if (u_limit_only) {
-        shorten = max(len - u_limit, 0.0);
+        shorten = max(len - limit, 0.0);
     } else {
         // XPBD, one iteration: dlambda = -C / (wa + wb + alpha / h^2), alpha = 1 / k
-        shorten = (len - u_rest) * wsum * u_kh2 / (wsum * u_kh2 + 1.0);
-        if (u_limited) shorten = max(shorten, len - u_limit);  // Provot
+        float kh2 = s.rest_k_limit.y * u_h * u_h;
+        shorten = (len - rest) * wsum * kh2 / (wsum * kh2 + 1.0);
+        if (s.rest_k_limit.w > 0.5) shorten = max(shorten, len - limit);  // Provot
     }
     float scale = shorten / (wsum * len);
     x[a] = vec4(x[a].xyz + (wa * scale) * d, 0.0);

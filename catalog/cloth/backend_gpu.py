@@ -62,6 +62,7 @@ class GpuBackend:
         self.vertex_buffer = ctx.buffer(reserve=n * 48)
         self.static_buffer = None
         self.index_buffer = None
+        self._members: dict = {}
         self._stale = False
         self.set_params(params)
 
@@ -82,9 +83,13 @@ class GpuBackend:
         self._set_uniforms()
 
     def _uniform(self, program: str, name: str, value) -> None:
-        prog = self.programs[program]
-        if name in prog:  # the compiler drops uniforms a pass does not use
-            prog[name].value = value
+        key = (program, name)
+        member = self._members.get(key, False)
+        if member is False:  # the compiler drops uniforms a pass does not use
+            prog = self.programs[program]
+            member = self._members[key] = prog[name] if name in prog else None
+        if member is not None:
+            member.value = value
 
     def _set_uniforms(self) -> None:
         p, c = self.params, self.constants
@@ -111,11 +116,20 @@ class GpuBackend:
             self._uniform(name, "u_wall", -p.wall_gap_m + p.thickness_m)
         self._uniform("UPDATE", "u_contact_damping", p.contact_damping_per_s)
         w, h = p.grid_w, p.grid_h
-        self._selectors = []
-        for sel in SELECTORS:
+        table = np.zeros(len(SELECTORS), dtype=[("offset_first", "i4", 4),
+                                                ("step_count", "i4", 4),
+                                                ("rest_k_limit", "f4", 4)])
+        self._selectors = []  # (index, selector, groups x, groups y)
+        for index, sel in enumerate(SELECTORS):
             rows, cols = sel.ranges(w, h)
-            self._selectors.append((sel, (rows.start, cols.start), (rows.step, cols.step),
-                                    (len(rows), len(cols))))
+            rest = float(c.rest_m[sel.family])
+            table[index] = ((sel.di, sel.dj, rows.start, cols.start),
+                            (rows.step, cols.step, len(rows), len(cols)),
+                            (rest, float(c.stiffness_n_m[sel.family]),
+                             (1.0 + p.max_stretch) * rest, float(c.strain_limited[sel.family])))
+            if len(rows) and len(cols):
+                self._selectors.append((index, sel, _groups(len(cols)), len(rows)))
+        self._selector_buffer = self.ctx.buffer(table.tobytes())
 
     def load(self, state: ClothState) -> None:
         """Upload a state (positions, velocities, rings)."""
@@ -143,6 +157,7 @@ class GpuBackend:
         self._targets.bind_to_storage_buffer(7)
         self._ring_cols.bind_to_storage_buffer(8)
         self.vertex_buffer.bind_to_storage_buffer(9)
+        self._selector_buffer.bind_to_storage_buffer(10)
 
     def _run(self, name: str, groups_x: int, groups_y: int = 1) -> None:
         self.programs[name].run(groups_x, groups_y)
@@ -161,39 +176,26 @@ class GpuBackend:
             self._run("NORMALS", groups)
             self._run("PREDICT", groups)
             self._run("RINGS", _groups(self.ring_count))
-            for sel, first, steps, count in self._selectors:
-                self._springs(sel, first, steps, count, h, limit_only=False)
+            self._uniform("SPRINGS", "u_limit_only", False)
+            for index, sel, gx, gy in self._selectors:
+                self._uniform("SPRINGS", "u_selector", index)
+                self._run("SPRINGS", gx, gy)
             self._run("ATTACH", groups)
             passes = p.strain_passes
             if step == substeps - 1:
                 passes = max(passes, min(p.final_strain_passes, GPU_FINAL_PASSES))
+            self._uniform("SPRINGS", "u_limit_only", True)
             for k in range(passes):
                 order = self._selectors[::-1] if k % 2 == 1 else self._selectors
-                for sel, first, steps, count in order:
+                for index, sel, gx, gy in order:
                     if self.constants.strain_limited[sel.family]:
-                        self._springs(sel, first, steps, count, h, limit_only=True)
+                        self._uniform("SPRINGS", "u_selector", index)
+                        self._run("SPRINGS", gx, gy)
             self._run("UPDATE", groups)
             self._time += h
         self._run("VERTICES", groups)
         state.time_s = self._time
         self._stale = True
-
-    def _springs(self, sel, first, steps, count, h: float, limit_only: bool) -> None:
-        if count[0] == 0 or count[1] == 0:
-            return
-        c = self.constants
-        prog = "SPRINGS"
-        rest = float(c.rest_m[sel.family])
-        self._uniform(prog, "u_offset", (sel.di, sel.dj))
-        self._uniform(prog, "u_first", first)
-        self._uniform(prog, "u_step", steps)
-        self._uniform(prog, "u_count", count)
-        self._uniform(prog, "u_rest", rest)
-        self._uniform(prog, "u_kh2", float(c.stiffness_n_m[sel.family]) * h * h)
-        self._uniform(prog, "u_limit", (1.0 + self.params.max_stretch) * rest)
-        self._uniform(prog, "u_limited", bool(c.strain_limited[sel.family]))
-        self._uniform(prog, "u_limit_only", limit_only)
-        self._run(prog, _groups(count[1]), count[0])
 
     def _write_vertices(self) -> None:
         self._bind()
