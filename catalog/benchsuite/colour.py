@@ -263,8 +263,9 @@ def plot(result: dict, folder) -> list:
     ax.axhline(GOAL_MEAN_DELTA_E, color="grey", linestyle="--", linewidth=1)
     ax.axvline(GOAL_TIME_RATIO, color="grey", linestyle=":", linewidth=1)
     ax.set_yscale("log")
-    ax.set_xlabel(f"frame time / physical RGB frame time ({result['settings']['device']['renderer'][:40]})")
-    ax.set_ylabel("mean Delta E 2000 vs float64 spectral (physical) reference")
+    ax.set_xlabel(f"frame time / physical RGB frame time, same fabric and light "
+                  f"({result['settings']['device']['renderer'][:30]})")
+    ax.set_ylabel("mean Delta E 2000 vs float64 spectral reference\n(below 1e-4 drawn at 1e-4)")
     default = result["summary"]["default"]
     ax.set_title(f"Colour error against frame time (default: {default or 'none meets the goal'})")
     ax.legend(fontsize=7, loc="best")

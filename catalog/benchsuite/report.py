@@ -128,8 +128,15 @@ def startup_md(result: dict) -> str:
         "Heavy modules loaded by importing: " + "; ".join(
             f"{k}: {', '.join(v) if v else 'none'}" for k, v in s["heavy_imports"].items()
             if v is not None) + ".",
-        f"The viewer process at its first frame: {', '.join(s['viewer_heavy_at_first_frame'] or []) or 'not measured'}; "
-        f"scipy loaded: {s['viewer_imports_scipy']}."])
+        viewer_line(s["viewer_heavy_at_first_frame"]) + f" scipy loaded: {s['viewer_imports_scipy']}."])
+
+
+def viewer_line(heavy: dict | None) -> str:
+    if not heavy:
+        return "The viewer's first frame was not measured."
+    loaded = ", ".join(heavy["loaded"]) or "none"
+    return (f"The viewer process at its first frame had loaded, of {', '.join(heavy['checked'])}: "
+            f"{loaded}.")
 
 
 SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),

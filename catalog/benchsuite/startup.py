@@ -77,7 +77,7 @@ def run(quick: bool = False, ctx=None, *, first_frames: bool = True, repeats=Non
     if first_frames:
         viewer_heavy, rows_note = first_frame_rows(rows, floor, frame_repeats)
     viewer_imports_scipy = ("scipy" in (imports.get("catalog.viewer") or [])
-                            or "scipy" in (viewer_heavy or []))
+                            or "scipy" in (viewer_heavy or {}).get("loaded", []))
     return {"rows": rows,
             "summary": {"import_catalog_s": next(r["median_s"] for r in rows if r["case"] == "import catalog"),
                         "help_s": next(r["median_s"] for r in rows if r["case"] == "catalog --help"),
@@ -115,7 +115,9 @@ def first_frame_rows(rows: list[dict], floor: float, frame_repeats: int):
             seconds, stdout = wall_seconds(view_cmd, frame_repeats, env)
             records = [json.loads(line) for line in stdout.splitlines() if line.startswith("{")]
             first = next((r for r in records if "heavy_modules" in r), {})
-            viewer_heavy = sorted(k for k, v in first.get("heavy_modules", {}).items() if v)
+            checked = first.get("heavy_modules")
+            viewer_heavy = None if checked is None else {"checked": sorted(checked),
+                                                         "loaded": sorted(k for k, v in checked.items() if v)}
             rows.append({"case": "catalog view 640x360, Xvfb (start to first frame, exit)",
                          "median_s": seconds, "ratio_to_python": seconds / floor,
                          "first_frame_ms": float(first.get("total_ms", 0.0))})
