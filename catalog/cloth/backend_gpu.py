@@ -74,6 +74,10 @@ class GpuBackend:
         particle[:, 0] = c.inv_mass_per_kg.ravel()
         particle[:, 1] = c.lra_limit_m.ravel()
         particle[:, 2] = c.lra_ring.ravel()
+        for name in ("_static", "_ring_cols", "_selector_buffer"):  # a change of parameters
+            old = getattr(self, name, None)
+            if old is not None:
+                old.release()
         self._static = self.ctx.buffer(particle.tobytes())
         self._ring_cols = self.ctx.buffer(c.ring_cols.astype(np.int32).tobytes())
         self.ring_count = int(c.ring_cols.size)
