@@ -91,3 +91,16 @@ def test_springs12_on_the_gpu_matches_the_reference(gl):
     gpu = Springs12Gpu(problem, ctx=gl)
     gpu.run(120)
     np.testing.assert_allclose(gpu.positions(), reference, atol=2e-5)
+
+
+def test_gpu_parameters_change_while_running(gl):
+    params = ClothParams(grid_w=12, grid_h=12, opening=0.8)
+    gpu = ClothSimulation(params, "gpu", ctx=gl)
+    cpu = ClothSimulation(params, "cpu")
+    for sim in (gpu, cpu):
+        sim.run(10, 1 / 30)
+        sim.set_params(stretch_stiffness_n_m=1e6, areal_density_kg_m2=0.3, wind_speed_m_s=1.0)
+        sim.run(10, 1 / 30)
+    assert gpu.finite and gpu.params.areal_density_kg_m2 == 0.3
+    diff = np.linalg.norm(gpu.positions() - cpu.positions(), axis=-1)
+    assert np.sqrt(np.mean(diff ** 2)) < 1e-2
