@@ -44,9 +44,12 @@ def gl_context():
 @pytest.fixture
 def gl(gl_context):
     """The shared context, checked for no pending GL error before and after each test."""
-    assert gl_context.error == "GL_NO_ERROR", f"GL error pending before the test: {gl_context.error}"
+    # read once: glGetError clears the flag, so a second read in the message would say "no error"
+    before = gl_context.error
+    assert before == "GL_NO_ERROR", f"GL error pending before the test: {before}"
     yield gl_context
-    assert gl_context.error == "GL_NO_ERROR", f"GL error left by the test: {gl_context.error}"
+    after = gl_context.error
+    assert after == "GL_NO_ERROR", f"GL error left by the test: {after}"
 
 
 @pytest.fixture
