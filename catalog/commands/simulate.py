@@ -82,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             params = ClothParams(**overrides)
         if args.backend == "cpu":  # compile (or load the cached code) outside the timing
-            ClothSimulation(ClothParams(grid_w=4, grid_h=4), "cpu").step(args.dt)
+            from catalog.cloth.backend_numba import warm_up
+            warm_up()
         sim = ClothSimulation(params, args.backend, monitor_every=1)
     except InputError as exc:
         option = _OPTION_OF_FIELD.get(exc.field or "")
