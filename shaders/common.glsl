@@ -1,7 +1,8 @@
 // common.glsl: the physical terms of model.md, one small function per term.
 // Included by every pass (catalog/render/shaderlib.py resolves #include and injects
 // #defines: N_BANDS, NV4 = ceil(N_BANDS / 4), FLUORESCENCE_OFF | FLUORESCENCE_PAPER |
-// FLUORESCENCE_PHYSICAL, SEE_THROUGH, ANISOTROPIC, GBUFFER). Band quantities travel as vec4 chunks.
+// FLUORESCENCE_PHYSICAL, SEE_THROUGH, ANISOTROPIC, GBUFFER, SHARED_DIVISION). Band quantities travel
+// as vec4 chunks.
 // The float64 twin of every function is in catalog/reference.py.
 
 #ifndef CATALOG_COMMON_GLSL
@@ -31,25 +32,65 @@ float woven_chord2(vec3 delta, vec3 t, vec3 b, vec3 n, float anisotropy) {
     return dt * dt * (1.0 - anisotropy) + db * db * (1.0 + anisotropy) + dn * dn;
 }
 
+// HG's d of eq. 6 (the lobe's denominator is d^1.5), as in hg_phase_robust but with the
+// mirrored form only where it is needed: for g >= HG_MIRROR_BELOW the form
+// (1 - g)^2 + g chord2 loses at most |g| * 5e-7 / (1 + g)^2 < 3e-7 (relative) to the rounding of a
+// chord2 near 4 (theta near pi), so the anti-chord is only formed for a strongly backward lobe.
+// With the scene's g compiled in as constants (SPECIALISED), the choice costs nothing.
+const float HG_MIRROR_BELOW = -0.2;
+float hg_d(float chord2, float anti2, float g) {
+    return (g >= HG_MIRROR_BELOW) ? (1.0 - g) * (1.0 - g) + g * chord2
+                                  : (1.0 + g) * (1.0 + g) - g * anti2;
+}
+
+// What the anisotropic chord needs of a fragment, shared by every light: the view direction
+// and the tangent frame without the warp vector or a normalised tangent.
+// vn = v.n, vt = v.T, tn = T.n, inv_t2 = 1 / |T - (T.n) n|^2 (T: interpolated weft tangent).
+struct WovenView { vec3 to_viewer; float vn; float vt; float tn; float inv_t2; };
+
+WovenView woven_view(vec3 to_viewer, vec3 n, vec3 tangent) {
+    float tn = dot(tangent, n);
+    return WovenView(to_viewer, dot(to_viewer, n), dot(to_viewer, tangent), tn,
+                     1.0 / (dot(tangent, tangent) - tn * tn));
+}
+
 // Tobitani et al. 2014, woven-cloth HG BTDF; model.md eq. 5 and 7 without LD (the see-through
-// is the background term below): radiance per unit of a directional light's normal irradiance,
-// |cos theta_i| (a_diff ph_diff + a_spec ph_spec), a_* = rho e^-tau k_*. Two-sided: only
-// |n . l| and the angle between the light's travel and the view direction enter, so the same
-// thin layer transmits light from behind and scatters it back towards a light in front.
-float woven_transmission(vec3 to_light, vec3 to_viewer, vec3 t, vec3 b, vec3 n,
-                         float a_diff, float g_diff, float a_spec, float g_spec, float anisotropy) {
-    vec3 travel = -to_light;
-    vec3 delta = to_viewer - travel;
-    vec3 sum = to_viewer + travel;
+// is the background term): radiance per unit of a directional light's normal irradiance,
+// G = |cos theta_i| (a_diff ph_diff + a_spec ph_spec), a_* = rho e^-tau k_*, returned as the
+// ratio vec2(numerator, denominator) so that the caller divides once for several lights.
+// Two-sided: only |n . l| and the angle between the light's travel and the view direction
+// enter, so the same thin layer transmits light from behind and scatters it back.
+// to_light: unit, towards the light; cos_i = n . to_light; tan_i = T . to_light.
+// Anisotropy (ANISOTROPIC, directional lobe with g >= 0): the chord in the frame (t weft,
+// b warp, n), dt^2 (1 - a) + db^2 (1 + a) + dn^2, written with db^2 = chord2 - dt^2 - dn^2 as
+// (1 + a) chord2 - a dn^2 - 2 a dt^2, where dt = delta . (T - (T.n) n) / |T - (T.n) n|.
+vec2 woven_transmission_ratio(vec3 to_light, float cos_i, float tan_i, WovenView w,
+                              float a_diff, float g_diff, float a_spec, float g_spec,
+                              float anisotropy) {
+    vec3 delta = w.to_viewer + to_light;          // w_view - w_travel, travel = -to_light
     float chord2 = dot(delta, delta);
-    float anti2 = dot(sum, sum);
-    float ph_diff = hg_phase_robust(chord2, anti2, g_diff);                       // eq. 6
+    float anti2 = 0.0;
+    if (min(g_diff, g_spec) < HG_MIRROR_BELOW) {
+        vec3 sum = w.to_viewer - to_light;         // w_view + w_travel
+        anti2 = dot(sum, sum);
+    }
+    float chord_spec = chord2;
 #ifdef ANISOTROPIC
-    float ph_spec = hg_phase_robust(woven_chord2(delta, t, b, n, anisotropy), anti2, g_spec);
-#else
-    float ph_spec = hg_phase_robust(chord2, anti2, g_spec);                       // eq. 6
+    if (g_spec >= 0.0) {
+        float dn = w.vn + cos_i;
+        float dtp = w.vt + tan_i - w.tn * dn;
+        chord_spec = (1.0 + anisotropy) * chord2 - anisotropy * (dn * dn)
+                   - (2.0 * anisotropy) * (dtp * dtp * w.inv_t2);
+    }
 #endif
-    return abs(dot(n, to_light)) * (a_diff * ph_diff + a_spec * ph_spec);      // eq. 5, 7
+    float d_diff = hg_d(chord2, anti2, g_diff);                                    // eq. 6
+    float d_spec = hg_d(chord_spec, anti2, g_spec);                                // eq. 6
+    float x_diff = d_diff * sqrt(d_diff);
+    float x_spec = d_spec * sqrt(d_spec);
+    // (1 - g)(1 + g) / (4 pi): exact in float32 for g near +-1; folded when specialised
+    float k_diff = a_diff * ((1.0 - g_diff) * (1.0 + g_diff) / (4.0 * PI));
+    float k_spec = a_spec * ((1.0 - g_spec) * (1.0 + g_spec) / (4.0 * PI));
+    return vec2(abs(cos_i) * (k_diff * x_spec + k_spec * x_diff), x_diff * x_spec);  // eq. 5, 7
 }
 
 // Tobitani et al. 2014, eq. 8 paper mode: I_fluor F_c, a constant per light (pre-integrated
@@ -81,6 +122,15 @@ vec4 background_weights(vec3 dir, vec3 to_sun, float sun_chord2_inner, float sun
     float disc = 1.0 - smoothstep(sun_chord2_inner, sun_chord2_outer, dot(d, d));
     float sky = outside * above;
     return vec4(sky, outside - sky, sky * disc, 1.0 - outside);
+}
+
+// background_weights' ingredients for the curtain (regrouped there): vec3(outside, above,
+// disc), disc = 1 - smoothstep across the sun's rim (the reciprocal of its width folded).
+vec3 background_terms(vec3 dir, vec3 to_sun, float sun_chord2_inner, float sun_chord2_outer) {
+    vec3 d = dir - to_sun;
+    float s = clamp((dot(d, d) - sun_chord2_inner) * (1.0 / (sun_chord2_outer - sun_chord2_inner)),
+                    0.0, 1.0);
+    return vec3(1.0 - step(0.0, dir.z), step(0.0, dir.y), 1.0 - s * s * (3.0 - 2.0 * s));
 }
 
 // Reinhard, Stark, Shirley, Ferwerda 2002, "Photographic tone reproduction", eq. 4 (extended,

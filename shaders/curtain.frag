@@ -1,6 +1,12 @@
 #version 430
 // Eq. 8 per fragment (model.md section 6) in N_BANDS bands, converted to linear sRGB radiance
 // (683 * integral of the sRGB matching functions times radiance: cd m^-2 scale) at the end.
+// Costed for a CPU rasteriser (llvmpipe), where every operation runs per fragment: the view
+// ray is interpolated (curtain.vert), the tangent frame is used in the scalar form the chord
+// needs, each light's two HG lobes come back as one ratio, and with SHARED_DIVISION (set by
+// frame.py when float32 cannot underflow) the key, the fill and the fluorescence saturation
+// share one division; constants are summed at compile time (SPECIALISED). docs/render.md has
+// the measured cost of each step.
 #include "common.glsl"
 
 in vec3 v_view_ray;                // position - camera, world space
@@ -56,15 +62,24 @@ layout(location = 3) out vec4 out_tangent;
 #endif
 
 // One chunk of 4 bands: eq. 8's terms summed, then projected to display colour. Called with a
-// constant k (unrolled below by NV4), so every uniform array index is a compile-time constant.
-vec3 shade_chunk(int k, float g_key, float g_fill, vec4 w_bg, float effective) {
-    vec4 band = g_key * u_key_dyed[k] + g_fill * u_fill_dyed[k] + u_ambient[k];
-#ifdef SEE_THROUGH
-    band += w_bg.x * u_sky[k] + w_bg.y * u_ground[k] + w_bg.z * u_sun_disc[k] + w_bg.w * u_room[k];
-#endif
+// constant k (unrolled below by NV4), so every array index is a compile-time constant and the
+// sums of constants fold. The see-through (LD = u_direct) is background_weights regrouped:
+// sky above / ground below the horizon and the sun's disc outside, the room inside:
+// LD (room + outside (ground - room + above (sky - ground + disc sun_disc))), disc = 1 - the
+// rim's smoothstep (exactly 0 off the disc: the disc's huge radiance must not be cancelled).
+vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
+    vec4 band = g_key * u_key_dyed[k] + g_fill * u_fill_dyed[k];
+    vec4 constant = u_ambient[k];
 #ifdef FLUORESCENCE_PAPER
-    band += fluorescence_paper(u_fluorescence[k]);
+    constant += fluorescence_paper(u_fluorescence[k]);
 #endif
+#ifdef SEE_THROUGH
+    vec4 outside = bg.y * (u_direct * (u_sky[k] - u_ground[k]) + bg.z * (u_direct * u_sun_disc[k]))
+                 + u_direct * (u_ground[k] - u_room[k]);
+    band += bg.x * outside;
+    constant += u_direct * u_room[k];
+#endif
+    band += constant;
 #ifdef FLUORESCENCE_PHYSICAL
     band += fluorescence_physical(effective, u_fluorescence[k]);
 #endif
@@ -77,40 +92,54 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec4 w_bg, float effective) {
 
 void main() {
     vec3 n = normalize(v_normal);
-#ifdef ANISOTROPIC
-    vec3 t = normalize(v_tangent - dot(v_tangent, n) * n);   // Gram-Schmidt: weft
-    vec3 b = cross(n, t);                                     // warp
-#else
-    vec3 t = vec3(0.0);                                       // isotropic: the frame is not needed
-    vec3 b = vec3(0.0);
-#endif
     vec3 ray = normalize(v_view_ray);
-    vec3 to_viewer = -ray;
-
-    float g_key = woven_transmission(u_key_to_light, to_viewer, t, b, n,
-                                     u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
-    float g_fill = woven_transmission(u_fill_to_light, to_viewer, t, b, n,
-                                      u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
-    vec4 w_bg = vec4(0.0);
-#ifdef SEE_THROUGH
-    w_bg = u_direct * background_weights(ray, u_sun_direction, u_sun_chord2.x, u_sun_chord2.y);
+#ifdef ANISOTROPIC
+    WovenView view = woven_view(-ray, n, v_tangent);
+    float tan_key = dot(v_tangent, u_key_to_light);
+    float tan_fill = dot(v_tangent, u_fill_to_light);
+#else
+    WovenView view = WovenView(-ray, 0.0, 0.0, 0.0, 0.0);
+    float tan_key = 0.0;
+    float tan_fill = 0.0;
 #endif
-    float effective = 0.0;
+    float cos_key = dot(n, u_key_to_light);
+    float cos_fill = dot(n, u_fill_to_light);
+    vec2 key = woven_transmission_ratio(u_key_to_light, cos_key, tan_key, view,
+                                        u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
+    vec2 fill = woven_transmission_ratio(u_fill_to_light, cos_fill, tan_fill, view,
+                                         u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
+    // eq. 8 fluorescence, physical: absorbed / (1 + absorbed / N_sat), again as a ratio
+    float absorbed = 0.0;
+    float saturation = 1.0;
 #ifdef FLUORESCENCE_PHYSICAL
-    float absorbed = abs(dot(n, u_key_to_light)) * u_absorbed_photons.x
-                   + abs(dot(n, u_fill_to_light)) * u_absorbed_photons.y + u_absorbed_photons.z;
-    effective = fluorescence_effective_photons(absorbed, u_inv_saturation);
+    absorbed = abs(cos_key) * u_absorbed_photons.x + abs(cos_fill) * u_absorbed_photons.y
+             + u_absorbed_photons.z;
+    saturation = 1.0 + absorbed * u_inv_saturation;
+#endif
+#ifdef SHARED_DIVISION
+    float inv = 1.0 / (key.y * fill.y * saturation);
+    float g_key = key.x * (fill.y * saturation) * inv;
+    float g_fill = fill.x * (key.y * saturation) * inv;
+    float effective = absorbed * (key.y * fill.y) * inv;
+#else
+    float g_key = key.x / key.y;
+    float g_fill = fill.x / fill.y;
+    float effective = absorbed / saturation;
+#endif
+    vec3 bg = vec3(0.0);   // outside, above, sun disc
+#ifdef SEE_THROUGH
+    bg = background_terms(ray, u_sun_direction, u_sun_chord2.x, u_sun_chord2.y);
 #endif
 
-    vec3 rgb = shade_chunk(0, g_key, g_fill, w_bg, effective);
+    vec3 rgb = shade_chunk(0, g_key, g_fill, bg, effective);
 #if NV4 > 1
-    rgb += shade_chunk(1, g_key, g_fill, w_bg, effective);
+    rgb += shade_chunk(1, g_key, g_fill, bg, effective);
 #endif
 #if NV4 > 2
-    rgb += shade_chunk(2, g_key, g_fill, w_bg, effective);
+    rgb += shade_chunk(2, g_key, g_fill, bg, effective);
 #endif
 #if NV4 > 3
-    rgb += shade_chunk(3, g_key, g_fill, w_bg, effective);
+    rgb += shade_chunk(3, g_key, g_fill, bg, effective);
 #endif
     out_radiance = vec4(rgb, 1.0);
 #ifdef GBUFFER

@@ -39,6 +39,14 @@ MAX_SPECIALISED = 8
 MAX_SIDE_PX = 16384
 
 
+def shared_division_safe(g_diff: float, g_spec: float) -> bool:
+    """Whether curtain.frag may divide once for the key, the fill and the fluorescence
+    (``SHARED_DIVISION``): the product of the two lights' HG denominators, each at least
+    ((1 - |g_diff|)(1 - |g_spec|))^3, must stay a normal float32 (> 1.2e-38) in the worst case."""
+    margin = (1.0 - abs(g_diff)) * (1.0 - abs(g_spec))
+    return margin ** 6 > 1e-30
+
+
 def check_size(size, ctx=None) -> tuple[int, int]:
     """(width, height) in pixels, refused with a one-line error when impossible."""
     try:
@@ -292,7 +300,8 @@ class FrameRenderer:
         defines = {"N_BANDS": self.n_bands, "NV4": band_lib.chunks(self.n_bands),
                    f"FLUORESCENCE_{inputs.fluorescence_mode.upper()}": True,
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
-                   "GBUFFER": gbuffer, "SPECIALISED": self.specialise}
+                   "GBUFFER": gbuffer, "SPECIALISED": self.specialise,
+                   "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
         return defines
 
     def scene_values(self) -> dict:
