@@ -409,10 +409,14 @@ class FrameRenderer:
         s(program, "u_sun_direction", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_sun_chord2", tuple(float(v) for v in inputs.sun_chord2))
 
-    def draw_curtain(self, view_proj, trivial: bool = False, gbuffer: bool = False) -> None:
-        """The curtain pass alone into the bound framebuffer (the benchmark times this)."""
+    def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False) -> None:
+        """The curtain pass alone into the bound framebuffer (the benchmark times this).
+
+        ``trivial``: True draws the same mesh with shaders/trivial.frag (the benchmark's floor);
+        a file name draws it with that fragment shader instead (the benchmark's other floors)."""
         if trivial:
-            program = self._program("curtain.vert", "trivial.frag")
+            fragment = trivial if isinstance(trivial, str) else "trivial.frag"
+            program = self._program("curtain.vert", fragment)
             self._set(program, "u_view_proj", gl_bytes(view_proj))
             self._set(program, "u_mesh_offset", self._mesh_offset)
             self._set(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
