@@ -70,6 +70,7 @@ def test_bind_to_vertex_array_draws_the_curtain(gl):
     vao = sim.backend.bind_to_vertex_array(program)
     size = (32, 32)
     fbo = gl.framebuffer(color_attachments=[gl.texture(size, 4, dtype="f4")])
+    previous = gl.fbo  # bound again below: a deleted bound framebuffer breaks the next test
     fbo.use()
     fbo.clear(0.0, 0.0, 0.0, 0.0)
     vao.render()
@@ -78,6 +79,7 @@ def test_bind_to_vertex_array_draws_the_curtain(gl):
     assert covered.mean() > 0.5  # the curtain fills the view set up by the test shader
     normals = pixels[covered][:, :3]
     assert np.all(normals[:, 2] > 0.9)  # nearly flat, facing the room
+    previous.use()
     vao.release()
     fbo.release()
 
