@@ -191,6 +191,7 @@ def main(argv=None) -> int:
             samples[label].append(time_draws(ctx, draw, 1, args.draws))
             cpu_samples[label].append(time_draws(ctx, draw, 1, args.draws, time.process_time))
     floor = statistics.median(samples["trivial"])
+    best_floor = min(samples["trivial"])
     cpu_floor = statistics.median(cpu_samples["trivial"])
     rows = []
     for label in drawers:
@@ -198,22 +199,28 @@ def main(argv=None) -> int:
         cpu_seconds = statistics.median(cpu_samples[label])
         rows.append({"variant": label, "ms": seconds * 1e3, "ratio": seconds / floor,
                      "cpu_ms": cpu_seconds * 1e3, "cpu_ratio": cpu_seconds / cpu_floor,
+                     "best_ms": min(samples[label]) * 1e3,
+                     "best_ratio": min(samples[label]) / best_floor,
                      "defines": defines_of.get(label, {}),
                      "ms_rounds": [round(v * 1e3, 2) for v in samples[label]]})
 
     print(f"{describe(ctx)['renderer']}, {size[0]}x{size[1]}, median of {args.repeats} interleaved rounds of {args.draws} draws")
-    print(f"{'variant':<66} {'wall ms':>8} {'x trivial':>10} {'CPU ms':>8} {'x trivial':>10}")
+    print("(best: the fastest round of each variant, the least disturbed by other work on the machine)")
+    print(f"{'variant':<66} {'wall ms':>8} {'x trivial':>10} {'CPU ms':>8} {'x trivial':>10} "
+          f"{'best ms':>8} {'x trivial':>10}")
     for row in rows:
         print(f"{row['variant']:<66} {row['ms']:8.2f} {row['ratio']:10.2f} "
-              f"{row['cpu_ms']:8.2f} {row['cpu_ratio']:10.2f}")
+              f"{row['cpu_ms']:8.2f} {row['cpu_ratio']:10.2f} {row['best_ms']:8.2f} {row['best_ratio']:10.2f}")
     full = next(r for r in rows if r["variant"] == "rgb physical")
     goal_met = full["ratio"] <= 1.3
-    print(f"full RGB shader / trivial = {full['ratio']:.2f} wall, {full['cpu_ratio']:.2f} CPU "
+    print(f"full RGB shader / trivial = {full['ratio']:.2f} wall, {full['cpu_ratio']:.2f} CPU, "
+          f"{full['best_ratio']:.2f} best "
           f"(goal <= 1.3: {'met' if goal_met else 'NOT met'})")
 
     result = {"device": describe(ctx), "size": list(size), "repeats": args.repeats,
               "draws": args.draws, "fabric": renderer.preset.name, "rows": rows,
               "full_rgb_ratio": full["ratio"], "full_rgb_cpu_ratio": full["cpu_ratio"],
+              "full_rgb_best_ratio": full["best_ratio"],
               "goal_met": goal_met}
     if not args.quick:
         errors = band_errors(ctx, renderer.preset)
