@@ -108,7 +108,8 @@ void main() {
                                         u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
     vec2 fill = woven_transmission_ratio(u_fill_to_light, cos_fill, tan_fill, view,
                                          u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
-    // eq. 8 fluorescence, physical: absorbed / (1 + absorbed / N_sat), again as a ratio
+    // eq. 8 fluorescence, physical: fluorescence_effective_photons, N / (1 + N / N_sat), with its
+    // denominator kept apart so that SHARED_DIVISION can fold it into the one division
     float absorbed = 0.0;
     float saturation = 1.0;
 #ifdef FLUORESCENCE_PHYSICAL
@@ -124,7 +125,7 @@ void main() {
 #else
     float g_key = key.x / key.y;
     float g_fill = fill.x / fill.y;
-    float effective = absorbed / saturation;
+    float effective = fluorescence_effective_photons(absorbed, u_inv_saturation);
 #endif
     vec3 bg = vec3(0.0);   // outside, above, sun disc
 #ifdef SEE_THROUGH
