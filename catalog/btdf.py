@@ -100,7 +100,14 @@ def hg_phase_one_minus_cos(one_minus_cos, g):
     ``g`` in (-1, 1) (scalar or broadcastable array); integrates to 1 over the sphere.
     """
     _check_g(g)
-    d = hg_denominator(one_minus_cos, g)
+    # 1 - cos theta lies in [0, 2]; rounding can step just outside, and for g -> -1 at
+    # theta = pi the forward form (1-g)^2 + 2g(1 - cos) cancels to a tiny negative number
+    # (NaN from the square root). For g < 0 use the mirrored form (1+g)^2 - 2g(1 + cos),
+    # a sum of non-negative terms, as hg_phase_between does.
+    one_minus_cos = np.clip(np.asarray(one_minus_cos), 0.0, 2.0)  # keeps float32 as float32
+    one_plus_g = 1 + g
+    d = np.where(np.asarray(g) >= 0, hg_denominator(one_minus_cos, g),
+                 one_plus_g * one_plus_g - 2 * g * (2.0 - one_minus_cos))
     return (1 - g) * (1 + g) / (FOUR_PI * d * np.sqrt(d))  # eq. 6
 
 

@@ -247,3 +247,15 @@ def test_ct_peaks_straight_through_and_is_finite_at_grazing():
                                               0.5, 0.2)
     assert np.all(np.isfinite(values)) and np.all(values > 0)
     assert int(np.argmax(values)) == 59                    # camera on the normal
+
+
+@pytest.mark.parametrize("g", [-(1 - 1e-6), -(1 - 1e-9), -(1 - 1e-12), 1 - 1e-12])
+def test_one_minus_cos_form_is_finite_at_the_extremes_of_g_and_theta(g):
+    """Found by the stability sweep of `catalog bench`: g -> -1 at theta = pi used to cancel
+    to a negative denominator (NaN). Closed form there: (1 - g^2) / (4 pi (1 + |g|)^3 ...)."""
+    omc = np.array([0.0, 1e-12, 1.0, 2.0 - 1e-12, 2.0, 2.0 + 1e-15, -1e-17])
+    values = btdf.hg_phase_one_minus_cos(omc, g)
+    assert np.all(np.isfinite(values)) and np.all(values > 0)
+    # exact value at theta = pi: (1 - g^2) / (4 pi (1 + g)^3) = (1 - g) / (4 pi (1 + g)^2)
+    at_pi = (1 - g) / (4 * np.pi * (1 + g) ** 2)
+    assert values[4] == pytest.approx(at_pi, rel=1e-9)
