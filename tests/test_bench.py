@@ -123,9 +123,10 @@ def test_colour_section_on_one_fabric_and_light(gl, tmp_path):
 
 @pytest.mark.gl
 def test_truth_switches_on_the_emission_as_the_renderer_does(gl):
-    from catalog.benchsuite import colour
+    """The bench's truth forces the emission on with the scene's with_physical_emission;
+    the renderer's own physical mode must build the same terms."""
     from catalog.render.frame import FrameRenderer
-    from catalog.render.scene import fluorescent_material
+    from catalog.render.scene import fluorescent_material, with_physical_emission
 
     renderer = FrameRenderer(gl, (16, 16))
     try:
@@ -135,8 +136,8 @@ def test_truth_switches_on_the_emission_as_the_renderer_does(gl):
         kept = renderer.shading_inputs()
         assert kept.fluorescence_mode == "physical"
         renderer.set_fluorescence("off")
-        forced = colour.with_emission(renderer.shading_inputs(),
-                                      fluorescent_material(renderer.preset))
+        forced = with_physical_emission(renderer.shading_inputs(),
+                                        fluorescent_material(renderer.preset))
     finally:
         renderer.release()
     np.testing.assert_allclose(forced.absorbed_photons, kept.absorbed_photons, rtol=1e-12)

@@ -25,7 +25,6 @@ time (llvmpipe's threads included; steadier on a machine shared with other work)
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 
@@ -67,33 +66,14 @@ def truth_inputs(renderer):
     """The physical-mode ShadingInputs of the renderer's scene with the brightener's emission
     always on: the renderer leaves it out where it judges it invisible (Delta E < 0.1, on its
     own test background); the truth does not."""
-    from catalog.render.scene import fluorescent_material  # noqa: PLC0415
+    from catalog.render.scene import fluorescent_material, with_physical_emission  # noqa: PLC0415
 
     renderer.set_fluorescence("physical")
     inputs = renderer.shading_inputs()
     material = fluorescent_material(renderer.preset)
     if material is None or inputs.fluorescence_mode == "physical":
         return inputs
-    return with_emission(inputs, material)
-
-
-def with_emission(inputs, material):
-    """``inputs`` with the physical-mode emission of ``material`` switched on, its terms as
-    catalog.render.scene.build_shading_inputs makes them (a test checks they agree)."""
-    from catalog.fluorescence import absorbed_photon_irradiance, photon_energy_j  # noqa: PLC0415
-    from catalog.spectra import GRID_NM  # noqa: PLC0415
-
-    # both sides of the cloth see the outside half-space and the room
-    ambient_irradiance = math.pi * (0.5 * (inputs.sky_radiance + inputs.ground_radiance)
-                                    + inputs.room_radiance)
-    absorbed = (absorbed_photon_irradiance(material, inputs.key_irradiance),
-                absorbed_photon_irradiance(material, inputs.fill_irradiance),
-                absorbed_photon_irradiance(material, ambient_irradiance))
-    emission = (material.quantum_yield * material.emission_pdf_per_nm
-                * photon_energy_j(GRID_NM) / (2 * math.pi))  # M / pi shared by two sides
-    return replace(inputs, fluorescence_mode="physical", absorbed_photons=absorbed,
-                   saturation_photons=material.saturation_photon_irradiance,
-                   emission_per_photon=emission)
+    return with_physical_emission(inputs, material)
 
 
 def case_errors(renderer, reference_inputs) -> tuple[dict[str, np.ndarray], dict]:
