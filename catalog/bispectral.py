@@ -60,6 +60,18 @@ REFLECTANCE_BAND_NM = 10.0
 #: A fitted excitation or emission sample is kept only while the matrix entries it
 #: predicts rise above this many standard deviations of the measurement noise.
 NOISE_SIGMAS = 3.0
+#: Lights the colour refinement trains on (:func:`refine_for_colour`): Planckian radiators
+#: ("planck:K"), CIE daylights and lamps, none of them a light of the goal set (D65, A,
+#: FL2, FL11, LED-B4), so the goal's figures are measured on lights the fit never saw.
+COLOUR_TRAINING_LIGHTS = ("planck:2200", "planck:2500", "planck:3300", "planck:4000",
+                          "planck:5000", "planck:6500", "D50", "D55", "D75",
+                          "FL1", "FL3", "FL4", "FL6", "FL7", "FL8", "FL10", "FL12",
+                          "LED-B1", "LED-B2", "LED-B3", "LED-B5", "LED-BH1", "LED-RGB1",
+                          "LED-V1", "LED-V2")
+#: Relative uncertainty granted to the reflectance in the refinement: R may move by about
+#: this fraction of itself (plus the noise of the band sum) at the cost of one unit of
+#: colour error; a photometric scale tolerance of the order of a spectrophotometer's.
+REFLECTANCE_TOLERANCE = 0.005
 
 
 @dataclass(frozen=True)
@@ -423,6 +435,7 @@ def _alternating_nnls(values: np.ndarray, weight: np.ndarray, energy: np.ndarray
 
 def fit_separable(matrix: DonaldsonMatrix, *, noise_sigmas: float = NOISE_SIGMAS,
                   band_nm: float = REFLECTANCE_BAND_NM, single_band: bool = True,
+                  colour_lights: tuple[str, ...] | None = COLOUR_TRAINING_LIGHTS,
                   max_iterations: int = 5000, tolerance: float = 1e-9) -> SeparableFit:
     """Fit reflectance + rank-1 photon-conserving re-radiation to ``matrix``.
 
@@ -442,6 +455,9 @@ def fit_separable(matrix: DonaldsonMatrix, *, noise_sigmas: float = NOISE_SIGMAS
     3. Reflectance: R(lo) = sum over the band |lo - li| <= ``band_nm`` of (D - fit), i.e.
        the diagonal plus the reflectance the 10 nm bandpass spilled into its neighbours,
        minus the re-radiation the rank-1 part already gives there; clipped at 0.
+    4. Unless ``colour_lights`` is None: :func:`refine_for_colour` moves R, u and v (same
+       supports, same model) so that the colours under those TRAINING lights (none of the
+       goal lights) match the matrix's, while the entries and R stay near the data.
     """
     shift = matrix.stokes_shift_nm()
     values = matrix.values
@@ -480,21 +496,38 @@ def fit_separable(matrix: DonaldsonMatrix, *, noise_sigmas: float = NOISE_SIGMAS
         raise InputError("no re-radiation above the measurement noise: the matrix is not "
                          "fluorescent (only its reflectance can be used)", path=matrix.path or None)
 
+    fit = _assemble(matrix, u, v, None, sigma, weight > 0, band_nm, total_iterations, ())
+    if colour_lights:
+        fit = refine_for_colour(matrix, fit, colour_lights)
+    return fit
+
+
+def _assemble(matrix: DonaldsonMatrix, u: np.ndarray, v: np.ndarray,
+              reflectance: np.ndarray | None, sigma: float, fitted_mask: np.ndarray,
+              band_nm: float, iterations: int, notes: tuple[str, ...]) -> SeparableFit:
+    """Normalise the factors, derive R (unless given), split phi x a_peak, build the fit."""
+    shift = matrix.stokes_shift_nm()
+    values = matrix.values
+    lo = matrix.emission_nm
+    li = matrix.excitation_nm
+    step = matrix.excitation_step_nm
+    energy = (li[None, :] / lo[:, None]) * step
     # scale: u integrates to 1 over nm after interpolation onto GRID_NM
     u_area = float(np.sum(np.interp(GRID_NM, lo, u, left=0.0, right=0.0))) * _grid_step()
     u, v = u / u_area, v * u_area
     fluorescence = np.outer(u, v) * energy
-    residual = (values - fluorescence)[weight > 0]
-    rank1_residual = float(np.sqrt(np.sum(residual ** 2) / np.sum(values[weight > 0] ** 2)))
+    residual = (values - fluorescence)[fitted_mask]
+    rank1_residual = float(np.sqrt(np.sum(residual ** 2) / np.sum(values[fitted_mask] ** 2)))
     residual_over_noise = float(np.sqrt(np.mean(residual ** 2)) / sigma) if sigma > 0 else math.inf
 
-    band = np.abs(shift) <= band_nm
-    reflectance = np.maximum(np.sum(np.where(band, values - fluorescence, 0.0), axis=1), 0.0)
+    if reflectance is None:
+        band = np.abs(shift) <= band_nm
+        reflectance = np.maximum(np.sum(np.where(band, values - fluorescence, 0.0), axis=1), 0.0)
 
     yield_absorptance = float(np.max(v))  # = phi * a_peak, since u is a pdf
     peak_nm = float(li[int(np.argmax(v))])
     r_at_peak = float(np.interp(peak_nm, lo, matrix.diagonal()))  # 380 nm value below 380
-    notes = []
+    notes = list(notes)
     peak_absorptance = min(1.0, max(1.0 - r_at_peak, 1e-6))
     quantum_yield = yield_absorptance / peak_absorptance
     clipped = False
@@ -506,8 +539,8 @@ def fit_separable(matrix: DonaldsonMatrix, *, noise_sigmas: float = NOISE_SIGMAS
         if clipped:
             notes.append(f"phi * a_peak = {yield_absorptance:.3g} > 1 breaks photon "
                          "conservation for a Lambertian emitter; capped at 1")
-    arrays = dict(reflectance=reflectance, emission_weight=u, absorption_weight=v,
-                  fitted_mask=weight > 0)
+    arrays = dict(reflectance=np.array(reflectance, dtype=np.float64), emission_weight=u,
+                  absorption_weight=v, fitted_mask=np.array(fitted_mask))
     for array in arrays.values():
         array.setflags(write=False)
     return SeparableFit(matrix_name=matrix.name, emission_nm=lo, excitation_nm=li,
@@ -515,7 +548,113 @@ def fit_separable(matrix: DonaldsonMatrix, *, noise_sigmas: float = NOISE_SIGMAS
                         rank1_residual=rank1_residual, residual_over_noise=residual_over_noise,
                         yield_absorptance=yield_absorptance, quantum_yield=float(quantum_yield),
                         peak_absorptance=float(peak_absorptance), clipped=clipped,
-                        iterations=total_iterations, notes=tuple(notes), **arrays)
+                        iterations=iterations, notes=tuple(notes), **arrays)
+
+
+# --------------------------------------------------------------- colour refinement
+
+def training_light(name: str) -> np.ndarray:
+    """A training light's spectral irradiance on GRID_NM (``planck:K`` or a library name)."""
+    from catalog.lights import get_light, planck_w_m2_nm
+
+    if name.startswith("planck:"):
+        return planck_w_m2_nm(float(name.split(":", 1)[1]))
+    return np.asarray(get_light(name).irradiance_w_m2_nm, dtype=np.float64)
+
+
+def _interpolation_matrix(samples_nm: np.ndarray) -> np.ndarray:
+    """W with W @ y = np.interp(GRID_NM, samples_nm, y, left=0, right=0) for any y."""
+    return np.stack([np.interp(GRID_NM, samples_nm, column, left=0.0, right=0.0)
+                     for column in np.eye(samples_nm.size)], axis=1)
+
+
+def refine_for_colour(matrix: DonaldsonMatrix, fit: SeparableFit | None = None,
+                      lights: tuple[str, ...] = COLOUR_TRAINING_LIGHTS,
+                      reflectance_tolerance: float = REFLECTANCE_TOLERANCE,
+                      entry_weight: float = 1.0,
+                      max_evaluations: int = 200) -> SeparableFit:
+    """Refine a separable fit so that its colours under ``lights`` match the matrix's.
+
+    The model stays the same (one absorption band and one emission band on the supports
+    ``fit`` found, Stokes factor li/lo, photons counted, phi <= 1); only its numbers move.
+    Least squares (scipy, R, u, v >= 0) of three groups of residuals:
+
+    - the matrix entries the rank-1 part was fitted on, in units of the noise sigma,
+      divided by sqrt(their count) (times ``entry_weight``): the data still hold the
+      factors;
+    - R(lo) - R0(lo) over (sqrt(3) sigma + ``reflectance_tolerance`` x R0), divided by
+      sqrt(41): the reflectance stays near the band sum of :func:`fit_separable`;
+    - the CIELAB difference between the physical-mode colour of the model and the exact
+      colour (:func:`exact_exitance_on_grid`) under each light, white = the light,
+      divided by sqrt(the number of lights).
+
+    Colours are linear in R and, per light, bilinear in (u, v), so each light is reduced
+    once to a few small matrices. ``reflectance_tolerance`` (0.005) was chosen by
+    leave-group-out cross-validation on the training lights alone (docs/bispectral.md).
+    A noiseless matrix (sigma below 1e-9 of its largest entry) is returned unchanged.
+    """
+    from scipy.optimize import least_squares
+
+    from catalog.colorimetry import cmfs, xyz_to_lab
+
+    fit = fit_separable(matrix, colour_lights=None) if fit is None else fit
+    if not fit.noise_sigma > 1e-9 * float(np.max(np.abs(matrix.values))):
+        return fit  # a noiseless (synthetic) matrix: the entries already fix the model
+    lo, li = fit.emission_nm, fit.excitation_nm
+    energy = (li[None, :] / lo[:, None]) * fit.excitation_step_nm
+    mask = fit.fitted_mask
+    sigma = fit.noise_sigma
+    band_count = int(np.max(np.sum(np.abs(matrix.stokes_shift_nm()) <= REFLECTANCE_BAND_NM,
+                                   axis=1)))
+    r0 = np.array(fit.reflectance)
+    r_scale = math.sqrt(band_count) * sigma + reflectance_tolerance * r0
+    keep_u, keep_v = fit.emission_weight > 0, fit.absorption_weight > 0
+
+    cmf = np.asarray(cmfs(GRID_NM)) * _grid_step()           # the scale cancels in L*a*b*
+    irradiance = np.stack([training_light(name) for name in lights])            # (L, grid)
+    w_r, w_u, w_v = (_interpolation_matrix(lo), _interpolation_matrix(lo)[:, keep_u],
+                     _interpolation_matrix(li)[:, keep_v])
+    reflect = np.einsum("gc,lg,gk->lck", cmf, irradiance, w_r)   # XYZ of R: reflect @ R
+    absorb = (irradiance * GRID_NM) @ w_v                       # photons absorbed ~ absorb @ v
+    emit = (cmf / GRID_NM[:, None]).T @ w_u                     # XYZ of photons p: emit @ u
+    area = w_u.sum(axis=0)                                       # integral of p over nm
+    exact = np.stack([_grid_xyz(exact_exitance_on_grid(matrix, e), cmf) for e in irradiance])
+    white = irradiance @ cmf
+    exact_lab = xyz_to_lab(exact, white)
+
+    n_r, n_u = lo.size, int(keep_u.sum())
+    values_fitted = matrix.values[mask]
+    n_entries = values_fitted.size
+
+    def unpack(params):
+        u = np.zeros(lo.size)
+        v = np.zeros(li.size)
+        u[keep_u] = params[n_r:n_r + n_u]
+        v[keep_v] = params[n_r + n_u:]
+        return params[:n_r], u, v
+
+    def residuals(params):
+        r, u_in, v_in = params[:n_r], params[n_r:n_r + n_u], params[n_r + n_u:]
+        _, u, v = unpack(params)
+        entries = (values_fitted - (np.outer(u, v) * energy)[mask]) / sigma
+        xyz = reflect @ r + np.outer(absorb @ v_in, emit @ u_in / (area @ u_in))  # eq. of
+        colour = xyz_to_lab(xyz, white) - exact_lab    # emitted_exitance_w_m2_nm, per light
+        return np.concatenate([entry_weight * entries / math.sqrt(n_entries),
+                               (r - r0) / r_scale / math.sqrt(n_r),
+                               colour.ravel() / math.sqrt(len(lights))])
+
+    start = np.concatenate([r0, fit.emission_weight[keep_u], fit.absorption_weight[keep_v]])
+    scale = np.maximum(start, 1e-3 * float(np.max(start)))
+    solution = least_squares(residuals, start, bounds=(0.0, np.inf), x_scale=scale,
+                             max_nfev=max_evaluations)
+    reflectance, u, v = unpack(solution.x)
+    return _assemble(matrix, u, v, reflectance, fit.noise_sigma, mask, REFLECTANCE_BAND_NM,
+                     fit.iterations + int(solution.nfev),
+                     fit.notes + (f"refined for colour under {len(lights)} training lights",))
+
+
+def _grid_xyz(spectrum: np.ndarray, cmf: np.ndarray) -> np.ndarray:
+    return np.asarray(spectrum, dtype=np.float64) @ cmf
 
 
 # ------------------------------------------------------------------------------- export

@@ -40,13 +40,15 @@ Methods (model.md sections 6 and 8):
   ``reduced_3x3_uv``: the same with a fourth input band, a box over 300-379 nm that
   carries the light's UV (3x4).
 
-Diagnostics: ``data_antistokes`` is the colour difference the matrix's anti-Stokes entries
+Diagnostics: ``physical_lsq`` is ``physical`` with the separable fit by least squares on
+the matrix entries alone (``fit_separable(colour_lights=None)``, the default before the
+colour refinement); ``data_antistokes`` is the colour difference the matrix's anti-Stokes entries
 beyond the reflectance band make (emission at a wavelength 20 nm or more SHORTER than the
 excitation: physically nothing for these materials, so measurement noise and instrument
 stray light; a measure of how well the data pin the colour down); ``physical_no_antistokes``
 is ``physical`` against the exact result of the matrix without those entries;
 ``physical_islands`` is ``physical`` with a fit that keeps absorption islands outside the
-main band (``fit_separable(single_band=False)``): it follows the anti-Stokes artefact, and
+main band (``fit_separable(single_band=False, colour_lights=None)``): it follows the anti-Stokes artefact, and
 is reported to show what that buys, not as a model;
 ``data_10nm`` is the exact result evaluated the literal way, everything (light, emission,
 colour-matching functions) sampled every 10 nm, against ours.
@@ -73,7 +75,8 @@ METHODS = ("ignore", "paper", "paper_global", "physical", "physical_rgb", "rgb_p
            "reduced_3x3", "reduced_3x3_uv")
 #: The UV band of ``reduced_3x3_uv``, nm (a box below the visible).
 UV_BAND_NM = (300.0, 379.0)
-DIAGNOSTICS = ("physical_no_antistokes", "physical_islands", "data_antistokes", "data_10nm")
+DIAGNOSTICS = ("physical_lsq", "physical_no_antistokes", "physical_islands", "data_antistokes",
+               "data_10nm")
 #: model.md section 8: the state of the art on the same 8 matrices x GOAL_LIGHTS, Delta E
 #: 2000 (mean, max).
 STATE_OF_THE_ART = {"ignoring fluorescence": (11.6, 26.0), "naive 3x3": (10.7, 20.6),
@@ -243,12 +246,12 @@ def _diagnostic_delta_e(models: MaterialModels, name: str, light: np.ndarray,
             return float(delta_e_2000(cleaned, exact, white))
         return float(delta_e_2000(method_xyz(models, "physical", light), cleaned,
                                   white_xyz(light, cleaned)))
-    if name == "physical_islands":
+    if name in ("physical_islands", "physical_lsq"):
         from dataclasses import replace
 
-        islands = fit_separable(matrix, single_band=False)
-        return float(delta_e_2000(method_xyz(replace(models, fit=islands,
-                                                     reflectance_fit=islands.reflectance_on_grid()),
+        other = fit_separable(matrix, single_band=name == "physical_lsq", colour_lights=None)
+        return float(delta_e_2000(method_xyz(replace(models, fit=other,
+                                                     reflectance_fit=other.reflectance_on_grid()),
                                              "physical", light), exact, white))
     if name == "data_10nm":
         lo = matrix.emission_nm

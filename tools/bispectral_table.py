@@ -23,6 +23,7 @@ LABELS = {"ignore": "(a) ignore", "paper": "(b) paper, k per material",
           "paper_global": "(b') paper, one k", "physical": "(c) physical",
           "physical_rgb": "(d) physical, RGB pipeline", "rgb_product": "(d') RGB albedo x light",
           "reduced_3x3": "(e) reduced 3x3", "reduced_3x3_uv": "(e') reduced 3x3 + UV",
+          "physical_lsq": "(c) least squares on entries only",
           "physical_no_antistokes": "(c) vs matrix without anti-Stokes part",
           "physical_islands": "(c) with absorption islands",
           "data_antistokes": "data: anti-Stokes part", "data_10nm": "data: 10 nm colour"}
