@@ -26,8 +26,10 @@ The separable fit (:func:`fit_separable`) writes the fluorescent part in photon 
 (phi: quantum yield, a: absorptance of the fluorophore, p: emitted photon spectrum per nm,
 dli: the 10 nm excitation bin; li/lo converts absorbed to emitted energy per photon), so
 that it becomes a :class:`catalog.fluorescence.FluorescentMaterial` and the project's
-physical mode (``emitted_exitance_w_m2_nm``) reproduces the matrix. docs/bispectral.md
-gives the figures.
+physical mode (``emitted_exitance_w_m2_nm``) reproduces the matrix. By default the
+least-squares factors are then refined (:func:`refine_for_colour`, same model) so that the
+colours under a set of training lights (:data:`COLOUR_TRAINING_LIGHTS`, none of the
+study's goal lights) match the matrix's. docs/bispectral.md gives the figures.
 """
 
 from __future__ import annotations
@@ -597,6 +599,8 @@ def refine_for_colour(matrix: DonaldsonMatrix, fit: SeparableFit | None = None,
 
     from catalog.colorimetry import cmfs, xyz_to_lab
 
+    if not lights:
+        raise ValueError("refine_for_colour needs at least one training light")
     fit = fit_separable(matrix, colour_lights=None) if fit is None else fit
     if not fit.noise_sigma > 1e-9 * float(np.max(np.abs(matrix.values))):
         return fit  # a noiseless (synthetic) matrix: the entries already fix the model
@@ -637,8 +641,9 @@ def refine_for_colour(matrix: DonaldsonMatrix, fit: SeparableFit | None = None,
         r, u_in, v_in = params[:n_r], params[n_r:n_r + n_u], params[n_r + n_u:]
         _, u, v = unpack(params)
         entries = (values_fitted - (np.outer(u, v) * energy)[mask]) / sigma
-        xyz = reflect @ r + np.outer(absorb @ v_in, emit @ u_in / (area @ u_in))  # eq. of
-        colour = xyz_to_lab(xyz, white) - exact_lab    # emitted_exitance_w_m2_nm, per light
+        # reflected + emitted (emitted_exitance_w_m2_nm: phi N_abs p(l) h c / l), per light
+        xyz = reflect @ r + np.outer(absorb @ v_in, emit @ u_in / max(float(area @ u_in), 1e-300))
+        colour = xyz_to_lab(xyz, white) - exact_lab
         return np.concatenate([entry_weight * entries / math.sqrt(n_entries),
                                (r - r0) / r_scale / math.sqrt(n_r),
                                colour.ravel() / math.sqrt(len(lights))])
