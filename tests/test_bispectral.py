@@ -224,6 +224,9 @@ def test_colour_refinement_never_sees_a_goal_light():
     # and they are real, distinct spectra
     spectra = np.stack([bispectral.training_light(n) for n in sorted(training)])
     assert np.all(spectra >= 0) and np.all(spectra.sum(axis=1) > 0)
+    noisy, _, _ = _synthetic(noise=5e-4)
+    with pytest.raises(ValueError, match="at least one training light"):
+        bispectral.refine_for_colour(noisy, lights=())
 
 
 def test_colour_refinement_keeps_the_model_and_stays_near_the_data(matrices, fits):
