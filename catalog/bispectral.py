@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from catalog.csvtable import read_text
 from catalog.errors import InputError
 from catalog.spectra import GRID_NM
 
@@ -150,14 +151,7 @@ def read_bfc(path: str | Path) -> DonaldsonMatrix:
     InputError naming the file and line.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="ascii")
-    except FileNotFoundError:
-        raise InputError("no such file", path=path) from None
-    except UnicodeDecodeError as exc:
-        raise InputError(f"not an ASCII text file ({exc.reason})", path=path) from None
-    except OSError as exc:
-        raise InputError(f"cannot read: {exc.strerror}", path=path) from None
+    text = read_text(path, encoding="ascii")
     lines = text.splitlines()
     if not lines or not text.strip():
         raise InputError("empty file", path=path)

@@ -40,14 +40,7 @@ def read_numeric_csv(path: str | Path, required: tuple[str, ...],
     ``min_rows`` rows.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError("no such file", path=path) from None
-    except UnicodeDecodeError as exc:
-        raise InputError(f"not a UTF-8 text file ({exc.reason})", path=path) from None
-    except OSError as exc:
-        raise InputError(f"cannot read: {exc.strerror}", path=path) from None
+    text = read_text(path)
 
     comments: list[str] = []
     header: list[str] | None = None
@@ -97,6 +90,20 @@ def read_numeric_csv(path: str | Path, required: tuple[str, ...],
                         columns={name: data[:, i].copy() for i, name in enumerate(header)},
                         line_numbers=np.asarray(line_numbers, dtype=np.int64),
                         comments=tuple(comments))
+
+
+def read_text(path: str | Path, encoding: str = "utf-8") -> str:
+    """The whole text of a measurement file; a missing, unreadable or undecodable file is an
+    InputError naming it."""
+    path = Path(path)
+    try:
+        return path.read_text(encoding=encoding)
+    except FileNotFoundError:
+        raise InputError("no such file", path=path) from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not a {encoding.upper()} text file ({exc.reason})", path=path) from None
+    except OSError as exc:
+        raise InputError(f"cannot read: {exc.strerror}", path=path) from None
 
 
 def _check_header(path: Path, line_no: int, header: list[str], required: tuple[str, ...],
