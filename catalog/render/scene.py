@@ -207,31 +207,13 @@ class SunAtHour:
 SUN_DAY_OF_YEAR = 172
 
 
-def solar_declination_and_equation_of_time(day_of_year: int) -> tuple[float, float]:
-    """Spencer (1971), "Fourier series representation of the position of the sun": the
-    declination (rad) and the equation of time (minutes) for a day of the year."""
-    g = 2 * math.pi * (day_of_year - 1) / 365.0
-    declination = (0.006918 - 0.399912 * math.cos(g) + 0.070257 * math.sin(g)
-                   - 0.006758 * math.cos(2 * g) + 0.000907 * math.sin(2 * g)
-                   - 0.002697 * math.cos(3 * g) + 0.00148 * math.sin(3 * g))
-    equation_of_time_min = 229.18 * (0.000075 + 0.001868 * math.cos(g) - 0.032077 * math.sin(g)
-                                     - 0.014615 * math.cos(2 * g) - 0.040849 * math.sin(2 * g))
-    return declination, equation_of_time_min
-
-
 def solar_zenith_deg(hour: float, day_of_year: int = SUN_DAY_OF_YEAR,
                      latitude_deg: float = SUN_LATITUDE_DEG) -> float:
-    """Geometric solar zenith (deg) at ``hour`` of local mean solar time: hour angle from the
-    apparent solar time (mean time + equation of time), cos z = sin(phi) sin(delta) +
-    cos(phi) cos(delta) cos(h). Within a few tenths of a degree of pvlib's NREL SPA above
-    the horizon (tests/test_render_scene.py checks it), without importing pvlib and scipy,
-    which drawing a frame must not."""
-    declination, eot_min = solar_declination_and_equation_of_time(day_of_year)
-    hour_angle = math.radians(15.0 * (hour + eot_min / 60.0 - 12.0))
-    lat = math.radians(latitude_deg)
-    cos_z = (math.sin(lat) * math.sin(declination)
-             + math.cos(lat) * math.cos(declination) * math.cos(hour_angle))
-    return math.degrees(math.acos(max(-1.0, min(1.0, cos_z))))
+    """The scene's sun: :func:`catalog.sun.solar_zenith_deg_at_solar_time` on SUN_DATE at
+    SUN_LATITUDE (closed form, no pvlib: drawing a frame must not import scipy)."""
+    from catalog.sun import solar_zenith_deg_at_solar_time  # noqa: PLC0415
+
+    return solar_zenith_deg_at_solar_time(hour, day_of_year, latitude_deg)
 
 
 def sun_at_hour(hour: float) -> SunAtHour:
