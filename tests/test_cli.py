@@ -53,3 +53,18 @@ def test_unknown_command_is_refused():
                           capture_output=True, text=True)
     assert proc.returncode == 2
     assert "no-such-command" in proc.stderr
+
+
+def test_wxh_values_are_parsed_and_refused_by_one_rule():
+    import pytest
+
+    from catalog.cliargs import parse_wxh
+    from catalog.errors import InputError
+
+    assert parse_wxh(" 64X48 ", "--size", 1, 100) == (64, 48)
+    assert parse_wxh("2x100000", "--grid", 2) == (2, 100000)  # no upper bound given
+    for text, low, high in (("40x", 1, 100), ("axb", 1, 100), ("0x4", 1, 100),
+                            ("101x4", 1, 100), ("1x4", 2, None), ("-3x4", 1, 100)):
+        with pytest.raises(InputError) as err:
+            parse_wxh(text, "--opt", low, high)
+        assert str(err.value).startswith("--opt: ")

@@ -37,16 +37,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _parse_grid(text: str) -> tuple[int, int]:
-    from catalog.errors import CatalogError
+    from catalog.cliargs import parse_wxh
 
-    parts = text.lower().split("x")
-    if len(parts) != 2 or not all(p.strip().isdigit() for p in parts):
-        raise CatalogError(f"--grid: expected WxH with two whole numbers, e.g. 64x96; "
-                           f"found {text!r}")
-    w, h = (int(p) for p in parts)
-    if w < 2 or h < 2:
-        raise CatalogError(f"--grid: needs at least 2x2 particles, found {text!r}")
-    return w, h
+    return parse_wxh(text, "--grid", 2, unit="particles", example="64x96")
 
 
 def run(args: argparse.Namespace) -> int:

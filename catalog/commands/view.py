@@ -5,30 +5,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from catalog.cliargs import wxh_type
+
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
 FLUORESCENCE_CHOICES = ("off", "paper", "physical")
 BAND_CHOICES = (3, 6, 9, 16)
 
 
-def _size(text: str) -> tuple[int, int]:
-    try:
-        width, height = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WxH, e.g. 1280x720, found {text!r}") from None
-    if not (16 <= width <= 16384 and 16 <= height <= 16384):
-        raise argparse.ArgumentTypeError(f"{text}: each side must be 16-16384 px")
-    return width, height
-
-
-def _grid(text: str) -> tuple[int, int]:
-    try:
-        width, height = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WxH, e.g. 48x64, found {text!r}") from None
-    if not (2 <= width <= 1024 and 2 <= height <= 1024):
-        raise argparse.ArgumentTypeError(f"{text}: each side must be 2-1024 particles")
-    return width, height
+_size = wxh_type("--size", 16, 16384)
+_grid = wxh_type("--grid", 2, 1024, unit="particles", example="48x64")
 
 
 def _positive_int(text: str) -> int:

@@ -8,7 +8,6 @@ beside the target, renamed when complete), so an error leaves no partial image.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,17 +21,11 @@ FRAME_DT_S = 1.0 / 60.0
 
 
 def parse_size(text: str) -> tuple[int, int]:
-    """``WxH`` -> (width, height), refused unless both are whole numbers >= 1."""
-    match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", str(text))
-    if match is None:
-        raise InputError(f"{text!r} is not WIDTHxHEIGHT in pixels (e.g. 1280x720)", field="--size")
-    width, height = int(match.group(1)), int(match.group(2))
+    """``WxH`` -> (width, height), refused unless both are whole numbers in 1..MAX_SIDE_PX."""
+    from catalog.cliargs import parse_wxh  # noqa: PLC0415
     from catalog.render.frame import MAX_SIDE_PX  # noqa: PLC0415
 
-    if not (1 <= width <= MAX_SIDE_PX and 1 <= height <= MAX_SIDE_PX):
-        raise InputError(f"{width}x{height} is impossible: each side must lie in 1..{MAX_SIDE_PX} px",
-                         field="--size")
-    return width, height
+    return parse_wxh(text, "--size", 1, MAX_SIDE_PX)
 
 
 def check_output(path: str | Path) -> Path:
