@@ -90,22 +90,22 @@ class ViewerApp:
         self.messages: dict[str, str] = {}  # topic -> one-line error shown in the panel
         self.last_screenshot: str | None = None
 
+    def _loadable_index(self, name: str) -> int:
+        """The catalog index of fabric ``name``, refused in one line if it does not load."""
+        index = self.catalog.index_of(name)
+        entry = self.catalog.load(index)
+        if entry.preset is None:
+            raise CatalogError(entry.error or f"cannot load fabric {name!r}")
+        return index
+
     def _choose_start(self, options: ViewerOptions) -> None:
         if options.fabric is not None:
-            index = self.catalog.index_of(options.fabric)
-            entry = self.catalog.load(index)
-            if entry.preset is None:
-                raise CatalogError(entry.error or f"cannot load fabric {options.fabric!r}")
-            self.settings.fabric_index = index
+            self.settings.fabric_index = self._loadable_index(options.fabric)
         else:
             first = self.catalog.first_usable(0)
             self.settings.fabric_index = 0 if first is None else first
         if options.compare is not None:
-            index = self.catalog.index_of(options.compare)
-            entry = self.catalog.load(index)
-            if entry.preset is None:
-                raise CatalogError(entry.error or f"cannot load fabric {options.compare!r}")
-            self.settings.compare_index = index
+            self.settings.compare_index = self._loadable_index(options.compare)
         if options.light is not None:
             from catalog.lights import get_light  # noqa: PLC0415
 
