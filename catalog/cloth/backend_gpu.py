@@ -12,7 +12,7 @@ Float32 throughout, so it follows the float64 reference to about 1e-4 m after a 
 test would need a read-back.
 
 Shaders: shaders/cloth_step.comp (one program per pass, by #define), and
-shaders/cloth_springs12.comp for the benchmark problem (:class:`Springs12Gpu`).
+catalog/bench/shaders/cloth_springs12.comp for the benchmark problem (:class:`Springs12Gpu`).
 """
 
 from __future__ import annotations
@@ -46,10 +46,10 @@ class GpuBackend:
     name = "gpu"
 
     def __init__(self, params: ClothParams, ctx=None):
-        from catalog.render.shaderlib import create_compute
+        from catalog.gl.shaderlib import create_compute
 
         if ctx is None:
-            from catalog.render.context import create_headless_context
+            from catalog.gl.context import create_headless_context
             ctx = create_headless_context()
         self.ctx = ctx
         self.programs = {name: create_compute(ctx, "cloth_step.comp", {f"PASS_{name}": True})
@@ -255,14 +255,14 @@ class GpuBackend:
 
 
 class Springs12Gpu:
-    """The benchmark problem (springs12.py) in shaders/cloth_springs12.comp."""
+    """The benchmark problem (springs12.py) in catalog/bench/shaders/cloth_springs12.comp."""
 
     def __init__(self, problem, ctx=None):
         from catalog.cloth.topology import GATHER_OFFSETS
-        from catalog.render.shaderlib import create_compute
+        from catalog.gl.shaderlib import create_compute
 
         if ctx is None:
-            from catalog.render.context import create_headless_context
+            from catalog.gl.context import create_headless_context
             ctx = create_headless_context()
         self.ctx = ctx
         self.problem = problem

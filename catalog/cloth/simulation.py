@@ -20,7 +20,7 @@ import numpy as np
 from catalog.cloth.params import ClothParams
 from catalog.cloth.state import ClothState, inverse_mass, ring_positions
 from catalog.cloth.topology import FAMILIES, rest_lengths_m
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 BACKENDS = ("numpy", "cpu", "gpu")
 
