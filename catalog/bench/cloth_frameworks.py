@@ -221,7 +221,7 @@ def make(name: str, problem: Springs12Problem, ctx=None):
     if name == "cpu-2t":
         return Springs12Numba(problem, threads=2)
     if name == "gpu":
-        from catalog.cloth.backend_gpu import Springs12Gpu
+        from catalog.bench.springs12 import Springs12Gpu
         return Springs12Gpu(problem, ctx=ctx)
     if name == "taichi":
         return TaichiCloth(problem)

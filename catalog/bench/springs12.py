@@ -13,7 +13,8 @@ reads only the old buffers, so every particle can be computed independently: the
 "gather" form, each spring evaluated from both ends).
 
 This module holds the problem, a float64 numpy reference, and the numba kernels of the
-``cpu`` backend (serial and threaded). The GLSL version is catalog/bench/shaders/cloth_springs12.comp.
+``cpu`` backend (serial and threaded), and the GLSL version on the GPU (:class:`Springs12Gpu`,
+catalog/bench/shaders/cloth_springs12.comp).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from catalog.cloth.backend_gpu import _groups, _vec4
 from catalog.cloth.params import GRAVITY_M_S2
 from catalog.cloth.topology import GATHER_OFFSETS
 
@@ -256,3 +258,54 @@ class Springs12Numba:
     def positions(self) -> np.ndarray:
         buf = self.a if self.current == 0 else self.b
         return np.stack([buf[0], buf[1], buf[2]], axis=-1).astype(np.float64)
+
+
+class Springs12Gpu:
+    """The benchmark problem in catalog/bench/shaders/cloth_springs12.comp (a compute shader)."""
+
+    def __init__(self, problem, ctx=None):
+        from catalog.gl.shaderlib import create_compute
+
+        if ctx is None:
+            from catalog.gl.context import create_headless_context
+            ctx = create_headless_context()
+        self.ctx = ctx
+        self.problem = problem
+        self.program = create_compute(ctx, "cloth_springs12.comp")
+        springs = problem.springs()
+        prog = self.program
+        prog["u_n"].value = problem.n
+        prog["u_offset"].write(np.array(GATHER_OFFSETS, dtype=np.int32).tobytes())
+        prog["u_rest"].write(np.array([s[2] for s in springs], dtype=np.float32).tobytes())
+        prog["u_ke"].write(np.array([s[3] for s in springs], dtype=np.float32).tobytes())
+        prog["u_kd"].value = problem.k_damping_n_s_m
+        prog["u_dt"].value = problem.dt_s
+        prog["u_inv_mass"].value = 1.0 / problem.mass_kg
+        prog["u_gravity"].value = problem.gravity_m_s2
+        n = problem.n * problem.n
+        self.bufs = [[ctx.buffer(reserve=n * 16), ctx.buffer(reserve=n * 16)] for _ in range(2)]
+        self.reset()
+
+    def reset(self) -> None:
+        x = _vec4(self.problem.initial_positions())
+        self.bufs[0][0].write(x.tobytes())
+        self.bufs[0][1].write(np.zeros_like(x).tobytes())
+        self.current = 0
+
+    def run(self, steps: int) -> None:
+        groups = _groups(self.problem.n ** 2)
+        for _ in range(steps):
+            src, dst = self.bufs[self.current], self.bufs[1 - self.current]
+            src[0].bind_to_storage_buffer(0)
+            src[1].bind_to_storage_buffer(1)
+            dst[0].bind_to_storage_buffer(2)
+            dst[1].bind_to_storage_buffer(3)
+            self.program.run(groups)
+            self.ctx.memory_barrier()
+            self.current = 1 - self.current
+
+    def positions(self) -> np.ndarray:
+        """(n, n, 3) float64 (waits for the GPU)."""
+        data = np.frombuffer(self.bufs[self.current][0].read(), dtype=np.float32)
+        n = self.problem.n
+        return data.reshape(n, n, 4)[..., :3].astype(np.float64)

@@ -75,8 +75,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             params = ClothParams(**overrides)
         if args.backend == "cpu":  # compile (or load the cached code) outside the timing
-            from catalog.cloth.backend_numba import warm_up
-            warm_up()
+            from catalog.cloth.simulation import warm_up_numba
+            warm_up_numba()
         sim = ClothSimulation(params, args.backend, monitor_every=1)
     except InputError as exc:
         option = _OPTION_OF_FIELD.get(exc.field or "")
