@@ -110,7 +110,7 @@ def _curtain_mask(a: np.ndarray, b: np.ndarray, threshold: float = 0.02) -> np.n
 
 def test_no_display_says_so_in_one_line(tmp_path):
     result = _catalog(["view"], display=None, cwd=tmp_path, timeout=60)
-    assert result.returncode == 2
+    assert result.returncode == 3  # an environment failure, not bad input
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
     assert "no display" in lines[0]
@@ -119,10 +119,10 @@ def test_no_display_says_so_in_one_line(tmp_path):
 
 
 def test_unreachable_display_says_so_in_one_line(tmp_path):
-    # a display number nobody serves: glfw.init fails -> the same one-line hint, exit 2
+    # a display number nobody serves: glfw.init fails -> the same one-line hint, exit 3
     free = next(n for n in range(4321, 4400) if not Path(f"/tmp/.X11-unix/X{n}").exists())
     result = _catalog(["view", *QUICK], display=f":{free}", cwd=tmp_path, timeout=60)
-    assert result.returncode == 2, result.stderr
+    assert result.returncode == 3, result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
     assert "catalog snapshot" in lines[0] and "cannot open the display" in lines[0]
@@ -481,6 +481,24 @@ def test_broken_preset_on_the_command_line_is_refused(xdisplay, tmp_path):
                       xdisplay, tmp_path, timeout=60)
     assert result.returncode == 2
     assert "bad.toml" in result.stderr and "display_name" in result.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_a_failed_frame_fails_a_frames_run(xdisplay, tmp_path):
+    """--frames N --screenshot: a frame that could not be drawn as asked (here the shown
+    fabric's dye file is missing) ends the run with its one-line error, exit 2, and no
+    screenshot, instead of exit 0 with the error only in the panel."""
+    _need_presets(VOILE)
+    fabrics = tmp_path / "fabrics"
+    _copy_fabrics(fabrics, [VOILE])
+    preset = fabrics / f"{VOILE}.toml"
+    preset.write_text(preset.read_text() + '\n[dye]\ntransmittance = "no-such-dye.csv"\n')
+    result = _catalog(["view", *QUICK, "--fabric-dir", str(fabrics), "--fabric", VOILE,
+                       "--frames", "2", "--screenshot", str(tmp_path / "x.png")],
+                      xdisplay, tmp_path, timeout=120)
+    assert result.returncode == 2, result.stderr
+    assert "no-such-dye.csv" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
     assert not (tmp_path / "x.png").exists()
 
 

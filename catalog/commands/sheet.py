@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+RESOURCES = ("fabrics",)
 HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
 
@@ -10,7 +11,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--size", default="320x240", help="WIDTHxHEIGHT of each image")
     parser.add_argument("--fabrics", default=None,
-                        help="comma-separated preset names or .toml paths (default: every fabrics/*.toml)")
+                        help="comma-separated preset names, .toml paths or folders of your own "
+                             "presets (a folder is searched before the built-in catalog; default: "
+                             "every preset, $CATALOG_FABRICS first)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
     parser.add_argument("--mode", choices=("paper", "physical"), default="physical")
     parser.add_argument("--bands", type=int, default=3)
@@ -25,7 +28,9 @@ def run(args) -> int:
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
     lights = [name.strip() for name in args.lights.split(",") if name.strip()]
-    fabrics = None if args.fabrics is None else [f.strip() for f in args.fabrics.split(",") if f.strip()]
+    from catalog.core.cliargs import fabric_list  # noqa: PLC0415
+
+    fabrics = fabric_list(args.fabrics)  # folders join the search path, names select
     report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=fabrics,
                           fluorescence="off" if args.no_fluorescence else args.mode,
                           bands=args.bands, progress=not args.json)

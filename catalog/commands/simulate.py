@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+RESOURCES = ("fabrics",)
 HELP = "simulate a curtain (mass-spring cloth) headless; report stretch, energy and speed"
 
 #: ClothParams field -> the option that sets it (for error messages)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+RESOURCES = ("fabrics",)
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
 
 

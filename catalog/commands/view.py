@@ -7,6 +7,7 @@ from pathlib import Path
 
 from catalog.core.cliargs import wxh_type
 
+RESOURCES = ("fabrics",)
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
 FLUORESCENCE_CHOICES = ("off", "paper", "physical")
@@ -94,10 +95,10 @@ def _forbid_scipy() -> None:
 
 def run(args: argparse.Namespace) -> int:
     _forbid_scipy()
-    from catalog.core.resources import FABRIC_DIR
     from catalog.core.errors import CatalogError
     from catalog.viewer.app import ViewerApp, ViewerOptions
-    from catalog.viewer.window import NO_DISPLAY_HINT, display_available, init_glfw
+    from catalog.viewer.window import (NO_DISPLAY_HINT, NoDisplayError, display_available,
+                                       init_glfw)
 
     if args.screenshot is not None and args.frames is None:
         raise CatalogError("--screenshot needs --frames N (the S key saves screenshots "
@@ -107,8 +108,8 @@ def run(args: argparse.Namespace) -> int:
     if args.wind is not None and not 0.0 <= args.wind <= 50.0:
         raise CatalogError(f"--wind: {args.wind:g} m/s is outside 0-50 m/s")
     if not display_available():  # say so before any heavy import or preset read
-        raise CatalogError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
-                           + NO_DISPLAY_HINT)
+        raise NoDisplayError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
+                             + NO_DISPLAY_HINT)
     init_glfw()  # a named display that cannot be opened: the same one line, exit 2
     fabric, fabric_dir = args.fabric, args.fabric_dir
     if fabric is not None and fabric.endswith(".toml"):  # a preset file: browse its folder
@@ -123,5 +124,5 @@ def run(args: argparse.Namespace) -> int:
         wind_m_s=args.wind, grid=args.grid,
         cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
-        fabric_dir=fabric_dir if fabric_dir is not None else FABRIC_DIR)
+        fabric_dir=fabric_dir)
     return ViewerApp(options).run()

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Mapping
 
 from catalog.core.resources import SHADER_DIR
-from catalog.core.errors import CatalogError
+from catalog.core.errors import CatalogError, EnvironmentFailure
 
 #: Deeper nesting than this is an error (an include cycle always reaches it).
 MAX_INCLUDE_DEPTH = 8
@@ -41,7 +41,7 @@ def find_shader(name: str, near: Path | None = None) -> Path:
         if candidate.is_file():
             return candidate
     searched = ", ".join(str(f) for f in folders)
-    raise CatalogError(f"shader file {name!r} not found (searched {searched})")
+    raise EnvironmentFailure(f"shader file {name!r} not found (searched {searched})")
 
 
 def _expand(path: Path, depth: int, chain: tuple[str, ...]) -> list[str]:
@@ -118,7 +118,8 @@ def glsl_literal(value) -> str:
 
 def create_program(ctx, vertex: str, fragment: str | None = None,
                    defines: Mapping[str, object] | None = None, fragment_outputs=None):
-    """A moderngl program from shader files; compile errors become one-line CatalogErrors."""
+    """A moderngl program from shader files; compile errors become one-line
+    EnvironmentFailures (the installed shaders or the driver are at fault, exit 3)."""
     import moderngl  # noqa: PLC0415
 
     sources = {"vertex_shader": load_source(vertex, defines)}
@@ -128,7 +129,7 @@ def create_program(ctx, vertex: str, fragment: str | None = None,
         return ctx.program(**sources, fragment_outputs=fragment_outputs)
     except moderngl.Error as exc:
         first = next((ln for ln in str(exc).splitlines() if "error" in ln.lower()), str(exc))
-        raise CatalogError(f"shader {vertex}+{fragment} failed to compile: {first.strip()}") from None
+        raise EnvironmentFailure(f"shader {vertex}+{fragment} failed to compile: {first.strip()}") from None
 
 
 def create_compute(ctx, name: str, defines: Mapping[str, object] | None = None):
@@ -139,4 +140,4 @@ def create_compute(ctx, name: str, defines: Mapping[str, object] | None = None):
         return ctx.compute_shader(load_source(name, defines))
     except moderngl.Error as exc:
         first = next((ln for ln in str(exc).splitlines() if "error" in ln.lower()), str(exc))
-        raise CatalogError(f"compute shader {name} failed to compile: {first.strip()}") from None
+        raise EnvironmentFailure(f"compute shader {name} failed to compile: {first.strip()}") from None

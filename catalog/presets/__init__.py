@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from catalog.core.resources import FABRIC_DIR
+from catalog.core.resources import FABRIC_DIR, fabric_dirs
 from catalog.core.errors import InputError
 
 SCHEMA = 1
@@ -189,24 +189,35 @@ def load_preset(path: str | Path) -> Preset:
     return preset_from_dict(doc, path)
 
 
-def find_preset(name_or_path: str | Path, fabric_dir: Path = FABRIC_DIR) -> Path:
-    """A preset name (``lace-fwa``) or a path to a .toml -> the file's path."""
+def _folders(fabric_dir: Path | None) -> list[Path]:
+    return fabric_dirs() if fabric_dir is None else [Path(fabric_dir)]
+
+
+def find_preset(name_or_path: str | Path, fabric_dir: Path | None = None) -> Path:
+    """A preset name (``lace-fwa``) or a path to a .toml -> the file's path. A name is looked
+    up in ``fabric_dir``, or by default in the user's fabric folders (``--fabrics``,
+    ``$CATALOG_FABRICS``) and then the built-in catalog (the first match wins)."""
     candidate = Path(name_or_path)
     if candidate.suffix == ".toml" or candidate.exists():
         if not candidate.exists():
             raise InputError("no such preset file", path=candidate)
         return candidate
-    path = fabric_dir / f"{name_or_path}.toml"
-    if not path.exists():
-        known = ", ".join(sorted(p.stem for p in fabric_dir.glob("*.toml"))) or "none"
-        raise InputError(f"unknown fabric {str(name_or_path)!r} (known: {known})",
-                         field="--fabric")
-    return path
+    for folder in _folders(fabric_dir):
+        path = folder / f"{name_or_path}.toml"
+        if path.exists():
+            return path
+    known = ", ".join(p.stem for p in list_presets(fabric_dir)) or "none"
+    raise InputError(f"unknown fabric {str(name_or_path)!r} (known: {known})", field="--fabric")
 
 
-def list_presets(fabric_dir: Path = FABRIC_DIR) -> list[Path]:
-    """Preset files in ``fabric_dir``, sorted by name."""
-    return sorted(fabric_dir.glob("*.toml"))
+def list_presets(fabric_dir: Path | None = None) -> list[Path]:
+    """Preset files in ``fabric_dir`` (default: every fabric folder, a name found in an
+    earlier folder hiding the same name in a later one), sorted by name."""
+    found: dict[str, Path] = {}
+    for folder in _folders(fabric_dir):
+        for path in sorted(folder.glob("*.toml")):
+            found.setdefault(path.stem, path)
+    return [found[name] for name in sorted(found)]
 
 
 def preset_to_dict(preset: Preset) -> dict[str, Any]:

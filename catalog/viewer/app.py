@@ -19,7 +19,6 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.core.resources import FABRIC_DIR
 from catalog.core.errors import CatalogError
 from catalog.viewer.catalog_state import FabricCatalog
 from catalog.viewer.input import Action, MouseOrbit, OrbitCamera, action_for_key
@@ -57,7 +56,7 @@ class ViewerOptions:
     panel: bool = True
     paused: bool = False
     render_scale: float | None = None  # scene resolution / window resolution; None: auto
-    fabric_dir: Path = FABRIC_DIR
+    fabric_dir: Path | None = None  # None: --fabrics / $CATALOG_FABRICS, then the built-in catalog
 
 
 def heavy_modules_loaded() -> dict[str, bool]:
@@ -74,7 +73,7 @@ class ViewerApp:
         self.options = options
         self.catalog = FabricCatalog(options.fabric_dir)
         if len(self.catalog) == 0:
-            raise CatalogError(f"no presets (*.toml) in {options.fabric_dir}")
+            raise CatalogError(f"no presets (*.toml) in {self.catalog.where}")
         self.settings = ViewerSettings(fluorescence=options.fluorescence, bands=options.bands,
                                        show_panel=options.panel, paused=options.paused)
         if options.hour is not None:
@@ -88,6 +87,10 @@ class ViewerApp:
         self._quit = False
         self._screenshot_requested = False
         self.messages: dict[str, str] = {}  # topic -> one-line error shown in the panel
+        #: The first error that spoiled a frame (a fabric or light that could not be applied, a
+        #: render that failed). Interactive use shows it in the panel and goes on; a --frames
+        #: run ends with it (no screenshot, non-zero exit).
+        self.frame_error: CatalogError | None = None
         self.last_screenshot: str | None = None
 
     def _loadable_index(self, name: str) -> int:
@@ -200,6 +203,7 @@ class ViewerApp:
                         self.messages.pop(f"render{slot}", None)
                     except CatalogError as exc:  # e.g. no fabric loads: say so, keep running
                         self.messages[f"render{slot}"] = str(exc)
+                        self.frame_error = self.frame_error or exc
                 self.ctx.finish()
 
             with self.timer.part("ui"):
@@ -218,7 +222,7 @@ class ViewerApp:
             if self._screenshot_requested:
                 self._screenshot_requested = False
                 self._save_screenshot_pair()
-            if last_frame and self.options.screenshot is not None:
+            if last_frame and self.options.screenshot is not None and self.frame_error is None:
                 self._save_window_png(self.options.screenshot)
 
             self.ctx.copy_framebuffer(self.ctx.screen, self._fbo)
@@ -238,6 +242,8 @@ class ViewerApp:
                           for k, v in self.timer.median_ms().items()}}
             print(json.dumps(summary), flush=True)
         self.gui.shutdown()
+        if self.options.frames is not None and self.frame_error is not None:
+            raise self.frame_error  # one line on stderr, exit 2 (or 3 for the environment)
         return 0
 
     def _refresh_catalog(self) -> None:
@@ -403,7 +409,7 @@ class ViewerApp:
         """Pass the settings to each renderer, only what changed since the last frame."""
         settings = self.settings
         if len(self.catalog) == 0:
-            self.messages["catalog"] = f"no presets (*.toml) in {self.catalog.fabric_dir}"
+            self.messages["catalog"] = f"no presets (*.toml) in {self.catalog.where}"
             return
         self.messages.pop("catalog", None)
         fabrics = [settings.fabric_index]
@@ -420,6 +426,7 @@ class ViewerApp:
                     self.messages.pop(f"fabric{slot}", None)
                 except CatalogError as exc:
                     self.messages[f"fabric{slot}"] = str(exc)
+                    self.frame_error = self.frame_error or exc
                 applied["fabric"] = (entry.name, id(entry.preset))
             light_key = (settings.light, settings.sun_hour if settings.light == SUN else None)
             if applied.get("light") != light_key:
@@ -432,6 +439,7 @@ class ViewerApp:
                     self.messages.pop("light", None)
                 except CatalogError as exc:
                     self.messages["light"] = str(exc)
+                    self.frame_error = self.frame_error or exc
                 applied["light"] = light_key
             if applied.get("fluorescence") != settings.fluorescence:
                 renderer.set_fluorescence(settings.fluorescence)

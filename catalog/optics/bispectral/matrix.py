@@ -49,9 +49,10 @@ if TYPE_CHECKING:  # pragma: no cover
     from catalog.optics.fluorescence import FluorescentMaterial
 
 def bispectral_dir() -> Path:
-    """The shared data folder of measured matrices (read in place, never copied)."""
-    from catalog.core.resources import SHARED_DATA_DIR
-    return SHARED_DATA_DIR / "bispectral"
+    """The validation data's folder of measured matrices (read in place, never copied); a
+    one-line input error when it is absent (see :func:`catalog.core.resources.data_dir`)."""
+    from catalog.core.resources import data_dir
+    return data_dir("bispectral")
 
 
 #: Lines before the dimension line in a BFC-450 matrix file (the dimension line is line 11).
@@ -233,6 +234,11 @@ def find_bfc(name_or_path: str | Path) -> Path:
     if path.is_file():
         return path
     stem = path.name.upper().removesuffix(".BFC")
+    from catalog.core.resources import data_missing_reason
+    reason = data_missing_reason("bispectral")
+    if reason is not None:
+        raise InputError(f"no such file, and no matrices to look the name up in ({reason})",
+                         path=name_or_path)
     folder = bispectral_dir()
     if folder.is_dir():
         for candidate in list_bfc(folder):
