@@ -1,6 +1,7 @@
 """Bispectral (Donaldson) matrices: reader, exact rendering, separable fit, colour-error study.
 
-The measured matrices are read in place from ../shared/data/bispectral (never copied).
+The measured matrices are read in place from the validation data's bispectral/ folder (never copied;
+skipped with the reason when it is absent).
 """
 
 from __future__ import annotations

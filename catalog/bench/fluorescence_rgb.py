@@ -1,6 +1,6 @@
 """Fluorescence in an RGB engine against the state of the art, on measured Donaldson matrices.
 
-For each of the eight shared matrices (../shared/data/bispectral, catalog.optics.bispectral.matrix) and
+For each of the eight shared matrices (the validation data's bispectral/, catalog.optics.bispectral.matrix) and
 every light of the library (catalog.optics.lights.light_names), the colour each representation
 gives is compared by CIEDE2000 with the exact spectral result of the matrix (the ground
 truth and white of catalog/optics/bispectral/study.py, which also supplies the paper-mode, the

@@ -82,7 +82,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _forbid_scipy() -> None:
     """Mark scipy absent in the viewer's process.
 
-    Drawing a frame never needs scipy (architecture.md: render and viewer never import the
+    Drawing a frame never needs scipy (docs/architecture.md: render and viewer never import the
     tools' fitting code). numba's own import probes for scipy (a version check) and its CPU
     target then loads scipy.linalg's BLAS bindings, a few hundred ms of start-up for nothing;
     with scipy marked absent numba skips both, and an accidental scipy import anywhere in the
