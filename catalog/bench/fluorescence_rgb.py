@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 
+from catalog.core.constants import LUMINOUS_EFFICACY_LM_W as LM_PER_W
 from catalog.bench.timing import median_seconds
 
 #: method -> (label, numbers the shader carries, recomputed per light?)
@@ -43,7 +44,6 @@ METHODS = {
 }
 STUDY_METHODS = ("ignore", "paper", "paper_global", "physical", "physical_rgb", "rgb_product")
 BAND_COUNTS = (6, 9, 16)
-LM_PER_W = 683.0
 
 
 def bands_xyz(models, light: np.ndarray, n_bands: int) -> np.ndarray:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from catalog.core.constants import FLUORESCENT_MODES
+
 RESOURCES = ("fabrics",)
 HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
@@ -15,7 +17,7 @@ def add_arguments(parser) -> None:
                              "presets (a folder is searched before the built-in catalog; default: "
                              "every preset, $CATALOG_FABRICS first)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
-    parser.add_argument("--mode", choices=("paper", "physical"), default="physical")
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical")
     parser.add_argument("--bands", type=int, default=3)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 

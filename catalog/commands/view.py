@@ -5,12 +5,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from catalog.core.constants import FLUORESCENCE_MODES as FLUORESCENCE_CHOICES
 from catalog.core.cliargs import wxh_type
 
 RESOURCES = ("fabrics",)
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
-FLUORESCENCE_CHOICES = ("off", "paper", "physical")
 BAND_CHOICES = (3, 6, 9, 16)
 
 

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from catalog.core.constants import FLUORESCENCE_MODES
 from catalog.core.errors import CatalogError
 from catalog.render import bands as band_lib
 from catalog.render import scene as scene_lib
@@ -32,7 +33,6 @@ EXPOSURE_KEY = 5.0
 EXPOSURE_FLOOR_LX = 200.0
 #: Tone curve white point (after exposure): this luminance maps to display white.
 TONE_WHITE = 6.0
-FLUORESCENCE_MODES = ("off", "paper", "physical")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
