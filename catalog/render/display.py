@@ -204,6 +204,15 @@ def check_ev(ev100: float) -> float:
     return float(ev100)
 
 
+def meter_signal(rgb: np.ndarray) -> np.ndarray:
+    """What the auto exposure measures per pixel (cd m^-2 scale): the largest of R, G, B
+    (linear sRGB, Y-scaled), as a camera that protects its channels meters. Equal to Y for a
+    neutral colour; larger for a saturated one, which also looks brighter than its luminance
+    says (Helmholtz-Kohlrausch), most of all a saturated blue (Y is 7 % of the blue primary's
+    channel value): metering Y alone exposes a blue glow until it can only be shown pale."""
+    return np.maximum(np.asarray(rgb, dtype=np.float64).max(axis=-1), 0.0)
+
+
 def luminance_histogram(luminance_cd_m2: np.ndarray, weights=None) -> np.ndarray:
     """Counts of log2 Y in HISTOGRAM_BINS bins over HISTOGRAM_LOG2_RANGE (Y <= 0 -> first bin)."""
     y = np.asarray(luminance_cd_m2, dtype=np.float64).ravel()

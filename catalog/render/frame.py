@@ -444,8 +444,7 @@ class FrameRenderer:
         data = np.frombuffer(self._hdr.read(level=level), dtype=np.float32).reshape(h, w, 4)
         cw, ch = max(1, -(-vw >> level)), max(1, -(-vh >> level))
         rgb = data[:ch, :cw, :3].astype(np.float64)
-        luminance = rgb @ display_lib.matrices().luminance
-        return display_lib.meter_ev100(display_lib.luminance_histogram(luminance))
+        return display_lib.meter_ev100(display_lib.luminance_histogram(display_lib.meter_signal(rgb)))
 
     # ------------------------------------------------------------------ passes    # ------------------------------------------------------------------ passes
     def _scene_uniforms(self, program, view_proj, inputs) -> None:
