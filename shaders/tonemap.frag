@@ -22,7 +22,13 @@ uniform vec3 u_gamut;             // (R_KNEE, R_LIMIT, CUBE_TOP): chroma ratios 
 
 layout(location = 0) out vec4 out_colour;
 
-const int GAMUT_STEPS = 14;       // display.GAMUT_STEPS
+const int GAMUT_STEPS = 8;        // display.GAMUT_STEPS
+
+// DISPLAY_STAGES (the benchmark's variants; default all): 0 exposure and the sRGB curve
+// only, 1 + white balance, 2 + tone curve, 3 + gamut compression.
+#ifndef DISPLAY_STAGES
+#define DISPLAY_STAGES 3
+#endif
 
 vec3 signed_cbrt(vec3 v) {
     return sign(v) * pow(abs(v), vec3(1.0 / 3.0));
@@ -71,14 +77,22 @@ vec3 gamut_compress(vec3 rgb) {
 }
 
 vec3 display_linear(vec3 hdr) {
-    vec3 c = u_white_balance * (u_exposure * hdr);
+    vec3 c = u_exposure * hdr;
+#if DISPLAY_STAGES >= 1
+    c = u_white_balance * c;
+#endif
+#if DISPLAY_STAGES >= 2
     float y = dot(c, u_luminance);
     if (!(y > 0.0)) {
         return vec3(0.0);
     }
     float x = y / (y + u_tone.x);
     c *= pow(x, u_tone.y) / y;
-    return clamp(gamut_compress(c), 0.0, 1.0);
+#endif
+#if DISPLAY_STAGES >= 3
+    c = gamut_compress(c);
+#endif
+    return clamp(c, 0.0, 1.0);
 }
 
 void main() {

@@ -16,7 +16,8 @@ optionally, ``plot(result, folder) -> list[Path]``:
   (:mod:`catalog.benchsuite.cloth`);
 - ``stability``: every model's parameters swept to their edges
   (:mod:`catalog.benchsuite.stability`);
-- ``startup``: import time and time to the first frame (:mod:`catalog.benchsuite.startup`).
+- ``startup``: import time and time to the first frame (:mod:`catalog.benchsuite.startup`);
+- ``display``: each display transform's cost in the frame (:mod:`catalog.benchsuite.display`).
 
 docs/bench.md has the figures and how to reproduce them.
 """
@@ -31,4 +32,5 @@ SECTIONS: dict[str, str] = {
     "cloth": "catalog.benchsuite.cloth",
     "stability": "catalog.benchsuite.stability",
     "startup": "catalog.benchsuite.startup",
+    "display": "catalog.benchsuite.display",
 }

@@ -96,6 +96,7 @@ class FrameRenderer:
         self.ev100 = None                # None: metered per frame (auto exposure)
         self.white_balance = display_lib.DEFAULT_WHITE_BALANCE
         self.metered_ev100 = None        # the auto exposure's current EV100 (adapted)
+        self.display_stages = 3          # tonemap.frag's DISPLAY_STAGES (benchmark variants)
         self._wb_cache = None
         self._inputs = None
         self._inputs_key = None
@@ -552,7 +553,8 @@ class FrameRenderer:
         target = fbo if fbo is not None else self._ldr_fbo
         target.use()
         self.ctx.viewport = tuple(viewport) if (fbo is not None and viewport is not None) else (0, 0, vw, vh)
-        program = self._program("fullscreen.vert", "tonemap.frag")
+        program = self._program("fullscreen.vert", "tonemap.frag",
+                                {"DISPLAY_STAGES": self.display_stages})
         self._hdr.use(location=0)
         self._set(program, "u_hdr", 0)
         self._set(program, "u_hdr_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
