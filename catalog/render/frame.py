@@ -444,7 +444,7 @@ class FrameRenderer:
         w, h = max(1, self.size[0] >> level), max(1, self.size[1] >> level)
         data = np.frombuffer(self._hdr.read(level=level), dtype=np.float32).reshape(h, w, 4)
         cw, ch = max(1, -(-vw >> level)), max(1, -(-vh >> level))
-        rgb = data[:ch, :cw, :3].astype(np.float64)
+        rgb = data[:ch, :cw, :3].astype(np.float64) @ self.white_balance_matrix().T  # as shown
         return display_lib.meter_ev100(display_lib.luminance_histogram(display_lib.meter_signal(rgb)))
 
     # ------------------------------------------------------------------ passes    # ------------------------------------------------------------------ passes
