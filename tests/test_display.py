@@ -29,8 +29,8 @@ def test_tables_equal_a_fresh_copy_from_colour_science():
 def test_cat16_matches_colour_science(light):
     import colour
 
-    from catalog.colorimetry import spectrum_to_xyz
-    from catalog.lights import get_light
+    from catalog.optics.colorimetry import spectrum_to_xyz
+    from catalog.optics.lights import get_light
 
     white = spectrum_to_xyz(get_light(light).irradiance_w_m2_nm)
     ours = display.cat16_xyz_matrix(white, display.d65_white_xyz())
@@ -45,8 +45,8 @@ def test_cat16_matches_colour_science(light):
 
 
 def test_white_balance_choices():
-    from catalog.colorimetry import spectrum_to_xyz
-    from catalog.lights import get_light
+    from catalog.optics.colorimetry import spectrum_to_xyz
+    from catalog.optics.lights import get_light
 
     uva = spectrum_to_xyz(get_light("UV-A").irradiance_w_m2_nm)
     a = spectrum_to_xyz(get_light("A").irradiance_w_m2_nm)

@@ -31,8 +31,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catalog import FABRIC_DIR
-from catalog.colorimetry import delta_e_2000_lab, linear_srgb_to_xyz, srgb_decode, xyz_to_lab
+from catalog.core.resources import FABRIC_DIR
+from catalog.optics.colorimetry import delta_e_2000_lab, linear_srgb_to_xyz, srgb_decode, xyz_to_lab
 from catalog.render import display
 from catalog.render.frame import FrameRenderer
 
@@ -77,7 +77,7 @@ def _displayed_mean_linear(renderer, mask):
 
 def _exact_mean_linear(renderer, mask, like):
     """The float64 spectral colour of the curtain pixels, white-balanced, scaled to ``like``'s Y."""
-    from catalog import reference as ref
+    from catalog.optics import shading_reference as ref
 
     gbuffer = renderer.render_gbuffer()
     exact = ref.reference_linear_srgb(renderer.shading_inputs(), gbuffer["position"][mask],

@@ -1,4 +1,4 @@
-"""Copy the display step's matrices from colour-science into catalog/data/display_tables.npz.
+"""Copy the display step's matrices from colour-science into catalog/render/data/display_tables.npz.
 
 Run after upgrading colour-science; tests/test_display.py checks the file equals a fresh copy.
 """

@@ -19,7 +19,7 @@ def add_display_arguments(parser) -> None:
 
 def display_choices(args) -> tuple[float | None, str]:
     """(ev100 or None, white balance) from the parsed options, refused with InputError."""
-    from catalog.errors import InputError  # noqa: PLC0415
+    from catalog.core.errors import InputError  # noqa: PLC0415
     from catalog.render.snapshot import check_display_choices  # noqa: PLC0415
 
     ev = args.ev

@@ -22,7 +22,7 @@ numpy twin (tests compare the two per pixel). The steps, on linear sRGB radiance
 5. the sRGB transfer curve (IEC 61966-2-1).
 
 The matrices (CAT16, OKLab's two, sRGB's) are colour-science's, copied by program into
-``catalog/data/display_tables.npz`` (:func:`build_display_tables`; a test regenerates it),
+``catalog/render/data/display_tables.npz`` (:func:`build_display_tables`; a test regenerates it),
 so a frame never imports colour or scipy.
 """
 
@@ -35,9 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
-TABLE_PATH = Path(__file__).resolve().parents[1] / "data" / "display_tables.npz"
+TABLE_PATH = Path(__file__).resolve().parent / "data" / "display_tables.npz"
 
 #: White balance settings: "room" adapts to the light's white (what a person in the room
 #: sees after a minute), "camera" keeps a fixed D65 balance (what a daylight camera records).
@@ -94,7 +94,7 @@ def build_display_tables() -> dict[str, np.ndarray]:
 
 
 def write_display_tables(path: Path = TABLE_PATH) -> Path:
-    from catalog.atomic import atomic_path  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
 
     tables = build_display_tables()
     with atomic_path(path) as tmp:
@@ -155,8 +155,8 @@ def cat16_xyz_matrix(source_white_xyz, target_white_xyz) -> np.ndarray:
 
 @functools.lru_cache(maxsize=1)
 def _planckian_uv() -> np.ndarray:
-    from catalog.colorimetry import spectrum_to_xyz  # noqa: PLC0415
-    from catalog.lights import planck_w_m2_nm  # noqa: PLC0415
+    from catalog.optics.colorimetry import spectrum_to_xyz  # noqa: PLC0415
+    from catalog.optics.lights import planck_w_m2_nm  # noqa: PLC0415
 
     temperatures = np.geomspace(1000.0, 40000.0, 400)
     xyz = np.array([spectrum_to_xyz(planck_w_m2_nm(t)) for t in temperatures])
@@ -340,7 +340,7 @@ def display_linear(hdr_rgb: np.ndarray, exposure: float, white_balance: np.ndarr
 
 def display_transform(hdr_rgb: np.ndarray, exposure: float, white_balance: np.ndarray) -> np.ndarray:
     """The whole display step, as tonemap.frag: uint8-ready sRGB in [0, 1]."""
-    from catalog.colorimetry import srgb_encode  # noqa: PLC0415
+    from catalog.optics.colorimetry import srgb_encode  # noqa: PLC0415
 
     return srgb_encode(display_linear(hdr_rgb, exposure, white_balance))
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 THUMBNAIL_SIZE_PX = (72, 54)
 #: Thumbnails drawn per frame at most.
