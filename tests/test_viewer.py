@@ -609,7 +609,7 @@ def test_catalog_loads_lazily_and_reloads_on_change(tmp_path):
     (tmp_path / "c.toml").write_text(_preset_text("c"))
     clock[0] = 2.0
     assert sorted(catalog.refresh()) == ["b", "c"]
-    assert catalog.load(1).preset is not None and catalog.core.errors() == []
+    assert catalog.load(1).preset is not None and catalog.errors() == []
     (tmp_path / "c.toml").unlink()
     clock[0] = 3.0
     assert catalog.refresh() == ["c"] and catalog.names == ["a", "b"]

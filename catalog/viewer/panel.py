@@ -119,7 +119,7 @@ class Panel:
             imgui.pop_id()
         if shown == 0:
             imgui.text_colored(DIM_COLOUR, "no fabric has these facts")
-        for error in catalog.core.errors():
+        for error in catalog.errors():
             imgui.push_text_wrap_pos(self.width_px - 10)
             imgui.text_colored(ERROR_COLOUR, error)
             imgui.pop_text_wrap_pos()
