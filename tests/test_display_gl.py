@@ -183,3 +183,17 @@ def test_table_2_direction_in_the_display_image(gl, capsys):
     assert change[2] > 3.0
     assert change[2] > 5 * abs(change[1]) and change[2] > 5 * abs(change[0])
     assert abs(change[0]) <= abs(change[1])
+
+
+def test_display_benchmark_section_reports_every_step(gl):
+    """The benchmark's shape (not its speed): four pass variants, meter and frame per scene."""
+    from catalog.bench.display import SCENES, STAGES, markdown_tables, run
+
+    result = run(quick=True, ctx=gl, size=(32, 24))
+    assert len(result["rows"]) == len(SCENES) and result["stages"] == list(STAGES)
+    for row in result["rows"]:
+        assert len(row["pass_ms"]) == 4 and all(t > 0 for t in row["pass_ms"])
+        assert row["meter_ms"] > 0 and row["frame_ms"] > 0
+        assert np.isclose(sum(row["cost_ms"]), row["pass_ms"][3])
+    table = markdown_tables(result)["display_cost"]
+    assert table.count("\n") == 1 + len(SCENES)
