@@ -138,3 +138,20 @@ def test_exposure_scale_and_ev_range():
     for bad in (float("nan"), 40.0, -20.0):
         with pytest.raises(Exception, match="--ev"):
             display.check_ev(bad)
+
+
+def test_highlights_roll_off_and_desaturate_toward_white():
+    """A saturated red exposed brighter and brighter: lightness rises toward the cube's top
+    grey and chroma falls toward zero (no channel clips on the way), at a constant hue."""
+    red = np.array([1.0, 0.1, 0.05])
+    scales = np.geomspace(0.3, 3000.0, 40)
+    shown = display.display_linear(red[None, :] * scales[:, None], 1.0, np.eye(3))
+    lab = display.rgb_to_oklab(shown)
+    chroma = np.hypot(lab[:, 1], lab[:, 2])
+    assert np.all(np.diff(lab[:, 0]) > -1e-12)        # up to the ceiling, then held there
+    assert lab[-1, 0] == pytest.approx(display.lightness_ceiling(), abs=1e-9)
+    peak = int(np.argmax(chroma))
+    assert np.all(np.diff(chroma[peak:]) < 1e-12) and chroma[-1] < 0.1 * chroma[peak]
+    assert np.all(shown <= display.CUBE_TOP + 1e-12) and np.all(shown >= 0)
+    hue = np.arctan2(lab[:, 2], lab[:, 1])
+    assert np.ptp(hue[chroma > 1e-3]) < 1e-6
