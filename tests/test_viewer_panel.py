@@ -14,7 +14,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from test_viewer import LACE, QUICK, _catalog, _need_presets, _read_image, _stats_records, xdisplay  # noqa: F401
+import time
+
+from catalog.core.resources import FABRIC_DIR
+from test_viewer import (LACE, QUICK, Viewer, _catalog, _need_presets, _read_image,  # noqa: F401
+                         _stats_records, xdisplay)
 
 GREY = "net-grey"
 
@@ -115,3 +119,22 @@ def test_thumbnail_cache_renders_once_per_scene_and_again_on_change(gl):
     assert cache.update(entries, ("UV-A",), apply_scene) == 1
     assert np.abs(cache.get(LACE).pixels.astype(int) - before).mean() > 10
     cache.release()
+
+
+def test_thumbnails_are_drawn_again_when_the_light_changes(xdisplay, tmp_path):
+    """The L key (D65 -> A) in a running viewer: every thumbnail is drawn again for the new
+    light (a few per frame), and the panel's summary lists them all as current for A."""
+    count = len(list(FABRIC_DIR.glob("*.toml")))
+    viewer = Viewer(xdisplay, tmp_path, ["--fabric", LACE, "--light", "D65", "--paused", "--stats"])
+    try:
+        viewer.wait_title("light D65")
+        time.sleep(4.0)  # two thumbnails a frame
+        viewer.keys("l")
+        viewer.wait_title("light A ")
+        time.sleep(4.0)
+        assert viewer.quit() == 0
+        summary = [r for r in _stats_records(viewer.proc.stdout.read()) if r.get("summary")][0]
+    finally:
+        viewer.close()
+    assert summary["thumbnail_renders"] >= 2 * count
+    assert len(summary["thumbnails"]) == count  # all current for the light now shown
