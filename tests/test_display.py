@@ -155,3 +155,25 @@ def test_highlights_roll_off_and_desaturate_toward_white():
     assert np.all(shown <= display.CUBE_TOP + 1e-12) and np.all(shown >= 0)
     hue = np.arctan2(lab[:, 2], lab[:, 1])
     assert np.ptp(hue[chroma > 1e-3]) < 1e-6
+
+
+def test_display_shader_compiles_as_glsl_es_300(tmp_path):
+    """The web page compiles the same sources as GLSL ES 3.00: tonemap.frag (with
+    common.glsl) and fullscreen.vert, with the #version line swapped, pass glslangValidator
+    (tools/setup.sh installs glslang-tools)."""
+    import shutil
+    import subprocess
+
+    from catalog.gl.shaderlib import load_source
+
+    validator = shutil.which("glslangValidator")
+    if validator is None:
+        pytest.fail("glslangValidator missing: tools/setup.sh installs glslang-tools")
+    for name, stage in (("tonemap.frag", "frag"), ("fullscreen.vert", "vert")):
+        for stages in ((0, 1, 2, 3) if stage == "frag" else (3,)):
+            lines = load_source(name, {"DISPLAY_STAGES": stages}).splitlines()
+            assert lines[0].startswith("#version")
+            path = tmp_path / f"es_{stages}.{stage}"
+            path.write_text("\n".join(["#version 300 es", "precision highp float;", *lines[1:]]) + "\n")
+            result = subprocess.run([validator, str(path)], capture_output=True, text=True)
+            assert result.returncode == 0, f"{name} (DISPLAY_STAGES {stages}): {result.stdout}"
