@@ -216,7 +216,8 @@ def meter_signal(rgb: np.ndarray) -> np.ndarray:
 
 
 def luminance_histogram(luminance_cd_m2: np.ndarray, weights=None) -> np.ndarray:
-    """Counts of log2 Y in HISTOGRAM_BINS bins over HISTOGRAM_LOG2_RANGE (Y <= 0 -> first bin)."""
+    """Counts of log2 of a per-pixel signal in cd m^-2 (Y, or :func:`meter_signal`) in
+    HISTOGRAM_BINS bins over HISTOGRAM_LOG2_RANGE (values <= 0 -> the first bin)."""
     y = np.asarray(luminance_cd_m2, dtype=np.float64).ravel()
     lo, hi = HISTOGRAM_LOG2_RANGE
     with np.errstate(divide="ignore", invalid="ignore"):
