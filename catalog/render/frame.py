@@ -434,7 +434,8 @@ class FrameRenderer:
         return display_lib.shader_uniforms(self.exposure_scale(), self.white_balance_matrix())
 
     def meter(self, vw: int, vh: int) -> float:
-        """EV100 of the HDR target's (vw, vh) corner: histogram of a mip level's luminance."""
+        """EV100 of the HDR target's (vw, vh) corner: a histogram of a mip level (at most
+        METER_MAX_SIDE_PX wide), white-balanced, of display.meter_signal (largest channel)."""
         level = 0
         while max(vw, vh) >> level > METER_MAX_SIDE_PX:
             level += 1
@@ -447,7 +448,7 @@ class FrameRenderer:
         rgb = data[:ch, :cw, :3].astype(np.float64) @ self.white_balance_matrix().T  # as shown
         return display_lib.meter_ev100(display_lib.luminance_histogram(display_lib.meter_signal(rgb)))
 
-    # ------------------------------------------------------------------ passes    # ------------------------------------------------------------------ passes
+    # ------------------------------------------------------------------ passes
     def _scene_uniforms(self, program, view_proj, inputs) -> None:
         s = self._set
         s(program, "u_view_proj", gl_bytes(view_proj))
