@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from catalog.commands.displayargs import add_display_arguments, display_choices
 from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
@@ -19,6 +20,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical")
     parser.add_argument("--bands", type=int, default=3)
+    add_display_arguments(parser)
+    parser.add_argument("--no-labels", action="store_true",
+                        help="grid without the fabric (row) and light (column) labels")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
@@ -29,13 +33,15 @@ def run(args) -> int:
     from catalog.render.sheet import render_sheet  # noqa: PLC0415
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
+    ev, white_balance = display_choices(args)
     lights = [name.strip() for name in args.lights.split(",") if name.strip()]
     from catalog.core.cliargs import fabric_list  # noqa: PLC0415
 
     fabrics = fabric_list(args.fabrics)  # folders join the search path, names select
     report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=fabrics,
                           fluorescence="off" if args.no_fluorescence else args.mode,
-                          bands=args.bands, progress=not args.json)
+                          bands=args.bands, progress=not args.json, ev=ev,
+                          white_balance=white_balance, labels=not args.no_labels)
     if args.json:
         print_json(report)
     else:
