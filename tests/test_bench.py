@@ -198,6 +198,7 @@ def test_cloth_runs_are_deterministic_and_deviation_is_a_distance():
     assert rms == pytest.approx(0.003) and worst == pytest.approx(0.003)
 
 
+@pytest.mark.slow
 def test_startup_section_without_first_frames():
     from catalog.bench import startup
 

@@ -197,6 +197,7 @@ def test_gusty_wind_stays_finite_and_limited(stiffness):
     assert sim.finite and sim.kinetic_energy > 0.0 and not sim.sleeping
 
 
+@pytest.mark.slow
 def test_hundred_thousand_steps_stay_finite():
     p = ClothParams(grid_w=4, grid_h=4, wind_speed_m_s=2.0, stretch_stiffness_n_m=1e6)
     sim = ClothSimulation(p, "cpu", monitor_every=1000)

@@ -131,6 +131,7 @@ def test_unreachable_display_says_so_in_one_line(tmp_path):
 # ----------------------------------------------------------------------------------
 # Screenshots of N frames
 
+@pytest.mark.slow
 def test_screenshot_is_the_curtain_in_the_fabrics_colour(xdisplay, tmp_path):
     """--frames N --screenshot: the window shows the curtain, coloured by its fabric.
 
@@ -230,6 +231,7 @@ def test_split_screen_shows_two_fabrics(xdisplay, tmp_path):
     assert right_teal[0] / right_teal[1] < 0.8 * right_lace[0] / right_lace[1]
 
 
+@pytest.mark.slow
 def test_gpu_cloth_draws_the_same_curtain_as_the_cpu_cloth(xdisplay, tmp_path):
     """--cloth-backend gpu: the compute shader writes the vertex buffer the renderer draws
     (moved onto the rod in the vertex shader). After 20 windy frames its picture matches
