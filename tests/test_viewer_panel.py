@@ -134,7 +134,7 @@ def test_thumbnails_are_drawn_again_when_the_light_changes(xdisplay, tmp_path):
         viewer.wait_title("light A ")
         time.sleep(4.0)
         assert viewer.quit() == 0
-        summary = [r for r in _stats_records(viewer.proc.stdout.read()) if r.get("summary")][0]
+        summary = [r for r in _stats_records(viewer.stdout_text()) if r.get("summary")][0]
     finally:
         viewer.close()
     assert summary["thumbnail_renders"] >= 2 * count
