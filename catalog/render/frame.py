@@ -112,6 +112,7 @@ class FrameRenderer:
         for texture in (self._oit_accum, self._oit_weight):
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self._oit_fbo = ctx.framebuffer([self._oit_accum, self._oit_weight], self._depth)
+        self._oit_fbo.depth_mask = False  # the layers are tested against the room, not each other
         self.patterned = True
         self._pattern_texture = None
         self._pattern_key = None
@@ -191,6 +192,19 @@ class FrameRenderer:
         self._pattern_repeat_m = tuple(float(v) for v in repeat)
         self._pattern_mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
         self._pattern_key = key
+
+    def set_pattern_filtering(self, filtered: bool) -> None:
+        """True (default): trilinear mipmapped, anisotropic; False: nearest texel, no mips
+        (for measuring what the filtering buys: shimmer, the far limit)."""
+        mgl = self._moderngl
+        texture = self._pattern_texture
+        if filtered:
+            texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+            max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
+            texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
+        else:
+            texture.filter = (mgl.NEAREST, mgl.NEAREST)
+            texture.anisotropy = 1.0
 
     @property
     def pattern(self):
@@ -609,12 +623,10 @@ class FrameRenderer:
         ctx.viewport = (0, 0, vw, vh)
         ctx.clear(0.0, 0.0, 0.0, 1.0, viewport=(0, 0, vw, vh))   # accum: revealage 1
         # clear() wrote (0, 0, 0, 1) into both targets: the weight target's alpha is unused
-        ctx.depth_mask = False
         ctx.enable(mgl.BLEND)
         ctx.blend_equation = mgl.FUNC_ADD
         ctx.blend_func = (mgl.ONE, mgl.ONE, mgl.ZERO, mgl.ONE_MINUS_SRC_ALPHA)
         self.draw_curtain(view_proj)
-        ctx.depth_mask = True
         # resolve: average colour x (1 - revealage) + behind x revealage
         self._hdr_fbo.use()
         ctx.viewport = (0, 0, vw, vh)
