@@ -16,8 +16,9 @@ Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
    what is really behind, undimmed, and overlapping folds multiply their open fractions;
    ``patterned = False`` draws the paper's flat cloth instead (opaque, LD times the
    background by ray direction: the frame before issue 12, kept for comparison);
-4. tone map (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
-   target): exposure, Reinhard on luminance, the sRGB curve.
+4. tone map (fullscreen.vert + tonemap.frag): exposure, Reinhard on luminance, the sRGB
+   curve; then FXAA (fxaa.frag) into the caller's framebuffer (or our RGBA8 target);
+   ``set_antialiasing("off")`` tone-maps straight into it.
 """
 
 from __future__ import annotations
@@ -39,6 +40,8 @@ EXPOSURE_FLOOR_LX = 200.0
 #: Tone curve white point (after exposure): this luminance maps to display white.
 TONE_WHITE = 6.0
 FLUORESCENCE_MODES = ("off", "paper", "physical")
+#: Anti-aliasing of the display image: a post-process (shaders/fxaa.frag) or none.
+ANTIALIASING_MODES = ("fxaa", "off")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
 #: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
@@ -105,6 +108,12 @@ class FrameRenderer:
         self._hdr_fbo = ctx.framebuffer([self._hdr], self._depth)
         self._ldr = ctx.texture((w, h), 4)
         self._ldr_fbo = ctx.framebuffer([self._ldr])
+        # the tone-mapped image before FXAA (read bilinearly by fxaa.frag)
+        self._pre = ctx.texture((w, h), 4)
+        self._pre.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self._pre.repeat_x = self._pre.repeat_y = False
+        self._pre_fbo = ctx.framebuffer([self._pre])
+        self.antialiasing = "fxaa"
         self._gbuffer = None
         # weighted blended OIT: sum C a w | prod (1 - a), and sum a w; the scene's depth
         self._oit_accum = ctx.texture((w, h), 4, dtype="f4")
@@ -641,13 +650,27 @@ class FrameRenderer:
         ctx.disable(mgl.BLEND)
         ctx.blend_func = mgl.DEFAULT_BLENDING
 
+    def set_antialiasing(self, mode: str) -> None:
+        """``fxaa`` (default): the post-process on the display image (shaders/fxaa.frag);
+        ``off``: the tone-mapped image as it is."""
+        if mode not in ANTIALIASING_MODES:
+            raise CatalogError(f"anti-aliasing {mode!r}: choose one of {', '.join(ANTIALIASING_MODES)}")
+        self.antialiasing = mode
+
     def render(self, fbo=None, viewport=None) -> None:
-        """One frame: HDR passes, then the tone map into ``fbo`` (default: our RGBA8 target)
-        at ``viewport`` (x, y, w, h; default the whole renderer size)."""
+        """One frame: HDR passes, then the tone map (and FXAA) into ``fbo`` (default: our
+        RGBA8 target) at ``viewport`` (x, y, w, h; default the whole renderer size)."""
         vw, vh = self.render_hdr(viewport)
         target = fbo if fbo is not None else self._ldr_fbo
-        target.use()
-        self.ctx.viewport = tuple(viewport) if (fbo is not None and viewport is not None) else (0, 0, vw, vh)
+        target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
+                           else (0, 0, vw, vh))
+        fxaa = self.antialiasing == "fxaa"
+        if fxaa:
+            self._pre_fbo.use()
+            self.ctx.viewport = (0, 0, vw, vh)
+        else:
+            target.use()
+            self.ctx.viewport = target_viewport
         program = self._program("fullscreen.vert", "tonemap.frag")
         self._hdr.use(location=0)
         self._set(program, "u_hdr", 0)
@@ -655,6 +678,15 @@ class FrameRenderer:
         self._set(program, "u_exposure", self.exposure_scale())
         self._set(program, "u_white", TONE_WHITE)
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
+        if fxaa:
+            target.use()
+            self.ctx.viewport = target_viewport
+            program = self._program("fullscreen.vert", "fxaa.frag")
+            self._pre.use(location=0)
+            self._set(program, "u_ldr", 0)
+            self._set(program, "u_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
+            self._set(program, "u_texel", (1.0 / self.size[0], 1.0 / self.size[1]))
+            self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
         self._last = (vw, vh, fbo, viewport)
 
     # ------------------------------------------------------------------ read back
@@ -728,13 +760,13 @@ class FrameRenderer:
 
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
-        ours = [self._hdr_fbo, self._ldr_fbo, self._oit_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
+        ours = [self._hdr_fbo, self._ldr_fbo, self._oit_fbo, self._pre_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._release_vaos()
         self._release_own_buffers()
         for obj in (self._hdr_fbo, self._hdr, self._depth, self._ldr_fbo, self._ldr, self._room_vbo,
-                    self._oit_fbo, self._oit_accum, self._oit_weight):
+                    self._oit_fbo, self._oit_accum, self._oit_weight, self._pre_fbo, self._pre):
             obj.release()
         if self._pattern_texture is not None:
             self._pattern_texture.release()
