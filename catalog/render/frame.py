@@ -46,7 +46,7 @@ ANTIALIASING_MODES = ("fxaa", "off")
 MAX_SPECIALISED = 8
 #: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
 PATTERN_UNIT = 3
-PATTERN_ANISOTROPY = 8.0
+PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
 
@@ -117,7 +117,7 @@ class FrameRenderer:
         self._gbuffer = None
         # weighted blended OIT: sum C a w | prod (1 - a), and sum a w; the scene's depth
         self._oit_accum = ctx.texture((w, h), 4, dtype="f4")
-        self._oit_weight = ctx.texture((w, h), 4, dtype="f4")
+        self._oit_weight = ctx.texture((w, h), 1, dtype="f4")
         for texture in (self._oit_accum, self._oit_weight):
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self._oit_fbo = ctx.framebuffer([self._oit_accum, self._oit_weight], self._depth)
@@ -149,6 +149,7 @@ class FrameRenderer:
         positions, normals = scene_lib.room_props()
         self._room_vbo = ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
         self._curtain_buffers = None
+        self._ring_vbo = None
         default = scene_lib.draped_curtain()
         self.set_mesh(default.positions, default.normals, default.uvs, default.tangents,
                       default.indices)
@@ -164,6 +165,17 @@ class FrameRenderer:
         scene_lib.fluorescent_material(preset)
         self._set_pattern(preset)
         self.preset = preset
+
+    def set_rings(self, xs_m) -> None:
+        """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
+        positions, normals = scene_lib.ring_mesh(xs_m)
+        if self._ring_vbo is not None:
+            self._ring_vbo.release()
+            self._ring_vbo = None
+            for key in [k for k in self._vaos if k[0] == "rings"]:
+                self._vaos.pop(key).release()
+        if len(positions):
+            self._ring_vbo = self.ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
 
     def set_patterned(self, patterned: bool) -> None:
         """True (default): the fabric's pattern, holes and layers (OIT); False: the flat,
@@ -585,6 +597,12 @@ class FrameRenderer:
         self._set(program, "u_room_rgb", colours["u_room_rgb"])
         self._set(program, "u_fill_rgb", colours["u_fill_rgb"])
         self._room_vao(program).render(self._moderngl.TRIANGLES)
+        if self._ring_vbo is not None:
+            key = ("rings", id(program))
+            if key not in self._vaos:
+                self._vaos[key] = self.ctx.vertex_array(
+                    program, [(self._ring_vbo, "3f 3f", "in_position", "in_normal")])
+            self._vaos[key].render(self._moderngl.TRIANGLES)
 
     def _viewport_size(self, viewport) -> tuple[int, int]:
         if viewport is None:
@@ -771,6 +789,9 @@ class FrameRenderer:
         if self._pattern_texture is not None:
             self._pattern_texture.release()
             self._pattern_texture = None
+        if self._ring_vbo is not None:
+            self._ring_vbo.release()
+            self._ring_vbo = None
         if self._gbuffer is not None:
             for texture in self._gbuffer[0]:
                 texture.release()

@@ -107,6 +107,15 @@ def simulated_curtain(preset, frames: int):
             (params.width_m, params.height_m))
 
 
+def ring_xs_m(preset) -> list[float]:
+    """x of the curtain's rings on the scene's rod (m): the settled drape's ring columns."""
+    from catalog.cloth.drape import drape_params, rod_centre_x_m  # noqa: PLC0415
+    from catalog.cloth.state import ring_positions  # noqa: PLC0415
+
+    params = drape_params(preset)
+    return [float(x) - rod_centre_x_m(params) for x in ring_positions(params)[:, 0]]
+
+
 def validate(request: SnapshotRequest):
     """Everything that can be refused before a context exists: the preset, the light, the
     size, the output name. Returns (preset, light)."""
@@ -151,6 +160,7 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.set_exposure(request.exposure)
         *mesh, fabric_size = simulated_curtain(preset, request.frame)
         renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+        renderer.set_rings(ring_xs_m(preset))
         mesh_source = ("settled drape" if request.frame == 0
                        else f"cloth simulation from the settled drape, frame {request.frame}")
         start = time.perf_counter()
