@@ -37,7 +37,7 @@ PATTERNS: dict[str, dict] = {
     "net-grey": {"kind": "net", "cell_mm": 2.0, "cells_u": 8, "row_pairs_v": 5, "size": 256},
     "safety-yellow": {"kind": "net", "cell_mm": 1.5, "cells_u": 8, "row_pairs_v": 5, "size": 256},
     # woven sheers: pitch = thread spacing, the yarn width found from LD
-    "voile-white": {"kind": "plain", "pitch_mm": 0.8, "size": 64},
+    "voile-white": {"kind": "plain", "pitch_mm": 1.0, "size": 64},  # a coarse (etamine) voile
     "batiste-cream": {"kind": "plain", "pitch_mm": 0.3, "size": 64},
     "organza-ivory": {"kind": "plain", "pitch_mm": 0.25, "size": 64},
     "sheer-teal": {"kind": "plain", "pitch_mm": 0.5, "size": 64},
