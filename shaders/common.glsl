@@ -172,6 +172,17 @@ float oit_weight(float depth_m) {
     return exp2(-30.0 * clamp(depth_m, 0.0, 3.0));
 }
 
+// The resolve of weighted blended OIT: (mean layer colour x (1 - revealage), revealage) to be
+// blended ONE, SRC_ALPHA over what is behind. accum = (sum C a w, prod (1 - a)), weight = sum a w.
+vec4 oit_resolve(vec4 accum, float weight) {
+    return vec4(accum.rgb / max(weight, 1e-30) * (1.0 - accum.a), accum.a);
+}
+
+// Luma of a display-encoded colour (ITU-R BT.601 weights, as FXAA uses): edge detection only.
+float display_luma(vec3 encoded) {
+    return dot(encoded, vec3(0.299, 0.587, 0.114));
+}
+
 // Reinhard, Stark, Shirley, Ferwerda 2002, "Photographic tone reproduction", eq. 4 (extended,
 // on luminance, so hue is kept): L_d = L (1 + L / L_white^2) / (1 + L), applied after exposure.
 vec3 tone_map_reinhard_luminance(vec3 rgb, float white) {

@@ -6,6 +6,8 @@
 // from its neighbours' mean (sub-pixel aliasing: a thread or a silhouette that lands on a
 // pixel centre or misses it). Chosen over MSAA because the curtain is drawn into float OIT
 // targets, which llvmpipe multisamples slowly (docs/pattern.md has the measurement).
+#include "common.glsl"
+
 in vec2 v_ndc;
 in vec2 v_uv;
 
@@ -15,21 +17,17 @@ uniform vec2 u_texel;          // 1 / size of u_ldr in texels
 
 layout(location = 0) out vec4 out_colour;
 
-float luma(vec3 c) {
-    return dot(c, vec3(0.299, 0.587, 0.114));
-}
-
 const float CONTRAST_MIN = 0.0312;     // below this absolute contrast: no edge
 const float CONTRAST_REL = 0.125;      // ... or below this fraction of the local maximum
 
 void main() {
     vec2 uv = u_rect.xy + v_uv * u_rect.zw;
     vec3 m = texture(u_ldr, uv).rgb;
-    float lm = luma(m);
-    float ln = luma(texture(u_ldr, uv + vec2(0.0, u_texel.y)).rgb);
-    float ls = luma(texture(u_ldr, uv - vec2(0.0, u_texel.y)).rgb);
-    float le = luma(texture(u_ldr, uv + vec2(u_texel.x, 0.0)).rgb);
-    float lw = luma(texture(u_ldr, uv - vec2(u_texel.x, 0.0)).rgb);
+    float lm = display_luma(m);
+    float ln = display_luma(texture(u_ldr, uv + vec2(0.0, u_texel.y)).rgb);
+    float ls = display_luma(texture(u_ldr, uv - vec2(0.0, u_texel.y)).rgb);
+    float le = display_luma(texture(u_ldr, uv + vec2(u_texel.x, 0.0)).rgb);
+    float lw = display_luma(texture(u_ldr, uv - vec2(u_texel.x, 0.0)).rgb);
     float lo = min(lm, min(min(ln, ls), min(le, lw)));
     float hi = max(lm, max(max(ln, ls), max(le, lw)));
     float range = hi - lo;

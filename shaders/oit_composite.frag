@@ -4,6 +4,8 @@
 // background: result = average layer colour x (1 - revealage) + behind x revealage, where
 // revealage = prod(1 - c_i), the product of the layers' open fractions (model.md section 9:
 // layers multiply their transmittances; the holes show what is behind, undimmed).
+#include "common.glsl"
+
 in vec2 v_ndc;
 in vec2 v_uv;
 
@@ -19,7 +21,5 @@ void main() {
     if (revealage >= 1.0) {
         discard;   // no cloth here
     }
-    float weight = texelFetch(u_weight, p, 0).r;
-    vec3 average = accum.rgb / max(weight, 1e-30);
-    out_radiance = vec4(average * (1.0 - revealage), revealage);
+    out_radiance = oit_resolve(accum, texelFetch(u_weight, p, 0).r);
 }
