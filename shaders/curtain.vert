@@ -4,7 +4,7 @@
 // the G-buffer variant and the trivial floor shader. The view ray (position - camera) is
 // linear in the position, so it is formed here and interpolated exactly: the fragment shader
 // then needs no per-frame uniform. The tangent travels only where it is used. PATTERN: the
-// fabric's texture coordinates in pattern repeats (catalog/patterns.py) for curtain.frag.
+// fabric's texture coordinates in pattern repeats (catalog/presets/patterns.py) for curtain.frag.
 in vec3 in_position;
 in vec3 in_normal;
 in vec3 in_tangent;

@@ -10,7 +10,7 @@ from catalog.cloth.drape import (FULLNESS_DEFAULTS, ROD_SPAN_M, drape_params, fu
                                  hem_displacement_m, rod_centre_x_m, settled_simulation,
                                  settled_state)
 from catalog.cloth.state import ring_positions
-from catalog.errors import InputError
+from catalog.core.errors import InputError
 from catalog.presets import list_presets, load_preset
 from catalog.viewer.settings import DEFAULT_WIND_M_S
 

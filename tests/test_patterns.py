@@ -1,4 +1,4 @@
-"""Fabric patterns (catalog/patterns.py, tools/make_patterns.py): every preset's coverage
+"""Fabric patterns (catalog/presets/patterns.py, tools/make_patterns.py): every preset's coverage
 agrees with its fitted LD, the generator reproduces the committed images, and bad pattern
 images are refused naming the file and the problem."""
 
@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from catalog import FABRIC_DIR, PROJECT_ROOT
-from catalog.errors import InputError
-from catalog.patterns import OPEN_AREA_TOLERANCE, load_pattern, pattern_from_images
+from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
+from catalog.core.errors import InputError
+from catalog.presets.patterns import OPEN_AREA_TOLERANCE, load_pattern, pattern_from_images
 from catalog.presets import list_presets, load_preset, save_preset_dict
 
 

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from catalog import FABRIC_DIR
-from catalog.colorimetry import delta_e_2000, linear_srgb_to_xyz, srgb_decode
-from catalog.patterns import OPEN_AREA_TOLERANCE
+from catalog.core.resources import FABRIC_DIR
+from catalog.optics.colorimetry import delta_e_2000, linear_srgb_to_xyz, srgb_decode
+from catalog.presets.patterns import OPEN_AREA_TOLERANCE
 from catalog.presets import list_presets, load_preset
 from catalog.render.frame import FrameRenderer
 
@@ -316,7 +316,7 @@ def test_fxaa_brings_edges_closer_to_a_supersampled_frame(gl):
     4x4 the pixels and box-filtered down in linear light (the supersampled reference). On
     the pixels where aliasing shows (the unfiltered frame differs from the reference by more
     than 8 levels of 255), FXAA's mean error is at most 0.8 times the unfiltered one."""
-    from catalog.colorimetry import srgb_encode
+    from catalog.optics.colorimetry import srgb_encode
 
     def frame(size, mode):
         renderer = FrameRenderer(gl, size)

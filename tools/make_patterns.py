@@ -269,7 +269,7 @@ def pattern_table(name: str, repeat) -> dict:
 def regenerate(name: str, fabrics: Path = FABRICS, write: bool = True) -> dict:
     """Make one fabric's pattern; write the PNGs and the preset's [pattern] (``write``), or
     only return the quantised arrays and the table."""
-    from catalog.patterns import Pattern, quantise16, write_pattern_images
+    from catalog.presets.patterns import Pattern, quantise16, write_pattern_images
     from catalog.presets import load_preset, preset_to_dict, save_preset_dict
 
     preset_path = fabrics / f"{name}.toml"
@@ -304,7 +304,7 @@ def main(argv: list[str] | None = None) -> int:
         line = (f"{name:15s} {result['table']['kind']:7s} open {result['open_area']:.5f} "
                 f"LD {result['direct']:.5f}  repeat {result['table']['repeat_m']} m")
         if args.check:
-            from catalog.patterns import read_image
+            from catalog.presets.patterns import read_image
 
             on_disk = read_image(args.out_dir / result["table"]["coverage"])[..., 0]
             same = on_disk.shape == result["coverage"].shape and np.array_equal(

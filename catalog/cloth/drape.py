@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from catalog.cloth.params import DEFAULT_WEAVE, ClothParams
-from catalog.errors import InputError
+from catalog.core.errors import InputError
 
 #: Fabric width / rod span by weave: sheers are hung full, a heavy damask flatter.
 FULLNESS_DEFAULTS = {"lace": 2.0, "voile": 2.5, "plain": 2.0, "twill": 1.8, "satin": 1.6}

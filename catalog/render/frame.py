@@ -1,7 +1,7 @@
 """FrameRenderer: one frame of the curtain scene into an HDR target, tone-mapped to sRGB.
 
 The viewer and the snapshot command both drive this class (docs/render.md has the API).
-It never creates a GL context: it is handed one (:mod:`catalog.render.context`).
+It never creates a GL context: it is handed one (:mod:`catalog.gl.context`).
 
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
@@ -10,7 +10,7 @@ Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
    shades only the pixels nothing covers: the outside through the window (sky, ground, the
    sun's disc) or the room, per camera ray;
 3. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling, with the
-   fabric's pattern (catalog/patterns.py): the threads' radiance (the fitted lobes over the
+   fabric's pattern (catalog/presets/patterns.py): the threads' radiance (the fitted lobes over the
    mean coverage) and coverage c into weighted blended OIT targets (McGuire & Bavoil 2013),
    resolved over the room and background drawn in 1-2 (oit_composite.frag): the holes show
    what is really behind, undimmed, and overlapping folds multiply their open fractions;
@@ -27,11 +27,11 @@ import math
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 from catalog.render import bands as band_lib
 from catalog.render import scene as scene_lib
 from catalog.render.camera import OrbitCamera, gl_bytes
-from catalog.render.shaderlib import create_program, glsl_literal
+from catalog.gl.shaderlib import create_program, glsl_literal
 
 #: Auto exposure: a white diffuser under the key light maps to this (before the curve).
 EXPOSURE_KEY = 5.0
@@ -185,7 +185,7 @@ class FrameRenderer:
     def _set_pattern(self, preset) -> None:
         """The preset's pattern as a mipmapped RGBA32F texture (thread normal, coverage);
         without a [pattern] a uniform coverage 1 - LD (one texel)."""
-        from catalog.patterns import load_pattern  # noqa: PLC0415
+        from catalog.presets.patterns import load_pattern  # noqa: PLC0415
 
         table = preset.table("pattern")
         key = (str(preset.path), repr(sorted(table.items())), preset.btdf.direct)
@@ -229,7 +229,7 @@ class FrameRenderer:
 
     @property
     def pattern(self):
-        """The current fabric's :class:`catalog.patterns.Pattern` (None: uniform coverage)."""
+        """The current fabric's :class:`catalog.presets.patterns.Pattern` (None: uniform coverage)."""
         return self._pattern
 
     def pattern_mip_level(self, level: int) -> np.ndarray:
@@ -241,12 +241,12 @@ class FrameRenderer:
         return np.frombuffer(data, dtype=np.float32).reshape(h, w, 4).copy()
 
     def set_light(self, light) -> None:
-        """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.lights.Light.
+        """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.optics.lights.Light.
 
         The sun stands behind the window at the elevation its path length implies; a lamp at
         scene.LAMP_ELEVATION_DEG. :meth:`set_sun_hour` and :meth:`set_key_direction` move it.
         """
-        from catalog.lights import get_light  # noqa: PLC0415
+        from catalog.optics.lights import get_light  # noqa: PLC0415
 
         if isinstance(light, str):
             light = get_light(light)
@@ -260,7 +260,7 @@ class FrameRenderer:
 
     def set_sun_hour(self, hour: float) -> dict:
         """The sun at ``hour`` (local solar time, summer solstice, 34.7 N) behind the window."""
-        from catalog.lights import get_light  # noqa: PLC0415
+        from catalog.optics.lights import get_light  # noqa: PLC0415
 
         sun = scene_lib.sun_at_hour(hour)
         self.light = get_light(sun.light_name)
@@ -400,7 +400,7 @@ class FrameRenderer:
         return bool(self.camera.position[2] > scene_lib.WINDOW_Z)
 
     def shading_inputs(self):
-        """The scene's :class:`catalog.reference.ShadingInputs` (rebuilt only on change)."""
+        """The scene's :class:`catalog.optics.shading_reference.ShadingInputs` (rebuilt only on change)."""
         self._require_ready()
         key = (id(self.preset), self.light.name, id(self.light), tuple(self._key_to_light),
                self.mode, self.viewer_inside, self._is_sun)
@@ -543,7 +543,7 @@ class FrameRenderer:
     def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer (the benchmark times this).
 
-        ``trivial``: True draws the same mesh with shaders/trivial.frag (the benchmark's floor);
+        ``trivial``: True draws the same mesh with catalog/bench/shaders/trivial.frag (the benchmark's floor);
         a file name draws it with that fragment shader instead (the benchmark's other floors)."""
         if trivial:
             fragment = trivial if isinstance(trivial, str) else "trivial.frag"
