@@ -183,17 +183,6 @@ float display_luma(vec3 encoded) {
     return dot(encoded, vec3(0.299, 0.587, 0.114));
 }
 
-// Reinhard, Stark, Shirley, Ferwerda 2002, "Photographic tone reproduction", eq. 4 (extended,
-// on luminance, so hue is kept): L_d = L (1 + L / L_white^2) / (1 + L), applied after exposure.
-vec3 tone_map_reinhard_luminance(vec3 rgb, float white) {
-    float lum = dot(rgb, vec3(0.2126, 0.7152, 0.0722));
-    if (lum <= 0.0) {
-        return vec3(0.0);
-    }
-    float mapped = lum * (1.0 + lum / (white * white)) / (1.0 + lum);
-    return rgb * (mapped / lum);
-}
-
 // IEC 61966-2-1:1999 sRGB transfer function (the piecewise curve, not a 2.2 power).
 vec3 srgb_encode(vec3 linear) {
     vec3 c = clamp(linear, 0.0, 1.0);
