@@ -286,16 +286,25 @@ def dolly_change(renderer, mask_frames, filtered: bool, frames: int = 40) -> flo
 
 
 def test_a_slow_dolly_does_not_shimmer(gl):
-    """Static lace, 40 frames from 3 m to 0.2 m (7 % closer each frame), 128x96. The change
+    """Static lace, 40 frames from 3 m to 0.2 m (7 % closer each frame), 128x96, one fixed
+    exposure. The change
     between frames has a part every image of a zoom has (edges and motifs move by their
     gradient) and a part from aliasing (sub-pixel threads landing on or between pixel
     centres), which only the filtering removes. Bound: with mipmaps and filtered normals the
     mean frame-to-frame change is at most 0.6 times the unfiltered one (the aliasing part
     is most of the unfiltered change while the net's 1 mm cells are below a pixel, i.e.
-    beyond 0.4 m at this size), and below 6 levels of 255."""
+    beyond 0.4 m at this size), and below 8 levels of 255 (first stated as 6 under the
+    Reinhard tone map, where it measured 5.5; issue 14's display curve is steeper in the
+    mid-tones and the same dolly reads 6.2: the bound follows the display, the ratio is the
+    test)."""
     renderer = FrameRenderer(gl, (128, 96))
     renderer.set_fabric("lace-fwa")
     renderer.set_light("D65")
+    # one exposure for the whole dolly (the one metered at 3 m): the auto exposure's own
+    # changes between frames are the display's, not shimmer
+    renderer.set_camera(0.0, 0.0, 3.0)
+    renderer.render()
+    renderer.set_ev(renderer.current_ev100())
     masks = []
     for distance in np.geomspace(3.0, 0.2, 40):
         renderer.set_camera(0.0, 0.0, float(distance))
@@ -305,7 +314,7 @@ def test_a_slow_dolly_does_not_shimmer(gl):
     print(f"dolly: mean frame-to-frame change {filtered:.2f} levels filtered, "
           f"{unfiltered:.2f} unfiltered")
     assert filtered <= 0.6 * unfiltered
-    assert filtered < 6.0
+    assert filtered < 8.0
     renderer.release()
 
 
