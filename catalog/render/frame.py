@@ -40,8 +40,16 @@ from catalog.gl.shaderlib import create_program, glsl_literal
 #: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
 METER_MAX_SIDE_PX = 96
 FLUORESCENCE_MODES = ("off", "paper", "physical")
-#: Anti-aliasing of the display image: a post-process (shaders/fxaa.frag) or none.
-ANTIALIASING_MODES = ("fxaa", "off")
+#: Anti-aliasing: a post-process on the display image (shaders/fxaa.frag), multisampling of
+#: the HDR passes (the OIT targets too, resolved before the composite), none, or ``auto``
+#: (:func:`choose_antialiasing`: by the context's GL_MAX_SAMPLES and the cost rule).
+ANTIALIASING_MODES = ("auto", "fxaa", "msaa", "off")
+#: Samples per pixel of the MSAA path.
+MSAA_SAMPLES = 4
+#: Renderer strings of CPU rasterisers: there MSAA multiplies the HDR passes' cost (each
+#: sample shaded and blended in float: 3.5x the flat frame's HDR passes on llvmpipe, where
+#: FXAA costs a fifth of the frame; benchmarks/bench_pattern.json), so ``auto`` takes FXAA.
+SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "swrast", "lavapipe", "swiftshader")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
 #: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
@@ -57,6 +65,18 @@ def shared_division_safe(g_diff: float, g_spec: float) -> bool:
     ((1 - |g_diff|)(1 - |g_spec|))^3, must stay a normal float32 (> 1.2e-38) in the worst case."""
     margin = (1.0 - abs(g_diff)) * (1.0 - abs(g_spec))
     return margin ** 6 > 1e-30
+
+
+def choose_antialiasing(info: dict) -> str:
+    """``auto``'s choice for a context (``ctx.info`` plus ``GL_RENDERER``): ``msaa`` where
+    the context multisamples float targets with at least MSAA_SAMPLES samples
+    (GL_MAX_SAMPLES) on a GPU, where multisampling is paid in bandwidth, not shading;
+    ``fxaa`` on CPU rasterisers (the measured cost rule) and where samples are lacking."""
+    renderer = str(info.get("GL_RENDERER", "")).lower()
+    samples = int(info.get("GL_MAX_SAMPLES", 0) or 0)
+    if samples < MSAA_SAMPLES or any(name in renderer for name in SOFTWARE_RASTERISERS):
+        return "fxaa"
+    return "msaa"
 
 
 def check_size(size, ctx=None) -> tuple[int, int]:
@@ -114,6 +134,8 @@ class FrameRenderer:
         self._pre.repeat_x = self._pre.repeat_y = False
         self._pre_fbo = ctx.framebuffer([self._pre])
         self.antialiasing = "fxaa"
+        self._msaa = None                # the multisampled targets, made on first use
+        self.set_antialiasing("auto")
         self._gbuffer = None
         # weighted blended OIT: sum C a w | prod (1 - a), and sum a w; the scene's depth
         self._oit_accum = ctx.texture((w, h), 4, dtype="f4")
@@ -669,9 +691,11 @@ class FrameRenderer:
         inputs = self.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
-        self._hdr_fbo.use()
+        msaa = self._msaa_targets() if self.antialiasing == "msaa" else None
+        hdr_fbo = msaa["hdr_fbo"] if msaa else self._hdr_fbo
+        hdr_fbo.use()
         self.ctx.viewport = (0, 0, vw, vh)
-        self._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
+        hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
         self.ctx.disable(mgl.BLEND)
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<="
@@ -681,7 +705,9 @@ class FrameRenderer:
         # on the far plane: the depth test leaves only the pixels nothing covers
         self._draw_background(view_proj, inputs)
         if self.patterned:
-            self._draw_curtain_oit(view_proj, vw, vh)
+            self._draw_curtain_oit(view_proj, vw, vh, msaa)
+        elif msaa:
+            self.ctx.copy_framebuffer(self._hdr_fbo, msaa["hdr_fbo"])   # resolve
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
@@ -691,12 +717,42 @@ class FrameRenderer:
         the curtain can be (the camera's distance to its target less a metre)."""
         return max(0.0, self.camera.distance_m - 1.0)
 
-    def _draw_curtain_oit(self, view_proj, vw: int, vh: int) -> None:
+    def _msaa_targets(self) -> dict:
+        """The MSAA path's targets (MSAA_SAMPLES float renderbuffers: HDR, depth, the two OIT
+        targets) and single-target framebuffers to resolve them from, made once."""
+        if self._msaa is None:
+            ctx, size, n = self.ctx, self.size, MSAA_SAMPLES
+            hdr = ctx.renderbuffer(size, 4, samples=n, dtype="f4")
+            depth = ctx.depth_renderbuffer(size, samples=n)
+            accum = ctx.renderbuffer(size, 4, samples=n, dtype="f4")
+            weight = ctx.renderbuffer(size, 1, samples=n, dtype="f4")
+            oit_fbo = ctx.framebuffer([accum, weight], depth)
+            oit_fbo.depth_mask = False
+            self._msaa = {
+                "objects": [hdr, depth, accum, weight],
+                "hdr_fbo": ctx.framebuffer([hdr], depth), "oit_fbo": oit_fbo,
+                "accum_src": ctx.framebuffer([accum]), "weight_src": ctx.framebuffer([weight]),
+                "accum_dst": ctx.framebuffer([self._oit_accum]),
+                "weight_dst": ctx.framebuffer([self._oit_weight]),
+            }
+        return self._msaa
+
+    def _release_msaa(self) -> None:
+        if self._msaa is not None:
+            for name in ("hdr_fbo", "oit_fbo", "accum_src", "weight_src", "accum_dst", "weight_dst"):
+                self._msaa[name].release()
+            for obj in self._msaa["objects"]:
+                obj.release()
+            self._msaa = None
+
+    def _draw_curtain_oit(self, view_proj, vw: int, vh: int, msaa: dict | None = None) -> None:
         """The curtain's layers into the OIT targets (depth-tested against the room, not
-        written), then resolved over the HDR target."""
+        written), then resolved over the HDR target. ``msaa``: into the multisampled targets,
+        each resolved (averaged over the samples) before the composite: at an edge pixel the
+        composite takes the samples' mean layer colour, revealage and background."""
         mgl = self._moderngl
         ctx = self.ctx
-        self._oit_fbo.use()
+        (msaa["oit_fbo"] if msaa else self._oit_fbo).use()
         ctx.viewport = (0, 0, vw, vh)
         ctx.clear(0.0, 0.0, 0.0, 1.0, viewport=(0, 0, vw, vh))   # accum: revealage 1
         # clear() wrote (0, 0, 0, 1) into both targets: the weight target's alpha is unused
@@ -704,6 +760,13 @@ class FrameRenderer:
         ctx.blend_equation = mgl.FUNC_ADD
         ctx.blend_func = (mgl.ONE, mgl.ONE, mgl.ZERO, mgl.ONE_MINUS_SRC_ALPHA)
         self.draw_curtain(view_proj)
+        if msaa:
+            ctx.disable(mgl.BLEND)
+            for src, dst in (("hdr_fbo", None), ("accum_src", "accum_dst"),
+                             ("weight_src", "weight_dst")):
+                ctx.copy_framebuffer(self._hdr_fbo if dst is None else msaa[dst], msaa[src])
+            ctx.enable(mgl.BLEND)
+            ctx.blend_equation = mgl.FUNC_ADD
         # resolve: average colour x (1 - revealage) + behind x revealage
         self._hdr_fbo.use()
         ctx.viewport = (0, 0, vw, vh)
@@ -719,10 +782,22 @@ class FrameRenderer:
         ctx.blend_func = mgl.DEFAULT_BLENDING
 
     def set_antialiasing(self, mode: str) -> None:
-        """``fxaa`` (default): the post-process on the display image (shaders/fxaa.frag);
-        ``off``: the tone-mapped image as it is."""
+        """``auto`` (default): :func:`choose_antialiasing` for this context (FXAA on llvmpipe);
+        ``fxaa``: the post-process on the display image (shaders/fxaa.frag); ``msaa``:
+        MSAA_SAMPLES samples per pixel in the HDR passes (refused where the context has
+        fewer); ``off``: the tone-mapped image as it is. :attr:`antialiasing` holds the
+        mode in use (never ``auto``)."""
         if mode not in ANTIALIASING_MODES:
             raise CatalogError(f"anti-aliasing {mode!r}: choose one of {', '.join(ANTIALIASING_MODES)}")
+        info = dict(self.ctx.info)
+        info.setdefault("GL_RENDERER", self.ctx.info.get("GL_RENDERER", ""))
+        if mode == "auto":
+            mode = choose_antialiasing(info)
+        if mode == "msaa" and int(info.get("GL_MAX_SAMPLES", 0) or 0) < MSAA_SAMPLES:
+            raise CatalogError(f"anti-aliasing msaa: this context has fewer than "
+                               f"{MSAA_SAMPLES} samples (GL_MAX_SAMPLES); use fxaa")
+        if mode != "msaa":
+            self._release_msaa()
         self.antialiasing = mode
 
     def render(self, fbo=None, viewport=None, dt_s: float | None = None) -> None:
@@ -843,8 +918,11 @@ class FrameRenderer:
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
         ours = [self._hdr_fbo, self._ldr_fbo, self._oit_fbo, self._pre_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
+        if self._msaa is not None:
+            ours += [self._msaa["hdr_fbo"], self._msaa["oit_fbo"]]
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
+        self._release_msaa()
         self._release_vaos()
         self._release_own_buffers()
         for obj in (self._hdr_fbo, self._hdr, self._depth, self._ldr_fbo, self._ldr, self._room_vbo,
