@@ -14,7 +14,10 @@ before each clock read):
 - ``MSAA 4x (flat)`` against ``1x (flat)``: the HDR passes of the flat frame into a 4-sample
   float target and resolved, against one sample: what multisampling costs llvmpipe before
   any OIT target is multisampled;
-- ``FXAA pass``: the post-process alone (frame with FXAA minus frame without).
+- ``FXAA pass``: the post-process alone (frame with FXAA minus frame without);
+- ``... with the first FXAA``: the settled frame with issue 12's first FXAA shader (six
+  bilinear reads, catalog/bench/shaders/fxaa_filtered.frag) instead of today's (five texel
+  fetches, the blend in the shader): what that rewrite saved, in the same run.
 
 :func:`markdown_tables` renders the JSON as the tables of docs/pattern.md and BENCHMARKS.md.
 """
@@ -47,7 +50,7 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     from catalog.render.snapshot import simulated_curtain  # noqa: PLC0415
 
     ctx = ctx or create_headless_context()
-    repeats = repeats or (3 if quick else 7)
+    repeats = repeats or (3 if quick else 11)
     if quick:
         size = (320, 180)
     preset = load_preset(find_preset(FABRIC))
@@ -59,7 +62,8 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
 
     def configure(patterned, aa, mesh):
         renderer.set_patterned(patterned)
-        renderer.set_antialiasing(aa)
+        renderer.fxaa_shader = "fxaa_filtered.frag" if aa == "fxaa-filtered" else "fxaa.frag"
+        renderer.set_antialiasing("fxaa" if aa == "fxaa-filtered" else aa)
         if mesh == "static":
             renderer.set_mesh(static.positions, static.normals, static.uvs, static.tangents,
                               static.indices)
@@ -71,6 +75,7 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
         "patterned + OIT, no AA (static drape)": (True, "off", "static"),
         "patterned + OIT + FXAA (static drape)": (True, "fxaa", "static"),
         "patterned + OIT + FXAA (settled drape)": (True, "fxaa", "settled"),
+        "... with the first FXAA (6 filtered reads)": (True, "fxaa-filtered", "settled"),
     }
     msaa_case = "patterned + OIT + MSAA 4x (settled drape)"
     if int(ctx.info.get("GL_MAX_SAMPLES", 0) or 0) >= MSAA_SAMPLES:
@@ -115,14 +120,19 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     renderer.release()
     del moderngl
 
-    def row(name, times, base):
+    def row(name, times, base, base_times=None):
         median = statistics.median(times)
-        return {"case": name, "median_ms": round(1e3 * median, 2),
-                "best_ms": round(1e3 * min(times), 2),
-                "ratio_to_before": round(median / base, 3)}
+        out = {"case": name, "median_ms": round(1e3 * median, 2),
+               "best_ms": round(1e3 * min(times), 2),
+               "ratio_to_before": round(median / base, 3)}
+        if base_times is not None:   # each round's own ratio (same load), their median
+            out["round_ratio"] = round(statistics.median(
+                t / b for t, b in zip(times, base_times)), 3)
+        return out
 
     base = statistics.median(samples["before (flat, no AA, static drape)"])
-    rows = [row(name, times, base) for name, times in samples.items()]
+    before_times = samples["before (flat, no AA, static drape)"]
+    rows = [row(name, times, base, before_times) for name, times in samples.items()]
     by_case = {r["case"]: r for r in rows}
     fxaa_row = by_case["patterned + OIT + FXAA (settled drape)"]
     msaa_base = statistics.median(msaa_samples["1x (flat HDR passes)"])
@@ -133,6 +143,7 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     return {"size": list(size), "repeats": repeats, "fabric": FABRIC, "light": LIGHT,
             "gl": describe(ctx), "rows": rows, "msaa_rows": msaa_rows,
             "summary": {"frame_ratio": fxaa_row["ratio_to_before"],
+                        "frame_round_ratio": fxaa_row["round_ratio"],
                         "frame_ratio_best": round(fxaa_row["best_ms"] / by_case[
                             "before (flat, no AA, static drape)"]["best_ms"], 3),
                         "msaa_frame_ratio": msaa_row["ratio_to_before"] if msaa_row else None,
@@ -145,12 +156,14 @@ def markdown_tables(result: dict) -> dict[str, str]:
     """``pattern_cost`` and ``pattern_msaa``: NAME -> markdown table."""
     w, h = result["size"]
     lines = [f"| frame at {w}x{h} ({result['fabric']}, {result['light']}) | median ms | best ms "
-             f"| / before |", "|---|---|---|---|"]
+             f"| / before (medians) | / before (median of rounds) |", "|---|---|---|---|---|"]
     lines += [f"| {r['case']} | {r['median_ms']:.1f} | {r['best_ms']:.1f} | "
-              f"{r['ratio_to_before']:.2f} |" for r in result["rows"]]
+              f"{r['ratio_to_before']:.2f} | {r.get('round_ratio', float('nan')):.2f} |"
+              for r in result["rows"]]
     summary = result["summary"]
     lines.append("")
-    lines.append(f"Whole frame / before: {summary['frame_ratio']:.2f} (medians), "
+    lines.append(f"Whole frame / before: {summary.get('frame_round_ratio', float('nan')):.2f} "
+                 f"(median of the rounds' ratios), {summary['frame_ratio']:.2f} (medians), "
                  f"{summary.get('frame_ratio_best', float('nan')):.2f} (best rounds); "
                  f"`auto` anti-aliasing takes **{summary.get('choice', 'fxaa')}** on this context.")
     msaa = ["| HDR passes of the flat frame | median ms | / 1x |", "|---|---|---|"]

@@ -128,12 +128,14 @@ class FrameRenderer:
         self._hdr_fbo = ctx.framebuffer([self._hdr], self._depth)
         self._ldr = ctx.texture((w, h), 4)
         self._ldr_fbo = ctx.framebuffer([self._ldr])
-        # the tone-mapped image before FXAA (read texel by texel by fxaa.frag)
+        # the tone-mapped image before FXAA (fxaa.frag reads texels; LINEAR for the
+        # benchmark's earlier FXAA of filtered reads, FXAA_SHADER)
         self._pre = ctx.texture((w, h), 4)
-        self._pre.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self._pre.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self._pre.repeat_x = self._pre.repeat_y = False
         self._pre_fbo = ctx.framebuffer([self._pre])
         self.antialiasing = "fxaa"
+        self.fxaa_shader = "fxaa.frag"   # the benchmark swaps in its earlier version
         self._msaa = None                # the multisampled targets, made on first use
         self.set_antialiasing("auto")
         self._gbuffer = None
@@ -834,10 +836,12 @@ class FrameRenderer:
         if fxaa:
             target.use()
             self.ctx.viewport = target_viewport
-            program = self._program("fullscreen.vert", "fxaa.frag")
+            program = self._program("fullscreen.vert", self.fxaa_shader)
             self._pre.use(location=0)
             self._set(program, "u_ldr", 0)
             self._set(program, "u_size_px", (float(vw), float(vh)))
+            self._set(program, "u_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
+            self._set(program, "u_texel", (1.0 / self.size[0], 1.0 / self.size[1]))
             self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
         self._last = (vw, vh, fbo, viewport)
 
