@@ -397,3 +397,35 @@ def test_msaa_keeps_the_curtain_interior_and_the_layers(gl):
           f"difference {rel.mean():.4f}")
     assert rel.mean() < 0.02
     renderer.release()
+
+
+def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl):
+    """The settled lace at 320x180, MSAA against one sample: a resolved pixel averages samples
+    that each see what the one-sample frame sees within a pixel, so its luma stays below the
+    one-sample frame's 3x3 neighbourhood maximum + 10 levels of 255 (margin for sub-pixel
+    detail and the tone curve). Attributes extrapolated past a fold's silhouette (a pixel
+    centre outside the triangle, without ``centroid``) broke this: 18 pixels, up to +29."""
+    if int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
+        pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
+    from catalog.render.snapshot import simulated_curtain
+
+    preset = load_preset(FABRIC_DIR / "lace-fwa.toml")
+    *settled, fabric_size = simulated_curtain(preset, 0)
+    luma = {}
+    for mode in ("off", "msaa"):
+        renderer = FrameRenderer(gl, (320, 180))
+        renderer.set_fabric(preset)
+        renderer.set_light("D65")
+        renderer.set_mesh(*settled, fabric_size_m=fabric_size)
+        renderer.set_ev(11.5)
+        renderer.set_antialiasing(mode)
+        renderer.render()
+        luma[mode] = renderer.read_srgb8().astype(np.float64) @ [0.2126, 0.7152, 0.0722]
+        renderer.release()
+    pad = np.pad(luma["off"], 1, mode="edge")
+    h, w = luma["off"].shape
+    ceiling = np.max([pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w]
+                      for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+    excess = luma["msaa"] - ceiling
+    print(f"MSAA above the one-sample 3x3 maximum: at most {excess.max():.1f} levels")
+    assert excess.max() < 10.0

@@ -468,6 +468,8 @@ class FrameRenderer:
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
                    "GBUFFER": gbuffer, "SPECIALISED": self.specialise,
                    "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
+        if self.antialiasing == "msaa" and not gbuffer:
+            defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
             # the holes are drawn by the OIT composite: no see-through term in the shader
             defines.update({"PATTERN": True, "OIT": True, "SEE_THROUGH": False})
