@@ -22,6 +22,7 @@ import numpy as np
 
 from catalog.errors import CatalogError
 from catalog.render import bands as band_lib
+from catalog.render import room_light
 from catalog.render import scene as scene_lib
 from catalog.render.camera import OrbitCamera, gl_bytes
 from catalog.render.shaderlib import create_program, glsl_literal
@@ -100,6 +101,11 @@ class FrameRenderer:
         self._uniforms = None
         self._uniforms_key = None
         self._last = None  # (vw, vh, fbo, viewport)
+        #: issue 13: the room lit through the curtain (False: the earlier constant room)
+        self.room_lighting = True
+        self.curtain_open = False
+        self.room_lamps: list[tuple] = []   # (catalog.lights.Light, (x, y, z) m)
+        self._room_gl = None
 
         positions, normals = scene_lib.room_props()
         self._room_vbo = ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
@@ -156,6 +162,27 @@ class FrameRenderer:
         if mode not in FLUORESCENCE_MODES:
             raise CatalogError(f"fluorescence mode {mode!r}: choose one of {', '.join(FLUORESCENCE_MODES)}")
         self.mode = mode
+
+    def set_room_lighting(self, on: bool) -> None:
+        """Light the room through the curtain (shadow map, area light, bounce: issue 13) or
+        keep the earlier constant room (a fraction of the key light plus the fill light)."""
+        self.room_lighting = bool(on)
+
+    def set_curtain_open(self, open_: bool) -> None:
+        """Open: the curtain is drawn aside (not drawn, casts nothing, lights nothing)."""
+        self.curtain_open = bool(open_)
+
+    def set_room_lamps(self, lamps) -> None:
+        """Lamps placed in the room: (light name or Light, (x, y, z) m) pairs, at most
+        room_light.MAX_ROOM_LAMPS; each an isotropic point whose normal irradiance at 1 m is
+        the light's spectrum. They light the room (not the curtain's shading)."""
+        from catalog.lights import get_light  # noqa: PLC0415
+
+        lamps = list(lamps)
+        if len(lamps) > room_light.MAX_ROOM_LAMPS:
+            raise CatalogError(f"at most {room_light.MAX_ROOM_LAMPS} room lamps, got {len(lamps)}")
+        self.room_lamps = [(get_light(light) if isinstance(light, str) else light,
+                            room_light.check_lamp_position(position)) for light, position in lamps]
 
     def set_bands(self, n_bands: int) -> None:
         self.n_bands = band_lib.check_band_count(n_bands)
@@ -320,12 +347,25 @@ class FrameRenderer:
             values[name] = tuple(float(v) for v in value) if isinstance(value, tuple) else value
         return values
 
-    def _curtain_program(self, gbuffer: bool):
+    def _curtain_program(self, gbuffer: bool, overrides: dict | None = None):
         defines = self.variant_defines(gbuffer)
         if self.specialise:
-            for name, value in self.scene_values().items():
+            for name, value in self._scene_values_with(overrides).items():
                 defines["S_" + name[2:].upper()] = glsl_literal(value)
         return self._program("curtain.vert", "curtain.frag", defines)
+
+    def _scene_values_with(self, overrides: dict | None) -> dict:
+        values = self.scene_values()
+        if overrides:
+            values = {**values, **overrides}
+        return values
+
+    def _no_disc_overrides(self) -> dict:
+        """The curtain's values without the sun's disc seen through it (the luminaire capture:
+        the key light's beam reaches the room through the shadow map instead)."""
+        disc = self.scene_values()["u_sun_disc"]
+        return {"u_sun_disc": np.zeros_like(disc) if isinstance(disc, np.ndarray)
+                else tuple(0.0 for _ in disc)}
 
     def _program(self, vertex: str, fragment: str, defines: dict | None = None):
         key = (vertex, fragment, tuple(sorted((defines or {}).items())))
@@ -400,33 +440,37 @@ class FrameRenderer:
         return self.exposure * EXPOSURE_KEY * math.pi / illuminance
 
     # ------------------------------------------------------------------ passes
-    def _scene_uniforms(self, program, view_proj, inputs) -> None:
+    def _scene_uniforms(self, program, view_proj, inputs, camera_position=None) -> None:
         s = self._set
         s(program, "u_view_proj", gl_bytes(view_proj))
-        s(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
+        eye = self.camera.position if camera_position is None else camera_position
+        s(program, "u_camera_position", tuple(float(v) for v in eye))
         s(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_fill_to_light", tuple(float(v) for v in inputs.fill_to_light))
         s(program, "u_sun_direction", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_sun_chord2", tuple(float(v) for v in inputs.sun_chord2))
 
-    def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False) -> None:
+    def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False,
+                     camera_position=None, overrides: dict | None = None) -> None:
         """The curtain pass alone into the bound framebuffer (the benchmark times this).
 
         ``trivial``: True draws the same mesh with shaders/trivial.frag (the benchmark's floor);
         a file name draws it with that fragment shader instead (the benchmark's other floors)."""
+        eye = tuple(float(v) for v in (self.camera.position if camera_position is None
+                                       else camera_position))
         if trivial:
             fragment = trivial if isinstance(trivial, str) else "trivial.frag"
             program = self._program("curtain.vert", fragment)
             self._set(program, "u_view_proj", gl_bytes(view_proj))
             self._set(program, "u_mesh_offset", self._mesh_offset)
-            self._set(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
+            self._set(program, "u_camera_position", eye)
         else:
-            program = self._curtain_program(gbuffer)
+            program = self._curtain_program(gbuffer, overrides)
             self._set(program, "u_view_proj", gl_bytes(view_proj))
-            self._set(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
+            self._set(program, "u_camera_position", eye)
             self._set(program, "u_mesh_offset", self._mesh_offset)
             if not self.specialise:
-                for name, value in self.scene_values().items():
+                for name, value in self._scene_values_with(overrides).items():
                     self._set(program, name, value)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program).render(self._moderngl.TRIANGLES)
@@ -437,28 +481,220 @@ class FrameRenderer:
             spectra = {"u_sky_rgb": inputs.sky_radiance, "u_ground_rgb": inputs.ground_radiance,
                        "u_sun_disc_rgb": inputs.sun_disc_radiance,
                        "u_room_rgb": inputs.room_radiance,
-                       "u_fill_rgb": scene_lib.ROOM_ALBEDO * inputs.fill_irradiance / math.pi}
+                       "u_fill_rgb": scene_lib.ROOM_ALBEDO * inputs.fill_irradiance / math.pi,
+                       "u_key_rgb": inputs.key_irradiance,
+                       "key_dyed_rgb": inputs.key_irradiance * inputs.dye_transmittance}
             self._display = {name: tuple(float(v) for v in band_lib.spectrum_to_display_rgb(s))
                              for name, s in spectra.items()}
             self._display_key = self._inputs_key
         return self._display
 
-    def _draw_background(self, view_proj, inputs) -> None:
+    def _draw_background(self, view_proj, inputs, camera_position=None, sun_disc=True) -> None:
         program = self._program("fullscreen.vert", "background.frag")
-        self._scene_uniforms(program, view_proj, inputs)
+        self._scene_uniforms(program, view_proj, inputs, camera_position)
         self._set(program, "u_inverse_view_proj", gl_bytes(np.linalg.inv(view_proj)))
         colours = self._display_colours(inputs)
         for name in ("u_sky_rgb", "u_ground_rgb", "u_sun_disc_rgb", "u_room_rgb"):
             self._set(program, name, colours[name])
+        if not sun_disc:
+            self._set(program, "u_sun_disc_rgb", (0.0, 0.0, 0.0))
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
 
     def _draw_room(self, view_proj, inputs) -> None:
-        program = self._program("room.vert", "room.frag")
+        lit = self.room_lighting
+        program = self._program("room.vert", "room.frag", {"ROOM_LIGHTING": lit})
         self._scene_uniforms(program, view_proj, inputs)
         colours = self._display_colours(inputs)
         self._set(program, "u_room_rgb", colours["u_room_rgb"])
         self._set(program, "u_fill_rgb", colours["u_fill_rgb"])
+        if lit:
+            gl = self._room_gl
+            self._room_common_uniforms(program, inputs)
+            self._set(program, "u_face_texels", float(room_light.FACE_TEXELS))
+            gl["lightmap"].use(location=1)
+            self._set(program, "u_lightmap", 1)
+            gl["shadow"].use(location=2)
+            self._set(program, "u_shadow", 2)
+            self._set(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light))
+            self._set(program, "u_curtain_z", scene_lib.CURTAIN_Z)
         self._room_vao(program).render(self._moderngl.TRIANGLES)
+
+    # ------------------------------------------------------------------ the room's light (issue 13)
+    def _room_resources(self) -> dict:
+        """The room lighting's GL objects, made on first use (docs/room.md)."""
+        if self._room_gl is None:
+            mgl, ctx = self._moderngl, self.ctx
+            n = room_light.SHADOW_TEXELS
+            shadow = ctx.texture((n, n), 4, dtype="f2")
+            shadow.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+            shadow.repeat_x = shadow.repeat_y = False
+            lw, lh = room_light.LUMINAIRE_TEXELS
+            luminaire = ctx.texture((lw, lh), 4, dtype="f4")
+            luminaire.filter = (mgl.NEAREST, mgl.NEAREST)
+            luminaire_depth = ctx.depth_renderbuffer((lw, lh))
+            aw, ah = room_light.atlas_size()
+            direct = ctx.texture((aw, ah), 4, dtype="f4")
+            direct.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            lightmap = ctx.texture((aw, ah), 4, dtype="f4")
+            lightmap.filter = (mgl.LINEAR, mgl.LINEAR)
+            lightmap.repeat_x = lightmap.repeat_y = False
+            ao = ctx.texture((aw, ah), 4, data=room_light.ao_and_mask_texture().tobytes(), dtype="f4")
+            ao.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            ao.build_mipmaps()
+            self._room_gl = {
+                "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
+                "luminaire": luminaire, "luminaire_depth": luminaire_depth,
+                "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
+                "direct": direct, "direct_fbo": ctx.framebuffer([direct]),
+                "lightmap": lightmap, "lightmap_fbo": ctx.framebuffer([lightmap]), "ao": ao,
+            }
+        return self._room_gl
+
+    def _room_colours(self, inputs) -> dict:
+        """Linear sRGB of the key light (irradiance) and of the beam a thread passes: the
+        directional lobe's forward-scattered part, a_spec forward(g_spec), in the dye's colour
+        under the key light, per unit of thread coverage (mean coverage 1 - LD)."""
+        from catalog.reference import hg_hemisphere_factors  # noqa: PLC0415
+
+        colours = self._display_colours(inputs)
+        key = np.asarray(colours["u_key_rgb"])
+        dyed = np.asarray(colours["key_dyed_rgb"])
+        dye_rgb = np.where(key > 1e-6 * max(float(key.max()), 1e-30), dyed / np.where(key > 0, key, 1.0), 1.0)
+        coverage = max(1.0 - float(inputs.direct), 1e-6)
+        forward = hg_hemisphere_factors(float(inputs.g_spec))[0]
+        thread = np.clip(float(inputs.a_spec) * forward * dye_rgb / coverage, 0.0, 1.0)
+        return {"u_key_rgb": tuple(float(v) for v in key), "u_mean_coverage": 1.0 - float(inputs.direct),
+                "u_thread_beam_rgb": tuple(float(v) for v in thread)}
+
+    def _room_common_uniforms(self, program, inputs) -> None:
+        s = self._set
+        for name, value in room_light.face_uniforms().items():
+            s(program, name, value)
+        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+        z0 = scene_lib.ROOM_BOX[2][0]
+        s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
+        s(program, "u_wall_z", (z0, z0 - 0.1))
+        s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+        s(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
+        s(program, "u_key_rgb", self._room_colours(inputs)["u_key_rgb"])
+        s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
+        s(program, "u_albedo", scene_lib.ROOM_ALBEDO)
+
+    def _shadow_vao(self, program):
+        key = ("shadow", id(program))
+        if key not in self._vaos:
+            b = self._curtain_buffers
+            if self._curtain_format == "interleaved":
+                content = [(b["interleaved"], "3f 36x", "in_position")]
+            else:
+                content = [(b["position"], self._curtain_format, "in_position")]
+            if "in_uv" in program and "uv" in b and self._curtain_format != "interleaved":
+                content.append((b["uv"], "2f", "in_uv"))
+            self._vaos[key] = self.ctx.vertex_array(program, content, index_buffer=b["index"],
+                                                    index_element_size=4)
+        return self._vaos[key]
+
+    def draw_room_shadow(self, inputs) -> None:
+        """Pass R1: the key light's transmittance through the curtain (room_shadow.frag)."""
+        mgl, gl = self._moderngl, self._room_resources()
+        n = room_light.SHADOW_TEXELS
+        gl["shadow_fbo"].use()
+        self.ctx.viewport = (0, 0, n, n)
+        gl["shadow_fbo"].clear(1.0, 1.0, 1.0, 1.0)
+        if not self.curtain_open:
+            program = self._program("room_shadow.vert", "room_shadow.frag", {"HAS_UV": True})
+            colours = self._room_colours(inputs)
+            self._set(program, "u_light_view_proj",
+                      gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+            self._set(program, "u_mesh_offset", self._mesh_offset)
+            self._set(program, "u_mean_coverage", colours["u_mean_coverage"])
+            self._set(program, "u_thread_beam_rgb", colours["u_thread_beam_rgb"])
+            self.ctx.disable(mgl.DEPTH_TEST)
+            self.ctx.disable(mgl.CULL_FACE)
+            self.ctx.enable(mgl.BLEND)
+            self.ctx.blend_func = (mgl.ZERO, mgl.SRC_COLOR)   # dst *= this layer's transmittance
+            self._shadow_vao(program).render(mgl.TRIANGLES)
+            self.ctx.blend_func = mgl.DEFAULT_BLENDING
+            self.ctx.disable(mgl.BLEND)
+        gl["shadow"].build_mipmaps()
+
+    def draw_room_luminaire(self, inputs) -> None:
+        """Pass R2: what the room sees in the window (the curtain's room-side radiance, or the
+        outside where it is open), one texel per window patch, the sun's disc left out."""
+        mgl, gl = self._moderngl, self._room_resources()
+        lw, lh = room_light.LUMINAIRE_TEXELS
+        gl["luminaire_fbo"].use()
+        self.ctx.viewport = (0, 0, lw, lh)
+        gl["luminaire_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<="
+        view_proj = room_light.luminaire_view_projection()
+        eye = room_light.LUMINAIRE_EYE
+        if not self.curtain_open:
+            self.draw_curtain(view_proj, camera_position=eye, overrides=self._no_disc_overrides())
+        self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False)
+        self.ctx.depth_func = "<"
+        self.ctx.disable(mgl.DEPTH_TEST)
+
+    def draw_room_lightmap(self, inputs) -> None:
+        """Passes R3 and R4: the light map's direct part (area light, beam, lamps), then one
+        bounce with ambient occlusion into the light map the room reads."""
+        mgl, gl = self._moderngl, self._room_resources()
+        aw, ah = room_light.atlas_size()
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        gl["direct_fbo"].use()
+        self.ctx.viewport = (0, 0, aw, ah)
+        program = self._program("fullscreen.vert", "room_lightmap.frag")
+        self._room_common_uniforms(program, inputs)
+        gl["luminaire"].use(location=1)
+        self._set(program, "u_luminaire", 1)
+        self._set(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)
+        self._set(program, "u_patch_area_m2", room_light.window_patch_area_m2())
+        gl["shadow"].use(location=2)
+        self._set(program, "u_shadow", 2)
+        (x0, x1), _, _ = scene_lib.ROOM_BOX
+        texel_m = (x1 - x0) / room_light.FACE_TEXELS
+        self._set(program, "u_shadow_lod",
+                  max(0.0, math.log2(texel_m / room_light.shadow_texel_m(inputs.key_to_light))))
+        self._set(program, "u_key_on", 1.0)
+        lamps = self.room_lamps
+        positions = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
+        rgbs = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
+        for k, (light, position) in enumerate(lamps):
+            positions[k] = position
+            rgbs[k] = band_lib.spectrum_to_display_rgb(light.irradiance_w_m2_nm)
+        self._set(program, "u_lamp_count", len(lamps))
+        self._set(program, "u_lamp_position", positions)
+        self._set(program, "u_lamp_rgb", rgbs)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        gl["direct"].build_mipmaps()
+
+        gl["lightmap_fbo"].use()
+        program = self._program("fullscreen.vert", "room_bounce.frag")
+        for name, value in room_light.face_uniforms().items():
+            self._set(program, name, value)
+        gl["direct"].use(location=1)
+        self._set(program, "u_direct", 1)
+        gl["ao"].use(location=2)
+        self._set(program, "u_ao_mask", 2)
+        self._set(program, "u_bounce_level", room_light.BOUNCE_LEVEL)
+        self._set(program, "u_coarse_texels", room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL)
+        self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+
+    def draw_room_light(self, inputs) -> None:
+        """All the room lighting's passes before the frame (R1-R4)."""
+        self.draw_room_shadow(inputs)
+        self.draw_room_luminaire(inputs)
+        self.draw_room_lightmap(inputs)
+
+    def read_room_lightmap(self) -> np.ndarray:
+        """The last light map (irradiance, linear sRGB), float32 (R, 6R, 3), row 0 = t = 0."""
+        gl = self._room_resources()
+        aw, ah = room_light.atlas_size()
+        data = gl["lightmap_fbo"].read(viewport=(0, 0, aw, ah), components=4, dtype="f4")
+        return np.frombuffer(data, dtype=np.float32).reshape(ah, aw, 4)[..., :3].copy()
 
     def _viewport_size(self, viewport) -> tuple[int, int]:
         if viewport is None:
@@ -475,6 +711,8 @@ class FrameRenderer:
         inputs = self.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
+        if self.room_lighting:
+            self.draw_room_light(inputs)
         self._hdr_fbo.use()
         self.ctx.viewport = (0, 0, vw, vh)
         self._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
@@ -482,7 +720,8 @@ class FrameRenderer:
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<="
         self._draw_room(view_proj, inputs)
-        self.draw_curtain(view_proj)
+        if not self.curtain_open:
+            self.draw_curtain(view_proj)
         # last, on the far plane: the depth test leaves only the pixels nothing covers
         self._draw_background(view_proj, inputs)
         self.ctx.depth_func = "<"
@@ -591,3 +830,6 @@ class FrameRenderer:
         for program in self._programs.values():
             program.release()
         self._programs.clear()
+        for obj in (self._room_gl or {}).values():
+            obj.release()
+        self._room_gl = None
