@@ -1,7 +1,7 @@
 #version 430
 // The room's light map, one diffuse bounce (issue 13): per atlas texel, the direct light map
 // adds the light that the room's own walls reflect onto it, gathered from its coarse mip
-// level (patches of face area / RC^2): E_1 = sum_j (rho / pi) E_j m_j cos_r cos_j A_j / max(r^2, A_j),
+// level, the key's beam included (patches of face area / RC^2): E_1 = sum_j (rho / pi) E_j m_j cos_r cos_j A_j / max(r^2, A_j),
 // with m_j the patch's wall fraction (0 in the window opening). The room is a convex box, so
 // every patch sees every other; the precomputed ambient occlusion (corners, the window's
 // reveals) scales the bounce.
@@ -15,7 +15,8 @@ uniform vec3 u_face_s[6];
 uniform vec3 u_face_t[6];
 uniform vec3 u_face_normal[6];
 
-uniform sampler2D u_direct;          // the direct light map, mipmapped
+uniform sampler2D u_direct;          // the direct light map (area light, lamps), mipmapped
+uniform sampler2D u_beam;            // the key's beam at the light map's texels, mipmapped
 uniform sampler2D u_ao_mask;         // r: ambient occlusion, g: wall fraction; mipmapped
 uniform int u_bounce_level;          // the mip level gathered
 uniform int u_coarse_texels;         // face texels at that level
@@ -51,7 +52,9 @@ void main() {
                 float geometry = max(dot(n, d) * inv_r, 0.0) * max(-dot(nf, d) * inv_r, 0.0)
                                * area / max(r2, area);
                 float wall = texelFetch(u_ao_mask, texel, u_bounce_level).g;
-                bounce += texelFetch(u_direct, texel, u_bounce_level).rgb * (wall * geometry);
+                vec3 source = texelFetch(u_direct, texel, u_bounce_level).rgb
+                            + texelFetch(u_beam, texel, u_bounce_level).rgb;
+                bounce += source * (wall * geometry);
             }
         }
     }

@@ -35,7 +35,9 @@ uniform int u_lamp_count;
 uniform vec3 u_lamp_position[4];
 uniform vec3 u_lamp_rgb[4];          // intensity as linear sRGB (irradiance at 1 m)
 
-layout(location = 0) out vec4 out_irradiance;
+layout(location = 0) out vec4 out_irradiance;   // area light and lamps (the room reads it)
+layout(location = 1) out vec4 out_beam;         // the key's beam (per pixel in room.frag; here
+                                                // only as a source of the bounce)
 
 void main() {
     float x = v_uv.x * float(ROOM_FACES);
@@ -60,12 +62,13 @@ void main() {
         }
     }
 
+    vec3 e_beam = vec3(0.0);
     float cos_key = dot(n, u_key_to_light);
     if (cos_key > 0.0 && u_key_on > 0.0) {
         float beam = room_window_beam(p, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius);
         vec4 clip = u_light_view_proj * vec4(p, 1.0);
         vec3 t = textureLod(u_shadow, clip.xy * 0.5 + 0.5, u_shadow_lod).rgb;
-        e += u_key_rgb * (cos_key * beam) * t;
+        e_beam = u_key_rgb * (cos_key * beam) * t;
     }
 
     for (int k = 0; k < u_lamp_count; ++k) {
@@ -74,4 +77,5 @@ void main() {
         e += u_lamp_rgb[k] * (max(dot(n, d), 0.0) * inversesqrt(r2) / r2);
     }
     out_irradiance = vec4(e, 1.0);
+    out_beam = vec4(e_beam, 1.0);
 }

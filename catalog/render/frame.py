@@ -535,6 +535,8 @@ class FrameRenderer:
             aw, ah = room_light.atlas_size()
             direct = ctx.texture((aw, ah), 4, dtype="f4")
             direct.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            beam = ctx.texture((aw, ah), 4, dtype="f4")
+            beam.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             lightmap = ctx.texture((aw, ah), 4, dtype="f4")
             lightmap.filter = (mgl.LINEAR, mgl.LINEAR)
             lightmap.repeat_x = lightmap.repeat_y = False
@@ -545,7 +547,7 @@ class FrameRenderer:
                 "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
                 "luminaire": luminaire, "luminaire_depth": luminaire_depth,
                 "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
-                "direct": direct, "direct_fbo": ctx.framebuffer([direct]),
+                "direct": direct, "beam": beam, "direct_fbo": ctx.framebuffer([direct, beam]),
                 "lightmap": lightmap, "lightmap_fbo": ctx.framebuffer([lightmap]), "ao": ao,
             }
         return self._room_gl
@@ -669,6 +671,7 @@ class FrameRenderer:
         self._set(program, "u_lamp_rgb", rgbs)
         self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
         gl["direct"].build_mipmaps()
+        gl["beam"].build_mipmaps()
 
         gl["lightmap_fbo"].use()
         program = self._program("fullscreen.vert", "room_bounce.frag")
@@ -678,6 +681,8 @@ class FrameRenderer:
         self._set(program, "u_direct", 1)
         gl["ao"].use(location=2)
         self._set(program, "u_ao_mask", 2)
+        gl["beam"].use(location=3)
+        self._set(program, "u_beam", 3)
         self._set(program, "u_bounce_level", room_light.BOUNCE_LEVEL)
         self._set(program, "u_coarse_texels", room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL)
         self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
@@ -688,6 +693,13 @@ class FrameRenderer:
         self.draw_room_shadow(inputs)
         self.draw_room_luminaire(inputs)
         self.draw_room_lightmap(inputs)
+
+    def read_room_shadow(self) -> np.ndarray:
+        """The last transmittance shadow map, float32 (N, N, 3), row 0 = the map's bottom."""
+        gl = self._room_resources()
+        n = room_light.SHADOW_TEXELS
+        data = gl["shadow"].read(level=0)
+        return np.frombuffer(data, dtype=np.float16).reshape(n, n, 4)[..., :3].astype(np.float32)
 
     def read_room_lightmap(self) -> np.ndarray:
         """The last light map (irradiance, linear sRGB), float32 (R, 6R, 3), row 0 = t = 0."""
@@ -816,6 +828,7 @@ class FrameRenderer:
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
         ours = [self._hdr_fbo, self._ldr_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
+        ours += [obj for name, obj in (self._room_gl or {}).items() if name.endswith("_fbo")]
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._release_vaos()

@@ -1,0 +1,255 @@
+"""The room lit through the curtain (issue 13), on read-back pixels.
+
+A view from the back of the room looking down at the floor in front of the window; the key
+light stands at 45 deg elevation so that its beam through the window lands on the visible
+floor. The floor patch "through the curtain" is found by geometry in numpy (camera ray ->
+floor -> along the key direction -> inside the window opening and inside the hanging
+curtain, with margins), independently of the shaders. Bounds are stated with their reason.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from catalog.reference import hg_hemisphere_factors
+from catalog.render import room_light
+from catalog.render import scene as scene_lib
+from catalog.render.bands import spectrum_to_display_rgb
+from catalog.render.frame import FrameRenderer
+
+pytestmark = pytest.mark.gl
+
+SIZE = (160, 90)
+LUMA = np.array([0.2126, 0.7152, 0.0722])
+
+
+def _luma(rgb):
+    return np.asarray(rgb) @ LUMA
+
+
+def _renderer(gl, fabric="lace-fwa", light="sun:60", azimuth_deg=15.0):
+    r = FrameRenderer(gl, SIZE)
+    r.set_fabric(fabric)
+    r.set_light(light)
+    r.set_key_direction(45.0, azimuth_deg)
+    r.set_camera(0.0, 18.0, 4.3)
+    return r
+
+
+def _floor_regions(r):
+    """(patch, far): floor pixels lit through the curtain's inside (margins 0.08-0.15 m from
+    every edge), and floor pixels whose beam would cross the wall 0.3 m or more outside the
+    opening."""
+    w, h = SIZE
+    inv = np.linalg.inv(r.camera.view_projection(w / h))
+    ys, xs = np.mgrid[0:h, 0:w]
+    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2,
+                    np.ones((h, w)), np.ones((h, w))], -1)
+    far = ndc @ inv.T
+    eye = r.camera.position
+    d = far[..., :3] / far[..., 3:] - eye
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    t = (scene_lib.ROOM_BOX[1][0] - eye[1]) / d[..., 1]
+    p = eye + t[..., None] * d
+    floor = (t > 0) & (np.abs(p[..., 0]) < 2.0) & (p[..., 2] > 0.2) & (p[..., 2] < 4.3)
+    to_light = r.shading_inputs().key_to_light
+
+    def crossing(z):
+        s = (z - p[..., 2]) / to_light[2]
+        return p[..., :2] + s[..., None] * to_light[:2]
+
+    q = crossing(scene_lib.ROOM_BOX[2][0])
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    m = 0.08
+    in_window = (q[..., 0] > wx0 + m) & (q[..., 0] < wx1 - m) & (q[..., 1] > wy0 + m) & (q[..., 1] < wy1 - m)
+    qc = crossing(scene_lib.CURTAIN_Z)
+    half = scene_lib.CURTAIN_WIDTH_M / 2
+    through = ((np.abs(qc[..., 0]) < half - 0.1) & (qc[..., 1] < scene_lib.CURTAIN_TOP_Y - 0.1)
+               & (qc[..., 1] > scene_lib.CURTAIN_TOP_Y - scene_lib.CURTAIN_HEIGHT_M + 0.15))
+    away = ((q[..., 0] < wx0 - 0.3) | (q[..., 0] > wx1 + 0.3) | (q[..., 1] < wy0 - 0.3)
+            | (q[..., 1] > wy1 + 0.3))
+    return floor & in_window & through, floor & away
+
+
+def _frame(r, curtain_open):
+    r.set_curtain_open(curtain_open)
+    r.render()
+    return r.read_linear()
+
+
+def _beam_transmittance(inputs):
+    """Independent of the shaders: LD + a_spec forward(g_spec) (model.md eq. 5-7, the
+    directional lobe's forward-scattered part kept in the beam; undyed cloth)."""
+    return inputs.direct + inputs.a_spec * hg_hemisphere_factors(inputs.g_spec)[0]
+
+
+def test_open_window_beam_is_the_key_irradiance(gl):
+    """Curtain open: the patch's excess over the floor away from it is the Lambertian floor
+    under the key light, rho / pi * E * cos(theta) (E the key's illuminance as linear sRGB Y).
+    Bound 5 %: the area light and the bounce differ a little between the two regions."""
+    r = _renderer(gl)
+    patch, away = _floor_regions(r)
+    assert patch.sum() > 200 and away.sum() > 200
+    img = _frame(r, True)
+    inputs = r.shading_inputs()
+    expected = (scene_lib.ROOM_ALBEDO / math.pi * _luma(spectrum_to_display_rgb(inputs.key_irradiance))
+                * inputs.key_to_light[1])
+    excess = _luma(img[patch]).mean() - _luma(img[away]).mean()
+    assert excess == pytest.approx(expected, rel=0.05)
+    r.release()
+
+
+def test_closing_the_lace_dims_the_patch_by_its_transmittance(gl):
+    """Closing lace-fwa leaves the beam's transmittance LD + a_spec fwd(g_spec) (0.65): the
+    patch's closed/open ratio is at least that and at most 0.08 above it (the glowing curtain
+    lights the patch a little more than the open window's sky)."""
+    r = _renderer(gl)
+    patch, _ = _floor_regions(r)
+    open_y = _luma(_frame(r, True)[patch]).mean()
+    closed_y = _luma(_frame(r, False)[patch]).mean()
+    t = _beam_transmittance(r.shading_inputs())
+    assert t <= closed_y / open_y <= t + 0.08
+    r.release()
+
+
+def test_folds_pattern_the_patch(gl):
+    """With the key 50 deg to the side, its beam crosses the deepest folds twice (the fold's
+    slope, up to 55 deg, is steeper than the ray's in the x-z plane): those stripes pass T^2,
+    the rest T, so the closed/open ratio varies across the patch (coefficient of variation
+    above 3 %), while with the key 15 deg to the side
+    (one crossing everywhere, the fabric pattern not yet bound) it is flat within 1 %."""
+    for azimuth, patterned in ((50.0, True), (15.0, False)):
+        r = _renderer(gl, azimuth_deg=azimuth)
+        patch, _ = _floor_regions(r)
+        ratio = _luma(_frame(r, False)[patch]) / _luma(_frame(r, True)[patch])
+        cv = ratio.std() / ratio.mean()
+        if patterned:
+            assert cv > 0.03
+        else:
+            assert cv < 0.01
+        r.release()
+
+
+def test_safety_yellow_tints_the_patch(gl):
+    """Yellowness (R + G) / 2B of the patch: the yellow dye scatters yellow light into the beam,
+    so closing safety-yellow raises it by more than 30 %; undyed lace-fwa changes it by less
+    than 3 %."""
+    for fabric, tinted in (("safety-yellow", True), ("lace-fwa", False)):
+        r = _renderer(gl, fabric)
+        patch, _ = _floor_regions(r)
+        ratios = []
+        for curtain_open in (True, False):
+            rgb = _frame(r, curtain_open)[patch].mean(axis=0)
+            ratios.append((rgb[0] + rgb[1]) / (2 * rgb[2]))
+        change = ratios[1] / ratios[0]
+        if tinted:
+            assert change > 1.3
+        else:
+            assert abs(change - 1.0) < 0.03
+        r.release()
+
+
+def _wall_strips(img):
+    """The window wall beside the window in the default view: the outer fifths of the frame."""
+    w = img.shape[1]
+    return np.concatenate([img[:, : w // 5].reshape(-1, 3), img[:, -(w // 5):].reshape(-1, 3)])
+
+
+def test_uv_fluorescence_raises_the_rooms_blue(gl):
+    """Under UV-A, lace-fwa's brightener emits blue from the curtain into the room: the wall's
+    blue rises by more than 20 % against the same scene without fluorescence, and more than
+    its red."""
+    r = FrameRenderer(gl, SIZE)
+    r.set_fabric("lace-fwa")
+    r.set_light("UV-A")
+    walls = {}
+    for mode in ("off", "physical"):
+        r.set_fluorescence(mode)
+        r.render()
+        walls[mode] = _wall_strips(r.read_linear()).mean(axis=0)
+    gain = walls["physical"] / np.maximum(walls["off"], 1e-12)
+    assert gain[2] > 1.2
+    assert gain[2] > gain[0]
+    r.release()
+
+
+def test_walls_differ_between_fabrics(gl):
+    """Default view, D65: with the room lit through the curtain, the window wall's mean
+    luminance differs between the ten fabrics (no two within 0.5 %, max / min above 1.2);
+    the earlier constant room gave all ten the same value."""
+    from catalog.presets import list_presets
+
+    names = sorted(p.stem for p in list_presets())
+    assert len(names) >= 10
+    r = FrameRenderer(gl, (96, 54))
+    r.set_light("D65")
+    lit, constant = [], []
+    for name in names:
+        r.set_fabric(name)
+        r.set_room_lighting(True)
+        r.render()
+        lit.append(_luma(_wall_strips(r.read_linear())).mean())
+        r.set_room_lighting(False)
+        r.render()
+        constant.append(_luma(_wall_strips(r.read_linear())).mean())
+    lit = np.sort(np.array(lit))
+    assert np.all(np.diff(lit) / lit[:-1] > 0.005)
+    assert lit[-1] / lit[0] > 1.2
+    assert np.ptp(constant) == 0.0
+    r.release()
+
+
+def test_layers_multiply_in_the_shadow_map(gl):
+    """Two parallel sheets across the window, facing the key: the shadow map passes T^2 where
+    one sheet passes T (half-float storage: 2e-3)."""
+    r = _renderer(gl, "lace-fwa")
+    quads = []
+    for z in (-0.15, 0.05):
+        quads.append([[-1.2, -1.2, z], [1.2, -1.2, z], [1.2, 1.6, z], [-1.2, 1.6, z]])
+    positions = np.array(quads, dtype="f4").reshape(-1, 3)
+    normals = np.tile([0.0, 0.0, 1.0], (8, 1)).astype("f4")
+    tangents = np.tile([1.0, 0.0, 0.0], (8, 1)).astype("f4")
+    uvs = np.tile([[0, 0], [1, 0], [1, 1], [0, 1]], (2, 1)).astype("f4")
+    indices = np.array([0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7], dtype="i4")
+    r.set_mesh(positions, normals, uvs, tangents, indices)
+    r.draw_room_shadow(r.shading_inputs())
+    shadow = r.read_room_shadow()
+    n = shadow.shape[0]
+    centre = shadow[n // 2 - 4: n // 2 + 4, n // 2 - 4: n // 2 + 4].reshape(-1, 3)
+    t = _beam_transmittance(r.shading_inputs())
+    assert np.allclose(centre, t * t, atol=2e-3)
+    r.release()
+
+
+def test_room_lamp_lights_the_floor_by_inverse_square(gl):
+    """A lamp 1.5 m above a floor texel's centre adds at least I / h^2 there (the light map,
+    read back) and at most 25 % more (its light bounced off the walls)."""
+    r = _renderer(gl)
+    faces = room_light.room_faces()
+    floor = faces[0]
+    k = room_light.FACE_TEXELS
+    i, j = 10, 12  # texel (s, t) of the floor
+    centre = floor.origin + (i + 0.5) / k * floor.axis_s + (j + 0.5) / k * floor.axis_t
+    lamp = (float(centre[0]), float(centre[1] + 1.5), float(centre[2]))
+    r.set_curtain_open(False)
+    r.render()
+    before = r.read_room_lightmap()[j, i]
+    r.set_room_lamps([("A", lamp)])
+    r.render()
+    after = r.read_room_lightmap()[j, i]
+    intensity = _luma(spectrum_to_display_rgb(r.room_lamps[0][0].irradiance_w_m2_nm))
+    added = _luma(after) - _luma(before)
+    assert intensity / 1.5 ** 2 <= added <= 1.25 * intensity / 1.5 ** 2
+    r.release()
+
+
+def test_room_lamp_outside_the_room_is_refused(gl):
+    from catalog.errors import CatalogError
+
+    r = FrameRenderer(gl, (16, 16))
+    with pytest.raises(CatalogError, match="inside the room"):
+        r.set_room_lamps([("A", (0.0, 5.0, 1.0))])
+    r.release()
