@@ -200,4 +200,19 @@ float room_window_beam(vec3 p, vec3 to_light, vec4 opening, vec2 wall_z, float t
          * soft_rect(q_out, opening, s_out * tan_radius + 1e-3);
 }
 
+
+// ---- The clear sky (issue 13; catalog/sky.py is the float64 twin). Preetham, Shirley & Smits
+// 1999, the Perez et al. 1993 function F(theta, gamma) = (1 + A e^(B / cos theta))
+// (1 + C e^(D gamma) + E cos^2 gamma) for x, y and Y at once (columns of the coefficients).
+vec3 perez_xyY(float cos_theta, float gamma, vec3 a, vec3 b, vec3 c, vec3 d, vec3 e) {
+    float cos_gamma = cos(gamma);
+    return (1.0 + a * exp(b / max(cos_theta, 0.01)))
+         * (1.0 + c * exp(d * gamma) + e * (cos_gamma * cos_gamma));
+}
+
+// xyY -> XYZ.
+vec3 xyY_to_XYZ(vec3 xyY) {
+    return vec3(xyY.x * xyY.z / xyY.y, xyY.z, (1.0 - xyY.x - xyY.y) * xyY.z / xyY.y);
+}
+
 #endif

@@ -4,8 +4,8 @@
 //  - the key light's beam through the window opening and the curtain, per pixel: the
 //    transmittance shadow map (room_shadow.frag) filtered over the penumbra a source of the
 //    sun's angular radius casts at the receiver's distance from the curtain (PCSS with the
-//    blocker distance known: the curtain hangs in the plane u_curtain_z), times the opening's
-//    soft mask (room_window_beam);
+//    blocker distance known: the curtain hangs in the plane u_curtain_z; the filter is the
+//    map's mip level of that width, one tap), times the opening's soft mask (room_window_beam);
 //  - the light map (room_lightmap.frag + room_bounce.frag): the curtain as an area light,
 //    lamps in the room, one bounce, ambient occlusion.
 // Without it, the earlier scene design: a constant fraction of the key plus the fill light.
@@ -19,10 +19,8 @@ uniform vec3 u_fill_rgb;          // radiance added by the fill light at normal 
 uniform vec3 u_fill_to_light;
 
 #ifdef ROOM_LIGHTING
-uniform vec3 u_face_origin[6];
-uniform vec3 u_face_s[6];
-uniform vec3 u_face_t[6];
-uniform float u_face_texels;
+in vec2 v_atlas;                  // light-map atlas coordinates (room.vert)
+flat in vec4 v_atlas_box;
 uniform sampler2D u_lightmap;     // irradiance, linear sRGB (x pi cd m^-2)
 uniform sampler2D u_shadow;       // the key light's transmittance through the curtain
 uniform mat4 u_light_view_proj;
@@ -35,11 +33,7 @@ uniform float u_curtain_z;
 uniform float u_tan_sun_radius;
 uniform float u_albedo;
 
-// 8 taps on a disc (a rotated Vogel spiral) plus the centre, radius 1.
-const vec2 PCF_TAPS[8] = vec2[8](vec2(0.250, 0.000), vec2(-0.318, 0.291), vec2(0.042, -0.559),
-                                 vec2(0.440, 0.487), vec2(-0.733, -0.108), vec2(0.628, -0.509),
-                                 vec2(-0.159, 0.857), vec2(-0.507, -0.803));
-
+#ifdef KEY_BEAM
 vec3 key_beam(vec3 p, vec3 n) {
     float cos_key = dot(n, u_key_to_light);
     if (cos_key <= 0.0) {
@@ -54,13 +48,18 @@ vec3 key_beam(vec3 p, vec3 n) {
     float radius_m = max(blocker * u_tan_sun_radius, 0.5 * u_shadow_texel_m);
     vec4 clip = u_light_view_proj * vec4(p, 1.0);
     vec2 uv = clip.xy * 0.5 + 0.5;
-    vec2 step_uv = vec2(radius_m / u_shadow_texel_m) / vec2(textureSize(u_shadow, 0));
-    vec3 t = texture(u_shadow, uv).rgb;
-    for (int k = 0; k < 8; ++k) {
-        t += texture(u_shadow, uv + PCF_TAPS[k] * step_uv).rgb;
-    }
-    return u_key_rgb * (cos_key * beam / 9.0) * t;
+    // the penumbra as a prefiltered lookup: the mip level whose texel spans its diameter
+    // (one trilinear tap where PCF would take many; a CPU rasteriser pays per tap)
+    vec3 t = textureLod(u_shadow, uv, log2(max(2.0 * radius_m / u_shadow_texel_m, 1.0))).rgb;
+    return u_key_rgb * (cos_key * beam) * t;
 }
+#else
+// faces turned away from the key light (frame.py draws them apart: a CPU rasteriser runs
+// both sides of a branch, so the beam's arithmetic is compiled only where it can be lit)
+vec3 key_beam(vec3 p, vec3 n) {
+    return vec3(0.0);
+}
+#endif
 #endif
 
 layout(location = 0) out vec4 out_radiance;
@@ -68,9 +67,7 @@ layout(location = 0) out vec4 out_radiance;
 void main() {
     vec3 n = normalize(v_normal);
 #ifdef ROOM_LIGHTING
-    int face = room_face_of_normal(n);
-    vec2 uv = room_atlas_uv(face, v_position, u_face_origin[face], u_face_s[face],
-                            u_face_t[face], u_face_texels);
+    vec2 uv = clamp(v_atlas, v_atlas_box.xz, v_atlas_box.yw);
     vec3 irradiance = texture(u_lightmap, uv).rgb + key_beam(v_position, n);
     out_radiance = vec4((u_albedo / PI) * irradiance, 1.0);
 #else

@@ -34,6 +34,10 @@ EXPOSURE_FLOOR_LX = 200.0
 #: Tone curve white point (after exposure): this luminance maps to display white.
 TONE_WHITE = 6.0
 FLUORESCENCE_MODES = ("off", "paper", "physical")
+#: Glare (bloom.frag): the fraction of the frame's radiance spread into the blurs, and the
+#: blurs' weights (mip levels 1..6, wider blurs weighted less; normalised to sum 1).
+BLOOM_STRENGTH = 0.04
+BLOOM_LEVEL_WEIGHTS = (0.30, 0.24, 0.18, 0.13, 0.09, 0.06)
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
@@ -61,6 +65,11 @@ def check_size(size, ctx=None) -> tuple[int, int]:
         raise CatalogError(f"image size {width}x{height} is impossible: each side must lie in "
                            f"1..{limit} px")
     return width, height
+
+
+def gl_bytes_mat3(matrix: np.ndarray) -> bytes:
+    """A 3x3 matrix (column-vector convention) as GLSL's column-major mat3."""
+    return np.ascontiguousarray(np.asarray(matrix, dtype=np.float32).T).tobytes()
 
 
 class FrameRenderer:
@@ -106,6 +115,16 @@ class FrameRenderer:
         self.curtain_open = False
         self.room_lamps: list[tuple] = []   # (catalog.lights.Light, (x, y, z) m)
         self._room_gl = None
+        #: the room's light (shadow map, capture, light map) is redrawn when the scene, the
+        #: mesh or the lamps change; a cloth drawn from GPU buffers changes unseen, so then
+        #: every ``room_update_every`` frames (1: every frame)
+        self.room_update_every = 1
+        self._room_key = None
+        self._room_frames = 0
+        self._mesh_version = 0
+        self.sky_model = True      # the clear sky of catalog/sky.py behind the window (a sun)
+        self.bloom = True          # glare before the tone map (bloom.frag)
+        self._bloom_gl = None
 
         positions, normals = scene_lib.room_props()
         self._room_vbo = ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
@@ -184,6 +203,14 @@ class FrameRenderer:
         self.room_lamps = [(get_light(light) if isinstance(light, str) else light,
                             room_light.check_lamp_position(position)) for light, position in lamps]
 
+    def set_sky_model(self, on: bool) -> None:
+        """The clear sky by direction (catalog/sky.py) or the earlier flat sky and ground."""
+        self.sky_model = bool(on)
+
+    def set_bloom(self, on: bool) -> None:
+        """Glare before the tone map (energy-preserving, bloom.frag) on or off."""
+        self.bloom = bool(on)
+
     def set_bands(self, n_bands: int) -> None:
         self.n_bands = band_lib.check_band_count(n_bands)
 
@@ -224,6 +251,7 @@ class FrameRenderer:
         self._vertex_count = count
         self._release_vaos()
         self.mesh_arrays = (positions, normals, tangents)
+        self._mesh_version = getattr(self, "_mesh_version", 0) + 1
 
     def update_positions(self, positions, normals) -> None:
         """New positions and normals for the same vertices (a simulation frame)."""
@@ -238,6 +266,7 @@ class FrameRenderer:
         self._curtain_buffers["position"].write(positions.tobytes())
         self._curtain_buffers["normal"].write(normals.tobytes())
         self.mesh_arrays = (positions, normals, self.mesh_arrays[2])
+        self._mesh_version += 1
 
     def bind_cloth_buffers(self, position_buffer, normal_buffer) -> None:
         """Read positions and normals straight from GPU buffers (vec4 per vertex, xyz used),
@@ -489,35 +518,93 @@ class FrameRenderer:
             self._display_key = self._inputs_key
         return self._display
 
+    def _sky(self, inputs):
+        """The clear-sky model for a sun above the horizon (catalog/sky.py), else None."""
+        if not (self.sky_model and self._is_sun and inputs.key_to_light[1] > 1e-3):
+            return None
+        key = tuple(float(v) for v in inputs.key_to_light)
+        if getattr(self, "_sky_key", None) != key:
+            from catalog.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
+            from catalog.sky import HAZE_RAD, sky_model  # noqa: PLC0415
+
+            model = sky_model(inputs.key_to_light)
+            self._sky_value = {
+                "u_perez": np.asarray(model.perez, dtype="f4"),
+                "u_zenith_xyY": tuple(float(v) for v in model.zenith),
+                "u_perez_sun": tuple(float(v) for v in np.ravel(model.perez_sun)),
+                "u_sky_scale": tuple(float(v) for v in model.scale_rgb),
+                "u_xyz_to_rgb": gl_bytes_mat3(xyz_to_linear_srgb(np.eye(3)).T),
+                "u_haze_rad": HAZE_RAD,
+                "u_ground_rgb": tuple(float(v) for v in model.ground_rgb),
+            }
+            self._sky_key = key
+        return self._sky_value
+
     def _draw_background(self, view_proj, inputs, camera_position=None, sun_disc=True) -> None:
-        program = self._program("fullscreen.vert", "background.frag")
+        sky = self._sky(inputs)
+        program = self._program("fullscreen.vert", "background.frag", {"SKY_MODEL": sky is not None})
         self._scene_uniforms(program, view_proj, inputs, camera_position)
         self._set(program, "u_inverse_view_proj", gl_bytes(np.linalg.inv(view_proj)))
         colours = self._display_colours(inputs)
         for name in ("u_sky_rgb", "u_ground_rgb", "u_sun_disc_rgb", "u_room_rgb"):
             self._set(program, name, colours[name])
+        if sky is not None:
+            for name, value in sky.items():
+                self._set(program, name, value)
         if not sun_disc:
             self._set(program, "u_sun_disc_rgb", (0.0, 0.0, 0.0))
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
 
+    def _room_order(self, to_light) -> int:
+        """Reorder the room's triangles so that those facing the key light come first;
+        returns their vertex count (cached per key direction)."""
+        key = tuple(float(v) for v in to_light)
+        if getattr(self, "_room_order_key", None) != key:
+            positions, normals = scene_lib.room_props()
+            facing = (normals[0::3] @ np.asarray(to_light, dtype=np.float32)) > 0.0
+            order = np.concatenate([np.flatnonzero(facing), np.flatnonzero(~facing)])
+            tri_p = positions.reshape(-1, 3, 3)[order].reshape(-1, 3)
+            tri_n = normals.reshape(-1, 3, 3)[order].reshape(-1, 3)
+            self._room_vbo.write(np.hstack([tri_p, tri_n]).astype("f4").tobytes())
+            self._room_order_key = key
+            self._room_facing = 3 * int(facing.sum())
+        return self._room_facing
+
     def _draw_room(self, view_proj, inputs) -> None:
         lit = self.room_lighting
-        program = self._program("room.vert", "room.frag", {"ROOM_LIGHTING": lit})
+        if lit:
+            facing = self._room_order(inputs.key_to_light)
+            total = self._room_vbo.size // 24
+            self.ctx.enable(self._moderngl.CULL_FACE)
+            for beam, first, count in ((True, 0, facing), (False, facing, total - facing)):
+                if count:
+                    program = self._program("room.vert", "room.frag",
+                                            {"ROOM_LIGHTING": True, "KEY_BEAM": beam})
+                    self._room_lit_uniforms(program, view_proj, inputs)
+                    self._room_vao(program).render(self._moderngl.TRIANGLES, vertices=count,
+                                                   first=first)
+            self.ctx.disable(self._moderngl.CULL_FACE)
+            return
+        program = self._program("room.vert", "room.frag", {"ROOM_LIGHTING": False})
         self._scene_uniforms(program, view_proj, inputs)
         colours = self._display_colours(inputs)
         self._set(program, "u_room_rgb", colours["u_room_rgb"])
         self._set(program, "u_fill_rgb", colours["u_fill_rgb"])
-        if lit:
-            gl = self._room_gl
-            self._room_common_uniforms(program, inputs)
-            self._set(program, "u_face_texels", float(room_light.FACE_TEXELS))
-            gl["lightmap"].use(location=1)
-            self._set(program, "u_lightmap", 1)
-            gl["shadow"].use(location=2)
-            self._set(program, "u_shadow", 2)
-            self._set(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light))
-            self._set(program, "u_curtain_z", scene_lib.CURTAIN_Z)
+        self.ctx.enable(self._moderngl.CULL_FACE)
         self._room_vao(program).render(self._moderngl.TRIANGLES)
+        self.ctx.disable(self._moderngl.CULL_FACE)
+
+    def _room_lit_uniforms(self, program, view_proj, inputs) -> None:
+        self._scene_uniforms(program, view_proj, inputs)
+        gl = self._room_gl
+        self._room_common_uniforms(program, inputs)
+        self._set(program, "u_face_texels", float(room_light.FACE_TEXELS))
+        gl["lightmap"].use(location=1)
+        self._set(program, "u_lightmap", 1)
+        gl["shadow"].use(location=2)
+        self._set(program, "u_shadow", 2)
+        self._set(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light))
+        self._set(program, "u_curtain_z", scene_lib.CURTAIN_Z)
 
     # ------------------------------------------------------------------ the room's light (issue 13)
     def _room_resources(self) -> dict:
@@ -717,43 +804,150 @@ class FrameRenderer:
                                f"{self.size[0]}x{self.size[1]} HDR target")
         return vw, vh
 
-    def render_hdr(self, viewport=None) -> tuple[int, int]:
-        """Background, room and curtain into the HDR target; returns the size drawn."""
+    def _room_light_stale(self) -> bool:
+        """Whether the room's light must be redrawn this frame (see room_update_every)."""
+        key = (self._inputs_key, self._mesh_version, self.curtain_open,
+               tuple((light.name, position) for light, position in self.room_lamps))
+        self._room_frames += 1
+        moving = self._curtain_format != "3f" and self._room_frames >= self.room_update_every
+        if key != self._room_key or moving or self._room_gl is None:
+            self._room_key = key
+            self._room_frames = 0
+            return True
+        return False
+
+    def invalidate_room_light(self) -> None:
+        """Redraw the room's light at the next frame (e.g. after the cloth moved on the GPU)."""
+        self._room_key = None
+
+    def _timed(self, profile, name, work) -> None:
+        """Run ``work()``; with a ``profile`` dict, finish the GL queue and add its wall time (s)."""
+        if profile is None:
+            work()
+            return
+        import time  # noqa: PLC0415
+
+        self.ctx.finish()
+        start = time.perf_counter()
+        work()
+        self.ctx.finish()
+        profile[name] = profile.get(name, 0.0) + time.perf_counter() - start
+
+    def render_hdr(self, viewport=None, profile: dict | None = None) -> tuple[int, int]:
+        """Background, room and curtain into the HDR target; returns the size drawn.
+        ``profile``: a dict that receives each pass's wall time (s), the GL queue finished
+        around each (the benchmark's per-pass shares; slower than a frame without it)."""
         mgl = self._moderngl
         inputs = self.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
-        if self.room_lighting:
-            self.draw_room_light(inputs)
+        if self.room_lighting and self._room_light_stale():
+            self._timed(profile, "room_shadow", lambda: self.draw_room_shadow(inputs))
+            self._timed(profile, "room_luminaire", lambda: self.draw_room_luminaire(inputs))
+            self._timed(profile, "room_lightmap", lambda: self.draw_room_lightmap(inputs))
         self._hdr_fbo.use()
         self.ctx.viewport = (0, 0, vw, vh)
         self._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
         self.ctx.disable(mgl.BLEND)
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<="
-        self._draw_room(view_proj, inputs)
+        # the curtain first: the depth test then skips the room behind it (early z)
         if not self.curtain_open:
-            self.draw_curtain(view_proj)
+            self._timed(profile, "curtain", lambda: self.draw_curtain(view_proj))
+        self._timed(profile, "room", lambda: self._draw_room(view_proj, inputs))
         # last, on the far plane: the depth test leaves only the pixels nothing covers
-        self._draw_background(view_proj, inputs)
+        self._timed(profile, "background", lambda: self._draw_background(view_proj, inputs))
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
 
-    def render(self, fbo=None, viewport=None) -> None:
+    def _bloom_resources(self) -> dict:
+        if self._bloom_gl is None:
+            mgl, ctx = self._moderngl, self.ctx
+            w, h = self.size
+            half = ctx.texture((max(1, (w + 1) // 2), max(1, (h + 1) // 2)), 4, dtype="f2")
+            half.filter = (mgl.LINEAR_MIPMAP_NEAREST, mgl.LINEAR)  # whole levels: bilinear taps
+            half.repeat_x = half.repeat_y = False
+            glow = ctx.texture((max(1, (half.size[0] + 1) // 2), max(1, (half.size[1] + 1) // 2)),
+                               4, dtype="f2")   # quarter size: the glow is wide
+            glow.filter = (mgl.LINEAR, mgl.LINEAR)
+            glow.repeat_x = glow.repeat_y = False
+            out = ctx.texture((w, h), 4, dtype="f4")
+            out.filter = (mgl.NEAREST, mgl.NEAREST)
+            self._bloom_gl = {"half": half, "half_fbo": ctx.framebuffer([half]),
+                              "glow": glow, "glow_fbo": ctx.framebuffer([glow]),
+                              "out": out, "out_fbo": ctx.framebuffer([out])}
+        return self._bloom_gl
+
+    def draw_bloom(self, vw: int, vh: int) -> object:
+        """Glare: the HDR frame with BLOOM_STRENGTH of it spread over wide blurs
+        (bloom_down.frag, then bloom.frag); returns the texture the tone map reads."""
+        mgl, gl = self._moderngl, self._bloom_resources()
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        hw, hh = (vw + 1) // 2, (vh + 1) // 2
+        gl["half_fbo"].use()
+        self.ctx.viewport = (0, 0, hw, hh)
+        program = self._program("fullscreen.vert", "bloom_down.frag")
+        self._hdr.use(location=0)
+        self._set(program, "u_hdr", 0)
+        self._set(program, "u_hdr_size", (vw, vh))
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        gl["half"].build_mipmaps()
+        full_w, full_h = gl["half"].size
+        rect = (0.0, 0.0, hw / full_w, hh / full_h)
+        gw, gh = gl["glow"].size
+        qw, qh = (hw + 1) // 2, (hh + 1) // 2
+        gl["glow_fbo"].use()
+        self.ctx.viewport = (0, 0, qw, qh)
+        program = self._program("fullscreen.vert", "bloom_glow.frag",
+                                {"BLOOM_LEVELS": len(BLOOM_LEVEL_WEIGHTS)})
+        gl["half"].use(location=1)
+        self._set(program, "u_half", 1)
+        self._set(program, "u_half_rect", rect)
+        weights = np.asarray(BLOOM_LEVEL_WEIGHTS, dtype="f4")
+        self._set(program, "u_level_weight", weights / weights.sum())
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        gl["out_fbo"].use()
+        self.ctx.viewport = (0, 0, vw, vh)
+        program = self._program("fullscreen.vert", "bloom.frag")
+        self._hdr.use(location=0)
+        self._set(program, "u_hdr", 0)
+        gl["glow"].use(location=1)
+        self._set(program, "u_glow", 1)
+        self._set(program, "u_glow_rect", (0.0, 0.0, qw / gw, qh / gh))
+        self._set(program, "u_strength", BLOOM_STRENGTH)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        return gl["out"]
+
+    def render(self, fbo=None, viewport=None, profile: dict | None = None) -> None:
         """One frame: HDR passes, then the tone map into ``fbo`` (default: our RGBA8 target)
-        at ``viewport`` (x, y, w, h; default the whole renderer size)."""
-        vw, vh = self.render_hdr(viewport)
+        at ``viewport`` (x, y, w, h; default the whole renderer size). ``profile``: see
+        :meth:`render_hdr` (adds "bloom" and "tonemap")."""
+        vw, vh = self.render_hdr(viewport, profile)
+        hdr = self._hdr
+        if self.bloom:
+            box = {}
+            self._timed(profile, "bloom", lambda: box.update(texture=self.draw_bloom(vw, vh)))
+            hdr = box["texture"]
+        if profile is not None:
+            self.ctx.finish()
+            import time  # noqa: PLC0415
+
+            start = time.perf_counter()
         target = fbo if fbo is not None else self._ldr_fbo
         target.use()
         self.ctx.viewport = tuple(viewport) if (fbo is not None and viewport is not None) else (0, 0, vw, vh)
         program = self._program("fullscreen.vert", "tonemap.frag")
-        self._hdr.use(location=0)
+        hdr.use(location=0)
         self._set(program, "u_hdr", 0)
         self._set(program, "u_hdr_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
         self._set(program, "u_exposure", self.exposure_scale())
         self._set(program, "u_white", TONE_WHITE)
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
+        if profile is not None:
+            self.ctx.finish()
+            profile["tonemap"] = profile.get("tonemap", 0.0) + time.perf_counter() - start
         self._last = (vw, vh, fbo, viewport)
 
     # ------------------------------------------------------------------ read back
@@ -828,7 +1022,8 @@ class FrameRenderer:
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
         ours = [self._hdr_fbo, self._ldr_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
-        ours += [obj for name, obj in (self._room_gl or {}).items() if name.endswith("_fbo")]
+        ours += [obj for name, obj in list((self._room_gl or {}).items())
+                 + list((self._bloom_gl or {}).items()) if name.endswith("_fbo")]
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._release_vaos()
@@ -843,6 +1038,7 @@ class FrameRenderer:
         for program in self._programs.values():
             program.release()
         self._programs.clear()
-        for obj in (self._room_gl or {}).values():
+        for obj in list((self._room_gl or {}).values()) + list((self._bloom_gl or {}).values()):
             obj.release()
         self._room_gl = None
+        self._bloom_gl = None

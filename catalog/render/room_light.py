@@ -43,7 +43,7 @@ LUMINAIRE_TEXELS = (16, 12)
 #: Where the luminaire capture looks from (metres): the middle of the room, eye height.
 LUMINAIRE_EYE = (0.0, 0.2, 2.0)
 #: The transmittance shadow map's side (texels).
-SHADOW_TEXELS = 512
+SHADOW_TEXELS = 256
 #: Ambient occlusion: rays per texel and the distance within which geometry occludes.
 AO_RAYS = 96
 AO_RADIUS_M = 0.6

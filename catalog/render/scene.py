@@ -10,8 +10,9 @@ Lighting model (the numbers are scene design, stated once here; the physics is e
 
 - key: the light the user picks, as a distant source behind the window (the sun's disc
   size, 0.2666 deg), normal irradiance = the light's spectrum;
-- sky: outside above the horizon, radiance SKY_FRACTION E / pi, tinted (550 / l)^4 for
-  the sun (Rayleigh) and untinted for a lamp (a lit backdrop); ground below: albedo
+- sky: for the sun, the clear sky of the same atmosphere (:func:`outside_radiances`,
+  catalog/sky.py for its distribution over directions); for a lamp, outside above the
+  horizon, radiance SKY_FRACTION E / pi (a lit backdrop); ground below: albedo
   GROUND_ALBEDO under the key light's horizontal irradiance;
 - fill: the light bounced into the room, a directional light on the viewer's side with
   FILL_FRACTION of the key's spectrum (so a front-lit curtain is not black);
@@ -345,6 +346,27 @@ def decide_fluorescence(preset, irradiance: np.ndarray, requested: str) -> Fluor
     return FluorescenceDecision(requested, requested if needed else "off", needed, delta_e)
 
 
+def outside_radiances(key_irradiance: np.ndarray, to_light: np.ndarray,
+                      is_sun: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Mean radiance spectra of the sky and the ground outside the window.
+
+    The sun above the horizon: the clear sky of the same atmosphere (catalog.sun.clear_sky
+    at the sun's zenith): sky = diffuse horizontal / pi (a uniform sky with the same
+    irradiance; catalog/sky.py spreads it over the sky by Preetham's distribution), ground =
+    albedo x global horizontal / pi. A lamp (or the sun at or below the horizon): the scene
+    design of the module docstring (a lit backdrop, SKY_FRACTION of the key)."""
+    if is_sun and to_light[1] > 1e-3:
+        from catalog.sun import Atmosphere, clear_sky  # noqa: PLC0415
+
+        zenith = min(math.degrees(math.acos(min(float(to_light[1]), 1.0))), 89.5)
+        sky = clear_sky(zenith)
+        return (sky.diffuse_horizontal / math.pi,
+                Atmosphere().ground_albedo * sky.global_horizontal / math.pi)
+    tint = (550.0 / GRID_NM) ** 4 if is_sun else np.ones(GRID_NM.size)
+    return (SKY_FRACTION * key_irradiance * tint / math.pi,
+            GROUND_ALBEDO * key_irradiance * max(to_light[1], 0.0) / math.pi)
+
+
 def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.ndarray, *,
                          is_sun: bool, fluorescence: str = "physical",
                          viewer_inside: bool = True) -> tuple[ShadingInputs, FluorescenceDecision]:
@@ -355,9 +377,7 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
     key = np.asarray(key_irradiance, dtype=np.float64)
     to_light = np.asarray(key_to_light, dtype=np.float64)
     to_light = to_light / np.linalg.norm(to_light)
-    tint = (550.0 / GRID_NM) ** 4 if is_sun else np.ones(GRID_NM.size)
-    sky = SKY_FRACTION * key * tint / math.pi
-    ground = GROUND_ALBEDO * key * max(to_light[1], 0.0) / math.pi
+    sky, ground = outside_radiances(key, to_light, is_sun)
     fill = FILL_FRACTION * key
     room = ROOM_ALBEDO * ROOM_FRACTION * key / math.pi
     disc = key / (math.pi * SUN_RADIUS_RAD ** 2)
