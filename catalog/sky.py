@@ -131,6 +131,7 @@ class SkyModel:
         d = np.asarray(directions, dtype=np.float64)
         horizon = d.copy()
         horizon[..., 1] = np.maximum(horizon[..., 1], 0.0)
+        horizon /= np.maximum(np.linalg.norm(horizon, axis=-1, keepdims=True), 1e-12)
         sky = self.scale_rgb * preetham_rgb(horizon, self.to_sun, self.turbidity)
         depression = np.arcsin(np.clip(-d[..., 1], 0.0, 1.0))
         fade = np.exp(-depression / HAZE_RAD)[..., None]

@@ -865,11 +865,12 @@ class FrameRenderer:
         if self._bloom_gl is None:
             mgl, ctx = self._moderngl, self.ctx
             w, h = self.size
-            half = ctx.texture((max(1, (w + 1) // 2), max(1, (h + 1) // 2)), 4, dtype="f2")
+            # float32: the sun's disc (~1e9 cd m^-2) overflows half floats
+            half = ctx.texture((max(1, (w + 1) // 2), max(1, (h + 1) // 2)), 4, dtype="f4")
             half.filter = (mgl.LINEAR_MIPMAP_NEAREST, mgl.LINEAR)  # whole levels: bilinear taps
             half.repeat_x = half.repeat_y = False
             glow = ctx.texture((max(1, (half.size[0] + 1) // 2), max(1, (half.size[1] + 1) // 2)),
-                               4, dtype="f2")   # quarter size: the glow is wide
+                               4, dtype="f4")   # quarter size: the glow is wide
             glow.filter = (mgl.LINEAR, mgl.LINEAR)
             glow.repeat_x = glow.repeat_y = False
             out = ctx.texture((w, h), 4, dtype="f4")
