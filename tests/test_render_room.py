@@ -177,9 +177,10 @@ def test_uv_fluorescence_raises_the_rooms_blue(gl):
 
 
 def test_walls_differ_between_fabrics(gl):
-    """Default view, D65: with the room lit through the curtain, the window wall's mean
-    luminance differs between the ten fabrics (no two within 0.5 %, max / min above 1.2);
-    the earlier constant room gave all ten the same value."""
+    """Default view, D65: with the room lit through the curtain, the window wall's mean colour
+    differs between every two of the ten fabrics (by more than 0.3 % in some channel of linear
+    sRGB) and its luminance spans more than 1.2x; the earlier constant room gave all ten the
+    same colour."""
     from catalog.presets import list_presets
 
     names = sorted(p.stem for p in list_presets())
@@ -191,14 +192,18 @@ def test_walls_differ_between_fabrics(gl):
         r.set_fabric(name)
         r.set_room_lighting(True)
         r.render()
-        lit.append(_luma(_wall_strips(r.read_linear())).mean())
+        lit.append(_wall_strips(r.read_linear()).mean(axis=0))
         r.set_room_lighting(False)
         r.render()
-        constant.append(_luma(_wall_strips(r.read_linear())).mean())
-    lit = np.sort(np.array(lit))
-    assert np.all(np.diff(lit) / lit[:-1] > 0.005)
-    assert lit[-1] / lit[0] > 1.2
-    assert np.ptp(constant) == 0.0
+        constant.append(_wall_strips(r.read_linear()).mean(axis=0))
+    lit = np.array(lit)
+    for a in range(len(names)):
+        for b in range(a + 1, len(names)):
+            change = np.abs(lit[a] - lit[b]) / np.maximum(lit[a], lit[b])
+            assert change.max() > 0.003, (names[a], names[b], change)
+    luma = _luma(lit)
+    assert luma.max() / luma.min() > 1.2
+    assert np.ptp(np.array(constant), axis=0).max() == 0.0
     r.release()
 
 
@@ -225,13 +230,14 @@ def test_layers_multiply_in_the_shadow_map(gl):
 
 
 def test_room_lamp_lights_the_floor_by_inverse_square(gl):
-    """A lamp 1.5 m above a floor texel's centre adds at least I / h^2 there (the light map,
-    read back) and at most 25 % more (its light bounced off the walls)."""
+    """A lamp 1.5 m above a floor texel's centre in the middle of the room adds at least
+    I / h^2 there (the light map, read back) and at most 25 % more: its light bounced off the
+    walls, by the integrating-sphere estimate rho 4 pi I / A_room ~ 18 % of I / h^2 here."""
     r = _renderer(gl)
     faces = room_light.room_faces()
     floor = faces[0]
     k = room_light.FACE_TEXELS
-    i, j = 10, 12  # texel (s, t) of the floor
+    i, j = k // 2, k // 2  # a floor texel in the middle of the room
     centre = floor.origin + (i + 0.5) / k * floor.axis_s + (j + 0.5) / k * floor.axis_t
     lamp = (float(centre[0]), float(centre[1] + 1.5), float(centre[2]))
     r.set_curtain_open(False)

@@ -115,9 +115,9 @@ class FrameRenderer:
         self.curtain_open = False
         self.room_lamps: list[tuple] = []   # (catalog.lights.Light, (x, y, z) m)
         self._room_gl = None
-        #: the room's light (shadow map, capture, light map) is redrawn when the scene, the
-        #: mesh or the lamps change; a cloth drawn from GPU buffers changes unseen, so then
-        #: every ``room_update_every`` frames (1: every frame)
+        #: the room's light (shadow map, capture, light map) is redrawn at once when the light,
+        #: fabric, curtain or lamps change, and every ``room_update_every`` frames while the
+        #: cloth moves (a cloth drawn from GPU buffers is taken as moving); 1: every frame
         self.room_update_every = 1
         self._room_key = None
         self._room_frames = 0
@@ -806,12 +806,15 @@ class FrameRenderer:
 
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
-        key = (self._inputs_key, self._mesh_version, self.curtain_open,
+        key = (self._inputs_key, self.curtain_open,
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
-        moving = self._curtain_format != "3f" and self._room_frames >= self.room_update_every
-        if key != self._room_key or moving or self._room_gl is None:
+        moved = self._mesh_version != getattr(self, "_room_mesh_version", None) or (
+            self._curtain_format != "3f")  # a cloth on the GPU moves unseen
+        due = moved and self._room_frames >= self.room_update_every
+        if key != self._room_key or due or self._room_gl is None:
             self._room_key = key
+            self._room_mesh_version = self._mesh_version
             self._room_frames = 0
             return True
         return False

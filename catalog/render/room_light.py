@@ -33,13 +33,13 @@ import numpy as np
 from catalog.render import scene as scene_lib
 
 #: Light-map texels per side of each room face.
-FACE_TEXELS = 24
+FACE_TEXELS = 16
 #: Faces of the room, in atlas order.
 FACE_NAMES = ("floor", "ceiling", "left", "right", "back", "window_wall")
-#: Coarse mip level of the direct light map used as the bounce's sources (24 -> 6 per side).
+#: Coarse mip level of the direct light map used as the bounce's sources (16 -> 4 per side).
 BOUNCE_LEVEL = 2
 #: The luminaire capture: texels across and down the window opening.
-LUMINAIRE_TEXELS = (16, 12)
+LUMINAIRE_TEXELS = (12, 9)
 #: Where the luminaire capture looks from (metres): the middle of the room, eye height.
 LUMINAIRE_EYE = (0.0, 0.2, 2.0)
 #: The transmittance shadow map's side (texels).

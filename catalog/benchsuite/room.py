@@ -1,0 +1,174 @@
+"""The room lit through the curtain (issue 13): frame time with and without, side by side.
+
+    .venv/bin/python -m catalog.benchsuite.room [--size 1280x720] [--repeats 7] [--quick]
+        [--json benchmarks/bench_room.json]
+
+In one run, one context, one renderer (lace-fwa under sun:60, the default view), frames of
+four configurations, interleaved round by round so that the shared machine's load falls on
+all alike (median of the rounds):
+
+- ``without``: the earlier room (constant fraction of the key + fill), flat sky, no bloom;
+- ``room+sky, static``: room lighting (shadow map, area light, bounce, AO) and the clear
+  sky; the room's light drawn once and reused (a still cloth: the viewer's usual case);
+- ``room+sky, moving``: the same, every pass every frame (a simulated cloth);
+- ``room+sky+bloom, moving``: and the glare.
+
+The goal of issue 13: ``room+sky`` at most 1.5x ``without``. Each pass's share comes from a
+separate profiled frame (the GL queue finished around each pass). The GPU estimate counts
+each pass's work (fragments x loop iterations) and divides by a stated nominal throughput;
+it is an estimate, not a measurement (no device was lent to this run).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from pathlib import Path
+
+#: Nominal GPU throughput for the estimate: shaded fragment-iterations per second (a
+#: mid-range discrete GPU runs ~1e11 simple fragment operations/s; a loop iteration of the
+#: light-map gather is ~10 of them).
+GPU_ITERATIONS_PER_S = 1.0e10
+
+CONFIGS = (
+    ("without", dict(room_lighting=False, sky_model=False, bloom=False, moving=False)),
+    ("room+sky, static", dict(room_lighting=True, sky_model=True, bloom=False, moving=False)),
+    ("room+sky, moving", dict(room_lighting=True, sky_model=True, bloom=False, moving=True)),
+    ("room+sky+bloom, moving", dict(room_lighting=True, sky_model=True, bloom=True, moving=True)),
+)
+
+
+def _configure(renderer, config) -> None:
+    renderer.set_room_lighting(config["room_lighting"])
+    renderer.set_sky_model(config["sky_model"])
+    renderer.set_bloom(config["bloom"])
+
+
+def _frame(renderer, ctx, config) -> float:
+    if config["moving"]:
+        renderer.invalidate_room_light()
+    start = time.perf_counter()
+    renderer.render()
+    ctx.finish()
+    return time.perf_counter() - start
+
+
+def work_counts(size) -> dict[str, float]:
+    """Fragment-iterations per pass (the GPU estimate's numerator)."""
+    from catalog.render import room_light  # noqa: PLC0415
+
+    w, h = size
+    aw, ah = room_light.atlas_size()
+    lw, lh = room_light.LUMINAIRE_TEXELS
+    coarse = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
+    n = room_light.SHADOW_TEXELS
+    return {
+        "room_shadow": 0.6 * n * n,
+        "room_luminaire": float(lw * lh),
+        "room_lightmap": float(aw * ah * (lw * lh + 5 * coarse * coarse)),
+        "room": 0.5 * w * h,
+        "curtain": 0.5 * w * h * 4,
+        "background": 0.2 * w * h,
+        "bloom": w * h * (0.25 + 6 / 16 + 1),
+        "tonemap": float(w * h),
+    }
+
+
+def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int = 7) -> dict:
+    from catalog.render.context import create_headless_context  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    own = ctx is None
+    if own:
+        ctx = create_headless_context()
+    if quick:
+        size, repeats = (320, 180), 3
+    renderer = FrameRenderer(ctx, size)
+    renderer.set_fabric("lace-fwa")
+    renderer.set_light("sun:60")
+    samples = {name: [] for name, _ in CONFIGS}
+    for name, config in CONFIGS:  # warm-up: compile every variant
+        _configure(renderer, config)
+        _frame(renderer, ctx, config)
+        _frame(renderer, ctx, config)
+    for _ in range(repeats):
+        for name, config in CONFIGS:
+            _configure(renderer, config)
+            _frame(renderer, ctx, config)  # the switch's own first frame is not timed
+            samples[name].append(_frame(renderer, ctx, config))
+    base = statistics.median(samples["without"])
+    rows = []
+    counts = work_counts(size)
+    for name, config in CONFIGS:
+        _configure(renderer, config)
+        profile: dict[str, float] = {}
+        for _ in range(3):
+            if config["moving"]:
+                renderer.invalidate_room_light()
+            renderer.render(profile=profile)
+        total = sum(profile.values())
+        passes = {k: {"ms": 1000 * v / 3, "share": v / total} for k, v in profile.items()}
+        gpu_ms = 1000 * sum(counts[k] for k in profile) / GPU_ITERATIONS_PER_S
+        median = statistics.median(samples[name])
+        rows.append({"config": name, "frame_ms": 1000 * median, "ratio": median / base,
+                     "best_ratio": min(samples[name]) / min(samples["without"]),
+                     "passes": passes, "gpu_estimate_ms": gpu_ms})
+    renderer.release()
+    if own:
+        ctx.release()
+    by = {row["config"]: row for row in rows}
+    return {"size": list(size), "repeats": repeats, "rows": rows,
+            "summary": {"goal_ratio": 1.5,
+                        "static_ratio": by["room+sky, static"]["ratio"],
+                        "moving_ratio": by["room+sky, moving"]["ratio"],
+                        "bloom_ratio": by["room+sky+bloom, moving"]["ratio"]}}
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    w, h = result["size"]
+    lines = [f"| configuration ({w}x{h}, llvmpipe) | frame ms (median) | x without | best-round x | GPU estimate ms |",
+             "|---|---:|---:|---:|---:|"]
+    for row in result["rows"]:
+        lines.append(f"| {row['config']} | {row['frame_ms']:.1f} | {row['ratio']:.2f} | "
+                     f"{row['best_ratio']:.2f} | {row['gpu_estimate_ms']:.2f} |")
+    names = []
+    for row in result["rows"]:
+        for name in row["passes"]:
+            if name not in names:
+                names.append(name)
+    passes = ["| pass | " + " | ".join(row["config"] for row in result["rows"]) + " |",
+              "|---|" + "---:|" * len(result["rows"])]
+    for name in names:
+        cells = []
+        for row in result["rows"]:
+            p = row["passes"].get(name)
+            cells.append(f"{p['ms']:.1f} ms ({100 * p['share']:.0f} %)" if p else "-")
+        passes.append(f"| {name} | " + " | ".join(cells) + " |")
+    return {"room_frame": "\n".join(lines), "room_passes": "\n".join(passes)}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--size", default="1280x720")
+    parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--json", default=None, help="write the result here")
+    args = parser.parse_args(argv)
+    from catalog.cliargs import parse_wxh  # noqa: PLC0415
+
+    size = parse_wxh(args.size, "--size", 1, 16384)
+    result = run(args.quick, size=size, repeats=args.repeats)
+    for table in markdown_tables(result).values():
+        print(table)
+        print()
+    if args.json:
+        from catalog.atomic import write_text_atomic  # noqa: PLC0415
+
+        write_text_atomic(Path(args.json), json.dumps(result, indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
