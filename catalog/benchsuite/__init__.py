@@ -16,7 +16,9 @@ optionally, ``plot(result, folder) -> list[Path]``:
   (:mod:`catalog.benchsuite.cloth`);
 - ``stability``: every model's parameters swept to their edges
   (:mod:`catalog.benchsuite.stability`);
-- ``startup``: import time and time to the first frame (:mod:`catalog.benchsuite.startup`).
+- ``startup``: import time and time to the first frame (:mod:`catalog.benchsuite.startup`);
+- ``room``: the frame with the room lit through the curtain, the clear sky and the glare
+  against the frame without, each pass's share (:mod:`catalog.benchsuite.room`).
 
 docs/bench.md has the figures and how to reproduce them.
 """
@@ -31,4 +33,5 @@ SECTIONS: dict[str, str] = {
     "cloth": "catalog.benchsuite.cloth",
     "stability": "catalog.benchsuite.stability",
     "startup": "catalog.benchsuite.startup",
+    "room": "catalog.benchsuite.room",
 }

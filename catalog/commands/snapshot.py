@@ -24,6 +24,14 @@ def add_arguments(parser) -> None:
     parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
     parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")
     parser.add_argument("--exposure", type=float, default=1.0, help="exposure multiplier")
+    parser.add_argument("--environment", metavar="FILE.exr", default=None,
+                        help="an HDR latitude-longitude image as the view behind the window "
+                             "(scaled to the light's sky; default: the procedural clear sky)")
+    parser.add_argument("--curtain", choices=("closed", "open"), default="closed",
+                        help="open: the curtain drawn aside (the room lit by the window alone)")
+    parser.add_argument("--no-room-light", action="store_true",
+                        help="the earlier constant room instead of the room lit through the curtain")
+    parser.add_argument("--no-bloom", action="store_true", help="no glare before the tone map")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
@@ -37,7 +45,9 @@ def run(args) -> int:
         fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
         frame=args.frame, fluorescence="off" if args.no_fluorescence else args.mode,
         bands=args.bands, hour=args.hour, yaw_deg=args.yaw, pitch_deg=args.pitch,
-        distance_m=args.distance, exposure=args.exposure)
+        distance_m=args.distance, exposure=args.exposure, environment=args.environment,
+        curtain_open=args.curtain == "open", room_light=not args.no_room_light,
+        bloom=not args.no_bloom)
     report = render_snapshot(request)
     if args.json:
         print_json(report)

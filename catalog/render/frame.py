@@ -124,6 +124,7 @@ class FrameRenderer:
         self._mesh_version = 0
         self.sky_model = True      # the clear sky of catalog/sky.py behind the window (a sun)
         self.bloom = True          # glare before the tone map (bloom.frag)
+        self.environment = None    # (path, texture, upper-hemisphere illuminance) or None
         self._bloom_gl = None
 
         positions, normals = scene_lib.room_props()
@@ -206,6 +207,25 @@ class FrameRenderer:
     def set_sky_model(self, on: bool) -> None:
         """The clear sky by direction (catalog/sky.py) or the earlier flat sky and ground."""
         self.sky_model = bool(on)
+
+    def set_environment(self, path) -> None:
+        """An HDR latitude-longitude image (EXR, ...) as the view behind the window, scaled to
+        the light's sky (catalog/render/environment.py); None: the procedural clear sky."""
+        from catalog.render import environment as env  # noqa: PLC0415
+
+        if self.environment is not None:
+            self.environment[1].release()
+            self.environment = None
+        if path is None:
+            return
+        pixels = env.load_environment(path)
+        h, w = pixels.shape[:2]
+        texture = self.ctx.texture((w, h), 3, data=np.ascontiguousarray(pixels[::-1]).tobytes(),
+                                   dtype="f4")
+        texture.filter = (self._moderngl.LINEAR, self._moderngl.LINEAR)
+        texture.repeat_x, texture.repeat_y = True, False
+        self.environment = (str(path), texture, env.upper_illuminance(pixels))
+        self._room_key = None
 
     def set_bloom(self, on: bool) -> None:
         """Glare before the tone map (energy-preserving, bloom.frag) on or off."""
@@ -540,10 +560,24 @@ class FrameRenderer:
             self._sky_key = key
         return self._sky_value
 
+    def environment_scale(self, inputs) -> float:
+        """The environment image's factor: its upper hemisphere's horizontal illuminance made
+        the light's sky's, pi x Y(sky radiance) (the clear sky's diffuse illuminance for the
+        sun, the lit backdrop's for a lamp)."""
+        target = math.pi * float(np.dot(band_lib.spectrum_to_display_rgb(inputs.sky_radiance),
+                                        (0.2126, 0.7152, 0.0722)))
+        return target / self.environment[2]
+
     def _draw_background(self, view_proj, inputs, camera_position=None, sun_disc=True) -> None:
-        sky = self._sky(inputs)
-        program = self._program("fullscreen.vert", "background.frag", {"SKY_MODEL": sky is not None})
+        sky = None if self.environment is not None else self._sky(inputs)
+        program = self._program("fullscreen.vert", "background.frag",
+                                {"SKY_MODEL": sky is not None,
+                                 "ENVIRONMENT": self.environment is not None})
         self._scene_uniforms(program, view_proj, inputs, camera_position)
+        if self.environment is not None:
+            self.environment[1].use(location=5)
+            self._set(program, "u_environment", 5)
+            self._set(program, "u_environment_scale", self.environment_scale(inputs))
         self._set(program, "u_inverse_view_proj", gl_bytes(np.linalg.inv(view_proj)))
         colours = self._display_colours(inputs)
         for name in ("u_sky_rgb", "u_ground_rgb", "u_sun_disc_rgb", "u_room_rgb"):
@@ -1046,3 +1080,6 @@ class FrameRenderer:
             obj.release()
         self._room_gl = None
         self._bloom_gl = None
+        if self.environment is not None:
+            self.environment[1].release()
+            self.environment = None

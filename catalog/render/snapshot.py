@@ -52,6 +52,10 @@ class SnapshotRequest:
     pitch_deg: float = 0.0
     distance_m: float = 2.6
     exposure: float = 1.0
+    environment: str | None = None    # FILE.exr behind the window (issue 13)
+    curtain_open: bool = False
+    room_light: bool = True
+    bloom: bool = True
 
 
 def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
@@ -123,6 +127,10 @@ def validate(request: SnapshotRequest):
     scene_lib.dye_transmittance(preset)
     scene_lib.fluorescent_material(preset)
     light = get_light(request.light) if request.hour is None else None
+    if request.environment is not None:
+        from catalog.render.environment import load_environment  # noqa: PLC0415
+
+        load_environment(request.environment)  # refused now, before a context exists
     return preset, light
 
 
@@ -147,6 +155,11 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.set_bands(request.bands)
         renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
         renderer.set_exposure(request.exposure)
+        renderer.set_curtain_open(request.curtain_open)
+        renderer.set_room_lighting(request.room_light)
+        renderer.set_bloom(request.bloom)
+        if request.environment is not None:
+            renderer.set_environment(request.environment)
         mesh_source = "static drape"
         if request.frame > 0:
             renderer.set_mesh(*simulated_curtain(preset, request.frame))
