@@ -17,8 +17,9 @@ uniform vec3 u_face_s[6];
 uniform vec3 u_face_t[6];
 uniform vec3 u_face_normal[6];
 
-uniform sampler2D u_luminaire;
+uniform sampler2D u_luminaire;       // mipmapped; level u_luminaire_level = one texel a patch
 uniform ivec2 u_luminaire_size;
+uniform int u_luminaire_level;
 uniform vec4 u_window_rect;          // x0, x1, y0, y1 of the opening (m)
 uniform vec2 u_wall_z;               // the window wall's inner and outer planes (m)
 uniform float u_patch_area_m2;
@@ -57,7 +58,7 @@ void main() {
             float inv_r = inversesqrt(r2);
             float cos_r = max(dot(n, d) * inv_r, 0.0);
             float cos_p = max(-d.z * inv_r, 0.0);
-            e += texelFetch(u_luminaire, ivec2(i, j), 0).rgb
+            e += texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level).rgb
                * (cos_r * cos_p * u_patch_area_m2 / max(r2, u_patch_area_m2));
         }
     }

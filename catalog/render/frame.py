@@ -649,9 +649,9 @@ class FrameRenderer:
             shadow = ctx.texture((n, n), 4, dtype="f2")
             shadow.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
             shadow.repeat_x = shadow.repeat_y = False
-            lw, lh = room_light.LUMINAIRE_TEXELS
+            lw, lh = room_light.luminaire_capture_size()
             luminaire = ctx.texture((lw, lh), 4, dtype="f4")
-            luminaire.filter = (mgl.NEAREST, mgl.NEAREST)
+            luminaire.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             luminaire_depth = ctx.depth_renderbuffer((lw, lh))
             aw, ah = room_light.atlas_size()
             direct = ctx.texture((aw, ah), 4, dtype="f4")
@@ -745,7 +745,7 @@ class FrameRenderer:
         """Pass R2: what the room sees in the window (the curtain's room-side radiance, or the
         outside where it is open), one texel per window patch, the sun's disc left out."""
         mgl, gl = self._moderngl, self._room_resources()
-        lw, lh = room_light.LUMINAIRE_TEXELS
+        lw, lh = room_light.luminaire_capture_size()
         gl["luminaire_fbo"].use()
         self.ctx.viewport = (0, 0, lw, lh)
         gl["luminaire_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
@@ -758,6 +758,7 @@ class FrameRenderer:
         self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False)
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
+        gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
 
     def draw_room_lightmap(self, inputs) -> None:
         """Passes R3 and R4: the light map's direct part (area light, beam, lamps), then one
@@ -773,6 +774,7 @@ class FrameRenderer:
         gl["luminaire"].use(location=1)
         self._set(program, "u_luminaire", 1)
         self._set(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)
+        self._set(program, "u_luminaire_level", room_light.LUMINAIRE_LEVEL)
         self._set(program, "u_patch_area_m2", room_light.window_patch_area_m2())
         gl["shadow"].use(location=2)
         self._set(program, "u_shadow", 2)

@@ -38,8 +38,11 @@ FACE_TEXELS = 16
 FACE_NAMES = ("floor", "ceiling", "left", "right", "back", "window_wall")
 #: Coarse mip level of the direct light map used as the bounce's sources (16 -> 4 per side).
 BOUNCE_LEVEL = 2
-#: The luminaire capture: texels across and down the window opening.
+#: The luminaire capture: patches across and down the window opening, each the mean of
+#: 2^LUMINAIRE_LEVEL x 2^LUMINAIRE_LEVEL samples (the capture's mip level), so that a fold
+#: moving across a patch changes its radiance smoothly (no shimmer in the room's light).
 LUMINAIRE_TEXELS = (12, 9)
+LUMINAIRE_LEVEL = 2
 #: Where the luminaire capture looks from (metres): the middle of the room, eye height.
 LUMINAIRE_EYE = (0.0, 0.2, 2.0)
 #: The transmittance shadow map's side (texels).
@@ -251,6 +254,11 @@ def luminaire_view_projection(eye=LUMINAIRE_EYE) -> np.ndarray:
     view = np.eye(4)
     view[:3, 3] = -eye  # axes aligned with the world: looking down -z
     return proj @ view
+
+
+def luminaire_capture_size() -> tuple[int, int]:
+    """The capture's render size: LUMINAIRE_TEXELS supersampled by 2^LUMINAIRE_LEVEL."""
+    return LUMINAIRE_TEXELS[0] << LUMINAIRE_LEVEL, LUMINAIRE_TEXELS[1] << LUMINAIRE_LEVEL
 
 
 def window_patch_area_m2() -> float:
