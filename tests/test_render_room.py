@@ -280,3 +280,19 @@ def test_room_light_is_stable_as_the_cloth_moves(gl):
         previous = light
     assert worst < 0.05
     r.release()
+
+
+@pytest.mark.parametrize("lamp, needle", [("A@0,9,2.5", "inside the room"),
+                                          ("A0,1,2", "LIGHT@X,Y,Z"),
+                                          ("NOPE@0,1,2", "NOPE")])
+def test_cli_refuses_a_bad_lamp_in_one_line(tmp_path, lamp, needle):
+    import subprocess
+    import sys
+
+    out = tmp_path / "x.png"
+    run = subprocess.run([sys.executable, "-m", "catalog", "snapshot", "--fabric", "lace-fwa",
+                          "--size", "32x24", "--lamp", lamp, "--out", str(out)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and run.stdout == ""
+    assert len(run.stderr.strip().splitlines()) == 1 and needle in run.stderr
+    assert not out.exists()

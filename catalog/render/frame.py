@@ -207,6 +207,7 @@ class FrameRenderer:
     def set_sky_model(self, on: bool) -> None:
         """The clear sky by direction (catalog/sky.py) or the earlier flat sky and ground."""
         self.sky_model = bool(on)
+        self._room_key = None  # the window's capture sees the sky
 
     def set_environment(self, path) -> None:
         """An HDR latitude-longitude image (EXR, ...) as the view behind the window, scaled to
@@ -216,6 +217,7 @@ class FrameRenderer:
         if self.environment is not None:
             self.environment[1].release()
             self.environment = None
+        self._room_key = None  # the window's capture sees the outside
         if path is None:
             return
         pixels = env.load_environment(path)
@@ -1057,6 +1059,10 @@ class FrameRenderer:
                        "distance_m": self.camera.distance_m},
             "exposure": self.exposure_scale(),
             "size": list(self.size),
+            "room_lighting": self.room_lighting, "curtain_open": self.curtain_open,
+            "sky_model": self.sky_model, "bloom": self.bloom,
+            "environment": None if self.environment is None else self.environment[0],
+            "room_lamps": [[light.name, list(position)] for light, position in self.room_lamps],
         }
 
     def release(self) -> None:

@@ -56,6 +56,7 @@ class SnapshotRequest:
     curtain_open: bool = False
     room_light: bool = True
     bloom: bool = True
+    lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
 
 
 def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
@@ -131,6 +132,17 @@ def validate(request: SnapshotRequest):
         from catalog.render.environment import load_environment  # noqa: PLC0415
 
         load_environment(request.environment)  # refused now, before a context exists
+    from catalog.render import room_light  # noqa: PLC0415
+
+    if len(request.lamps) > room_light.MAX_ROOM_LAMPS:
+        raise InputError(f"at most {room_light.MAX_ROOM_LAMPS} lamps, got {len(request.lamps)}",
+                         field="--lamp")
+    for name, position in request.lamps:
+        get_light(name)
+        try:
+            room_light.check_lamp_position(position)
+        except CatalogError as exc:
+            raise InputError(str(exc), field="--lamp") from None
     return preset, light
 
 
@@ -160,6 +172,7 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.set_bloom(request.bloom)
         if request.environment is not None:
             renderer.set_environment(request.environment)
+        renderer.set_room_lamps(request.lamps)
         mesh_source = "static drape"
         if request.frame > 0:
             renderer.set_mesh(*simulated_curtain(preset, request.frame))

@@ -61,6 +61,7 @@ class ViewerOptions:
     panel: bool = True
     paused: bool = False
     render_scale: float | None = None  # scene resolution / window resolution; None: auto
+    room_light: bool = True  # the room lit through the curtain, the clear sky, glare (issue 13)
     fabric_dir: Path = FABRIC_DIR
 
 
@@ -143,7 +144,7 @@ class ViewerApp:
         self.render_scale = self._choose_render_scale()
         self.cloth_backend = self._choose_cloth_backend()
         self.room_settings = self._choose_room_settings()
-        if self._software_gl():
+        if self._software_gl() and self.options.room_light:
             import sys  # noqa: PLC0415
 
             print(f"catalog view: software rasteriser ({self.ctx.info.get('GL_RENDERER', '?')}): "
@@ -381,6 +382,8 @@ class ViewerApp:
                 self._scaled_fbos.append(self.ctx.simple_framebuffer(size, components=4))
             renderer = FrameRenderer(self.ctx, size)
             renderer.set_bloom(self.room_settings["bloom"])
+            renderer.set_room_lighting(self.room_settings["room_light"])
+            renderer.set_sky_model(self.room_settings["room_light"])
             renderer.room_update_every = self.room_settings["room_update_every"]
             self._renderers.append(renderer)
 
@@ -393,9 +396,12 @@ class ViewerApp:
     def _choose_room_settings(self) -> dict:
         """The room lighting's cheaper settings on a software rasteriser (the frame budget:
         docs/room.md), the full ones on a GPU."""
+        if not self.options.room_light:
+            return {"room_light": False, "bloom": False, "room_update_every": 1}
         if self._software_gl():
-            return {"bloom": SOFTWARE_BLOOM, "room_update_every": SOFTWARE_ROOM_UPDATE_EVERY}
-        return {"bloom": True, "room_update_every": 1}
+            return {"room_light": True, "bloom": SOFTWARE_BLOOM,
+                    "room_update_every": SOFTWARE_ROOM_UPDATE_EVERY}
+        return {"room_light": True, "bloom": True, "room_update_every": 1}
 
     def _software_gl(self) -> bool:
         renderer = self.ctx.info.get("GL_RENDERER", "")
