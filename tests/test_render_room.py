@@ -296,3 +296,15 @@ def test_cli_refuses_a_bad_lamp_in_one_line(tmp_path, lamp, needle):
     assert run.returncode == 2 and run.stdout == ""
     assert len(run.stderr.strip().splitlines()) == 1 and needle in run.stderr
     assert not out.exists()
+
+
+def test_stored_ambient_occlusion_is_the_computed_one():
+    """catalog/data/room_ao.npz (tools/make_room_ao.py) is what ambient_occlusion computes for
+    this room; corners are occluded (< 0.7) and the middle of the floor is open (1)."""
+    assert room_light.AO_TABLE_PATH.is_file()
+    stored = room_light.stored_ambient_occlusion()
+    computed = room_light.ambient_occlusion()
+    assert np.array_equal(stored, computed)
+    k = room_light.FACE_TEXELS
+    floor = computed[:, :k]
+    assert floor[0, 0] < 0.7 and floor[k // 2, k // 2] == 1.0

@@ -27,6 +27,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -182,11 +183,39 @@ def ambient_occlusion(face_texels: int = FACE_TEXELS, rays: int = AO_RAYS,
     return out
 
 
+#: The precomputed occlusion (tools/make_room_ao.py writes it; the room is static).
+AO_TABLE_PATH = Path(__file__).resolve().parent.parent / "data" / "room_ao.npz"
+
+
+def ao_table_key(face_texels: int = FACE_TEXELS) -> np.ndarray:
+    """What the stored table was computed for: texels, rays, radius, the room's geometry."""
+    return np.array([face_texels, AO_RAYS, AO_RADIUS_M, *np.ravel(scene_lib.ROOM_BOX),
+                     *scene_lib.WINDOW_RECT, scene_lib.CURTAIN_TOP_Y, scene_lib.CURTAIN_Z,
+                     scene_lib.CURTAIN_WIDTH_M], dtype=np.float64)
+
+
+def write_ao_table(path: Path = AO_TABLE_PATH) -> None:
+    from catalog.atomic import atomic_path  # noqa: PLC0415
+
+    with atomic_path(path, suffix=".npz") as tmp:
+        np.savez_compressed(tmp, key=ao_table_key(), ao=ambient_occlusion())
+
+
+def stored_ambient_occlusion(face_texels: int = FACE_TEXELS) -> np.ndarray:
+    """The stored table when it was made for this room and these settings, else computed
+    (~1 s of numpy; the table spares the first frame that)."""
+    if face_texels == FACE_TEXELS and AO_TABLE_PATH.is_file():
+        with np.load(AO_TABLE_PATH, allow_pickle=False) as data:
+            if np.array_equal(data["key"], ao_table_key(face_texels)):
+                return data["ao"].astype(np.float32)
+    return ambient_occlusion(face_texels)
+
+
 def ao_and_mask_texture(face_texels: int = FACE_TEXELS) -> np.ndarray:
     """(R, 6R, 4) float32: AO, surface mask, 0, 1 (row 0 = t = 0, as GL stores it)."""
     positions, _ = texel_points(face_texels)
     out = np.zeros(positions.shape[:2] + (4,), dtype=np.float32)
-    out[..., 0] = ambient_occlusion(face_texels)
+    out[..., 0] = stored_ambient_occlusion(face_texels)
     out[..., 1] = surface_mask(positions)
     out[..., 3] = 1.0
     return out
