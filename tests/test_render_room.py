@@ -308,3 +308,19 @@ def test_stored_ambient_occlusion_is_the_computed_one():
     k = room_light.FACE_TEXELS
     floor = computed[:, :k]
     assert floor[0, 0] < 0.7 and floor[k // 2, k // 2] == 1.0
+
+
+def test_room_benchmark_quick_runs_and_tabulates(gl):
+    """The benchmark's quick run: every configuration timed, finite ratios, each pass's
+    share summing to 1, and both generated tables."""
+    from catalog.benchsuite import room as bench
+
+    result = bench.run(quick=True, ctx=gl, repeats=1)
+    assert [row["config"] for row in result["rows"]] == [name for name, _ in bench.CONFIGS]
+    for row in result["rows"]:
+        assert np.isfinite(row["frame_ms"]) and row["frame_ms"] > 0
+        assert sum(p["share"] for p in row["passes"].values()) == pytest.approx(1.0)
+    moving = result["rows"][3]["passes"]
+    assert {"room_shadow", "room_luminaire", "room_lightmap"} <= set(moving)
+    tables = bench.markdown_tables(result)
+    assert set(tables) == {"room_frame", "room_passes"} and "room+sky" in tables["room_frame"]
