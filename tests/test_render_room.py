@@ -324,3 +324,22 @@ def test_room_benchmark_quick_runs_and_tabulates(gl):
     assert {"room_shadow", "room_luminaire", "room_lightmap"} <= set(moving)
     tables = bench.markdown_tables(result)
     assert set(tables) == {"room_frame", "room_passes"} and "room+sky" in tables["room_frame"]
+
+
+def test_coarse_grid_covers_the_same_cloth():
+    """The room passes' coarser grid of the drape: every 3rd row and column (the last kept),
+    about 9x fewer triangles, the same flat area; a mesh that is not a row-major grid gets none."""
+    mesh = scene_lib.draped_curtain(columns=120, rows=80, depth_m=0.0)
+    coarse = room_light.coarse_grid_indices(mesh.uvs)
+    full = mesh.indices.ravel()
+
+    def area(indices):
+        tri = mesh.positions.astype(np.float64)[indices.reshape(-1, 3)]
+        return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+
+    assert 8 < full.size / coarse.size < 10
+    assert area(coarse) == pytest.approx(area(full), rel=1e-9)
+    shuffled = mesh.uvs[::-1].copy()
+    assert room_light.coarse_grid_indices(shuffled) is None
+    small = scene_lib.draped_curtain(columns=30, rows=20)
+    assert room_light.coarse_grid_indices(small.uvs) is None

@@ -267,6 +267,9 @@ class FrameRenderer:
             "uv": self.ctx.buffer(uvs.tobytes()),
             "index": self.ctx.buffer(indices.tobytes()),
         }
+        coarse = room_light.coarse_grid_indices(uvs)
+        if coarse is not None:  # the room's passes draw this coarser grid
+            self._curtain_buffers["coarse_index"] = self.ctx.buffer(coarse.tobytes())
         self._own_buffers = list(self._curtain_buffers.values())  # the cloth's are not ours
         self._curtain_format = "3f"
         self._mesh_offset = (0.0, 0.0, 0.0)
@@ -318,6 +321,7 @@ class FrameRenderer:
         self._curtain_buffers["interleaved"] = vertex_buffer
         if index_buffer is not None:
             self._curtain_buffers["index"] = index_buffer
+            self._curtain_buffers.pop("coarse_index", None)  # another mesh: no coarse grid
         self._vertex_count = count
         self._curtain_format = "interleaved"
         self.set_mesh_offset(offset_m)
@@ -430,9 +434,10 @@ class FrameRenderer:
         specialised = [k for k in self._programs if dict(k[2]).get("SPECIALISED")]
         for key in specialised[:max(0, len(specialised) - MAX_SPECIALISED + 1)]:
             program = self._programs.pop(key)
-            vao = self._vaos.pop(("curtain", id(program)), None)
-            if vao is not None:
-                vao.release()
+            for vao_key in (("curtain", id(program)), ("curtain", id(program), "coarse")):
+                vao = self._vaos.pop(vao_key, None)
+                if vao is not None:
+                    vao.release()
             program.release()
 
     def compiled_variants(self) -> list[dict]:
@@ -440,8 +445,9 @@ class FrameRenderer:
         return [{k: v for k, v in k2[2] if not k.startswith("S_")}
                 for k2 in self._programs if k2[1] == "curtain.frag"]
 
-    def _curtain_vao(self, program):
-        key = ("curtain", id(program))
+    def _curtain_vao(self, program, coarse: bool = False):
+        coarse = coarse and "coarse_index" in self._curtain_buffers
+        key = ("curtain", id(program)) + (("coarse",) if coarse else ())
         if key not in self._vaos:
             b = self._curtain_buffers
             if self._curtain_format == "interleaved":
@@ -455,8 +461,9 @@ class FrameRenderer:
                     content.append((b["normal"], self._curtain_format, "in_normal"))
                 if "in_tangent" in program:
                     content.append((b["tangent"], "3f", "in_tangent"))
-            self._vaos[key] = self.ctx.vertex_array(program, content, index_buffer=b["index"],
-                                                    index_element_size=4)
+            self._vaos[key] = self.ctx.vertex_array(
+                program, content, index_buffer=b["coarse_index" if coarse else "index"],
+                index_element_size=4)
         return self._vaos[key]
 
     def _room_vao(self, program):
@@ -502,7 +509,8 @@ class FrameRenderer:
         s(program, "u_sun_chord2", tuple(float(v) for v in inputs.sun_chord2))
 
     def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False,
-                     camera_position=None, overrides: dict | None = None) -> None:
+                     camera_position=None, overrides: dict | None = None,
+                     coarse: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer (the benchmark times this).
 
         ``trivial``: True draws the same mesh with shaders/trivial.frag (the benchmark's floor);
@@ -524,7 +532,7 @@ class FrameRenderer:
                 for name, value in self._scene_values_with(overrides).items():
                     self._set(program, name, value)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
-        self._curtain_vao(program).render(self._moderngl.TRIANGLES)
+        self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
 
     def _display_colours(self, inputs) -> dict[str, tuple]:
         """Exact linear sRGB of the background and room radiances (once per scene change)."""
@@ -715,8 +723,9 @@ class FrameRenderer:
                 content = [(b["position"], self._curtain_format, "in_position")]
             if "in_uv" in program and "uv" in b and self._curtain_format != "interleaved":
                 content.append((b["uv"], "2f", "in_uv"))
-            self._vaos[key] = self.ctx.vertex_array(program, content, index_buffer=b["index"],
-                                                    index_element_size=4)
+            self._vaos[key] = self.ctx.vertex_array(
+                program, content, index_buffer=b.get("coarse_index", b["index"]),
+                index_element_size=4)
         return self._vaos[key]
 
     def draw_room_shadow(self, inputs) -> None:
@@ -756,7 +765,8 @@ class FrameRenderer:
         view_proj = room_light.luminaire_view_projection()
         eye = room_light.LUMINAIRE_EYE
         if not self.curtain_open:
-            self.draw_curtain(view_proj, camera_position=eye, overrides=self._no_disc_overrides())
+            self.draw_curtain(view_proj, camera_position=eye, overrides=self._no_disc_overrides(),
+                              coarse=True)
         self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False)
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)

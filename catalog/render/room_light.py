@@ -295,6 +295,44 @@ def window_patch_area_m2() -> float:
     return (wx1 - wx0) * (wy1 - wy0) / (LUMINAIRE_TEXELS[0] * LUMINAIRE_TEXELS[1])
 
 
+#: The room's passes (shadow map, capture) draw the curtain from a grid with at most this many
+#: vertices a side: on a CPU rasteriser a draw costs per triangle, and the beam's pattern
+#: needs the folds (5.5 across), not every vertex.
+COARSE_GRID_SIDE = 40
+
+
+def coarse_grid_indices(uvs: np.ndarray, max_side: int = COARSE_GRID_SIDE) -> np.ndarray | None:
+    """Triangles (int32, flat) over every k-th row and column of a row-major grid mesh, or
+    None when the vertices are not such a grid (u running 0..1 along each row, v constant in
+    it) or the grid is small already. The last row and column are always kept."""
+    uvs = np.asarray(uvs, dtype=np.float64).reshape(-1, 2)
+    n = uvs.shape[0]
+    starts = np.flatnonzero(np.abs(uvs[:, 0]) < 1e-9)
+    if starts.size < 2:
+        return None
+    columns = int(starts[1] - starts[0])
+    if columns < 2 or n % columns:
+        return None
+    rows = n // columns
+    grid = uvs.reshape(rows, columns, 2)
+    if not (np.allclose(grid[:, :, 0], np.linspace(0.0, 1.0, columns)[None, :], atol=1e-6)
+            and np.allclose(grid[:, :, 1], grid[:, :1, 1], atol=1e-9)):
+        return None
+    step = int(math.ceil(max(rows, columns) / max_side))
+    if step <= 1:
+        return None
+
+    def keep(count):
+        picks = list(range(0, count, step))
+        return picks if picks[-1] == count - 1 else picks + [count - 1]
+
+    r, c = np.array(keep(rows)), np.array(keep(columns))
+    index = r[:, None] * columns + c[None, :]
+    a, b = index[:-1, :-1].ravel(), index[:-1, 1:].ravel()
+    cc, d = index[1:, :-1].ravel(), index[1:, 1:].ravel()
+    return np.concatenate([np.stack([a, cc, b], 1), np.stack([b, cc, d], 1)]).astype(np.int32).ravel()
+
+
 @dataclass(frozen=True)
 class RoomLamp:
     """A lamp in the room: a light of the library at ``position_m``, isotropic, its normal
