@@ -121,3 +121,14 @@ def test_bloom_keeps_the_frames_energy_and_glows_around_the_sun(gl):
     assert ring.sum() > 10
     assert bloomed[ring].sum() > 1.05 * sharp[ring].sum()
     r.release()
+
+
+def test_a_dated_sun_stands_where_it_stands_then():
+    """sun@WHEN,LAT,LON: the key light (and so the sky behind the window) at the elevation
+    catalog.sun.sun_position gives for that time and place (it stood at a lamp's 25 deg)."""
+    from catalog.sun import sun_position
+
+    name = "sun@2026-12-21T12:00,34.7,135.5"
+    expected = 90.0 - sun_position("2026-12-21T12:00", 34.7, 135.5).zenith_deg
+    assert scene_lib.key_elevation_for(name) == pytest.approx(expected, abs=1e-9)
+    assert abs(expected - scene_lib.LAMP_ELEVATION_DEG) > 5.0

@@ -235,12 +235,21 @@ def sun_at_hour(hour: float) -> SunAtHour:
 
 
 def key_elevation_for(light_name: str) -> float:
-    """Elevation (deg) of the key light: the sun's from its path length, a lamp's fixed."""
+    """Elevation (deg) of the key light: the sun's from its path length (``sun:PATH``,
+    ``sun-clear:PATH``) or from its date, time and place (``sun@WHEN,LAT[,LON]``), so that the
+    sky behind the window (catalog/sky.py) is the one of that sun; a lamp's fixed."""
     if light_name.startswith(("sun:", "sun-clear:")):
         from catalog.sun import zenith_deg_from_path  # noqa: PLC0415
 
         path = float(light_name.split(":", 1)[1])
         return 90.0 - zenith_deg_from_path(path)
+    if light_name.startswith("sun@"):
+        from catalog.sun import sun_position  # noqa: PLC0415
+
+        parts = [p.strip() for p in light_name[4:].split(",")]
+        position = sun_position(parts[0], float(parts[1]),
+                                float(parts[2]) if len(parts) > 2 else 0.0)
+        return 90.0 - position.zenith_deg
     return LAMP_ELEVATION_DEG
 
 
