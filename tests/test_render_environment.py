@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from catalog.errors import InputError
+from catalog.core.errors import InputError
 from catalog.render import environment as env
 from catalog.render.snapshot import write_image
 

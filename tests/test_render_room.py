@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from catalog.reference import hg_hemisphere_factors
+from catalog.optics.shading_reference import hg_hemisphere_factors
 from catalog.render import room_light
 from catalog.render import scene as scene_lib
 from catalog.render.bands import spectrum_to_display_rgb
@@ -253,7 +253,7 @@ def test_room_lamp_lights_the_floor_by_inverse_square(gl):
 
 
 def test_room_lamp_outside_the_room_is_refused(gl):
-    from catalog.errors import CatalogError
+    from catalog.core.errors import CatalogError
 
     r = FrameRenderer(gl, (16, 16))
     with pytest.raises(CatalogError, match="inside the room"):
@@ -299,7 +299,7 @@ def test_cli_refuses_a_bad_lamp_in_one_line(tmp_path, lamp, needle):
 
 
 def test_stored_ambient_occlusion_is_the_computed_one():
-    """catalog/data/room_ao.npz (tools/make_room_ao.py) is what ambient_occlusion computes for
+    """catalog/render/data/room_ao.npz (tools/make_room_ao.py) is what ambient_occlusion computes for
     this room; corners are occluded (< 0.7) and the middle of the floor is open (1)."""
     assert room_light.AO_TABLE_PATH.is_file()
     stored = room_light.stored_ambient_occlusion()
@@ -313,7 +313,7 @@ def test_stored_ambient_occlusion_is_the_computed_one():
 def test_room_benchmark_quick_runs_and_tabulates(gl):
     """The benchmark's quick run: every configuration timed, finite ratios, each pass's
     share summing to 1, and both generated tables."""
-    from catalog.benchsuite import room as bench
+    from catalog.bench import room as bench
 
     result = bench.run(quick=True, ctx=gl, repeats=1)
     assert [row["config"] for row in result["rows"]] == [name for name, _ in bench.CONFIGS]

@@ -1,5 +1,5 @@
-"""The outside (issue 13): the clear sky by direction against its float64 twin (catalog/sky.py),
-its illuminance against the atmosphere's (catalog.sun.clear_sky), no seam at the horizon;
+"""The outside (issue 13): the clear sky by direction against its float64 twin (catalog/optics/sun/sky.py),
+its illuminance against the atmosphere's (catalog.optics.sun.model.clear_sky), no seam at the horizon;
 and the glare (bloom) keeps the frame's energy."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from catalog import sky
-from catalog.reference import spectral_to_linear_srgb
+from catalog.optics.sun import sky
+from catalog.optics.shading_reference import spectral_to_linear_srgb
 from catalog.render import scene as scene_lib
 from catalog.render.frame import FrameRenderer
 
@@ -31,12 +31,12 @@ def _rays(r):
 
 def test_sky_illuminance_is_the_atmospheres_diffuse():
     """The sky's radiance integrated with cos(theta) over the upper hemisphere equals the
-    diffuse horizontal irradiance of catalog.sun.clear_sky at the same zenith, per linear
+    diffuse horizontal irradiance of catalog.optics.sun.model.clear_sky at the same zenith, per linear
     sRGB channel, within 0.5 % (the midpoint rule on 96 x 192 cells; the scale is fitted on the
     same grid, so a finer grid checks the quadrature: 1 %)."""
     to_sun = scene_lib.key_direction(35.0, 20.0)
     model = sky.sky_model(to_sun)
-    from catalog.sun import clear_sky
+    from catalog.optics.sun.model import clear_sky
 
     expected = spectral_to_linear_srgb(clear_sky(55.0).diffuse_horizontal)
     got = sky.horizontal_irradiance_rgb(model.radiance, n_theta=192)
@@ -125,8 +125,8 @@ def test_bloom_keeps_the_frames_energy_and_glows_around_the_sun(gl):
 
 def test_a_dated_sun_stands_where_it_stands_then():
     """sun@WHEN,LAT,LON: the key light (and so the sky behind the window) at the elevation
-    catalog.sun.sun_position gives for that time and place (it stood at a lamp's 25 deg)."""
-    from catalog.sun import sun_position
+    catalog.optics.sun.model.sun_position gives for that time and place (it stood at a lamp's 25 deg)."""
+    from catalog.optics.sun.model import sun_position
 
     name = "sun@2026-12-21T12:00,34.7,135.5"
     expected = 90.0 - sun_position("2026-12-21T12:00", 34.7, 135.5).zenith_deg

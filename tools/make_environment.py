@@ -1,9 +1,9 @@
 """Write the project's own default view behind the window, the procedural clear sky of
-catalog/sky.py, as a latitude-longitude EXR (usable with ``catalog snapshot --environment``).
+catalog/optics/sun/sky.py, as a latitude-longitude EXR (usable with ``catalog snapshot --environment``).
 
     .venv/bin/python tools/make_environment.py OUT.exr [--elevation DEG] [--azimuth DEG] [--height PX]
 
-Made by this project from the Preetham et al. 1999 formulas and catalog.sun.clear_sky: it
+Made by this project from the Preetham et al. 1999 formulas and catalog.optics.sun.model.clear_sky: it
 carries the project's licence, no third-party image.
 """
 

@@ -1,5 +1,5 @@
 """Precompute the room's ambient occlusion (catalog/render/room_light.py) into
-catalog/data/room_ao.npz: the room is static, so the first frame need not pay for it.
+catalog/render/data/room_ao.npz: the room is static, so the first frame need not pay for it.
 
     .venv/bin/python tools/make_room_ao.py
 

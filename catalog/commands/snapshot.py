@@ -40,7 +40,7 @@ def add_arguments(parser) -> None:
 
 def parse_lamp(text: str) -> tuple[str, tuple[float, float, float]]:
     """``LIGHT@X,Y,Z`` -> (light name, position m); refused in one line naming --lamp."""
-    from catalog.errors import InputError  # noqa: PLC0415
+    from catalog.core.errors import InputError  # noqa: PLC0415
 
     name, _, where = text.rpartition("@")
     try:
@@ -55,7 +55,7 @@ def parse_lamp(text: str) -> tuple[str, tuple[float, float, float]]:
 def run(args) -> int:
     from pathlib import Path  # noqa: PLC0415
 
-    from catalog.jsonout import print_json  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.snapshot import SnapshotRequest, parse_size, render_snapshot  # noqa: PLC0415
 
     request = SnapshotRequest(

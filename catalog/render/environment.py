@@ -4,11 +4,11 @@ The image is latitude-longitude (equirectangular): width = 2 x height, row 0 the
 last row the nadir, the middle column looking out of the window (-z), x to the right. Its
 absolute scale is replaced so that its illuminance agrees with the chosen light: the upper
 hemisphere's horizontal illuminance (the integral of Y cos(theta) d omega) is made equal to
-the clear sky's of the same sun (catalog/sky.py, catalog.sun.clear_sky) or, for a lamp, to
+the clear sky's of the same sun (catalog/optics/sun/sky.py, catalog.optics.sun.model.clear_sky) or, for a lamp, to
 the lit backdrop's (scene.SKY_FRACTION of its illuminance). Read through OpenImageIO; a file
 that cannot serve is refused with its name and the problem.
 
-The default (no file) is the project's own procedural clear sky (catalog/sky.py), which
+The default (no file) is the project's own procedural clear sky (catalog/optics/sun/sky.py), which
 :func:`write_sky_environment` also writes as such an image (tools/make_environment.py).
 """
 
@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.errors import InputError
+from catalog.core.errors import InputError
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 #: The smallest image accepted (width x height).
@@ -86,13 +86,13 @@ def upper_illuminance(pixels: np.ndarray) -> float:
 
 
 def write_sky_environment(path: str | Path, to_sun, height: int = 256) -> None:
-    """Write the procedural clear sky (catalog/sky.py, the sun's disc left out) as a
+    """Write the procedural clear sky (catalog/optics/sun/sky.py, the sun's disc left out) as a
     latitude-longitude EXR: the project's own default view, under the project's licence."""
     from catalog.render.snapshot import write_image  # noqa: PLC0415
-    from catalog.sky import sky_model  # noqa: PLC0415
+    from catalog.optics.sun.sky import sky_model  # noqa: PLC0415
 
     dirs, _ = directions(int(height))
     pixels = sky_model(np.asarray(to_sun, dtype=np.float64)).radiance(dirs).astype(np.float32)
     write_image(Path(path), np.maximum(pixels, 0.0),
                 {"catalog:environment": "procedural clear sky (Preetham 1999 scaled to "
-                                        "catalog.sun.clear_sky)"})
+                                        "catalog.optics.sun.model.clear_sky)"})

@@ -1,7 +1,7 @@
 """FrameRenderer: one frame of the curtain scene into an HDR target, tone-mapped to sRGB.
 
 The viewer and the snapshot command both drive this class (docs/render.md has the API).
-It never creates a GL context: it is handed one (:mod:`catalog.render.context`).
+It never creates a GL context: it is handed one (:mod:`catalog.gl.context`).
 
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
@@ -20,12 +20,12 @@ import math
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 from catalog.render import bands as band_lib
 from catalog.render import room_light
 from catalog.render import scene as scene_lib
 from catalog.render.camera import OrbitCamera, gl_bytes
-from catalog.render.shaderlib import create_program, glsl_literal
+from catalog.gl.shaderlib import create_program, glsl_literal
 
 #: Auto exposure: a white diffuser under the key light maps to this (before the curve).
 EXPOSURE_KEY = 5.0
@@ -113,7 +113,7 @@ class FrameRenderer:
         #: issue 13: the room lit through the curtain (False: the earlier constant room)
         self.room_lighting = True
         self.curtain_open = False
-        self.room_lamps: list[tuple] = []   # (catalog.lights.Light, (x, y, z) m)
+        self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
         self._room_gl = None
         #: the room's light (shadow map, capture, light map) is redrawn at once when the light,
         #: fabric, curtain or lamps change, and every ``room_update_every`` frames while the
@@ -122,7 +122,7 @@ class FrameRenderer:
         self._room_key = None
         self._room_frames = 0
         self._mesh_version = 0
-        self.sky_model = True      # the clear sky of catalog/sky.py behind the window (a sun)
+        self.sky_model = True      # the clear sky of catalog/optics/sun/sky.py behind the window (a sun)
         self.bloom = True          # glare before the tone map (bloom.frag)
         self.environment = None    # (path, texture, upper-hemisphere illuminance) or None
         self._bloom_gl = None
@@ -146,12 +146,12 @@ class FrameRenderer:
         self.preset = preset
 
     def set_light(self, light) -> None:
-        """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.lights.Light.
+        """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.optics.lights.Light.
 
         The sun stands behind the window at the elevation its path length implies; a lamp at
         scene.LAMP_ELEVATION_DEG. :meth:`set_sun_hour` and :meth:`set_key_direction` move it.
         """
-        from catalog.lights import get_light  # noqa: PLC0415
+        from catalog.optics.lights import get_light  # noqa: PLC0415
 
         if isinstance(light, str):
             light = get_light(light)
@@ -165,7 +165,7 @@ class FrameRenderer:
 
     def set_sun_hour(self, hour: float) -> dict:
         """The sun at ``hour`` (local solar time, summer solstice, 34.7 N) behind the window."""
-        from catalog.lights import get_light  # noqa: PLC0415
+        from catalog.optics.lights import get_light  # noqa: PLC0415
 
         sun = scene_lib.sun_at_hour(hour)
         self.light = get_light(sun.light_name)
@@ -196,7 +196,7 @@ class FrameRenderer:
         """Lamps placed in the room: (light name or Light, (x, y, z) m) pairs, at most
         room_light.MAX_ROOM_LAMPS; each an isotropic point whose normal irradiance at 1 m is
         the light's spectrum. They light the room (not the curtain's shading)."""
-        from catalog.lights import get_light  # noqa: PLC0415
+        from catalog.optics.lights import get_light  # noqa: PLC0415
 
         lamps = list(lamps)
         if len(lamps) > room_light.MAX_ROOM_LAMPS:
@@ -205,7 +205,7 @@ class FrameRenderer:
                             room_light.check_lamp_position(position)) for light, position in lamps]
 
     def set_sky_model(self, on: bool) -> None:
-        """The clear sky by direction (catalog/sky.py) or the earlier flat sky and ground."""
+        """The clear sky by direction (catalog/optics/sun/sky.py) or the earlier flat sky and ground."""
         self.sky_model = bool(on)
         self._room_key = None  # the window's capture sees the sky
 
@@ -356,7 +356,7 @@ class FrameRenderer:
         return bool(self.camera.position[2] > scene_lib.WINDOW_Z)
 
     def shading_inputs(self):
-        """The scene's :class:`catalog.reference.ShadingInputs` (rebuilt only on change)."""
+        """The scene's :class:`catalog.optics.shading_reference.ShadingInputs` (rebuilt only on change)."""
         self._require_ready()
         key = (id(self.preset), self.light.name, id(self.light), tuple(self._key_to_light),
                self.mode, self.viewer_inside, self._is_sun)
@@ -513,7 +513,7 @@ class FrameRenderer:
                      coarse: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer (the benchmark times this).
 
-        ``trivial``: True draws the same mesh with shaders/trivial.frag (the benchmark's floor);
+        ``trivial``: True draws the same mesh with catalog/bench/shaders/trivial.frag (the benchmark's floor);
         a file name draws it with that fragment shader instead (the benchmark's other floors)."""
         eye = tuple(float(v) for v in (self.camera.position if camera_position is None
                                        else camera_position))
@@ -549,13 +549,13 @@ class FrameRenderer:
         return self._display
 
     def _sky(self, inputs):
-        """The clear-sky model for a sun above the horizon (catalog/sky.py), else None."""
+        """The clear-sky model for a sun above the horizon (catalog/optics/sun/sky.py), else None."""
         if not (self.sky_model and self._is_sun and inputs.key_to_light[1] > 1e-3):
             return None
         key = tuple(float(v) for v in inputs.key_to_light)
         if getattr(self, "_sky_key", None) != key:
-            from catalog.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
-            from catalog.sky import HAZE_RAD, sky_model  # noqa: PLC0415
+            from catalog.optics.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
+            from catalog.optics.sun.sky import HAZE_RAD, sky_model  # noqa: PLC0415
 
             model = sky_model(inputs.key_to_light)
             self._sky_value = {
@@ -687,7 +687,7 @@ class FrameRenderer:
         """Linear sRGB of the key light (irradiance) and of the beam a thread passes: the
         directional lobe's forward-scattered part, a_spec forward(g_spec), in the dye's colour
         under the key light, per unit of thread coverage (mean coverage 1 - LD)."""
-        from catalog.reference import hg_hemisphere_factors  # noqa: PLC0415
+        from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
 
         colours = self._display_colours(inputs)
         key = np.asarray(colours["u_key_rgb"])

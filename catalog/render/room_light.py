@@ -184,7 +184,7 @@ def ambient_occlusion(face_texels: int = FACE_TEXELS, rays: int = AO_RAYS,
 
 
 #: The precomputed occlusion (tools/make_room_ao.py writes it; the room is static).
-AO_TABLE_PATH = Path(__file__).resolve().parent.parent / "data" / "room_ao.npz"
+AO_TABLE_PATH = Path(__file__).resolve().parent / "data" / "room_ao.npz"
 
 
 def ao_table_key(face_texels: int = FACE_TEXELS) -> np.ndarray:
@@ -195,7 +195,7 @@ def ao_table_key(face_texels: int = FACE_TEXELS) -> np.ndarray:
 
 
 def write_ao_table(path: Path = AO_TABLE_PATH) -> None:
-    from catalog.atomic import atomic_path  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
 
     with atomic_path(path, suffix=".npz") as tmp:
         np.savez_compressed(tmp, key=ao_table_key(), ao=ambient_occlusion())
@@ -343,7 +343,7 @@ class RoomLamp:
 
 
 def check_lamp_position(position_m) -> tuple[float, float, float]:
-    from catalog.errors import CatalogError  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
 
     p = tuple(float(v) for v in position_m)
     (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
