@@ -40,38 +40,10 @@ def _renderer(gl, fabric="lace-fwa", light="sun:60", azimuth_deg=15.0):
 
 
 def _floor_regions(r):
-    """(patch, far): floor pixels lit through the curtain's inside (margins 0.08-0.15 m from
-    every edge), and floor pixels whose beam would cross the wall 0.3 m or more outside the
-    opening."""
-    w, h = SIZE
-    inv = np.linalg.inv(r.camera.view_projection(w / h))
-    ys, xs = np.mgrid[0:h, 0:w]
-    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2,
-                    np.ones((h, w)), np.ones((h, w))], -1)
-    far = ndc @ inv.T
-    eye = r.camera.position
-    d = far[..., :3] / far[..., 3:] - eye
-    d /= np.linalg.norm(d, axis=-1, keepdims=True)
-    t = (scene_lib.ROOM_BOX[1][0] - eye[1]) / d[..., 1]
-    p = eye + t[..., None] * d
-    floor = (t > 0) & (np.abs(p[..., 0]) < 2.0) & (p[..., 2] > 0.2) & (p[..., 2] < 4.3)
-    to_light = r.shading_inputs().key_to_light
-
-    def crossing(z):
-        s = (z - p[..., 2]) / to_light[2]
-        return p[..., :2] + s[..., None] * to_light[:2]
-
-    q = crossing(scene_lib.ROOM_BOX[2][0])
-    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-    m = 0.08
-    in_window = (q[..., 0] > wx0 + m) & (q[..., 0] < wx1 - m) & (q[..., 1] > wy0 + m) & (q[..., 1] < wy1 - m)
-    qc = crossing(scene_lib.CURTAIN_Z)
-    half = scene_lib.CURTAIN_WIDTH_M / 2
-    through = ((np.abs(qc[..., 0]) < half - 0.1) & (qc[..., 1] < scene_lib.CURTAIN_TOP_Y - 0.1)
-               & (qc[..., 1] > scene_lib.CURTAIN_TOP_Y - scene_lib.CURTAIN_HEIGHT_M + 0.15))
-    away = ((q[..., 0] < wx0 - 0.3) | (q[..., 0] > wx1 + 0.3) | (q[..., 1] < wy0 - 0.3)
-            | (q[..., 1] > wy1 + 0.3))
-    return floor & in_window & through, floor & away
+    """(patch, away): room_light.view_regions' floor masks for this renderer's view."""
+    regions = room_light.view_regions(r.camera.view_projection(SIZE[0] / SIZE[1]),
+                                      r.camera.position, SIZE, r.shading_inputs().key_to_light)
+    return regions["floor_patch"], regions["floor_away"]
 
 
 def _frame(r, curtain_open):

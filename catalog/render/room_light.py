@@ -351,3 +351,58 @@ def check_lamp_position(position_m) -> tuple[float, float, float]:
         raise CatalogError(f"room lamp position {position_m!r} must lie inside the room "
                            f"x {x0}..{x1}, y {y0}..{y1}, z {z0}..{z1} m")
     return p
+
+
+# --------------------------------------------------------------------------- regions of a view
+
+#: Names of the regions :func:`view_regions` returns (the tests and the path-traced
+#: comparison of the same scene use the same masks).
+REGION_NAMES = ("floor_patch", "floor_away", "window_wall_strips")
+
+
+def view_regions(view_projection: np.ndarray, eye, size, to_light) -> dict[str, np.ndarray]:
+    """Boolean (H, W) masks of a view (row 0 = top), found by geometry, not by shading:
+
+    - ``floor_patch``: floor pixels the key's beam reaches through the hanging curtain
+      (margins of 0.08 m inside the opening and 0.1-0.15 m inside the curtain);
+    - ``floor_away``: floor pixels whose beam would cross the wall 0.3 m or more outside
+      the opening;
+    - ``window_wall_strips``: the outer fifths of the frame (the wall beside the window in
+      the default view).
+    """
+    w, h = size
+    inv = np.linalg.inv(np.asarray(view_projection, dtype=np.float64))
+    ys, xs = np.mgrid[0:h, 0:w]
+    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)),
+                    np.ones((h, w))], -1)
+    far = ndc @ inv.T
+    eye = np.asarray(eye, dtype=np.float64)
+    d = far[..., :3] / far[..., 3:] - eye
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    (x0, x1), (y0, _), (z0, z1) = scene_lib.ROOM_BOX
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (y0 - eye[1]) / d[..., 1]
+    p = eye + t[..., None] * d
+    floor = (t > 0) & (p[..., 0] > x0 + 0.2) & (p[..., 0] < x1 - 0.2) & (p[..., 2] > z0 + 0.4) & (p[..., 2] < z1 - 0.2)
+    to_light = np.asarray(to_light, dtype=np.float64)
+
+    def crossing(z):
+        s = (z - p[..., 2]) / to_light[2]
+        return p[..., :2] + s[..., None] * to_light[:2]
+
+    q = crossing(z0)
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    m = 0.08
+    in_window = (q[..., 0] > wx0 + m) & (q[..., 0] < wx1 - m) & (q[..., 1] > wy0 + m) & (q[..., 1] < wy1 - m)
+    qc = crossing(scene_lib.CURTAIN_Z)
+    half = scene_lib.CURTAIN_WIDTH_M / 2
+    through = ((np.abs(qc[..., 0]) < half - 0.1) & (qc[..., 1] < scene_lib.CURTAIN_TOP_Y - 0.1)
+               & (qc[..., 1] > scene_lib.CURTAIN_TOP_Y - scene_lib.CURTAIN_HEIGHT_M + 0.15))
+    away = ((q[..., 0] < wx0 - 0.3) | (q[..., 0] > wx1 + 0.3) | (q[..., 1] < wy0 - 0.3)
+            | (q[..., 1] > wy1 + 0.3))
+    strips = np.zeros((h, w), dtype=bool)
+    strips[:, : w // 5] = True
+    strips[:, w - w // 5:] = True
+    return {"floor_patch": floor & in_window & through, "floor_away": floor & away,
+            "window_wall_strips": strips}
+
