@@ -568,5 +568,5 @@ class ViewerApp:
             record["heavy_modules"] = heavy_modules_loaded()
             record["fabric"] = self._shown_name()
             record["light"] = self.settings.light_label
-            record["panel_errors"] = self.catalog.core.errors() + list(self.messages.values())
+            record["panel_errors"] = self.catalog.errors() + list(self.messages.values())
         print(json.dumps(record), flush=True)
