@@ -17,6 +17,7 @@ optionally, ``plot(result, folder) -> list[Path]``:
 - ``stability``: every model's parameters swept to their edges
   (:mod:`catalog.bench.stability`);
 - ``startup``: import time and time to the first frame (:mod:`catalog.bench.startup`);
+- ``display``: each display transform's cost in the frame (:mod:`catalog.bench.display`);
 - ``room``: the frame with the room lit through the curtain, the clear sky and the glare
   against the frame without, each pass's share (:mod:`catalog.bench.room`).
 
@@ -41,5 +42,6 @@ SECTIONS: dict[str, str] = {
     "cloth": "catalog.bench.cloth",
     "stability": "catalog.bench.stability",
     "startup": "catalog.bench.startup",
+    "display": "catalog.bench.display",
     "room": "catalog.bench.room",
 }

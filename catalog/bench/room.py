@@ -77,7 +77,8 @@ def work_counts(size) -> dict[str, float]:
         "curtain": 0.5 * w * h * 4,
         "background": 0.2 * w * h,
         "bloom": w * h * (0.25 + 6 / 16 + 1),
-        "tonemap": float(w * h),
+        "meter": float(w * h) / 16,
+        "display": float(w * h),
     }
 
 
