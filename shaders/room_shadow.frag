@@ -15,12 +15,22 @@ uniform vec3 u_thread_beam_rgb;      // per thread: a_spec forward(g_spec) dye /
 
 layout(location = 0) out vec4 out_transmittance;
 
-// THE PATTERN HOOK: thread coverage at cloth coordinate uv. Until the fabric's [pattern]
-// coverage map (issue 12: thread_coverage(uv) in common.glsl) is bound here, the cloth is
-// uniform: every point has the mean coverage, so the patch is dimmed, not patterned.
+// THE PATTERN HOOK: thread coverage at cloth coordinate uv (0..1 across the fabric). With
+// PATTERN (the fabric's [pattern] coverage map of issue 12: u_pattern and thread_coverage in
+// common.glsl, uv scaled to pattern repeats by u_uv_to_repeats), the holes are projected and
+// the texture's mip level follows this pass's footprint (motifs larger than a shadow-map texel
+// show, single threads average to the mean). Without it the cloth is uniform: every point has
+// the mean coverage, so the patch is dimmed and tinted, patterned only by folds and layers.
+#ifdef PATTERN
+uniform vec2 u_uv_to_repeats;
+float curtain_coverage(vec2 uv) {
+    return thread_coverage(uv * u_uv_to_repeats);
+}
+#else
 float curtain_coverage(vec2 uv) {
     return u_mean_coverage;
 }
+#endif
 
 void main() {
     float c = curtain_coverage(v_uv);

@@ -785,7 +785,18 @@ class FrameRenderer:
         self.ctx.viewport = (0, 0, n, n)
         gl["shadow_fbo"].clear(1.0, 1.0, 1.0, 1.0)
         if not self.curtain_open:
-            program = self._program("room_shadow.vert", "room_shadow.frag", {"HAS_UV": True})
+            # the fabric's pattern (issue 12's texture and scale, when this renderer has them
+            # and the mesh carries uvs) projects its holes; else the uniform mean coverage
+            pattern = getattr(self, "_pattern_texture", None)
+            patterned = (pattern is not None and getattr(self, "patterned", False)
+                         and self._curtain_format != "interleaved")
+            program = self._program("room_shadow.vert", "room_shadow.frag",
+                                    {"HAS_UV": True, "PATTERN": patterned})
+            if patterned:
+                pattern.use(location=3)
+                self._set(program, "u_pattern", 3)
+                self._set(program, "u_uv_to_repeats", tuple(
+                    f / r for f, r in zip(self._fabric_size_m, self._pattern_repeat_m)))
             colours = self._room_colours(inputs)
             self._set(program, "u_light_view_proj",
                       gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
@@ -814,8 +825,17 @@ class FrameRenderer:
         view_proj = room_light.luminaire_view_projection()
         eye = room_light.LUMINAIRE_EYE
         if not self.curtain_open:
-            self.draw_curtain(view_proj, camera_position=eye, overrides=self._no_disc_overrides(),
-                              coarse=True)
+            # the flat cloth (the pattern averaged, model.md section 9): each capture texel is
+            # a 4x4 mean over a window patch anyway, and the flat variant draws in one pass
+            patterned = getattr(self, "patterned", None)
+            if patterned:
+                self.patterned = False
+            try:
+                self.draw_curtain(view_proj, camera_position=eye,
+                                  overrides=self._no_disc_overrides(), coarse=True)
+            finally:
+                if patterned:
+                    self.patterned = patterned
         self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False)
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
