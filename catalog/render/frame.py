@@ -5,11 +5,19 @@ It never creates a GL context: it is handed one (:mod:`catalog.gl.context`).
 
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
-1. room props (room.vert/.frag): walls around the window, the curtain rod;
-2. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling;
+0. the room's light (issue 13, docs/room.md; when the scene, cloth or lamps changed): the key
+   light's transmittance shadow map through the curtain (room_shadow.*), the window as the
+   room sees it (the curtain's capture), the light map of the room box (room_lightmap.frag:
+   area light, lamps; room_bounce.frag: one bounce, ambient occlusion);
+1. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling;
+2. room props (room.vert/.frag): walls around the window, the curtain rod, lit by the light
+   map and the key's beam through the window and the curtain (or, switched off, the earlier
+   constant room);
 3. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
-   shades only the pixels nothing covers: the outside through the window (sky, ground, the
-   sun's disc) or the room, per camera ray;
+   shades only the pixels nothing covers: the outside through the window (the clear sky by
+   direction of catalog/optics/sun/sky.py or an environment image, the ground, the sun's
+   disc) or the room, per camera ray;
+3b. glare (bloom_down/glow/bloom.frag), energy-preserving, when on;
 4. display (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
    target): exposure (EV100, fixed or metered from a luminance histogram of this frame),
    white balance (CAT16), tone curve, gamut compression in OKLab, the sRGB curve
