@@ -63,7 +63,7 @@ def test_the_procedural_sky_as_an_image_renders_as_the_sky(gl, tmp_path):
     r.set_bloom(False)
     r.set_camera(0.0, 5.0, 1.0)
     path = tmp_path / "sky.exr"
-    env.write_sky_environment(path, r.shading_inputs().key_to_light, height=256)
+    env.write_sky_environment(path, r.sky_model_for(r.shading_inputs()), height=256)
     r.render()
     analytic = r.read_linear()
     r.set_environment(path)

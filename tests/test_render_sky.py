@@ -93,7 +93,7 @@ def test_background_pixels_match_the_sky_model(gl):
     to_sun = r.shading_inputs().key_to_light
     ok &= np.linalg.norm(d - to_sun, axis=-1) > 0.05
     assert ok.sum() > 0.3 * ok.size
-    model = sky.sky_model(to_sun)
+    model = r.sky_model_for(r.shading_inputs())
     expected = model.radiance(d[ok])
     assert np.allclose(img[ok], expected, rtol=3e-3, atol=1e-3 * np.abs(expected).max())
     r.release()

@@ -87,12 +87,14 @@ def upper_illuminance(pixels: np.ndarray) -> float:
 
 def write_sky_environment(path: str | Path, to_sun, height: int = 256) -> None:
     """Write the procedural clear sky (catalog/optics/sun/sky.py, the sun's disc left out) as a
-    latitude-longitude EXR: the project's own default view, under the project's licence."""
+    latitude-longitude EXR: the project's own default view, under the project's licence.
+    ``to_sun``: the sun's direction (the atmosphere's clear sky) or a ready SkyModel."""
+    from catalog.optics.sun.sky import SkyModel, sky_model  # noqa: PLC0415
     from catalog.render.snapshot import write_image  # noqa: PLC0415
-    from catalog.optics.sun.sky import sky_model  # noqa: PLC0415
 
     dirs, _ = directions(int(height))
-    pixels = sky_model(np.asarray(to_sun, dtype=np.float64)).radiance(dirs).astype(np.float32)
+    model = to_sun if isinstance(to_sun, SkyModel) else sky_model(np.asarray(to_sun, dtype=np.float64))
+    pixels = model.radiance(dirs).astype(np.float32)
     write_image(Path(path), np.maximum(pixels, 0.0),
                 {"catalog:environment": "procedural clear sky (Preetham 1999 scaled to "
                                         "catalog.optics.sun.model.clear_sky)"})

@@ -6,22 +6,31 @@ It never creates a GL context: it is handed one (:mod:`catalog.gl.context`).
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
 0. the room's light (issue 13, docs/room.md; when the scene, cloth or lamps changed): the key
-   light's transmittance shadow map through the curtain (room_shadow.*), the window as the
-   room sees it (the curtain's capture), the light map of the room box (room_lightmap.frag:
-   area light, lamps; room_bounce.frag: one bounce, ambient occlusion);
-1. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling;
-2. room props (room.vert/.frag): walls around the window, the curtain rod, lit by the light
+   light's transmittance shadow map through the curtain (room_shadow.*, the pattern's holes
+   projected), the window as the room sees it (the flat curtain's capture), the light map of
+   the room box (room_lightmap.frag: area light, lamps; room_bounce.frag: one bounce, ambient
+   occlusion);
+1. room props (room.vert/.frag): walls around the window, the curtain rod, lit by the light
    map and the key's beam through the window and the curtain (or, switched off, the earlier
    constant room);
-3. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
+2. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
    shades only the pixels nothing covers: the outside through the window (the clear sky by
    direction of catalog/optics/sun/sky.py or an environment image, the ground, the sun's
    disc) or the room, per camera ray;
+3. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling, with the
+   fabric's pattern (catalog/presets/patterns.py): the threads' radiance (the fitted lobes over the
+   mean coverage) and coverage c into weighted blended OIT targets (McGuire & Bavoil 2013),
+   resolved over the room and background drawn in 1-2 (oit_composite.frag): the holes show
+   what is really behind, undimmed, and overlapping folds multiply their open fractions;
+   ``patterned = False`` draws the paper's flat cloth instead (opaque, LD times the
+   background by ray direction: the frame before issue 12, kept for comparison);
 3b. glare (bloom_down/glow/bloom.frag), energy-preserving, when on;
 4. display (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
    target): exposure (EV100, fixed or metered from a luminance histogram of this frame),
    white balance (CAT16), tone curve, gamut compression in OKLab, the sRGB curve
-   (:mod:`catalog.render.display`, docs/display.md).
+   (:mod:`catalog.render.display`, docs/display.md).; then FXAA
+   (fxaa.frag, issue 12) on the display image; ``set_antialiasing("off")`` displays straight
+   into the target.
 """
 
 from __future__ import annotations
@@ -45,8 +54,13 @@ FLUORESCENCE_MODES = ("off", "paper", "physical")
 #: blurs' weights (mip levels 1..6, wider blurs weighted less; normalised to sum 1).
 BLOOM_STRENGTH = 0.04
 BLOOM_LEVEL_WEIGHTS = (0.30, 0.24, 0.18, 0.13, 0.09, 0.06)
+#: Anti-aliasing of the display image: a post-process (shaders/fxaa.frag) or none.
+ANTIALIASING_MODES = ("fxaa", "off")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
+#: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
+PATTERN_UNIT = 3
+PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
 
@@ -79,6 +93,21 @@ def gl_bytes_mat3(matrix: np.ndarray) -> bytes:
     return np.ascontiguousarray(np.asarray(matrix, dtype=np.float32).T).tobytes()
 
 
+def fabric_size_from_mesh(positions, uvs, indices) -> tuple[float, float]:
+    """The rest fabric's (width, length) in metres that uv 0..1 spans, measured on a grid
+    mesh: the median of |dP| / |du| over triangle edges along u (dv = 0), likewise along v."""
+    tri = np.asarray(indices).reshape(-1, 3)
+    a = np.concatenate([tri[:, 0], tri[:, 1], tri[:, 2]])
+    b = np.concatenate([tri[:, 1], tri[:, 2], tri[:, 0]])
+    dp = np.linalg.norm(positions[a].astype(np.float64) - positions[b], axis=1)
+    duv = np.abs(uvs[a].astype(np.float64) - uvs[b])
+    size = []
+    for along, across in ((0, 1), (1, 0)):
+        sel = (duv[:, along] > 1e-9) & (duv[:, across] < 1e-6 * duv[:, along] + 1e-12)
+        size.append(float(np.median(dp[sel] / duv[sel, along])) if sel.any() else 1.0)
+    return size[0], size[1]
+
+
 class FrameRenderer:
     """Renders the curtain scene with a given moderngl context at a given size (w, h)."""
 
@@ -98,7 +127,25 @@ class FrameRenderer:
         self._hdr_fbo = ctx.framebuffer([self._hdr], self._depth)
         self._ldr = ctx.texture((w, h), 4)
         self._ldr_fbo = ctx.framebuffer([self._ldr])
+        # the tone-mapped image before FXAA (read bilinearly by fxaa.frag)
+        self._pre = ctx.texture((w, h), 4)
+        self._pre.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self._pre.repeat_x = self._pre.repeat_y = False
+        self._pre_fbo = ctx.framebuffer([self._pre])
+        self.antialiasing = "fxaa"
         self._gbuffer = None
+        # weighted blended OIT: sum C a w | prod (1 - a), and sum a w; the scene's depth
+        self._oit_accum = ctx.texture((w, h), 4, dtype="f4")
+        self._oit_weight = ctx.texture((w, h), 1, dtype="f4")
+        for texture in (self._oit_accum, self._oit_weight):
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self._oit_fbo = ctx.framebuffer([self._oit_accum, self._oit_weight], self._depth)
+        self._oit_fbo.depth_mask = False  # the layers are tested against the room, not each other
+        self.patterned = True
+        self._pattern_texture = None
+        self._pattern_key = None
+        self._pattern = None
+        self._fabric_size_m = (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
         self._programs: dict[tuple, object] = {}
         self.specialise = bool(specialise)
         self._vaos: dict[tuple, object] = {}
@@ -142,6 +189,7 @@ class FrameRenderer:
         positions, normals = scene_lib.room_props()
         self._room_vbo = ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
         self._curtain_buffers = None
+        self._ring_vbo = None
         default = scene_lib.draped_curtain()
         self.set_mesh(default.positions, default.normals, default.uvs, default.tangents,
                       default.indices)
@@ -155,7 +203,82 @@ class FrameRenderer:
             preset = load_preset(find_preset(preset))
         scene_lib.dye_transmittance(preset)  # refuse a bad dye file now, not at render
         scene_lib.fluorescent_material(preset)
+        self._set_pattern(preset)
         self.preset = preset
+
+    def set_rings(self, xs_m) -> None:
+        """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
+        positions, normals = scene_lib.ring_mesh(xs_m)
+        if self._ring_vbo is not None:
+            self._ring_vbo.release()
+            self._ring_vbo = None
+            for key in [k for k in self._vaos if k[0] == "rings"]:
+                self._vaos.pop(key).release()
+        if len(positions):
+            self._ring_vbo = self.ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
+
+    def set_patterned(self, patterned: bool) -> None:
+        """True (default): the fabric's pattern, holes and layers (OIT); False: the flat,
+        opaque cloth of eq. 8 with LD times the background by ray direction."""
+        self.patterned = bool(patterned)
+
+    def _set_pattern(self, preset) -> None:
+        """The preset's pattern as a mipmapped RGBA32F texture (thread normal, coverage);
+        without a [pattern] a uniform coverage 1 - LD (one texel)."""
+        from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+
+        table = preset.table("pattern")
+        key = (str(preset.path), repr(sorted(table.items())), preset.btdf.direct)
+        if key == self._pattern_key:
+            return
+        pattern = load_pattern(preset)
+        if pattern is None:
+            texels = np.array([[[0.0, 0.0, 1.0, 1.0 - preset.btdf.direct]]], dtype=np.float32)
+            repeat = self._fabric_size_m
+        else:
+            texels = pattern.normal_map()
+            repeat = pattern.repeat_m
+        mgl = self._moderngl
+        if self._pattern_texture is not None:
+            self._pattern_texture.release()
+        h, w = texels.shape[:2]
+        texture = self.ctx.texture((w, h), 4, np.ascontiguousarray(texels).tobytes(), dtype="f4")
+        texture.repeat_x = texture.repeat_y = True
+        texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+        texture.build_mipmaps()
+        max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
+        texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
+        self._pattern_texture = texture
+        self._pattern = pattern
+        self._pattern_repeat_m = tuple(float(v) for v in repeat)
+        self._pattern_mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
+        self._pattern_key = key
+
+    def set_pattern_filtering(self, filtered: bool) -> None:
+        """True (default): trilinear mipmapped, anisotropic; False: nearest texel, no mips
+        (for measuring what the filtering buys: shimmer, the far limit)."""
+        mgl = self._moderngl
+        texture = self._pattern_texture
+        if filtered:
+            texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+            max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
+            texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
+        else:
+            texture.filter = (mgl.NEAREST, mgl.NEAREST)
+            texture.anisotropy = 1.0
+
+    @property
+    def pattern(self):
+        """The current fabric's :class:`catalog.presets.patterns.Pattern` (None: uniform coverage)."""
+        return self._pattern
+
+    def pattern_mip_level(self, level: int) -> np.ndarray:
+        """Level ``level`` of the pattern texture's mip chain as GL built it, (H, W, 4)."""
+        texture = self._pattern_texture
+        w = max(1, texture.width >> level)
+        h = max(1, texture.height >> level)
+        data = texture.read(level=level)
+        return np.frombuffer(data, dtype=np.float32).reshape(h, w, 4).copy()
 
     def set_light(self, light) -> None:
         """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.optics.lights.Light.
@@ -269,9 +392,11 @@ class FrameRenderer:
         self.white_balance = white_balance
 
     # ------------------------------------------------------------------ mesh
-    def set_mesh(self, positions, normals, uvs, tangents, indices) -> None:
+    def set_mesh(self, positions, normals, uvs, tangents, indices, fabric_size_m=None) -> None:
         """The curtain: float32 (V, 3) positions, normals, tangents (weft), (V, 2) uvs and
-        int32 triangle indices ((T, 3) or flat)."""
+        int32 triangle indices ((T, 3) or flat). ``fabric_size_m``: the rest fabric's width and
+        length (m) that uv 0..1 spans (the pattern's scale); default: measured on the mesh
+        (:func:`fabric_size_from_mesh`)."""
         positions = np.ascontiguousarray(positions, dtype="f4").reshape(-1, 3)
         count = positions.shape[0]
         normals = np.ascontiguousarray(normals, dtype="f4").reshape(-1, 3)
@@ -282,6 +407,9 @@ class FrameRenderer:
             raise CatalogError("curtain mesh arrays differ in vertex count")
         if indices.size == 0 or indices.size % 3 or indices.min() < 0 or indices.max() >= count:
             raise CatalogError("curtain mesh indices must be triangles of existing vertices")
+        if fabric_size_m is None:
+            fabric_size_m = fabric_size_from_mesh(positions, uvs, indices)
+        self._fabric_size_m = tuple(float(v) for v in fabric_size_m)
         self._release_own_buffers()
         self._curtain_buffers = {
             "position": self.ctx.buffer(positions.tobytes()),
@@ -386,7 +514,8 @@ class FrameRenderer:
         if key != self._inputs_key:
             self._inputs, self._decision = scene_lib.build_shading_inputs(
                 self.preset, self.light.irradiance_w_m2_nm, self._key_to_light,
-                is_sun=self._is_sun, fluorescence=self.mode, viewer_inside=self.viewer_inside)
+                is_sun=self._is_sun, fluorescence=self.mode, viewer_inside=self.viewer_inside,
+                paper_beam=self.light.name.startswith("sun:"))
             self._inputs_key = key
             self._uniforms_key = None
         return self._inputs
@@ -407,6 +536,9 @@ class FrameRenderer:
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
                    "GBUFFER": gbuffer, "SPECIALISED": self.specialise,
                    "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
+        if self.patterned and not gbuffer:
+            # the holes are drawn by the OIT composite: no see-through term in the shader
+            defines.update({"PATTERN": True, "OIT": True, "SEE_THROUGH": False})
         return defines
 
     def scene_values(self) -> dict:
@@ -427,6 +559,8 @@ class FrameRenderer:
 
     def _curtain_program(self, gbuffer: bool, overrides: dict | None = None):
         defines = self.variant_defines(gbuffer)
+        if overrides:
+            defines["ROOM_CAPTURE"] = True  # the room's window capture (issue 13), not the frame's
         if self.specialise:
             for name, value in self._scene_values_with(overrides).items():
                 defines["S_" + name[2:].upper()] = glsl_literal(value)
@@ -464,9 +598,11 @@ class FrameRenderer:
             program.release()
 
     def compiled_variants(self) -> list[dict]:
-        """The switches of every curtain program compiled so far (for tests and reports)."""
+        """The switches of every curtain program compiled so far for the frame itself (for
+        tests and reports; the room's window capture, ROOM_CAPTURE, is left out)."""
         return [{k: v for k, v in k2[2] if not k.startswith("S_")}
-                for k2 in self._programs if k2[1] == "curtain.frag"]
+                for k2 in self._programs
+                if k2[1] == "curtain.frag" and not dict(k2[2]).get("ROOM_CAPTURE")]
 
     def _curtain_vao(self, program, coarse: bool = False):
         coarse = coarse and "coarse_index" in self._curtain_buffers
@@ -484,6 +620,8 @@ class FrameRenderer:
                     content.append((b["normal"], self._curtain_format, "in_normal"))
                 if "in_tangent" in program:
                     content.append((b["tangent"], "3f", "in_tangent"))
+            if "in_uv" in program:
+                content.append((b["uv"], "2f", "in_uv"))
             self._vaos[key] = self.ctx.vertex_array(
                 program, content, index_buffer=b["coarse_index" if coarse else "index"],
                 index_element_size=4)
@@ -585,6 +723,13 @@ class FrameRenderer:
             self._set(program, "u_view_proj", gl_bytes(view_proj))
             self._set(program, "u_camera_position", eye)
             self._set(program, "u_mesh_offset", self._mesh_offset)
+            if "u_pattern" in program:
+                self._pattern_texture.use(location=PATTERN_UNIT)
+                self._set(program, "u_pattern", PATTERN_UNIT)
+                self._set(program, "u_uv_to_repeats",
+                          tuple(f / r for f, r in zip(self._fabric_size_m, self._pattern_repeat_m)))
+                self._set(program, "u_inv_mean_coverage", 1.0 / max(self._pattern_mean_coverage, 1e-6))
+                self._set(program, "u_oit_depth_ref", self.oit_depth_reference_m())
             if not self.specialise:
                 for name, value in self._scene_values_with(overrides).items():
                     self._set(program, name, value)
@@ -605,16 +750,24 @@ class FrameRenderer:
             self._display_key = self._inputs_key
         return self._display
 
+    def sky_model_for(self, inputs):
+        """The clear sky behind the window (catalog/optics/sun/sky.py) with the irradiance and
+        colour of the curtain's own sky term (inputs.sky_radiance), so the two agree."""
+        from catalog.optics.sun.sky import sky_model  # noqa: PLC0415
+
+        return sky_model(inputs.key_to_light, diffuse_horizontal=math.pi * inputs.sky_radiance,
+                         ground_radiance=inputs.ground_radiance)
+
     def _sky(self, inputs):
         """The clear-sky model for a sun above the horizon (catalog/optics/sun/sky.py), else None."""
         if not (self.sky_model and self._is_sun and inputs.key_to_light[1] > 1e-3):
             return None
-        key = tuple(float(v) for v in inputs.key_to_light)
+        key = self._inputs_key
         if getattr(self, "_sky_key", None) != key:
             from catalog.optics.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
-            from catalog.optics.sun.sky import HAZE_RAD, sky_model  # noqa: PLC0415
+            from catalog.optics.sun.sky import HAZE_RAD  # noqa: PLC0415
 
-            model = sky_model(inputs.key_to_light)
+            model = self.sky_model_for(inputs)
             self._sky_value = {
                 "u_perez": np.asarray(model.perez, dtype="f4"),
                 "u_zenith_xyY": tuple(float(v) for v in model.zenith),
@@ -685,6 +838,7 @@ class FrameRenderer:
                     self._room_vao(program).render(self._moderngl.TRIANGLES, vertices=count,
                                                    first=first)
             self.ctx.disable(self._moderngl.CULL_FACE)
+            self._draw_rings(program)  # the last (beam-free) program
             return
         program = self._program("room.vert", "room.frag", {"ROOM_LIGHTING": False})
         self._scene_uniforms(program, view_proj, inputs)
@@ -694,6 +848,17 @@ class FrameRenderer:
         self.ctx.enable(self._moderngl.CULL_FACE)
         self._room_vao(program).render(self._moderngl.TRIANGLES)
         self.ctx.disable(self._moderngl.CULL_FACE)
+        self._draw_rings(program)
+
+    def _draw_rings(self, program) -> None:
+        """The curtain's rings on the rod (issue 12), with the room's program (no culling)."""
+        if getattr(self, "_ring_vbo", None) is None:
+            return
+        key = ("rings", id(program))
+        if key not in self._vaos:
+            self._vaos[key] = self.ctx.vertex_array(
+                program, [(self._ring_vbo, "3f 3f", "in_position", "in_normal")])
+        self._vaos[key].render(self._moderngl.TRIANGLES)
 
     def _room_lit_uniforms(self, program, view_proj, inputs) -> None:
         self._scene_uniforms(program, view_proj, inputs)
@@ -931,7 +1096,8 @@ class FrameRenderer:
 
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
-        key = (self._inputs_key, self.curtain_open,
+        key = (self._inputs_key, self.curtain_open, getattr(self, "patterned", None),
+               getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
         moved = self._mesh_version != getattr(self, "_room_mesh_version", None) or (
@@ -979,12 +1145,14 @@ class FrameRenderer:
         self.ctx.disable(mgl.BLEND)
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<="
-        # the curtain first: the depth test then skips the room behind it (early z)
-        if not self.curtain_open:
+        if not self.curtain_open and not self.patterned:
+            # the opaque flat curtain first: the depth test then skips the room behind it
             self._timed(profile, "curtain", lambda: self.draw_curtain(view_proj))
         self._timed(profile, "room", lambda: self._draw_room(view_proj, inputs))
-        # last, on the far plane: the depth test leaves only the pixels nothing covers
+        # on the far plane: the depth test leaves only the pixels nothing covers
         self._timed(profile, "background", lambda: self._draw_background(view_proj, inputs))
+        if not self.curtain_open and self.patterned:
+            self._timed(profile, "curtain", lambda: self._draw_curtain_oit(view_proj, vw, vh))
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
@@ -1007,6 +1175,45 @@ class FrameRenderer:
                               "glow": glow, "glow_fbo": ctx.framebuffer([glow]),
                               "out": out, "out_fbo": ctx.framebuffer([out])}
         return self._bloom_gl
+
+    def oit_depth_reference_m(self) -> float:
+        """The view distance (m) where the OIT depth weight is 1: just before the nearest
+        the curtain can be (the camera's distance to its target less a metre)."""
+        return max(0.0, self.camera.distance_m - 1.0)
+
+    def _draw_curtain_oit(self, view_proj, vw: int, vh: int) -> None:
+        """The curtain's layers into the OIT targets (depth-tested against the room, not
+        written), then resolved over the HDR target."""
+        mgl = self._moderngl
+        ctx = self.ctx
+        self._oit_fbo.use()
+        ctx.viewport = (0, 0, vw, vh)
+        ctx.clear(0.0, 0.0, 0.0, 1.0, viewport=(0, 0, vw, vh))   # accum: revealage 1
+        # clear() wrote (0, 0, 0, 1) into both targets: the weight target's alpha is unused
+        ctx.enable(mgl.BLEND)
+        ctx.blend_equation = mgl.FUNC_ADD
+        ctx.blend_func = (mgl.ONE, mgl.ONE, mgl.ZERO, mgl.ONE_MINUS_SRC_ALPHA)
+        self.draw_curtain(view_proj)
+        # resolve: average colour x (1 - revealage) + behind x revealage
+        self._hdr_fbo.use()
+        ctx.viewport = (0, 0, vw, vh)
+        ctx.disable(mgl.DEPTH_TEST)
+        ctx.blend_func = (mgl.ONE, mgl.SRC_ALPHA, mgl.ZERO, mgl.ONE)
+        program = self._program("fullscreen.vert", "oit_composite.frag")
+        self._oit_accum.use(location=0)
+        self._oit_weight.use(location=1)
+        self._set(program, "u_accum", 0)
+        self._set(program, "u_weight", 1)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        ctx.disable(mgl.BLEND)
+        ctx.blend_func = mgl.DEFAULT_BLENDING
+
+    def set_antialiasing(self, mode: str) -> None:
+        """``fxaa`` (default): the post-process on the display image (shaders/fxaa.frag);
+        ``off``: the tone-mapped image as it is."""
+        if mode not in ANTIALIASING_MODES:
+            raise CatalogError(f"anti-aliasing {mode!r}: choose one of {', '.join(ANTIALIASING_MODES)}")
+        self.antialiasing = mode
 
     def draw_bloom(self, vw: int, vh: int) -> object:
         """Glare: the HDR frame with BLOOM_STRENGTH of it spread over wide blurs
@@ -1074,8 +1281,15 @@ class FrameRenderer:
         """The display transform of the HDR target's (vw, vh) corner (the benchmark times it);
         ``hdr``: the texture to show (default the HDR target; the glare's output when on)."""
         target = fbo if fbo is not None else self._ldr_fbo
-        target.use()
-        self.ctx.viewport = tuple(viewport) if (fbo is not None and viewport is not None) else (0, 0, vw, vh)
+        target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
+                           else (0, 0, vw, vh))
+        fxaa = self.antialiasing == "fxaa"
+        if fxaa:   # display into our copy, FXAA from it into the target
+            self._pre_fbo.use()
+            self.ctx.viewport = (0, 0, vw, vh)
+        else:
+            target.use()
+            self.ctx.viewport = target_viewport
         program = self._program("fullscreen.vert", "tonemap.frag",
                                 {"DISPLAY_STAGES": self.display_stages})
         (hdr if hdr is not None else self._hdr).use(location=0)
@@ -1084,6 +1298,15 @@ class FrameRenderer:
         for name, value in self.display_uniforms().items():
             self._set(program, name, value)
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
+        if fxaa:
+            target.use()
+            self.ctx.viewport = target_viewport
+            program = self._program("fullscreen.vert", "fxaa.frag")
+            self._pre.use(location=0)
+            self._set(program, "u_ldr", 0)
+            self._set(program, "u_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
+            self._set(program, "u_texel", (1.0 / self.size[0], 1.0 / self.size[1]))
+            self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
         self._last = (vw, vh, fbo, viewport)
 
     # ------------------------------------------------------------------ read back
@@ -1166,15 +1389,22 @@ class FrameRenderer:
 
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
-        ours = [self._hdr_fbo, self._ldr_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
+        ours = [self._hdr_fbo, self._ldr_fbo, self._oit_fbo, self._pre_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
         ours += [obj for name, obj in list((self._room_gl or {}).items())
                  + list((self._bloom_gl or {}).items()) if name.endswith("_fbo")]
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._release_vaos()
         self._release_own_buffers()
-        for obj in (self._hdr_fbo, self._hdr, self._depth, self._ldr_fbo, self._ldr, self._room_vbo):
+        for obj in (self._hdr_fbo, self._hdr, self._depth, self._ldr_fbo, self._ldr, self._room_vbo,
+                    self._oit_fbo, self._oit_accum, self._oit_weight, self._pre_fbo, self._pre):
             obj.release()
+        if self._pattern_texture is not None:
+            self._pattern_texture.release()
+            self._pattern_texture = None
+        if self._ring_vbo is not None:
+            self._ring_vbo.release()
+            self._ring_vbo = None
         if self._gbuffer is not None:
             for texture in self._gbuffer[0]:
                 texture.release()

@@ -135,6 +135,39 @@ def rod_triangles(radius_m: float, length_m: float, centre, sections: int = 16) 
     return np.array(tris)
 
 
+#: Curtain rings around the rod (m): the ring's radius (its bottom holds the heading at
+#: CURTAIN_TOP_Y) and the wire's radius.
+RING_RADIUS_M = 0.03
+RING_WIRE_M = 0.004
+ROD_Y = CURTAIN_TOP_Y + 0.03
+
+
+def ring_triangles(xs_m, sections: int = 16, wire_sections: int = 6) -> np.ndarray:
+    """Rings (tori in the y-z plane around the rod) at the given x positions, as triangles
+    (T, 3, 3), counter-clockwise from outside."""
+    xs_m = np.asarray(xs_m, dtype=np.float64).ravel()
+    if xs_m.size == 0:
+        return np.zeros((0, 3, 3))
+    a = np.linspace(0.0, 2 * math.pi, sections + 1)            # around the ring
+    b = np.linspace(0.0, 2 * math.pi, wire_sections + 1)       # around the wire
+    aa, bb = np.meshgrid(a, b, indexing="ij")
+    r = RING_RADIUS_M + RING_WIRE_M * np.cos(bb)
+    ring = np.stack([RING_WIRE_M * np.sin(bb), ROD_Y + r * np.cos(aa), CURTAIN_Z + r * np.sin(aa)], -1)
+    quads = []
+    for i in range(sections):
+        for j in range(wire_sections):
+            p00, p10 = ring[i, j], ring[i + 1, j]
+            p01, p11 = ring[i, j + 1], ring[i + 1, j + 1]
+            quads += [(p00, p10, p11), (p00, p11, p01)]
+    one = np.array(quads)
+    return np.concatenate([one + [x, 0.0, 0.0] for x in xs_m])
+
+
+def ring_mesh(xs_m) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`ring_triangles` flat-shaded: (positions, normals) float32 (3T, 3)."""
+    return _flat_shaded(ring_triangles(xs_m))
+
+
 def _room_parts() -> list[np.ndarray]:
     (x0, x1), (y0, y1), (z0, z1) = ROOM_BOX
     wx0, wx1, wy0, wy1 = WINDOW_RECT
@@ -150,7 +183,7 @@ def _room_parts() -> list[np.ndarray]:
         box_triangles(wx1, x1, y0, y1, z0 - t, z0),
         box_triangles(wx0, wx1, y0, wy0, z0 - t, z0),
         box_triangles(wx0, wx1, wy1, y1, z0 - t, z0),
-        rod_triangles(0.015, CURTAIN_WIDTH_M + 0.4, (0.0, CURTAIN_TOP_Y + 0.03, CURTAIN_Z)),
+        rod_triangles(0.015, CURTAIN_WIDTH_M + 0.4, (0.0, ROD_Y, CURTAIN_Z)),
     ]
 
 
@@ -355,29 +388,40 @@ def decide_fluorescence(preset, irradiance: np.ndarray, requested: str) -> Fluor
     return FluorescenceDecision(requested, requested if needed else "off", needed, delta_e)
 
 
-def outside_radiances(key_irradiance: np.ndarray, to_light: np.ndarray,
-                      is_sun: bool) -> tuple[np.ndarray, np.ndarray]:
+def outside_radiances(key_irradiance: np.ndarray, to_light: np.ndarray, is_sun: bool,
+                      paper_beam: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Mean radiance spectra of the sky and the ground outside the window.
 
-    The sun above the horizon: the clear sky of the same atmosphere (catalog.optics.sun.model.clear_sky
-    at the sun's zenith): sky = diffuse horizontal / pi (a uniform sky with the same
-    irradiance; catalog/optics/sun/sky.py spreads it over the sky by Preetham's distribution), ground =
-    albedo x global horizontal / pi. A lamp (or the sun at or below the horizon): the scene
+    The sun above the horizon: the clear sky of the same atmosphere (catalog.optics.sun.model
+    clear_sky at the sun's zenith): sky = diffuse horizontal / pi (a uniform sky with the same
+    irradiance; catalog/optics/sun/sky.py spreads it over the sky by Preetham's distribution),
+    ground = albedo x global horizontal / pi. ``paper_beam`` (the ``sun:PATH`` lights, the
+    paper's beam after Rayleigh scattering alone): that atmosphere's sky has the colour of
+    the same beam Rayleigh-scattered, key x (550 / l)^4, at the clear sky's luminance, and the
+    ground is lit by that beam and sky. A lamp (or the sun at or below the horizon): the scene
     design of the module docstring (a lit backdrop, SKY_FRACTION of the key)."""
+    tint = (550.0 / GRID_NM) ** 4
     if is_sun and to_light[1] > 1e-3:
+        from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
         from catalog.optics.sun.model import Atmosphere, clear_sky  # noqa: PLC0415
 
         zenith = min(math.degrees(math.acos(min(float(to_light[1]), 1.0))), 89.5)
-        sky = clear_sky(zenith)
-        return (sky.diffuse_horizontal / math.pi,
-                Atmosphere().ground_albedo * sky.global_horizontal / math.pi)
-    tint = (550.0 / GRID_NM) ** 4 if is_sun else np.ones(GRID_NM.size)
-    return (SKY_FRACTION * key_irradiance * tint / math.pi,
+        clear = clear_sky(zenith)
+        albedo = Atmosphere().ground_albedo
+        if not paper_beam:
+            return clear.diffuse_horizontal / math.pi, albedo * clear.global_horizontal / math.pi
+        ybar = cmfs(GRID_NM)[:, 1]
+        shape = key_irradiance * tint
+        scale = float(clear.diffuse_horizontal @ ybar) / max(float(shape @ ybar), 1e-300)
+        diffuse = shape * scale
+        cos_z = math.cos(math.radians(zenith))
+        return diffuse / math.pi, albedo * (key_irradiance * cos_z + diffuse) / math.pi
+    return (SKY_FRACTION * key_irradiance * (tint if is_sun else 1.0) / math.pi,
             GROUND_ALBEDO * key_irradiance * max(to_light[1], 0.0) / math.pi)
 
 
 def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.ndarray, *,
-                         is_sun: bool, fluorescence: str = "physical",
+                         is_sun: bool, fluorescence: str = "physical", paper_beam: bool = False,
                          viewer_inside: bool = True) -> tuple[ShadingInputs, FluorescenceDecision]:
     """The spectral description of the scene's light on the curtain for a preset."""
     from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
@@ -386,7 +430,7 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
     key = np.asarray(key_irradiance, dtype=np.float64)
     to_light = np.asarray(key_to_light, dtype=np.float64)
     to_light = to_light / np.linalg.norm(to_light)
-    sky, ground = outside_radiances(key, to_light, is_sun)
+    sky, ground = outside_radiances(key, to_light, is_sun, paper_beam)
     fill = FILL_FRACTION * key
     room = ROOM_ALBEDO * ROOM_FRACTION * key / math.pi
     disc = key / (math.pi * SUN_RADIUS_RAD ** 2)

@@ -138,8 +138,11 @@ class SkyModel:
         return np.where(d[..., 1:2] >= 0.0, sky, fade * sky + (1.0 - fade) * self.ground_rgb)
 
 
-def sky_model(to_sun: np.ndarray, atmosphere=None) -> SkyModel:
-    """The clear sky for a sun direction (y up), scaled to :func:`catalog.optics.sun.model.clear_sky`."""
+def sky_model(to_sun: np.ndarray, atmosphere=None, diffuse_horizontal=None,
+              ground_radiance=None) -> SkyModel:
+    """The clear sky for a sun direction (y up), scaled to :func:`catalog.optics.sun.model.clear_sky`
+    or, given, to ``diffuse_horizontal`` (W m^-2 nm^-1 on the grid: the light's own sky), with
+    the ground ``ground_radiance`` (W m^-2 sr^-1 nm^-1) instead of the atmosphere's."""
     from catalog.optics.shading_reference import spectral_to_linear_srgb as spectrum_to_display_rgb  # noqa: PLC0415
     from catalog.optics.sun.model import Atmosphere, clear_sky  # noqa: PLC0415
 
@@ -149,10 +152,13 @@ def sky_model(to_sun: np.ndarray, atmosphere=None) -> SkyModel:
     zenith_deg = min(zenith_deg, 89.5)
     turbidity = turbidity_from_atmosphere(atm)
     sky = clear_sky(zenith_deg, atmosphere=atm)
-    target = spectrum_to_display_rgb(sky.diffuse_horizontal)
+    target = spectrum_to_display_rgb(sky.diffuse_horizontal if diffuse_horizontal is None
+                                     else np.asarray(diffuse_horizontal, dtype=np.float64))
     preetham = horizontal_irradiance_rgb(lambda d: preetham_rgb(d, to_sun, turbidity))
     scale = target / np.where(np.abs(preetham) > 0, preetham, 1.0)
-    ground = spectrum_to_display_rgb(atm.ground_albedo * sky.global_horizontal / math.pi)
+    ground = spectrum_to_display_rgb(atm.ground_albedo * sky.global_horizontal / math.pi
+                                     if ground_radiance is None
+                                     else np.asarray(ground_radiance, dtype=np.float64))
     sun_zenith = math.radians(zenith_deg)
     perez = perez_coefficients(turbidity)
     perez_sun = _perez(perez, math.cos(sun_zenith), sun_zenith)
