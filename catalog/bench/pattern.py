@@ -1,7 +1,8 @@
 """Issue 12's frame cost: patterns, layers (OIT) and anti-aliasing against the frame before.
 
 Side by side in one run, on the same context, medians of interleaved repeats (GL finished
-before each clock read):
+before each clock read); issue 13's room light, sky model and glare are off on every side
+(``catalog.bench.room`` measures those):
 
 - ``before``: the flat cloth (``patterned = False``: opaque, LD x background by ray
   direction), no anti-aliasing, the static sinusoidal drape: the frame as it was;
@@ -59,6 +60,11 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     renderer = FrameRenderer(ctx, size)
     renderer.set_fabric(preset)
     renderer.set_light(LIGHT)
+    # issue 13's room light, sky and glare off on both sides: issue 12's additions alone
+    # (catalog.bench.room measures those against the frame without them)
+    renderer.set_room_lighting(False)
+    renderer.set_sky_model(False)
+    renderer.set_bloom(False)
 
     def configure(patterned, aa, mesh):
         renderer.set_patterned(patterned)

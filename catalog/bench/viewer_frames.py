@@ -65,7 +65,8 @@ def checkout(rev: str, into: Path) -> Path:
 
 
 def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backend: str,
-             fabric: str, light: str, render_scale: str, tree: Path = ROOT) -> dict:
+             fabric: str, light: str, render_scale: str, room_light: bool = True,
+             tree: Path = ROOT) -> dict:
     env = dict(os.environ, DISPLAY=display)
     env.pop("WAYLAND_DISPLAY", None)
     if tree != ROOT:   # that tree's package before the editable install of this one
@@ -74,6 +75,8 @@ def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backe
     cmd = [sys.executable, "-m", "catalog", "view", "--size", size, *grid_args,
            "--cloth-backend", backend, "--frames", str(frames + warmup), "--stats",
            "--wind", "2.0", "--fabric", fabric, "--light", light, "--render-scale", render_scale]
+    if not room_light:
+        cmd.append("--no-room-light")
     start = time.perf_counter()
     result = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=tree)
     wall = time.perf_counter() - start
@@ -110,6 +113,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--render-scale", default="auto",
                         help="scene resolution / window resolution, or auto (the viewer's default)")
     parser.add_argument("--display", help="use this X display instead of a private Xvfb")
+    parser.add_argument("--room-light", choices=("on", "off", "both"), default="on",
+                        help="the room lit through the curtain (issue 13); both: each case "
+                             "without and with, side by side")
     parser.add_argument("--json-out", type=Path, default=ROOT / "benchmarks" / "viewer.json")
     parser.add_argument("--before", metavar="REV",
                         help="also run every case on this commit's tree, interleaved")
@@ -127,14 +133,18 @@ def main(argv: list[str] | None = None) -> int:
         rows = []
         for case in args.cases.split(","):
             size, grid = case.split(":")
-            rows.append(run_case(display, size, grid, args.frames, args.warmup, args.backend,
-                                 args.fabric, args.light, args.render_scale))
-            row = rows[-1]
-            print(f"{row['size']:>10} x{row['render_scale']} grid {row['grid']:>8}: "
-                  f"total {row['total_ms']:7.1f} ms ({row['fps']} fps) = simulation {row['simulation_ms']:6.1f} + shading "
-                  f"{row['shading_ms']:6.1f} + UI {row['ui_ms']:5.1f} + other "
-                  f"{row['other_ms']:5.1f}; first frame {row['first_frame_ms']} ms",
-                  flush=True)
+            settings = {"on": (True,), "off": (False,), "both": (False, True)}[args.room_light]
+            for room_light in settings:
+                rows.append(run_case(display, size, grid, args.frames, args.warmup, args.backend,
+                                     args.fabric, args.light, args.render_scale, room_light))
+                rows[-1]["room_light"] = room_light
+                row = rows[-1]
+                print(f"{row['size']:>10} x{row['render_scale']} grid {row['grid']:>8} room light "
+                      f"{'on ' if room_light else 'off'}: "
+                      f"total {row['total_ms']:7.1f} ms ({row['fps']} fps) = simulation "
+                      f"{row['simulation_ms']:6.1f} + shading {row['shading_ms']:6.1f} + UI "
+                      f"{row['ui_ms']:5.1f} + other {row['other_ms']:5.1f}; first frame "
+                      f"{row['first_frame_ms']} ms", flush=True)
     finally:
         if xvfb is not None:
             xvfb.terminate()
@@ -165,9 +175,12 @@ def main_before_after(args) -> int:
                 runs: dict[str, list[dict]] = {"before": [], "after": []}
                 for _ in range(args.rounds):
                     for version, tree in (("before", before), ("after", ROOT)):
+                        # the before tree may predate --no-room-light: only "after" gets it
+                        room_light = version == "before" or args.room_light != "off"
                         runs[version].append(run_case(display, size, grid, args.frames,
                                                       args.warmup, args.backend, args.fabric,
-                                                      args.light, args.render_scale, tree))
+                                                      args.light, args.render_scale,
+                                                      room_light, tree))
                 for version, version_runs in runs.items():
                     row = dict(version_runs[0])
                     for part in PARTS:
