@@ -447,3 +447,24 @@ def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl):
     print(f"MSAA above the one-sample 3x3 maximum over {int(inner.sum())} interior pixels: "
           f"at most {excess.max():.1f} levels")
     assert excess.max() < 10.0
+
+
+def test_fxaa_and_the_msaa_curtain_vertex_shader_compile_as_glsl_es_300(tmp_path):
+    """fxaa.frag (texel fetches, the blend in the shader) and curtain.vert's MSAA variant
+    (centroid outputs), with the #version line swapped for ES 3.00, pass glslangValidator."""
+    import shutil
+    import subprocess
+
+    from catalog.gl.shaderlib import load_source
+
+    validator = shutil.which("glslangValidator")
+    if validator is None:
+        pytest.fail("glslangValidator missing: tools/setup.sh installs glslang-tools")
+    for name, defines in (("fxaa.frag", {}),
+                          ("curtain.vert", {"INTERPOLATION": "centroid", "PATTERN": True})):
+        lines = load_source(name, defines).splitlines()
+        path = tmp_path / f"es_{name}"
+        path.write_text("\n".join(["#version 300 es", "precision highp float;",
+                                   "precision highp int;", *lines[1:]]) + "\n")
+        result = subprocess.run([validator, str(path)], capture_output=True, text=True)
+        assert result.returncode == 0, f"{name}: {result.stdout}"
