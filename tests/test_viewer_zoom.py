@@ -23,6 +23,7 @@ def gui():
     io.display_size = imgui.ImVec2(400, 600)
     io.backend_flags |= imgui.BackendFlags_.renderer_has_textures  # no font texture needed
     io.mouse_double_click_time = 0.0  # two clicks in a row are two clicks, not a text edit
+    io.set_ini_filename("")           # no imgui.ini written into the working folder
     yield io
     imgui.destroy_context(context)
 
