@@ -10,6 +10,7 @@ imported here, so ``catalog --help`` answers at once. Parts:
 - :mod:`catalog.cli`: the ``catalog`` command.
 """
 
+import os
 from pathlib import Path
 
 __version__ = "0.1.0"
@@ -18,5 +19,6 @@ __version__ = "0.1.0"
 PROJECT_ROOT = Path(__file__).resolve().parent.parent
 SHADER_DIR = PROJECT_ROOT / "shaders"
 FABRIC_DIR = PROJECT_ROOT / "fabrics"
-#: Real measurements made by others, kept outside the project (see ../shared/data/README.md).
-SHARED_DATA_DIR = PROJECT_ROOT.parent / "shared" / "data"
+#: Real measurements made by others, kept outside the project (see ../shared/data/README.md);
+#: the environment variable CATALOG_SHARED_DATA points elsewhere (a checkout in another place).
+SHARED_DATA_DIR = Path(os.environ.get("CATALOG_SHARED_DATA") or PROJECT_ROOT.parent / "shared" / "data")
