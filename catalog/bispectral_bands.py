@@ -44,6 +44,11 @@ CANDIDATE_EDGES = {
     "14 bands: every 10 nm below 430": tuple(float(e) for e in range(310, 431, 10)),
 }
 
+#: The model the renderer carries: the candidate chosen on the selection lights by
+#: catalog/benchsuite/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
+CHOSEN = "14 bands: every 10 nm below 430"
+DEFAULT_EDGES_NM = CANDIDATE_EDGES[CHOSEN]
+
 
 @dataclass(frozen=True)
 class Component:
@@ -118,7 +123,7 @@ def _pdf_scale(emission_nm: np.ndarray, u: np.ndarray) -> float:
     return float(np.sum(np.interp(GRID_NM, emission_nm, u, left=0.0, right=0.0)))
 
 
-def fit_banded(matrix: DonaldsonMatrix, edges_nm: tuple[float, ...],
+def fit_banded(matrix: DonaldsonMatrix, edges_nm: tuple[float, ...] = DEFAULT_EDGES_NM,
                base: SeparableFit | None = None, band_nm: float = REFLECTANCE_BAND_NM) -> BandedFit:
     """The banded model of ``matrix`` with excitation band edges ``edges_nm`` (ascending).
 
