@@ -311,7 +311,100 @@ def markdown_tables(result: dict) -> dict[str, str]:
                      f"{_f(f['negatives'])} / "
                      f"{_f(f['sampling_10nm'])}) | {'yes' if r[choice] <= f['floor'] else '**no**'} |")
     out["uv-cases"] = "\n".join(lines)
+    if "frame" in result:
+        out["uv-frame"] = frame_table(result["frame"])
     return out
+
+
+def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> dict:
+    """Whole-frame time of a single-band fabric against the same fabric carrying the banded
+    model, side by side in one run (rounds interleaved; medians), under LED-405, plus the
+    CPU time of the per-light pre-integration (what a light change costs).
+
+    The banded fabric is lace-fwa's cloth with CIBA12's chosen banded fit when the measured
+    matrices are present (a temporary folder; never shipped), else lace-fwa's own spectra
+    given as two bands. Frame times are wall clock; llvmpipe in CI, so noisy: ratios count.
+    """
+    import statistics  # noqa: PLC0415
+    import tempfile  # noqa: PLC0415
+    import time  # noqa: PLC0415
+
+    from catalog.bispectral import bispectral_dir, find_bfc, read_bfc  # noqa: PLC0415
+    from catalog.bispectral_bands import banded_preset, fit_banded  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset, preset_from_dict, preset_to_dict  # noqa: PLC0415
+    from catalog.render.context import create_headless_context, describe  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    single = load_preset(find_preset("lace-fwa"))
+    folder = tempfile.mkdtemp(prefix="bench-uv-")
+    if (bispectral_dir() / "CIBA12.BFC").is_file():
+        fit = fit_banded(read_bfc(find_bfc("CIBA12")))
+        banded = banded_preset(single, fit, folder)
+        what = f"lace-fwa cloth with CIBA12's {len(fit.components)}-band fit"
+    else:
+        doc = preset_to_dict(single)
+        fl = dict(doc["fluorescence"])
+        fl["excitation"] = str(single.fluorescence.excitation)
+        fl["emission"] = str(single.fluorescence.emission)
+        fl["bands"] = [{"excitation": str(single.fluorescence.excitation),
+                        "emission": str(single.fluorescence.emission),
+                        "quantum_yield": 0.3, "peak_absorptance": 0.2}]
+        doc["fluorescence"] = fl
+        banded = preset_from_dict(doc, None)
+        what = "lace-fwa with its own spectra as two bands (measured matrices absent)"
+    ctx = ctx or create_headless_context()
+    renderers = {}
+    for label, preset in (("single band (today)", single), ("banded", banded)):
+        renderer = FrameRenderer(ctx, tuple(size))
+        renderer.set_fabric(preset)
+        renderer.set_light("LED-405")
+        renderer.set_fluorescence("physical")
+        renderer.render()
+        renderers[label] = renderer
+    ctx.finish()
+    samples = {label: [] for label in renderers}
+    for _ in range(repeats):
+        for label, renderer in renderers.items():
+            start = time.perf_counter()
+            for _ in range(draws):
+                renderer.render()
+            ctx.finish()
+            samples[label].append((time.perf_counter() - start) / draws)
+    light = renderers["banded"].light.irradiance_w_m2_nm
+    key = renderers["banded"]._key_to_light
+    prepare = {}
+    for label, renderer in renderers.items():
+        def build(preset=renderer.preset):
+            scene_lib.build_shading_inputs(preset, light, key, is_sun=False)
+        build()
+        times = []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            build()
+            times.append(time.perf_counter() - start)
+        prepare[label] = statistics.median(times)
+    for renderer in renderers.values():
+        renderer.release()
+    base = statistics.median(samples["single band (today)"])
+    return {"what": what, "size": list(size), "light": "LED-405", "repeats": repeats,
+            "draws": draws, "renderer": describe(ctx)["renderer"],
+            "rows": [{"variant": label, "frame_ms": 1e3 * statistics.median(samples[label]),
+                      "frame_ratio": statistics.median(samples[label]) / base,
+                      "light_change_ms": 1e3 * prepare[label]} for label in renderers]}
+
+
+def frame_table(frame: dict) -> str:
+    """The ``uv-frame`` block: frame time side by side."""
+    lines = [f"| fabric ({frame['light']}, {frame['size'][0]}x{frame['size'][1]}, "
+             f"{frame['renderer']}) | frame ms (median) | ratio | light change ms |",
+             "|---|---|---|---|"]
+    for row in frame["rows"]:
+        lines.append(f"| {row['variant']} | {row['frame_ms']:.2f} | {row['frame_ratio']:.3f} | "
+                     f"{row['light_change_ms']:.2f} |")
+    lines.append(f"\nBanded fabric: {frame['what']}; {frame['repeats']} interleaved rounds of "
+                 f"{frame['draws']} frames.")
+    return "\n".join(lines)
 
 
 def main(argv=None) -> int:
@@ -324,7 +417,15 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description="UV/violet fluorescence: noise floor and banded model")
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--out", default="benchmarks/bench_uv.json")
+    parser.add_argument("--frame", action="store_true",
+                        help="only the frame cost, into benchmarks/bench_uv_frame.json (needs GL)")
     args = parser.parse_args(argv)
+    if args.frame:
+        frame = frame_cost(repeats=3 if args.quick else 9)
+        out = args.out if args.out != "benchmarks/bench_uv.json" else "benchmarks/bench_uv_frame.json"
+        write_text_atomic(Path(out), json.dumps(frame, indent=1) + "\n")
+        print(frame_table(frame))
+        return 0
     result = run(quick=args.quick)
     write_text_atomic(Path(args.out), json.dumps(result, indent=1) + "\n")
     for name, table in markdown_tables(result).items():
