@@ -395,8 +395,14 @@ class FrameRenderer:
     def exposure_scale(self) -> float:
         """Linear radiance (cd m^-2) -> tone-curve input: EXPOSURE_KEY over a white diffuser's Y."""
         # a UV lamp has almost no illuminance: expose as for EXPOSURE_FLOOR_LX instead, so what
-        # shows is the fluorescence it excites, not a blown-out violet tail
-        illuminance = max(self.light.illuminance_lx, EXPOSURE_FLOOR_LX)
+        # shows is the fluorescence it excites, not a blown-out violet tail; a dim violet lamp
+        # (LED-405: 6 lx, but its linear-sRGB blue is 180 times its Y) is exposed so that a
+        # white diffuser's brightest display channel reaches 1, not EXPOSURE_KEY: nearly all
+        # of its light is in that one channel, which the luminance curve would not compress,
+        # so a white under it is deep violet instead of clipped magenta
+        illuminance = self.light.illuminance_lx
+        if illuminance < EXPOSURE_FLOOR_LX:
+            illuminance = max(EXPOSURE_FLOOR_LX, EXPOSURE_KEY * _brightest_channel(self.light))
         return self.exposure * EXPOSURE_KEY * math.pi / illuminance
 
     # ------------------------------------------------------------------ passes
@@ -591,3 +597,11 @@ class FrameRenderer:
         for program in self._programs.values():
             program.release()
         self._programs.clear()
+
+
+def _brightest_channel(light) -> float:
+    """The largest linear-sRGB channel of a light's XYZ (Y scale: lx)."""
+    from catalog.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
+    from catalog.fluorescence import light_xyz  # noqa: PLC0415
+
+    return float(np.max(xyz_to_linear_srgb(light_xyz(light.irradiance_w_m2_nm))))
