@@ -10,6 +10,8 @@ optionally, ``plot(result, folder) -> list[Path]``:
 - ``fluorescence``: representations of fluorescence in an RGB engine on the measured
   Donaldson matrices (:mod:`catalog.benchsuite.fluorescence_rgb`, with the reduced
   re-radiation matrices of :mod:`catalog.benchsuite.reduction`);
+- ``uv``: fluorescence under UV and violet light: the matrices' noise floor and the
+  banded model chosen on selection lights (:mod:`catalog.benchsuite.uv_fluorescence`);
 - ``fit``: Levenberg-Marquardt on 79 and 4800 gonio points against differential
   evolution (:mod:`catalog.benchsuite.fit`);
 - ``cloth``: substeps and backends against a small-step reference run
@@ -27,6 +29,7 @@ from __future__ import annotations
 SECTIONS: dict[str, str] = {
     "colour": "catalog.benchsuite.colour",
     "fluorescence": "catalog.benchsuite.fluorescence_rgb",
+    "uv": "catalog.benchsuite.uv_fluorescence",
     "fit": "catalog.benchsuite.fit",
     "cloth": "catalog.benchsuite.cloth",
     "stability": "catalog.benchsuite.stability",

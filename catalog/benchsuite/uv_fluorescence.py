@@ -1,6 +1,6 @@
 """Fluorescence under UV and violet light: the data's noise floor and the banded model.
 
-    .venv/bin/python -m catalog.benchsuite.uv_fluorescence [--quick] [--out benchmarks/bench_uv.json]
+    .venv/bin/python -m catalog.benchsuite.uv_fluorescence [--quick] [--no-frame] [--out benchmarks/bench_uv.json]
 
 (also ``catalog bench --sections uv``). Needs the eight measured matrices
 (../shared/data/bispectral); docs/bispectral.md reads the tables it makes.
@@ -22,8 +22,9 @@
    here first: TEST mean <= 1.5 and every case within its noise floor; GOAL mean <= 0.5,
    max <= 1.0; HELD_OUT mean not above the separable fit's.
 4. **Cost**: numbers stored per material, CPU time of the per-(material, light)
-   pre-integration (the renderer's shader takes the same uniforms whatever the model:
-   the frame cost is measured by ``benchmarks/bench_render.py``'s side-by-side run).
+   pre-integration (the renderer's shader takes the same uniforms whatever the model), and
+   (:func:`frame_cost`, unless ``--no-frame``) the whole frame of a banded fabric against
+   today's single-band one, side by side in one run.
 """
 
 from __future__ import annotations
@@ -417,16 +418,12 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description="UV/violet fluorescence: noise floor and banded model")
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--out", default="benchmarks/bench_uv.json")
-    parser.add_argument("--frame", action="store_true",
-                        help="only the frame cost, into benchmarks/bench_uv_frame.json (needs GL)")
+    parser.add_argument("--no-frame", action="store_true",
+                        help="skip the frame-cost part (it needs an OpenGL context)")
     args = parser.parse_args(argv)
-    if args.frame:
-        frame = frame_cost(repeats=3 if args.quick else 9)
-        out = args.out if args.out != "benchmarks/bench_uv.json" else "benchmarks/bench_uv_frame.json"
-        write_text_atomic(Path(out), json.dumps(frame, indent=1) + "\n")
-        print(frame_table(frame))
-        return 0
     result = run(quick=args.quick)
+    if not args.no_frame:
+        result["frame"] = frame_cost(repeats=3 if args.quick else 9)
     write_text_atomic(Path(args.out), json.dumps(result, indent=1) + "\n")
     for name, table in markdown_tables(result).items():
         print(f"<!-- generated:{name} -->\n{table}\n<!-- /generated:{name} -->\n")
