@@ -14,9 +14,9 @@ import sys
 import numpy as np
 import pytest
 
-from catalog import PROJECT_ROOT, SHARED_DATA_DIR
-from catalog.errors import InputError
-from catalog.spectra import GRID_NM
+from catalog.core.resources import PROJECT_ROOT, SHARED_DATA_DIR
+from catalog.core.errors import InputError
+from catalog.optics.spectra import GRID_NM
 
 colour = pytest.importorskip("colour")
 
@@ -29,7 +29,7 @@ needs_matrices = pytest.mark.skipif(not HAS_MATRICES, reason="measured matrices 
 
 @pytest.mark.parametrize("name, centre, fwhm", [("UV-385", 385.0, 10.0), ("LED-405", 405.0, 15.0)])
 def test_narrow_lamps_are_gaussians_of_10_w_m2(name, centre, fwhm):
-    from catalog.lights import get_light, light_names
+    from catalog.optics.lights import get_light, light_names
 
     light = get_light(name)
     assert name in light_names()
@@ -41,7 +41,7 @@ def test_narrow_lamps_are_gaussians_of_10_w_m2(name, centre, fwhm):
 
 
 def test_violet_white_led_is_4000k_with_a_violet_pump():
-    from catalog.lights import get_light, light_names
+    from catalog.optics.lights import get_light, light_names
 
     light = get_light("LED-violet-white")
     assert "LED-violet-white" in light_names()
@@ -64,13 +64,13 @@ def test_violet_white_csv_regenerates_byte_for_byte(tmp_path):
     out = tmp_path / "led.csv"
     subprocess.run([sys.executable, str(PROJECT_ROOT / "tools" / "make_violet_led.py"),
                     "--out", str(out)], check=True, capture_output=True)
-    shipped = PROJECT_ROOT / "catalog" / "data" / "led_violet_white.csv"
+    shipped = PROJECT_ROOT / "catalog" / "optics" / "data" / "led_violet_white.csv"
     assert out.read_bytes() == shipped.read_bytes()
 
 
 def test_planck_lights_are_at_a_lamps_level_and_bad_ones_refused():
-    from catalog.bispectral import training_light
-    from catalog.lights import illuminance_lx
+    from catalog.optics.bispectral.matrix import training_light
+    from catalog.optics.lights import illuminance_lx
 
     assert illuminance_lx(training_light("planck:2000")) == pytest.approx(1000.0, rel=1e-9)
     for bad in ("planck:x", "planck:-5", "planck:nan", "planck:1e9"):
@@ -81,7 +81,7 @@ def test_planck_lights_are_at_a_lamps_level_and_bad_ones_refused():
 # ------------------------------------------------------------ combining bands per light
 
 def _material(peak_nm, width_nm, emission_nm, qy, a):
-    from catalog.fluorescence import FluorescentMaterial
+    from catalog.optics.fluorescence import FluorescentMaterial
 
     absorptance = a * np.exp(-0.5 * ((GRID_NM - peak_nm) / width_nm) ** 2)
     pdf = np.exp(-0.5 * ((GRID_NM - emission_nm) / 15.0) ** 2)
@@ -92,8 +92,8 @@ def _material(peak_nm, width_nm, emission_nm, qy, a):
 @pytest.mark.parametrize("light", ["UV-A", "LED-405", "D65", "A"])
 def test_combined_material_emits_the_sum_of_the_bands(light):
     """Exact for the light it is made for (float64 round-off): relative 1e-12."""
-    from catalog.fluorescence import combine_under_light, emitted_exitance_w_m2_nm
-    from catalog.lights import get_light
+    from catalog.optics.fluorescence import combine_under_light, emitted_exitance_w_m2_nm
+    from catalog.optics.lights import get_light
 
     bands = [_material(350, 12, 420, 0.8, 0.6), _material(400, 10, 450, 0.5, 0.3),
              _material(480, 20, 560, 0.9, 0.2)]
@@ -106,7 +106,7 @@ def test_combined_material_emits_the_sum_of_the_bands(light):
 
 
 def test_combined_material_is_none_when_nothing_is_absorbed():
-    from catalog.fluorescence import combine_under_light
+    from catalog.optics.fluorescence import combine_under_light
 
     bands = [_material(350, 5, 420, 0.8, 0.6), _material(380, 5, 450, 0.5, 0.3)]
     red = np.where(GRID_NM > 600, 1.0, 0.0)
@@ -119,7 +119,7 @@ def _synthetic_matrix():
     """Reflectance 0.8 on the diagonal + a UV fluorophore (absorbs 300-380, emits at 420)
     + a blue one (absorbs 390-460, emits at 520), noiseless, in photon form; phi a at the
     peaks 0.6 and 0.5 (u integrates to about 50 and 63 nm)."""
-    from catalog.bispectral import DonaldsonMatrix
+    from catalog.optics.bispectral.matrix import DonaldsonMatrix
 
     lo = np.arange(380.0, 781.0, 10.0)
     li = np.arange(300.0, 781.0, 10.0)
@@ -134,8 +134,8 @@ def _synthetic_matrix():
 
 
 def test_one_band_is_the_separable_fit():
-    from catalog.bispectral import fit_separable
-    from catalog.bispectral_bands import fit_banded
+    from catalog.optics.bispectral.matrix import fit_separable
+    from catalog.optics.bispectral.bands import fit_banded
 
     matrix = _synthetic_matrix()
     base = fit_separable(matrix)
@@ -147,7 +147,7 @@ def test_one_band_is_the_separable_fit():
 def test_per_column_bands_reproduce_the_short_columns():
     """Every column below 430 nm its own band: its entries off the reflectance band are
     the matrix's (noiseless, nonnegative): to 1e-9 of the largest entry."""
-    from catalog.bispectral_bands import DEFAULT_EDGES_NM, fit_banded
+    from catalog.optics.bispectral.bands import DEFAULT_EDGES_NM, fit_banded
 
     matrix = _synthetic_matrix()
     banded = fit_banded(matrix, DEFAULT_EDGES_NM)
@@ -156,7 +156,7 @@ def test_per_column_bands_reproduce_the_short_columns():
     error = np.abs(banded.fluorescence_matrix() - matrix.values)[short]
     assert error.max() <= 1e-9 * matrix.values[short].max()
     # and the banded model follows the UV-excited emission the one-band fit cannot
-    from catalog.bispectral import fit_separable
+    from catalog.optics.bispectral.matrix import fit_separable
 
     rank1 = fit_separable(matrix).fluorescence_matrix()
     assert np.abs(rank1 - matrix.values)[short].max() > 100 * error.max()
@@ -166,8 +166,8 @@ def test_banded_preset_renders_the_sum_of_its_bands(tmp_path):
     """The renderer's per-light pre-integration of a banded preset: the emission it hands
     the shader for the key light equals the bands' summed emission (relative 1e-5: the
     preset's CSV files and 6-digit quantum yields)."""
-    from catalog.bispectral_bands import banded_preset, fit_banded
-    from catalog.lights import get_light
+    from catalog.optics.bispectral.bands import banded_preset, fit_banded
+    from catalog.optics.lights import get_light
     from catalog.presets import find_preset, load_preset
     from catalog.render import scene
 
@@ -185,7 +185,7 @@ def test_banded_preset_renders_the_sum_of_its_bands(tmp_path):
 
 
 def test_bad_band_entry_is_refused_naming_the_field(tmp_path):
-    from catalog.bispectral_bands import banded_preset, fit_banded
+    from catalog.optics.bispectral.bands import banded_preset, fit_banded
     from catalog.presets import find_preset, load_preset, preset_from_dict, preset_to_dict
     from catalog.render import scene
 
@@ -209,12 +209,12 @@ def test_bad_band_entry_is_refused_naming_the_field(tmp_path):
 def test_banded_model_follows_herpicer_under_uv():
     """HERPICER's UV-excited blue band (a second fluorophore): the one-band fit misses it
     by more than 20 Delta E under UV-385, the banded model is within 3 (bench: 30.4 / 2.3)."""
-    from catalog import bispectral_study as st
-    from catalog.bispectral import exact_exitance_on_grid, find_bfc, fit_separable, read_bfc
-    from catalog.bispectral_bands import fit_banded
-    from catalog.colorimetry import delta_e_2000
-    from catalog.fluorescence import emitted_exitance_w_m2_nm
-    from catalog.lights import get_light
+    from catalog.optics.bispectral import study as st
+    from catalog.optics.bispectral.matrix import exact_exitance_on_grid, find_bfc, fit_separable, read_bfc
+    from catalog.optics.bispectral.bands import fit_banded
+    from catalog.optics.colorimetry import delta_e_2000
+    from catalog.optics.fluorescence import emitted_exitance_w_m2_nm
+    from catalog.optics.lights import get_light
 
     matrix = read_bfc(find_bfc("HERPICER"))
     base = fit_separable(matrix)
@@ -231,8 +231,8 @@ def test_banded_model_follows_herpicer_under_uv():
 
 @needs_matrices
 def test_command_reports_exact_and_model_xyz_per_light(capsys):
-    from catalog.cli import main
-    from catalog.colorimetry import xyz_to_lab
+    from catalog.commands.cli import main
+    from catalog.optics.colorimetry import xyz_to_lab
 
     assert main(["bispectral", "TEXTYELL", "--json", "--lights", "LED-405,planck:2000"]) == 0
     payload = json.loads(capsys.readouterr().out)
@@ -251,8 +251,8 @@ def test_command_reports_exact_and_model_xyz_per_light(capsys):
 
 @needs_matrices
 def test_committed_benchmark_choice_is_the_model_the_renderer_carries():
-    from catalog.bispectral_bands import CHOSEN
-    from catalog.benchsuite.uv_fluorescence import SELECTION_LIGHTS, TEST_LIGHTS
+    from catalog.optics.bispectral.bands import CHOSEN
+    from catalog.bench.uv_fluorescence import SELECTION_LIGHTS, TEST_LIGHTS
 
     result = json.loads((PROJECT_ROOT / "benchmarks" / "bench_uv.json").read_text())
     assert result["summary"]["choice"] == CHOSEN

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerate the relative spectrum of the violet-pumped white LED (light ``LED-violet-white``).
 
-    .venv/bin/python tools/make_violet_led.py [--out catalog/data/led_violet_white.csv]
+    .venv/bin/python tools/make_violet_led.py [--out catalog/optics/data/led_violet_white.csv]
 
 A violet-pumped ("full spectrum") white LED is an InGaN chip emitting near 405 nm whose
 light is mostly converted by three phosphors, a blue, a green and a red one; part of the
@@ -31,11 +31,11 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from catalog.colorimetry import spectrum_to_xyz  # noqa: E402  (after the path set-up)
-from catalog.lights import _gaussian, planck_w_m2_nm  # noqa: E402
-from catalog.spectra import write_spectrum  # noqa: E402
+from catalog.optics.colorimetry import spectrum_to_xyz  # noqa: E402  (after the path set-up)
+from catalog.optics.lights import _gaussian, planck_w_m2_nm  # noqa: E402
+from catalog.optics.spectra import write_spectrum  # noqa: E402
 
-OUT = ROOT / "catalog" / "data" / "led_violet_white.csv"
+OUT = ROOT / "catalog" / "optics" / "data" / "led_violet_white.csv"
 GRID = np.arange(360.0, 781.0, 1.0)
 PUMP = (405.0, 15.0)
 PHOSPHORS = (("BAM:Eu2+ blue", 450.0, 50.0), ("beta-SiAlON:Eu2+ green", 538.0, 55.0),

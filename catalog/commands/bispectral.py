@@ -27,8 +27,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from catalog import bispectral, bispectral_bands, bispectral_study as study
-    from catalog.errors import InputError
+    from catalog.optics.bispectral import bands as bispectral_bands, matrix as bispectral, study
+    from catalog.core.errors import InputError
 
     path = bispectral.find_bfc(args.file)
     matrix = bispectral.read_bfc(path)
@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
                 "residual_over_noise": fit.residual_over_noise, "noise_sigma": fit.noise_sigma,
                 "notes": list(fit.notes)}
     if args.json:
-        from catalog.jsonout import print_json
+        from catalog.core.jsonout import print_json
 
         print_json({"file": str(path), "name": matrix.name, "description": matrix.description,
                     "shape": list(matrix.values.shape), "fit": fit_info,
@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-#: The white of every Delta E 2000 here (catalog.bispectral_study.white_xyz).
+#: The white of every Delta E 2000 here (catalog.optics.bispectral.study.white_xyz).
 WHITE_POINT = ("the light's own XYZ (a perfect white diffuser under it); when the sample is "
                "brighter than that, the D65 chromaticity at the sample's Y; XYZ absolute "
                "(683 lm/W x CIE 1931 2 deg at 1 nm: Y in lm m^-2)")
@@ -106,10 +106,10 @@ WHITE_POINT = ("the light's own XYZ (a perfect white diffuser under it); when th
 def banded_colours(matrix, banded, lights) -> dict:
     """Per light: exact XYZ (the whole matrix), the banded model's XYZ as the renderer
     pre-integrates it (one effective fluorophore per light), Delta E 2000 between them."""
-    from catalog import bispectral_study as study  # noqa: PLC0415
-    from catalog.bispectral import exact_exitance_on_grid, training_light  # noqa: PLC0415
-    from catalog.colorimetry import delta_e_2000  # noqa: PLC0415
-    from catalog.fluorescence import emitted_exitance_w_m2_nm  # noqa: PLC0415
+    from catalog.optics.bispectral import study as study  # noqa: PLC0415
+    from catalog.optics.bispectral.matrix import exact_exitance_on_grid, training_light  # noqa: PLC0415
+    from catalog.optics.colorimetry import delta_e_2000  # noqa: PLC0415
+    from catalog.optics.fluorescence import emitted_exitance_w_m2_nm  # noqa: PLC0415
 
     out = {}
     for name in lights:
