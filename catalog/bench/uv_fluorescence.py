@@ -187,6 +187,8 @@ def run(quick: bool = False, ctx=None) -> dict:
                     "cpu_ms_per_light": 1e3 * median_seconds(
                         lambda fit=fit: emitted_exitance_w_m2_nm(fit.effective_material(d65), d65),
                         3 if quick else 9)}
+    for label, seconds in fit_seconds.items():  # fitting the bands once per material
+        costs.setdefault(label, {})["fit_s_median"] = float(np.median(seconds))
     return {"rows": rows, "noise_floor": floors,
             "summary": summarise(rows, floors, costs, sets),
             "settings": {"lights": {k: list(v) for k, v in sets.items()},
@@ -399,6 +401,33 @@ def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> d
             "rows": [{"variant": label, "frame_ms": 1e3 * statistics.median(samples[label]),
                       "frame_ratio": statistics.median(samples[label]) / base,
                       "light_change_ms": 1e3 * prepare[label]} for label in renderers]}
+
+
+def plot(result: dict, folder) -> list:
+    """The Pareto: mean Delta E 2000 (selection, test, test against the cleaned matrices)
+    against the spectra each candidate stores; the shader's cost is the same for all."""
+    from pathlib import Path  # noqa: PLC0415
+
+    from catalog.bench.plots import pyplot, save_figure  # noqa: PLC0415
+
+    plt = pyplot()
+    per = result["summary"]["per_candidate"]
+    labels = list(per)
+    x = [per[k]["stored_numbers"] for k in labels]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for key, name in (("selection", "selection lights (the choice)"), ("test", "test lights"),
+                      ("test_vs_cleaned", "test lights, matrices without artefacts")):
+        ax.plot(x, [per[k][key]["mean"] for k in labels], "o-", label=name)
+    chosen = labels.index(result["summary"]["choice"])
+    ax.annotate("chosen", (x[chosen], per[labels[chosen]]["selection"]["mean"]),
+                textcoords="offset points", xytext=(-10, 12), fontsize=8)
+    ax.set_xscale("log")
+    ax.set_xlabel("numbers stored per material (bands x (49 + 41) + 2); shader: 6 for all")
+    ax.set_ylabel("mean Delta E 2000, 8 matrices")
+    ax.set_title("Banded fluorescence: error against stored size", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return [save_figure(fig, Path(folder) / "bench_uv_pareto.png")]
 
 
 def frame_table(frame: dict) -> str:
