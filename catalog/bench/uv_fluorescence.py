@@ -302,7 +302,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
               f"{sum(1 for r in result['rows'] if r['light'] in TEST_LIGHTS)} (above the largest "
               f"single part of it: {v['cases_over_largest_part']}, by at most "
               f"{_f(v['max_excess_over_largest_part'])}). Against the matrix without its "
-              f"artefacts (anti-Stokes part dropped, negative entries at 0), the TEST mean is "
+              f"artefacts (anti-Stokes part dropped, Stokes-side negative entries at 0), the TEST mean is "
               f"{_f(v['test_mean_vs_cleaned'])}."]
     out["uv-models"] = "\n".join(lines)
 
