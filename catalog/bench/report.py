@@ -140,10 +140,17 @@ def viewer_line(heavy: dict | None) -> str:
             f"{loaded}.")
 
 
+<<<<<<< HEAD
 def uv_md(section: dict) -> str:
     from catalog.bench.uv_fluorescence import markdown_tables  # noqa: PLC0415
 
     return "\n\n".join(markdown_tables(section).values())
+=======
+def display_md(result: dict) -> str:
+    from catalog.bench.display import markdown_tables  # noqa: PLC0415
+
+    return markdown_tables(result)["display_cost"]
+>>>>>>> main
 
 
 SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
@@ -152,7 +159,8 @@ SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "fit": ("Eq. 7 fit: accuracy against time", fit_md),
               "cloth": ("Cloth: substeps and backend against a small-step reference", cloth_md),
               "stability": ("Numerical stability at the parameters' edges", stability_md),
-              "startup": ("Start-up", startup_md)}
+              "startup": ("Start-up", startup_md),
+              "display": ("The display step's cost in the frame", display_md)}
 
 
 def markdown(report: dict) -> str:
