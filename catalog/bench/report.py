@@ -140,17 +140,16 @@ def viewer_line(heavy: dict | None) -> str:
             f"{loaded}.")
 
 
-<<<<<<< HEAD
 def uv_md(section: dict) -> str:
     from catalog.bench.uv_fluorescence import markdown_tables  # noqa: PLC0415
 
     return "\n\n".join(markdown_tables(section).values())
-=======
+
+
 def display_md(result: dict) -> str:
     from catalog.bench.display import markdown_tables  # noqa: PLC0415
 
     return markdown_tables(result)["display_cost"]
->>>>>>> main
 
 
 SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),

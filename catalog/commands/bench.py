@@ -24,13 +24,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
                         help=f"folder for bench.md, bench.json and the plots (default {DEFAULT_OUT})")
     parser.add_argument("--sections", metavar="NAME,NAME",
-<<<<<<< HEAD
                         help="run only these sections (default: all): colour, fluorescence, uv, "
-                             "fit, cloth, stability, startup")
-=======
-                        help="run only these sections (default: all): colour, fluorescence, "
                              "fit, cloth, stability, startup, display")
->>>>>>> main
 
 
 def parse_sections(text: str | None) -> list[str]:
