@@ -458,7 +458,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     result = run(quick=args.quick)
     if not args.no_frame:
-        result["frame"] = frame_cost(repeats=3 if args.quick else 9)
+        result["frame"] = frame_cost(repeats=3 if args.quick else 21)
     write_text_atomic(Path(args.out), json.dumps(result, indent=1) + "\n")
     for name, table in markdown_tables(result).items():
         print(f"<!-- generated:{name} -->\n{table}\n<!-- /generated:{name} -->\n")
