@@ -222,6 +222,13 @@ def banded_preset(base_preset, fit: BandedFit, folder, name: str | None = None):
     doc["name"] = name
     doc["display_name"] = f"{base_preset.display_name} ({fit.matrix_name}, {len(fit.components)} bands)"
     doc.pop("fit", None)
+    source_folder = Path(base_preset.path).parent if base_preset.path is not None else None
+    pattern = dict(doc.get("pattern", {}))
+    for key in ("coverage", "height"):  # the base's pattern images, where they lie
+        if isinstance(pattern.get(key), str) and source_folder is not None:
+            pattern[key] = str((source_folder / pattern[key]).resolve())
+    if pattern:
+        doc["pattern"] = pattern
     fluorescence = {k: v for k, v in doc["fluorescence"].items()
                     if k in ("xyz", "rgb", "saturation_photon_irradiance")}
     fluorescence.update(band_materials_table(fit, folder))
