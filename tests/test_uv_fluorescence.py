@@ -206,6 +206,7 @@ def test_bad_band_entry_is_refused_naming_the_field(tmp_path):
 # ------------------------------------------------------------------ with the real data
 
 @needs_matrices
+@pytest.mark.slow
 def test_banded_model_follows_herpicer_under_uv():
     """HERPICER's UV-excited blue band (a second fluorophore): the one-band fit misses it
     by more than 20 Delta E under UV-385, the banded model is within 3 (bench: 30.4 / 2.3)."""
@@ -230,6 +231,7 @@ def test_banded_model_follows_herpicer_under_uv():
 
 
 @needs_matrices
+@pytest.mark.slow
 def test_command_reports_exact_and_model_xyz_per_light(capsys):
     from catalog.commands.cli import main
     from catalog.optics.colorimetry import xyz_to_lab
@@ -264,6 +266,7 @@ def test_committed_benchmark_choice_is_the_model_the_renderer_carries():
 
 # ---------------------------------------------------------------------------- picture
 
+@pytest.mark.gl
 def test_violet_lamp_shows_the_brightened_lace_glow(gl):
     """Under LED-405 the brightened lace is bluer than a plain white voile (mean B of the
     cloth at least 1.2x) and the plain voile is not clipped (mean B below 250 of 255)."""
