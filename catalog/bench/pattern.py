@@ -121,6 +121,7 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
         msaa_samples["1x (flat HDR passes)"] += _clock(ctx, hdr_single, 1)
         msaa_samples["MSAA 4x (flat HDR passes + resolve)"] += _clock(ctx, hdr_msaa, 1)
     renderer._hdr_fbo = single_fbo
+    single_fbo.use()   # never leave a released framebuffer bound (the context is the caller's)
     for obj in (msaa_fbo, msaa_colour, msaa_depth):
         obj.release()
     renderer.release()
