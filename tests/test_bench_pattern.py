@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from catalog.bench import pattern, viewer_frames
+from catalog.bench import alpha_to_coverage, pattern, viewer_frames
 from catalog.render.frame import choose_antialiasing
 
 
@@ -36,3 +36,18 @@ def test_viewer_before_after_table():
     table = viewer_frames.markdown_tables({"rows": rows})["viewer_before_after"]
     lines = table.splitlines()
     assert len(lines) == 4 and lines[2].endswith("| 1.00 |") and lines[3].endswith("| 1.50 |")
+
+
+def test_alpha_to_coverage_study(gl):
+    """The study's shape, and what any 4-sample alpha-to-coverage must give: a layer whose
+    coverage is a whole number of quarters covers that fraction of the samples (within 1e-6)."""
+    if int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
+        import pytest
+        pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
+    result = alpha_to_coverage.run(gl)
+    rows = {row["coverage"]: row for row in result["rows"]}
+    assert set(rows) == set(alpha_to_coverage.COVERAGES)
+    for c in (0.25, 0.5, 0.75):
+        assert abs(rows[c]["open_one"] - (1.0 - c)) < 1e-6
+    print("two layers at c = 0.5: open", rows[0.5]["open_two"], "(product 0.25)")
+    assert alpha_to_coverage.markdown_tables(result)["a2c_layers"].count("\n") == len(rows) + 1
