@@ -1287,8 +1287,7 @@ class FrameRenderer:
         mode in use (never ``auto``)."""
         if mode not in ANTIALIASING_MODES:
             raise CatalogError(f"anti-aliasing {mode!r}: choose one of {', '.join(ANTIALIASING_MODES)}")
-        info = dict(self.ctx.info)
-        info.setdefault("GL_RENDERER", self.ctx.info.get("GL_RENDERER", ""))
+        info = dict(self.ctx.info)   # GL_RENDERER, GL_MAX_SAMPLES
         if mode == "auto":
             mode = choose_antialiasing(info)
         if mode == "msaa" and int(info.get("GL_MAX_SAMPLES", 0) or 0) < MSAA_SAMPLES:
