@@ -76,6 +76,22 @@ class BakedAnimation:
                 f"[{json.dumps(self.key)}] = {json.dumps(data)};\n")
 
 
+def read_script(path) -> BakedAnimation:
+    """The animation written by :meth:`BakedAnimation.script` (for tests and benchmarks)."""
+    import json  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    text = Path(path).read_text(encoding="utf-8")
+    data = json.loads(text[text.index("] = ") + len("] = "):].rstrip().rstrip(";"))
+    m = data["manifest"]
+    return BakedAnimation(
+        key=m["key"], frames=m["frames"], fps=m["fps"], vertex_count=m["vertex_count"],
+        indices=np.frombuffer(base64.b64decode(data["indices"]), dtype="<u4"),
+        uv=np.frombuffer(base64.b64decode(data["uv"]), dtype="<f4").reshape(-1, 2),
+        offset_m=tuple(m["offset_m"]), lo_m=np.array(m["lo_m"], dtype=np.float64),
+        payload=base64.b64decode(data["payload"]))
+
+
 def cloth_key(params) -> str:
     text = repr(sorted((k, v) for k, v in vars(params).items() if k != "extra"))
     return hashlib.sha256(text.encode()).hexdigest()[:12]

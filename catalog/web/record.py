@@ -35,6 +35,7 @@ class Recording:
     framebuffers: dict[int, dict] = field(default_factory=dict)  # id -> {colour: [ids], depth}
     vertex_arrays: dict[int, dict] = field(default_factory=dict)
     commands: list[dict] | None = None
+    bound_framebuffer: object = None
     _next_id: int = 1
     _pending_recipe: dict | None = None
 
@@ -97,6 +98,7 @@ class _Texture(_Proxy):
 
 class _Framebuffer(_Proxy):
     def use(self):
+        self._rec.bound_framebuffer = self
         self._rec.note({"op": "framebuffer", "framebuffer": self.rid})
         return self._real.use()
 
@@ -228,6 +230,14 @@ class RecordingContext:
         return proxy
 
     # -- state
+    @property
+    def fbo(self):
+        """The bound framebuffer: our proxy when one of ours is bound (the frame compares it
+        with its own before releasing them)."""
+        real = self._ctx.fbo
+        bound = self.recording.bound_framebuffer
+        return bound if bound is not None and bound._real is real else real
+
     def enable(self, flags) -> None:
         self.recording.note({"op": "enable", "flags": _flag_names(flags)})
         self._ctx.enable(flags)

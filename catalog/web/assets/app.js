@@ -491,7 +491,7 @@
 
   function frame(now) {
     requestAnimationFrame(frame);
-    if (state.view !== 'viewer' || !panes) { lastTime = now; return; }
+    if (state.view !== 'viewer' || !panes) { lastTime = now; dirty = false; return; }
     const anim = animations[fabricByName[state.fabric].animation];
     if (state.playing && lastTime !== null && anim && anim.done) { state.t += (now - lastTime) / 1000 * anim.value.fps; dirty = true; }
     lastTime = now;
