@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from catalog.render import shaderlib
+from catalog.gl import shaderlib
 
 
 # ---------------------------------------------------------------- the ES variant
@@ -40,7 +40,7 @@ def test_es_variant_of_every_frame_shader_has_no_include_left():
 
 
 def test_unknown_dialect_is_refused():
-    from catalog.errors import CatalogError
+    from catalog.core.errors import CatalogError
 
     with pytest.raises(CatalogError, match="dialect"):
         shaderlib.load_source("room.frag", dialect="es100")
@@ -179,7 +179,7 @@ def test_unwritable_folder_one_line_exit_2(tmp_path):
 def test_unwritable_folder_refused_before_any_work(tmp_path, monkeypatch):
     """The same refusal through the library, where the test runs as root: the writability
     check is made (os.access says no) before anything is baked or written."""
-    from catalog.errors import InputError
+    from catalog.core.errors import InputError
     from catalog.web import site
 
     real_access = os.access
@@ -204,7 +204,7 @@ def test_foreign_folder_is_not_replaced(tmp_path):
 def test_failure_midway_leaves_no_site_and_no_stage(tmp_path, monkeypatch):
     """An error after the work began (here: while recording) leaves neither DIR nor the
     staging folder beside it."""
-    from catalog.errors import CatalogError
+    from catalog.core.errors import CatalogError
     from catalog.web import export, site
 
     def broken(*args, **kw):

@@ -18,7 +18,7 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> int:
-    from catalog.jsonout import print_json  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.web.site import build_site  # noqa: PLC0415
 
     report = build_site(args.out, fabrics=args.fabrics, lights=args.lights)

@@ -114,7 +114,7 @@ def simulate_loop(params, fps: float = BAKE_FPS, loop_s: float = LOOP_S,
         simulation.step(dt)
         history.append(np.array(simulation.positions(), dtype=np.float64))
     if not simulation.finite:
-        from catalog.errors import CatalogError  # noqa: PLC0415
+        from catalog.core.errors import CatalogError  # noqa: PLC0415
         raise CatalogError("the cloth simulation diverged while baking the web animation")
     frames = np.stack(history[settle:])
     before = np.stack(history[settle - crossfade:settle])
@@ -129,7 +129,7 @@ def encode(frames_p, frames_n, frames_t):
     lo = frames_p.reshape(-1, 3).min(axis=0)
     q = np.rint((frames_p - lo) / POSITION_STEP_M).astype(np.int64)
     if q.max() > 65535:
-        from catalog.errors import CatalogError  # noqa: PLC0415
+        from catalog.core.errors import CatalogError  # noqa: PLC0415
         raise CatalogError("the baked curtain spans more than 6.5 m: uint16 positions overflow")
     qn = np.clip(np.rint(frames_n * 127.0), -127, 127).astype(np.int64)
     qt = np.clip(np.rint(frames_t * 127.0), -127, 127).astype(np.int64)

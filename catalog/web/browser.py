@@ -15,7 +15,7 @@ from urllib.parse import urlencode
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 CHROMIUM_ARGS = ("--headless=new", "--no-sandbox", "--use-angle=swiftshader",
                  "--enable-unsafe-swiftshader", "--disable-dev-shm-usage",
@@ -114,7 +114,7 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
               animation, ctx=None) -> np.ndarray:
     """The desktop frame (EGL) of the same fabric, light, fluorescence switch, baked cloth frame
     and default camera: uint8 (H, W, 3), row 0 = top."""
-    from catalog.render.context import create_headless_context  # noqa: PLC0415
+    from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.web import bake as bake_lib  # noqa: PLC0415
     from catalog.web.export import FLUORESCENCE  # noqa: PLC0415

@@ -9,7 +9,7 @@ scene's values, replacing only the camera's uniforms (:data:`CAMERA_UNIFORMS`, w
 computes from its orbit camera like :class:`catalog.render.camera.OrbitCamera`) and the
 curtain's vertex buffers (the baked animation, :mod:`catalog.web.bake`). The programs are the
 GLSL ES variant of the same shader files with the same ``#define``s
-(:func:`catalog.render.shaderlib.load_source` with ``dialect="es300"``).
+(:func:`catalog.gl.shaderlib.load_source` with ``dialect="es300"``).
 
 The renderer runs unspecialised (scene values as uniforms, not compiled-in constants): a
 light switch on the page then sets uniforms instead of compiling a program.
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 #: The lamps of the light switch when ``--lights`` is not given.
 DEFAULT_LAMPS = ("D65", "A", "FL2", "LED-B4", "LED-warm", "UV-A")
@@ -59,7 +59,8 @@ class LightChoice:
 
 
 def parse_fabrics(text: str | None) -> list[str]:
-    from catalog.presets import FABRIC_DIR, list_presets  # noqa: PLC0415
+    from catalog.core.resources import FABRIC_DIR  # noqa: PLC0415
+    from catalog.presets import list_presets  # noqa: PLC0415
 
     known = [p.stem for p in list_presets(FABRIC_DIR)]
     if not text:
@@ -77,7 +78,7 @@ def parse_fabrics(text: str | None) -> list[str]:
 
 
 def parse_lights(text: str | None) -> list[LightChoice]:
-    from catalog.lights import get_light  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
 
     names = [n.strip() for n in (text.split(",") if text else [*DEFAULT_LAMPS, SUN_TOKEN])
              if n.strip()]
@@ -160,7 +161,7 @@ class SiteExporter:
     """Records the desktop frame for each scene (see the module docstring)."""
 
     def __init__(self, ctx=None):
-        from catalog.render.context import create_headless_context  # noqa: PLC0415
+        from catalog.gl.context import create_headless_context  # noqa: PLC0415
         from catalog.render.frame import FrameRenderer  # noqa: PLC0415
         from catalog.web.record import RecordingContext  # noqa: PLC0415
 
@@ -226,7 +227,7 @@ class SiteExporter:
 
     def objects(self) -> dict:
         """The GL objects the recorded structures use, as the page creates them."""
-        from catalog.render.shaderlib import load_source  # noqa: PLC0415
+        from catalog.gl.shaderlib import load_source  # noqa: PLC0415
 
         rec = self.ctx.recording
         used_vaos, used_programs, used_fbos, used_textures = set(), set(), set(), set()

@@ -4,7 +4,7 @@
 :class:`catalog.render.frame.FrameRenderer` proxies of every object it creates. Each call the
 frame makes is forwarded to the real object (so the desktop frame renders as usual and
 ``name in program`` answers as GL does) and noted: the programs (shader files and ``#define``s,
-told by :func:`catalog.render.shaderlib.create_program`), the buffers' bytes, the textures and
+told by :func:`catalog.gl.shaderlib.create_program`), the buffers' bytes, the textures and
 framebuffers, and the ordered commands of one frame (bind a framebuffer, clear, viewport, GL
 state, a program's uniforms, a texture unit, a draw). The web page replays these commands
 with WebGL2 and the ES variant of the same shader files, so whatever passes, programs and
@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 #: moderngl enable flags -> names the page knows.
 _FLAGS = {1: "BLEND", 2: "DEPTH_TEST", 4: "CULL_FACE"}
@@ -175,7 +175,7 @@ class RecordingContext:
         recipe = self.recording._pending_recipe
         self.recording._pending_recipe = None
         if recipe is None:
-            raise CatalogError("a program was made without catalog.render.shaderlib: the web "
+            raise CatalogError("a program was made without catalog.gl.shaderlib: the web "
                                "page can only replay programs built from shader files")
         proxy = _Program(self._ctx.program(**kw), self.recording, self.recording.new_id())
         self.recording.programs[proxy.rid] = recipe

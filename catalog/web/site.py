@@ -27,7 +27,7 @@ import time
 from importlib import resources
 from pathlib import Path
 
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 #: The page's own files (catalog/web/assets), copied as they are.
 ASSET_FILES = ("index.html", "app.js", "style.css")
