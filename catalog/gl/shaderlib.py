@@ -7,7 +7,7 @@ Defines are written right after the ``#version`` line, so a variant is chosen at
 
 Dialects: the files are written for desktop GLSL 4.30 (``core``); :data:`DIALECTS` ``"es300"``
 emits the GLSL ES 3.00 variant of the same files for WebGL2 (the web catalog): the version line
-becomes ``#version 300 es`` and default precisions (highp) follow the defines. Nothing else
+names version 300 es and default precisions (highp) follow the defines. Nothing else
 differs, so a change to a shader file reaches the desktop and the web page alike.
 """
 
@@ -80,10 +80,10 @@ def _define_lines(defines: Mapping[str, object]) -> list[str]:
     return out
 
 
-#: Shader dialects: name -> (version line, lines after the defines).
+#: Shader dialects: name -> (version of the version line, lines after the defines).
 DIALECTS: dict[str, tuple[str | None, tuple[str, ...]]] = {
-    "core": (None, ()),  # the file's own #version line (430)
-    "es300": ("#version 300 es", ("precision highp float;", "precision highp int;",
+    "core": (None, ()),  # the file's own version line (430)
+    "es300": ("300 es", ("precision highp float;", "precision highp int;",
                                   "precision highp sampler2D;")),
 }
 
@@ -103,7 +103,7 @@ def load_source(name: str, defines: Mapping[str, object] | None = None,
     extra = _define_lines(defines or {}) + list(preamble)
     for index, line in enumerate(lines):
         if _VERSION.match(line):
-            head = [version] if version is not None else lines[index:index + 1]
+            head = [f"#version {version}"] if version is not None else lines[index:index + 1]
             return "\n".join(lines[:index] + head + extra + lines[index + 1:]) + "\n"
     raise CatalogError(f"shader file {path} has no #version line")
 
