@@ -573,7 +573,8 @@
         cpu.push(t1 - t0); frame.push(t2 - t0);
       }
       const median = (a) => { a.sort((x, y) => x - y); return a.length % 2 ? a[(a.length - 1) / 2] : (a[a.length / 2 - 1] + a[a.length / 2]) / 2; };
-      return { frame_ms: median(frame), cpu_ms: median(cpu), frames: n,
+      return { frame_ms: median(frame.slice()), cpu_ms: median(cpu.slice()), frames: n,
+               frame_samples_ms: frame, cpu_samples_ms: cpu,
                size: [panes[0].canvas.width, panes[0].canvas.height] };
     },
   };
