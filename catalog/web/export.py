@@ -21,6 +21,7 @@ import base64
 import hashlib
 import json
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,6 +49,10 @@ FLUORESCENCE = {"on": "physical", "off": "off"}
 ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_m": [1.2, 4.0]}
 #: The swatch of the catalog grid: a small desktop frame (EGL), px.
 SWATCH_SIZE = (120, 90)
+
+
+#: Vertex format tokens the page reads (moderngl: "3f", "4x" padding bytes).
+_VERTEX_TOKEN = re.compile(r"^\d*(f4?|x)$")
 
 
 @dataclass(frozen=True)
@@ -92,8 +97,14 @@ def parse_lights(text: str | None) -> list[LightChoice]:
             continue
         try:
             light = get_light(name)
-        except CatalogError as exc:
-            raise InputError(f"unknown light {name!r} ({exc}); or {SUN_TOKEN!r}",
+        except CatalogError:
+            import difflib  # noqa: PLC0415
+
+            from catalog.optics.lights import light_names  # noqa: PLC0415
+            close = difflib.get_close_matches(name, light_names(), n=3, cutoff=0.5)
+            hint = f" (close: {', '.join(close)})" if close else ""
+            raise InputError(f"unknown light {name!r}{hint}; `catalog lights` lists the "
+                             f"library, {SUN_TOKEN!r} adds the sun by hour",
                              field="--lights") from None
         choices.append(LightChoice(light.name, LAMP_LABELS.get(light.name, light.name), "lamp"))
     ids = [c.id for c in choices]
@@ -242,6 +253,13 @@ class SiteExporter:
                 elif c["op"] == "texture":
                     used_textures.add(c["texture"])
         vaos = {rid: rec.vertex_arrays[rid] for rid in sorted(used_vaos)}
+        for vao in vaos.values():
+            for entry in vao["content"]:
+                if not all(_VERTEX_TOKEN.match(t) for t in entry["layout"].split()):
+                    raise CatalogError(f"vertex format {entry['layout']!r} of the desktop frame: "
+                                       "the web page reads only float attributes and padding")
+            if vao["index_buffer"] is not None and vao["index_element_size"] != 4:
+                raise CatalogError("the web page draws only 32-bit indices")
         used_programs |= {v["program"] for v in vaos.values()}
         used_buffers = {e["buffer"] for v in vaos.values() for e in v["content"]}
         used_buffers |= {v["index_buffer"] for v in vaos.values() if v["index_buffer"]}

@@ -200,7 +200,7 @@
         const tokens = entry.layout.trim().split(/\s+/), parts = [];
         let stride = 0;
         for (const tok of tokens) {  // moderngl formats: "3f", "3f 4x", "16x" ...
-          const m = /^(\d*)([fx])(\d*)$/.exec(tok);
+          const m = /^(\d*)(f4?|x)$/.exec(tok);
           if (!m) throw new Error('vertex format ' + entry.layout + ' is not supported');
           const n = m[1] ? +m[1] : 1;
           if (m[2] === 'x') { stride += n; continue; }
