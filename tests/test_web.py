@@ -113,6 +113,24 @@ def test_recording_context_changes_nothing_of_the_desktop_frame(gl):
 
 
 @pytest.mark.gl
+def test_recording_context_refuses_what_the_page_cannot_replay(gl):
+    """A context call the page has no command for fails loudly (never a silent difference);
+    texels a frame gives a texture are kept for the page."""
+    from catalog.core.errors import CatalogError
+    from catalog.web.record import RecordingContext
+
+    ctx = RecordingContext(gl)
+    with pytest.raises(CatalogError, match="copy_framebuffer"):
+        ctx.copy_framebuffer(None, None)
+    with pytest.raises(CatalogError, match="wireframe"):
+        ctx.wireframe = True
+    texels = bytes(range(16))
+    texture = ctx.texture((2, 2), 4, texels)
+    assert ctx.recording.texture_data[texture.rid] == texels
+    texture.release()
+
+
+@pytest.mark.gl
 def test_split_commands_keeps_every_uniform_value_in_order(gl):
     from catalog.render.frame import FrameRenderer
     from catalog.web.export import split_commands

@@ -286,7 +286,9 @@ class SiteExporter:
             "shaders": list(sources.values()),
             "programs": programs,
             "buffers": buffers,
-            "textures": {rid: rec.textures[rid] for rid in sorted(used_textures)},
+            "textures": {rid: dict(rec.textures[rid], **({"data": _b64(rec.texture_data[rid])}
+                                                          if rid in rec.texture_data else {}))
+                         for rid in sorted(used_textures)},
             "renderbuffers": {rid: rec.renderbuffers[rid] for rid in
                               sorted({rec.framebuffers[f]["depth"] for f in used_fbos} - {None})},
             "framebuffers": {rid: rec.framebuffers[rid] for rid in sorted(used_fbos)},

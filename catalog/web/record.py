@@ -31,6 +31,7 @@ class Recording:
     programs: dict[int, dict] = field(default_factory=dict)     # id -> {vertex, fragment, defines}
     buffers: dict[int, bytes] = field(default_factory=dict)     # id -> current bytes
     textures: dict[int, dict] = field(default_factory=dict)     # id -> {size, components, dtype}
+    texture_data: dict[int, bytes] = field(default_factory=dict)  # id -> texels given by the frame
     renderbuffers: dict[int, dict] = field(default_factory=dict)
     framebuffers: dict[int, dict] = field(default_factory=dict)  # id -> {colour: [ids], depth}
     vertex_arrays: dict[int, dict] = field(default_factory=dict)
@@ -90,6 +91,15 @@ class _Texture(_Proxy):
     def filter(self, value) -> None:
         self._rec.textures[self.rid]["filter"] = [int(v) for v in value]
         self._real.filter = value
+
+    def write(self, data, **kw):
+        if kw:
+            raise CatalogError("the web page replays only whole-texture writes")
+        self._rec.texture_data[self.rid] = bytes(data)
+        return self._real.write(data)
+
+    def build_mipmaps(self, *args, **kw):
+        raise CatalogError("the desktop frame builds mipmaps, which the web page does not replay")
 
     def use(self, location: int = 0):
         self._rec.note({"op": "texture", "unit": int(location), "texture": self.rid})
@@ -156,15 +166,33 @@ class _VertexArray(_Proxy):
         return self._real.render(mode, vertices=vertices, **kw)
 
 
+#: Context attributes passed through unrecorded: they read, wait or release, and change
+#: nothing the page would have to replay. Any other (e.g. ``copy_framebuffer``, ``clear``,
+#: ``blend_equation``) is refused: the page would silently differ from the desktop frame.
+PASS_THROUGH = frozenset({"info", "version_code", "error", "finish", "screen",
+                          "detect_framebuffer", "release", "extensions", "max_samples",
+                          "max_texture_units", "default_texture_unit", "mglo", "gc_mode"})
+
+
 class RecordingContext:
     """A moderngl context that notes what is done with it (see the module docstring)."""
 
     def __init__(self, ctx):
-        self._ctx = ctx
-        self.recording = Recording()
+        object.__setattr__(self, "_ctx", ctx)
+        object.__setattr__(self, "recording", Recording())
 
     def __getattr__(self, name):
-        return getattr(self._ctx, name)
+        if name in PASS_THROUGH or name.startswith("__"):
+            return getattr(self._ctx, name)
+        raise CatalogError(f"the desktop frame uses ctx.{name}, which the web page does not "
+                           "replay (teach catalog/web/record.py and assets/app.js)")
+
+    def __setattr__(self, name, value):
+        if isinstance(getattr(type(self), name, None), property):
+            object.__setattr__(self, name, value)
+        else:
+            raise CatalogError(f"the desktop frame sets ctx.{name}, which the web page does "
+                               "not replay (teach catalog/web/record.py and assets/app.js)")
 
     # -- told by shaderlib.create_program just before it calls program()
     def program_recipe_sink(self, vertex: str, fragment: str | None, defines: dict) -> None:
@@ -193,6 +221,8 @@ class RecordingContext:
         self.recording.textures[proxy.rid] = {"size": [int(v) for v in size],
                                               "components": int(components), "dtype": dtype,
                                               "filter": [int(v) for v in real.filter]}
+        if data is not None:
+            self.recording.texture_data[proxy.rid] = bytes(data)
         return proxy
 
     def depth_renderbuffer(self, size, **kw):
@@ -254,6 +284,15 @@ class RecordingContext:
     def viewport(self, value) -> None:
         self.recording.note({"op": "viewport", "viewport": [int(v) for v in value]})
         self._ctx.viewport = value
+
+    @property
+    def blend_func(self):
+        return self._ctx.blend_func
+
+    @blend_func.setter
+    def blend_func(self, value) -> None:
+        self.recording.note({"op": "blend_func", "factors": [int(v) for v in value]})
+        self._ctx.blend_func = value
 
     @property
     def depth_func(self):

@@ -228,8 +228,16 @@
       for (const [rid, t] of Object.entries(D.textures)) {
         const tex = gl.createTexture(), s = sized(t.size);
         gl.bindTexture(gl.TEXTURE_2D, tex);
-        const float = t.dtype === 'f4';
-        gl.texImage2D(gl.TEXTURE_2D, 0, float ? gl.RGBA32F : gl.RGBA8, s[0], s[1], 0, gl.RGBA, float ? gl.FLOAT : gl.UNSIGNED_BYTE, null);
+        const float = t.dtype === 'f4', c = t.components - 1;
+        const formats = [gl.RED, gl.RG, gl.RGB, gl.RGBA];
+        const internal = float ? [gl.R32F, gl.RG32F, gl.RGB32F, gl.RGBA32F] : [gl.R8, gl.RG8, gl.RGB8, gl.RGBA8];
+        let texels = null;
+        if (t.data) {  // a texture the frame filled (e.g. a pattern): its texels as recorded
+          const bytes = b64bytes(t.data);
+          texels = float ? new Float32Array(bytes.buffer) : bytes;
+        }
+        gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+        gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
         const filter = float ? gl.NEAREST : (t.filter ? t.filter[0] : gl.LINEAR);  // float: no linear filtering in WebGL2
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, filter);
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, float ? gl.NEAREST : (t.filter ? t.filter[1] : gl.LINEAR));
@@ -292,6 +300,7 @@
           case 'enable': for (const f of c.flags) gl.enable(gl[f]); break;
           case 'disable': for (const f of c.flags) gl.disable(gl[f]); break;
           case 'depth_func': gl.depthFunc(gl[DEPTH_FUNCS[c.func]]); break;
+          case 'blend_func': c.factors.length === 4 ? gl.blendFuncSeparate(...c.factors) : gl.blendFunc(...c.factors); break;
           case 'texture':
             gl.activeTexture(gl.TEXTURE0 + c.unit); gl.bindTexture(gl.TEXTURE_2D, this.targets[c.texture].tex); break;
           case 'uniform': {
