@@ -220,8 +220,8 @@ def test_foreign_folder_is_not_replaced(tmp_path):
 @pytest.mark.gl
 @pytest.mark.slow
 def test_failure_midway_leaves_no_site_and_no_stage(tmp_path, monkeypatch):
-    """An error after the work began (here: while recording) leaves neither DIR nor the
-    staging folder beside it."""
+    """An error after the work began (here: while recording) leaves neither DIR, nor the
+    staging folder beside it, nor the missing folders above DIR that the build made."""
     from catalog.core.errors import CatalogError
     from catalog.web import export, site
 
@@ -230,8 +230,9 @@ def test_failure_midway_leaves_no_site_and_no_stage(tmp_path, monkeypatch):
 
     monkeypatch.setattr(export.SiteExporter, "record", broken)
     with pytest.raises(CatalogError, match="recording failed"):
-        site.build_site(tmp_path / "site", fabrics="voile-white", lights="D65")
-    assert list(tmp_path.iterdir()) == []
+        site.build_site(tmp_path / "made" / "for it" / "site", fabrics="voile-white",
+                        lights="D65")
+    assert list(tmp_path.iterdir()) == []  # the folders made above DIR are gone too
 
 
 @pytest.mark.gl

@@ -147,6 +147,26 @@ def test_orbit_zoom_keys_and_drag(page, web_site):
     assert np.array_equal(page.canvas(), first)
 
 
+def test_the_cloth_plays_and_pauses(page, web_site):
+    """Playing advances the loop (the picture moves); Space pauses it (the picture holds)."""
+    import time
+
+    out, _ = web_site
+    page.open(out, view="viewer", fabric="fluoro-pink", light="D65", size="160x120")
+    assert page.state()["playing"]
+    first, t0 = page.canvas(), page.state()["t"]
+    time.sleep(1.0)
+    page.settle()
+    assert page.state()["t"] > t0
+    assert not np.array_equal(page.canvas(), first)
+    page.driver.find_element("id", "canvas-a").send_keys(" ")
+    page.settle()
+    paused = page.canvas()
+    time.sleep(0.5)
+    assert not page.state()["playing"]
+    assert np.array_equal(page.canvas(), paused)
+
+
 def test_compare_shows_the_second_fabric(page, web_site):
     from selenium.webdriver.support.ui import Select
 

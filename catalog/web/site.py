@@ -39,16 +39,19 @@ FORMAT_VERSION = 1
 def _check_out(out: Path) -> Path:
     out = Path(out)
     parent = out.resolve().parent
-    if not parent.is_dir():
-        raise InputError(f"folder {str(parent)!r} does not exist", field="--out")
+    existing = parent
+    while not existing.exists():  # missing folders above DIR are made (and removed on failure)
+        existing = existing.parent
+    if not existing.is_dir():
+        raise InputError(f"{str(existing)!r} is a file, not a folder", field="--out")
     if out.exists():
         if not out.is_dir():
             raise InputError(f"{str(out)!r} is a file, not a folder", field="--out")
         if any(out.iterdir()) and not (out / MARKER).is_file():
             raise InputError(f"{str(out)!r} exists and is not a catalog site; refusing to "
                              "replace it", field="--out")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise InputError(f"folder {str(parent)!r} is not writable", field="--out")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(f"folder {str(existing)!r} is not writable", field="--out")
     return out
 
 
@@ -56,9 +59,17 @@ def _check_out(out: Path) -> Path:
 def staged_folder(out: Path):
     """A temporary folder beside ``out``, renamed onto ``out`` when the block succeeds."""
     parent = out.resolve().parent
+    made = []
+    folder = parent
+    while not folder.exists():
+        made.append(folder)
+        folder = folder.parent
     try:
+        for folder in reversed(made):
+            folder.mkdir()
         stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
     except OSError as exc:
+        _remove_empty(made)
         raise InputError(f"cannot write in {str(parent)!r}: {exc.strerror}", field="--out") from None
     try:
         yield stage
@@ -72,7 +83,15 @@ def staged_folder(out: Path):
             shutil.rmtree(old, ignore_errors=True)
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
+        _remove_empty(made)
         raise
+
+
+def _remove_empty(folders) -> None:
+    """Remove the folders we made above DIR (deepest first) when nothing was written."""
+    for folder in folders:
+        with contextlib.suppress(OSError):
+            folder.rmdir()
 
 
 def _umask() -> int:
