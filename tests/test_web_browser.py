@@ -5,6 +5,7 @@ session's `web_site` (tests/conftest.py). The page's frame time is measured by t
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -70,22 +71,25 @@ def test_page_loads_without_errors_and_renders(page, web_site):
     assert page.console_errors() == []
 
 
-@pytest.mark.parametrize("fabric, light, fluorescence, frame", [
-    ("fluoro-pink", "D65", "on", 0),
-    ("linen-dense", "sun@8", "on", 17),
-    ("fluoro-pink", "UV-A", "off", 30),
+@pytest.mark.parametrize("fabric, light, fluorescence, frame, camera", [
+    ("fluoro-pink", "D65", "on", 0, None),
+    ("linen-dense", "sun@8", "on", 17, None),
+    ("fluoro-pink", "UV-A", "off", 30, None),
+    ("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8)),   # the page's own camera matrices
 ])
 def test_page_frame_matches_the_egl_frame(page, web_site, animations, gl, fabric, light,
-                                          fluorescence, frame):
+                                          fluorescence, frame, camera):
     """The page's canvas and the desktop frame (EGL, same baked cloth frame, same camera):
     off edges every channel within 3/255, mean within 0.5/255, at most 1 % of the pixels
     over 3/255 on edges (browser.py states the rule)."""
     out, _ = web_site
-    shown = _viewer(page, out, fabric=fabric, light=light, fluorescence=fluorescence, frame=frame)
+    orbit = {} if camera is None else dict(zip(("yaw_deg", "pitch_deg", "distance_m"), camera))
+    shown = _viewer(page, out, fabric=fabric, light=light, fluorescence=fluorescence, frame=frame,
+                    **orbit)
     desktop = web_browser.egl_frame(fabric, light, fluorescence, frame, SIZE,
-                                    _animation_of(out, fabric, animations), ctx=gl)
+                                    _animation_of(out, fabric, animations), ctx=gl, camera=camera)
     figures = web_browser.compare_frames(shown, desktop)
-    assert web_browser.frames_match(figures), figures
+    assert web_browser.frames_match(figures), json.dumps(figures)
     assert page.console_errors() == []
 
 

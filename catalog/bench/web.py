@@ -143,19 +143,25 @@ def run(quick: bool = False) -> dict:
             result["frames_per_case"] = frames * rounds
             # the page frame against the EGL frame (the browser test's rule)
             comparisons = []
-            for fabric, light, switch, frame in (("fluoro-pink", "D65", "on", 0),
-                                                 ("fluoro-pink", "UV-A", "off", 30),
-                                                 ("linen-dense", "sun@8", "on", 17)):
+            for fabric, light, switch, frame, camera in (
+                    ("fluoro-pink", "D65", "on", 0, None),
+                    ("fluoro-pink", "UV-A", "off", 30, None),
+                    ("linen-dense", "sun@8", "on", 17, None),
+                    ("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8))):
                 size = (160, 120)
+                orbit = {} if camera is None else dict(
+                    zip(("yaw_deg", "pitch_deg", "distance_m"), camera))
                 b.open(out, view="viewer", fabric=fabric, light=light, fluorescence=switch,
-                       frame=frame, size=f"{size[0]}x{size[1]}")
+                       frame=frame, size=f"{size[0]}x{size[1]}", **orbit)
                 fabric_anim = next(f["animation"] for f in key["fabrics"] if f["name"] == fabric)
                 figures = web_browser.compare_frames(
                     b.canvas(), web_browser.egl_frame(fabric, light, switch, frame, size,
                                                       bake_lib.read_script(
-                                                          out / "anim" / f"{fabric_anim}.js")))
+                                                          out / "anim" / f"{fabric_anim}.js"),
+                                                      camera=camera))
+                view = "" if camera is None else " / camera yaw {:g} pitch {:g} d {:g} m".format(*camera)
                 comparisons.append({"scene": f"{fabric} / {light} / fluorescence {switch} / "
-                                             f"frame {frame}", **figures,
+                                             f"frame {frame}{view}", **figures,
                                     "match": web_browser.frames_match(figures)})
             result["pixels"] = comparisons
         finally:

@@ -221,10 +221,11 @@ class SiteExporter:
         """Refuse a desktop frame whose other uniforms depend on the camera: the page would
         not follow them (it computes only CAMERA_UNIFORMS)."""
         r = self.renderer
+        saved = r.camera
         first = self.record(preset, light, "on")
-        r.set_camera(30.0, 20.0, 2.0)
+        r.set_camera(saved.yaw_deg + 30.0, saved.pitch_deg + 20.0, saved.distance_m * 0.8)
         second = self.record(preset, light, "on")
-        r.set_camera(0.0, 0.0, 2.6)
+        r.camera = saved
         structure = self.structures[first["structure"]]
         if first["structure"] != second["structure"]:
             raise CatalogError("the desktop frame's passes change with the camera; the web "

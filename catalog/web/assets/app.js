@@ -441,6 +441,7 @@
     if (h.get('compare') && fabricByName[h.get('compare')]) p.compare = h.get('compare');
     if (h.get('view') === 'viewer') p.view = 'viewer';
     if (h.get('frame') !== null) { p.t = +h.get('frame'); p.playing = false; }
+    for (const k of ['yaw_deg', 'pitch_deg', 'distance_m']) if (h.get(k) !== null && isFinite(+h.get(k))) p[k] = +h.get(k);
     const size = /^(\d+)x(\d+)$/.exec(h.get('size') || '');
     if (size) p.size = [+size[1], +size[2]];
     return p;
