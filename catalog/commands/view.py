@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from catalog.core.cliargs import wxh_type
+from catalog.commands.displayargs import add_display_arguments
 
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
@@ -74,6 +75,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
+    parser.add_argument("--compare-fluorescence", choices=FLUORESCENCE_CHOICES, default=None,
+                        help="with --compare: the right half's fluorescence mode (default: "
+                        "the left's); --compare NAME --fabric NAME shows one fabric on | off")
+    add_display_arguments(parser)
     parser.add_argument("--fabric-dir", type=Path, metavar="DIR",
                         help="folder of presets (default: the catalog's fabrics/)")
 
@@ -99,6 +104,9 @@ def run(args: argparse.Namespace) -> int:
     from catalog.viewer.app import ViewerApp, ViewerOptions
     from catalog.viewer.window import NO_DISPLAY_HINT, display_available, init_glfw
 
+    from catalog.commands.displayargs import display_choices
+
+    ev, white_balance = display_choices(args)
     if args.screenshot is not None and args.frames is None:
         raise CatalogError("--screenshot needs --frames N (the S key saves screenshots "
                            "in interactive use)")
@@ -123,5 +131,6 @@ def run(args: argparse.Namespace) -> int:
         wind_m_s=args.wind, grid=args.grid,
         cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
+        ev100=ev, white_balance=white_balance, compare_fluorescence=args.compare_fluorescence,
         fabric_dir=fabric_dir if fabric_dir is not None else FABRIC_DIR)
     return ViewerApp(options).run()
