@@ -41,12 +41,8 @@ def animations(web_site):
 
 
 def _animation_of(out: Path, fabric: str, animations) -> object:
-    import json
-
-    text = (out / "data.js").read_text()
-    data = json.loads(text[text.index("= ") + 2:].rstrip().rstrip(";"))
-    key = next(f["animation"] for f in data["fabrics"] if f["name"] == fabric)
-    return animations[key]
+    data = web_browser.site_data(out)
+    return animations[next(f["animation"] for f in data["fabrics"] if f["name"] == fabric)]
 
 
 def _viewer(page, out, **state):
@@ -86,8 +82,10 @@ def test_page_frame_matches_the_egl_frame(page, web_site, animations, gl, fabric
     orbit = {} if camera is None else dict(zip(("yaw_deg", "pitch_deg", "distance_m"), camera))
     shown = _viewer(page, out, fabric=fabric, light=light, fluorescence=fluorescence, frame=frame,
                     **orbit)
+    scene = web_browser.site_data(out)["scenes"][f"{fabric}|{light}|{fluorescence}"]
     desktop = web_browser.egl_frame(fabric, light, fluorescence, frame, SIZE,
-                                    _animation_of(out, fabric, animations), ctx=gl, camera=camera)
+                                    _animation_of(out, fabric, animations), ctx=gl, camera=camera,
+                                    ev100=scene["ev100"])
     figures = web_browser.compare_frames(shown, desktop)
     assert web_browser.frames_match(figures), json.dumps(figures)
     assert page.console_errors() == []

@@ -47,6 +47,12 @@ RECORD_SIZE = (67, 43)
 FLUORESCENCE = {"on": "physical", "off": "off"}
 #: The orbit limits of the page: the camera stays in the room (in front of the window).
 ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_m": [1.2, 4.0]}
+#: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
+#: the page shows each scene at the EV100 a desktop frame of this size meters at the default
+#: camera (fixed while orbiting, like a photograph's), recorded as an ordinary uniform. The
+#: fluorescence switch keeps the exposure of "on" (as the desktop viewer's comparison does),
+#: so that switching shows the brightener's light, not a new exposure.
+METER_SIZE = (160, 120)
 #: The swatch of the catalog grid: a small desktop frame (EGL), px.
 SWATCH_SIZE = (120, 90)
 
@@ -176,8 +182,10 @@ class SiteExporter:
         from catalog.render.frame import FrameRenderer  # noqa: PLC0415
         from catalog.web.record import RecordingContext  # noqa: PLC0415
 
-        self.ctx = RecordingContext(ctx or create_headless_context())
+        real = ctx or create_headless_context()
+        self.ctx = RecordingContext(real)
         self.renderer = FrameRenderer(self.ctx, RECORD_SIZE, specialise=False)
+        self.meter = FrameRenderer(real, METER_SIZE)  # not recorded: meters the exposure
         self.structures: list[list[dict]] = []
         self._structure_index: dict[str, int] = {}
         self.curtain_tags: dict[int, str] = {}
@@ -185,8 +193,9 @@ class SiteExporter:
     # -- the curtain's buffers: found by their bytes after set_mesh
     def use_mesh(self, positions, normals, uvs, tangents, indices) -> None:
         arrays = {"position": positions, "normal": normals, "tangent": tangents, "uv": uvs}
-        self.renderer.set_mesh(positions, normals, uvs, tangents, indices)
-        self.renderer.set_mesh_offset((0.0, 0.0, 0.0))
+        for renderer in (self.renderer, self.meter):
+            renderer.set_mesh(positions, normals, uvs, tangents, indices)
+            renderer.set_mesh_offset((0.0, 0.0, 0.0))
         wanted = {np.ascontiguousarray(a, dtype="f4").tobytes(): tag for tag, a in arrays.items()}
         wanted[np.ascontiguousarray(indices, dtype="i4").ravel().tobytes()] = "index"
         self.curtain_tags = {}
@@ -196,14 +205,23 @@ class SiteExporter:
             if tag is not None and tag not in self.curtain_tags.values():
                 self.curtain_tags[rid] = tag
 
-    def record(self, preset, light: LightChoice, fluorescence: str) -> dict:
+    def record(self, preset, light: LightChoice, fluorescence: str,
+               ev100: float | None = None) -> dict:
+        """One scene's structure index and values; ``ev100``: its exposure (None: metered by
+        a METER_SIZE desktop frame at the default camera)."""
+        for r in (self.meter, self.renderer):
+            r.set_fabric(preset)
+            if light.kind == "sun":
+                r.set_sun_hour(light.hour)
+            else:
+                r.set_light(light.id)
+            r.set_fluorescence(FLUORESCENCE[fluorescence])
+        if ev100 is None:
+            self.meter.set_ev(None)
+            self.meter.render()
+            ev100 = self.meter.current_ev100()
         r = self.renderer
-        r.set_fabric(preset)
-        if light.kind == "sun":
-            r.set_sun_hour(light.hour)
-        else:
-            r.set_light(light.id)
-        r.set_fluorescence(FLUORESCENCE[fluorescence])
+        r.set_ev(ev100)
         rec = self.ctx.recording
         rec.start()
         r.render()
@@ -214,6 +232,7 @@ class SiteExporter:
             self.structures.append(structure)
         info = r.info()
         return {"structure": self._structure_index[key], "values": values,
+                "ev100": round(float(ev100), 6),
                 "fluorescence_variant": info["fluorescence_variant"],
                 "illuminance_lx": info["illuminance_lx"]}
 
@@ -298,6 +317,7 @@ class SiteExporter:
 
     def release(self) -> None:
         self.renderer.release()
+        self.meter.release()
 
 
 def swatch_png(ctx, preset, size=SWATCH_SIZE) -> bytes:

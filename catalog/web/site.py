@@ -148,9 +148,11 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             scenes = {}
             for preset in presets:
                 for choice in choices:
-                    for switch in export.FLUORESCENCE:
-                        scenes[f"{preset.name}|{choice.id}|{switch}"] = exporter.record(
-                            preset, choice, switch)
+                    on = exporter.record(preset, choice, "on")
+                    scenes[f"{preset.name}|{choice.id}|on"] = on
+                    # the switch keeps the exposure: it shows the brightener's light
+                    scenes[f"{preset.name}|{choice.id}|off"] = exporter.record(
+                        preset, choice, "off", ev100=on["ev100"])
             objects = exporter.objects()
             swatches = {p.name: base64.b64encode(export.swatch_png(exporter.ctx._ctx, p))
                         .decode("ascii") for p in presets}

@@ -270,7 +270,12 @@
         case gl.FLOAT_VEC2: gl.uniform2fv(u.loc, v); break;
         case gl.FLOAT_VEC3: gl.uniform3fv(u.loc, v); break;
         case gl.FLOAT_VEC4: gl.uniform4fv(u.loc, v); break;
+        case gl.FLOAT_MAT2: gl.uniformMatrix2fv(u.loc, false, v); break;
+        case gl.FLOAT_MAT3: gl.uniformMatrix3fv(u.loc, false, v); break;
         case gl.FLOAT_MAT4: gl.uniformMatrix4fv(u.loc, false, v); break;
+        case gl.INT_VEC2: gl.uniform2iv(u.loc, v.map(Math.round)); break;
+        case gl.INT_VEC3: gl.uniform3iv(u.loc, v.map(Math.round)); break;
+        case gl.INT_VEC4: gl.uniform4iv(u.loc, v.map(Math.round)); break;
         case gl.INT: case gl.SAMPLER_2D: case gl.BOOL: gl.uniform1iv(u.loc, v.map(Math.round)); break;
         default: throw new Error('uniform type ' + u.type + ' is not supported');
       }
