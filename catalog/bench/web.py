@@ -42,7 +42,9 @@ class DesktopFrames:
         self.renderer.set_mesh(positions, normals, animation.uv, tangents,
                                animation.indices.astype(np.int32))
         self.renderer.set_mesh_offset((0.0, 0.0, 0.0))
-        self.times(1)  # compile
+        self.times(1)  # compile, and meter the exposure once
+        # like the page: a fixed exposure (no per-frame read-back and histogram)
+        self.renderer.set_ev(self.renderer.current_ev100())
 
     def times(self, frames: int) -> list[float]:
         """ms of each of ``frames`` frames (render + finish)."""
@@ -192,7 +194,8 @@ def markdown_tables(result: dict) -> dict[str, str]:
         "",
         f"Frame times: medians of {result['frames_per_case']} frames per case, the page and the "
         "desktop variants measured in alternating rounds in one run; the page's frame ends "
-        "when its pixels can be read (readPixels), the desktop's at glFinish.",
+        "when its pixels can be read (readPixels), the desktop's at glFinish; both at a fixed "
+        "exposure (the desktop's per-frame auto-exposure metering is left out, as on the page).",
         "",
         "| size | page frame (SwiftShader) | page CPU part | desktop frame (llvmpipe) | "
         "desktop, unspecialised (the page's programs) | page / desktop | page / unspecialised |",
