@@ -47,6 +47,11 @@ RECORD_SIZE = (67, 43)
 FLUORESCENCE = {"on": "physical", "off": "off"}
 #: The orbit limits of the page: the camera stays in the room (in front of the window).
 ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_m": [1.2, 4.0]}
+#: The thread patterns (issue 12: per-fabric normal/coverage maps up to 1024^2 float texels,
+#: order-independent transparency of the layers) are not on the page yet: the page shows
+#: the desktop frame's flat-cloth mode (``FrameRenderer.set_patterned(False)``, the paper's
+#: model), and the browser test compares against that mode.
+PATTERNED = False
 #: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
 #: the page shows each scene at the EV100 a desktop frame of this size meters at the default
 #: camera (fixed while orbiting, like a photograph's), recorded as an ordinary uniform. The
@@ -138,11 +143,19 @@ def _clean(value):
 def split_commands(commands: list[dict]) -> tuple[list[dict], list]:
     """(structure, values): every uniform command's value moved into ``values`` (in order)."""
     structure, values = [], []
+    inverse = [_f32(1.0 / RECORD_SIZE[0]), _f32(1.0 / RECORD_SIZE[1])]
     for command in commands:
         if command["op"] == "uniform":
-            structure.append({"op": "uniform", "program": command["program"],
-                              "name": command["name"], "slot": len(values)})
-            values.append(_clean(command["value"]))
+            entry = {"op": "uniform", "program": command["program"], "name": command["name"],
+                     "slot": len(values)}
+            value = _clean(command["value"])
+            # a value that is the recorded frame's size or texel size: the page puts its own
+            if value == inverse:
+                entry["canvas"] = "texel"
+            elif value == [float(v) for v in RECORD_SIZE]:
+                entry["canvas"] = "size"
+            structure.append(entry)
+            values.append(value)
         else:
             structure.append(command)
     return structure, values
@@ -186,6 +199,8 @@ class SiteExporter:
         self.ctx = RecordingContext(real)
         self.renderer = FrameRenderer(self.ctx, RECORD_SIZE, specialise=False)
         self.meter = FrameRenderer(real, METER_SIZE)  # not recorded: meters the exposure
+        for renderer in (self.renderer, self.meter):
+            renderer.set_patterned(PATTERNED)
         self.structures: list[list[dict]] = []
         self._structure_index: dict[str, int] = {}
         self.curtain_tags: dict[int, str] = {}

@@ -98,8 +98,29 @@ class _Texture(_Proxy):
         self._rec.texture_data[self.rid] = bytes(data)
         return self._real.write(data)
 
-    def build_mipmaps(self, *args, **kw):
-        raise CatalogError("the desktop frame builds mipmaps, which the web page does not replay")
+    def build_mipmaps(self, base: int = 0, max_level: int = 1000):
+        if base != 0:
+            raise CatalogError("the web page replays only full mipmap chains")
+        self._rec.textures[self.rid]["mipmaps"] = True  # the page calls generateMipmap
+        return self._real.build_mipmaps(base, max_level)
+
+    @property
+    def repeat_x(self):
+        return self._real.repeat_x
+
+    @repeat_x.setter
+    def repeat_x(self, value) -> None:
+        self._rec.textures[self.rid]["repeat_x"] = bool(value)
+        self._real.repeat_x = value
+
+    @property
+    def repeat_y(self):
+        return self._real.repeat_y
+
+    @repeat_y.setter
+    def repeat_y(self, value) -> None:
+        self._rec.textures[self.rid]["repeat_y"] = bool(value)
+        self._real.repeat_y = value
 
     def use(self, location: int = 0):
         self._rec.note({"op": "texture", "unit": int(location), "texture": self.rid})
@@ -284,6 +305,23 @@ class RecordingContext:
     def viewport(self, value) -> None:
         self.recording.note({"op": "viewport", "viewport": [int(v) for v in value]})
         self._ctx.viewport = value
+
+    def clear(self, red=0.0, green=0.0, blue=0.0, alpha=0.0, depth=1.0, viewport=None, **kw):
+        """Clears the bound framebuffer (noted as a clear of it)."""
+        bound = self.recording.bound_framebuffer
+        if bound is None or bound._real is not self._ctx.fbo:
+            raise CatalogError("the desktop frame clears a framebuffer the web page does not know")
+        return bound.clear(red, green, blue, alpha, depth=depth, viewport=viewport, **kw)
+
+    @property
+    def blend_equation(self):
+        return self._ctx.blend_equation
+
+    @blend_equation.setter
+    def blend_equation(self, value) -> None:
+        values = value if isinstance(value, (tuple, list)) else (value,)
+        self.recording.note({"op": "blend_equation", "modes": [int(v) for v in values]})
+        self._ctx.blend_equation = value
 
     @property
     def blend_func(self):

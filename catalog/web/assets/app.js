@@ -134,6 +134,8 @@
       if (!gl) throw new Error('this browser has no WebGL2');
       if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('WebGL2 without EXT_color_buffer_float: cannot render into float targets');
       this.gl = gl;
+      this.floatLinear = !!gl.getExtension('OES_texture_float_linear');
+      gl.getExtension('EXT_float_blend');  // blending into float targets (layered cloth)
       this.shaders = {}; this.programs = {}; this.buffers = {}; this.vaos = {}; this.targets = null;
       this.size = [0, 0]; this.curtainCount = 0; this.curtainAnim = null;
     }
@@ -238,11 +240,16 @@
         }
         gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
         gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
-        const filter = float ? gl.NEAREST : (t.filter ? t.filter[0] : gl.LINEAR);  // float: no linear filtering in WebGL2
-        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, filter);
-        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, float ? gl.NEAREST : (t.filter ? t.filter[1] : gl.LINEAR));
-        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
-        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+        // float textures filter linearly only with OES_texture_float_linear
+        const linearOk = !float || this.floatLinear;
+        const pick = (f) => (linearOk ? f : (f === gl.LINEAR || f === gl.LINEAR_MIPMAP_LINEAR || f === gl.LINEAR_MIPMAP_NEAREST || f === gl.NEAREST_MIPMAP_LINEAR ? gl.NEAREST : f));
+        const filter = t.filter || [gl.LINEAR, gl.LINEAR];
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, t.mipmaps ? pick(filter[0]) : pick(filter[0] === gl.LINEAR_MIPMAP_LINEAR ? gl.LINEAR : filter[0]));
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, pick(filter[1]));
+        // moderngl's default is repeat (GL's); the frame says where it wants clamping
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, t.repeat_x === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, t.repeat_y === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
+        if (t.mipmaps) gl.generateMipmap(gl.TEXTURE_2D);
         textures[rid] = { tex };
       }
       for (const [rid, r] of Object.entries(D.renderbuffers)) {
@@ -305,6 +312,7 @@
           case 'enable': for (const f of c.flags) gl.enable(gl[f]); break;
           case 'disable': for (const f of c.flags) gl.disable(gl[f]); break;
           case 'depth_func': gl.depthFunc(gl[DEPTH_FUNCS[c.func]]); break;
+          case 'blend_equation': c.modes.length === 2 ? gl.blendEquationSeparate(...c.modes) : gl.blendEquation(c.modes[0]); break;
           case 'blend_func': c.factors.length === 4 ? gl.blendFuncSeparate(...c.factors) : gl.blendFunc(...c.factors); break;
           case 'texture':
             gl.activeTexture(gl.TEXTURE0 + c.unit); gl.bindTexture(gl.TEXTURE_2D, this.targets[c.texture].tex); break;
@@ -314,7 +322,8 @@
             const u = p.uniforms[c.name];
             if (!u) break;
             const which = D.camera_uniforms[c.name];
-            this.setUniform(u, which ? cam[which] : scene.values[c.slot]);
+            const canvas = c.canvas === 'texel' ? [1 / w, 1 / h] : c.canvas === 'size' ? [w, h] : null;
+            this.setUniform(u, which ? cam[which] : canvas || scene.values[c.slot]);
             break;
           }
           case 'draw': {
