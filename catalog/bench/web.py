@@ -20,7 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from catalog.web.export import PATTERNED  # noqa: E402  (the page's flat-cloth mode)
+from catalog.web.export import configure_desktop_frame  # noqa: E402  (the page's modes)
 
 #: The scene every timing uses.
 FABRIC, LIGHT = "fluoro-pink", "D65"
@@ -40,7 +40,7 @@ class DesktopFrames:
         positions, normals, tangents = bake_lib.decode_frame(animation, 0)
         self.renderer = FrameRenderer(self.ctx, size, specialise=specialise)
         self.renderer.set_fabric(FABRIC)
-        self.renderer.set_patterned(PATTERNED)
+        configure_desktop_frame(self.renderer)
         self.renderer.set_light(LIGHT)
         self.renderer.set_mesh(positions, normals, animation.uv, tangents,
                                animation.indices.astype(np.int32))

@@ -119,7 +119,7 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.web import bake as bake_lib  # noqa: PLC0415
-    from catalog.web.export import FLUORESCENCE, PATTERNED  # noqa: PLC0415
+    from catalog.web.export import FLUORESCENCE, configure_desktop_frame  # noqa: PLC0415
 
     positions, normals, tangents = bake_lib.decode_frame(animation, frame)
     renderer = FrameRenderer(ctx or create_headless_context(), size)
@@ -130,7 +130,7 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
         else:
             renderer.set_light(light)
         renderer.set_fluorescence(FLUORESCENCE[fluorescence])
-        renderer.set_patterned(PATTERNED)
+        configure_desktop_frame(renderer)
         if camera is not None:
             renderer.set_camera(*camera)
         if ev100 is not None:

@@ -47,11 +47,21 @@ RECORD_SIZE = (67, 43)
 FLUORESCENCE = {"on": "physical", "off": "off"}
 #: The orbit limits of the page: the camera stays in the room (in front of the window).
 ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_m": [1.2, 4.0]}
-#: The thread patterns (issue 12: per-fabric normal/coverage maps up to 1024^2 float texels,
-#: order-independent transparency of the layers) are not on the page yet: the page shows
-#: the desktop frame's flat-cloth mode (``FrameRenderer.set_patterned(False)``, the paper's
-#: model), and the browser test compares against that mode.
-PATTERNED = False
+#: The desktop frame's modes the page shows. Not on the page yet (docs/web.md): the thread
+#: patterns (issue 12: per-fabric normal/coverage maps up to 1024^2 float texels, the
+#: layers' order-independent transparency), the room lit through the curtain (issue 13:
+#: shadow map, luminaire, bounce, recomputed when the scene changes) and the glare. The page
+#: shows the desktop frame with these off (its flat-cloth, constant-room modes), and the
+#: browser test compares against the same modes.
+DESKTOP_MODES = {"patterned": False, "room_lighting": False, "bloom": False}
+
+
+def configure_desktop_frame(renderer) -> None:
+    """Put a FrameRenderer in the modes the page shows (:data:`DESKTOP_MODES`)."""
+    for name, value in DESKTOP_MODES.items():
+        setter = getattr(renderer, f"set_{name}", None)
+        if setter is not None:  # a mode this frame does not have is off anyway
+            setter(value)
 #: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
 #: the page shows each scene at the EV100 a desktop frame of this size meters at the default
 #: camera (fixed while orbiting, like a photograph's), recorded as an ordinary uniform. The
@@ -200,7 +210,7 @@ class SiteExporter:
         self.renderer = FrameRenderer(self.ctx, RECORD_SIZE, specialise=False)
         self.meter = FrameRenderer(real, METER_SIZE)  # not recorded: meters the exposure
         for renderer in (self.renderer, self.meter):
-            renderer.set_patterned(PATTERNED)
+            configure_desktop_frame(renderer)
         self.structures: list[list[dict]] = []
         self._structure_index: dict[str, int] = {}
         self.curtain_tags: dict[int, str] = {}
