@@ -103,7 +103,15 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
              for j, light in enumerate(light_objects)]
 
     def work(advance):
+        from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
+
+        shown = None
         for i, preset, j, light in pairs:
+            if shown is not preset:   # the drape catalog snapshot shows (its fullness, rings)
+                *mesh, fabric_size = simulated_curtain(preset, 0)
+                renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+                renderer.set_rings(ring_xs_m(preset))
+                shown = preset
             renderer.set_fabric(preset)
             renderer.set_light(light)
             renderer.render()

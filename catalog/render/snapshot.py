@@ -54,6 +54,11 @@ class SnapshotRequest:
     exposure: float = 1.0
     ev: float | None = None           # EV100; None: automatic exposure
     white_balance: str = "room"
+    environment: str | None = None    # FILE.exr behind the window (issue 13)
+    curtain_open: bool = False
+    room_light: bool = True
+    bloom: bool = True
+    lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
 
 
 def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
@@ -115,19 +120,30 @@ def read_metadata(path: str | Path) -> dict[str, str]:
 
 
 def simulated_curtain(preset, frames: int):
-    """The cloth simulation after ``frames`` frames, moved onto the scene's rod."""
+    """The curtain after ``frames`` frames of the cloth simulation started from the settled
+    drape (frame 0: the settled drape itself; catalog.cloth.drape), moved onto the scene's
+    rod. Returns (positions, normals, uv, tangents, indices, fabric size (w, h) m)."""
+    from catalog.cloth.drape import drape_params, rod_centre_x_m, settled_simulation  # noqa: PLC0415
     from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
-    from catalog.cloth.params import ClothParams  # noqa: PLC0415
-    from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
-    params = ClothParams.from_preset(preset)
-    simulation = ClothSimulation(params, backend="numpy")
+    params = drape_params(preset)
+    simulation = settled_simulation(params, backend="numpy")
     simulation.run(frames, FRAME_DT_S)
     mesh = CurtainMesh.from_grid(simulation.positions(), params)
-    offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - params.rod_y_m, scene_lib.CURTAIN_Z],
-                      dtype=np.float32)
-    return mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices
+    offset = np.array([-rod_centre_x_m(params), scene_lib.CURTAIN_TOP_Y - params.rod_y_m,
+                       scene_lib.CURTAIN_Z], dtype=np.float32)
+    return (mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices,
+            (params.width_m, params.height_m))
+
+
+def ring_xs_m(preset) -> list[float]:
+    """x of the curtain's rings on the scene's rod (m): the settled drape's ring columns."""
+    from catalog.cloth.drape import drape_params, rod_centre_x_m  # noqa: PLC0415
+    from catalog.cloth.state import ring_positions  # noqa: PLC0415
+
+    params = drape_params(preset)
+    return [float(x) - rod_centre_x_m(params) for x in ring_positions(params)[:, 0]]
 
 
 def check_display_choices(ev, white_balance, exposure=1.0) -> None:
@@ -167,6 +183,21 @@ def validate(request: SnapshotRequest):
     scene_lib.dye_transmittance(preset)
     scene_lib.fluorescent_material(preset)
     light = get_light(request.light) if request.hour is None else None
+    if request.environment is not None:
+        from catalog.render.environment import load_environment  # noqa: PLC0415
+
+        load_environment(request.environment)  # refused now, before a context exists
+    from catalog.render import room_light  # noqa: PLC0415
+
+    if len(request.lamps) > room_light.MAX_ROOM_LAMPS:
+        raise InputError(f"at most {room_light.MAX_ROOM_LAMPS} lamps, got {len(request.lamps)}",
+                         field="--lamp")
+    for name, position in request.lamps:
+        get_light(name)
+        try:
+            room_light.check_lamp_position(position)
+        except CatalogError as exc:
+            raise InputError(str(exc), field="--lamp") from None
     return preset, light
 
 
@@ -193,10 +224,17 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.set_exposure(request.exposure)
         renderer.set_ev(request.ev)
         renderer.set_white_balance(request.white_balance)
-        mesh_source = "static drape"
-        if request.frame > 0:
-            renderer.set_mesh(*simulated_curtain(preset, request.frame))
-            mesh_source = f"cloth simulation, frame {request.frame}"
+        renderer.set_curtain_open(request.curtain_open)
+        renderer.set_room_lighting(request.room_light)
+        renderer.set_bloom(request.bloom)
+        if request.environment is not None:
+            renderer.set_environment(request.environment)
+        renderer.set_room_lamps(request.lamps)
+        *mesh, fabric_size = simulated_curtain(preset, request.frame)
+        renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+        renderer.set_rings(ring_xs_m(preset))
+        mesh_source = ("settled drape" if request.frame == 0
+                       else f"cloth simulation from the settled drape, frame {request.frame}")
         start = time.perf_counter()
         renderer.render()
         pixels = (renderer.read_linear() if request.out.suffix.lower() == ".exr"
