@@ -54,11 +54,10 @@ class SnapshotRequest:
     exposure: float = 1.0
 
 
-def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
-    """Write (H, W, 3) pixels with OpenImageIO, atomically: float32 -> EXR, uint8 -> PNG."""
+def encode_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
+    """Write (H, W, 3) pixels to ``path`` with OpenImageIO (float32 -> EXR, uint8 -> PNG, by
+    the suffix), not atomically: callers write a temporary file and rename it."""
     import OpenImageIO as oiio  # noqa: PLC0415
-
-    from catalog.atomic import atomic_path  # noqa: PLC0415
 
     height, width, channels = pixels.shape
     kind = oiio.FLOAT if pixels.dtype == np.float32 else oiio.UINT8
@@ -66,15 +65,22 @@ def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> Non
     spec.channelnames = ("R", "G", "B")
     for key, value in metadata.items():
         spec.attribute(key, str(value))
+    output = oiio.ImageOutput.create(str(path))
+    if output is None:
+        raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
+    ok = output.open(str(path), spec) and output.write_image(np.ascontiguousarray(pixels))
+    error = output.geterror()
+    output.close()
+    if not ok:
+        raise CatalogError(f"cannot write {path}: {error}")
+
+
+def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
+    """Write (H, W, 3) pixels with OpenImageIO, atomically: float32 -> EXR, uint8 -> PNG."""
+    from catalog.atomic import atomic_path  # noqa: PLC0415
+
     with atomic_path(path) as tmp:
-        output = oiio.ImageOutput.create(str(tmp))
-        if output is None:
-            raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
-        ok = output.open(str(tmp), spec) and output.write_image(np.ascontiguousarray(pixels))
-        error = output.geterror()
-        output.close()
-        if not ok:
-            raise CatalogError(f"cannot write {path}: {error}")
+        encode_image(tmp, pixels, metadata)
 
 
 def read_metadata(path: str | Path) -> dict[str, str]:
@@ -91,14 +97,21 @@ def read_metadata(path: str | Path) -> dict[str, str]:
 
 def simulated_curtain(preset, frames: int):
     """The cloth simulation after ``frames`` frames, moved onto the scene's rod."""
-    from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
     from catalog.cloth.params import ClothParams  # noqa: PLC0415
     from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
+
+    simulation = ClothSimulation(ClothParams.from_preset(preset), backend="numpy")
+    simulation.run(frames, FRAME_DT_S)
+    return curtain_on_rod(simulation)
+
+
+def curtain_on_rod(simulation):
+    """A running simulation's curtain as mesh arrays (positions, normals, uvs, tangents,
+    indices) in scene coordinates: the grid moved onto the scene's rod."""
+    from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
-    params = ClothParams.from_preset(preset)
-    simulation = ClothSimulation(params, backend="numpy")
-    simulation.run(frames, FRAME_DT_S)
+    params = simulation.params
     mesh = CurtainMesh.from_grid(simulation.positions(), params)
     offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - params.rod_y_m, scene_lib.CURTAIN_Z],
                       dtype=np.float32)
