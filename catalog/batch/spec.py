@@ -20,7 +20,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from catalog.errors import InputError
+from catalog.errors import CatalogError, InputError
 
 FORMATS = ("png", "exr")
 FLUORESCENCE = ("off", "paper", "physical")
@@ -164,7 +164,10 @@ class JobSpec:
                              "--fabrics")
         lights = split_list(lights if isinstance(lights, str) else ",".join(lights), "--lights")
         for light in lights:
-            get_light(light)
+            try:
+                get_light(light)
+            except InputError as exc:
+                raise InputError(exc.problem, field="--lights") from None
         safe = [safe_name(light) for light in lights]
         if len(set(safe)) != len(safe):
             raise InputError(f"{', '.join(lights)}: two lights give the same file name",
@@ -184,7 +187,10 @@ class JobSpec:
         if fluorescence not in FLUORESCENCE:
             raise InputError(f"{fluorescence!r} is not one of {', '.join(FLUORESCENCE)}",
                              field="--mode")
-        band_lib.check_band_count(bands)
+        try:
+            band_lib.check_band_count(bands)
+        except CatalogError as exc:
+            raise InputError(getattr(exc, "problem", str(exc)), field="--bands") from None
         for value, option in ((distance_m, "--distance"), (exposure, "--exposure")):
             if not (math.isfinite(value) and value > 0):
                 raise InputError(f"{value!r} must be a positive number", field=option)

@@ -48,6 +48,7 @@ class RendererPool:
         self.lock = threading.Lock()
         self.ctx = ctx
         self._own_ctx = ctx is None
+        self._thread = threading.get_ident() if ctx is not None else None
         self.renderer = None
         self.contexts_created = 0
 
@@ -56,15 +57,24 @@ class RendererPool:
         from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
         if self.ctx is None:
-            self.ctx = create_headless_context(self.device_index)
+            self.ctx = create_headless_context(self.device_index)  # current in this thread
+            self._thread = threading.get_ident()
             self.contexts_created += 1
+        self.make_current()
         if self.renderer is None or tuple(self.renderer.size) != tuple(size):
-            with self.ctx:
-                if self.renderer is not None:
-                    self.renderer.release()
-                    self.renderer = None
-                self.renderer = FrameRenderer(self.ctx, tuple(size))
+            if self.renderer is not None:
+                self.renderer.release()
+                self.renderer = None
+            self.renderer = FrameRenderer(self.ctx, tuple(size))
         return self.renderer
+
+    def make_current(self) -> None:
+        """Make the context current in the calling thread if another thread had it (a
+        worker's task threads take turns under :attr:`lock`). Never undone: moderngl's
+        ``with ctx`` would leave no context current when it exits."""
+        if self._thread != threading.get_ident():
+            self.ctx.__enter__()
+            self._thread = threading.get_ident()
 
     def describe(self) -> dict:
         from catalog.render.context import describe  # noqa: PLC0415
@@ -80,9 +90,9 @@ class RendererPool:
         if self.ctx is None:
             return
         with contextlib.suppress(Exception):
-            with self.ctx:
-                if self.renderer is not None:
-                    self.renderer.release()
+            self.make_current()
+            if self.renderer is not None:
+                self.renderer.release()
         self.renderer = None
         if self._own_ctx:
             with contextlib.suppress(Exception):
@@ -226,54 +236,54 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
     for image in todo:
         by_frame.setdefault(image.frame, []).append(image)
     simulation = None
-    with pool.ctx:
-        renderer.set_fabric(preset)
-        renderer.set_fluorescence(task.fluorescence)
-        renderer.set_bands(task.bands)
-        renderer.set_exposure(task.exposure)
-        for frame in sorted(by_frame):
+    renderer.set_fabric(preset)
+    renderer.set_fluorescence(task.fluorescence)
+    renderer.set_bands(task.bands)
+    renderer.set_exposure(task.exposure)
+    for frame in sorted(by_frame):
+        t0 = time.perf_counter()
+        if frame == 0:  # the static drape, as `catalog snapshot --frame 0`
+            drape = scene_lib.draped_curtain()
+            mesh = (drape.positions, drape.normals, drape.uvs, drape.tangents, drape.indices)
+        else:
+            if simulation is None:
+                simulation = ClothSimulation(ClothParams.from_preset(preset), backend="numpy")
+            while simulation.state.frames < frame:
+                simulation.step(FRAME_DT_S)
+            if not simulation.finite:
+                raise CatalogError(f"{task.fabric}: the cloth simulation diverged by "
+                                   f"frame {frame}")
+            mesh = curtain_on_rod(simulation)
+        renderer.set_mesh(*mesh)
+        timings["simulate_s"] += time.perf_counter() - t0
+        for image in by_frame[frame]:
             t0 = time.perf_counter()
-            if frame == 0:  # the static drape, as `catalog snapshot --frame 0`
-                drape = scene_lib.draped_curtain()
-                mesh = (drape.positions, drape.normals, drape.uvs, drape.tangents, drape.indices)
-            else:
-                if simulation is None:
-                    simulation = ClothSimulation(ClothParams.from_preset(preset), backend="numpy")
-                while simulation.state.frames < frame:
-                    simulation.step(FRAME_DT_S)
-                if not simulation.finite:
-                    raise CatalogError(f"{task.fabric}: the cloth simulation diverged by "
-                                       f"frame {frame}")
-                mesh = curtain_on_rod(simulation)
-            renderer.set_mesh(*mesh)
-            timings["simulate_s"] += time.perf_counter() - t0
-            for image in by_frame[frame]:
-                t0 = time.perf_counter()
-                renderer.set_light(lights[image.light])
-                renderer.set_camera(image.yaw_deg, task.pitch_deg, task.distance_m)
-                renderer.render()
-                pixels = renderer.read_linear() if linear else renderer.read_srgb8()
-                render_s = time.perf_counter() - t0
-                if linear and not np.all(np.isfinite(pixels)):
-                    raise CatalogError(f"{image.path}: the render has NaN or infinite pixels")
-                info = renderer.info()
-                metadata = {
-                    "ImageDescription": f"catalog render-catalog: {task.fabric} under "
-                                        f"{image.light}, frame {image.frame}, yaw {image.yaw_deg:g} deg",
-                    "catalog:fabric": task.fabric, "catalog:light": image.light,
-                    "catalog:frame": str(image.frame), "catalog:yaw_deg": f"{image.yaw_deg:g}",
-                    "catalog:mode": info["mode"],
-                    "catalog:fluorescence_variant": info["fluorescence_variant"],
-                    "catalog:bands": str(info["bands"]),
-                    "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
-                                         if linear else "sRGB, Reinhard luminance tone map"),
-                    KEY_ATTRIBUTE: image.key,
-                }
-                t1 = time.perf_counter()
-                digest, size = write_durable(out_dir / image.path, pixels, metadata)
-                timings["write_s"] += time.perf_counter() - t1
-                timings["render_s"] += render_s
-                record = _record(image, "rendered", digest, size, render_s)
-                records.append(record)
-                if on_image:
-                    on_image(record)
+            renderer.set_light(lights[image.light])
+            renderer.set_camera(image.yaw_deg, task.pitch_deg, task.distance_m)
+            renderer.render()
+            pixels = renderer.read_linear() if linear else renderer.read_srgb8()
+            render_s = time.perf_counter() - t0
+            if linear and not np.all(np.isfinite(pixels)):
+                raise CatalogError(f"{image.path}: the render has NaN or infinite pixels")
+            info = renderer.info()
+            metadata = {
+                "ImageDescription": f"catalog render-catalog: {task.fabric} under "
+                                    f"{image.light}, frame {image.frame}, yaw {image.yaw_deg:g} deg",
+                "catalog:fabric": task.fabric, "catalog:light": image.light,
+                "catalog:frame": str(image.frame), "catalog:yaw_deg": f"{image.yaw_deg:g}",
+                "catalog:mode": info["mode"],
+                "catalog:fluorescence_variant": info["fluorescence_variant"],
+                "catalog:bands": str(info["bands"]),
+                "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
+                                     if linear else "sRGB, Reinhard luminance tone map"),
+                KEY_ATTRIBUTE: image.key,
+                "DateTime": "",  # OpenEXR would stamp the time: the bytes must not vary
+            }
+            t1 = time.perf_counter()
+            digest, size = write_durable(out_dir / image.path, pixels, metadata)
+            timings["write_s"] += time.perf_counter() - t1
+            timings["render_s"] += render_s
+            record = _record(image, "rendered", digest, size, render_s)
+            records.append(record)
+            if on_image:
+                on_image(record)
