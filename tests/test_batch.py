@@ -21,8 +21,8 @@ import pytest
 
 from catalog.batch import JobSpec, parse_frames, parse_yaws
 from catalog.batch.worker import RendererPool, render_fabric
-from catalog.cli import main
-from catalog.errors import InputError
+from catalog.commands.cli import main
+from catalog.core.errors import InputError
 
 CATALOG = [sys.executable, "-m", "catalog"]
 SMALL = ["--size", "48x32", "--no-progress"]

@@ -14,7 +14,7 @@ import time
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 #: Dask event topic for per-image progress.
 PROGRESS_TOPIC = "catalog-render-catalog"
@@ -37,7 +37,7 @@ class RendererPlugin(WorkerPlugin):
 
     def setup(self, worker) -> None:
         from catalog.batch.worker import process_pool  # noqa: PLC0415
-        from catalog.render.context import egl_device_count  # noqa: PLC0415
+        from catalog.gl.context import egl_device_count  # noqa: PLC0415
 
         rank, peers = self.host_workers.get(worker.address, (0, 1))
         if "LP_NUM_THREADS" not in os.environ:  # read by llvmpipe when a context is made

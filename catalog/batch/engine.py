@@ -23,7 +23,7 @@ from pathlib import Path
 
 from catalog.batch.manifest import Manifest
 from catalog.batch.spec import JobSpec
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 #: Seconds between manifest rewrites during a run (the journal holds what comes between).
 MANIFEST_EVERY_S = 60.0

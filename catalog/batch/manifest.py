@@ -21,7 +21,7 @@ import json
 import os
 from pathlib import Path
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 SCHEMA = 1
 MANIFEST = "manifest.json"
@@ -123,7 +123,7 @@ class Manifest:
 
     def write(self, job: dict, summary: dict | None = None) -> None:
         """Write manifest.json atomically with every record, then empty the journal."""
-        from catalog.atomic import atomic_path  # noqa: PLC0415
+        from catalog.core.atomic import atomic_path  # noqa: PLC0415
 
         doc = {"schema": SCHEMA, "job": job,
                "images": [self.images[path] for path in sorted(self.images)],

@@ -1,7 +1,7 @@
 """The job: which fabrics, lights, frames and camera yaws to render, how, and where.
 
 Everything the user can get wrong is refused here, before a context or a worker exists,
-with one line naming the option (:class:`catalog.errors.InputError`, exit 2). Presets are
+with one line naming the option (:class:`catalog.core.errors.InputError`, exit 2). Presets are
 only *found* here (a missing file is the user's to fix); they are loaded and checked by the
 worker, so one broken preset among thousands fails its fabric, not the job.
 
@@ -20,7 +20,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 FORMATS = ("png", "exr")
 FLUORESCENCE = ("off", "paper", "physical")
@@ -155,7 +155,7 @@ class JobSpec:
         """Check and normalise: ``fabrics``/``lights`` as lists or ``A,B`` strings,
         ``frames`` as ``A:B[:STEP]`` or a range, ``yaws`` as text or numbers, ``size`` as
         ``WxH`` or (w, h). Raises InputError naming the option."""
-        from catalog.lights import get_light  # noqa: PLC0415
+        from catalog.optics.lights import get_light  # noqa: PLC0415
         from catalog.presets import find_preset  # noqa: PLC0415
         from catalog.render import bands as band_lib  # noqa: PLC0415
         from catalog.render.snapshot import parse_size  # noqa: PLC0415

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 #: Metadata attribute holding the image's input key.
 KEY_ATTRIBUTE = "catalog:inputs"
@@ -53,7 +53,7 @@ class RendererPool:
         self.contexts_created = 0
 
     def renderer_for(self, size: tuple[int, int]):
-        from catalog.render.context import create_headless_context  # noqa: PLC0415
+        from catalog.gl.context import create_headless_context  # noqa: PLC0415
         from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
         if self.ctx is None:
@@ -77,7 +77,7 @@ class RendererPool:
             self._thread = threading.get_ident()
 
     def describe(self) -> dict:
-        from catalog.render.context import describe  # noqa: PLC0415
+        from catalog.gl.context import describe  # noqa: PLC0415
 
         info = {"device_index": self.device_index, "pid": os.getpid(),
                 "lp_num_threads": os.environ.get("LP_NUM_THREADS"),
@@ -218,7 +218,7 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
 def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> None:
     from catalog.cloth.params import ClothParams  # noqa: PLC0415
     from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
-    from catalog.lights import get_light  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.presets import load_preset  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
     from catalog.render.snapshot import FRAME_DT_S, curtain_on_rod  # noqa: PLC0415

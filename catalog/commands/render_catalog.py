@@ -45,8 +45,8 @@ def run(args) -> int:
     import sys  # noqa: PLC0415
 
     from catalog.batch import JobSpec, check_engine, render_catalog  # noqa: PLC0415
-    from catalog.errors import InputError  # noqa: PLC0415
-    from catalog.jsonout import print_json  # noqa: PLC0415
+    from catalog.core.errors import InputError  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
 
     check_engine(args.workers, args.scheduler)
     if args.lp_threads is not None and args.lp_threads < 1:
