@@ -303,3 +303,28 @@ def test_resume_after_kill(tmp_path):
     third = _run(job + ["--json"])  # and a run with nothing left does nothing
     assert third.returncode == 0 and json.loads(third.stdout)["skipped"] == total
     assert all(after[n].stat().st_mtime_ns == p.stat().st_mtime_ns for n, p in _images(out).items())
+
+
+def test_cost_model_by_hand():
+    """The paper model against a hand count: 16 fabrics, 1 light, frames 0..2, 8 workers per
+    node; a fabric costs 2 simulated frames (0.1 s each) + 3 images (0.01 s each) = 0.23 s,
+    a process per image pays 1 s start + 0.01 s + 0.1 s per frame simulated: 3.33 s a fabric."""
+    from catalog.bench.batch_scaling import cost_model, markdown_tables
+
+    model = cost_model(0.01, 0.1, 1.0, 5.0, fabrics=16, lights=1, frames=3, nodes=(1, 2),
+                       workers_per_node=8)
+    one, two = model["rows"]
+    assert model["images"] == 48
+    assert one["batch_s"] == pytest.approx(5.0 + 2 * 0.23, abs=2e-3)
+    assert two["batch_s"] == pytest.approx(5.0 + 0.23, abs=2e-3)
+    assert one["process_per_image_s"] == pytest.approx(16 * 3.33 / 8, abs=2e-3)
+    assert two["process_per_image_s"] == pytest.approx(16 * 3.33 / 16, abs=2e-3)
+    row = {"engine": "process", "wall_s": 1.0, "images_per_s": 200.0, "speedup_vs_dask_1": 1.0,
+           "cpu_s_per_image": 0.01, "simulate_s": 0.1, "render_s": 0.2, "write_s": 0.1,
+           "startup_s": 0.0}
+    tables = markdown_tables({"job": {"images": 200, "fabrics": ["a"] * 5, "lights": ["D65", "A"],
+                                      "frames": "0:5", "yaw_deg": "0,30", "size": "96x64"},
+                              "machine": {"cpus": 2, "load_average_1min": 1.0},
+                              "rows": [row], "model": model})
+    assert set(tables) == {"batch_engines", "batch_model"}
+    assert "| process | 1.0 | 200.00 |" in tables["batch_engines"]
