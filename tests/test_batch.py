@@ -328,3 +328,40 @@ def test_cost_model_by_hand():
                               "rows": [row], "model": model})
     assert set(tables) == {"batch_engines", "batch_model"}
     assert "| process | 1.0 | 200.00 |" in tables["batch_engines"]
+
+
+@needs_dask
+def test_worker_plugin_threads_and_device(monkeypatch):
+    """Per worker: LP_NUM_THREADS = cores / workers on the host (unless set or forced), and
+    the EGL device = the worker's rank on its host modulo the devices there."""
+    import catalog.batch.worker as worker
+    import catalog.gl.context as context
+    from catalog.batch.dask_engine import RendererPlugin
+
+    class FakeWorker:
+        def __init__(self, address):
+            self.address = address
+
+    ranks = {"tcp://10.0.0.1:4001": (0, 4), "tcp://10.0.0.1:4002": (1, 4),
+             "tcp://10.0.0.1:4003": (2, 4), "tcp://10.0.0.1:4004": (3, 4)}
+    cpus = len(os.sched_getaffinity(0))
+    try:
+        monkeypatch.setattr(context, "egl_device_count", lambda: 2)
+        monkeypatch.delenv("CATALOG_EGL_DEVICE", raising=False)
+        for address, (rank, _) in ranks.items():
+            monkeypatch.delenv("LP_NUM_THREADS", raising=False)
+            RendererPlugin(ranks).setup(FakeWorker(address))
+            assert worker.process_pool().device_index == rank % 2
+            assert os.environ["LP_NUM_THREADS"] == str(max(1, cpus // 4))
+        monkeypatch.setattr(context, "egl_device_count", lambda: 1)  # one device: the default
+        RendererPlugin(ranks).setup(FakeWorker("tcp://10.0.0.1:4002"))
+        assert worker.process_pool().device_index is None
+        monkeypatch.setenv("CATALOG_EGL_DEVICE", "3")
+        monkeypatch.setenv("LP_NUM_THREADS", "5")
+        RendererPlugin(ranks).setup(FakeWorker("tcp://10.0.0.9:1"))
+        assert worker.process_pool().device_index == 3
+        assert os.environ["LP_NUM_THREADS"] == "5"  # set by the cluster's owner: kept
+        RendererPlugin(ranks, lp_threads=7).setup(FakeWorker("tcp://10.0.0.9:1"))
+        assert os.environ["LP_NUM_THREADS"] == "7"  # --lp-threads forces it
+    finally:
+        worker.close_process_pool()

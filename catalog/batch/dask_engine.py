@@ -40,9 +40,12 @@ class RendererPlugin(WorkerPlugin):
         from catalog.gl.context import egl_device_count  # noqa: PLC0415
 
         rank, peers = self.host_workers.get(worker.address, (0, 1))
-        if "LP_NUM_THREADS" not in os.environ:  # read by llvmpipe when a context is made
+        # read by llvmpipe when the context is made (the first task): set before that
+        if self.lp_threads:
+            os.environ["LP_NUM_THREADS"] = str(self.lp_threads)
+        elif "LP_NUM_THREADS" not in os.environ:
             cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-            os.environ["LP_NUM_THREADS"] = str(self.lp_threads or max(1, (cpus or 1) // peers))
+            os.environ["LP_NUM_THREADS"] = str(max(1, (cpus or 1) // peers))
         device = os.environ.get("CATALOG_EGL_DEVICE")
         if device is not None:
             device_index = int(device)

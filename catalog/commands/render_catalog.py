@@ -67,7 +67,8 @@ def run(args) -> int:
               f"{summary['skipped']} already done, {summary['kept']} kept from an "
               f"interrupted run, {len(summary['failed'])} fabrics failed; "
               f"{summary['wall_s']:.1f} s ({rate or 0:.2f} images/s, {summary['engine']}, "
-              f"{summary['workers']} workers); manifest {summary['manifest']}")
+              f"{summary['workers']} worker{'' if summary['workers'] == 1 else 's'}); "
+              f"manifest {summary['manifest']}")
     for fabric, error in summary["failed"].items():
         print(f"catalog render-catalog: fabric {fabric} failed: {error}", file=sys.stderr)
     return EXIT_PARTIAL if summary["failed"] else 0
