@@ -223,8 +223,9 @@ def test_failing_fabric_on_dask_workers(tmp_path, make_preset):
 @pytest.mark.gl
 @pytest.mark.slow
 def test_same_images_whatever_the_engine_and_workers(tmp_path):
-    """One process, one Dask worker and two Dask workers write byte-identical files (PNG and
-    EXR), and the manifest's hashes are the files' hashes."""
+    """One process, one and two Dask workers (LocalCluster) and an existing cluster reached
+    with --scheduler write byte-identical files (PNG; EXR for one process against two
+    workers), and the manifest's hashes are the files' hashes."""
     job = ["render-catalog", "--fabrics", "lace-fwa,fluoro-pink", "--lights", "D65,LED-B4",
            "--frames", "0:3:2", "--yaw", "0,40", "--json", *SMALL]
     hashes = {}
@@ -232,26 +233,44 @@ def test_same_images_whatever_the_engine_and_workers(tmp_path):
     if _dask():
         runs += [("dask-1", "png", ["--workers", "1"]), ("dask-2", "png", ["--workers", "2"]),
                  ("dask-2", "exr", ["--workers", "2"])]
-    for name, fmt, extra in runs:
-        out = tmp_path / f"{name}-{fmt}"
-        run = _run(job + ["--format", fmt, "--out", str(out)] + extra)
-        assert run.returncode == 0, run.stderr
-        summary = json.loads(run.stdout)
-        assert summary["rendered"] == 2 * 2 * 2 * 2
-        if name == "dask-2":  # two processes, one context each, llvmpipe threads shared
-            assert len(summary["processes"]) == 2
-            assert all(p["contexts_created"] == 1 for p in summary["processes"])
-            assert {p["lp_num_threads"] for p in summary["processes"]} <= {
-                os.environ.get("LP_NUM_THREADS"), str(max(1, len(os.sched_getaffinity(0)) // 2))}
-        files = _images(out)
-        hashes[(name, fmt)] = {k: _sha(p) for k, p in files.items()}
-        assert len(files) == 16
-        manifest = json.loads((out / "manifest.json").read_text())
-        assert {r["path"]: r["sha256"] for r in manifest["images"]} == hashes[(name, fmt)]
+    cluster = None
+    if _dask():  # an existing cluster, reached by address (--scheduler), on loopback
+        import logging
+
+        from distributed import LocalCluster
+        cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                               host="127.0.0.1", dashboard_address=None,
+                               silence_logs=logging.ERROR)
+        runs.append(("scheduler", "png", ["--scheduler", cluster.scheduler_address]))
+    try:
+        for name, fmt, extra in runs:
+            _render_and_hash(job, tmp_path, name, fmt, extra, hashes)
+    finally:
+        if cluster is not None:
+            cluster.close()
     for name, fmt, _ in runs:
         assert hashes[(name, fmt)] == hashes[("process", fmt)], f"{name} {fmt} differs"
     if not _dask():
         pytest.skip("Dask not installed: only the one-process engine was compared")
+
+
+def _render_and_hash(job, tmp_path, name, fmt, extra, hashes):
+    """Render the job with one engine; record the files' hashes; check the manifest."""
+    out = tmp_path / f"{name}-{fmt}"
+    run = _run(job + ["--format", fmt, "--out", str(out)] + extra)
+    assert run.returncode == 0, run.stderr
+    summary = json.loads(run.stdout)
+    assert summary["rendered"] == 2 * 2 * 2 * 2
+    if name == "dask-2":  # two processes, one context each, llvmpipe threads shared
+        assert len(summary["processes"]) == 2
+        assert all(p["contexts_created"] == 1 for p in summary["processes"])
+        assert {p["lp_num_threads"] for p in summary["processes"]} <= {
+            os.environ.get("LP_NUM_THREADS"), str(max(1, len(os.sched_getaffinity(0)) // 2))}
+    files = _images(out)
+    hashes[(name, fmt)] = {k: _sha(p) for k, p in files.items()}
+    assert len(files) == 16
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert {r["path"]: r["sha256"] for r in manifest["images"]} == hashes[(name, fmt)]
 
 
 @pytest.mark.gl

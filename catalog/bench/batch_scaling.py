@@ -8,9 +8,9 @@ runs it (process start, cluster start and all):
 - ``dask-1``, ``dask-2``: ``--workers 1`` and ``--workers 2`` (LocalCluster on 127.0.0.1);
 - ``process-per-image``: ``catalog snapshot`` once per image (each process starts Python,
   makes a context, simulates the cloth up to its frame, renders one image). On a shared
-  machine this takes minutes per 100 images, so it runs on every ``per_image_every``-th
-  image of the job (a sample spanning every fabric, light, frame and yaw) and its time is
-  scaled to the 200 images by count (the JSON says how many were run).
+  machine this takes minutes per 100 images, so by default it runs one image per fabric
+  and frame (25: lights and yaws in turn; ``--per-image-all`` runs all 200) and scales
+  the mean time per image to the 200 (the JSON says how many were run).
 
 For each: wall seconds, images/s, CPU seconds per image (user + system of the process and
 its children, which a loaded machine changes less than wall time), and from the batch
@@ -18,7 +18,7 @@ summaries the split into simulation, render + read-back and encode + write. Spee
 images/s against ``dask-1``. A model on paper (:func:`cost_model`) scales the measured
 per-image and per-frame costs to 10 000 fabrics x 4 lights x 48 frames on N nodes.
 
-    .venv/bin/python -m catalog.bench.batch_scaling [--quick] [--out benchmarks/bench_batch.json]
+    .venv/bin/python -m catalog.bench.batch_scaling [--quick] [--repeats N] [--per-image-all] [--out F.json]
 """
 
 from __future__ import annotations
@@ -90,9 +90,23 @@ def run_engine(name: str, extra: list[str], size: str, repeats: int) -> dict:
             "write_s": summary["write_s"], "workers": summary["workers"]}
 
 
-def run_per_image(size: str, every: int) -> dict:
+def per_image_sample(all_images: bool = False) -> list[tuple[str, str, int, float]]:
+    """The images a process-per-image run renders: all 200, or one per (fabric, frame),
+    lights and yaws taken in turn (25 images; every fabric and frame equally often, as in
+    the job, so the mean time per image is the job's mean)."""
+    from catalog.batch.spec import parse_frames, parse_yaws  # noqa: PLC0415
+
+    if all_images:
+        return _job_images()
+    yaws = parse_yaws(YAWS)
+    return [(fabric, LIGHTS[k % len(LIGHTS)], frame, yaws[k % len(yaws)])
+            for k, (fabric, frame) in enumerate((f, n) for f in FABRICS
+                                                for n in parse_frames(FRAMES))]
+
+
+def run_per_image(size: str, all_images: bool = False) -> dict:
     images = _job_images()
-    sample = images[::every]
+    sample = per_image_sample(all_images)
     walls, cpus, by_frame = [], [], {}
     with tempfile.TemporaryDirectory(prefix="bench-batch-") as tmp:
         for i, (fabric, light, frame, yaw) in enumerate(sample):
@@ -154,13 +168,12 @@ def cost_model(per_image_s: float, sim_frame_s: float, process_start_s: float,
 
 
 def run(quick: bool = False, size: str = "96x64", repeats: int | None = None,
-        per_image_every: int | None = None) -> dict:
-    repeats = repeats or 1
-    every = per_image_every or (20 if quick else 10)
+        per_image_all: bool = False) -> dict:
+    repeats = repeats or (1 if quick else 3)
     rows = [run_engine("process", [], size, repeats),
             run_engine("dask-1", ["--workers", "1"], size, repeats),
             run_engine("dask-2", ["--workers", "2"], size, repeats),
-            run_per_image(size, every)]
+            run_per_image(size, per_image_all)]
     base = next(r for r in rows if r["engine"] == "dask-1")["images_per_s"]
     for row in rows:
         row["speedup_vs_dask_1"] = round(row["images_per_s"] / base, 3)
@@ -213,14 +226,15 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="sample fewer process-per-image runs")
+    parser.add_argument("--quick", action="store_true", help="one run per engine")
     parser.add_argument("--size", default="96x64")
-    parser.add_argument("--repeats", type=int, default=None, help="runs per engine (median)")
-    parser.add_argument("--per-image-every", type=int, default=None,
-                        help="run catalog snapshot for every K-th image (default 10)")
+    parser.add_argument("--repeats", type=int, default=None,
+                        help="runs per engine, median (default 3; --quick 1)")
+    parser.add_argument("--per-image-all", action="store_true",
+                        help="a process for each of the 200 images, not one per fabric and frame")
     parser.add_argument("--out", default=str(PROJECT_ROOT / "benchmarks" / "bench_batch.json"))
     args = parser.parse_args(argv)
-    result = run(args.quick, args.size, args.repeats, args.per_image_every)
+    result = run(args.quick, args.size, args.repeats, args.per_image_all)
     Path(args.out).write_text(json.dumps(result, indent=1) + "\n")
     for table in markdown_tables(result).values():
         print(table + "\n")
