@@ -1,7 +1,8 @@
 """render-catalog throughput: one process, Dask workers, and a process per image, on one job.
 
 The job: 5 fabrics x 2 lights x frames 0:5 x 4 yaws = 200 PNG images (96x64 by default).
-Each engine renders it from scratch into a fresh folder, through the command line as a user
+Each engine renders it from scratch into a fresh folder (engines in turn, ``repeats``
+rounds, medians), through the command line as a user
 runs it (process start, cluster start and all):
 
 - ``process``: ``catalog render-catalog`` in one process (no Dask);
@@ -69,22 +70,23 @@ def _job_images() -> list[tuple[str, str, int, float]]:
             for light in LIGHTS for yaw in parse_yaws(YAWS)]
 
 
-def run_engine(name: str, extra: list[str], size: str, repeats: int) -> dict:
-    walls, cpus, summaries = [], [], []
-    for _ in range(repeats):
-        with tempfile.TemporaryDirectory(prefix="bench-batch-") as tmp:
-            wall, cpu, result = _timed(CATALOG + _job_args(size, Path(tmp) / "out") + extra)
-        summary = json.loads(result.stdout)
-        walls.append(wall)
-        cpus.append(cpu)
-        summaries.append(summary)
-    summary = summaries[walls.index(statistics.median_low(walls))]
+def run_once(extra: list[str], size: str) -> tuple[float, float, dict]:
+    """One run of the job from scratch: (wall s, CPU s, the command's JSON summary)."""
+    with tempfile.TemporaryDirectory(prefix="bench-batch-") as tmp:
+        wall, cpu, result = _timed(CATALOG + _job_args(size, Path(tmp) / "out") + extra)
+    return wall, cpu, json.loads(result.stdout)
+
+
+def engine_row(name: str, runs: list[tuple[float, float, dict]]) -> dict:
+    """Median over an engine's runs (the summary of the median-wall run for the split)."""
+    walls = [w for w, _, _ in runs]
+    summary = runs[walls.index(statistics.median_low(walls))][2]
     images = summary["rendered"]
     wall = statistics.median(walls)
-    return {"engine": name, "images": images, "runs": repeats, "wall_s": round(wall, 3),
+    return {"engine": name, "images": images, "runs": len(runs), "wall_s": round(wall, 3),
             "wall_s_runs": [round(w, 3) for w in walls],
             "images_per_s": round(images / wall, 3),
-            "cpu_s_per_image": round(statistics.median(cpus) / images, 4),
+            "cpu_s_per_image": round(statistics.median(c for _, c, _ in runs) / images, 4),
             "startup_s": summary.get("startup_s", 0.0),
             "simulate_s": summary["simulate_s"], "render_s": summary["render_s"],
             "write_s": summary["write_s"], "workers": summary["workers"]}
@@ -170,10 +172,13 @@ def cost_model(per_image_s: float, sim_frame_s: float, process_start_s: float,
 def run(quick: bool = False, size: str = "96x64", repeats: int | None = None,
         per_image_all: bool = False) -> dict:
     repeats = repeats or (1 if quick else 3)
-    rows = [run_engine("process", [], size, repeats),
-            run_engine("dask-1", ["--workers", "1"], size, repeats),
-            run_engine("dask-2", ["--workers", "2"], size, repeats),
-            run_per_image(size, per_image_all)]
+    engines = {"process": [], "dask-1": ["--workers", "1"], "dask-2": ["--workers", "2"]}
+    runs: dict[str, list] = {name: [] for name in engines}
+    for _ in range(repeats):  # round robin: a change of the machine's load hits every engine
+        for name, extra in engines.items():
+            runs[name].append(run_once(extra, size))
+    rows = [engine_row(name, runs[name]) for name in engines]
+    rows.append(run_per_image(size, per_image_all))
     base = next(r for r in rows if r["engine"] == "dask-1")["images_per_s"]
     for row in rows:
         row["speedup_vs_dask_1"] = round(row["images_per_s"] / base, 3)
