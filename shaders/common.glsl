@@ -133,15 +133,54 @@ vec3 background_terms(vec3 dir, vec3 to_sun, float sun_chord2_inner, float sun_c
     return vec3(1.0 - step(0.0, dir.z), step(0.0, dir.y), 1.0 - s * s * (3.0 - 2.0 * s));
 }
 
-// Reinhard, Stark, Shirley, Ferwerda 2002, "Photographic tone reproduction", eq. 4 (extended,
-// on luminance, so hue is kept): L_d = L (1 + L / L_white^2) / (1 + L), applied after exposure.
-vec3 tone_map_reinhard_luminance(vec3 rgb, float white) {
-    float lum = dot(rgb, vec3(0.2126, 0.7152, 0.0722));
-    if (lum <= 0.0) {
-        return vec3(0.0);
-    }
-    float mapped = lum * (1.0 + lum / (white * white)) / (1.0 + lum);
-    return rgb * (mapped / lum);
+// ---------------------------------------------------------------- the fabric's pattern
+// (model.md section 9; catalog/presets/patterns.py). u_pattern: RGBA, mipmapped, repeating: rgb = the
+// thread's unit normal in the cloth's tangent frame (x weft, y warp, z the cloth normal), a =
+// the thread coverage c in [0, 1]. The mip chain averages both: far away c -> mean(c) = 1 - LD
+// (the fit's see-through) and the normals average to a shorter vector about the cloth normal
+// (the first moment of LEAN mapping, Olano & Baker 2010), so highlights fade instead of
+// sparkling. The room's shadow pass can call thread_coverage(uv) for the holes' shadow.
+#ifdef PATTERN
+uniform sampler2D u_pattern;
+
+vec4 thread_texel(vec2 uv_repeats) {
+    return texture(u_pattern, uv_repeats);
+}
+
+// Thread coverage at uv (in pattern repeats), mip-filtered by the hardware's footprint.
+float thread_coverage(vec2 uv_repeats) {
+    return texture(u_pattern, uv_repeats).a;
+}
+
+// The shading normal: the cloth normal n tilted by the pattern's mip-averaged normal m in
+// the frame (t weft, n x t, n). |m| < 1 where the mip averages slopes: m is used unnormalised,
+// so the tilt shrinks with the filtered slope variance (Toksvig 2005's shortening).
+vec3 thread_normal(vec3 n, vec3 tangent, vec3 m) {
+    vec3 t = tangent - dot(tangent, n) * n;
+    float len2 = dot(t, t);
+    t = len2 > 1e-12 ? t * inversesqrt(len2) : vec3(0.0);
+    vec3 b = cross(n, t);
+    return normalize(m.x * t + m.y * b + m.z * n);
+}
+#endif
+
+// Weighted blended order-independent transparency (McGuire & Bavoil 2013, JCGT 2(2)): each
+// layer adds C a w and a w, and multiplies the revealage by (1 - a); nearer layers weigh more.
+// depth_m: view distance beyond the reference, clamped to [0, 3] m; 2^(-30 m^-1 depth) keeps the
+// weights normal in float32 (>= 2^-90).
+float oit_weight(float depth_m) {
+    return exp2(-30.0 * clamp(depth_m, 0.0, 3.0));
+}
+
+// The resolve of weighted blended OIT: (mean layer colour x (1 - revealage), revealage) to be
+// blended ONE, SRC_ALPHA over what is behind. accum = (sum C a w, prod (1 - a)), weight = sum a w.
+vec4 oit_resolve(vec4 accum, float weight) {
+    return vec4(accum.rgb / max(weight, 1e-30) * (1.0 - accum.a), accum.a);
+}
+
+// Luma of a display-encoded colour (ITU-R BT.601 weights, as FXAA uses): edge detection only.
+float display_luma(vec3 encoded) {
+    return dot(encoded, vec3(0.299, 0.587, 0.114));
 }
 
 // IEC 61966-2-1:1999 sRGB transfer function (the piecewise curve, not a 2.2 power).
@@ -150,6 +189,69 @@ vec3 srgb_encode(vec3 linear) {
     vec3 lo = 12.92 * c;
     vec3 hi = 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055;
     return mix(hi, lo, lessThanEqual(c, vec3(0.0031308)));
+}
+
+// ---- The room (issue 13, model.md section 9): catalog/render/room_light.py has the layout.
+// The room box's six inside faces, P(s, t) = origin + s axis_s + t axis_t, side by side in a
+// light-map atlas (face k covers u in [k / 6, (k + 1) / 6]). Face order: floor, ceiling, left,
+// right, back, window wall.
+const int ROOM_FACES = 6;
+
+// The face a room surface belongs to, by its normal's dominant axis (into the room).
+int room_face_of_normal(vec3 n) {
+    vec3 a = abs(n);
+    if (a.y >= a.x && a.y >= a.z) {
+        return n.y > 0.0 ? 0 : 1;
+    }
+    if (a.x >= a.z) {
+        return n.x > 0.0 ? 2 : 3;
+    }
+    return n.z < 0.0 ? 4 : 5;
+}
+
+// Atlas coordinates of world point p on face k (clamped half a texel inside the face).
+vec2 room_atlas_uv(int face, vec3 p, vec3 origin, vec3 axis_s, vec3 axis_t, float face_texels) {
+    vec3 d = p - origin;
+    float edge = 0.5 / face_texels;
+    float s = clamp(dot(d, axis_s) / dot(axis_s, axis_s), edge, 1.0 - edge);
+    float t = clamp(dot(d, axis_t) / dot(axis_t, axis_t), edge, 1.0 - edge);
+    return vec2((float(face) + s) / float(ROOM_FACES), t);
+}
+
+// A box mask in 2D with soft edges of half-width w (the penumbra): 1 inside, 0 outside.
+float soft_rect(vec2 q, vec4 box, float half_width) {
+    vec2 lo = smoothstep(box.xz - half_width, box.xz + half_width, q);
+    vec2 hi = 1.0 - smoothstep(box.yw - half_width, box.yw + half_width, q);
+    return lo.x * lo.y * hi.x * hi.y;
+}
+
+// The key light's beam through the window opening at room point p (to_light.z < 0: the light
+// is outside): the ray p + s to_light must cross the opening (x0, x1, y0, y1) = rect in both
+// the wall's inner plane z = wall_z.x and outer plane z = wall_z.y (the reveals shade). The
+// edge is soft by the penumbra of a source of angular radius atan(tan_radius) at the distance
+// travelled (PCSS's estimate for a distant disc).
+float room_window_beam(vec3 p, vec3 to_light, vec4 opening, vec2 wall_z, float tan_radius) {
+    float s_in = (wall_z.x - p.z) / to_light.z;
+    float s_out = (wall_z.y - p.z) / to_light.z;
+    vec2 q_in = p.xy + s_in * to_light.xy;
+    vec2 q_out = p.xy + s_out * to_light.xy;
+    return step(0.0, s_in) * soft_rect(q_in, opening, s_in * tan_radius + 1e-3)
+         * soft_rect(q_out, opening, s_out * tan_radius + 1e-3);
+}
+
+
+// ---- The clear sky (issue 13; catalog/sky.py is the float64 twin). Preetham, Shirley & Smits
+// 1999, the Perez et al. 1993 function F(theta, gamma) = (1 + A e^(B / cos theta))
+// (1 + C e^(D gamma) + E cos^2 gamma) for x, y and Y at once (columns of the coefficients).
+vec3 perez_xyY(float cos_theta, float gamma, vec3 a, vec3 b, vec3 c, vec3 d, vec3 e) {
+    float cos_gamma = cos(gamma);
+    return (1.0 + a * exp(b / max(cos_theta, 0.01)))
+         * (1.0 + c * exp(d * gamma) + e * (cos_gamma * cos_gamma));
+}
+
+// xyY -> XYZ.
+vec3 xyY_to_XYZ(vec3 xyY) {
+    return vec3(xyY.x * xyY.z / xyY.y, xyY.z, (1.0 - xyY.x - xyY.y) * xyY.z / xyY.y);
 }
 
 #endif

@@ -31,7 +31,7 @@ _SLICE = re.compile(r"\s*(-?\d+)\s*:\s*(-?\d+)\s*(?::\s*(-?\d+)\s*)?")
 
 def parse_frames(text: str) -> range:
     """``A:B[:STEP]`` -> range(A, B, STEP), as a Python slice (B excluded). Frame 0 is the
-    static drape, frame N > 0 the cloth simulation after N steps of 1/60 s (as
+    settled drape, frame N > 0 the cloth simulated from it for N steps of 1/60 s (as
     ``catalog snapshot --frame N``)."""
     match = _SLICE.fullmatch(str(text))
     if match is None:

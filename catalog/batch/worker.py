@@ -216,18 +216,19 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
 
 
 def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> None:
-    from catalog.cloth.params import ClothParams  # noqa: PLC0415
-    from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.presets import load_preset  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
-    from catalog.render.snapshot import FRAME_DT_S, curtain_on_rod  # noqa: PLC0415
+    from catalog.render.snapshot import (FRAME_DT_S, SnapshotRequest,  # noqa: PLC0415
+                                         configure_renderer, curtain_on_rod, curtain_simulation,
+                                         image_metadata, ring_xs_m)
 
     t0 = time.perf_counter()
     preset = load_preset(task.preset_path)
     scene_lib.dye_transmittance(preset)
     scene_lib.fluorescent_material(preset)
     lights = {name: get_light(name) for name in sorted({image.light for image in todo})}
+    rings = ring_xs_m(preset)
     timings["load_s"] += time.perf_counter() - t0
 
     renderer = pool.renderer_for(task.size)
@@ -236,49 +237,40 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
     for image in todo:
         by_frame.setdefault(image.frame, []).append(image)
     simulation = None
-    renderer.set_fabric(preset)
-    renderer.set_fluorescence(task.fluorescence)
-    renderer.set_bands(task.bands)
-    renderer.set_exposure(task.exposure)
-    for frame in sorted(by_frame):
+    for frame in sorted(by_frame):  # one simulation, stepped through the frames asked for
         t0 = time.perf_counter()
-        if frame == 0:  # the static drape, as `catalog snapshot --frame 0`
-            drape = scene_lib.draped_curtain()
-            mesh = (drape.positions, drape.normals, drape.uvs, drape.tangents, drape.indices)
-        else:
-            if simulation is None:
-                simulation = ClothSimulation(ClothParams.from_preset(preset), backend="numpy")
-            while simulation.state.frames < frame:
-                simulation.step(FRAME_DT_S)
-            if not simulation.finite:
-                raise CatalogError(f"{task.fabric}: the cloth simulation diverged by "
-                                   f"frame {frame}")
-            mesh = curtain_on_rod(simulation)
-        renderer.set_mesh(*mesh)
+        if simulation is None:
+            simulation = curtain_simulation(preset)  # frame 0: the settled drape
+        while simulation.state.frames < frame:
+            simulation.step(FRAME_DT_S)
+        if not simulation.finite:
+            raise CatalogError(f"{task.fabric}: the cloth simulation diverged by frame {frame}")
+        *mesh, fabric_size = curtain_on_rod(simulation)
         timings["simulate_s"] += time.perf_counter() - t0
         for image in by_frame[frame]:
             t0 = time.perf_counter()
-            renderer.set_light(lights[image.light])
-            renderer.set_camera(image.yaw_deg, task.pitch_deg, task.distance_m)
+            # every setting an image depends on, as `catalog snapshot` sets it
+            request = SnapshotRequest(fabric=task.fabric, light=image.light, size=task.size,
+                                      out=out_dir / image.path, frame=frame,
+                                      fluorescence=task.fluorescence, bands=task.bands,
+                                      yaw_deg=image.yaw_deg, pitch_deg=task.pitch_deg,
+                                      distance_m=task.distance_m, exposure=task.exposure)
+            configure_renderer(renderer, request, preset, lights[image.light])
+            renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+            renderer.set_rings(rings)
             renderer.render()
             pixels = renderer.read_linear() if linear else renderer.read_srgb8()
             render_s = time.perf_counter() - t0
-            if linear and not np.all(np.isfinite(pixels)):
+            if not np.all(np.isfinite(pixels)):
                 raise CatalogError(f"{image.path}: the render has NaN or infinite pixels")
-            info = renderer.info()
-            metadata = {
+            metadata = image_metadata(renderer.info(), frame, linear)
+            metadata.update({
                 "ImageDescription": f"catalog render-catalog: {task.fabric} under "
-                                    f"{image.light}, frame {image.frame}, yaw {image.yaw_deg:g} deg",
-                "catalog:fabric": task.fabric, "catalog:light": image.light,
-                "catalog:frame": str(image.frame), "catalog:yaw_deg": f"{image.yaw_deg:g}",
-                "catalog:mode": info["mode"],
-                "catalog:fluorescence_variant": info["fluorescence_variant"],
-                "catalog:bands": str(info["bands"]),
-                "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
-                                     if linear else "sRGB, Reinhard luminance tone map"),
+                                    f"{image.light}, frame {frame}, yaw {image.yaw_deg:g} deg",
+                "catalog:yaw_deg": f"{image.yaw_deg:g}",
                 KEY_ATTRIBUTE: image.key,
                 "DateTime": "",  # OpenEXR would stamp the time: the bytes must not vary
-            }
+            })
             t1 = time.perf_counter()
             digest, size = write_durable(out_dir / image.path, pixels, metadata)
             timings["write_s"] += time.perf_counter() - t1

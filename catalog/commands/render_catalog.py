@@ -17,7 +17,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--fabrics", required=True, help="comma-separated preset names or .toml paths")
     parser.add_argument("--lights", required=True, help="comma-separated light names (D65,A,LED-B4,sun:22,...)")
     parser.add_argument("--frames", default="0:1",
-                        help="START:STOP[:STEP] as a Python slice, STOP excluded (0: the static "
+                        help="START:STOP[:STEP] as a Python slice, STOP excluded (0: the settled "
                              "drape, N: the cloth after N steps of 1/60 s); default 0:1")
     parser.add_argument("--yaw", default=None,
                         help="camera yaw angles in deg: 0,90,180 or START:STOP:STEP (default 0)")

@@ -52,9 +52,16 @@ class SnapshotRequest:
     pitch_deg: float = 0.0
     distance_m: float = 2.6
     exposure: float = 1.0
+    ev: float | None = None           # EV100; None: automatic exposure
+    white_balance: str = "room"
+    environment: str | None = None    # FILE.exr behind the window (issue 13)
+    curtain_open: bool = False
+    room_light: bool = True
+    bloom: bool = True
+    lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
 
 
-def encode_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
+def encode_image(path: Path, pixels: np.ndarray, metadata: dict) -> None:
     """Write (H, W, 3) pixels to ``path`` with OpenImageIO (float32 -> EXR, uint8 -> PNG, by
     the suffix), not atomically: callers write a temporary file and rename it."""
     import OpenImageIO as oiio  # noqa: PLC0415
@@ -64,7 +71,10 @@ def encode_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> No
     spec = oiio.ImageSpec(width, height, channels, kind)
     spec.channelnames = ("R", "G", "B")
     for key, value in metadata.items():
-        spec.attribute(key, str(value))
+        if key == "chromaticities":
+            spec.attribute(key, oiio.TypeDesc("float[8]"), tuple(value))
+        else:
+            spec.attribute(key, str(value))
     output = oiio.ImageOutput.create(str(path))
     if output is None:
         raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
@@ -75,12 +85,30 @@ def encode_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> No
         raise CatalogError(f"cannot write {path}: {error}")
 
 
-def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
+def write_image(path: Path, pixels: np.ndarray, metadata: dict) -> None:
     """Write (H, W, 3) pixels with OpenImageIO, atomically: float32 -> EXR, uint8 -> PNG."""
     from catalog.core.atomic import atomic_path  # noqa: PLC0415
 
     with atomic_path(path) as tmp:
         encode_image(tmp, pixels, metadata)
+
+
+def exr_colour_metadata() -> dict:
+    """What tools need to show our EXR with a standard view (OpenColorIO's built-in config
+    ``ocio://default``: the interop ID of its colour space "Linear Rec.709 (sRGB)"; the EXR chromaticities of
+    sRGB / Rec.709 with the D65 white, from colour-science's tables)."""
+    from catalog.render import display  # noqa: PLC0415
+
+    t = display.tables()
+    m = np.linalg.inv(t["srgb_xyz_to_rgb"])  # RGB -> XYZ: the columns are the primaries
+    xy = [(col[0] / col.sum(), col[1] / col.sum()) for col in m.T]
+    white = tuple(float(v) for v in t["srgb_whitepoint_xy"])
+    return {"oiio:ColorSpace": OCIO_LINEAR_SPACE,
+            "chromaticities": tuple(float(v) for pair in xy for v in pair) + white}
+
+
+#: The name of our EXR's colour space in OpenColorIO's built-in config (ocio://default).
+OCIO_LINEAR_SPACE = "lin_rec709_scene"   # the interop ID; "Linear Rec.709 (sRGB)" there
 
 
 def read_metadata(path: str | Path) -> dict[str, str]:
@@ -96,26 +124,62 @@ def read_metadata(path: str | Path) -> dict[str, str]:
 
 
 def simulated_curtain(preset, frames: int):
-    """The cloth simulation after ``frames`` frames, moved onto the scene's rod."""
-    from catalog.cloth.params import ClothParams  # noqa: PLC0415
-    from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
-
-    simulation = ClothSimulation(ClothParams.from_preset(preset), backend="numpy")
+    """The curtain after ``frames`` frames of the cloth simulation started from the settled
+    drape (frame 0: the settled drape itself; catalog.cloth.drape), moved onto the scene's
+    rod. Returns (positions, normals, uv, tangents, indices, fabric size (w, h) m)."""
+    simulation = curtain_simulation(preset)
     simulation.run(frames, FRAME_DT_S)
     return curtain_on_rod(simulation)
 
 
+def curtain_simulation(preset):
+    """The preset's cloth simulation at the settled drape (frame 0); step it by
+    ``FRAME_DT_S`` for the next frames (catalog render-catalog steps one through them all)."""
+    from catalog.cloth.drape import drape_params, settled_simulation  # noqa: PLC0415
+
+    return settled_simulation(drape_params(preset), backend="numpy")
+
+
 def curtain_on_rod(simulation):
-    """A running simulation's curtain as mesh arrays (positions, normals, uvs, tangents,
-    indices) in scene coordinates: the grid moved onto the scene's rod."""
+    """A running simulation's curtain moved onto the scene's rod: (positions, normals, uv,
+    tangents, indices, fabric size (w, h) m)."""
+    from catalog.cloth.drape import rod_centre_x_m  # noqa: PLC0415
     from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
     params = simulation.params
     mesh = CurtainMesh.from_grid(simulation.positions(), params)
-    offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - params.rod_y_m, scene_lib.CURTAIN_Z],
-                      dtype=np.float32)
-    return mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices
+    offset = np.array([-rod_centre_x_m(params), scene_lib.CURTAIN_TOP_Y - params.rod_y_m,
+                       scene_lib.CURTAIN_Z], dtype=np.float32)
+    return (mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices,
+            (params.width_m, params.height_m))
+
+
+def ring_xs_m(preset) -> list[float]:
+    """x of the curtain's rings on the scene's rod (m): the settled drape's ring columns."""
+    from catalog.cloth.drape import drape_params, rod_centre_x_m  # noqa: PLC0415
+    from catalog.cloth.state import ring_positions  # noqa: PLC0415
+
+    params = drape_params(preset)
+    return [float(x) - rod_centre_x_m(params) for x in ring_positions(params)[:, 0]]
+
+
+def check_display_choices(ev, white_balance, exposure=1.0) -> None:
+    """--ev, --white-balance and --exposure, refused in one line naming the option."""
+    import math  # noqa: PLC0415
+
+    from catalog.render import display  # noqa: PLC0415
+
+    if ev is not None:
+        try:
+            display.check_ev(ev)
+        except CatalogError as exc:
+            raise InputError(str(exc).split(": ", 1)[-1], field="--ev") from None
+    if white_balance not in display.WHITE_BALANCES:
+        raise InputError(f"{white_balance!r}: choose one of {', '.join(display.WHITE_BALANCES)}",
+                         field="--white-balance")
+    if not (math.isfinite(exposure) and exposure > 0):
+        raise InputError(f"{exposure!r} must be a positive number", field="--exposure")
 
 
 def validate(request: SnapshotRequest):
@@ -132,10 +196,26 @@ def validate(request: SnapshotRequest):
     if request.frame < 0:
         raise InputError(f"{request.frame} must be >= 0", field="--frame")
     band_lib.check_band_count(request.bands)
+    check_display_choices(request.ev, request.white_balance, request.exposure)
     preset = load_preset(find_preset(request.fabric))
     scene_lib.dye_transmittance(preset)
     scene_lib.fluorescent_material(preset)
     light = get_light(request.light) if request.hour is None else None
+    if request.environment is not None:
+        from catalog.render.environment import load_environment  # noqa: PLC0415
+
+        load_environment(request.environment)  # refused now, before a context exists
+    from catalog.render import room_light  # noqa: PLC0415
+
+    if len(request.lamps) > room_light.MAX_ROOM_LAMPS:
+        raise InputError(f"at most {room_light.MAX_ROOM_LAMPS} lamps, got {len(request.lamps)}",
+                         field="--lamp")
+    for name, position in request.lamps:
+        get_light(name)
+        try:
+            room_light.check_lamp_position(position)
+        except CatalogError as exc:
+            raise InputError(str(exc), field="--lamp") from None
     return preset, light
 
 
@@ -150,20 +230,12 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
     ctx = ctx or create_headless_context()
     renderer = FrameRenderer(ctx, request.size)
     try:
-        renderer.set_fabric(preset)
-        sun = None
-        if request.hour is not None:
-            sun = renderer.set_sun_hour(request.hour)
-        else:
-            renderer.set_light(light)
-        renderer.set_fluorescence(request.fluorescence)
-        renderer.set_bands(request.bands)
-        renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
-        renderer.set_exposure(request.exposure)
-        mesh_source = "static drape"
-        if request.frame > 0:
-            renderer.set_mesh(*simulated_curtain(preset, request.frame))
-            mesh_source = f"cloth simulation, frame {request.frame}"
+        sun = configure_renderer(renderer, request, preset, light)
+        *mesh, fabric_size = simulated_curtain(preset, request.frame)
+        renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+        renderer.set_rings(ring_xs_m(preset))
+        mesh_source = ("settled drape" if request.frame == 0
+                       else f"cloth simulation from the settled drape, frame {request.frame}")
         start = time.perf_counter()
         renderer.render()
         pixels = (renderer.read_linear() if request.out.suffix.lower() == ".exr"
@@ -174,19 +246,7 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.release()
     if not np.all(np.isfinite(pixels)):
         raise CatalogError("the render has NaN or infinite pixels; nothing written")
-    metadata = {
-        "ImageDescription": f"catalog snapshot: {info['fabric']} under {info['light']}, "
-                            f"fluorescence {info['fluorescence_variant']}",
-        "catalog:fabric": info["fabric"],
-        "catalog:light": info["light"],
-        "catalog:mode": info["mode"],
-        "catalog:fluorescence_variant": info["fluorescence_variant"],
-        "catalog:bands": str(info["bands"]),
-        "catalog:frame": str(request.frame),
-        "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
-                             if request.out.suffix.lower() == ".exr"
-                             else "sRGB, Reinhard luminance tone map"),
-    }
+    metadata = image_metadata(info, request.frame, request.out.suffix.lower() == ".exr")
     write_image(request.out, pixels, metadata)
     report = dict(info)
     report.update({"out": str(request.out), "frame": request.frame, "mesh": mesh_source,
@@ -196,3 +256,52 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
     if sun is not None:
         report["sun"] = sun
     return report
+
+
+def configure_renderer(renderer, request: SnapshotRequest, preset, light):
+    """Every renderer setting a snapshot depends on but the mesh, from ``request`` (the
+    preset and light already loaded). Returns the sun's report with ``request.hour``."""
+    renderer.set_fabric(preset)
+    sun = None
+    if request.hour is not None:
+        sun = renderer.set_sun_hour(request.hour)
+    else:
+        renderer.set_light(light)
+    renderer.set_fluorescence(request.fluorescence)
+    renderer.set_bands(request.bands)
+    renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
+    renderer.set_exposure(request.exposure)
+    renderer.set_ev(request.ev)
+    renderer.set_white_balance(request.white_balance)
+    renderer.set_curtain_open(request.curtain_open)
+    renderer.set_room_lighting(request.room_light)
+    renderer.set_bloom(request.bloom)
+    if request.environment is not None:
+        renderer.set_environment(request.environment)
+    renderer.set_room_lamps(request.lamps)
+    return sun
+
+
+def image_metadata(info: dict, frame: int, linear: bool) -> dict:
+    """The metadata a snapshot writes, from the renderer's ``info()``."""
+    metadata = {
+        "ImageDescription": f"catalog snapshot: {info['fabric']} under {info['light']}, "
+                            f"fluorescence {info['fluorescence_variant']}",
+        "catalog:fabric": info["fabric"],
+        "catalog:light": info["light"],
+        "catalog:mode": info["mode"],
+        "catalog:fluorescence_variant": info["fluorescence_variant"],
+        "catalog:bands": str(info["bands"]),
+        "catalog:frame": str(frame),
+        "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
+                             if linear
+                             else "sRGB; CAT16 white balance, Michaelis-Menten tone curve, "
+                                  "OKLab gamut compression (docs/display.md)"),
+        "catalog:ev100": f"{info['ev100']:.4f}",
+        "catalog:exposure_scale": repr(info["exposure"]),
+        "catalog:auto_exposure": str(info["auto_exposure"]).lower(),
+        "catalog:white_balance": info["white_balance"],
+    }
+    if linear:
+        metadata.update(exr_colour_metadata())
+    return metadata
