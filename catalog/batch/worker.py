@@ -236,13 +236,14 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
     by_frame: dict[int, list] = {}
     for image in todo:
         by_frame.setdefault(image.frame, []).append(image)
-    simulation = None
+    simulation, stepped = None, 0
     for frame in sorted(by_frame):  # one simulation, stepped through the frames asked for
         t0 = time.perf_counter()
         if simulation is None:
             simulation = curtain_simulation(preset)  # frame 0: the settled drape
-        while simulation.state.frames < frame:
+        while stepped < frame:  # (its own frame counter includes the settling)
             simulation.step(FRAME_DT_S)
+            stepped += 1
         if not simulation.finite:
             raise CatalogError(f"{task.fabric}: the cloth simulation diverged by frame {frame}")
         *mesh, fabric_size = curtain_on_rod(simulation)
