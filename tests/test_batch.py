@@ -338,6 +338,9 @@ def test_cost_model_by_hand():
     assert two["batch_s"] == pytest.approx(5.0 + 0.23, abs=2e-3)
     assert one["process_per_image_s"] == pytest.approx(16 * 3.33 / 8, abs=2e-3)
     assert two["process_per_image_s"] == pytest.approx(16 * 3.33 / 16, abs=2e-3)
+    settled = cost_model(0.01, 0.1, 1.0, 5.0, settle_s=2.0, fabrics=16, lights=1, frames=3,
+                         nodes=(1,), workers_per_node=8)["rows"][0]
+    assert settled["batch_s"] == pytest.approx(5.0 + 2 * (2.0 + 0.23), abs=2e-3)  # per fabric
     row = {"engine": "process", "wall_s": 1.0, "images_per_s": 200.0, "speedup_vs_dask_1": 1.0,
            "cpu_s_per_image": 0.01, "simulate_s": 0.1, "render_s": 0.2, "write_s": 0.1,
            "startup_s": 0.0}

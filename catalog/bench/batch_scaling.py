@@ -88,6 +88,7 @@ def engine_row(name: str, runs: list[tuple[float, float, dict]]) -> dict:
             "images_per_s": round(images / wall, 3),
             "cpu_s_per_image": round(statistics.median(c for _, c, _ in runs) / images, 4),
             "startup_s": summary.get("startup_s", 0.0),
+            "settle_s": summary.get("settle_s", 0.0),
             "simulate_s": summary["simulate_s"], "render_s": summary["render_s"],
             "write_s": summary["write_s"], "workers": summary["workers"]}
 
@@ -132,23 +133,25 @@ def run_per_image(size: str, all_images: bool = False) -> dict:
 
 
 def cost_model(per_image_s: float, sim_frame_s: float, process_start_s: float,
-               cluster_start_s: float, *, fabrics: int = 10_000, lights: int = 4,
-               frames: int = 48, yaws: int = 1, nodes=(1, 4, 16, 64),
+               cluster_start_s: float, *, settle_s: float = 0.0, fabrics: int = 10_000,
+               lights: int = 4, frames: int = 48, yaws: int = 1, nodes=(1, 4, 16, 64),
                workers_per_node: int = 8) -> dict:
     """Hours for ``fabrics x lights x frames x yaws`` images on N nodes of
     ``workers_per_node`` workers (one per GPU), one fabric per task:
 
-    - batch: a worker's fabric costs ``sim_frame_s * (frames - 1)`` (frame 0 is the static
-      drape; the cloth is simulated once) plus ``per_image_s`` per image; fabrics are dealt
+    - batch: a worker's fabric costs ``settle_s`` (the settled drape, frame 0) and
+      ``sim_frame_s * (frames - 1)`` (the cloth is simulated once) plus ``per_image_s`` per
+      image; fabrics are dealt
       to the N*W workers in whole tasks: ceil(fabrics / (N*W)) rounds, plus cluster start;
     - process per image: every image pays a process start and the simulation up to its
-      frame, sum over frames f of (process_start_s + sim_frame_s * f + per_image_s).
+      frame, sum over frames f of (process_start_s + sim_frame_s * f + per_image_s), where
+      the process start includes settling the drape (measured on frame-0 snapshots).
 
     Per-image and per-frame costs are the measured ones; nothing else is assumed (no GPU
     speed-up of the render is put in: on GPUs the render term shrinks and the CPU
     simulation and encoding dominate)."""
     images_per_fabric = lights * frames * yaws
-    per_fabric = sim_frame_s * max(frames - 1, 0) + per_image_s * images_per_fabric
+    per_fabric = settle_s + sim_frame_s * max(frames - 1, 0) + per_image_s * images_per_fabric
     per_image_process = (process_start_s + per_image_s) * images_per_fabric \
         + sim_frame_s * lights * yaws * frames * (frames - 1) / 2
     rows = []
@@ -164,7 +167,7 @@ def cost_model(per_image_s: float, sim_frame_s: float, process_start_s: float,
     return {"fabrics": fabrics, "lights": lights, "frames": frames, "yaws": yaws,
             "images": fabrics * images_per_fabric, "workers_per_node": workers_per_node,
             "per_image_s": round(per_image_s, 5), "sim_frame_s": round(sim_frame_s, 5),
-            "process_start_s": round(process_start_s, 4),
+            "process_start_s": round(process_start_s, 4), "settle_s": round(settle_s, 4),
             "cluster_start_s": round(cluster_start_s, 3),
             "batch_s_per_fabric": round(per_fabric, 3), "rows": rows}
 
@@ -185,11 +188,12 @@ def run(quick: bool = False, size: str = "96x64", repeats: int | None = None,
     process = rows[0]
     sim_frames = len(FABRICS) * (max(range(*map(int, FRAMES.split(":")))))
     per_image_s = (process["render_s"] + process["write_s"]) / process["images"]
-    sim_frame_s = process["simulate_s"] / sim_frames
+    settle_s = process["settle_s"] / len(FABRICS)
+    sim_frame_s = (process["simulate_s"] - process["settle_s"]) / sim_frames
     per_image = rows[-1]
     frame0 = per_image["wall_s_by_frame"].get("0", per_image["mean_wall_s_per_image"])
     model = cost_model(per_image_s, sim_frame_s, max(frame0 - per_image_s, 0.0),
-                       rows[2]["startup_s"])
+                       rows[2]["startup_s"], settle_s=settle_s)
     return {"job": {"fabrics": list(FABRICS), "lights": list(LIGHTS), "frames": FRAMES,
                     "yaw_deg": YAWS, "size": size, "format": "png", "images": 200},
             "machine": {"cpus": len(os.sched_getaffinity(0)),
@@ -204,14 +208,15 @@ def markdown_tables(result: dict) -> dict[str, str]:
              f"lights x frames {job['frames']} x yaws {job['yaw_deg']}, {job['size']} PNG), "
              f"{result['machine']['cpus']} CPUs shared (load {result['machine']['load_average_1min']}):",
              "", "| engine | wall s | images/s | speed-up vs 1 Dask worker | CPU s/image "
-             "| simulate s | render s | write s | start s |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "| settle s | simulate s | render s | write s | start s |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for row in result["rows"]:
         name = row["engine"]
         if name == "process-per-image":
             name += f" ({row['sampled_images']} run, scaled)"
         lines.append(f"| {name} | {row['wall_s']:.1f} | {row['images_per_s']:.2f} | "
                      f"{row['speedup_vs_dask_1']:.2f} | {row['cpu_s_per_image']:.3f} | "
+                     f"{row.get('settle_s', float('nan')):.2f} | "
                      f"{row.get('simulate_s', float('nan')):.2f} | "
                      f"{row.get('render_s', float('nan')):.2f} | "
                      f"{row.get('write_s', float('nan')):.2f} | {row['startup_s']:.1f} |")
@@ -220,6 +225,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
               f"lights x {model['frames']} frames), {model['workers_per_node']} workers per node, "
               f"from the measured {model['per_image_s'] * 1000:.1f} ms per image, "
               f"{model['sim_frame_s'] * 1000:.0f} ms per simulated frame, "
+              f"{model.get('settle_s', 0.0):.2f} s to settle a fabric's drape, "
               f"{model['process_start_s']:.2f} s per process start:",
               "", "| nodes | workers | batch (h) | process per image (h) | ratio |",
               "|---:|---:|---:|---:|---:|"]
