@@ -7,7 +7,8 @@ Each subcommand lives in ``catalog/commands/<name>.py`` and defines
 - ``run(args) -> int``: the work; it imports what it needs (numpy, scipy, GL) inside.
 
 Command modules import nothing heavy at module level, so ``catalog --help`` stays fast.
-A :class:`catalog.errors.CatalogError` becomes one line on stderr and exit status 2.
+A :class:`catalog.errors.CatalogError` becomes one line on stderr and exit status 2
+(3 for :class:`catalog.errors.EnvironmentFailure`: a library the machine lacks).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ COMMANDS: dict[str, str] = {
     "view": "catalog.commands.view",
     "simulate": "catalog.commands.simulate",
     "bench": "catalog.commands.bench",
+    "reference": "catalog.commands.reference",
 }
 
 
@@ -67,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
         return int(args._run(args) or 0)
     except CatalogError as exc:
         print(f"catalog {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return int(getattr(exc, "exit_code", 2))  # 2: the input; 3: the environment
     except KeyboardInterrupt:
         return 130
 

@@ -28,3 +28,10 @@ class InputError(CatalogError):
         if field is not None:
             where = f"{where}: {field}" if where else field
         super().__init__(f"{where}: {problem}" if where else problem)
+
+
+class EnvironmentFailure(CatalogError):
+    """The machine lacks something the command needs (a library, a device): not the
+    user's input. The CLI prints the one line and exits :attr:`exit_code` (3)."""
+
+    exit_code = 3

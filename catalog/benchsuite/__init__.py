@@ -16,7 +16,10 @@ optionally, ``plot(result, folder) -> list[Path]``:
   (:mod:`catalog.benchsuite.cloth`);
 - ``stability``: every model's parameters swept to their edges
   (:mod:`catalog.benchsuite.stability`);
-- ``startup``: import time and time to the first frame (:mod:`catalog.benchsuite.startup`).
+- ``startup``: import time and time to the first frame (:mod:`catalog.benchsuite.startup`);
+- ``image``: the real-time frame against the path-traced reference of the same scene, FLIP
+  and Delta E per region, both run times (:mod:`catalog.benchsuite.image`; needs the
+  ``pathtrace`` extra and LLVM 19, docs/pathtrace.md).
 
 docs/bench.md has the figures and how to reproduce them.
 """
@@ -31,4 +34,5 @@ SECTIONS: dict[str, str] = {
     "cloth": "catalog.benchsuite.cloth",
     "stability": "catalog.benchsuite.stability",
     "startup": "catalog.benchsuite.startup",
+    "image": "catalog.benchsuite.image",
 }

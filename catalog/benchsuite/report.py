@@ -132,6 +132,13 @@ def startup_md(result: dict) -> str:
         viewer_line(s["viewer_heavy_at_first_frame"]) + f" scipy loaded: {s['viewer_imports_scipy']}."])
 
 
+def image_md(result: dict) -> str:
+    from catalog.benchsuite.image import markdown_tables  # noqa: PLC0415
+
+    blocks = markdown_tables(result)
+    return blocks["image"] + "\n\nReal-time options (image-pareto.png):\n\n" + blocks["image-options"]
+
+
 def viewer_line(heavy: dict | None) -> str:
     if not heavy:
         return "The viewer's first frame was not measured."
@@ -145,7 +152,8 @@ SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "fit": ("Eq. 7 fit: accuracy against time", fit_md),
               "cloth": ("Cloth: substeps and backend against a small-step reference", cloth_md),
               "stability": ("Numerical stability at the parameters' edges", stability_md),
-              "startup": ("Start-up", startup_md)}
+              "startup": ("Start-up", startup_md),
+              "image": ("The real-time frame against the path-traced reference", image_md)}
 
 
 def markdown(report: dict) -> str:
