@@ -259,12 +259,21 @@ def _catalog(*args, env=None):
                           capture_output=True, text=True, env=env, timeout=300)
 
 
-def test_reference_command_writes_an_exr_with_json(tmp_path):
+def _main(capsys, *args):
+    """``catalog reference ARGS`` in this process: (exit status, stdout, stderr lines)."""
+    from catalog.cli import main
+
+    code = main(["reference", *args])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err.strip().splitlines()
+
+
+def test_reference_command_writes_an_exr_with_json(mi, tmp_path, capsys):
     out = tmp_path / "ref.exr"
-    result = _catalog("--fabric", "voile-white", "--light", "D65", "--size", "24x18",
-                      "--spp", "2", "--out", str(out), "--json")
-    assert result.returncode == 0, result.stderr
-    report = json.loads(result.stdout)
+    code, stdout, err = _main(capsys, "--fabric", "voile-white", "--light", "D65", "--size",
+                              "24x18", "--spp", "2", "--out", str(out), "--json")
+    assert code == 0, err
+    report = json.loads(stdout)
     assert report["spp"] == 2 and report["size"] == [24, 18] and out.is_file()
     import OpenImageIO as oiio
 
@@ -282,24 +291,22 @@ def test_reference_command_writes_an_exr_with_json(tmp_path):
     (["--spp", "0"], "--spp"),
     (["--size", "0x10"], "--size"),
 ])
-def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, needle):
+def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, args, needle):
     base = {"--fabric": "voile-white", "--light": "D65", "--size": "8x6", "--spp": "1"}
     for key, value in zip(args[::2], args[1::2]):
         base[key] = value
     flat = [x for kv in base.items() for x in kv]
-    result = _catalog(*flat, "--out", str(tmp_path / "x.exr"))
-    lines = result.stderr.strip().splitlines()
-    assert result.returncode == 2 and len(lines) == 1 and needle in lines[0], result.stderr
+    code, _out, lines = _main(capsys, *flat, "--out", str(tmp_path / "x.exr"))
+    assert code == 2 and len(lines) == 1 and needle in lines[0], lines
     assert list(tmp_path.iterdir()) == []
 
 
-def test_unwritable_output_is_one_line(tmp_path):
+def test_unwritable_output_is_one_line(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")
-    result = _catalog("--fabric", "voile-white", "--size", "8x6", "--spp", "1",
-                      "--out", str(blocker / "x.exr"))
-    lines = result.stderr.strip().splitlines()
-    assert result.returncode == 2 and len(lines) == 1 and "--out" in lines[0]
+    code, _out, lines = _main(capsys, "--fabric", "voile-white", "--size", "8x6", "--spp", "1",
+                              "--out", str(blocker / "x.exr"))
+    assert code == 2 and len(lines) == 1 and "--out" in lines[0]
     assert blocker.read_text() == "not a folder"
 
 
@@ -318,3 +325,24 @@ def test_the_frame_path_never_imports_the_reference():
             "print(bad); sys.exit(1 if bad else 0)")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_coverage_pattern_hook_makes_holes_null_transmission(mi):
+    """model.md section 9: where the coverage c is 0 the cloth is a hole (null transmission
+    1, no lobes), where it is 1 the lobes are scaled by 1 / mean(c)."""
+    from catalog.pathtrace.scene import woven_bsdf_dict
+
+    coverage = np.zeros((4, 4), dtype=np.float32)
+    coverage[:, 2:] = 1.0  # left half holes, right half thread; mean 0.5
+    fabric = {**LACE, "direct": 0.5, "anisotropy": 0.0, "dye_rgb": [1.0, 1.0, 1.0]}
+    bsdf = mi.load_dict(woven_bsdf_dict(fabric, {"coverage": coverage, "uv_scale": 1.0}))
+    plain = _bsdf(mi, **LACE)
+    si = _si(mi, (0.0, 0.0, 1.0), 2)
+    si.uv = mi.Point2f([0.2, 0.8], [0.5, 0.5])
+    null = np.asarray(bsdf.eval_null_transmission(si))[0]
+    assert np.allclose(null, [1.0, 0.0], atol=1e-6)
+    wo = mi.Vector3f(0.3, 0.0, -math.sqrt(0.91))
+    ctx = mi.BSDFContext()
+    f = np.asarray(bsdf.eval(ctx, si, wo))[0]
+    f_plain = np.asarray(plain.eval(ctx, _si(mi, (0.0, 0.0, 1.0), 2), wo))[0]
+    assert f[0] == 0 and np.isclose(f[1], 2.0 * np.ravel(f_plain)[-1], rtol=1e-5)

@@ -60,6 +60,9 @@ OPTIONS = (
     ("2x2 supersampled", 3, "physical", 2),
 )
 ABSENT_OPTIONS = ("room lighting on/off", "shadow map size")
+#: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
+#: curtain (noise falls as 1 / sqrt(spp): the spp that reaches it is spp (noise / 1 %)^2).
+NOISE_TARGET = 0.01
 GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
 REGIONS = ("curtain", "floor", "walls")
 #: The hour of "noon sun" (local solar time, the scene's date and latitude).
@@ -253,18 +256,28 @@ def plot(result: dict, folder) -> list[Path]:
     return written
 
 
+def spp_for_noise(spp: int, noise: float, target: float = NOISE_TARGET) -> float:
+    """Samples per pixel at which a render with relative noise ``noise`` at ``spp`` reaches
+    ``target`` (Monte Carlo: noise ~ 1 / sqrt(spp))."""
+    return spp * (noise / target) ** 2
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks for BENCHMARKS.md / docs: ``image`` (per scene), ``image-options``."""
     from catalog.benchsuite.report import table  # noqa: PLC0415
 
     s = result["summary"]
-    per_scene = table(result["rows"], [
+    rows = [dict(r, spp_for_1pct=spp_for_noise(r["spp"], r["reference_noise_curtain_rel"]))
+            for r in result["rows"]]
+    per_scene = table(rows, [
         "scene", "mean_flip", "curtain_delta_e_mean", "curtain_delta_e_p95", "floor_delta_e_mean",
         "floor_delta_e_p95", "walls_delta_e_mean", "walls_delta_e_p95", "frame_ms", "reference_s",
-        "speedup", "reference_noise_rel", "meets_goal"],
+        "speedup", "reference_noise_rel", "reference_noise_curtain_rel", "spp_for_1pct",
+        "meets_goal"],
         ["scene", "mean FLIP", "curtain dE mean", "curtain dE p95", "floor dE mean",
          "floor dE p95", "walls dE mean", "walls dE p95", "frame ms", "reference s",
-         "x faster", "ref. noise (rel. RMS)", "goal met"])
+         "x faster", "ref. noise (rel. RMS)", "ref. noise, curtain", "spp for 1 % on the curtain",
+         "goal met"])
     per_scene += (f"\n\n{result['settings']['size'][0]}x{result['settings']['size'][1]} px; "
                   f"reference: {s['integrator']}. Goal (issue 11): mean FLIP <= "
                   f"{GOAL['mean_flip_at_most']}, curtain dE mean <= "

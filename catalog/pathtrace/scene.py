@@ -295,7 +295,13 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
                                           "rr_depth": 5}}
     positions, normals, uvs, _tangents, indices = desc.curtain
     props = mi.Properties()
-    props["bsdf"] = mi.load_dict(woven_bsdf_dict(desc.fabric, desc.pattern))
+    fabric = dict(desc.fabric)
+    if mi.is_spectral:  # the dye per wavelength (visible range of the grid), not per channel
+        from catalog.spectra import GRID_NM  # noqa: PLC0415
+
+        visible = (GRID_NM >= 360) & (GRID_NM <= 830)
+        fabric["dye_spectrum"] = (GRID_NM[visible], desc.inputs.dye_transmittance[visible])
+    props["bsdf"] = mi.load_dict(woven_bsdf_dict(fabric, desc.pattern))
     scene["curtain"] = _mesh(mi, "curtain", positions, indices, normals, uvs, props)
     if room:
         tris = desc.room_positions.reshape(-1, 3)
