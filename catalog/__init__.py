@@ -1,22 +1,19 @@
 """Fabric catalog: woven-cloth transmission with fluorescence, rendered in real time.
 
 Importing the package is cheap on purpose: no numpy-heavy or GL module is
-imported here, so ``catalog --help`` answers at once. Parts:
+imported here, so ``catalog --help`` answers at once. One sub-package per room
+(docs/architecture.md):
 
-- optics: :mod:`catalog.spectra`, :mod:`catalog.colorimetry`, :mod:`catalog.lights`,
-  :mod:`catalog.fluorescence`, :mod:`catalog.btdf` (float64 numpy, no GL);
+- :mod:`catalog.core`: errors, atomic writes, JSON/CSV helpers, option parsers, resources;
+- :mod:`catalog.optics`: spectra, colorimetry, lights, fluorescence, BTDF, the float64
+  shading reference, the sun (:mod:`catalog.optics.sun`) and bispectral matrices
+  (:mod:`catalog.optics.bispectral`) (float64 numpy, no GL);
 - :mod:`catalog.presets`: preset TOML <-> typed object;
+- :mod:`catalog.fit`: gonio measurements and the eq. 7 fit;
+- :mod:`catalog.gl`: the GL context and shader loading (used by cloth and render);
 - :mod:`catalog.cloth`, :mod:`catalog.render`, :mod:`catalog.viewer`;
-- :mod:`catalog.cli`: the ``catalog`` command.
+- :mod:`catalog.commands`: the ``catalog`` command (parse, call, print);
+- :mod:`catalog.bench`: every benchmark and study.
 """
 
-from pathlib import Path
-
 __version__ = "0.1.0"
-
-#: Repository root (the package is installed editable; shaders/ and fabrics/ live beside it).
-PROJECT_ROOT = Path(__file__).resolve().parent.parent
-SHADER_DIR = PROJECT_ROOT / "shaders"
-FABRIC_DIR = PROJECT_ROOT / "fabrics"
-#: Real measurements made by others, kept outside the project (see ../shared/data/README.md).
-SHARED_DATA_DIR = PROJECT_ROOT.parent / "shared" / "data"

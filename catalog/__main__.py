@@ -1,5 +1,5 @@
 import sys
 
-from catalog.cli import main
+from catalog.commands.cli import main
 
 sys.exit(main())

@@ -6,7 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from catalog import FABRIC_DIR, PROJECT_ROOT, SHARED_DATA_DIR
+from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT, SHARED_DATA_DIR
+from catalog.gl.shaderlib import register_folder
+
+#: Test-only shaders (tests/shaders/) are found by name like the product's.
+register_folder(Path(__file__).resolve().parent / "shaders")
 
 DATA = SHARED_DATA_DIR
 
@@ -34,7 +38,7 @@ def fabric_dir() -> Path:
 @pytest.fixture(scope="session")
 def gl_context():
     """One headless OpenGL 4.3 context (EGL, Mesa llvmpipe in CI) shared by the GL tests."""
-    from catalog.render.context import create_headless_context
+    from catalog.gl.context import create_headless_context
 
     ctx = create_headless_context()
     yield ctx

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from catalog.atomic import atomic_path, write_text_atomic
+from catalog.core.atomic import atomic_path, write_text_atomic
 
 
 def test_write_replaces_whole_file(tmp_path):

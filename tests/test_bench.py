@@ -11,15 +11,15 @@ import sys
 import numpy as np
 import pytest
 
-from catalog.benchsuite import SECTIONS
-from catalog.benchsuite import reduction as red
-from catalog.spectra import GRID_NM
+from catalog.bench import SECTIONS
+from catalog.bench import reduction as red
+from catalog.optics.spectra import GRID_NM
 
 LM_PER_W = 683.0
 
 
 def _light(name: str) -> np.ndarray:
-    from catalog.lights import get_light
+    from catalog.optics.lights import get_light
 
     return np.asarray(get_light(name).irradiance_w_m2_nm, dtype=np.float64)
 
@@ -101,7 +101,7 @@ def test_every_section_module_has_run():
 
 @pytest.mark.gl
 def test_colour_section_on_one_fabric_and_light(gl, tmp_path):
-    from catalog.benchsuite import colour
+    from catalog.bench import colour
 
     result = colour.run(ctx=gl, fabrics=["lace-fwa"], lights=["D65"], error_size=(40, 24),
                         time_size=(64, 36), repeats=1)
@@ -146,7 +146,7 @@ def test_truth_switches_on_the_emission_as_the_renderer_does(gl):
 
 
 def test_pareto_front_and_default_choice():
-    from catalog.benchsuite import colour
+    from catalog.bench import colour
 
     points = [(1.0, 0.1, "a"), (0.9, 0.5, "b"), (1.2, 0.05, "c"), (1.3, 0.2, "d")]
     assert colour.pareto_front(points) == ["a", "b", "c"]  # d is beaten by a on both
@@ -163,8 +163,8 @@ def test_pareto_front_and_default_choice():
 
 
 def test_fit_errors_are_zero_for_the_true_parameters():
-    from catalog.benchsuite import fit
-    from catalog.btdf import eq7_transmittance
+    from catalog.bench import fit
+    from catalog.optics.btdf import eq7_transmittance
 
     data = fit.synthetic_gonio()
     t = fit.SYNTHETIC_TRUTH
@@ -178,7 +178,7 @@ def test_fit_errors_are_zero_for_the_true_parameters():
 
 
 def test_cloth_runs_are_deterministic_and_deviation_is_a_distance():
-    from catalog.benchsuite import cloth
+    from catalog.bench import cloth
 
     backend = cloth.fastest_backend()
     a, _, finite, used = cloth.trajectory((5, 6), 4, backend, 3)
@@ -192,12 +192,12 @@ def test_cloth_runs_are_deterministic_and_deviation_is_a_distance():
 
 
 def test_startup_section_without_first_frames():
-    from catalog.benchsuite import startup
+    from catalog.bench import startup
 
     result = startup.run(quick=True, first_frames=False, repeats=1)
     assert not _numbers_all_finite(result["rows"])
     heavy = result["summary"]["heavy_imports"]
-    assert heavy["catalog.cli"] == [] and "scipy" not in heavy["catalog.viewer"]
+    assert heavy["catalog.commands.cli"] == [] and "scipy" not in heavy["catalog.viewer"]
     assert result["summary"]["help_s"] > 0
 
 
@@ -247,8 +247,8 @@ def test_dual_basis_is_exact_for_a_light_in_the_cmf_span_even_when_fluorescent()
 
 
 def test_fichet_reduction_matches_the_bispectral_studys_implementation():
-    from catalog import bispectral_study as study
-    from catalog.bispectral import find_bfc, read_bfc
+    from catalog.optics.bispectral import study
+    from catalog.optics.bispectral.matrix import find_bfc, read_bfc
 
     matrix = read_bfc(find_bfc("TEXTYELL"))
     ours = red.fichet_reduced(matrix)
@@ -258,7 +258,7 @@ def test_fichet_reduction_matches_the_bispectral_studys_implementation():
 
 @pytest.mark.parametrize("light_name", ["D65", "UV-A"])
 def test_per_light_reduction_of_a_measured_matrix_is_the_exact_colour(light_name):
-    from catalog.bispectral import exact_exitance_on_grid, find_bfc, read_bfc
+    from catalog.optics.bispectral.matrix import exact_exitance_on_grid, find_bfc, read_bfc
 
     matrix = read_bfc(find_bfc("CIBA12"))
     light = _light(light_name)
@@ -274,8 +274,8 @@ def test_n_bands_are_exact_for_a_grey_non_fluorescent_material(n_bands):
     own, so the N-band colour equals the spectral one (closed form: 683 r sum cmf E)."""
     from types import SimpleNamespace
 
-    from catalog.benchsuite.fluorescence_rgb import bands_xyz
-    from catalog.fluorescence import FluorescentMaterial
+    from catalog.bench.fluorescence_rgb import bands_xyz
+    from catalog.optics.fluorescence import FluorescentMaterial
 
     dark = FluorescentMaterial(absorptance=np.full(GRID_NM.size, 0.5),  # absorbs, emits nothing
                                emission_pdf_per_nm=np.full(GRID_NM.size, 1.0 / GRID_NM.size),

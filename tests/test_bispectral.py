@@ -11,12 +11,13 @@ import re
 import numpy as np
 import pytest
 
-from catalog import bispectral, bispectral_study as study
-from catalog.errors import InputError
-from catalog.fluorescence import (absorbed_photon_irradiance, emitted_exitance_w_m2_nm,
+from catalog.optics.bispectral import matrix as bispectral
+from catalog.optics.bispectral import study
+from catalog.core.errors import InputError
+from catalog.optics.fluorescence import (absorbed_photon_irradiance, emitted_exitance_w_m2_nm,
                                   emitted_photon_exitance, material_from_spectra,
                                   photon_energy_j)
-from catalog.spectra import GRID_NM, read_spectrum
+from catalog.optics.spectra import GRID_NM, read_spectrum
 
 NAMES = ("CIBA12", "CIPLAW10", "HERPICER", "HERPIORA", "IXCRLALE", "PHP8HP1C", "POLGREE",
          "TEXTYELL")
@@ -233,7 +234,7 @@ def test_colour_refinement_keeps_the_model_and_stays_near_the_data(matrices, fit
     """Same supports (one absorption band, one emission band), phi <= 1, the reflectance
     within 0.01 of the least-squares one, the strength within 5%, the entries still within
     3 noise sigmas rms; and over the eight matrices the colours under the TRAINING lights
-    (physical mode, computed here through catalog.fluorescence, not the refinement's own
+    (physical mode, computed here through catalog.optics.fluorescence, not the refinement's own
     reduced sums) are at least 10% closer to the exact ones on average."""
     errors = {"plain": [], "refined": []}
     for name, m in matrices.items():
@@ -453,7 +454,7 @@ def test_table_tool_prints_markdown_and_json(tmp_path):
     import subprocess
     import sys
 
-    from catalog import PROJECT_ROOT
+    from catalog.core.resources import PROJECT_ROOT
 
     out = tmp_path / "table.json"
     doc = tmp_path / "doc.md"
@@ -473,7 +474,7 @@ def test_table_tool_prints_markdown_and_json(tmp_path):
 def test_command_json_and_export(tmp_path, capsys):
     import json
 
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     assert main(["bispectral", "CIBA12", "--json", "--lights", "D65,A",
                  "--export", str(tmp_path / "ciba")]) == 0

@@ -1,4 +1,4 @@
-"""The HG phase function (eq. 6), eq. 7 and the Cook-Torrance baseline (catalog/btdf.py).
+"""The HG phase function (eq. 6), eq. 7 and the Cook-Torrance baseline (catalog/optics/btdf.py).
 
 References: the printed eq. 6 evaluated in 50-digit decimal arithmetic from the same
 vectors, the closed-form HG cumulative distribution, quadrature, and the half-angle
@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from catalog import btdf
+from catalog.optics import btdf
 
 G = st.floats(min_value=-0.9999, max_value=0.9999, allow_nan=False)
 

@@ -6,7 +6,7 @@ import json
 import subprocess
 import sys
 
-from catalog.cli import COMMANDS
+from catalog.commands.cli import COMMANDS
 
 HEAVY = ("numpy", "scipy", "colour", "matplotlib", "moderngl", "OpenImageIO", "numba",
          "trimesh", "pvlib", "glfw", "imgui_bundle")
@@ -20,7 +20,7 @@ def _python(code: str) -> str:
 def test_help_builds_every_command_parser_without_heavy_imports():
     out = _python(
         "import sys\n"
-        "from catalog.cli import build_parser\n"
+        "from catalog.commands.cli import build_parser\n"
         "parser = build_parser()\n"
         "parser.format_help()\n"
         "import json\n"
@@ -58,8 +58,8 @@ def test_unknown_command_is_refused():
 def test_wxh_values_are_parsed_and_refused_by_one_rule():
     import pytest
 
-    from catalog.cliargs import parse_wxh
-    from catalog.errors import InputError
+    from catalog.core.cliargs import parse_wxh
+    from catalog.core.errors import InputError
 
     assert parse_wxh(" 64X48 ", "--size", 1, 100) == (64, 48)
     assert parse_wxh("2x100000", "--grid", 2) == (2, 100000)  # no upper bound given

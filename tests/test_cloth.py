@@ -17,7 +17,7 @@ from catalog.cloth.simulation import kinetic_energy_j, max_spring_strain
 from catalog.cloth.state import attachments, rest_pose, ring_columns, ring_positions
 from catalog.cloth.topology import (COLOUR_COUNT, FAMILIES, GATHER_OFFSETS, SELECTORS,
                                     rest_lengths_m, spring_pairs, triangle_indices)
-from catalog.errors import InputError
+from catalog.core.errors import InputError
 
 STRAIN_SLACK = 1e-3  # the adaptive sweeps stop at 5e-4 over the limit; collisions nudge
 
@@ -255,7 +255,7 @@ def test_sleeps_at_rest_and_wakes_on_change():
 
 
 def test_grid_cannot_change_on_a_running_simulation():
-    from catalog.errors import CatalogError
+    from catalog.core.errors import CatalogError
 
     sim = ClothSimulation(ClothParams(grid_w=4, grid_h=4), "numpy")
     with pytest.raises(CatalogError, match="grid"):

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from catalog.cli import main
+from catalog.commands.cli import main
 
 KEYS = {"steps", "dt", "substeps", "finite", "max_stretch", "kinetic_energy",
         "steps_per_second"}

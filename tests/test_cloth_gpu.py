@@ -61,7 +61,7 @@ def test_vertex_buffer_holds_the_mesh(gl):
 def test_bind_to_vertex_array_draws_the_curtain(gl):
     """Draw the simulated curtain with a tiny program into a float framebuffer: the
     covered pixels carry the normals the simulation wrote."""
-    from catalog.render.shaderlib import create_program
+    from catalog.gl.shaderlib import create_program
 
     params = ClothParams(grid_w=8, grid_h=8, opening=1.0)
     sim = ClothSimulation(params, "gpu", ctx=gl)
@@ -79,14 +79,15 @@ def test_bind_to_vertex_array_draws_the_curtain(gl):
     assert covered.mean() > 0.5  # the curtain fills the view set up by the test shader
     normals = pixels[covered][:, :3]
     assert np.all(normals[:, 2] > 0.9)  # nearly flat, facing the room
-    previous.use()
+    if previous is not None:  # a fresh standalone context has no default framebuffer
+        previous.use()
     vao.release()
     fbo.release()
 
 
 def test_springs12_on_the_gpu_matches_the_reference(gl):
-    from catalog.cloth.backend_gpu import Springs12Gpu
-    from catalog.cloth.springs12 import Springs12Problem, reference_steps
+    from catalog.bench.springs12 import Springs12Gpu
+    from catalog.bench.springs12 import Springs12Problem, reference_steps
 
     problem = Springs12Problem(n=20)
     reference, _ = reference_steps(problem, 120)

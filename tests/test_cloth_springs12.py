@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from catalog.cloth.springs12 import Springs12Numba, Springs12Problem, reference_steps
+from catalog.bench.springs12 import Springs12Numba, Springs12Problem, reference_steps
 
 
 @pytest.mark.parametrize("n", [2, 3, 7, 33])
@@ -60,7 +60,7 @@ def test_one_spring_oscillates_at_its_natural_frequency():
 
     # run the reference from a displaced start (the function starts at rest pose,
     # so reproduce its loop on a copy with the displaced free row)
-    import catalog.cloth.springs12 as s12
+    import catalog.bench.springs12 as s12
 
     original = s12.Springs12Problem.initial_positions
 

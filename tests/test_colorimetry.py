@@ -6,8 +6,8 @@ import colour
 import numpy as np
 import pytest
 
-from catalog import colorimetry as cm
-from catalog.spectra import GRID_NM
+from catalog.optics import colorimetry as cm
+from catalog.optics.spectra import GRID_NM
 
 
 def test_cmfs_match_colour_on_its_own_wavelengths():
@@ -84,7 +84,7 @@ def test_colorimetry_does_not_import_colour_or_scipy():
     import sys
 
     code = ("import sys, numpy as np\n"
-            "from catalog import colorimetry as cm\n"
+            "from catalog.optics import colorimetry as cm\n"
             "cm.delta_e_2000(np.ones(3), np.ones(3) * 2, np.ones(3) * 3)\n"
             "cm.spectrum_to_xyz(np.ones(481)); cm.xyz_to_linear_srgb(np.ones(3))\n"
             "print(sorted({'colour', 'scipy'} & {m.split('.')[0] for m in sys.modules}))")

@@ -1,4 +1,4 @@
-"""Fitting eq. 7 and Cook-Torrance (catalog/fitting.py) and the ``catalog fit`` command."""
+"""Fitting eq. 7 and Cook-Torrance (catalog/fit/fitting.py) and the ``catalog fit`` command."""
 
 from __future__ import annotations
 
@@ -8,8 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from catalog import btdf, fitting, gonio
-from catalog.cli import main as catalog_main
+from catalog.optics import btdf
+from catalog.fit import fitting
+from catalog.fit import gonio
+from catalog.commands.cli import main as catalog_main
 
 GRID = gonio.ogm3_grid()
 SUBSET = gonio.paper_subset_mask(GRID)
@@ -144,13 +146,13 @@ def test_split_amplitudes_inverts_the_products():
 # --- the yarn-level measurements: HG beats Cook-Torrance ---------------------------------------
 
 def _measurement(name):
-    from catalog import FABRIC_DIR
+    from catalog.core.resources import FABRIC_DIR
 
     return FABRIC_DIR / "measurements" / name / "gonio.csv"
 
 
 def _catalog_fabrics():
-    from catalog import FABRIC_DIR
+    from catalog.core.resources import FABRIC_DIR
 
     return sorted(p.parent.name for p in (FABRIC_DIR / "measurements").glob("*/gonio.csv"))
 

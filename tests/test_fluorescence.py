@@ -9,12 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from catalog import FABRIC_DIR
-from catalog import fluorescence as fl
-from catalog.colorimetry import M_PAPER_XYZ_TO_RGB
-from catalog.errors import CatalogError, InputError
-from catalog.lights import get_light
-from catalog.spectra import GRID_NM, Spectrum, read_spectrum
+from catalog.core.resources import FABRIC_DIR
+from catalog.optics import fluorescence as fl
+from catalog.optics.colorimetry import M_PAPER_XYZ_TO_RGB
+from catalog.core.errors import CatalogError, InputError
+from catalog.optics.lights import get_light
+from catalog.optics.spectra import GRID_NM, Spectrum, read_spectrum
 
 LACE = FABRIC_DIR / "measurements" / "lace-fwa"
 

@@ -10,11 +10,11 @@ import sys
 import numpy as np
 import pytest
 
-from catalog import FABRIC_DIR
-from catalog import fluorescence as fl
-from catalog.cli import main
-from catalog.lights import get_light
-from catalog.spectra import GRID_NM, read_spectrum
+from catalog.core.resources import FABRIC_DIR
+from catalog.optics import fluorescence as fl
+from catalog.commands.cli import main
+from catalog.optics.lights import get_light
+from catalog.optics.spectra import GRID_NM, read_spectrum
 
 LACE = FABRIC_DIR / "measurements" / "lace-fwa"
 ARGS = ["fluorescence", "--excitation", str(LACE / "excitation.csv"),

@@ -9,8 +9,8 @@ import sys
 import numpy as np
 import pytest
 
-from catalog import FABRIC_DIR, PROJECT_ROOT
-from catalog.spectra import read_spectrum
+from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
+from catalog.optics.spectra import read_spectrum
 
 MEASUREMENTS = FABRIC_DIR / "measurements"
 FABRICS = ("lace-fwa", "safety-yellow", "fluoro-pink")

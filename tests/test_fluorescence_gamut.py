@@ -7,7 +7,7 @@ import importlib.util
 
 import pytest
 
-from catalog import PROJECT_ROOT
+from catalog.core.resources import PROJECT_ROOT
 
 
 @pytest.fixture(scope="module")

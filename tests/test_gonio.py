@@ -1,5 +1,5 @@
 """Gonio data: the paper's angle convention, the OGM-3 grid and the 79-point subset, and
-the gonio CSV reader's refusals (catalog/gonio.py)."""
+the gonio CSV reader's refusals (catalog/fit/gonio.py)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from catalog import gonio
-from catalog.errors import InputError
+from catalog.fit import gonio
+from catalog.core.errors import InputError
 
 HEADER = ",".join(gonio.GONIO_COLUMNS)
 
@@ -178,7 +178,7 @@ def _make_gonio_module():
     import importlib.util
     import sys
 
-    from catalog import PROJECT_ROOT
+    from catalog.core.resources import PROJECT_ROOT
 
     if "make_gonio" not in sys.modules:
         spec = importlib.util.spec_from_file_location("make_gonio",
@@ -190,7 +190,7 @@ def _make_gonio_module():
 
 
 def test_generator_reproduces_the_committed_measurement(tmp_path):
-    from catalog import FABRIC_DIR
+    from catalog.core.resources import FABRIC_DIR
 
     make_gonio = _make_gonio_module()
     fabric = next(f for f in make_gonio.CATALOG if f.name == "sheer-teal")

@@ -10,8 +10,8 @@ import sys
 import numpy as np
 import pytest
 
-from catalog.errors import CatalogError, InputError
-from catalog.lights import (
+from catalog.core.errors import CatalogError, InputError
+from catalog.optics.lights import (
     DAYLIGHT_LX,
     LAMP_LX,
     UVA_TOTAL_W_M2,
@@ -20,7 +20,7 @@ from catalog.lights import (
     illuminance_lx,
     light_names,
 )
-from catalog.spectra import GRID_NM
+from catalog.optics.spectra import GRID_NM
 
 colour = pytest.importorskip("colour")
 
@@ -170,7 +170,7 @@ def test_illuminance_of_nothing_is_zero():
 def test_cie_light_does_not_import_pvlib():
     """A CIE light costs colour-science's import and nothing more (pvlib/pandas are the
     sun's): checked by what is imported, since timings belong in benchmarks."""
-    code = ("import sys; from catalog.lights import get_light; get_light('D65'); "
+    code = ("import sys; from catalog.optics.lights import get_light; get_light('D65'); "
             "get_light('UV-A'); get_light('LED-warm'); print('pvlib' in sys.modules)")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             check=True)
@@ -178,7 +178,7 @@ def test_cie_light_does_not_import_pvlib():
 
 
 def test_cli_lights_json_parses(capsys):
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     assert main(["lights", "--json", "--names", "D65,UV-A,sun:22"]) == 0
     out = json.loads(capsys.readouterr().out)
@@ -190,7 +190,7 @@ def test_cli_lights_json_parses(capsys):
 
 
 def test_cli_lights_lists_everything_as_json(capsys):
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     assert main(["lights", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
@@ -198,7 +198,7 @@ def test_cli_lights_lists_everything_as_json(capsys):
 
 
 def test_cli_lights_plot_is_written_atomically(tmp_path, capsys):
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     target = tmp_path / "lights.png"
     assert main(["lights", "--plot", str(target), "--names", "D65,A,UV-A", "--json"]) == 0
@@ -209,7 +209,7 @@ def test_cli_lights_plot_is_written_atomically(tmp_path, capsys):
 
 
 def test_cli_lights_bad_name_is_one_line_exit_2(tmp_path, capsys):
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     target = tmp_path / "x.png"
     assert main(["lights", "--plot", str(target), "--names", "D65,nope"]) == 2

@@ -1,7 +1,7 @@
 """The path-traced reference (catalog.pathtrace, issue 11): the woven BSDF plugin against
 independent references (chi-square of its sampling against its density, the white
 furnace against the closed-form HG integrals, reciprocity, eval against the float64
-eq. 5-7 of catalog.reference), the scene export, the direct-light reference against the
+eq. 5-7 of catalog.optics.shading_reference), the scene export, the direct-light reference against the
 float64 per-pixel reference, the noise's convergence, and the command's bad input.
 
 Tolerances (set before running): chi-square at the 1 % significance level (Mitsuba's own
@@ -75,7 +75,7 @@ def test_sampling_matches_the_density_chi_square(mi, wi):
 
 @pytest.mark.parametrize("g_diff,g_spec", [(-0.0892, 0.8224), (0.3, 0.6), (0.0, 0.95)])
 def test_white_furnace_equals_the_fitted_albedo(mi, g_diff, g_spec):
-    from catalog.reference import hg_hemisphere_factors
+    from catalog.optics.shading_reference import hg_hemisphere_factors
 
     a_diff, a_spec, direct = 0.29, 0.32, 0.38
     bsdf = _bsdf(mi, direct=direct, a_diff=a_diff, g_diff=g_diff, a_spec=a_spec, g_spec=g_spec)
@@ -118,7 +118,7 @@ def _directions(count, seed):
 
 
 def test_reciprocity_and_eval_against_the_float64_eq7(mi):
-    from catalog.reference import ShadingInputs, woven_transmission
+    from catalog.optics.shading_reference import ShadingInputs, woven_transmission
 
     params = {**LACE, "anisotropy": 0.3}
     bsdf = _bsdf(mi, **params)
@@ -133,7 +133,7 @@ def test_reciprocity_and_eval_against_the_float64_eq7(mi):
     f_io = ev(wi, wo) / np.abs(wo[:, 2])
     f_oi = ev(wo, wi) / np.abs(wi[:, 2])
     assert np.allclose(f_io, f_oi, rtol=1e-5, atol=0)
-    # independent: catalog.reference's eq. 5-7 (float64), light along wo, viewer along wi
+    # independent: catalog.optics.shading_reference's eq. 5-7 (float64), light along wo, viewer along wi
     zeros = np.zeros(3)
     inputs = ShadingInputs(key_irradiance=zeros, key_to_light=zeros, fill_irradiance=zeros,
                            fill_to_light=zeros, sky_radiance=zeros, ground_radiance=zeros,
@@ -149,7 +149,7 @@ def test_reciprocity_and_eval_against_the_float64_eq7(mi):
 # --------------------------------------------------------------------------- the scene
 
 def _lace_d65(size=(48, 36), **kw):
-    from catalog.lights import get_light
+    from catalog.optics.lights import get_light
     from catalog.pathtrace.scene import describe_scene
     from catalog.presets import find_preset, load_preset
 
@@ -189,11 +189,11 @@ def test_direct_light_matches_the_float64_reference_per_pixel(mi):
     """Curtain alone under the frame's key (behind) and fill (viewer side) as directional
     lights, each in its own render (one light: no light selection noise), direct light only,
     one sample per pixel whose position, normal and tangent Mitsuba reports (AOVs): the
-    float64 eq. 5-7 (catalog.reference) at those points must agree within 1 % per pixel."""
+    float64 eq. 5-7 (catalog.optics.shading_reference) at those points must agree within 1 % per pixel."""
     from dataclasses import replace
 
     from catalog.pathtrace.scene import build_mitsuba_scene
-    from catalog.reference import reference_linear_srgb
+    from catalog.optics.shading_reference import reference_linear_srgb
     from catalog.render import scene as scene_lib
 
     flat = scene_lib.draped_curtain(columns=60, rows=40, depth_m=0.01)  # folds cast no shadows
@@ -261,7 +261,7 @@ def _catalog(*args, env=None):
 
 def _main(capsys, *args):
     """``catalog reference ARGS`` in this process: (exit status, stdout, stderr lines)."""
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     code = main(["reference", *args])
     captured = capsys.readouterr()

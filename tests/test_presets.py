@@ -1,6 +1,6 @@
 """Fabric presets: the committed catalog (fabrics/*.toml), its regeneration from
 fabrics/measurements/ by tools/make_presets.py, and the preset loader's validation
-(catalog/presets.py)."""
+(catalog/presets/__init__.py)."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ import tomllib
 import numpy as np
 import pytest
 
-from catalog import FABRIC_DIR, PROJECT_ROOT
-from catalog.errors import InputError
+from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
+from catalog.core.errors import InputError
 from catalog.presets import list_presets, load_preset, preset_from_dict, save_preset_dict
 
 REQUIRED_FABRICS = {"lace-fwa", "voile-white", "linen-dense", "sheer-teal", "safety-yellow",
@@ -72,7 +72,7 @@ def test_cloth_table_is_what_the_simulator_reads(path):
 
 @pytest.mark.filterwarnings("ignore:Aligning")   # colour-science reshaping E and the dye to its CMFs
 def test_dyed_sheer_is_coloured_per_channel_and_spectrally():
-    from catalog.spectra import read_spectrum
+    from catalog.optics.spectra import read_spectrum
 
     preset = load_preset(FABRIC_DIR / "sheer-teal.toml")
     rgb = preset.raw["btdf"]["rgb"]
@@ -136,7 +136,7 @@ def test_regenerating_reproduces_the_committed_presets(tmp_path):
         _assert_same_document(new, old, path.stem)
 
 
-# --- the loader's validation (catalog/presets.py) -------------------------------------------
+# --- the loader's validation (catalog/presets/__init__.py) -------------------------------------------
 
 def _valid_doc():
     return tomllib.loads((FABRIC_DIR / "lace-fwa.toml").read_text())

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from catalog import reference_tables
+from catalog.optics import reference_tables
 
 
 def test_cache_equals_a_fresh_copy_from_the_packages():

@@ -1,7 +1,7 @@
 """The curtain shader against the float64 reference, per pixel (eq. 5-8), and its invariants.
 
 The G-buffer variant of the curtain pass writes, beside the radiance, the world position,
-normal and weft tangent each fragment used; catalog.reference shades those positions at
+normal and weft tangent each fragment used; catalog.optics.shading_reference shades those positions at
 1 nm in float64 and converts to linear sRGB. RGB mode must agree within 1e-3 relative per
 pixel and channel; every band count's Delta E 2000 is reported and bounded.
 """
@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catalog import reference as ref
-from catalog.colorimetry import delta_e_2000, linear_srgb_to_xyz
+from catalog.optics import shading_reference as ref
+from catalog.optics.colorimetry import delta_e_2000, linear_srgb_to_xyz
 from catalog.render.frame import FrameRenderer
 
 pytestmark = pytest.mark.gl
@@ -177,7 +177,7 @@ def test_viewport_split_screen_and_mesh_updates(gl, make_preset):
 
 def test_tone_map_and_srgb_encoding_match_numpy(gl, make_preset):
     """The tonemap pass against Reinhard (luminance) + colour-science's sRGB curve."""
-    from catalog.colorimetry import srgb_encode
+    from catalog.optics.colorimetry import srgb_encode
     from catalog.render.frame import TONE_WHITE
 
     renderer = _renderer(gl, make_preset(), "sun:300")
@@ -193,13 +193,13 @@ def test_tone_map_and_srgb_encoding_match_numpy(gl, make_preset):
 
 
 def test_paper_mode_colour_is_eq_1_to_3_of_the_emission(gl, make_preset):
-    """Paper mode's added radiance has the chromaticity of F (eq. 1-3, catalog.fluorescence)
+    """Paper mode's added radiance has the chromaticity of F (eq. 1-3, catalog.optics.fluorescence)
     and the size I_fluor F / 255 of a white diffuser (eq. 4, 8; docs/render.md)."""
     import math
 
-    from catalog.colorimetry import spectrum_to_xyz
-    from catalog.fluorescence import paper_colour, paper_intensity
-    from catalog.spectra import GRID_NM, read_spectrum
+    from catalog.optics.colorimetry import spectrum_to_xyz
+    from catalog.optics.fluorescence import paper_colour, paper_intensity
+    from catalog.optics.spectra import GRID_NM, read_spectrum
 
     path = make_preset()
     renderer = _renderer(gl, path, "D65", "paper")
@@ -240,8 +240,8 @@ def test_cloth_interleaved_vertex_buffer_draws_like_set_mesh(gl, make_preset):
 
 @pytest.mark.parametrize("illuminance_lx", [0.0, 1e9])
 def test_zero_and_huge_light_stay_finite_and_match_the_reference(gl, make_preset, illuminance_lx):
-    from catalog.lights import Light, get_light
-    from catalog.spectra import GRID_NM
+    from catalog.optics.lights import Light, get_light
+    from catalog.optics.spectra import GRID_NM
 
     if illuminance_lx == 0.0:
         light = Light("dark", "no light at all", np.zeros(GRID_NM.size))

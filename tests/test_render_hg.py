@@ -1,4 +1,4 @@
-"""HG in float32 GLSL (shaders/common.glsl) against float64 (catalog.btdf), eq. 6."""
+"""HG in float32 GLSL (shaders/common.glsl) against float64 (catalog.optics.btdf), eq. 6."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from catalog.btdf import hg_phase_one_minus_cos, hg_phase_printed
-from catalog.render.shaderlib import create_compute
+from catalog.optics.btdf import hg_phase_one_minus_cos, hg_phase_printed
+from catalog.gl.shaderlib import create_compute
 
 pytestmark = pytest.mark.gl
 

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from catalog import reference as ref
-from catalog.errors import CatalogError, InputError
+from catalog.optics import shading_reference as ref
+from catalog.core.errors import CatalogError, InputError
 from catalog.render import bands, scene
-from catalog.spectra import GRID_NM
+from catalog.optics.spectra import GRID_NM
 
 
 def test_draped_curtain_frame_is_orthonormal_and_faces_the_room():
@@ -48,8 +48,8 @@ def test_room_props_have_the_window_open():
 @pytest.mark.parametrize("hour", [6.0, 9.0, 12.0, 15.5, 18.5])
 def test_solar_zenith_matches_pvlib_spa(hour):
     """The renderer's closed-form sun (no pvlib at draw time) against pvlib's NREL SPA
-    through catalog.sun, at the same date, local mean solar time and latitude."""
-    from catalog.sun import sun_position
+    through catalog.optics.sun.model, at the same date, local mean solar time and latitude."""
+    from catalog.optics.sun.model import sun_position
 
     minutes = int(round(hour * 60))
     lon = 135.5
@@ -74,11 +74,11 @@ def test_sun_by_the_hour():
 
 @pytest.mark.parametrize("g", [0.0, 0.3, -0.4, 0.97, 0.999, -0.999])
 def test_hemisphere_factors_against_adaptive_quadrature(g):
-    """The closed form against scipy's adaptive quadrature of eq. 6 (catalog.btdf), split at
+    """The closed form against scipy's adaptive quadrature of eq. 6 (catalog.optics.btdf), split at
     the peak; and its invariants (g = 0, mirror symmetry, forward > backward for g > 0)."""
     from scipy.integrate import quad
 
-    from catalog.btdf import hg_phase_one_minus_cos
+    from catalog.optics.btdf import hg_phase_one_minus_cos
 
     forward, backward = ref.hg_hemisphere_factors(g)
 
@@ -112,7 +112,7 @@ def test_hemisphere_factors_near_g_one():
 
 
 def test_rgb_bands_are_exact_linear_srgb_and_interval_bands_exact_for_the_key():
-    from catalog.lights import get_light
+    from catalog.optics.lights import get_light
 
     key = get_light("FL11").irradiance_w_m2_nm
     exact = ref.spectral_to_linear_srgb(key)
@@ -131,7 +131,7 @@ def test_uniform_packing_in_vec4_chunks():
 
 
 def test_relative_dye_keeps_the_grey_fit_on_average():
-    from catalog.colorimetry import cmfs
+    from catalog.optics.colorimetry import cmfs
 
     t = np.clip((GRID_NM - 420) / 100, 0.05, 0.9)
     shape = scene.relative_dye(t)
@@ -167,9 +167,10 @@ def test_frame_setup_imports_no_scipy():
     import sys
 
     code = ("import sys\n"
-            "from catalog.render import scene, bands, frame, camera, shaderlib, snapshot\n"
+            "from catalog.render import scene, bands, frame, camera, snapshot\n"
+            "from catalog.gl import shaderlib\n"
             "scene.room_props(); scene.draped_curtain(); scene.sun_at_hour(12.0)\n"
-            "from catalog.lights import get_light; get_light(scene.sun_at_hour(17.0).light_name)\n"
+            "from catalog.optics.lights import get_light; get_light(scene.sun_at_hour(17.0).light_name)\n"
             "print('scipy' in sys.modules, 'trimesh' in sys.modules, 'pvlib' in sys.modules)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr

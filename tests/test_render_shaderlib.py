@@ -6,9 +6,9 @@ import re
 
 import pytest
 
-from catalog import PROJECT_ROOT, SHADER_DIR
-from catalog.errors import CatalogError
-from catalog.render import shaderlib
+from catalog.core.resources import PROJECT_ROOT, SHADER_DIR
+from catalog.core.errors import CatalogError
+from catalog.gl import shaderlib
 
 
 @pytest.fixture

@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 from catalog.render.snapshot import SnapshotRequest, read_metadata, render_snapshot
 
 pytestmark = pytest.mark.gl
@@ -83,7 +83,7 @@ def test_bad_options_are_refused_without_a_file(gl, make_preset, tmp_path, field
 def test_no_egl_device_is_one_line(monkeypatch):
     import moderngl
 
-    from catalog.render.context import create_headless_context
+    from catalog.gl.context import create_headless_context
 
     def refuse(*args, **kwargs):
         raise Exception("eglGetDisplay failed\nno device")

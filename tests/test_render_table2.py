@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catalog import FABRIC_DIR
+from catalog.core.resources import FABRIC_DIR
 from catalog.render.frame import FrameRenderer
 
 pytestmark = pytest.mark.gl

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catalog.errors import InputError
-from catalog.spectra import GRID_NM, Spectrum, read_spectrum, resample, write_spectrum
+from catalog.core.errors import InputError
+from catalog.optics.spectra import GRID_NM, Spectrum, read_spectrum, resample, write_spectrum
 
 HEADER = "wavelength_nm,intensity"
 

@@ -11,10 +11,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from catalog.errors import CatalogError, InputError
-from catalog.lights import get_light
-from catalog.spectra import GRID_NM
-from catalog.sun import (
+from catalog.core.errors import CatalogError, InputError
+from catalog.optics.lights import get_light
+from catalog.optics.spectra import GRID_NM
+from catalog.optics.sun.model import (
     EARTH_RADIUS_KM,
     LAYER_KM,
     Atmosphere,
@@ -34,7 +34,7 @@ from catalog.sun import (
     sun_position,
     zenith_deg_from_path,
 )
-from catalog.sun_spectrl2 import compare_at_zenith
+from catalog.optics.sun.spectrl2 import compare_at_zenith
 
 pvlib = pytest.importorskip("pvlib")
 
@@ -399,7 +399,7 @@ def test_bad_dates_and_places_are_refused(bad, pattern):
 
 
 def test_cli_sun_plot_and_json(tmp_path, capsys):
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     target = tmp_path / "fig10.png"
     assert main(["sun", "--plot", str(target), "--json"]) == 0
@@ -412,7 +412,7 @@ def test_cli_sun_plot_and_json(tmp_path, capsys):
 
 
 def test_cli_sun_position_and_comparison_json(capsys):
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     assert main(["sun", "--date", "2026-06-21", "--hour", "12", "--lat", "34.7", "--lon",
                  "135.5", "--compare-spectrl2", "--json"]) == 0
@@ -423,7 +423,7 @@ def test_cli_sun_position_and_comparison_json(capsys):
 
 
 def test_cli_sun_bad_paths_exit_2(capsys):
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     assert main(["sun", "--paths", "22,abc"]) == 2
     assert "--paths" in capsys.readouterr().err

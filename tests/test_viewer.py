@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from catalog import FABRIC_DIR, PROJECT_ROOT
+from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
 
 #: Small and quick: a 16x24 cloth with the numpy backend (no JIT warm-up), a small window.
 QUICK = ["--grid", "16x24", "--cloth-backend", "numpy", "--size", "480x320"]

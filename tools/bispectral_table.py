@@ -1,5 +1,5 @@
 """The colour-error table of docs/bispectral.md: fluorescence models against the measured
-Donaldson matrices of ../shared/data/bispectral (catalog.bispectral_study).
+Donaldson matrices of ../shared/data/bispectral (catalog.optics.bispectral.study).
 
     .venv/bin/python tools/bispectral_table.py                       # markdown on stdout
     .venv/bin/python tools/bispectral_table.py --json out.json       # also the rows as JSON
@@ -128,8 +128,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="draws per matrix and light of the noise-floor table (0: skip)")
     args = parser.parse_args(argv)
 
-    from catalog import bispectral_study as study
-    from catalog.atomic import write_text_atomic
+    from catalog.optics.bispectral import study
+    from catalog.core.atomic import write_text_atomic
 
     models = study.reference_models()
     rows = [row for m in models for row in study.study_material(m, study.STUDY_LIGHTS)]

@@ -22,11 +22,11 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from catalog import SHARED_DATA_DIR  # noqa: E402
-from catalog import fluorescence as fl  # noqa: E402
-from catalog.colorimetry import delta_e_2000, xyz_to_linear_srgb  # noqa: E402
-from catalog.lights import get_light  # noqa: E402
-from catalog.spectra import GRID_NM, read_spectrum  # noqa: E402
+from catalog.core.resources import SHARED_DATA_DIR  # noqa: E402
+from catalog.optics import fluorescence as fl  # noqa: E402
+from catalog.optics.colorimetry import delta_e_2000, xyz_to_linear_srgb  # noqa: E402
+from catalog.optics.lights import get_light  # noqa: E402
+from catalog.optics.spectra import GRID_NM, read_spectrum  # noqa: E402
 
 INTENSITY_LIGHTS = ("D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "UV-A", "sun:22", "sun:500")
 GAMUT_LIGHTS = ("D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "UV-A", "sun:22", "sun:500")
@@ -189,7 +189,7 @@ def main(argv: list[str] | None = None) -> int:
         ("desaturate_display", "desat., display", ".3g"),
         ("signed_display_desaturate", "signed, display desat.", ".3g")]))
     if args.json:
-        from catalog.atomic import write_text_atomic  # noqa: PLC0415
+        from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
         write_text_atomic(args.json, json.dumps({"intensity": intensity, "gamut": gamut},
                                                 indent=1, default=float))
     return 0

@@ -28,7 +28,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from catalog.spectra import write_spectrum  # noqa: E402  (after the path set-up)
+from catalog.optics.spectra import write_spectrum  # noqa: E402  (after the path set-up)
 
 #: Dense sampling used to find the continuous peak of a band sum (nm).
 _FINE_STEP_NM = 0.001

@@ -4,7 +4,7 @@
     .venv/bin/python tools/make_gonio.py [--out fabrics/measurements] [NAME ...]
 
 Writes ``<out>/<name>/gonio.csv`` on the paper's OGM-3 grid (4800 points, see
-catalog/gonio.py) and, for dyed fabrics, ``dye.csv`` (the dye's spectral transmittance)
+catalog/fit/gonio.py) and, for dyed fabrics, ``dye.csv`` (the dye's spectral transmittance)
 and per-channel ``r,g,b`` columns. Deterministic: each fabric has its own seed.
 
 The model is deliberately *not* eq. 7, so that fitting eq. 7 to its output is a real fit:
@@ -51,8 +51,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from catalog.gonio import GonioData, ogm3_grid, write_gonio  # noqa: E402
-from catalog.spectra import GRID_NM, write_spectrum  # noqa: E402
+from catalog.fit.gonio import GonioData, ogm3_grid, write_gonio  # noqa: E402
+from catalog.optics.spectra import GRID_NM, write_spectrum  # noqa: E402
 
 #: Crossings above this are treated as diffuse.
 N_LOBE = 10

@@ -57,7 +57,7 @@ def fit_argv(folder: Path, out_dir: Path) -> list[str]:
 
 def run_fit(argv: list[str]) -> dict:
     """Run ``catalog`` in this process and return its JSON summary."""
-    from catalog.cli import main
+    from catalog.commands.cli import main
 
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):
@@ -76,8 +76,8 @@ def error_table(measurements: Path = MEASUREMENTS, names=()) -> str:
     """Markdown: rmse of eq. 7 (HG, isotropic as printed) and Cook-Torrance per fabric,
     subset and weighting, and of eq. 7 with the fitted warp/weft anisotropy (the presets'
     fit) on all points."""
-    from catalog.fitting import fit_gonio_ct, fit_gonio_hg
-    from catalog.gonio import paper_subset_mask, read_gonio
+    from catalog.fit.fitting import fit_gonio_ct, fit_gonio_hg
+    from catalog.fit.gonio import paper_subset_mask, read_gonio
 
     rows = ["| fabric | points | weighting | HG rmse | CT rmse | CT / HG | HG rel. rms | CT rel. rms "
             "| HG + anisotropy rmse |",
@@ -115,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
               f"{summary['g_spec']:+.3f}  rmse HG {summary['rmse']:.3e} CT {summary['ct_rmse']:.3e}"
               f"  -> {summary['out']}")
     if args.table is not None:
-        from catalog.atomic import write_text_atomic
+        from catalog.core.atomic import write_text_atomic
 
         write_text_atomic(args.table, error_table(args.measurements, args.names))
         print(f"wrote {args.table}")

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Regenerate catalog/data/reference_tables.npz from the installed colour-science and pvlib.
+"""Regenerate catalog/optics/data/reference_tables.npz from the installed colour-science and pvlib.
 
     .venv/bin/python tools/make_reference_tables.py [--out PATH]
 """
@@ -12,8 +12,8 @@ import sys
 
 import numpy as np
 
-from catalog.atomic import write_bytes_atomic
-from catalog.reference_tables import TABLE_PATH, build_tables
+from catalog.core.atomic import write_bytes_atomic
+from catalog.optics.reference_tables import TABLE_PATH, build_tables
 
 
 def main(argv: list[str] | None = None) -> int:

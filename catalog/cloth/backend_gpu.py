@@ -11,8 +11,7 @@ Float32 throughout, so it follows the float64 reference to about 1e-4 m after a 
 (``gpu_final_passes``) instead of the CPU backends' adaptive count, as a convergence
 test would need a read-back.
 
-Shaders: shaders/cloth_step.comp (one program per pass, by #define), and
-shaders/cloth_springs12.comp for the benchmark problem (:class:`Springs12Gpu`).
+Shaders: shaders/cloth_step.comp (one program per pass, by #define).
 """
 
 from __future__ import annotations
@@ -46,10 +45,10 @@ class GpuBackend:
     name = "gpu"
 
     def __init__(self, params: ClothParams, ctx=None):
-        from catalog.render.shaderlib import create_compute
+        from catalog.gl.shaderlib import create_compute
 
         if ctx is None:
-            from catalog.render.context import create_headless_context
+            from catalog.gl.context import create_headless_context
             ctx = create_headless_context()
         self.ctx = ctx
         self.programs = {name: create_compute(ctx, "cloth_step.comp", {f"PASS_{name}": True})
@@ -253,54 +252,3 @@ class GpuBackend:
         return self.ctx.vertex_array(program, content, self.index_buffer,
                                      index_element_size=4)
 
-
-class Springs12Gpu:
-    """The benchmark problem (springs12.py) in shaders/cloth_springs12.comp."""
-
-    def __init__(self, problem, ctx=None):
-        from catalog.cloth.topology import GATHER_OFFSETS
-        from catalog.render.shaderlib import create_compute
-
-        if ctx is None:
-            from catalog.render.context import create_headless_context
-            ctx = create_headless_context()
-        self.ctx = ctx
-        self.problem = problem
-        self.program = create_compute(ctx, "cloth_springs12.comp")
-        springs = problem.springs()
-        prog = self.program
-        prog["u_n"].value = problem.n
-        prog["u_offset"].write(np.array(GATHER_OFFSETS, dtype=np.int32).tobytes())
-        prog["u_rest"].write(np.array([s[2] for s in springs], dtype=np.float32).tobytes())
-        prog["u_ke"].write(np.array([s[3] for s in springs], dtype=np.float32).tobytes())
-        prog["u_kd"].value = problem.k_damping_n_s_m
-        prog["u_dt"].value = problem.dt_s
-        prog["u_inv_mass"].value = 1.0 / problem.mass_kg
-        prog["u_gravity"].value = problem.gravity_m_s2
-        n = problem.n * problem.n
-        self.bufs = [[ctx.buffer(reserve=n * 16), ctx.buffer(reserve=n * 16)] for _ in range(2)]
-        self.reset()
-
-    def reset(self) -> None:
-        x = _vec4(self.problem.initial_positions())
-        self.bufs[0][0].write(x.tobytes())
-        self.bufs[0][1].write(np.zeros_like(x).tobytes())
-        self.current = 0
-
-    def run(self, steps: int) -> None:
-        groups = _groups(self.problem.n ** 2)
-        for _ in range(steps):
-            src, dst = self.bufs[self.current], self.bufs[1 - self.current]
-            src[0].bind_to_storage_buffer(0)
-            src[1].bind_to_storage_buffer(1)
-            dst[0].bind_to_storage_buffer(2)
-            dst[1].bind_to_storage_buffer(3)
-            self.program.run(groups)
-            self.ctx.memory_barrier()
-            self.current = 1 - self.current
-
-    def positions(self) -> np.ndarray:
-        """(n, n, 3) float64 (waits for the GPU)."""
-        data = np.frombuffer(self.bufs[self.current][0].read(), dtype=np.float32)
-        n = self.problem.n
-        return data.reshape(n, n, 4)[..., :3].astype(np.float64)

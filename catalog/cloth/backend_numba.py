@@ -81,15 +81,3 @@ class NumbaBackend:
     def sync(self, state: ClothState) -> None:
         """Nothing to do: the state's arrays are the working arrays."""
 
-
-def warm_up() -> float:
-    """Compile (first run on a machine) or load from numba's cache (later runs) the
-    kernels, on a 4x4 curtain; returns the seconds it took. A viewer can call this in a
-    background thread at start so the first frame does not wait for it."""
-    import time
-
-    from catalog.cloth.simulation import ClothSimulation
-
-    start = time.perf_counter()
-    ClothSimulation(ClothParams(grid_w=4, grid_h=4, wind_speed_m_s=1.0), "cpu").step(1 / 60)
-    return time.perf_counter() - start

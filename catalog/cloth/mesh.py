@@ -23,11 +23,11 @@ from typing import Iterable
 
 import numpy as np
 
-from catalog.atomic import atomic_path
+from catalog.core.atomic import atomic_path
 from catalog.cloth.params import ClothParams
 from catalog.cloth.state import rest_pose
 from catalog.cloth.topology import triangle_indices
-from catalog.errors import InputError
+from catalog.core.errors import InputError
 
 #: Floats per vertex of the dynamic buffer: position vec4, normal vec4, tangent vec4.
 DYNAMIC_FLOATS = 12

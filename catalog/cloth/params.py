@@ -9,7 +9,7 @@ Stiffness is a membrane stiffness in N/m (force per unit width per unit strain).
 square grid a structural spring then has exactly that stiffness in N/m whatever the
 spacing (k = K * width / length), so ``--stiffness`` means the same on every grid.
 
-A bad value is refused with :class:`catalog.errors.InputError` naming the field.
+A bad value is refused with :class:`catalog.core.errors.InputError` naming the field.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import math
 from dataclasses import dataclass, field, fields, replace
 from typing import Any, Mapping
 
-from catalog.errors import InputError
+from catalog.core.errors import InputError
 
 #: Standard gravity, m s^-2 (the one value used everywhere in the cloth code).
 GRAVITY_M_S2 = 9.80665

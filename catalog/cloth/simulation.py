@@ -20,7 +20,7 @@ import numpy as np
 from catalog.cloth.params import ClothParams
 from catalog.cloth.state import ClothState, inverse_mass, ring_positions
 from catalog.cloth.topology import FAMILIES, rest_lengths_m
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 BACKENDS = ("numpy", "cpu", "gpu")
 
@@ -183,3 +183,14 @@ class ClothSimulation:
         """The current curtain as a CurtainMesh (positions, normals, uv, tangents, indices)."""
         from catalog.cloth.mesh import CurtainMesh
         return CurtainMesh.from_grid(self.positions(), self.params)
+
+
+def warm_up_numba() -> float:
+    """Compile (first run on a machine) or load from numba's cache (later runs) the cpu
+    backend's kernels, on a 4x4 curtain; returns the seconds it took. A viewer can call this
+    in a background thread at start so the first frame does not wait for it."""
+    import time
+
+    start = time.perf_counter()
+    ClothSimulation(ClothParams(grid_w=4, grid_h=4, wind_speed_m_s=1.0), "cpu").step(1 / 60)
+    return time.perf_counter() - start

@@ -2,7 +2,7 @@
 
     catalog bench [--quick] [--json] [--out DIR] [--sections colour,fluorescence,...]
 
-Runs the sections of :mod:`catalog.benchsuite` (colour accuracy against frame time,
+Runs the sections of :mod:`catalog.bench` (colour accuracy against frame time,
 fluorescence representations on measured matrices, fit, cloth, numerical stability,
 start-up) and writes ``bench.md`` (tables), ``bench.json`` and PNG plots into DIR
 (default ``bench-out``). ``--json`` prints the same report as one JSON object on stdout;
@@ -29,8 +29,8 @@ def add_arguments(parser) -> None:
 
 
 def parse_sections(text: str | None) -> list[str]:
-    from catalog.benchsuite import SECTIONS  # noqa: PLC0415
-    from catalog.errors import InputError  # noqa: PLC0415
+    from catalog.bench import SECTIONS  # noqa: PLC0415
+    from catalog.core.errors import InputError  # noqa: PLC0415
 
     if text is None:
         return list(SECTIONS)
@@ -51,10 +51,10 @@ def run(args) -> int:
     import traceback  # noqa: PLC0415
     from pathlib import Path  # noqa: PLC0415
 
-    from catalog.benchsuite import SECTIONS  # noqa: PLC0415
-    from catalog.benchsuite.report import write_report  # noqa: PLC0415
-    from catalog.errors import InputError  # noqa: PLC0415
-    from catalog.jsonout import print_json  # noqa: PLC0415
+    from catalog.bench import SECTIONS  # noqa: PLC0415
+    from catalog.bench.report import write_report  # noqa: PLC0415
+    from catalog.core.errors import InputError  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
 
     names = parse_sections(args.sections)
     out = Path(args.out)
@@ -68,7 +68,7 @@ def run(args) -> int:
     machine = {"cpu_count": os.cpu_count(), "platform": platform.platform(),
                "python": platform.python_version()}
     if any(n in ("colour", "stability", "image") for n in names):
-        from catalog.render.context import create_headless_context, describe  # noqa: PLC0415
+        from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
 
         ctx = create_headless_context()
         machine["gl_renderer"] = describe(ctx)["renderer"]

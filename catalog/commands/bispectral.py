@@ -25,9 +25,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from catalog import bispectral, bispectral_study as study
-    from catalog.errors import InputError
-    from catalog.lights import get_light
+    from catalog.optics.bispectral import matrix as bispectral
+    from catalog.optics.bispectral import study
+    from catalog.core.errors import InputError
+    from catalog.optics.lights import get_light
 
     path = bispectral.find_bfc(args.file)
     matrix = bispectral.read_bfc(path)
@@ -55,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
                 "residual_over_noise": fit.residual_over_noise, "noise_sigma": fit.noise_sigma,
                 "notes": list(fit.notes)}
     if args.json:
-        from catalog.jsonout import print_json
+        from catalog.core.jsonout import print_json
 
         print_json({"file": str(path), "name": matrix.name, "description": matrix.description,
                     "shape": list(matrix.values.shape), "fit": fit_info,

@@ -5,7 +5,7 @@ the fabric preset.
                 [--points all|79] [--weighting relative|none] [--plot FIG.png] [--json]
 
 The identifiable parameters (direct, a_diff, a_spec, g_diff, g_spec) are fitted by
-Levenberg-Marquardt (catalog/fitting.py); rho is the weave's cover factor, 1 - direct
+Levenberg-Marquardt (catalog/fit/fitting.py); rho is the weave's cover factor, 1 - direct
 (the see-through at normal incidence is the open area), unless ``--rho`` gives it;
 tau comes from the dye's luminance-weighted transmittance (``dye.csv`` beside the gonio
 file, or ``--dye``), else a small default; k_d and k_s follow. Cook-Torrance is fitted to
@@ -66,8 +66,8 @@ def run(args) -> int:
     import time
     from pathlib import Path
 
-    from catalog.errors import InputError
-    from catalog.gonio import paper_subset_mask, read_gonio
+    from catalog.core.errors import InputError
+    from catalog.fit.gonio import paper_subset_mask, read_gonio
     from catalog.presets import preset_from_dict, save_preset_dict
 
     t0 = time.perf_counter()
@@ -110,7 +110,7 @@ def run(args) -> int:
 
     summary = json_summary(doc, result, out, elapsed)
     if args.json:
-        from catalog.jsonout import print_json
+        from catalog.core.jsonout import print_json
         print_json(summary)
     else:
         _print_summary(summary)
@@ -121,7 +121,7 @@ def run(args) -> int:
 
 def fit_measurement(data, weighting: str) -> dict:
     """HG (grey and per channel) and Cook-Torrance fits of one measurement."""
-    from catalog.fitting import fit_channels, fit_gonio_ct, fit_gonio_hg
+    from catalog.fit.fitting import fit_channels, fit_gonio_ct, fit_gonio_hg
 
     hg = fit_gonio_hg(data, weighting=weighting)
     ct = fit_gonio_ct(data, weighting=weighting)
@@ -161,9 +161,9 @@ def dye_tau(path) -> float:
 
     import numpy as np
 
-    from catalog.colorimetry import cmfs
-    from catalog.errors import InputError
-    from catalog.spectra import GRID_NM, read_spectrum
+    from catalog.optics.colorimetry import cmfs
+    from catalog.core.errors import InputError
+    from catalog.optics.spectra import GRID_NM, read_spectrum
 
     spectrum = read_spectrum(path)
     if np.any(spectrum.values > 1.0):
@@ -189,7 +189,7 @@ def _relative(path, folder) -> str:
 
 def preset_document(args, out, data, header, result, rho, tau, dye_path) -> dict:
     """The preset as a dict (formats.md keys plus [btdf.rgb], [cloth], [dye])."""
-    from catalog.fitting import split_amplitudes
+    from catalog.fit.fitting import split_amplitudes
 
     hg, ct, channels = result["hg"], result["ct"], result["channels"]
     p = hg.params
@@ -229,8 +229,8 @@ def preset_document(args, out, data, header, result, rho, tau, dye_path) -> dict
 
 def fluorescence_table(args, folder) -> dict:
     """[fluorescence]: paper colour (eq. 1-3) of the emission and the physical-mode keys."""
-    from catalog import fluorescence
-    from catalog.spectra import read_spectrum
+    from catalog.optics import fluorescence
+    from catalog.optics.spectra import read_spectrum
 
     read_spectrum(args.excitation, normalise=True)          # refuse a bad file now
     emission = read_spectrum(args.emission, normalise=True)
@@ -252,7 +252,7 @@ def cloth_table(weave, header) -> dict:
     """[cloth]: the weave's defaults (catalog.cloth.params), overridden by ``cloth.*``
     header fields of the gonio file."""
     from catalog.cloth.params import DEFAULT_WEAVE, WEAVE_DEFAULTS
-    from catalog.errors import InputError
+    from catalog.core.errors import InputError
 
     weave = weave or DEFAULT_WEAVE
     if weave not in WEAVE_DEFAULTS:
@@ -326,11 +326,11 @@ def plot_fit(data, hg, ct, path, title: str = "") -> None:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from catalog.atomic import atomic_path
-    from catalog.btdf import (cook_torrance_transmittance, hg_phase_one_minus_cos,
+    from catalog.core.atomic import atomic_path
+    from catalog.optics.btdf import (cook_torrance_transmittance, hg_phase_one_minus_cos,
                               one_minus_cos_between, woven_one_minus_cos)
-    from catalog.errors import InputError
-    from catalog.gonio import light_direction, view_direction
+    from catalog.core.errors import InputError
+    from catalog.fit.gonio import light_direction, view_direction
 
     elevations = [e for e in (180.0, 155.0) if np.any(
         (np.abs(data.light_elevation_deg - e) < 1e-6) & (np.abs(data.light_azimuth_deg) < 1e-6))]

@@ -73,9 +73,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _physical_fields(args, excitation, emission, light) -> dict:
     import numpy as np  # noqa: PLC0415
 
-    from catalog import fluorescence as fl  # noqa: PLC0415
-    from catalog.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
-    from catalog.spectra import GRID_NM  # noqa: PLC0415
+    from catalog.optics import fluorescence as fl  # noqa: PLC0415
+    from catalog.optics.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
 
     options = {}
     if args.quantum_yield is not None:
@@ -127,8 +127,8 @@ def _plot(path: str, excitation, emission, light, title: str) -> None:
     import matplotlib.pyplot as plt  # noqa: PLC0415
     import numpy as np  # noqa: PLC0415
 
-    from catalog.atomic import atomic_path  # noqa: PLC0415
-    from catalog.spectra import GRID_NM, VISIBLE_NM  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM, VISIBLE_NM  # noqa: PLC0415
 
     light_values = light.irradiance_w_m2_nm
     peak = float(np.max(light_values))
@@ -160,10 +160,10 @@ def _plot(path: str, excitation, emission, light, title: str) -> None:
 
 
 def run(args) -> int:
-    from catalog import fluorescence as fl  # noqa: PLC0415
-    from catalog.jsonout import print_json  # noqa: PLC0415
-    from catalog.lights import get_light  # noqa: PLC0415
-    from catalog.spectra import GRID_NM, read_spectrum  # noqa: PLC0415
+    from catalog.optics import fluorescence as fl  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM, read_spectrum  # noqa: PLC0415
 
     light = get_light(args.light, illuminance_lx=args.illuminance)
     excitation = read_spectrum(args.excitation, normalise=True)

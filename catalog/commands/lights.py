@@ -22,7 +22,7 @@ PLOT_DEFAULT = "D65,A,FL2,LED-B4,UV-A,LED-warm,sun:22"
 
 
 def _names(text: str | None, default: list[str]) -> list[str]:
-    from catalog.errors import CatalogError  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
 
     if text is None:
         return default
@@ -39,8 +39,8 @@ def _plot(path: str, lights: list, normalise: bool) -> None:
     import matplotlib.pyplot as plt  # noqa: PLC0415
     import numpy as np  # noqa: PLC0415
 
-    from catalog.atomic import atomic_path  # noqa: PLC0415
-    from catalog.spectra import GRID_NM  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
 
     fig, ax = plt.subplots(figsize=(7.0, 4.5), dpi=120)
     for light in lights:
@@ -70,8 +70,8 @@ def _plot(path: str, lights: list, normalise: bool) -> None:
 
 
 def run(args) -> int:
-    from catalog.jsonout import print_json  # noqa: PLC0415
-    from catalog.lights import get_light, light_names  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.optics.lights import get_light, light_names  # noqa: PLC0415
 
     if args.plot is not None:
         names = _names(args.names, PLOT_DEFAULT.split(","))

@@ -20,7 +20,7 @@ def add_arguments(parser) -> None:
 def run(args) -> int:
     from pathlib import Path  # noqa: PLC0415
 
-    from catalog.jsonout import print_json  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.sheet import render_sheet  # noqa: PLC0415
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 

@@ -37,7 +37,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _parse_grid(text: str) -> tuple[int, int]:
-    from catalog.cliargs import parse_wxh
+    from catalog.core.cliargs import parse_wxh
 
     return parse_wxh(text, "--grid", 2, unit="particles", example="64x96")
 
@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
     import math
     import time
 
-    from catalog.errors import CatalogError, InputError
+    from catalog.core.errors import CatalogError, InputError
 
     w, h = _parse_grid(args.grid)
     if args.steps < 1:
@@ -75,8 +75,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             params = ClothParams(**overrides)
         if args.backend == "cpu":  # compile (or load the cached code) outside the timing
-            from catalog.cloth.backend_numba import warm_up
-            warm_up()
+            from catalog.cloth.simulation import warm_up_numba
+            warm_up_numba()
         sim = ClothSimulation(params, args.backend, monitor_every=1)
     except InputError as exc:
         option = _OPTION_OF_FIELD.get(exc.field or "")
@@ -113,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
         "seconds": seconds,
     }
     if args.json:
-        from catalog.jsonout import print_json
+        from catalog.core.jsonout import print_json
         print_json(result)
     else:
         for key, value in result.items():

@@ -30,7 +30,7 @@ def add_arguments(parser) -> None:
 def run(args) -> int:
     from pathlib import Path  # noqa: PLC0415
 
-    from catalog.jsonout import print_json  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.snapshot import SnapshotRequest, parse_size, render_snapshot  # noqa: PLC0415
 
     request = SnapshotRequest(

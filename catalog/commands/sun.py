@@ -33,8 +33,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _parse_paths(text: str) -> list[float]:
-    from catalog.errors import CatalogError  # noqa: PLC0415
-    from catalog.sun import check_path_km  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+    from catalog.optics.sun.model import check_path_km  # noqa: PLC0415
 
     paths = []
     for item in text.split(","):
@@ -50,7 +50,7 @@ def _parse_paths(text: str) -> list[float]:
 
 
 def _when_text(args) -> str:
-    from catalog.errors import CatalogError  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
 
     if not 0.0 <= args.hour <= 24.0:
         raise CatalogError(f"--hour {args.hour:g} is outside 0-24")
@@ -69,8 +69,8 @@ def _when_text(args) -> str:
 
 
 def _position(args) -> dict:
-    from catalog.errors import CatalogError  # noqa: PLC0415
-    from catalog.sun import horizon_path_km, sun_position  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+    from catalog.optics.sun.model import horizon_path_km, sun_position  # noqa: PLC0415
 
     if args.lat is None:
         raise CatalogError("--date needs --lat (deg north)")
@@ -88,8 +88,8 @@ def _plot(path: str, lights: list, model: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
-    from catalog.atomic import atomic_path  # noqa: PLC0415
-    from catalog.spectra import GRID_NM  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
 
     fig, ax = plt.subplots(figsize=(7.0, 4.5), dpi=120)
     cmap = plt.get_cmap("plasma")
@@ -117,17 +117,17 @@ def _plot(path: str, lights: list, model: str) -> None:
 
 
 def run(args) -> int:
-    from catalog.jsonout import print_json  # noqa: PLC0415
-    from catalog.lights import get_light  # noqa: PLC0415
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
 
     out: dict = {}
     if args.date is not None:
         out["position"] = _position(args)
     elif args.lat is not None or args.utc_offset is not None:
-        from catalog.errors import CatalogError  # noqa: PLC0415
+        from catalog.core.errors import CatalogError  # noqa: PLC0415
         raise CatalogError("--lat/--utc-offset go with --date")
     if args.compare_spectrl2:
-        from catalog.sun_spectrl2 import comparison_table  # noqa: PLC0415
+        from catalog.optics.sun.spectrl2 import comparison_table  # noqa: PLC0415
         out["spectrl2"] = comparison_table()
     show_paths = args.plot is not None or (args.date is None and not args.compare_spectrl2)
     if show_paths:
@@ -148,7 +148,7 @@ def run(args) -> int:
 def _summary(light) -> dict:
     import numpy as np  # noqa: PLC0415
 
-    from catalog.spectra import GRID_NM  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
 
     e = light.irradiance_w_m2_nm
     blue = float(np.mean(e[(GRID_NM >= 440) & (GRID_NM <= 460)]))

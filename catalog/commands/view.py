@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from catalog.cliargs import wxh_type
+from catalog.core.cliargs import wxh_type
 
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
@@ -94,8 +94,8 @@ def _forbid_scipy() -> None:
 
 def run(args: argparse.Namespace) -> int:
     _forbid_scipy()
-    from catalog import FABRIC_DIR
-    from catalog.errors import CatalogError
+    from catalog.core.resources import FABRIC_DIR
+    from catalog.core.errors import CatalogError
     from catalog.viewer.app import ViewerApp, ViewerOptions
     from catalog.viewer.window import NO_DISPLAY_HINT, display_available, init_glfw
 

@@ -4,7 +4,7 @@ Dr.Jit's LLVM backend loads ``libLLVM`` at run time. Mesa's LLVM 14/15 (what the
 rasteriser brings) fails in the JIT ("Cannot select fminimum"); LLVM 19 works. The path
 is taken from ``DRJIT_LIBLLVM_PATH`` when set, else from the usual Debian/Ubuntu places
 (tools/setup.sh installs ``libllvm19``). A missing library is an environment failure
-(:class:`catalog.errors.EnvironmentFailure`, exit 3), reported in one line.
+(:class:`catalog.core.errors.EnvironmentFailure`, exit 3), reported in one line.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from __future__ import annotations
 import glob
 import os
 
-from catalog.errors import EnvironmentFailure, InputError
+from catalog.core.errors import EnvironmentFailure, InputError
 
 #: The variants a reference may use: RGB (default) or spectral, both on the CPU.
 VARIANTS = ("llvm_ad_rgb", "llvm_ad_spectral")

@@ -5,8 +5,8 @@
   the comparison is of what a viewer sees;
 - FLIP (LDR-FLIP, Andersson et al. 2020, PyPI ``flip-evaluator``) of the two display
   images, mean over the image, at 67 pixels per degree (a 0.7 m, 24-inch 4K monitor);
-- Delta E 2000 (catalog.colorimetry) on the linear images in CIELAB, the white a perfect
-  diffuser under the key light (catalog.reference.white_xyz), per region: curtain, floor,
+- Delta E 2000 (catalog.optics.colorimetry) on the linear images in CIELAB, the white a perfect
+  diffuser under the key light (catalog.optics.shading_reference.white_xyz), per region: curtain, floor,
   walls (:func:`catalog.pathtrace.render.region_masks`), mean and 95th percentile.
 """
 
@@ -55,7 +55,7 @@ def flip_map(test_display: np.ndarray, reference_display: np.ndarray) -> np.ndar
 def delta_e_map(test_linear: np.ndarray, reference_linear: np.ndarray,
                 white_xyz: np.ndarray) -> np.ndarray:
     """Delta E 2000 (H, W) of two linear sRGB images, CIELAB relative to ``white_xyz``."""
-    from catalog.colorimetry import delta_e_2000, linear_srgb_to_xyz  # noqa: PLC0415
+    from catalog.optics.colorimetry import delta_e_2000, linear_srgb_to_xyz  # noqa: PLC0415
 
     xyz_t = linear_srgb_to_xyz(np.asarray(test_linear, dtype=np.float64))
     xyz_r = linear_srgb_to_xyz(np.asarray(reference_linear, dtype=np.float64))

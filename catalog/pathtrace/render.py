@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 MAX_DEPTH = 16
 RR_DEPTH = 5
@@ -69,7 +69,7 @@ def check_out(path) -> Path:
 
 def validate(request: ReferenceRequest):
     """Refuse bad input before Mitsuba is loaded. Returns (preset, light)."""
-    from catalog.lights import get_light  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace.backend import check_variant  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415

@@ -71,7 +71,7 @@ class SceneDescription:
     fill_rgb: np.ndarray                 # the real-time stand-in (used with stand_ins only)
     fill_to_light: np.ndarray
     fluorescence: dict | None            # per-vertex emission recipe (see module doc)
-    inputs: object                       # catalog.reference.ShadingInputs of the frame
+    inputs: object                       # catalog.optics.shading_reference.ShadingInputs of the frame
     info: dict = field(default_factory=dict)
     pattern: dict | None = None          # coverage hook: {"coverage": (H, W) array, "uv_scale": s}
 
@@ -87,7 +87,7 @@ def rgb_weights(key_irradiance: np.ndarray) -> np.ndarray:
 def key_light_for(light) -> tuple[np.ndarray, bool]:
     """The key light's direction (unit, to the light) and whether it is the sun, as the
     real-time frame places it (:meth:`catalog.render.frame.FrameRenderer.set_light`)."""
-    from catalog.errors import CatalogError  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
     is_sun = light.name.startswith(("sun:", "sun-clear:", "sun@"))
@@ -101,7 +101,7 @@ def key_light_for(light) -> tuple[np.ndarray, bool]:
 def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: float = 0.0,
                    pitch_deg: float = 0.0, distance_m: float = 2.6,
                    fluorescence: str = "physical", curtain=None) -> SceneDescription:
-    """The snapshot scene for ``preset`` under ``light`` (a catalog.lights.Light)."""
+    """The snapshot scene for ``preset`` under ``light`` (a catalog.optics.lights.Light)."""
     from catalog.render import scene as scene_lib  # noqa: PLC0415
     from catalog.render.camera import OrbitCamera  # noqa: PLC0415
 
@@ -132,7 +132,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
               "dye_rgb": dye_rgb}
     fl = None
     if inputs.fluorescence_mode == "physical":
-        from catalog.fluorescence import absorbed_photon_irradiance  # noqa: PLC0415
+        from catalog.optics.fluorescence import absorbed_photon_irradiance  # noqa: PLC0415
 
         material = scene_lib.fluorescent_material(preset)
         outside = math.pi * 0.5 * (inputs.sky_radiance + inputs.ground_radiance)
@@ -297,7 +297,7 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     props = mi.Properties()
     fabric = dict(desc.fabric)
     if mi.is_spectral:  # the dye per wavelength (visible range of the grid), not per channel
-        from catalog.spectra import GRID_NM  # noqa: PLC0415
+        from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
 
         visible = (GRID_NM >= 360) & (GRID_NM <= 830)
         fabric["dye_spectrum"] = (GRID_NM[visible], desc.inputs.dye_transmittance[visible])

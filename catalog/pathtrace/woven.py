@@ -9,10 +9,10 @@ that direction of travel and the view ``wi`` (theta = 0: straight through, ``wo 
                                                                         (eq. 5-7, per sr)
     + LD delta(wo + wi)                      (eq. 7's LD: straight through the gaps, a null lobe)
 
-ph is eq. 6 in the robust chord form of :mod:`catalog.btdf` (``|wi + wo|^2`` = 2 (1 - cos
+ph is eq. 6 in the robust chord form of :mod:`catalog.optics.btdf` (``|wi + wo|^2`` = 2 (1 - cos
 theta), the mirrored ``|wi - wo|^2`` for g < 0); the directional lobe's chord is weighted
 (1 - anisotropy) along the weft and (1 + anisotropy) along the warp, as
-:func:`catalog.reference.woven_chord2`. f is symmetric in (wi, wo) (reciprocal), two-sided
+:func:`catalog.optics.shading_reference.woven_chord2`. f is symmetric in (wi, wo) (reciprocal), two-sided
 (|cos|, no side test) and multiplies the dye per channel (a texture: RGB in the RGB variant,
 a spectrum in the spectral one).
 
@@ -40,7 +40,7 @@ G_ISOTROPIC = 1e-3
 
 def hg_from_chords(dr, chord2, anti2, g: float):
     """Eq. 6 from chord2 = |view - travel|^2 and anti2 = |view + travel|^2 (Dr.Jit arrays)."""
-    if g >= 0:  # chord2 / 2 = 1 - cos theta, held in [0, 2] as catalog.btdf does
+    if g >= 0:  # chord2 / 2 = 1 - cos theta, held in [0, 2] as catalog.optics.btdf does
         d = (1.0 - g) * (1.0 - g) + g * dr.clip(chord2, 0.0, 4.0)
     else:
         d = (1.0 + g) * (1.0 + g) - g * anti2

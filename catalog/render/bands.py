@@ -1,6 +1,6 @@
 """Light, dye and fluorescence spectra -> N bands, once per light (or fabric) change.
 
-Every spectral quantity of :class:`catalog.reference.ShadingInputs` is integrated against
+Every spectral quantity of :class:`catalog.optics.shading_reference.ShadingInputs` is integrated against
 band weight functions w_b(l); the shader adds the bands and converts them to display
 colour with a 3 x N matrix at the end. Only the products of two spectra (light x dye) are
 approximated by bands; sums (fluorescence emission, the background) are exact in any basis.
@@ -21,9 +21,9 @@ import math
 
 import numpy as np
 
-from catalog.errors import CatalogError
-from catalog.reference import LUMINOUS_EFFICACY_LM_W, PHOTON_UNIT, STEP_NM, ShadingInputs
-from catalog.spectra import GRID_NM
+from catalog.core.errors import CatalogError
+from catalog.optics.shading_reference import LUMINOUS_EFFICACY_LM_W, PHOTON_UNIT, STEP_NM, ShadingInputs
+from catalog.optics.spectra import GRID_NM
 
 #: Band counts the shaders are built for.
 BAND_COUNTS = (3, 6, 9, 16)
@@ -44,7 +44,7 @@ def chunks(n_bands: int) -> int:
 
 def band_weights(n_bands: int, key_irradiance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(weights (N, len(GRID_NM)) incl. dl, band_to_rgb (3, N)) for a key light."""
-    from catalog.colorimetry import cmfs, xyz_to_linear_srgb  # noqa: PLC0415
+    from catalog.optics.colorimetry import cmfs, xyz_to_linear_srgb  # noqa: PLC0415
 
     check_band_count(n_bands)
     cmf = cmfs(GRID_NM)  # (L, 3)
@@ -110,6 +110,6 @@ def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray |
 
 def spectrum_to_display_rgb(spectrum: np.ndarray) -> np.ndarray:
     """Exact linear sRGB (cd m^-2 scale) of a radiance spectrum: for the background passes."""
-    from catalog.reference import spectral_to_linear_srgb  # noqa: PLC0415
+    from catalog.optics.shading_reference import spectral_to_linear_srgb  # noqa: PLC0415
 
     return spectral_to_linear_srgb(spectrum)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 #: Pitch is kept inside +-89 deg (the up vector degenerates at the poles).
 PITCH_LIMIT_DEG = 89.0

@@ -1,7 +1,7 @@
 """FrameRenderer: one frame of the curtain scene into an HDR target, tone-mapped to sRGB.
 
 The viewer and the snapshot command both drive this class (docs/render.md has the API).
-It never creates a GL context: it is handed one (:mod:`catalog.render.context`).
+It never creates a GL context: it is handed one (:mod:`catalog.gl.context`).
 
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
@@ -20,11 +20,11 @@ import math
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 from catalog.render import bands as band_lib
 from catalog.render import scene as scene_lib
 from catalog.render.camera import OrbitCamera, gl_bytes
-from catalog.render.shaderlib import create_program, glsl_literal
+from catalog.gl.shaderlib import create_program, glsl_literal
 
 #: Auto exposure: a white diffuser under the key light maps to this (before the curve).
 EXPOSURE_KEY = 5.0
@@ -120,12 +120,12 @@ class FrameRenderer:
         self.preset = preset
 
     def set_light(self, light) -> None:
-        """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.lights.Light.
+        """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.optics.lights.Light.
 
         The sun stands behind the window at the elevation its path length implies; a lamp at
         scene.LAMP_ELEVATION_DEG. :meth:`set_sun_hour` and :meth:`set_key_direction` move it.
         """
-        from catalog.lights import get_light  # noqa: PLC0415
+        from catalog.optics.lights import get_light  # noqa: PLC0415
 
         if isinstance(light, str):
             light = get_light(light)
@@ -139,7 +139,7 @@ class FrameRenderer:
 
     def set_sun_hour(self, hour: float) -> dict:
         """The sun at ``hour`` (local solar time, summer solstice, 34.7 N) behind the window."""
-        from catalog.lights import get_light  # noqa: PLC0415
+        from catalog.optics.lights import get_light  # noqa: PLC0415
 
         sun = scene_lib.sun_at_hour(hour)
         self.light = get_light(sun.light_name)
@@ -274,7 +274,7 @@ class FrameRenderer:
         return bool(self.camera.position[2] > scene_lib.WINDOW_Z)
 
     def shading_inputs(self):
-        """The scene's :class:`catalog.reference.ShadingInputs` (rebuilt only on change)."""
+        """The scene's :class:`catalog.optics.shading_reference.ShadingInputs` (rebuilt only on change)."""
         self._require_ready()
         key = (id(self.preset), self.light.name, id(self.light), tuple(self._key_to_light),
                self.mode, self.viewer_inside, self._is_sun)
@@ -412,7 +412,7 @@ class FrameRenderer:
     def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer (the benchmark times this).
 
-        ``trivial``: True draws the same mesh with shaders/trivial.frag (the benchmark's floor);
+        ``trivial``: True draws the same mesh with catalog/bench/shaders/trivial.frag (the benchmark's floor);
         a file name draws it with that fragment shader instead (the benchmark's other floors)."""
         if trivial:
             fragment = trivial if isinstance(trivial, str) else "trivial.frag"

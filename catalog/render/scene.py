@@ -1,5 +1,5 @@
 """The scene: a curtain hanging in a window, the sun (or a lamp) behind it, a room around
-the viewer; and the spectral description of its light (:class:`catalog.reference.ShadingInputs`).
+the viewer; and the spectral description of its light (:class:`catalog.optics.shading_reference.ShadingInputs`).
 
 Coordinates: metres, y up; the window is in the wall z = WINDOW_Z, the outside lies towards
 -z, the room (and the viewer) towards +z. No GL here: meshes are numpy arrays and the
@@ -17,7 +17,7 @@ Lighting model (the numbers are scene design, stated once here; the physics is e
   FILL_FRACTION of the key's spectrum (so a front-lit curtain is not black);
 - room: grey walls of albedo ROOM_ALBEDO under ROOM_FRACTION of the key;
 - ambient: the cloth's radiance under the sky/ground behind it and the room in front,
-  through eq. 7's lobes integrated over each hemisphere (:func:`catalog.reference.hg_hemisphere_factors`).
+  through eq. 7's lobes integrated over each hemisphere (:func:`catalog.optics.shading_reference.hg_hemisphere_factors`).
 """
 
 from __future__ import annotations
@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from catalog.errors import CatalogError, InputError
-from catalog.reference import ShadingInputs, hg_hemisphere_factors
-from catalog.spectra import GRID_NM
+from catalog.core.errors import CatalogError, InputError
+from catalog.optics.shading_reference import ShadingInputs, hg_hemisphere_factors
+from catalog.optics.spectra import GRID_NM
 
 WINDOW_Z = -0.2
 #: Window opening in the wall (x from, x to, y from, y to), metres.
@@ -209,9 +209,9 @@ SUN_DAY_OF_YEAR = 172
 
 def solar_zenith_deg(hour: float, day_of_year: int = SUN_DAY_OF_YEAR,
                      latitude_deg: float = SUN_LATITUDE_DEG) -> float:
-    """The scene's sun: :func:`catalog.sun.solar_zenith_deg_at_solar_time` on SUN_DATE at
+    """The scene's sun: :func:`catalog.optics.sun.model.solar_zenith_deg_at_solar_time` on SUN_DATE at
     SUN_LATITUDE (closed form, no pvlib: drawing a frame must not import scipy)."""
-    from catalog.sun import solar_zenith_deg_at_solar_time  # noqa: PLC0415
+    from catalog.optics.sun.model import solar_zenith_deg_at_solar_time  # noqa: PLC0415
 
     return solar_zenith_deg_at_solar_time(hour, day_of_year, latitude_deg)
 
@@ -219,8 +219,8 @@ def solar_zenith_deg(hour: float, day_of_year: int = SUN_DAY_OF_YEAR,
 def sun_at_hour(hour: float) -> SunAtHour:
     """Hour of local mean solar time on SUN_DATE at SUN_LATITUDE -> the sun through a
     south-facing window: zenith (:func:`solar_zenith_deg`), path length through the paper's
-    22 km shell (catalog.sun), and the light name ``sun:PATH_KM`` of the light library."""
-    from catalog.sun import path_km_from_zenith  # noqa: PLC0415
+    22 km shell (catalog.optics.sun.model), and the light name ``sun:PATH_KM`` of the light library."""
+    from catalog.optics.sun.model import path_km_from_zenith  # noqa: PLC0415
 
     if not (math.isfinite(hour) and 0.0 <= hour < 24.0):
         raise InputError(f"{hour!r} is not an hour of the day (0 <= hour < 24)", field="--hour")
@@ -236,7 +236,7 @@ def sun_at_hour(hour: float) -> SunAtHour:
 def key_elevation_for(light_name: str) -> float:
     """Elevation (deg) of the key light: the sun's from its path length, a lamp's fixed."""
     if light_name.startswith(("sun:", "sun-clear:")):
-        from catalog.sun import zenith_deg_from_path  # noqa: PLC0415
+        from catalog.optics.sun.model import zenith_deg_from_path  # noqa: PLC0415
 
         path = float(light_name.split(":", 1)[1])
         return 90.0 - zenith_deg_from_path(path)
@@ -247,7 +247,7 @@ def key_elevation_for(light_name: str) -> float:
 
 def dye_transmittance(preset) -> np.ndarray:
     """T(l) of a preset's ``[dye] transmittance`` CSV on GRID_NM (edge values held), or 1."""
-    from catalog.spectra import read_spectrum  # noqa: PLC0415
+    from catalog.optics.spectra import read_spectrum  # noqa: PLC0415
 
     rel = preset.table("dye").get("transmittance")
     if rel is None:
@@ -267,7 +267,7 @@ def relative_dye(transmittance: np.ndarray) -> np.ndarray:
     already hold the dye's mean absorption; the spectral factor only redistributes it
     (a cloth with no dye, T = 1, gets exactly 1).
     """
-    from catalog.colorimetry import cmfs  # noqa: PLC0415
+    from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
 
     ybar = cmfs(GRID_NM)[:, 1]
     mean = float(transmittance @ ybar) / float(np.sum(ybar))
@@ -279,8 +279,8 @@ def relative_dye(transmittance: np.ndarray) -> np.ndarray:
 @functools.lru_cache(maxsize=32)
 def _material_cached(excitation_path: str, emission_path: str, peak_absorptance: float,
                      quantum_yield: float, saturation: float):
-    from catalog.fluorescence import material_from_spectra  # noqa: PLC0415
-    from catalog.spectra import read_spectrum  # noqa: PLC0415
+    from catalog.optics.fluorescence import material_from_spectra  # noqa: PLC0415
+    from catalog.optics.spectra import read_spectrum  # noqa: PLC0415
 
     return material_from_spectra(read_spectrum(excitation_path), read_spectrum(emission_path),
                                  peak_absorptance=peak_absorptance, quantum_yield=quantum_yield,
@@ -289,7 +289,7 @@ def _material_cached(excitation_path: str, emission_path: str, peak_absorptance:
 
 def fluorescent_material(preset):
     """The physical-mode material of a preset with a ``[fluorescence]`` table (else None)."""
-    from catalog import fluorescence as fl  # noqa: PLC0415
+    from catalog.optics import fluorescence as fl  # noqa: PLC0415
 
     if preset.fluorescence is None:
         return None
@@ -307,8 +307,8 @@ def fluorescent_material(preset):
 def paper_emission_shape(preset) -> np.ndarray:
     """The emission Le on GRID_NM, 380-780 nm only (eq. 1), scaled so that sum ybar s dl = 1
     (eq. 3's K / 100): F = 100 sum cmf s is the paper's fluorescence colour."""
-    from catalog.colorimetry import cmfs  # noqa: PLC0415
-    from catalog.spectra import VISIBLE_NM, read_spectrum  # noqa: PLC0415
+    from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
+    from catalog.optics.spectra import VISIBLE_NM, read_spectrum  # noqa: PLC0415
 
     emission = read_spectrum(preset.fluorescence.emission).resample(GRID_NM)
     emission = np.where((GRID_NM >= VISIBLE_NM[0]) & (GRID_NM <= VISIBLE_NM[1]), emission, 0.0)
@@ -332,8 +332,8 @@ class FluorescenceDecision:
 def decide_fluorescence(preset, irradiance: np.ndarray, requested: str) -> FluorescenceDecision:
     """Which fluorescence variant a scene needs: none for a fabric without brightener, none
     when the emission changes the lit cloth by less than Delta E 2000 0.1 under this light
-    (:func:`catalog.fluorescence.fluorescence_needed`; the same judgement for both modes)."""
-    from catalog.fluorescence import fluorescence_delta_e  # noqa: PLC0415
+    (:func:`catalog.optics.fluorescence.fluorescence_needed`; the same judgement for both modes)."""
+    from catalog.optics.fluorescence import fluorescence_delta_e  # noqa: PLC0415
 
     if requested not in ("off", "paper", "physical"):
         raise CatalogError(f"fluorescence mode {requested!r}: choose off, paper or physical")
@@ -349,8 +349,8 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
                          is_sun: bool, fluorescence: str = "physical",
                          viewer_inside: bool = True) -> tuple[ShadingInputs, FluorescenceDecision]:
     """The spectral description of the scene's light on the curtain for a preset."""
-    from catalog.colorimetry import cmfs  # noqa: PLC0415
-    from catalog.fluorescence import paper_intensity  # noqa: PLC0415
+    from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
+    from catalog.optics.fluorescence import paper_intensity  # noqa: PLC0415
 
     key = np.asarray(key_irradiance, dtype=np.float64)
     to_light = np.asarray(key_to_light, dtype=np.float64)
@@ -412,7 +412,7 @@ def with_physical_emission(inputs: ShadingInputs, material) -> ShadingInputs:
     two sides of a thin cloth (M / (2 pi) on each)."""
     from dataclasses import replace  # noqa: PLC0415
 
-    from catalog.fluorescence import absorbed_photon_irradiance, photon_energy_j  # noqa: PLC0415
+    from catalog.optics.fluorescence import absorbed_photon_irradiance, photon_energy_j  # noqa: PLC0415
 
     ambient_irradiance = math.pi * (0.5 * (inputs.sky_radiance + inputs.ground_radiance)
                                     + inputs.room_radiance)
@@ -427,6 +427,6 @@ def with_physical_emission(inputs: ShadingInputs, material) -> ShadingInputs:
 
 
 def _excitation_on_grid(preset) -> np.ndarray:
-    from catalog.spectra import read_spectrum  # noqa: PLC0415
+    from catalog.optics.spectra import read_spectrum  # noqa: PLC0415
 
     return read_spectrum(preset.fluorescence.excitation, normalise=True).resample(GRID_NM)

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 
 def _fabric_list(fabrics):
@@ -26,10 +26,10 @@ def _fabric_list(fabrics):
 def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fabrics=None,
                  fluorescence: str = "physical", bands: int = 3, progress: bool = True,
                  ctx=None) -> dict:
-    from catalog.lights import get_light  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.render import bands as band_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
-    from catalog.render.context import create_headless_context  # noqa: PLC0415
+    from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.render.snapshot import write_image  # noqa: PLC0415
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, InputError
 
 IMAGE_SUFFIXES = (".exr", ".png")
 #: Frame step of the cloth simulation behind ``--frame N`` (s).
@@ -22,7 +22,7 @@ FRAME_DT_S = 1.0 / 60.0
 
 def parse_size(text: str) -> tuple[int, int]:
     """``WxH`` -> (width, height), refused unless both are whole numbers in 1..MAX_SIDE_PX."""
-    from catalog.cliargs import parse_wxh  # noqa: PLC0415
+    from catalog.core.cliargs import parse_wxh  # noqa: PLC0415
     from catalog.render.frame import MAX_SIDE_PX  # noqa: PLC0415
 
     return parse_wxh(text, "--size", 1, MAX_SIDE_PX)
@@ -58,7 +58,7 @@ def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> Non
     """Write (H, W, 3) pixels with OpenImageIO, atomically: float32 -> EXR, uint8 -> PNG."""
     import OpenImageIO as oiio  # noqa: PLC0415
 
-    from catalog.atomic import atomic_path  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
 
     height, width, channels = pixels.shape
     kind = oiio.FLOAT if pixels.dtype == np.float32 else oiio.UINT8
@@ -108,7 +108,7 @@ def simulated_curtain(preset, frames: int):
 def validate(request: SnapshotRequest):
     """Everything that can be refused before a context exists: the preset, the light, the
     size, the output name. Returns (preset, light)."""
-    from catalog.lights import get_light  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render import bands as band_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
@@ -130,7 +130,7 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
     """Render one image as asked and write it; returns a JSON-able report."""
     import time  # noqa: PLC0415
 
-    from catalog.render.context import create_headless_context, describe  # noqa: PLC0415
+    from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
     preset, light = validate(request)

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog import FABRIC_DIR
-from catalog.errors import CatalogError
+from catalog.core.resources import FABRIC_DIR
+from catalog.core.errors import CatalogError
 from catalog.viewer.catalog_state import FabricCatalog
 from catalog.viewer.input import Action, MouseOrbit, OrbitCamera, action_for_key
 from catalog.viewer.settings import (SUN, ViewerSettings, next_fluorescence, next_light)
@@ -107,7 +107,7 @@ class ViewerApp:
         if options.compare is not None:
             self.settings.compare_index = self._loadable_index(options.compare)
         if options.light is not None:
-            from catalog.lights import get_light  # noqa: PLC0415
+            from catalog.optics.lights import get_light  # noqa: PLC0415
 
             if options.light != SUN:
                 get_light(options.light)  # an unknown name is refused before a window opens
@@ -129,7 +129,7 @@ class ViewerApp:
         from imgui_bundle import imgui  # noqa: PLC0415
         from imgui_bundle.python_backends.glfw_backend import GlfwRenderer  # noqa: PLC0415
 
-        from catalog.render.context import wrap_window_context  # noqa: PLC0415
+        from catalog.gl.context import wrap_window_context  # noqa: PLC0415
         from catalog.viewer.panel import Panel, PanelInfo  # noqa: PLC0415
         from catalog.viewer.scene import CurtainScene  # noqa: PLC0415
 
@@ -446,7 +446,7 @@ class ViewerApp:
 
     def _cie_light_names(self) -> list[str]:
         try:
-            from catalog.lights import cie_names  # noqa: PLC0415
+            from catalog.optics.lights import cie_names  # noqa: PLC0415
 
             return list(cie_names())
         except CatalogError:

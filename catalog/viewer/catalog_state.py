@@ -17,15 +17,15 @@ from typing import Callable
 
 import numpy as np
 
-from catalog import FABRIC_DIR
-from catalog.errors import CatalogError
+from catalog.core.resources import FABRIC_DIR
+from catalog.core.errors import CatalogError
 from catalog.presets import Preset, list_presets, load_preset
 
 
 def _srgb_encode(linear: np.ndarray) -> np.ndarray:
     """The sRGB transfer function (IEC 61966-2-1, piecewise) for the panel's swatches.
 
-    catalog.colorimetry.srgb_encode goes through colour-science, which imports scipy; the
+    catalog.optics.colorimetry.srgb_encode goes through colour-science, which imports scipy; the
     viewer must not, so the swatch uses this four-line numpy form of the same curve.
     """
     linear = np.clip(np.asarray(linear, dtype=np.float64), 0.0, 1.0)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 
 def write_image(path: str | Path, pixels: np.ndarray, metadata: dict[str, str]) -> Path:

@@ -48,7 +48,7 @@ class ViewerSettings:
 
     fabric_index: int = 0
     compare_index: int | None = None  # split screen: the right half's fabric
-    light: str = SUN  # SUN (path from ``sun_hour``) or a light name of catalog.lights
+    light: str = SUN  # SUN (path from ``sun_hour``) or a light name of catalog.optics.lights
     sun_hour: float = DEFAULT_SUN_HOUR
     fluorescence: str = "physical"
     bands: int = 3

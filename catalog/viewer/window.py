@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 
-from catalog.errors import CatalogError
+from catalog.core.errors import CatalogError
 
 #: The renderer's shaders need OpenGL 4.3 (compute shaders, SSBOs).
 GL_VERSION = (4, 3)

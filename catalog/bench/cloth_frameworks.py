@@ -1,0 +1,382 @@
+"""Cloth benchmark: this project's backends against Taichi and NVIDIA Warp, one run.
+
+    .venv/bin/python -m catalog.bench.cloth_frameworks [--quick] [--out benchmarks/bench_cloth.json]
+
+1. The same problem everywhere (catalog/bench/springs12.py): n x n explicit mass-spring
+   cloth, the same 12 springs per particle (Provot's structural, shear, bend), Hooke plus
+   dashpot, semi-implicit Euler, float32, one substep per step, row 0 pinned; 64x64 and
+   128x128 on this 2-core CPU. Implementations:
+   - ``numpy-f32``: the vectorised numpy reference in float32;
+   - ``cpu``, ``cpu-2t``: the numba kernel of the cpu backend (each spring once, rows
+     streamed through a 3-row force buffer), one thread and two threads (bands of rows);
+   - ``gpu``: catalog/bench/shaders/cloth_springs12.comp (Mesa llvmpipe here: a CPU rasteriser);
+   - ``taichi``: Taichi 1.7 CPU backend (``cpu_max_num_threads=2``), one thread per
+     particle gathering its 12 springs (ti.kernel over the grid);
+   - ``warp``: NVIDIA Warp (warp-lang) CPU device, the same gather kernel written with
+     ``@wp.kernel`` (warp.sim is gone from warp-lang 1.19).
+   All must agree with the float64 numpy reference after 200 steps (max |dx| < 1e-4 m).
+   Speed: steps per second, the median of interleaved repeats (the machine is shared, so
+   every implementation sees the same noise); ratio to the fastest peer (Taichi, Warp).
+2. Stiffness cost of the real simulation (XPBD + strain limiting + LRA, cpu backend,
+   64x64, 1/30 s frames): milliseconds per frame at 1e3 and 1e6 N/m, and the ratio.
+3. The GPU backend's frame on llvmpipe at 128x128, and how much of it is issue cost
+   (the same frame at 4x4), for the 60 fps estimate on a real GPU (see docs/cloth.md).
+
+Numba compiles before timing (and caches); Taichi and Warp compile in their warm-up.
+"""
+
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from catalog.core.resources import PROJECT_ROOT as ROOT  # noqa: E402
+# numba's OpenMP threads spin while waiting by default; on a 2-core machine shared with
+# other work that spinning starves the other thread (measured: 2 threads at 1/5 the speed
+# of 1). Passive waiting, before numba loads OpenMP:
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+from catalog.bench.springs12 import Springs12Numba, Springs12Problem, reference_steps  # noqa: E402
+from catalog.cloth.topology import GATHER_OFFSETS  # noqa: E402
+
+AGREE_STEPS = 200
+AGREE_TOLERANCE_M = 1e-4
+PEERS = ("taichi", "warp")
+
+
+# ---- peers ------------------------------------------------------------------------------
+
+class TaichiCloth:
+    """The gather kernel in Taichi (CPU backend, 2 threads)."""
+
+    _initialised = False
+
+    def __init__(self, problem: Springs12Problem):
+        import taichi as ti
+
+        if not TaichiCloth._initialised:
+            ti.init(arch=ti.cpu, cpu_max_num_threads=2, default_fp=ti.f32, log_level=ti.WARN)
+            TaichiCloth._initialised = True
+        self.ti = ti
+        self.problem = problem
+        n = problem.n
+        self.fields = [(ti.Vector.field(3, ti.f32, shape=(n, n)),
+                        ti.Vector.field(3, ti.f32, shape=(n, n))) for _ in range(2)]
+        springs = problem.springs()
+        offsets = [(dr, dc) for dr, dc, _, _ in springs]
+        rests = [float(r) for _, _, r, _ in springs]
+        kes = [float(k) for _, _, _, k in springs]
+        kd, dt = problem.k_damping_n_s_m, problem.dt_s
+        inv_m, g = 1.0 / problem.mass_kg, problem.gravity_m_s2
+
+        @ti.kernel
+        def step(sx: ti.template(), sv: ti.template(), dx: ti.template(), dv: ti.template()):
+            for i, j in sx:
+                p = sx[i, j]
+                vel = sv[i, j]
+                if i == 0:
+                    dx[i, j] = p
+                    dv[i, j] = ti.Vector([0.0, 0.0, 0.0])
+                else:
+                    f = ti.Vector([0.0, -g / inv_m, 0.0])
+                    for k in ti.static(range(12)):
+                        i2 = i + offsets[k][0]
+                        j2 = j + offsets[k][1]
+                        if 0 <= i2 < n and 0 <= j2 < n:
+                            d = sx[i2, j2] - p
+                            length = d.norm()
+                            direction = d / length
+                            along = (sv[i2, j2] - vel).dot(direction)
+                            f += direction * (kes[k] * (length - rests[k]) + kd * along)
+                    vel += dt * f * inv_m
+                    dv[i, j] = vel
+                    dx[i, j] = p + dt * vel
+
+        self._step = step
+        self.reset()
+
+    def reset(self) -> None:
+        x = self.problem.initial_positions().astype(np.float32)
+        self.fields[0][0].from_numpy(x)
+        self.fields[0][1].from_numpy(np.zeros_like(x))
+        self.current = 0
+
+    def run(self, steps: int) -> None:
+        for _ in range(steps):
+            src, dst = self.fields[self.current], self.fields[1 - self.current]
+            self._step(src[0], src[1], dst[0], dst[1])
+            self.current = 1 - self.current
+        self.ti.sync()
+
+    def positions(self) -> np.ndarray:
+        return self.fields[self.current][0].to_numpy().astype(np.float64)
+
+
+class WarpCloth:
+    """The gather kernel in NVIDIA Warp on its CPU device."""
+
+    _kernel = None
+
+    def __init__(self, problem: Springs12Problem):
+        import warp as wp
+
+        wp.config.quiet = True
+        wp.init()
+        self.wp = wp
+        self.problem = problem
+        if WarpCloth._kernel is None:
+            WarpCloth._kernel = _make_warp_kernel(wp)
+        n = problem.n
+        springs = problem.springs()
+        self.offsets = wp.array(np.array(GATHER_OFFSETS, dtype=np.int32), dtype=wp.vec2i,
+                                device="cpu")
+        self.rest = wp.array(np.array([s[2] for s in springs], dtype=np.float32), device="cpu")
+        self.ke = wp.array(np.array([s[3] for s in springs], dtype=np.float32), device="cpu")
+        self.bufs = [(wp.zeros((n, n), dtype=wp.vec3, device="cpu"),
+                      wp.zeros((n, n), dtype=wp.vec3, device="cpu")) for _ in range(2)]
+        self.reset()
+
+    def reset(self) -> None:
+        wp = self.wp
+        x = self.problem.initial_positions().astype(np.float32)
+        self.bufs[0][0].assign(wp.array(x, dtype=wp.vec3, device="cpu"))
+        self.bufs[0][1].zero_()
+        self.current = 0
+
+    def run(self, steps: int) -> None:
+        wp, p = self.wp, self.problem
+        for _ in range(steps):
+            src, dst = self.bufs[self.current], self.bufs[1 - self.current]
+            wp.launch(WarpCloth._kernel, dim=(p.n, p.n),
+                      inputs=[src[0], src[1], dst[0], dst[1], self.offsets, self.rest,
+                              self.ke, p.k_damping_n_s_m, p.dt_s, 1.0 / p.mass_kg,
+                              p.gravity_m_s2, p.n], device="cpu")
+            self.current = 1 - self.current
+        wp.synchronize()
+
+    def positions(self) -> np.ndarray:
+        return self.bufs[self.current][0].numpy().astype(np.float64)
+
+
+def _make_warp_kernel(wp):
+    @wp.kernel
+    def cloth_step(sx: wp.array2d(dtype=wp.vec3), sv: wp.array2d(dtype=wp.vec3),
+                   dx: wp.array2d(dtype=wp.vec3), dv: wp.array2d(dtype=wp.vec3),
+                   offsets: wp.array(dtype=wp.vec2i), rest: wp.array(dtype=float),
+                   ke: wp.array(dtype=float), kd: float, dt: float, inv_m: float,
+                   gravity: float, n: int):
+        i, j = wp.tid()
+        p = sx[i, j]
+        vel = sv[i, j]
+        if i == 0:
+            dx[i, j] = p
+            dv[i, j] = wp.vec3(0.0, 0.0, 0.0)
+            return
+        f = wp.vec3(0.0, -gravity / inv_m, 0.0)
+        for k in range(12):
+            o = offsets[k]
+            i2 = i + o[0]
+            j2 = j + o[1]
+            if i2 >= 0 and i2 < n and j2 >= 0 and j2 < n:
+                d = sx[i2, j2] - p
+                length = wp.length(d)
+                direction = d / length
+                along = wp.dot(sv[i2, j2] - vel, direction)
+                f = f + direction * (ke[k] * (length - rest[k]) + kd * along)
+        vel = vel + dt * f * inv_m
+        dv[i, j] = vel
+        dx[i, j] = p + dt * vel
+
+    return cloth_step
+
+
+# ---- ours -------------------------------------------------------------------------------
+
+class NumpyCloth:
+    def __init__(self, problem):
+        self.problem = problem
+        self.x = None
+
+    def reset(self):
+        self.x = None
+
+    def run(self, steps):
+        self.x, _ = reference_steps(self.problem, steps, np.float32)
+
+    def positions(self):
+        return self.x.astype(np.float64)
+
+
+def make(name: str, problem: Springs12Problem, ctx=None):
+    if name == "numpy-f32":
+        return NumpyCloth(problem)
+    if name == "cpu":
+        return Springs12Numba(problem, threads=1)
+    if name == "cpu-2t":
+        return Springs12Numba(problem, threads=2)
+    if name == "gpu":
+        from catalog.bench.springs12 import Springs12Gpu
+        return Springs12Gpu(problem, ctx=ctx)
+    if name == "taichi":
+        return TaichiCloth(problem)
+    if name == "warp":
+        return WarpCloth(problem)
+    raise ValueError(name)
+
+
+def bench_springs(sizes, repeats: int, seconds_per_repeat: float, ctx) -> list[dict]:
+    rows = []
+    names = ["numpy-f32", "cpu", "cpu-2t", "gpu", "taichi", "warp"]
+    for n in sizes:
+        problem = Springs12Problem(n=n)
+        reference, _ = reference_steps(problem, AGREE_STEPS)
+        impls, info = {}, {}
+        for name in names:
+            try:
+                impl = make(name, problem, ctx)
+                impl.run(AGREE_STEPS)  # compiles, then the agreement check
+                error = float(np.abs(impl.positions() - reference).max())
+                impls[name] = impl
+                info[name] = {"max_error_m": error, "agrees": error < AGREE_TOLERANCE_M}
+            except Exception as exc:  # noqa: BLE001 - a missing peer is reported
+                info[name] = {"unavailable": f"{type(exc).__name__}: {exc}"[:200]}
+        # steps per repeat so that one repeat takes about seconds_per_repeat
+        steps = {}
+        for name, impl in impls.items():
+            trial = 2 if name == "numpy-f32" else 20
+            impl.reset()
+            start = time.perf_counter()
+            impl.run(trial)
+            rate = trial / max(time.perf_counter() - start, 1e-6)
+            steps[name] = max(trial, int(rate * seconds_per_repeat))
+        samples = {name: [] for name in impls}
+        for _ in range(repeats):  # interleaved: every implementation sees the same noise
+            for name, impl in impls.items():
+                if name == "numpy-f32" and len(samples[name]) >= 2:
+                    continue  # the slow reference: two samples are enough
+                impl.reset()
+                start = time.perf_counter()
+                impl.run(steps[name])
+                samples[name].append(steps[name] / (time.perf_counter() - start))
+        peer_rates = [statistics.median(samples[p]) for p in PEERS if p in samples]
+        fastest_peer = max(peer_rates) if peer_rates else float("nan")
+        for name in names:
+            row = {"n": n, "impl": name, **info[name]}
+            if name in samples:
+                rate = statistics.median(samples[name])
+                row.update(steps_per_second=rate, samples=samples[name],
+                           ratio_to_fastest_peer=rate / fastest_peer)
+            rows.append(row)
+    return rows
+
+
+# ---- stiffness cost and the GPU frame -------------------------------------------------
+
+def _frame_ms(sim, frames: int, dt: float, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(frames):
+            sim.step(dt)
+        if sim.backend_name == "gpu":
+            sim.backend.ctx.finish()
+        times.append((time.perf_counter() - start) / frames * 1e3)
+    return statistics.median(times)
+
+
+def bench_stiffness(repeats: int) -> list[dict]:
+    from catalog.cloth import ClothParams, ClothSimulation
+
+    rows = []
+    for wind in (0.0, 1.0):
+        for k in (1e3, 1e6):
+            p = ClothParams(grid_w=64, grid_h=64, opening=0.8, stretch_stiffness_n_m=k,
+                            wind_speed_m_s=wind, sleep_frames=10 ** 9)
+            sim = ClothSimulation(p, "cpu")
+            sim.run(15, 1 / 30)  # past the first fall
+            ms = _frame_ms(sim, 15, 1 / 30, repeats)
+            rows.append({"stiffness_n_m": k, "wind_m_s": wind, "ms_per_frame": ms,
+                         "substeps": sim.last_substeps, "max_stretch": sim.max_stretch})
+    return rows
+
+
+def bench_gpu_frame(ctx, repeats: int) -> list[dict]:
+    from catalog.cloth import ClothParams, ClothSimulation
+
+    rows = []
+    for n in (4, 64, 128):
+        p = ClothParams(grid_w=n, grid_h=n, opening=0.8, wind_speed_m_s=1.0)
+        sim = ClothSimulation(p, "gpu", ctx=ctx, monitor_every=10 ** 9)
+        sim.step(1 / 60)
+        ms = _frame_ms(sim, 5, 1 / 60, repeats)
+        rows.append({"n": n, "ms_per_frame_llvmpipe": ms, "substeps": sim.last_substeps})
+    return rows
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--out", default=str(ROOT / "benchmarks" / "bench_cloth.json"))
+    args = parser.parse_args()
+    repeats = 3 if args.quick else 7
+    ctx = None
+    try:
+        from catalog.gl.context import create_headless_context
+        ctx = create_headless_context()
+    except Exception as exc:  # noqa: BLE001
+        print(f"no GL context: {exc}", file=sys.stderr)
+
+    started = time.time()
+    springs = bench_springs((64, 128), repeats, 0.25 if args.quick else 0.5, ctx)
+    print("\n12-spring explicit cloth, float32, 1 substep per step (steps/s, median of "
+          f"{repeats} interleaved repeats)")
+    print(f"{'n':>4} {'impl':>10} {'steps/s':>10} {'vs fastest peer':>16} {'max |dx| m':>11}")
+    for row in springs:
+        if "steps_per_second" in row:
+            print(f"{row['n']:>4} {row['impl']:>10} {row['steps_per_second']:>10.0f} "
+                  f"{row['ratio_to_fastest_peer']:>15.2f}x {row['max_error_m']:>11.1e}"
+                  + ("" if row["agrees"] else "  DISAGREES"))
+        else:
+            print(f"{row['n']:>4} {row['impl']:>10}  unavailable: {row['unavailable']}")
+
+    stiffness = bench_stiffness(repeats)
+    print("\nStiffness cost: cpu backend, 64x64, 1/30 s frames (XPBD, strain limit, LRA)")
+    for row in stiffness:
+        print(f"  k = {row['stiffness_n_m']:>9.0e} N/m, wind {row['wind_m_s']} m/s: "
+              f"{row['ms_per_frame']:7.2f} ms/frame, {row['substeps']} substeps, "
+              f"max stretch {row['max_stretch']:.3f}")
+    ratios = {}
+    for wind in (0.0, 1.0):
+        by_k = {r["stiffness_n_m"]: r["ms_per_frame"] for r in stiffness if r["wind_m_s"] == wind}
+        ratios[str(wind)] = by_k[1e6] / by_k[1e3]
+        print(f"  cost(1e6) / cost(1e3), wind {wind}: {ratios[str(wind)]:.2f}")
+
+    gpu_frames = bench_gpu_frame(ctx, repeats) if ctx is not None else []
+    if gpu_frames:
+        print("\nGPU backend on llvmpipe, 1/60 s frames (10 substeps)")
+        for row in gpu_frames:
+            print(f"  {row['n']:>3}x{row['n']:<3} {row['ms_per_frame_llvmpipe']:8.1f} ms/frame")
+
+    result = {
+        "benchmark": "cloth",
+        "machine": {"cpus": os.cpu_count(), "load_average": os.getloadavg(),
+                    "omp_wait_policy": os.environ.get("OMP_WAIT_POLICY")},
+        "springs12": springs,
+        "stiffness_cost": {"rows": stiffness, "ratio_1e6_to_1e3": ratios},
+        "gpu_frame_llvmpipe": gpu_frames,
+        "seconds": time.time() - started,
+    }
+    from catalog.core.atomic import write_text_atomic
+    write_text_atomic(args.out, json.dumps(result, indent=1) + "\n")
+    print(f"\nwrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,295 @@
+"""The real-time frame against the path-traced reference of the same scene (issue 11).
+
+For each scene of :data:`SCENES` (lace, voile and safety-yellow; the noon sun, D65 and the
+UV-A lamp; the room view and a close-up) the frame (:class:`catalog.render.frame.FrameRenderer`,
+the default options) and the reference (:mod:`catalog.pathtrace`: Mitsuba 3, volpath, two
+independent renders of spp / 2 averaged) are drawn at the same size from the same scene
+description and curtain mesh. Measured:
+
+- mean FLIP (LDR-FLIP of the two display images: the frame's own exposure and tone curve);
+- Delta E 2000 (mean, 95th percentile) on the curtain, the floor and the walls (masks from a
+  ray per pixel centre through the reference's geometry), the white a white diffuser under
+  the key light, raised to the cloth's 95th-percentile luminance where the cloth is brighter
+  (the UV-A glow; as the colour section does);
+- the reference's remaining noise: relative RMS of luminance from the two renders
+  (:func:`catalog.pathtrace.metrics.noise_between`);
+- both run times (frame: median of repeats with glFinish; reference: the two renders'
+  wall time, scene building excluded) and their ratio, at equal resolution.
+
+Real-time options (the Pareto plot): spectral bands 3/6/9/16, paper vs physical
+fluorescence, 2x2 supersampling (anti-aliasing). Room lighting and shadow-map size join
+:data:`OPTIONS` when the frame has them (issue 13); until then they are listed as absent.
+
+The goal of issue 11 (stated before measuring): on every scene mean FLIP <= 0.10, curtain
+Delta E 2000 mean <= 2, and the frame >= 1000x faster than the reference.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from catalog.bench.timing import median_wall_and_cpu
+
+#: The camera of each view: (yaw deg, pitch deg, distance m). The room view looks down
+#: across the room so that the floor by the window is in the picture.
+VIEWS = {"room": (20.0, 15.0, 2.6), "close-up": (0.0, 0.0, 0.8)}
+#: (label, fabric, light, view)
+SCENES = (
+    ("lace, noon sun, room", "lace-fwa", "noon", "room"),
+    ("voile, D65, room", "voile-white", "D65", "room"),
+    ("safety-yellow, UV-A, room", "safety-yellow", "UV-A", "room"),
+    ("lace, UV-A, close-up", "lace-fwa", "UV-A", "close-up"),
+    ("voile, noon sun, close-up", "voile-white", "noon", "close-up"),
+    ("safety-yellow, D65, close-up", "safety-yellow", "D65", "close-up"),
+)
+QUICK_SCENES = SCENES[1:2]
+SIZE = (192, 144)
+QUICK_SIZE = (64, 48)
+SPP = 256
+QUICK_SPP = 16
+#: (label, bands, fluorescence mode, supersample factor). The first is the frame's default.
+OPTIONS = (
+    ("default (physical, 3 bands)", 3, "physical", 1),
+    ("6 bands", 6, "physical", 1),
+    ("16 bands", 16, "physical", 1),
+    ("paper fluorescence", 3, "paper", 1),
+    ("2x2 supersampled", 3, "physical", 2),
+)
+ABSENT_OPTIONS = ("room lighting on/off", "shadow map size")
+#: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
+#: curtain (noise falls as 1 / sqrt(spp): the spp that reaches it is spp (noise / 1 %)^2).
+NOISE_TARGET = 0.01
+GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
+REGIONS = ("curtain", "floor", "walls")
+#: The hour of "noon sun" (local solar time, the scene's date and latitude).
+NOON_HOUR = 12.0
+
+
+def light_name(key: str) -> str:
+    if key == "noon":
+        from catalog.render.scene import sun_at_hour  # noqa: PLC0415
+
+        return sun_at_hour(NOON_HOUR).light_name
+    return key
+
+
+def frame_linear(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
+                 repeats: int = 5) -> tuple[np.ndarray, float]:
+    """The real-time frame's linear radiance (H, W, 3) at desc.size and its median wall time
+    (s) of render + glFinish; ``supersample`` renders s x s larger and box-averages."""
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    width, height = desc.size
+    renderer = FrameRenderer(ctx, (width * supersample, height * supersample))
+    try:
+        renderer.set_fabric(preset)
+        renderer.set_light(light)
+        renderer.set_fluorescence(mode)
+        renderer.set_bands(bands)
+        cam = desc.info["camera"]
+        renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
+        renderer.set_mesh(*desc.curtain)
+        wall, _cpu = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)
+        pixels = renderer.read_linear()
+    finally:
+        renderer.release()
+    if supersample > 1:
+        s = supersample
+        pixels = pixels.reshape(height, s, width, s, 3).mean(axis=(1, 3))
+    return pixels.astype(np.float32), wall
+
+
+def compare(frame: np.ndarray, reference: np.ndarray, masks: dict, light, inputs) -> dict:
+    """FLIP and Delta E of one frame against the reference (maps and summaries)."""
+    from catalog.bench.colour import adapted_white  # noqa: PLC0415
+    from catalog.optics.colorimetry import linear_srgb_to_xyz  # noqa: PLC0415
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+    from catalog.optics.shading_reference import white_xyz  # noqa: PLC0415
+
+    exposure = metrics.exposure_for(light)
+    flip = metrics.flip_map(metrics.display(frame, exposure), metrics.display(reference, exposure))
+    cloth_xyz = linear_srgb_to_xyz(reference[masks["curtain"]].astype(np.float64))
+    white = adapted_white(white_xyz(inputs), cloth_xyz)
+    delta_e = metrics.delta_e_map(frame, reference, white)
+    return {"mean_flip": float(flip.mean()), "flip_map": flip,
+            "delta_e": metrics.region_stats(delta_e, {r: masks[r] for r in REGIONS})}
+
+
+def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
+        out: Path | None = None) -> dict:
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+    from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
+    from catalog.pathtrace.render import MAX_DEPTH, region_masks, render_radiance  # noqa: PLC0415
+    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+
+    if ctx is None:
+        from catalog.gl.context import create_headless_context  # noqa: PLC0415
+
+        ctx = create_headless_context()
+    scenes = scenes or (QUICK_SCENES if quick else SCENES)
+    size = tuple(size or (QUICK_SIZE if quick else SIZE))
+    spp = int(spp or (QUICK_SPP if quick else SPP))
+    options = OPTIONS[:2] if quick else OPTIONS
+    mi = load_mitsuba()
+    rows, pareto, images = [], [], {}
+    for label, fabric, light_key, view in scenes:
+        preset = load_preset(find_preset(fabric))
+        light = get_light(light_name(light_key))
+        yaw, pitch, distance = VIEWS[view]
+        desc = describe_scene(preset, light, size=size, yaw_deg=yaw, pitch_deg=pitch,
+                              distance_m=distance)
+        scene = build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH)
+        start = time.perf_counter()
+        a = render_radiance(mi, scene, spp // 2, seed=0)
+        b = render_radiance(mi, scene, spp // 2, seed=1)
+        reference_s = time.perf_counter() - start
+        reference = 0.5 * (a + b)
+        masks = region_masks(mi, scene, desc)
+        noise = metrics.noise_between(a, b)
+        noise_curtain = metrics.noise_between(a, b, masks["curtain"])
+        option_rows = []
+        for opt_label, bands, mode, supersample in options:
+            frame, frame_s = frame_linear(ctx, desc, preset, light, bands, mode, supersample,
+                                          repeats=3 if quick else 7)
+            result = compare(frame, reference, masks, light, desc.inputs)
+            option_rows.append({"option": opt_label, "mean_flip": result["mean_flip"],
+                                "curtain_mean_delta_e": (result["delta_e"]["curtain"] or {}).get("mean"),
+                                "frame_s": frame_s})
+            if opt_label == options[0][0]:
+                default = (frame, frame_s, result)
+        frame, frame_s, result = default
+        de = result["delta_e"]
+        row = {"scene": label, "fabric": fabric, "light": light.name, "view": view,
+               "camera": {"yaw_deg": yaw, "pitch_deg": pitch, "distance_m": distance}, "size": list(size), "spp": spp,
+               "mean_flip": result["mean_flip"],
+               **{f"{r}_delta_e_mean": (de[r] or {}).get("mean") for r in REGIONS},
+               **{f"{r}_delta_e_p95": (de[r] or {}).get("p95") for r in REGIONS},
+               "frame_ms": 1e3 * frame_s, "reference_s": reference_s,
+               "speedup": reference_s / frame_s if frame_s > 0 else math.inf,
+               "reference_noise_rel": noise, "reference_noise_curtain_rel": noise_curtain,
+               "fluorescence": desc.info["fluorescence_variant"]}
+        row["meets_goal"] = bool(row["mean_flip"] <= GOAL["mean_flip_at_most"]
+                                 and (row["curtain_delta_e_mean"] or math.inf)
+                                 <= GOAL["curtain_mean_delta_e_at_most"]
+                                 and row["speedup"] >= GOAL["speedup_at_least"])
+        rows.append(row)
+        pareto.append({"scene": label, "options": option_rows})
+        images[label] = {"frame": frame, "reference": reference, "flip": result["flip_map"],
+                         "exposure": metrics.exposure_for(light)}
+    summary = {
+        "goal": GOAL,
+        "scenes_meeting_goal": sum(r["meets_goal"] for r in rows),
+        "scenes": len(rows),
+        "worst_mean_flip": max(r["mean_flip"] for r in rows),
+        "worst_curtain_delta_e_mean": max((r["curtain_delta_e_mean"] or 0.0) for r in rows),
+        "median_speedup": float(np.median([r["speedup"] for r in rows])),
+        "max_reference_noise_rel": max(r["reference_noise_rel"] for r in rows),
+        "absent_options": list(ABSENT_OPTIONS),
+        "integrator": f"Mitsuba {mi.__version__} volpath, max_depth {MAX_DEPTH}, "
+                      f"{spp} spp (2 x {spp // 2}), llvm_ad_rgb",
+    }
+    result = {"rows": rows, "pareto": pareto, "summary": summary,
+              "settings": {"size": list(size), "spp": spp, "quick": bool(quick)}}
+    result["_images"] = images  # not JSON: plot() writes them and drops them
+    if out is not None:
+        plot(result, out)
+    return result
+
+
+def _display_u8(linear, exposure):
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+
+    return (metrics.display(linear, exposure) * 255 + 0.5).astype(np.uint8)
+
+
+def triptych(images: dict) -> np.ndarray:
+    """real-time | reference | FLIP map, uint8 (H, 3W + 8, 3)."""
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+
+    frame = _display_u8(images["frame"], images["exposure"])
+    reference = _display_u8(images["reference"], images["exposure"])
+    gap = np.full((frame.shape[0], 4, 3), 255, dtype=np.uint8)
+    return np.concatenate([frame, gap, reference, gap, metrics.error_map_image(images["flip"])], 1)
+
+
+def slug(label: str) -> str:
+    return "".join(c if c.isalnum() else "-" for c in label.lower()).strip("-").replace("--", "-")
+
+
+def plot(result: dict, folder) -> list[Path]:
+    """Per scene: real-time | reference | FLIP map (PNG); the Pareto plot of the options."""
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+    from catalog.bench.plots import pyplot, save_figure  # noqa: PLC0415
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    plt = pyplot()
+    written = []
+    for label, images in result.pop("_images", {}).items():
+        path = folder / f"image-{slug(label)}.png"
+        with atomic_path(path) as tmp:
+            plt.imsave(tmp, triptych(images), format="png")
+        written.append(path)
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    markers = "osD^v<>p"
+    labels = [o["option"] for o in result["pareto"][0]["options"]] if result["pareto"] else []
+    for i, option in enumerate(labels):
+        xs = [1e3 * next(o for o in p["options"] if o["option"] == option)["frame_s"]
+              for p in result["pareto"]]
+        ys = [next(o for o in p["options"] if o["option"] == option)["mean_flip"]
+              for p in result["pareto"]]
+        ax.scatter(xs, ys, marker=markers[i % len(markers)], label=option)
+    ax.axhline(GOAL["mean_flip_at_most"], color="grey", ls="--", lw=0.8, label="goal (FLIP 0.10)")
+    ax.set_xscale("log")
+    ax.set_xlabel("frame time, ms (llvmpipe, median)")
+    ax.set_ylabel("mean FLIP against the path-traced reference")
+    ax.set_title("Real-time options against the reference (one point per scene)")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    written.append(save_figure(fig, folder / "image-pareto.png"))
+    return written
+
+
+def spp_for_noise(spp: int, noise: float, target: float = NOISE_TARGET) -> float:
+    """Samples per pixel at which a render with relative noise ``noise`` at ``spp`` reaches
+    ``target`` (Monte Carlo: noise ~ 1 / sqrt(spp))."""
+    return spp * (noise / target) ** 2
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """Generated blocks for BENCHMARKS.md / docs: ``image`` (per scene), ``image-options``."""
+    from catalog.bench.report import table  # noqa: PLC0415
+
+    s = result["summary"]
+    rows = [dict(r, spp_for_1pct=spp_for_noise(r["spp"], r["reference_noise_curtain_rel"]))
+            for r in result["rows"]]
+    per_scene = table(rows, [
+        "scene", "mean_flip", "curtain_delta_e_mean", "curtain_delta_e_p95", "floor_delta_e_mean",
+        "floor_delta_e_p95", "walls_delta_e_mean", "walls_delta_e_p95", "frame_ms", "reference_s",
+        "speedup", "reference_noise_rel", "reference_noise_curtain_rel", "spp_for_1pct",
+        "meets_goal"],
+        ["scene", "mean FLIP", "curtain dE mean", "curtain dE p95", "floor dE mean",
+         "floor dE p95", "walls dE mean", "walls dE p95", "frame ms", "reference s",
+         "x faster", "ref. noise (rel. RMS)", "ref. noise, curtain", "spp for 1 % on the curtain",
+         "goal met"])
+    per_scene += (f"\n\n{result['settings']['size'][0]}x{result['settings']['size'][1]} px; "
+                  f"reference: {s['integrator']}. Goal (issue 11): mean FLIP <= "
+                  f"{GOAL['mean_flip_at_most']}, curtain dE mean <= "
+                  f"{GOAL['curtain_mean_delta_e_at_most']}, >= {GOAL['speedup_at_least']:g}x "
+                  f"faster: met on {s['scenes_meeting_goal']} of {s['scenes']} scenes.")
+    option_rows = []
+    for p in result["pareto"]:
+        for o in p["options"]:
+            option_rows.append({"scene": p["scene"], **o, "frame_ms": 1e3 * o["frame_s"]})
+    options = table(option_rows, ["scene", "option", "mean_flip", "curtain_mean_delta_e", "frame_ms"],
+                    ["scene", "real-time option", "mean FLIP", "curtain dE mean", "frame ms"])
+    options += (f"\n\nNot yet in the frame (measured when they land): "
+                f"{', '.join(s['absent_options'])}.")
+    return {"image": per_scene, "image-options": options}
+

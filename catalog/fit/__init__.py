@@ -1,0 +1,1 @@
+"""Measurement and fitting: gonio data (:mod:`.gonio`) and the eq. 7 fit (:mod:`.fitting`)."""

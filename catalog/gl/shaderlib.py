@@ -1,0 +1,142 @@
+"""Shader files: ``#include "name"`` resolved from registered folders, ``#define``s injected.
+
+After moderngl-window's program loader: sources are files (never strings in Python), an
+include is searched in the including file's folder and then in the registered folders, and
+nesting deeper than :data:`MAX_INCLUDE_DEPTH` is refused (which also catches cycles).
+Defines are written right after the ``#version`` line, so a variant is chosen at compile time.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Mapping
+
+from catalog.core.resources import SHADER_DIR
+from catalog.core.errors import CatalogError
+
+#: Deeper nesting than this is an error (an include cycle always reaches it).
+MAX_INCLUDE_DEPTH = 8
+
+_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
+_VERSION = re.compile(r"^\s*#\s*version\b")
+_DEFINE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+#: Folders searched for shader files, in order.
+SEARCH_PATH: list[Path] = [SHADER_DIR]
+
+
+def register_folder(folder: str | Path) -> None:
+    """Add a folder to the search path (searched after those already there)."""
+    folder = Path(folder).resolve()
+    if folder not in SEARCH_PATH:
+        SEARCH_PATH.append(folder)
+
+
+def find_shader(name: str, near: Path | None = None) -> Path:
+    """The file ``name``: next to ``near`` first, then in the registered folders."""
+    folders = ([near] if near is not None else []) + SEARCH_PATH
+    for folder in folders:
+        candidate = folder / name
+        if candidate.is_file():
+            return candidate
+    searched = ", ".join(str(f) for f in folders)
+    raise CatalogError(f"shader file {name!r} not found (searched {searched})")
+
+
+def _expand(path: Path, depth: int, chain: tuple[str, ...]) -> list[str]:
+    if depth > MAX_INCLUDE_DEPTH:
+        raise CatalogError(f"shader includes nested deeper than {MAX_INCLUDE_DEPTH} "
+                           f"(a cycle?): {' -> '.join(chain)}")
+    lines = []
+    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+        match = _INCLUDE.match(line)
+        if match is None:
+            lines.append(line)
+            continue
+        included = find_shader(match.group(1), near=path.parent)
+        lines.append(f"// begin {match.group(1)} (from {path.name}:{number})")
+        lines.extend(_expand(included, depth + 1, chain + (included.name,)))
+        lines.append(f"// end {match.group(1)}")
+    return lines
+
+
+def _define_lines(defines: Mapping[str, object]) -> list[str]:
+    out = []
+    for name, value in sorted(defines.items()):
+        if not _DEFINE_NAME.match(name):
+            raise CatalogError(f"bad shader #define name {name!r}")
+        if value is None or value is True:
+            out.append(f"#define {name}")
+        elif value is False:
+            continue
+        else:
+            out.append(f"#define {name} {value}")
+    return out
+
+
+def load_source(name: str, defines: Mapping[str, object] | None = None) -> str:
+    """The full source of shader file ``name``: includes expanded, ``defines`` injected.
+
+    ``defines`` maps a name to a value (``N_BANDS=6``), or to None/True for a bare
+    ``#define NAME``; False leaves it out.
+    """
+    path = find_shader(name)
+    lines = _expand(path, 0, (path.name,))
+    extra = _define_lines(defines or {})
+    for index, line in enumerate(lines):
+        if _VERSION.match(line):
+            return "\n".join(lines[:index + 1] + extra + lines[index + 1:]) + "\n"
+    raise CatalogError(f"shader file {path} has no #version line")
+
+
+def glsl_literal(value) -> str:
+    """A value as a GLSL constant expression for a #define: a float, a vec2/vec3/vec4 tuple, or
+    a float array of 4k values as ``vec4[k](...)``. Floats keep 9 significant digits, which
+    round-trips float32 exactly."""
+    import numpy as np  # noqa: PLC0415
+
+    def number(x) -> str:
+        x = float(np.float32(x))
+        if not np.isfinite(x):
+            raise CatalogError(f"a shader constant must be finite, got {x}")
+        return f"{x:.9e}"
+
+    if isinstance(value, np.ndarray):
+        flat = value.astype(np.float32).ravel()
+        if flat.size == 0 or flat.size % 4:
+            raise CatalogError(f"a vec4 array constant needs 4k values, got {flat.size}")
+        chunks = [f"vec4({', '.join(number(v) for v in flat[i:i + 4])})"
+                  for i in range(0, flat.size, 4)]
+        return f"vec4[{len(chunks)}]({', '.join(chunks)})"
+    if isinstance(value, (tuple, list)):
+        if len(value) not in (2, 3, 4):
+            raise CatalogError(f"a vector constant needs 2 to 4 values, got {len(value)}")
+        return f"vec{len(value)}({', '.join(number(v) for v in value)})"
+    return number(value)
+
+
+def create_program(ctx, vertex: str, fragment: str | None = None,
+                   defines: Mapping[str, object] | None = None, fragment_outputs=None):
+    """A moderngl program from shader files; compile errors become one-line CatalogErrors."""
+    import moderngl  # noqa: PLC0415
+
+    sources = {"vertex_shader": load_source(vertex, defines)}
+    if fragment is not None:
+        sources["fragment_shader"] = load_source(fragment, defines)
+    try:
+        return ctx.program(**sources, fragment_outputs=fragment_outputs)
+    except moderngl.Error as exc:
+        first = next((ln for ln in str(exc).splitlines() if "error" in ln.lower()), str(exc))
+        raise CatalogError(f"shader {vertex}+{fragment} failed to compile: {first.strip()}") from None
+
+
+def create_compute(ctx, name: str, defines: Mapping[str, object] | None = None):
+    """A moderngl compute shader from a file."""
+    import moderngl  # noqa: PLC0415
+
+    try:
+        return ctx.compute_shader(load_source(name, defines))
+    except moderngl.Error as exc:
+        first = next((ln for ln in str(exc).splitlines() if "error" in ln.lower()), str(exc))
+        raise CatalogError(f"compute shader {name} failed to compile: {first.strip()}") from None

@@ -1,0 +1,213 @@
+"""The float64 reference renderer the shaders are checked against (optics side: no GL).
+
+A scene's light is described spectrally, once, by :class:`ShadingInputs` (on
+:data:`catalog.optics.spectra.GRID_NM`, 1 nm). The renderer turns it into a few numbers per band
+(:mod:`catalog.render.bands`); this module shades the same pixels from the same inputs at
+every wavelength in float64 and converts to colour at the end:
+
+    L(l) = G_key E_key(l) T(l) + G_fill E_fill(l) T(l) + L_ambient(l)          (eq. 7 lobes)
+         + LD L_background(l, ray)                                            (eq. 7 LD: see-through)
+         + L_fluorescence(l)                                                   (eq. 8, paper or physical)
+    G    = |n . l| (a_diff ph(theta; g_diff) + a_spec ph(theta_aniso; g_spec))  (eq. 5-7)
+
+with ph the HG phase function of :mod:`catalog.optics.btdf` (eq. 6, robust form) and theta the
+angle between the light's direction of travel and the direction to the viewer. The pixels'
+geometry (world position, normal, weft tangent) comes from a G-buffer pass of the same
+mesh and camera read back from GL: this module shades those positions; it does not
+rasterise (so the comparison is of the shading, not of the rasteriser's coverage).
+
+Colour: ``linear_srgb = 683 * M_sRGB . sum_l cmf(l) L(l) dl`` (cd m^-2 scale for Y).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from catalog.optics.btdf import hg_phase_one_minus_cos
+from catalog.optics.spectra import GRID_NM
+
+#: Luminous efficacy (lm/W) that puts Y in cd m^-2 for a radiance in W m^-2 sr^-1.
+LUMINOUS_EFFICACY_LM_W = 683.0
+#: Grid step of GRID_NM (nm).
+STEP_NM = 1.0
+#: Photons are carried in units of 1e18 m^-2 s^-1 in the shader (float32 range and precision).
+PHOTON_UNIT = 1.0e18
+
+
+@dataclass(frozen=True)
+class ShadingInputs:
+    """Everything eq. 8 needs for one scene, spectrally (arrays on GRID_NM, float64).
+
+    Irradiances in W m^-2 nm^-1 (on a plane normal to the beam), radiances in
+    W m^-2 sr^-1 nm^-1, directions as unit 3-vectors in world space (outside = -z).
+    """
+
+    key_irradiance: np.ndarray            # the sun or lamp behind the curtain
+    key_to_light: np.ndarray
+    fill_irradiance: np.ndarray           # a directional light on the viewer's side
+    fill_to_light: np.ndarray
+    sky_radiance: np.ndarray              # outside, above the horizon
+    ground_radiance: np.ndarray           # outside, below the horizon
+    sun_disc_radiance: np.ndarray         # the key light's disc
+    room_radiance: np.ndarray             # the room's walls
+    sun_chord2: tuple[float, float]       # disc edge: |dir - sun|^2 inner, outer
+    direct: float                         # LD, open-area see-through fraction
+    a_diff: float
+    g_diff: float
+    a_spec: float
+    g_spec: float
+    anisotropy: float                     # warp/weft spread of the directional lobe, (-1, 1)
+    dye_transmittance: np.ndarray         # T(l) multiplying both lobes (1 for an undyed cloth)
+    ambient_radiance: np.ndarray          # cloth radiance towards the viewer from the diffuse surroundings
+    fluorescence_mode: str                # "off" | "paper" | "physical" (after the "needed" judgement)
+    paper_radiance: np.ndarray | None = None          # eq. 8: I_fluor F as a radiance
+    absorbed_photons: tuple[float, float, float] = (0.0, 0.0, 0.0)  # key, fill (normal incidence), ambient; m^-2 s^-1
+    saturation_photons: float = math.inf  # N_sat, m^-2 s^-1
+    emission_per_photon: np.ndarray | None = None     # radiance per effective absorbed photon m^-2 s^-1, per side
+
+
+# --------------------------------------------------------------------------- terms
+
+def hg_phase_chords(chord2, anti2, g):
+    """Eq. 6 from the chords |view - travel|^2 and |view + travel|^2 (float64).
+
+    g >= 0: :func:`catalog.optics.btdf.hg_phase_one_minus_cos` with 1 - cos = chord2 / 2 (the same
+    robust form as shaders/common.glsl). g < 0: the mirrored form (1 + g)^2 - g anti2 that the
+    shader uses so that float32 keeps its digits near g = -1, theta = pi.
+    """
+    chord2 = np.asarray(chord2, dtype=np.float64)
+    anti2 = np.asarray(anti2, dtype=np.float64)
+    if g >= 0:
+        return hg_phase_one_minus_cos(0.5 * chord2, g)
+    d = (1 + g) * (1 + g) - g * anti2
+    return (1 - g) * (1 + g) / (4 * math.pi * d * np.sqrt(d))  # eq. 6
+
+
+def woven_chord2(delta, t, b, n, anisotropy):
+    """The anisotropic chord of the directional lobe (see shaders/common.glsl)."""
+    dt = np.einsum("...i,...i->...", delta, t)
+    db = np.einsum("...i,...i->...", delta, b)
+    dn = np.einsum("...i,...i->...", delta, n)
+    return dt * dt * (1 - anisotropy) + db * db * (1 + anisotropy) + dn * dn
+
+
+def woven_transmission(to_light, to_viewer, t, b, n, inputs: ShadingInputs):
+    """Eq. 5-7 without LD: radiance per unit normal irradiance of a directional light."""
+    travel = -np.asarray(to_light, dtype=np.float64)
+    delta = to_viewer - travel
+    total = to_viewer + travel
+    chord2 = np.einsum("...i,...i->...", delta, delta)
+    anti2 = np.einsum("...i,...i->...", total, total)
+    ph_diff = hg_phase_chords(chord2, anti2, inputs.g_diff)
+    ph_spec = hg_phase_chords(woven_chord2(delta, t, b, n, inputs.anisotropy), anti2,
+                              inputs.g_spec)
+    cos_i = np.abs(np.einsum("...i,i->...", n, np.asarray(to_light, dtype=np.float64)))
+    return cos_i * (inputs.a_diff * ph_diff + inputs.a_spec * ph_spec)  # eq. 5, 7
+
+
+def _smoothstep(edge0, edge1, x):
+    s = np.clip((x - edge0) / (edge1 - edge0), 0.0, 1.0)
+    return s * s * (3 - 2 * s)
+
+
+def background_weights(ray, to_sun, chord2_inner, chord2_outer):
+    """Weights of (sky, ground, sun disc, room) for ray directions (..., 3); outside is -z."""
+    ray = np.asarray(ray, dtype=np.float64)
+    d = ray - np.asarray(to_sun, dtype=np.float64)
+    disc = 1.0 - _smoothstep(chord2_inner, chord2_outer, np.einsum("...i,...i->...", d, d))
+    outside = ray[..., 2] < 0
+    above = ray[..., 1] >= 0
+    w = np.zeros(ray.shape[:-1] + (4,))
+    w[..., 0] = outside & above
+    w[..., 1] = outside & ~above
+    w[..., 2] = np.where(outside & above, disc, 0.0)
+    w[..., 3] = ~outside
+    return w
+
+
+def hg_hemisphere_factors(g: float) -> tuple[float, float]:
+    """Cloth radiance per unit radiance of a uniform hemisphere, for a view along the normal.
+
+    forward: the lit hemisphere behind the cloth (transmission),
+    2 pi integral_0^1 ph(mu; g) mu d mu with cos(theta) = mu; backward: the hemisphere on the
+    viewer's side (the thin layer scattering back), the same with cos(theta) = -mu, which by
+    HG's mirror symmetry is forward(-g). In closed form (eq. 6 integrated; written without
+    the cancellation of the textbook form at small g):
+
+        forward(g) = (1 + g) / 2 - (1 - g^2) / (2 (1 + sqrt(1 + g^2)))
+
+    forward(0) = backward(0) = 1/4; forward + backward = 1 - (1 - g^2) / (1 + sqrt(1 + g^2)),
+    the integral of ph |cos| over the sphere. (A quadrature would need nodes finer than the
+    peak, (1 - g)^2 / 2g in cos theta: a 20 000-node midpoint rule is 4e-4 off at g = 0.97
+    and 75 % off at g = 0.999.)
+    """
+    if not -1.0 < g < 1.0:
+        raise ValueError(f"HG g must lie in (-1, 1), got {g!r}")
+    shared = (1.0 - g * g) / (2.0 * (1.0 + math.sqrt(1.0 + g * g)))
+    return (1.0 + g) / 2.0 - shared, (1.0 - g) / 2.0 - shared
+
+
+# --------------------------------------------------------------------------- shading
+
+def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
+                   camera_position) -> np.ndarray:
+    """Spectral radiance (P, len(GRID_NM)) W m^-2 sr^-1 nm^-1 at world positions (P, 3)."""
+    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    n = n / np.linalg.norm(n, axis=1, keepdims=True)
+    t = np.asarray(tangents, dtype=np.float64).reshape(-1, 3)
+    t = t - np.einsum("pi,pi->p", t, n)[:, None] * n
+    t = t / np.linalg.norm(t, axis=1, keepdims=True)
+    b = np.cross(n, t)
+    ray = p - np.asarray(camera_position, dtype=np.float64)
+    ray = ray / np.linalg.norm(ray, axis=1, keepdims=True)
+    to_viewer = -ray
+
+    g_key = woven_transmission(inputs.key_to_light, to_viewer, t, b, n, inputs)
+    g_fill = woven_transmission(inputs.fill_to_light, to_viewer, t, b, n, inputs)
+    dyed_key = inputs.key_irradiance * inputs.dye_transmittance
+    dyed_fill = inputs.fill_irradiance * inputs.dye_transmittance
+    radiance = (g_key[:, None] * dyed_key + g_fill[:, None] * dyed_fill
+                + inputs.ambient_radiance[None, :])
+    if inputs.direct > 0:
+        w = inputs.direct * background_weights(ray, inputs.key_to_light, *inputs.sun_chord2)
+        radiance += (w[:, 0:1] * inputs.sky_radiance + w[:, 1:2] * inputs.ground_radiance
+                     + w[:, 2:3] * inputs.sun_disc_radiance + w[:, 3:4] * inputs.room_radiance)
+    if inputs.fluorescence_mode == "paper":
+        radiance += inputs.paper_radiance[None, :]  # eq. 8: a constant per light
+    elif inputs.fluorescence_mode == "physical":
+        n_key, n_fill, n_ambient = inputs.absorbed_photons
+        absorbed = (np.abs(n @ np.asarray(inputs.key_to_light)) * n_key
+                    + np.abs(n @ np.asarray(inputs.fill_to_light)) * n_fill + n_ambient)
+        effective = absorbed / (1.0 + absorbed / inputs.saturation_photons)
+        radiance += effective[:, None] * inputs.emission_per_photon[None, :]
+    return radiance
+
+
+def spectral_to_linear_srgb(radiance: np.ndarray) -> np.ndarray:
+    """683 * M_sRGB . sum cmf L dl: linear sRGB with Y in cd m^-2 (negatives kept)."""
+    from catalog.optics.colorimetry import spectrum_to_xyz, xyz_to_linear_srgb  # noqa: PLC0415
+
+    return xyz_to_linear_srgb(LUMINOUS_EFFICACY_LM_W * spectrum_to_xyz(radiance, GRID_NM, STEP_NM))
+
+
+def spectral_to_xyz(radiance: np.ndarray) -> np.ndarray:
+    """683 * sum cmf L dl: XYZ with Y in cd m^-2."""
+    from catalog.optics.colorimetry import spectrum_to_xyz  # noqa: PLC0415
+
+    return LUMINOUS_EFFICACY_LM_W * spectrum_to_xyz(radiance, GRID_NM, STEP_NM)
+
+
+def reference_linear_srgb(inputs: ShadingInputs, positions, normals, tangents,
+                          camera_position) -> np.ndarray:
+    """The full-spectral (1 nm) float64 reference colour of the given pixels, (P, 3)."""
+    return spectral_to_linear_srgb(shade_spectral(inputs, positions, normals, tangents,
+                                                  camera_position))
+
+
+def white_xyz(inputs: ShadingInputs) -> np.ndarray:
+    """The adapted white for Delta E: a perfect white diffuser under the key light, cd m^-2."""
+    return spectral_to_xyz(inputs.key_irradiance / math.pi)
