@@ -272,6 +272,37 @@ def fluorescence_per_vertex(desc: SceneDescription, scene=None, mi=None) -> np.n
     return effective[:, None] * np.asarray(fl["emission_rgb_per_photon"])[None, :]
 
 
+#: The least share of next-event samples an emitter gets (none is starved).
+MIN_SAMPLING_SHARE = 0.15
+
+
+def emitter_sampling_weights(desc: SceneDescription, emission: np.ndarray) -> dict[str, float]:
+    """Next-event estimation's choice between the environment (sky, ground, the key's disc)
+    and each fluorescence shell, in proportion to the luminous power each sends into the
+    room (the environment's through the window, a shell's pi L A), at least
+    MIN_SAMPLING_SHARE each. Mitsuba's default, uniform over emitters, spends two thirds of
+    the shadow rays on a faint glow under daylight and on a black sky under a UV lamp."""
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    luma = np.array([0.2126, 0.7152, 0.0722])
+    x0, x1, y0, y1 = scene_lib.WINDOW_RECT
+    window_m2 = (x1 - x0) * (y1 - y0)
+    env = max(float(desc.key_rgb @ luma), 0.0) + math.pi * 0.5 * max(
+        float((desc.sky_rgb + desc.ground_rgb) @ luma), 0.0)
+    env *= window_m2
+    positions = np.asarray(desc.curtain[0], dtype=np.float64).reshape(-1, 3)
+    tri = np.asarray(desc.curtain[4]).reshape(-1, 3)
+    area = 0.5 * np.linalg.norm(np.cross(positions[tri[:, 1]] - positions[tri[:, 0]],
+                                         positions[tri[:, 2]] - positions[tri[:, 0]]), axis=1).sum()
+    shell = math.pi * max(float(np.mean(np.abs(emission @ luma))), 0.0) * area
+    total = env + 2 * shell
+    if not total > 0:
+        return {"environment": 1.0, "shell": 1.0}
+    env_w, shell_w = env / total, shell / total
+    env_w, shell_w = max(env_w, MIN_SAMPLING_SHARE), max(shell_w, MIN_SAMPLING_SHARE)
+    return {"environment": env_w, "shell": shell_w}
+
+
 def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
                         integrator: dict | None = None, room: bool = True,
                         environment: bool = True, stand_ins: bool = False,
@@ -329,11 +360,15 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     tri = np.asarray(indices).reshape(-1, 3)
+    weights = emitter_sampling_weights(desc, emission)
+    if environment:
+        scene["environment"]["sampling_weight"] = weights["environment"]
     for side, sign in (("front", 1.0), ("back", -1.0)):
         shell_props = mi.Properties()
         shell_props["bsdf"] = mi.load_dict({"type": "null"})
-        shell_props["emitter"] = mi.load_dict({"type": "area", "radiance": {
-            "type": "mesh_attribute", "name": "vertex_fluorescence"}})
+        shell_props["emitter"] = mi.load_dict({"type": "area", "sampling_weight": weights["shell"],
+                                               "radiance": {"type": "mesh_attribute",
+                                                            "name": "vertex_fluorescence"}})
         faces = tri if sign > 0 else tri[:, ::-1]
         shell = _mesh(mi, f"fluorescence_{side}", p + sign * SHELL_OFFSET_M * n, faces,
                       sign * n, None, shell_props)
