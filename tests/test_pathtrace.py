@@ -346,3 +346,23 @@ def test_coverage_pattern_hook_makes_holes_null_transmission(mi):
     f = np.asarray(bsdf.eval(ctx, si, wo))[0]
     f_plain = np.asarray(plain.eval(ctx, _si(mi, (0.0, 0.0, 1.0), 2), wo))[0]
     assert f[0] == 0 and np.isclose(f[1], 2.0 * np.ravel(f_plain)[-1], rtol=1e-5)
+
+
+def test_image_section_tables_and_pareto_front_from_a_result():
+    from catalog.bench import image
+
+    def option(label, flip, ms):
+        return {"option": label, "mean_flip": flip, "curtain_mean_delta_e": 1.0, "frame_s": ms / 1e3}
+
+    row = {"scene": "s", "spp": 64, "mean_flip": 0.2, "reference_noise_rel": 0.04, "reference_flip_noise_bound": 0.05,
+           "reference_noise_curtain_rel": 0.02, "meets_goal": False}
+    result = {"rows": [row], "settings": {"size": [8, 6], "spp": 64},
+              "summary": {"integrator": "x", "scenes_meeting_goal": 0, "scenes": 1,
+                          "absent_options": ["shadow map size"]},
+              "pareto": [{"scene": "s", "options": [option("a", 0.2, 10), option("b", 0.3, 20),
+                                                    option("c", 0.1, 30)]}]}
+    front = {r["option"]: r["pareto"] for r in image.option_summary(result)}
+    assert front == {"a": True, "b": False, "c": True}
+    assert image.spp_for_noise(64, 0.02, 0.01) == 256
+    tables = image.markdown_tables(result)
+    assert "| s |" in tables["image"] and "256" in tables["image"] and "shadow map size" in tables["image-options"]

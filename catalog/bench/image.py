@@ -153,6 +153,11 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
         masks = region_masks(mi, scene, desc)
         noise = metrics.noise_between(a, b)
         noise_curtain = metrics.noise_between(a, b, masks["curtain"])
+        # FLIP between the two half renders: what noise alone scores (each half has sqrt(2)
+        # the noise of their mean, so this bounds the noise's share of the frame's FLIP)
+        exposure = metrics.exposure_for(light)
+        flip_noise = float(metrics.flip_map(metrics.display(a, exposure),
+                                            metrics.display(b, exposure)).mean())
         option_rows = []
         for opt_label, bands, mode, supersample in options:
             frame, frame_s = frame_linear(ctx, desc, preset, light, bands, mode, supersample,
@@ -173,6 +178,7 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
                "frame_ms": 1e3 * frame_s, "reference_s": reference_s,
                "speedup": reference_s / frame_s if frame_s > 0 else math.inf,
                "reference_noise_rel": noise, "reference_noise_curtain_rel": noise_curtain,
+               "reference_flip_noise_bound": flip_noise,
                "fluorescence": desc.info["fluorescence_variant"]}
         row["meets_goal"] = bool(row["mean_flip"] <= GOAL["mean_flip_at_most"]
                                  and (row["curtain_delta_e_mean"] or math.inf)
@@ -284,6 +290,12 @@ def plot_pareto(result: dict, folder) -> Path:
     return save_figure(fig, Path(folder) / "image-pareto.png")
 
 
+def spp_for_noise(spp: int, noise: float, target: float = NOISE_TARGET) -> float:
+    """Samples per pixel at which a render with relative noise ``noise`` at ``spp`` reaches
+    ``target`` (Monte Carlo: noise ~ 1 / sqrt(spp))."""
+    return spp * (noise / target) ** 2
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks for BENCHMARKS.md / docs: ``image`` (per scene), ``image-options``."""
     from catalog.bench.report import table  # noqa: PLC0415
@@ -295,10 +307,12 @@ def markdown_tables(result: dict) -> dict[str, str]:
         "scene", "mean_flip", "curtain_delta_e_mean", "curtain_delta_e_p95", "floor_delta_e_mean",
         "floor_delta_e_p95", "walls_delta_e_mean", "walls_delta_e_p95", "frame_ms", "reference_s",
         "speedup", "reference_noise_rel", "reference_noise_curtain_rel", "spp_for_1pct",
+        "reference_flip_noise_bound",
         "meets_goal"],
         ["scene", "mean FLIP", "curtain dE mean", "curtain dE p95", "floor dE mean",
          "floor dE p95", "walls dE mean", "walls dE p95", "frame ms", "reference s",
          "x faster", "ref. noise (rel. RMS)", "ref. noise, curtain", "spp for 1 % on the curtain",
+         "FLIP of the two half renders (noise bound)",
          "goal met"])
     per_scene += (f"\n\n{result['settings']['size'][0]}x{result['settings']['size'][1]} px; "
                   f"reference: {s['integrator']}. Goal (issue 11): mean FLIP <= "
