@@ -148,6 +148,12 @@ def test_reciprocity_and_eval_against_the_float64_eq7(mi):
 
 # --------------------------------------------------------------------------- the scene
 
+def desc_preset(name):
+    from catalog.presets import find_preset, load_preset
+
+    return load_preset(find_preset(name))
+
+
 def _lace_d65(size=(48, 36), **kw):
     from catalog.optics.lights import get_light
     from catalog.pathtrace.scene import describe_scene
@@ -158,13 +164,18 @@ def _lace_d65(size=(48, 36), **kw):
 
 def test_export_reads_the_real_time_scene():
     from catalog.render import bands, scene as scene_lib
+    from catalog.render.snapshot import simulated_curtain
 
     desc = _lace_d65()
+    assert desc.fabric_size_m is not None and len(desc.ring_xs_m) > 0
+    assert np.array_equal(desc.curtain[0], simulated_curtain(desc_preset("lace-fwa"), 0)[0])
+    assert desc.pattern is not None and desc.pattern["coverage"].ndim == 2
     assert desc.room_albedo == scene_lib.ROOM_ALBEDO
     assert np.allclose(desc.sky_rgb, bands.spectrum_to_display_rgb(desc.inputs.sky_radiance), rtol=1e-9)
     assert np.allclose(desc.key_to_light, scene_lib.key_direction(scene_lib.LAMP_ELEVATION_DEG))
     assert desc.key_radius_rad == scene_lib.SUN_RADIUS_RAD
-    assert np.array_equal(desc.room_positions, scene_lib.room_props()[0].astype(np.float64))
+    room = scene_lib.room_props()[0].astype(np.float64)
+    assert np.array_equal(desc.room_positions[:room.shape[0]], room)  # then the rings
 
 
 def test_environment_disc_integrates_to_the_key_irradiance():
@@ -200,6 +211,7 @@ def test_direct_light_matches_the_float64_reference_per_pixel(mi):
     desc = _lace_d65(size=(64, 48), fluorescence="off", distance_m=1.6,
                      curtain=(flat.positions, flat.normals, flat.uvs, flat.tangents, flat.indices))
     desc.fabric["direct"] = 0.0
+    desc.pattern = None  # eq. 7 as fitted (the float64 reference has no pattern)
     integrator = {"type": "aov", "aovs": "p:position,n:sh_normal,t:dp_du",
                   "radiance": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0}}
     zero = np.zeros_like(desc.inputs.ambient_radiance)
@@ -227,7 +239,10 @@ def test_noise_falls_as_one_over_root_spp_and_the_estimates_agree(mi):
     from catalog.pathtrace.render import render_radiance
     from catalog.pathtrace.scene import build_mitsuba_scene
 
-    desc = _lace_d65(size=(32, 24), fluorescence="off")
+    d = __import__("catalog.render.scene", fromlist=["draped_curtain"]).draped_curtain(40, 30)
+    desc = _lace_d65(size=(32, 24), fluorescence="off",
+                     curtain=(d.positions, d.normals, d.uvs, d.tangents, d.indices))
+    desc.pattern = None
     scene = build_mitsuba_scene(mi, desc, max_depth=8)
     noise = {}
     for spp in (8, 32):

@@ -17,6 +17,7 @@ optionally, ``plot(result, folder) -> list[Path]``:
 - ``stability``: every model's parameters swept to their edges
   (:mod:`catalog.bench.stability`);
 - ``startup``: import time and time to the first frame (:mod:`catalog.bench.startup`);
+- ``display``: each display transform's cost in the frame (:mod:`catalog.bench.display`);
 - ``image``: the real-time frame against the path-traced reference of the same scene, FLIP
   and Delta E per region, both run times (:mod:`catalog.bench.image`; needs the
   ``pathtrace`` extra and LLVM 19, docs/pathtrace.md).
@@ -42,5 +43,6 @@ SECTIONS: dict[str, str] = {
     "cloth": "catalog.bench.cloth",
     "stability": "catalog.bench.stability",
     "startup": "catalog.bench.startup",
+    "display": "catalog.bench.display",
     "image": "catalog.bench.image",
 }

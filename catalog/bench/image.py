@@ -16,8 +16,8 @@ description and curtain mesh. Measured:
 - both run times (frame: median of repeats with glFinish; reference: the two renders'
   wall time, scene building excluded) and their ratio, at equal resolution.
 
-Real-time options (the Pareto plot): spectral bands 3/6/9/16, paper vs physical
-fluorescence, 2x2 supersampling (anti-aliasing). Room lighting and shadow-map size join
+Real-time options (the Pareto plot): spectral bands 3/6/16, paper vs physical
+fluorescence, anti-aliasing (FXAA, the default; none; 2x2 supersampling). Room lighting and shadow-map size join
 :data:`OPTIONS` when the frame has them (issue 13); until then they are listed as absent.
 
 The goal of issue 11 (stated before measuring): on every scene mean FLIP <= 0.10, curtain
@@ -51,13 +51,15 @@ SIZE = (192, 144)
 QUICK_SIZE = (64, 48)
 SPP = 256
 QUICK_SPP = 16
-#: (label, bands, fluorescence mode, supersample factor). The first is the frame's default.
+#: (label, bands, fluorescence mode, supersample factor, anti-aliasing (None: the frame's
+#: default, FXAA)). The first is the frame's default.
 OPTIONS = (
-    ("default (physical, 3 bands)", 3, "physical", 1),
-    ("6 bands", 6, "physical", 1),
-    ("16 bands", 16, "physical", 1),
-    ("paper fluorescence", 3, "paper", 1),
-    ("2x2 supersampled", 3, "physical", 2),
+    ("default (physical, 3 bands, FXAA)", 3, "physical", 1, None),
+    ("FXAA off", 3, "physical", 1, "off"),
+    ("6 bands", 6, "physical", 1, None),
+    ("16 bands", 16, "physical", 1, None),
+    ("paper fluorescence", 3, "paper", 1, None),
+    ("2x2 supersampled", 3, "physical", 2, "off"),
 )
 ABSENT_OPTIONS = ("room lighting on/off", "shadow map size")
 #: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
@@ -77,10 +79,14 @@ def light_name(key: str) -> str:
     return key
 
 
-def frame_linear(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
-                 repeats: int = 5) -> tuple[np.ndarray, float]:
-    """The real-time frame's linear radiance (H, W, 3) at desc.size and its median wall time
-    (s) of render + glFinish; ``supersample`` renders s x s larger and box-averages."""
+def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
+                 antialiasing: str | None = None, repeats: int = 5) -> dict:
+    """The real-time frame at desc.size: ``linear`` radiance (H, W, 3), ``display`` (the
+    frame's own display image, sRGB in [0, 1]), the ``exposure`` and ``white_balance`` its
+    display step used, and ``seconds``, the median wall time of render + glFinish.
+    ``supersample`` renders s x s larger and box-averages the radiance (then displays it
+    with the same exposure and white balance); ``antialiasing`` None keeps the default."""
+    from catalog.pathtrace import metrics  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
     width, height = desc.size
@@ -90,31 +96,39 @@ def frame_linear(ctx, desc, preset, light, bands: int, mode: str, supersample: i
         renderer.set_light(light)
         renderer.set_fluorescence(mode)
         renderer.set_bands(bands)
+        if antialiasing is not None:
+            renderer.set_antialiasing(antialiasing)
         cam = desc.info["camera"]
         renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
-        renderer.set_mesh(*desc.curtain)
+        renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
+        renderer.set_rings(list(desc.ring_xs_m))
         wall, _cpu = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)
-        pixels = renderer.read_linear()
+        linear = renderer.read_linear()
+        shown = renderer.read_srgb8().astype(np.float32) / 255.0
+        exposure = renderer.exposure_scale()
+        white_balance = renderer.white_balance_matrix()
     finally:
         renderer.release()
     if supersample > 1:
         s = supersample
-        pixels = pixels.reshape(height, s, width, s, 3).mean(axis=(1, 3))
-    return pixels.astype(np.float32), wall
+        linear = linear.reshape(height, s, width, s, 3).mean(axis=(1, 3))
+        shown = metrics.display(linear, exposure, white_balance)
+    return {"linear": linear.astype(np.float32), "display": shown, "exposure": exposure,
+            "white_balance": white_balance, "seconds": wall}
 
 
-def compare(frame: np.ndarray, reference: np.ndarray, masks: dict, light, inputs) -> dict:
-    """FLIP and Delta E of one frame against the reference (maps and summaries)."""
+def compare(frame: dict, reference: np.ndarray, masks: dict, inputs,
+            exposure: float, white_balance) -> dict:
+    """FLIP (display images) and Delta E (radiance) of one frame against the reference."""
     from catalog.bench.colour import adapted_white  # noqa: PLC0415
     from catalog.optics.colorimetry import linear_srgb_to_xyz  # noqa: PLC0415
-    from catalog.pathtrace import metrics  # noqa: PLC0415
     from catalog.optics.shading_reference import white_xyz  # noqa: PLC0415
+    from catalog.pathtrace import metrics  # noqa: PLC0415
 
-    exposure = metrics.exposure_for(light)
-    flip = metrics.flip_map(metrics.display(frame, exposure), metrics.display(reference, exposure))
+    flip = metrics.flip_map(frame["display"], metrics.display(reference, exposure, white_balance))
     cloth_xyz = linear_srgb_to_xyz(reference[masks["curtain"]].astype(np.float64))
     white = adapted_white(white_xyz(inputs), cloth_xyz)
-    delta_e = metrics.delta_e_map(frame, reference, white)
+    delta_e = metrics.delta_e_map(frame["linear"], reference, white)
     return {"mean_flip": float(flip.mean()), "flip_map": flip,
             "delta_e": metrics.region_stats(delta_e, {r: masks[r] for r in REGIONS})}
 
@@ -153,22 +167,24 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
         masks = region_masks(mi, scene, desc)
         noise = metrics.noise_between(a, b)
         noise_curtain = metrics.noise_between(a, b, masks["curtain"])
-        # FLIP between the two half renders: what noise alone scores (each half has sqrt(2)
-        # the noise of their mean, so this bounds the noise's share of the frame's FLIP)
-        exposure = metrics.exposure_for(light)
-        flip_noise = float(metrics.flip_map(metrics.display(a, exposure),
-                                            metrics.display(b, exposure)).mean())
         option_rows = []
-        for opt_label, bands, mode, supersample in options:
-            frame, frame_s = frame_linear(ctx, desc, preset, light, bands, mode, supersample,
-                                          repeats=3 if quick else 7)
-            result = compare(frame, reference, masks, light, desc.inputs)
+        default = None
+        for opt_label, bands, mode, supersample, antialiasing in options:
+            frame = frame_images(ctx, desc, preset, light, bands, mode, supersample,
+                                 antialiasing, repeats=3 if quick else 7)
+            if default is None:  # the default frame's exposure and white balance show both
+                exposure, white_balance = frame["exposure"], frame["white_balance"]
+            result = compare(frame, reference, masks, desc.inputs, exposure, white_balance)
             option_rows.append({"option": opt_label, "mean_flip": result["mean_flip"],
                                 "curtain_mean_delta_e": (result["delta_e"]["curtain"] or {}).get("mean"),
-                                "frame_s": frame_s})
-            if opt_label == options[0][0]:
-                default = (frame, frame_s, result)
+                                "frame_s": frame["seconds"]})
+            if default is None:
+                default = (frame, frame["seconds"], result)
         frame, frame_s, result = default
+        # FLIP between the two half renders: what noise alone scores (each half has sqrt(2)
+        # the noise of their mean, so this bounds the noise's share of the frame's FLIP)
+        flip_noise = float(metrics.flip_map(metrics.display(a, exposure, white_balance),
+                                            metrics.display(b, exposure, white_balance)).mean())
         de = result["delta_e"]
         row = {"scene": label, "fabric": fabric, "light": light.name, "view": view,
                "camera": {"yaw_deg": yaw, "pitch_deg": pitch, "distance_m": distance}, "size": list(size), "spp": spp,
@@ -186,8 +202,9 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
                                  and row["speedup"] >= GOAL["speedup_at_least"])
         rows.append(row)
         pareto.append({"scene": label, "options": option_rows})
-        images[label] = {"frame": frame, "reference": reference, "flip": result["flip_map"],
-                         "exposure": metrics.exposure_for(light)}
+        images[label] = {"frame": frame["display"],
+                         "reference": metrics.display(reference, exposure, white_balance),
+                         "flip": result["flip_map"]}
     summary = {
         "goal": GOAL,
         "scenes_meeting_goal": sum(r["meets_goal"] for r in rows),
@@ -208,18 +225,16 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
     return result
 
 
-def _display_u8(linear, exposure):
-    from catalog.pathtrace import metrics  # noqa: PLC0415
-
-    return (metrics.display(linear, exposure) * 255 + 0.5).astype(np.uint8)
+def _u8(display):
+    return (np.clip(display, 0, 1) * 255 + 0.5).astype(np.uint8)
 
 
 def triptych(images: dict) -> np.ndarray:
     """real-time | reference | FLIP map, uint8 (H, 3W + 8, 3)."""
     from catalog.pathtrace import metrics  # noqa: PLC0415
 
-    frame = _display_u8(images["frame"], images["exposure"])
-    reference = _display_u8(images["reference"], images["exposure"])
+    frame = _u8(images["frame"])
+    reference = _u8(images["reference"])
     gap = np.full((frame.shape[0], 4, 3), 255, dtype=np.uint8)
     return np.concatenate([frame, gap, reference, gap, metrics.error_map_image(images["flip"])], 1)
 

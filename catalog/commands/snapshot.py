@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from catalog.commands.displayargs import add_display_arguments, display_choices
+
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
 
 
@@ -14,7 +16,7 @@ def add_arguments(parser) -> None:
                              "summer solstice, 34.7 N) behind the window")
     parser.add_argument("--size", default="1280x720", help="WIDTHxHEIGHT in pixels")
     parser.add_argument("--frame", type=int, default=0,
-                        help="cloth simulation frame (0: the static drape)")
+                        help="cloth simulation frame (0: the settled drape every simulation starts from)")
     parser.add_argument("--out", required=True, help="FILE.exr (linear) or FILE.png (sRGB)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
     parser.add_argument("--mode", choices=("paper", "physical"), default="physical",
@@ -23,7 +25,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--yaw", type=float, default=0.0, help="camera yaw, deg")
     parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
     parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")
-    parser.add_argument("--exposure", type=float, default=1.0, help="exposure multiplier")
+    parser.add_argument("--exposure", type=float, default=1.0,
+                        help="exposure multiplier on top of --ev or the automatic exposure")
+    add_display_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
@@ -33,11 +37,13 @@ def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.snapshot import SnapshotRequest, parse_size, render_snapshot  # noqa: PLC0415
 
+    ev, white_balance = display_choices(args)
     request = SnapshotRequest(
         fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
         frame=args.frame, fluorescence="off" if args.no_fluorescence else args.mode,
         bands=args.bands, hour=args.hour, yaw_deg=args.yaw, pitch_deg=args.pitch,
-        distance_m=args.distance, exposure=args.exposure)
+        distance_m=args.distance, exposure=args.exposure, ev=ev,
+        white_balance=white_balance)
     report = render_snapshot(request)
     if args.json:
         print_json(report)

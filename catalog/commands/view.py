@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from catalog.core.cliargs import wxh_type
+from catalog.commands.displayargs import add_display_arguments
 
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
@@ -62,8 +64,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="spectral bands (3 = RGB)")
     parser.add_argument("--hour", type=float, help="hour of day for the sun (6-18)")
     parser.add_argument("--wind", type=float, metavar="M_S", help="wind speed, m/s")
-    parser.add_argument("--grid", type=_grid, default=(48, 64), metavar="WxH",
-                        help="cloth particles across x down (default 48x64)")
+    parser.add_argument("--grid", type=_grid, default=(96, 56), metavar="WxH",
+                        help="cloth particles across x down (default 96x56: the fabric is "
+                             "fullness x the rod wide)")
+    parser.add_argument("--distance", type=float, default=2.6, metavar="M",
+                        help="camera distance from the curtain, m (0.2-4; the wheel zooms, "
+                             "R resets; default 2.6)")
     parser.add_argument("--cloth-backend", choices=("auto", "numpy", "cpu", "gpu"),
                         default="auto",
                         help="cloth simulation backend: gpu (compute shaders writing the "
@@ -74,6 +80,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
+    parser.add_argument("--compare-fluorescence", choices=FLUORESCENCE_CHOICES, default=None,
+                        help="with --compare: the right half's fluorescence mode (default: "
+                        "the left's); --compare NAME --fabric NAME shows one fabric on | off")
+    add_display_arguments(parser)
     parser.add_argument("--fabric-dir", type=Path, metavar="DIR",
                         help="folder of presets (default: the catalog's fabrics/)")
 
@@ -99,11 +109,16 @@ def run(args: argparse.Namespace) -> int:
     from catalog.viewer.app import ViewerApp, ViewerOptions
     from catalog.viewer.window import NO_DISPLAY_HINT, display_available, init_glfw
 
+    from catalog.commands.displayargs import display_choices
+
+    ev, white_balance = display_choices(args)
     if args.screenshot is not None and args.frames is None:
         raise CatalogError("--screenshot needs --frames N (the S key saves screenshots "
                            "in interactive use)")
     if args.hour is not None and not 0.0 <= args.hour <= 24.0:
         raise CatalogError(f"--hour: {args.hour:g} is not an hour of the day (0-24)")
+    if not (math.isfinite(args.distance) and 0.2 <= args.distance <= 4.0):
+        raise CatalogError(f"--distance: {args.distance:g} m is outside 0.2-4 m (the room)")
     if args.wind is not None and not 0.0 <= args.wind <= 50.0:
         raise CatalogError(f"--wind: {args.wind:g} m/s is outside 0-50 m/s")
     if not display_available():  # say so before any heavy import or preset read
@@ -120,8 +135,9 @@ def run(args: argparse.Namespace) -> int:
         fabric=fabric, light=args.light, compare=args.compare, size=args.size,
         frames=args.frames, screenshot=args.screenshot, screenshot_dir=args.screenshot_dir,
         stats=args.stats, fluorescence=args.fluorescence, bands=args.bands, hour=args.hour,
-        wind_m_s=args.wind, grid=args.grid,
+        wind_m_s=args.wind, grid=args.grid, distance_m=args.distance,
         cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
+        ev100=ev, white_balance=white_balance, compare_fluorescence=args.compare_fluorescence,
         fabric_dir=fabric_dir if fabric_dir is not None else FABRIC_DIR)
     return ViewerApp(options).run()

@@ -1,8 +1,9 @@
 """The real-time frame's error against the reference (numpy; FLIP from ``flip-evaluator``).
 
-- display: both linear images go through the frame's own display step (exposure for the
-  light, Reinhard on luminance to TONE_WHITE, the sRGB curve: shaders/tonemap.frag), so
-  the comparison is of what a viewer sees;
+- display: the frame's display image as it draws it (its exposure, white balance, tone
+  curve, gamut step and anti-aliasing), the reference through the same display step with
+  the frame's exposure and white balance (catalog.render.display), so the comparison is
+  of what a viewer sees;
 - FLIP (LDR-FLIP, Andersson et al. 2020, PyPI ``flip-evaluator``) of the two display
   images, mean over the image, at 67 pixels per degree (a 0.7 m, 24-inch 4K monitor);
 - Delta E 2000 (catalog.optics.colorimetry) on the linear images in CIELAB, the white a perfect
@@ -21,23 +22,14 @@ PIXELS_PER_DEGREE = 67.0
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 
 
-def exposure_for(light) -> float:
-    """The frame's exposure scale for a light (FrameRenderer.exposure_scale, multiplier 1)."""
-    from catalog.render.frame import EXPOSURE_FLOOR_LX, EXPOSURE_KEY  # noqa: PLC0415
+def display(linear: np.ndarray, exposure: float, white_balance=None) -> np.ndarray:
+    """Linear sRGB radiance -> display sRGB in [0, 1] (float32) through the frame's own
+    display step (:func:`catalog.render.display.display_transform`: exposure, white
+    balance, tone curve, gamut compression, the sRGB curve)."""
+    from catalog.render import display as display_lib  # noqa: PLC0415
 
-    return EXPOSURE_KEY * math.pi / max(light.illuminance_lx, EXPOSURE_FLOOR_LX)
-
-
-def display(linear: np.ndarray, exposure: float) -> np.ndarray:
-    """Linear sRGB radiance -> display sRGB in [0, 1] (float32), as shaders/tonemap.frag."""
-    from catalog.render.frame import TONE_WHITE  # noqa: PLC0415
-
-    x = np.asarray(linear, dtype=np.float64) * exposure
-    lum = x @ LUMA
-    mapped = lum * (1 + lum / (TONE_WHITE * TONE_WHITE)) / (1 + lum)
-    scale = np.where(lum > 0, mapped / np.where(lum > 0, lum, 1.0), 0.0)
-    c = np.clip(x * scale[..., None], 0.0, 1.0)
-    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1 / 2.4) - 0.055).astype(np.float32)
+    wb = np.eye(3) if white_balance is None else np.asarray(white_balance, dtype=np.float64)
+    return np.asarray(display_lib.display_transform(linear, exposure, wb), dtype=np.float32)
 
 
 def flip_map(test_display: np.ndarray, reference_display: np.ndarray) -> np.ndarray:

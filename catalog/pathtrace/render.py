@@ -117,8 +117,9 @@ def render_reference(request: ReferenceRequest, desc=None) -> tuple[np.ndarray, 
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
     from catalog.pathtrace.scene import build_mitsuba_scene  # noqa: PLC0415
 
-    desc = desc if desc is not None else describe(request)
+    validate(request)  # bad input first, then the library (one line each), then the scene
     mi = load_mitsuba(request.variant)
+    desc = desc if desc is not None else describe(request)
     start = time.perf_counter()
     scene = build_mitsuba_scene(mi, desc, max_depth=request.max_depth)
     build_s = time.perf_counter() - start

@@ -73,7 +73,9 @@ class SceneDescription:
     fluorescence: dict | None            # per-vertex emission recipe (see module doc)
     inputs: object                       # catalog.optics.shading_reference.ShadingInputs of the frame
     info: dict = field(default_factory=dict)
-    pattern: dict | None = None          # coverage hook: {"coverage": (H, W) array, "uv_scale": s}
+    pattern: dict | None = None          # {"coverage": (H, W) array, "uv_scale": (su, sv)}
+    fabric_size_m: tuple | None = None   # the rest fabric's (width, length) that uv 0..1 spans
+    ring_xs_m: tuple = ()                # the curtain rings on the rod (x, m)
 
 
 def rgb_weights(key_irradiance: np.ndarray) -> np.ndarray:
@@ -112,15 +114,29 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
     inputs, decision = scene_lib.build_shading_inputs(
         preset, light.irradiance_w_m2_nm, to_light, is_sun=is_sun, fluorescence=fluorescence,
         viewer_inside=inside)
-    if curtain is None:
-        if frame > 0:
-            from catalog.render.snapshot import simulated_curtain  # noqa: PLC0415
+    fabric_size = None
+    rings: tuple = ()
+    if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth
+        from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
 
-            curtain = simulated_curtain(preset, frame)
-        else:
-            d = scene_lib.draped_curtain()
-            curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
+        *curtain, fabric_size = simulated_curtain(preset, frame)
+        rings = tuple(ring_xs_m(preset))
+    elif len(curtain) == 6:
+        *curtain, fabric_size = curtain
     room_positions, _ = scene_lib.room_props()
+    if rings:
+        ring_positions, _ = scene_lib.ring_mesh(list(rings))
+        room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
+                                         np.asarray(ring_positions).reshape(-1, 3)])
+    pattern = None
+    from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+
+    loaded = load_pattern(preset)
+    if loaded is not None:
+        cloth_m = fabric_size or (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
+        pattern = {"coverage": np.asarray(loaded.coverage, dtype=np.float32),
+                   "uv_scale": (float(cloth_m[0]) / loaded.repeat_m[0],
+                                float(cloth_m[1]) / loaded.repeat_m[1])}
     w = rgb_weights(inputs.key_irradiance)
     key_rgb = w @ inputs.key_irradiance
     dyed = w @ (inputs.key_irradiance * inputs.dye_transmittance)
@@ -152,7 +168,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         key_rgb=key_rgb, key_to_light=np.asarray(inputs.key_to_light, dtype=np.float64),
         key_radius_rad=scene_lib.SUN_RADIUS_RAD, fill_rgb=w @ inputs.fill_irradiance,
         fill_to_light=np.asarray(inputs.fill_to_light, dtype=np.float64), fluorescence=fl,
-        inputs=inputs,
+        inputs=inputs, pattern=pattern, fabric_size_m=fabric_size, ring_xs_m=rings,
         info={"fabric": preset.name, "light": light.name, "fluorescence_requested": decision.requested,
               "fluorescence_variant": inputs.fluorescence_mode, "frame": int(frame),
               "camera": {"yaw_deg": camera.yaw_deg, "pitch_deg": camera.pitch_deg,
@@ -243,7 +259,9 @@ def woven_bsdf_dict(fabric: dict, pattern: dict | None = None) -> dict:
         out["coverage"] = {"type": "bitmap", "raw": True,
                            "bitmap": mi.Bitmap(coverage[..., None])}
         out["coverage_mean"] = float(coverage.mean())
-        out["uv_scale"] = float(pattern.get("uv_scale", 1.0))
+        scale = pattern.get("uv_scale", 1.0)
+        su, sv = (scale, scale) if np.isscalar(scale) else scale
+        out["uv_scale_u"], out["uv_scale_v"] = float(su), float(sv)
     return out
 
 

@@ -75,7 +75,7 @@ def register(mi) -> None:
             self.coverage = (props.get_texture("coverage", 1.0)
                              if "coverage" in props else None)
             self.coverage_mean = float(props.get("coverage_mean", 1.0 - self.direct))
-            self.uv_scale = float(props.get("uv_scale", 1.0))
+            self.uv_scale = (float(props.get("uv_scale_u", 1.0)), float(props.get("uv_scale_v", 1.0)))
             lobes = (mi.BSDFFlags.GlossyTransmission | mi.BSDFFlags.GlossyReflection
                      | mi.BSDFFlags.FrontSide | mi.BSDFFlags.BackSide)
             null = mi.BSDFFlags.Null | mi.BSDFFlags.FrontSide | mi.BSDFFlags.BackSide
@@ -88,7 +88,7 @@ def register(mi) -> None:
             if self.coverage is None:
                 return mi.Float(self.direct), mi.Float(1.0)
             si2 = mi.SurfaceInteraction3f(si)
-            si2.uv = si.uv * self.uv_scale
+            si2.uv = mi.Point2f(si.uv.x * self.uv_scale[0], si.uv.y * self.uv_scale[1])
             c = dr.clip(self.coverage.eval_1(si2, active), 0.0, 1.0)
             return 1.0 - c, c / max(self.coverage_mean, 1e-6)
 

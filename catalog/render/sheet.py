@@ -23,9 +23,52 @@ def _fabric_list(fabrics):
     return [load_preset(p) for p in paths]
 
 
+#: Label strips of the grid (px): the fabric names' column and the lights' header row.
+LABEL_COLUMN_PX = 200
+LABEL_ROW_PX = 22
+LABEL_FONT_PX = 13
+
+
+def labelled_grid(grid: np.ndarray, rows: list[str], columns: list[str], cell: tuple[int, int]) -> np.ndarray:
+    """``grid`` with a header row naming each column and a left column naming each row
+    (OpenImageIO's text renderer and its built-in font)."""
+    import OpenImageIO as oiio  # noqa: PLC0415
+
+    width, height = cell
+    out = np.full((grid.shape[0] + LABEL_ROW_PX, grid.shape[1] + LABEL_COLUMN_PX, 3), 24, np.uint8)
+    out[LABEL_ROW_PX:, LABEL_COLUMN_PX:] = grid
+    buf = oiio.ImageBuf(oiio.ImageSpec(out.shape[1], out.shape[0], 3, oiio.UINT8))
+    buf.set_pixels(oiio.ROI(), out)
+    baseline = (LABEL_ROW_PX + LABEL_FONT_PX) // 2 - 1
+    for j, name in enumerate(columns):
+        oiio.ImageBufAlgo.render_text(buf, LABEL_COLUMN_PX + j * width + 4, baseline, name,
+                                      LABEL_FONT_PX, "", (0.92, 0.92, 0.92))
+    for i, name in enumerate(rows):
+        y = LABEL_ROW_PX + i * height + height // 2 + LABEL_FONT_PX // 2
+        for k, line in enumerate(_wrap(name, LABEL_COLUMN_PX - 8, LABEL_FONT_PX)):
+            oiio.ImageBufAlgo.render_text(buf, 4, int(y + (k - 1) * (LABEL_FONT_PX + 2)), line,
+                                          LABEL_FONT_PX, "", (0.92, 0.92, 0.92))
+    return buf.get_pixels(oiio.UINT8).reshape(out.shape)
+
+
+def _wrap(text: str, width_px: int, font_px: int) -> list[str]:
+    """At most three lines of about width_px (average glyph ~0.55 font sizes)."""
+    per_line = max(4, int(width_px / (0.55 * font_px)))
+    words, lines, line = text.split(), [], ""
+    for word in words:
+        if line and len(line) + 1 + len(word) > per_line:
+            lines.append(line)
+            line = word
+        else:
+            line = f"{line} {word}".strip()
+    lines.append(line)
+    return lines if len(lines) <= 3 else [*lines[:2], " ".join(lines[2:])[:per_line]]
+
+
 def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fabrics=None,
                  fluorescence: str = "physical", bands: int = 3, progress: bool = True,
-                 ctx=None) -> dict:
+                 ctx=None, ev: float | None = None, white_balance: str = "room",
+                 labels: bool = True) -> dict:
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.render import bands as band_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
@@ -41,6 +84,9 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
         scene_lib.dye_transmittance(preset)
         scene_lib.fluorescent_material(preset)
     band_lib.check_band_count(bands)
+    from catalog.render.snapshot import check_display_choices  # noqa: PLC0415
+
+    check_display_choices(ev, white_balance)
     if out_dir.exists() and not out_dir.is_dir():
         raise InputError(f"{str(out_dir)!r} exists and is not a folder", field="--out")
 
@@ -48,6 +94,8 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     renderer = FrameRenderer(ctx, size)
     renderer.set_fluorescence(fluorescence)
     renderer.set_bands(bands)
+    renderer.set_ev(ev)
+    renderer.set_white_balance(white_balance)
     width, height = size
     grid = np.zeros((height * len(presets), width * len(lights), 3), dtype=np.uint8)
     images = []
@@ -55,7 +103,15 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
              for j, light in enumerate(light_objects)]
 
     def work(advance):
+        from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
+
+        shown = None
         for i, preset, j, light in pairs:
+            if shown is not preset:   # the drape catalog snapshot shows (its fullness, rings)
+                *mesh, fabric_size = simulated_curtain(preset, 0)
+                renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+                renderer.set_rings(ring_xs_m(preset))
+                shown = preset
             renderer.set_fabric(preset)
             renderer.set_light(light)
             renderer.render()
@@ -65,10 +121,13 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
             info = renderer.info()
             write_image(path, pixels, {"catalog:fabric": preset.name, "catalog:light": light.name,
                                        "catalog:mode": info["mode"],
-                                       "catalog:fluorescence_variant": info["fluorescence_variant"]})
+                                       "catalog:fluorescence_variant": info["fluorescence_variant"],
+                                       "catalog:ev100": f"{info['ev100']:.4f}",
+                                       "catalog:white_balance": info["white_balance"]})
             grid[i * height:(i + 1) * height, j * width:(j + 1) * width] = pixels
             images.append({"fabric": preset.name, "light": light.name, "path": str(path),
-                           "fluorescence_variant": info["fluorescence_variant"]})
+                           "fluorescence_variant": info["fluorescence_variant"],
+                           "ev100": info["ev100"]})
             advance()
 
     try:
@@ -83,6 +142,9 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     finally:
         renderer.release()
     grid_path = out_dir / "grid.png"
+    if labels:
+        grid = labelled_grid(grid, [f"{p.display_name} ({p.name})" for p in presets],
+                             [l.name for l in light_objects], (width, height))
     write_image(grid_path, grid, {
         "ImageDescription": "rows: " + ", ".join(p.name for p in presets)
                             + "; columns: " + ", ".join(l.name for l in light_objects),
@@ -91,4 +153,5 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     if not images:
         raise CatalogError("nothing rendered")
     return {"images": images, "grid": str(grid_path), "rows": [p.name for p in presets],
-            "columns": [l.name for l in light_objects], "size": list(size)}
+            "columns": [l.name for l in light_objects], "size": list(size), "labels": labels,
+            "label_offset_px": [LABEL_COLUMN_PX, LABEL_ROW_PX] if labels else [0, 0]}

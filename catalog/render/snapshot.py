@@ -52,6 +52,8 @@ class SnapshotRequest:
     pitch_deg: float = 0.0
     distance_m: float = 2.6
     exposure: float = 1.0
+    ev: float | None = None           # EV100; None: automatic exposure
+    white_balance: str = "room"
 
 
 def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
@@ -65,7 +67,12 @@ def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> Non
     spec = oiio.ImageSpec(width, height, channels, kind)
     spec.channelnames = ("R", "G", "B")
     for key, value in metadata.items():
-        spec.attribute(key, str(value))
+        if key == "chromaticities":
+            import OpenImageIO as oiio  # noqa: PLC0415
+
+            spec.attribute(key, oiio.TypeDesc("float[8]"), tuple(value))
+        else:
+            spec.attribute(key, str(value))
     with atomic_path(path) as tmp:
         output = oiio.ImageOutput.create(str(tmp))
         if output is None:
@@ -75,6 +82,24 @@ def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> Non
         output.close()
         if not ok:
             raise CatalogError(f"cannot write {path}: {error}")
+
+
+def exr_colour_metadata() -> dict:
+    """What tools need to show our EXR with a standard view (OpenColorIO's built-in config
+    ``ocio://default``: the interop ID of its colour space "Linear Rec.709 (sRGB)"; the EXR chromaticities of
+    sRGB / Rec.709 with the D65 white, from colour-science's tables)."""
+    from catalog.render import display  # noqa: PLC0415
+
+    t = display.tables()
+    m = np.linalg.inv(t["srgb_xyz_to_rgb"])  # RGB -> XYZ: the columns are the primaries
+    xy = [(col[0] / col.sum(), col[1] / col.sum()) for col in m.T]
+    white = tuple(float(v) for v in t["srgb_whitepoint_xy"])
+    return {"oiio:ColorSpace": OCIO_LINEAR_SPACE,
+            "chromaticities": tuple(float(v) for pair in xy for v in pair) + white}
+
+
+#: The name of our EXR's colour space in OpenColorIO's built-in config (ocio://default).
+OCIO_LINEAR_SPACE = "lin_rec709_scene"   # the interop ID; "Linear Rec.709 (sRGB)" there
 
 
 def read_metadata(path: str | Path) -> dict[str, str]:
@@ -90,19 +115,48 @@ def read_metadata(path: str | Path) -> dict[str, str]:
 
 
 def simulated_curtain(preset, frames: int):
-    """The cloth simulation after ``frames`` frames, moved onto the scene's rod."""
+    """The curtain after ``frames`` frames of the cloth simulation started from the settled
+    drape (frame 0: the settled drape itself; catalog.cloth.drape), moved onto the scene's
+    rod. Returns (positions, normals, uv, tangents, indices, fabric size (w, h) m)."""
+    from catalog.cloth.drape import drape_params, rod_centre_x_m, settled_simulation  # noqa: PLC0415
     from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
-    from catalog.cloth.params import ClothParams  # noqa: PLC0415
-    from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
-    params = ClothParams.from_preset(preset)
-    simulation = ClothSimulation(params, backend="numpy")
+    params = drape_params(preset)
+    simulation = settled_simulation(params, backend="numpy")
     simulation.run(frames, FRAME_DT_S)
     mesh = CurtainMesh.from_grid(simulation.positions(), params)
-    offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - params.rod_y_m, scene_lib.CURTAIN_Z],
-                      dtype=np.float32)
-    return mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices
+    offset = np.array([-rod_centre_x_m(params), scene_lib.CURTAIN_TOP_Y - params.rod_y_m,
+                       scene_lib.CURTAIN_Z], dtype=np.float32)
+    return (mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices,
+            (params.width_m, params.height_m))
+
+
+def ring_xs_m(preset) -> list[float]:
+    """x of the curtain's rings on the scene's rod (m): the settled drape's ring columns."""
+    from catalog.cloth.drape import drape_params, rod_centre_x_m  # noqa: PLC0415
+    from catalog.cloth.state import ring_positions  # noqa: PLC0415
+
+    params = drape_params(preset)
+    return [float(x) - rod_centre_x_m(params) for x in ring_positions(params)[:, 0]]
+
+
+def check_display_choices(ev, white_balance, exposure=1.0) -> None:
+    """--ev, --white-balance and --exposure, refused in one line naming the option."""
+    import math  # noqa: PLC0415
+
+    from catalog.render import display  # noqa: PLC0415
+
+    if ev is not None:
+        try:
+            display.check_ev(ev)
+        except CatalogError as exc:
+            raise InputError(str(exc).split(": ", 1)[-1], field="--ev") from None
+    if white_balance not in display.WHITE_BALANCES:
+        raise InputError(f"{white_balance!r}: choose one of {', '.join(display.WHITE_BALANCES)}",
+                         field="--white-balance")
+    if not (math.isfinite(exposure) and exposure > 0):
+        raise InputError(f"{exposure!r} must be a positive number", field="--exposure")
 
 
 def validate(request: SnapshotRequest):
@@ -119,6 +173,7 @@ def validate(request: SnapshotRequest):
     if request.frame < 0:
         raise InputError(f"{request.frame} must be >= 0", field="--frame")
     band_lib.check_band_count(request.bands)
+    check_display_choices(request.ev, request.white_balance, request.exposure)
     preset = load_preset(find_preset(request.fabric))
     scene_lib.dye_transmittance(preset)
     scene_lib.fluorescent_material(preset)
@@ -147,10 +202,13 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.set_bands(request.bands)
         renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
         renderer.set_exposure(request.exposure)
-        mesh_source = "static drape"
-        if request.frame > 0:
-            renderer.set_mesh(*simulated_curtain(preset, request.frame))
-            mesh_source = f"cloth simulation, frame {request.frame}"
+        renderer.set_ev(request.ev)
+        renderer.set_white_balance(request.white_balance)
+        *mesh, fabric_size = simulated_curtain(preset, request.frame)
+        renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+        renderer.set_rings(ring_xs_m(preset))
+        mesh_source = ("settled drape" if request.frame == 0
+                       else f"cloth simulation from the settled drape, frame {request.frame}")
         start = time.perf_counter()
         renderer.render()
         pixels = (renderer.read_linear() if request.out.suffix.lower() == ".exr"
@@ -172,8 +230,15 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         "catalog:frame": str(request.frame),
         "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
                              if request.out.suffix.lower() == ".exr"
-                             else "sRGB, Reinhard luminance tone map"),
+                             else "sRGB; CAT16 white balance, Michaelis-Menten tone curve, "
+                                  "OKLab gamut compression (docs/display.md)"),
+        "catalog:ev100": f"{info['ev100']:.4f}",
+        "catalog:exposure_scale": repr(info["exposure"]),
+        "catalog:auto_exposure": str(info["auto_exposure"]).lower(),
+        "catalog:white_balance": info["white_balance"],
     }
+    if request.out.suffix.lower() == ".exr":
+        metadata.update(exr_colour_metadata())
     write_image(request.out, pixels, metadata)
     report = dict(info)
     report.update({"out": str(request.out), "frame": request.frame, "mesh": mesh_source,
