@@ -285,7 +285,7 @@ def _main(capsys, *args):
 
 def test_reference_command_writes_an_exr_with_json(mi, tmp_path, capsys):
     out = tmp_path / "ref.exr"
-    code, stdout, err = _main(capsys, "--fabric", "voile-white", "--light", "D65", "--size",
+    code, stdout, err = _main(capsys, "--fabric", "lace-fwa", "--light", "D65", "--size",
                               "24x18", "--spp", "2", "--out", str(out), "--json")
     assert code == 0, err
     report = json.loads(stdout)
