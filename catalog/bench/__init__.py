@@ -10,6 +10,8 @@ optionally, ``plot(result, folder) -> list[Path]``:
 - ``fluorescence``: representations of fluorescence in an RGB engine on the measured
   Donaldson matrices (:mod:`catalog.bench.fluorescence_rgb`, with the reduced
   re-radiation matrices of :mod:`catalog.bench.reduction`);
+- ``uv``: fluorescence under UV and violet light: the matrices' noise floor and the
+  banded model chosen on selection lights (:mod:`catalog.bench.uv_fluorescence`);
 - ``fit``: Levenberg-Marquardt on 79 and 4800 gonio points against differential
   evolution (:mod:`catalog.bench.fit`);
 - ``cloth``: substeps and backends against a small-step reference run
@@ -18,6 +20,8 @@ optionally, ``plot(result, folder) -> list[Path]``:
   (:mod:`catalog.bench.stability`);
 - ``startup``: import time and time to the first frame (:mod:`catalog.bench.startup`);
 - ``display``: each display transform's cost in the frame (:mod:`catalog.bench.display`);
+- ``room``: the frame with the room lit through the curtain, the clear sky and the glare
+  against the frame without, each pass's share (:mod:`catalog.bench.room`);
 - ``image``: the real-time frame against the path-traced reference of the same scene, FLIP
   and Delta E per region, both run times (:mod:`catalog.bench.image`; needs the
   ``pathtrace`` extra and LLVM 19, docs/pathtrace.md).
@@ -39,10 +43,12 @@ register_folder(SHADER_DIR)
 SECTIONS: dict[str, str] = {
     "colour": "catalog.bench.colour",
     "fluorescence": "catalog.bench.fluorescence_rgb",
+    "uv": "catalog.bench.uv_fluorescence",
     "fit": "catalog.bench.fit",
     "cloth": "catalog.bench.cloth",
     "stability": "catalog.bench.stability",
     "startup": "catalog.bench.startup",
     "display": "catalog.bench.display",
+    "room": "catalog.bench.room",
     "image": "catalog.bench.image",
 }

@@ -17,8 +17,9 @@ description and curtain mesh. Measured:
   wall time, scene building excluded) and their ratio, at equal resolution.
 
 Real-time options (the Pareto plot): spectral bands 3/6/16, paper vs physical
-fluorescence, anti-aliasing (FXAA, the default; none; 2x2 supersampling). Room lighting and shadow-map size join
-:data:`OPTIONS` when the frame has them (issue 13); until then they are listed as absent.
+fluorescence, anti-aliasing (FXAA, the default; none; 2x2 supersampling), the room lit
+through the curtain (issue 13, the default) or the earlier constant room. The shadow map's size
+is a module constant, not a frame option: listed as absent.
 
 The goal of issue 11 (stated before measuring): on every scene mean FLIP <= 0.10, curtain
 Delta E 2000 mean <= 2, and the frame >= 1000x faster than the reference.
@@ -55,13 +56,14 @@ QUICK_SPP = 16
 #: default, FXAA)). The first is the frame's default.
 OPTIONS = (
     ("default (physical, 3 bands, FXAA)", 3, "physical", 1, None),
+    ("room lighting off", 3, "physical", 1, None, False),
     ("FXAA off", 3, "physical", 1, "off"),
     ("6 bands", 6, "physical", 1, None),
     ("16 bands", 16, "physical", 1, None),
     ("paper fluorescence", 3, "paper", 1, None),
     ("2x2 supersampled", 3, "physical", 2, "off"),
 )
-ABSENT_OPTIONS = ("room lighting on/off", "shadow map size")
+ABSENT_OPTIONS = ("shadow map size (catalog.render.room_light.SHADOW_TEXELS, not a frame option)",)
 #: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
 #: curtain (noise falls as 1 / sqrt(spp): the spp that reaches it is spp (noise / 1 %)^2).
 NOISE_TARGET = 0.01
@@ -80,7 +82,8 @@ def light_name(key: str) -> str:
 
 
 def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
-                 antialiasing: str | None = None, repeats: int = 5) -> dict:
+                 antialiasing: str | None = None, room_lighting: bool | None = None,
+                 repeats: int = 5) -> dict:
     """The real-time frame at desc.size: ``linear`` radiance (H, W, 3), ``display`` (the
     frame's own display image, sRGB in [0, 1]), the ``exposure`` and ``white_balance`` its
     display step used, and ``seconds``, the median wall time of render + glFinish.
@@ -98,6 +101,8 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
         renderer.set_bands(bands)
         if antialiasing is not None:
             renderer.set_antialiasing(antialiasing)
+        if room_lighting is not None:
+            renderer.set_room_lighting(room_lighting)
         cam = desc.info["camera"]
         renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
         renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
@@ -169,9 +174,10 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
         noise_curtain = metrics.noise_between(a, b, masks["curtain"])
         option_rows = []
         default = None
-        for opt_label, bands, mode, supersample, antialiasing in options:
+        for opt_label, bands, mode, supersample, antialiasing, *room in options:
             frame = frame_images(ctx, desc, preset, light, bands, mode, supersample,
-                                 antialiasing, repeats=3 if quick else 7)
+                                 antialiasing, room[0] if room else None,
+                                 repeats=3 if quick else 7)
             if default is None:  # the default frame's exposure and white balance show both
                 exposure, white_balance = frame["exposure"], frame["white_balance"]
             result = compare(frame, reference, masks, desc.inputs, exposure, white_balance)

@@ -132,6 +132,12 @@ def startup_md(result: dict) -> str:
         viewer_line(s["viewer_heavy_at_first_frame"]) + f" scipy loaded: {s['viewer_imports_scipy']}."])
 
 
+def room_md(result: dict) -> str:
+    from catalog.bench.room import markdown_tables  # noqa: PLC0415
+
+    return "\n\n".join(markdown_tables(result).values())
+
+
 def image_md(result: dict) -> str:
     from catalog.bench.image import markdown_tables  # noqa: PLC0415
 
@@ -147,6 +153,12 @@ def viewer_line(heavy: dict | None) -> str:
             f"{loaded}.")
 
 
+def uv_md(section: dict) -> str:
+    from catalog.bench.uv_fluorescence import markdown_tables  # noqa: PLC0415
+
+    return "\n\n".join(markdown_tables(section).values())
+
+
 def display_md(result: dict) -> str:
     from catalog.bench.display import markdown_tables  # noqa: PLC0415
 
@@ -155,10 +167,12 @@ def display_md(result: dict) -> str:
 
 SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "fluorescence": ("Fluorescence in an RGB engine (measured Donaldson matrices)", fluorescence_md),
+              "uv": ("Fluorescence under UV and violet light: noise floor and banded model", uv_md),
               "fit": ("Eq. 7 fit: accuracy against time", fit_md),
               "cloth": ("Cloth: substeps and backend against a small-step reference", cloth_md),
               "stability": ("Numerical stability at the parameters' edges", stability_md),
               "startup": ("Start-up", startup_md),
+              "room": ("The room lit through the curtain: frame with and without", room_md),
               "display": ("The display step's cost in the frame", display_md),
               "image": ("The real-time frame against the path-traced reference", image_md)}
 

@@ -44,7 +44,8 @@ def _render_scale(text: str) -> float | None:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fabric", help="fabric to show first (preset name or .toml)")
     parser.add_argument("--light", help="light to start with: 'sun' (hour slider), a CIE "
-                        "illuminant (D65, A, FL2, LED-B4, ...), UV-A, LED-warm, sun:PATH_KM")
+                        "illuminant (D65, A, FL2, LED-B4, ...), UV-A, UV-385, LED-405, "
+                        "LED-violet-white, LED-warm, sun:PATH_KM")
     parser.add_argument("--compare", metavar="NAME",
                         help="split screen: this fabric on the right, same light")
     parser.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",
@@ -78,6 +79,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--render-scale", type=_render_scale, metavar="S|auto", default=None,
                         help="scene resolution relative to the window, 0.25-1 (default auto: "
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")
+    parser.add_argument("--no-room-light", action="store_true",
+                        help="the earlier constant room and flat sky, no glare (docs/room.md)")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
     parser.add_argument("--compare-fluorescence", choices=FLUORESCENCE_CHOICES, default=None,
@@ -139,5 +142,6 @@ def run(args: argparse.Namespace) -> int:
         cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
         ev100=ev, white_balance=white_balance, compare_fluorescence=args.compare_fluorescence,
+        room_light=not args.no_room_light,
         fabric_dir=fabric_dir if fabric_dir is not None else FABRIC_DIR)
     return ViewerApp(options).run()

@@ -13,8 +13,8 @@ it cannot trace are not light sources here; path tracing computes what they stan
 - kept: the room box with its window opening and the rod (grey Lambertian, ROOM_ALBEDO),
   the curtain mesh, the camera (position, target, vertical field of view), the key light
   as a distant source with the disc of SUN_RADIUS_RAD and the key's normal irradiance, the
-  sky above and the ground below the horizon with the real-time radiances, all in one
-  environment map (the disc resolved by supersampling, normalised to the exact irradiance);
+  sky above and the ground below the horizon with the real-time radiances (for a sun, the
+  frame's clear sky by direction, catalog.optics.sun.sky), all in one environment map (the disc resolved by supersampling, normalised to the exact irradiance);
 - replaced: the fill light (FILL_FRACTION of the key, a stand-in for the light bounced
   into the room), the walls' constant ROOM_FRACTION radiance and the cloth's ambient term
   (stand-ins for the inter-reflections): the path tracer follows the light's paths instead.
@@ -76,6 +76,7 @@ class SceneDescription:
     pattern: dict | None = None          # {"coverage": (H, W) array, "uv_scale": (su, sv)}
     fabric_size_m: tuple | None = None   # the rest fabric's (width, length) that uv 0..1 spans
     ring_xs_m: tuple = ()                # the curtain rings on the rod (x, m)
+    sky: object = None                   # the frame's clear-sky model (a sun above the horizon)
 
 
 def rgb_weights(key_irradiance: np.ndarray) -> np.ndarray:
@@ -169,6 +170,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         key_radius_rad=scene_lib.SUN_RADIUS_RAD, fill_rgb=w @ inputs.fill_irradiance,
         fill_to_light=np.asarray(inputs.fill_to_light, dtype=np.float64), fluorescence=fl,
         inputs=inputs, pattern=pattern, fabric_size_m=fabric_size, ring_xs_m=rings,
+        sky=clear_sky_for(inputs, is_sun),
         info={"fabric": preset.name, "light": light.name, "fluorescence_requested": decision.requested,
               "fluorescence_variant": inputs.fluorescence_mode, "frame": int(frame),
               "camera": {"yaw_deg": camera.yaw_deg, "pitch_deg": camera.pitch_deg,
@@ -176,6 +178,18 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
 
 
 # --------------------------------------------------------------------------- environment
+
+def clear_sky_for(inputs, is_sun: bool):
+    """The clear sky the frame draws behind the window for a sun above the horizon
+    (:meth:`catalog.render.frame.FrameRenderer.sky_model_for`: Preetham's distribution with
+    the irradiance of the scene's sky term and its ground), else None (the flat sky)."""
+    if not (is_sun and inputs.key_to_light[1] > 1e-3):
+        return None
+    from catalog.optics.sun.sky import sky_model  # noqa: PLC0415
+
+    return sky_model(inputs.key_to_light, diffuse_horizontal=math.pi * inputs.sky_radiance,
+                     ground_radiance=inputs.ground_radiance)
+
 
 def texel_directions(width: int, height: int, offsets=(0.5, 0.5)) -> np.ndarray:
     """Unit directions (H, W, 3) of a lat-long map as Mitsuba's envmap reads it:
@@ -187,14 +201,17 @@ def texel_directions(width: int, height: int, offsets=(0.5, 0.5)) -> np.ndarray:
 
 
 def environment_map(sky_rgb, ground_rgb, key_rgb, key_to_light, radius_rad,
-                    width: int = ENV_WIDTH) -> np.ndarray:
+                    width: int = ENV_WIDTH, sky=None) -> np.ndarray:
     """Lat-long RGB radiance (H, W, 3) float32: sky above the horizon, ground below, the key
     light's disc of angular radius ``radius_rad`` whose integral over solid angle equals the
     key's normal irradiance ``key_rgb`` exactly (texel coverage by DISC_SUPERSAMPLE^2 samples)."""
     height = width // 2
     d = texel_directions(width, height)
-    env = np.where(d[..., 1:2] >= 0, np.asarray(sky_rgb)[None, None, :],
-                   np.asarray(ground_rgb)[None, None, :]).astype(np.float64)
+    if sky is not None:  # the frame's clear sky (and hazy ground) by direction
+        env = np.asarray(sky.radiance(d), dtype=np.float64)
+    else:
+        env = np.where(d[..., 1:2] >= 0, np.asarray(sky_rgb)[None, None, :],
+                       np.asarray(ground_rgb)[None, None, :]).astype(np.float64)
     to_light = np.asarray(key_to_light, dtype=np.float64)
     to_light = to_light / np.linalg.norm(to_light)
     cos_r = math.cos(radius_rad)
@@ -362,7 +379,7 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     if environment:
         env = environment_map(desc.sky_rgb, desc.ground_rgb,
                               np.zeros(3) if key_as_directional else desc.key_rgb,
-                              desc.key_to_light, desc.key_radius_rad)
+                              desc.key_to_light, desc.key_radius_rad, sky=desc.sky)
         scene["environment"] = {"type": "envmap", "bitmap": mi.Bitmap(env)}
     if key_as_directional:
         scene["key"] = {"type": "directional", "direction": [float(-v) for v in desc.key_to_light],
