@@ -381,3 +381,20 @@ def test_image_section_tables_and_pareto_front_from_a_result():
     assert image.spp_for_noise(64, 0.02, 0.01) == 256
     tables = image.markdown_tables(result)
     assert "| s |" in tables["image"] and "256" in tables["image"] and "shadow map size" in tables["image-options"]
+
+
+def test_a_sun_brings_the_frames_clear_sky_into_the_environment():
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace.scene import describe_scene, environment_map, texel_directions
+    from catalog.render import scene as scene_lib
+
+    d = scene_lib.draped_curtain(20, 10)
+    curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
+    lamp = describe_scene(desc_preset("voile-white"), get_light("D65"), size=(8, 6), curtain=curtain)
+    assert lamp.sky is None  # a lamp: the flat lit backdrop, as the frame draws it
+    sun = describe_scene(desc_preset("voile-white"), get_light("sun:100"), size=(8, 6), curtain=curtain)
+    assert sun.sky is not None
+    env = environment_map(sun.sky_rgb, sun.ground_rgb, np.zeros(3), sun.key_to_light, 0.005,
+                          width=64, sky=sun.sky)
+    dirs = texel_directions(64, 32)
+    assert np.allclose(env, sun.sky.radiance(dirs), rtol=1e-5, atol=1e-6)
