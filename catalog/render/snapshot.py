@@ -54,11 +54,14 @@ class SnapshotRequest:
     exposure: float = 1.0
 
 
-def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
-    """Write (H, W, 3) pixels with OpenImageIO, atomically: float32 -> EXR, uint8 -> PNG."""
+def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str], *,
+                inputs=()) -> None:
+    """Write (H, W, 3) pixels with OpenImageIO through the output layer: float32 -> EXR,
+    uint8 -> PNG. The file is read back (size and pixels) before it replaces ``path``, so a
+    full disk can never leave an empty or truncated image in place of a good one."""
     import OpenImageIO as oiio  # noqa: PLC0415
 
-    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+    from catalog.core.atomic import OutputError, atomic_path  # noqa: PLC0415
 
     height, width, channels = pixels.shape
     kind = oiio.FLOAT if pixels.dtype == np.float32 else oiio.UINT8
@@ -66,7 +69,23 @@ def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> Non
     spec.channelnames = ("R", "G", "B")
     for key, value in metadata.items():
         spec.attribute(key, str(value))
-    with atomic_path(path) as tmp:
+
+    def verify(tmp: Path) -> None:
+        back = oiio.ImageInput.open(str(tmp))
+        if back is None:
+            raise OutputError(path, f"the written image does not read back ({oiio.geterror()})")
+        try:
+            read_spec = back.spec()
+            data = back.read_image(0, 0, 0, channels, "float" if kind == oiio.FLOAT else "uint8")
+        finally:
+            back.close()
+        if (read_spec.width, read_spec.height, read_spec.nchannels) != (width, height, channels) \
+                or data is None or not np.array_equal(np.asarray(data).reshape(pixels.shape), pixels):
+            raise OutputError(path, "the written image does not read back as written "
+                                    "(the disk may be full); the old file is kept")
+
+    raw_bytes = pixels.nbytes
+    with atomic_path(path, inputs=inputs, estimate_bytes=raw_bytes, verify=verify) as tmp:
         output = oiio.ImageOutput.create(str(tmp))
         if output is None:
             raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
@@ -74,7 +93,7 @@ def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> Non
         error = output.geterror()
         output.close()
         if not ok:
-            raise CatalogError(f"cannot write {path}: {error}")
+            raise OutputError(path, error or "the image writer failed")
 
 
 def read_metadata(path: str | Path) -> dict[str, str]:
