@@ -13,6 +13,8 @@ docs/bench.md has the latest figures.
 from __future__ import annotations
 
 RESOURCES = ("data",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+OUTPUT_FOLDERS = ("out",)
 HELP = "benchmarks: colour error against frame time, fluorescence, fit, cloth, stability, start-up"
 
 DEFAULT_OUT = "bench-out"

@@ -8,6 +8,9 @@ from pathlib import Path
 from catalog.core.cliargs import wxh_type
 
 RESOURCES = ("fabrics",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("fabric", "compare")
+OUTPUT_FILES = ("screenshot",)
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
 FLUORESCENCE_CHOICES = ("off", "paper", "physical")
