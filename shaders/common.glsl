@@ -133,17 +133,6 @@ vec3 background_terms(vec3 dir, vec3 to_sun, float sun_chord2_inner, float sun_c
     return vec3(1.0 - step(0.0, dir.z), step(0.0, dir.y), 1.0 - s * s * (3.0 - 2.0 * s));
 }
 
-// Reinhard, Stark, Shirley, Ferwerda 2002, "Photographic tone reproduction", eq. 4 (extended,
-// on luminance, so hue is kept): L_d = L (1 + L / L_white^2) / (1 + L), applied after exposure.
-vec3 tone_map_reinhard_luminance(vec3 rgb, float white) {
-    float lum = dot(rgb, vec3(0.2126, 0.7152, 0.0722));
-    if (lum <= 0.0) {
-        return vec3(0.0);
-    }
-    float mapped = lum * (1.0 + lum / (white * white)) / (1.0 + lum);
-    return rgb * (mapped / lum);
-}
-
 // IEC 61966-2-1:1999 sRGB transfer function (the piecewise curve, not a 2.2 power).
 vec3 srgb_encode(vec3 linear) {
     vec3 c = clamp(linear, 0.0, 1.0);

@@ -1,5 +1,7 @@
 #version 430
-// HDR -> display: exposure, the luminance Reinhard curve, the sRGB transfer function.
+// HDR radiance -> display (docs/display.md; numpy twin: catalog/render/display.py):
+// exposure, white balance (a CAT16 3x3), the tone curve on luminance, gamut compression in
+// OKLab at constant lightness and hue, the sRGB transfer function. GLSL ES 3.00-compatible.
 #include "common.glsl"
 
 in vec2 v_ndc;
@@ -7,13 +9,93 @@ in vec2 v_uv;
 
 uniform sampler2D u_hdr;
 uniform vec4 u_hdr_rect;          // (u0, v0, du, dv): the part of the HDR target this viewport shows
-uniform float u_exposure;         // multiplies the linear radiance (cd m^-2 -> scene units of 1 = "white")
-uniform float u_white;            // the luminance (after exposure) that maps to 1
+uniform float u_exposure;         // cd m^-2 -> scene value (EV100 and compensation folded in)
+uniform mat3 u_white_balance;     // linear sRGB -> linear sRGB adapted to D65 (CAT16)
+uniform vec3 u_luminance;         // Y row of linear sRGB -> XYZ
+uniform mat3 u_rgb_to_lms;        // OKLab M1 after sRGB -> XYZ
+uniform mat3 u_lms_to_rgb;
+uniform mat3 u_lms_to_lab;        // OKLab M2
+uniform mat3 u_lab_to_lms;
+uniform vec2 u_tone;              // (S0, G): y = (x / (x + S0))^G
+uniform float u_lightness_ceiling; // the largest OKLab L kept (display.lightness_ceiling)
+uniform vec3 u_gamut;             // (R_KNEE, R_LIMIT, CUBE_TOP): chroma ratios kept / approached, cube
 
 layout(location = 0) out vec4 out_colour;
 
+const int GAMUT_STEPS = 8;        // display.GAMUT_STEPS
+
+// DISPLAY_STAGES (the benchmark's variants; default all): 0 exposure and the sRGB curve
+// only, 1 + white balance, 2 + tone curve, 3 + gamut compression.
+#ifndef DISPLAY_STAGES
+#define DISPLAY_STAGES 3
+#endif
+
+vec3 signed_cbrt(vec3 v) {
+    return sign(v) * pow(abs(v), vec3(1.0 / 3.0));
+}
+
+vec3 rgb_to_oklab(vec3 rgb) {
+    return u_lms_to_lab * signed_cbrt(u_rgb_to_lms * rgb);
+}
+
+vec3 oklab_to_rgb(vec3 lab) {
+    vec3 lms = u_lab_to_lms * lab;
+    return u_lms_to_rgb * (lms * lms * lms);
+}
+
+bool in_gamut(vec3 lab) {
+    vec3 rgb = oklab_to_rgb(lab);
+    return all(greaterThanEqual(rgb, vec3(0.0))) && all(lessThanEqual(rgb, vec3(u_gamut.z)));
+}
+
+// Chroma ratio r = C / C_boundary at this L and hue: identity below the knee, then rolled off
+// toward the limit (< 1) so no channel lands on the cube's faces.
+vec3 gamut_compress(vec3 rgb) {
+    vec3 lab = rgb_to_oklab(rgb);
+    float lightness = clamp(lab.x, 0.0, u_lightness_ceiling);
+    bool clamped = lightness != lab.x;
+    lab.x = lightness;
+    float t_hi = 1.0 / u_gamut.x;
+    if (!clamped && in_gamut(vec3(lab.x, lab.yz * t_hi))) {
+        return rgb;
+    }
+    float lo = 0.0;
+    float hi = t_hi;
+    for (int i = 0; i < GAMUT_STEPS; ++i) {
+        float mid = 0.5 * (lo + hi);
+        if (in_gamut(vec3(lab.x, lab.yz * mid))) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    float r = 1.0 / max(lo, 1e-12);   // lo: the boundary from below
+    float span = u_gamut.y - u_gamut.x;
+    float u = max(r - u_gamut.x, 0.0) / span;
+    float compressed = (r <= u_gamut.x) ? r : u_gamut.x + span * u / (1.0 + u);
+    return oklab_to_rgb(vec3(lab.x, lab.yz * (compressed / r)));
+}
+
+vec3 display_linear(vec3 hdr) {
+    vec3 c = u_exposure * hdr;
+#if DISPLAY_STAGES >= 1
+    c = u_white_balance * c;
+#endif
+#if DISPLAY_STAGES >= 2
+    float y = dot(c, u_luminance);
+    if (!(y > 0.0)) {
+        return vec3(0.0);
+    }
+    float x = y / (y + u_tone.x);
+    c *= pow(x, u_tone.y) / y;
+#endif
+#if DISPLAY_STAGES >= 3
+    c = gamut_compress(c);
+#endif
+    return clamp(c, 0.0, 1.0);
+}
+
 void main() {
     vec3 hdr = texture(u_hdr, u_hdr_rect.xy + v_uv * u_hdr_rect.zw).rgb;
-    vec3 mapped = tone_map_reinhard_luminance(u_exposure * hdr, u_white);
-    out_colour = vec4(srgb_encode(mapped), 1.0);
+    out_colour = vec4(srgb_encode(display_linear(hdr)), 1.0);
 }

@@ -175,23 +175,6 @@ def test_viewport_split_screen_and_mesh_updates(gl, make_preset):
         obj.release()
 
 
-def test_tone_map_and_srgb_encoding_match_numpy(gl, make_preset):
-    """The tonemap pass against Reinhard (luminance) + colour-science's sRGB curve."""
-    from catalog.optics.colorimetry import srgb_encode
-    from catalog.render.frame import TONE_WHITE
-
-    renderer = _renderer(gl, make_preset(), "sun:300")
-    renderer.render()
-    hdr = renderer.read_linear().astype(np.float64) * renderer.exposure_scale()
-    lum = hdr @ np.array([0.2126, 0.7152, 0.0722])
-    mapped_lum = lum * (1 + lum / TONE_WHITE ** 2) / (1 + lum)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mapped = np.where(lum[..., None] > 0, hdr * (mapped_lum / lum)[..., None], 0.0)
-    expected = np.round(255 * srgb_encode(np.clip(mapped, 0, 1)))
-    assert np.abs(renderer.read_srgb8().astype(int) - expected).max() <= 1
-    renderer.release()
-
-
 def test_paper_mode_colour_is_eq_1_to_3_of_the_emission(gl, make_preset):
     """Paper mode's added radiance has the chromaticity of F (eq. 1-3, catalog.optics.fluorescence)
     and the size I_fluor F / 255 of a white diffuser (eq. 4, 8; docs/render.md)."""

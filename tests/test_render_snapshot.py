@@ -124,7 +124,9 @@ def test_sheet_every_fabric_and_light(gl, make_preset, tmp_path):
     import OpenImageIO as oiio
 
     grid = oiio.ImageBuf(report["grid"])
-    assert (grid.spec().width, grid.spec().height) == (48, 32)
+    dx, dy = report["label_offset_px"]
+    assert dx > 0 and dy > 0  # labelled by default
+    assert (grid.spec().width, grid.spec().height) == (48 + dx, 32 + dy)
     for image in report["images"]:
         assert oiio.ImageBuf(image["path"]).spec().width == 24
 

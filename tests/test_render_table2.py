@@ -29,8 +29,9 @@ def _lace(make_preset):
     return real if real.exists() else make_preset("lace-fwa", direct=0.012)
 
 
-def _lit_cloth_mean(gl, preset, mode, *, hour=None, light=None, paper_mode=False):
+def _lit_cloth_mean(gl, preset, mode, *, hour=None, light=None, paper_mode=False, ev=None):
     renderer = FrameRenderer(gl, SIZE)
+    renderer.set_ev(ev)  # None: automatic exposure, metered from this frame
     renderer.set_fabric(preset)
     if hour is not None:
         renderer.set_sun_hour(hour)
@@ -51,8 +52,9 @@ def _lit_cloth_mean(gl, preset, mode, *, hour=None, light=None, paper_mode=False
 @pytest.mark.parametrize("mode", ["physical", "paper"])
 def test_brightened_lace_under_noon_sun_turns_blue(gl, make_preset, mode, capsys):
     lace = _lace(make_preset)
-    off, off8, _, _ = _lit_cloth_mean(gl, lace, "off", hour=12.0)
-    on, on8, info, _ = _lit_cloth_mean(gl, lace, mode, hour=12.0)
+    off, off8, off_info, _ = _lit_cloth_mean(gl, lace, "off", hour=12.0)
+    # the same exposure for both (the automatic one would meter the added blue away)
+    on, on8, info, _ = _lit_cloth_mean(gl, lace, mode, hour=12.0, ev=off_info["ev100"])
     assert info["fluorescence_variant"] == mode
     change = (on - off) / off  # relative, per channel (R, G, B)
     with capsys.disabled():

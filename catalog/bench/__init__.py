@@ -16,7 +16,8 @@ optionally, ``plot(result, folder) -> list[Path]``:
   (:mod:`catalog.bench.cloth`);
 - ``stability``: every model's parameters swept to their edges
   (:mod:`catalog.bench.stability`);
-- ``startup``: import time and time to the first frame (:mod:`catalog.bench.startup`).
+- ``startup``: import time and time to the first frame (:mod:`catalog.bench.startup`);
+- ``display``: each display transform's cost in the frame (:mod:`catalog.bench.display`).
 
 docs/bench.md has the figures and how to reproduce them.
 """
@@ -39,4 +40,5 @@ SECTIONS: dict[str, str] = {
     "cloth": "catalog.bench.cloth",
     "stability": "catalog.bench.stability",
     "startup": "catalog.bench.startup",
+    "display": "catalog.bench.display",
 }

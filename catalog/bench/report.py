@@ -140,12 +140,19 @@ def viewer_line(heavy: dict | None) -> str:
             f"{loaded}.")
 
 
+def display_md(result: dict) -> str:
+    from catalog.bench.display import markdown_tables  # noqa: PLC0415
+
+    return markdown_tables(result)["display_cost"]
+
+
 SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "fluorescence": ("Fluorescence in an RGB engine (measured Donaldson matrices)", fluorescence_md),
               "fit": ("Eq. 7 fit: accuracy against time", fit_md),
               "cloth": ("Cloth: substeps and backend against a small-step reference", cloth_md),
               "stability": ("Numerical stability at the parameters' edges", stability_md),
-              "startup": ("Start-up", startup_md)}
+              "startup": ("Start-up", startup_md),
+              "display": ("The display step's cost in the frame", display_md)}
 
 
 def markdown(report: dict) -> str:

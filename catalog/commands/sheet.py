@@ -5,6 +5,9 @@ from __future__ import annotations
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
+
+from catalog.commands.displayargs import add_display_arguments, display_choices
+
 HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
 
@@ -19,6 +22,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
     parser.add_argument("--mode", choices=("paper", "physical"), default="physical")
     parser.add_argument("--bands", type=int, default=3)
+    add_display_arguments(parser)
+    parser.add_argument("--no-labels", action="store_true",
+                        help="grid without the fabric (row) and light (column) labels")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
@@ -30,6 +36,7 @@ def run(args) -> int:
     from catalog.render.sheet import render_sheet  # noqa: PLC0415
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
+    ev, white_balance = display_choices(args)
     names = [name.strip() for name in args.lights.split(",")]
     if any(not name for name in names) and any(names):
         raise InputError(f"{args.lights!r}: an empty light name between commas", field="--lights")
@@ -39,7 +46,8 @@ def run(args) -> int:
     fabrics = fabric_list(args.fabrics)  # folders join the search path, names select
     report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=fabrics,
                           fluorescence="off" if args.no_fluorescence else args.mode,
-                          bands=args.bands, progress=not args.json)
+                          bands=args.bands, progress=not args.json, ev=ev,
+                          white_balance=white_balance, labels=not args.no_labels)
     if args.json:
         print_json(report)
     else:

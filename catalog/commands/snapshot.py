@@ -6,6 +6,9 @@ RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 INPUT_FILES = ("fabric",)
 OUTPUT_FILES = ("out",)
+
+from catalog.commands.displayargs import add_display_arguments, display_choices
+
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
 
 
@@ -29,7 +32,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--yaw", type=number_type(-360.0, 360.0, unit="deg"), default=0.0, help="camera yaw, deg")
     parser.add_argument("--pitch", type=number_type(-89.0, 89.0, unit="deg"), default=0.0, help="camera pitch, deg")
     parser.add_argument("--distance", type=number_type(0.05, 50.0, unit="m", low_open=True), default=2.6, help="camera distance, m")
-    parser.add_argument("--exposure", type=number_type(0.0, 1e9, low_open=True), default=1.0, help="exposure multiplier")
+    parser.add_argument("--exposure", type=number_type(0.0, 1e9, low_open=True), default=1.0,
+                        help="exposure multiplier on top of --ev or the automatic exposure")
+    add_display_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
@@ -39,11 +44,13 @@ def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.snapshot import SnapshotRequest, parse_size, render_snapshot  # noqa: PLC0415
 
+    ev, white_balance = display_choices(args)
     request = SnapshotRequest(
         fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
         frame=args.frame, fluorescence="off" if args.no_fluorescence else args.mode,
         bands=args.bands, hour=args.hour, yaw_deg=args.yaw, pitch_deg=args.pitch,
-        distance_m=args.distance, exposure=args.exposure)
+        distance_m=args.distance, exposure=args.exposure, ev=ev,
+        white_balance=white_balance)
     report = render_snapshot(request)
     if args.json:
         print_json(report)

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from catalog.core.cliargs import wxh_type
+from catalog.commands.displayargs import add_display_arguments
 
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
@@ -78,6 +79,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
+    parser.add_argument("--compare-fluorescence", choices=FLUORESCENCE_CHOICES, default=None,
+                        help="with --compare: the right half's fluorescence mode (default: "
+                        "the left's); --compare NAME --fabric NAME shows one fabric on | off")
+    add_display_arguments(parser)
     parser.add_argument("--fabric-dir", type=Path, metavar="DIR",
                         help="folder of presets (default: the catalog's fabrics/)")
 
@@ -103,6 +108,9 @@ def run(args: argparse.Namespace) -> int:
     from catalog.viewer.window import (NO_DISPLAY_HINT, NoDisplayError, display_available,
                                        init_glfw)
 
+    from catalog.commands.displayargs import display_choices
+
+    ev, white_balance = display_choices(args)
     if args.screenshot is not None and args.frames is None:
         raise CatalogError("--screenshot needs --frames N (the S key saves screenshots "
                            "in interactive use)")
@@ -127,5 +135,6 @@ def run(args: argparse.Namespace) -> int:
         wind_m_s=args.wind, grid=args.grid,
         cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
+        ev100=ev, white_balance=white_balance, compare_fluorescence=args.compare_fluorescence,
         fabric_dir=fabric_dir)
     return ViewerApp(options).run()

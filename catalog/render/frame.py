@@ -10,8 +10,10 @@ Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 3. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
    shades only the pixels nothing covers: the outside through the window (sky, ground, the
    sun's disc) or the room, per camera ray;
-4. tone map (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
-   target): exposure, Reinhard on luminance, the sRGB curve.
+4. display (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
+   target): exposure (EV100, fixed or metered from a luminance histogram of this frame),
+   white balance (CAT16), tone curve, gamut compression in OKLab, the sRGB curve
+   (:mod:`catalog.render.display`, docs/display.md).
 """
 
 from __future__ import annotations
@@ -22,16 +24,13 @@ import numpy as np
 
 from catalog.core.errors import CatalogError
 from catalog.render import bands as band_lib
+from catalog.render import display as display_lib
 from catalog.render import scene as scene_lib
 from catalog.render.camera import OrbitCamera, gl_bytes
 from catalog.gl.shaderlib import create_program, glsl_literal
 
-#: Auto exposure: a white diffuser under the key light maps to this (before the curve).
-EXPOSURE_KEY = 5.0
-#: The least illuminance (lx) the auto exposure assumes.
-EXPOSURE_FLOOR_LX = 200.0
-#: Tone curve white point (after exposure): this luminance maps to display white.
-TONE_WHITE = 6.0
+#: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
+METER_MAX_SIDE_PX = 96
 FLUORESCENCE_MODES = ("off", "paper", "physical")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
@@ -130,7 +129,12 @@ class FrameRenderer:
         self.mode = "physical"
         self.n_bands = 3
         self.camera = OrbitCamera()
-        self.exposure = 1.0
+        self.exposure = 1.0              # a multiplier on top of the EV (compensation)
+        self.ev100 = None                # None: metered per frame (auto exposure)
+        self.white_balance = display_lib.DEFAULT_WHITE_BALANCE
+        self.metered_ev100 = None        # the auto exposure's current EV100 (adapted)
+        self.display_stages = 3          # tonemap.frag's DISPLAY_STAGES (benchmark variants)
+        self._wb_cache = None
         self._inputs = None
         self._inputs_key = None
         self._decision = None
@@ -205,6 +209,17 @@ class FrameRenderer:
         if not (math.isfinite(multiplier) and multiplier > 0):
             raise CatalogError(f"exposure {multiplier!r} must be a positive number")
         self.exposure = float(multiplier)
+
+    def set_ev(self, ev100: float | None) -> None:
+        """A fixed exposure (EV100, as a camera's), or None for the automatic exposure."""
+        self.ev100 = None if ev100 is None else display_lib.check_ev(ev100)
+
+    def set_white_balance(self, white_balance: str) -> None:
+        """"room" (adapt to the light's white) or "camera" (fixed D65), see display.py."""
+        if white_balance not in display_lib.WHITE_BALANCES:
+            raise CatalogError(f"white balance {white_balance!r}: choose one of "
+                               f"{', '.join(display_lib.WHITE_BALANCES)}")
+        self.white_balance = white_balance
 
     # ------------------------------------------------------------------ mesh
     def set_mesh(self, positions, normals, uvs, tangents, indices) -> None:
@@ -429,12 +444,46 @@ class FrameRenderer:
         else:
             program[name].value = value
 
+    def current_ev100(self) -> float:
+        """The EV100 the next display pass uses (fixed, or the auto exposure's)."""
+        if self.ev100 is not None:
+            return self.ev100
+        if self.metered_ev100 is None:
+            raise CatalogError("auto exposure: nothing metered yet (render a frame first)")
+        return self.metered_ev100
+
     def exposure_scale(self) -> float:
-        """Linear radiance (cd m^-2) -> tone-curve input: EXPOSURE_KEY over a white diffuser's Y."""
-        # a UV lamp has almost no illuminance: expose as for EXPOSURE_FLOOR_LX instead, so what
-        # shows is the fluorescence it excites, not a blown-out violet tail
-        illuminance = max(self.light.illuminance_lx, EXPOSURE_FLOOR_LX)
-        return self.exposure * EXPOSURE_KEY * math.pi / illuminance
+        """Linear radiance (cd m^-2) -> scene value the tone curve takes (EV and multiplier)."""
+        return self.exposure * display_lib.exposure_scale(self.current_ev100())
+
+    def white_balance_matrix(self) -> np.ndarray:
+        """Linear sRGB -> linear sRGB: CAT16 from the key light's white to D65 (or identity)."""
+        inputs = self.shading_inputs()
+        key = (self._inputs_key, self.white_balance)
+        if self._wb_cache is None or self._wb_cache[0] != key:
+            from catalog.optics.shading_reference import white_xyz  # noqa: PLC0415
+
+            self._wb_cache = (key, display_lib.white_balance_matrix(white_xyz(inputs),
+                                                                     self.white_balance))
+        return self._wb_cache[1]
+
+    def display_uniforms(self) -> dict:
+        return display_lib.shader_uniforms(self.exposure_scale(), self.white_balance_matrix())
+
+    def meter(self, vw: int, vh: int) -> float:
+        """EV100 of the HDR target's (vw, vh) corner: a histogram of a mip level (at most
+        METER_MAX_SIDE_PX wide), white-balanced, of display.meter_signal (largest channel)."""
+        level = 0
+        while max(vw, vh) >> level > METER_MAX_SIDE_PX:
+            level += 1
+        if level:
+            self._hdr.build_mipmaps(0, level)
+            self._hdr.filter = (self._moderngl.NEAREST, self._moderngl.NEAREST)
+        w, h = max(1, self.size[0] >> level), max(1, self.size[1] >> level)
+        data = np.frombuffer(self._hdr.read(level=level), dtype=np.float32).reshape(h, w, 4)
+        cw, ch = max(1, -(-vw >> level)), max(1, -(-vh >> level))
+        rgb = data[:ch, :cw, :3].astype(np.float64) @ self.white_balance_matrix().T  # as shown
+        return display_lib.meter_ev100(display_lib.luminance_histogram(display_lib.meter_signal(rgb)))
 
     # ------------------------------------------------------------------ passes
     def _scene_uniforms(self, program, view_proj, inputs) -> None:
@@ -526,19 +575,29 @@ class FrameRenderer:
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
 
-    def render(self, fbo=None, viewport=None) -> None:
-        """One frame: HDR passes, then the tone map into ``fbo`` (default: our RGBA8 target)
-        at ``viewport`` (x, y, w, h; default the whole renderer size)."""
+    def render(self, fbo=None, viewport=None, dt_s: float | None = None) -> None:
+        """One frame: HDR passes, then the display pass into ``fbo`` (default: our RGBA8
+        target) at ``viewport`` (x, y, w, h; default the whole renderer size).
+
+        Auto exposure (no :meth:`set_ev`): this frame is metered; ``dt_s`` (the viewer's frame
+        time) adapts the exposure toward it over display.ADAPTATION_TAU_S, None jumps."""
         vw, vh = self.render_hdr(viewport)
+        if self.ev100 is None:
+            self.metered_ev100 = display_lib.adapt_ev(self.metered_ev100, self.meter(vw, vh), dt_s)
+        self.display_pass(vw, vh, fbo, viewport)
+
+    def display_pass(self, vw: int, vh: int, fbo=None, viewport=None) -> None:
+        """The display transform of the HDR target's (vw, vh) corner (the benchmark times it)."""
         target = fbo if fbo is not None else self._ldr_fbo
         target.use()
         self.ctx.viewport = tuple(viewport) if (fbo is not None and viewport is not None) else (0, 0, vw, vh)
-        program = self._program("fullscreen.vert", "tonemap.frag")
+        program = self._program("fullscreen.vert", "tonemap.frag",
+                                {"DISPLAY_STAGES": self.display_stages})
         self._hdr.use(location=0)
         self._set(program, "u_hdr", 0)
         self._set(program, "u_hdr_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
-        self._set(program, "u_exposure", self.exposure_scale())
-        self._set(program, "u_white", TONE_WHITE)
+        for name, value in self.display_uniforms().items():
+            self._set(program, name, value)
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
         self._last = (vw, vh, fbo, viewport)
 
@@ -594,6 +653,7 @@ class FrameRenderer:
     def info(self) -> dict:
         inputs = self.shading_inputs()
         decision = self._decision
+        metered = self.ev100 is not None or self.metered_ev100 is not None
         return {
             "fabric": self.preset.name,
             "light": self.light.name,
@@ -607,7 +667,11 @@ class FrameRenderer:
             "key_to_light": [round(float(v), 6) for v in inputs.key_to_light],
             "camera": {"yaw_deg": self.camera.yaw_deg, "pitch_deg": self.camera.pitch_deg,
                        "distance_m": self.camera.distance_m},
-            "exposure": self.exposure_scale(),
+            "exposure": self.exposure_scale() if metered else None,
+            "ev100": round(self.current_ev100(), 4) if metered else None,
+            "auto_exposure": self.ev100 is None,
+            "white_balance": self.white_balance,
+            "white_balance_adapted": not np.allclose(self.white_balance_matrix(), np.eye(3)),
             "size": list(self.size),
         }
 

@@ -25,9 +25,52 @@ def _fabric_list(fabrics):
     return [load_preset(p) for p in paths]
 
 
+#: Label strips of the grid (px): the fabric names' column and the lights' header row.
+LABEL_COLUMN_PX = 200
+LABEL_ROW_PX = 22
+LABEL_FONT_PX = 13
+
+
+def labelled_grid(grid: np.ndarray, rows: list[str], columns: list[str], cell: tuple[int, int]) -> np.ndarray:
+    """``grid`` with a header row naming each column and a left column naming each row
+    (OpenImageIO's text renderer and its built-in font)."""
+    import OpenImageIO as oiio  # noqa: PLC0415
+
+    width, height = cell
+    out = np.full((grid.shape[0] + LABEL_ROW_PX, grid.shape[1] + LABEL_COLUMN_PX, 3), 24, np.uint8)
+    out[LABEL_ROW_PX:, LABEL_COLUMN_PX:] = grid
+    buf = oiio.ImageBuf(oiio.ImageSpec(out.shape[1], out.shape[0], 3, oiio.UINT8))
+    buf.set_pixels(oiio.ROI(), out)
+    baseline = (LABEL_ROW_PX + LABEL_FONT_PX) // 2 - 1
+    for j, name in enumerate(columns):
+        oiio.ImageBufAlgo.render_text(buf, LABEL_COLUMN_PX + j * width + 4, baseline, name,
+                                      LABEL_FONT_PX, "", (0.92, 0.92, 0.92))
+    for i, name in enumerate(rows):
+        y = LABEL_ROW_PX + i * height + height // 2 + LABEL_FONT_PX // 2
+        for k, line in enumerate(_wrap(name, LABEL_COLUMN_PX - 8, LABEL_FONT_PX)):
+            oiio.ImageBufAlgo.render_text(buf, 4, int(y + (k - 1) * (LABEL_FONT_PX + 2)), line,
+                                          LABEL_FONT_PX, "", (0.92, 0.92, 0.92))
+    return buf.get_pixels(oiio.UINT8).reshape(out.shape)
+
+
+def _wrap(text: str, width_px: int, font_px: int) -> list[str]:
+    """At most three lines of about width_px (average glyph ~0.55 font sizes)."""
+    per_line = max(4, int(width_px / (0.55 * font_px)))
+    words, lines, line = text.split(), [], ""
+    for word in words:
+        if line and len(line) + 1 + len(word) > per_line:
+            lines.append(line)
+            line = word
+        else:
+            line = f"{line} {word}".strip()
+    lines.append(line)
+    return lines if len(lines) <= 3 else [*lines[:2], " ".join(lines[2:])[:per_line]]
+
+
 def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fabrics=None,
                  fluorescence: str = "physical", bands: int = 3, progress: bool = True,
-                 ctx=None) -> dict:
+                 ctx=None, ev: float | None = None, white_balance: str = "room",
+                 labels: bool = True) -> dict:
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.render import bands as band_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
@@ -41,6 +84,9 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
         scene_lib.dye_transmittance(preset)
         scene_lib.fluorescent_material(preset)
     band_lib.check_band_count(bands)
+    from catalog.render.snapshot import check_display_choices  # noqa: PLC0415
+
+    check_display_choices(ev, white_balance)
     if out_dir.exists() and not out_dir.is_dir():
         raise InputError(f"{str(out_dir)!r} exists and is not a folder", field="--out")
     width, height = size
@@ -48,12 +94,12 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     estimate_bytes = 2 * len(presets) * len(light_objects) * width * height * 3
     with staged_folder(out_dir, estimate_bytes=estimate_bytes) as stage:
         report = _render_into(stage, out_dir, presets, light_objects, size, fluorescence,
-                              bands, progress, ctx)
+                              bands, progress, ctx, ev, white_balance, labels)
     return report
 
 
 def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluorescence,
-                 bands, progress, ctx) -> dict:
+                 bands, progress, ctx, ev, white_balance, labels) -> dict:
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.render.snapshot import write_image  # noqa: PLC0415
@@ -62,6 +108,8 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
     renderer = FrameRenderer(ctx, size)
     renderer.set_fluorescence(fluorescence)
     renderer.set_bands(bands)
+    renderer.set_ev(ev)
+    renderer.set_white_balance(white_balance)
     width, height = size
     grid = np.zeros((height * len(presets), width * len(light_objects), 3), dtype=np.uint8)
     images = []
@@ -80,10 +128,13 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
             info = renderer.info()
             write_image(stage / name, pixels, {"catalog:fabric": preset.name, "catalog:light": light.name,
                                        "catalog:mode": info["mode"],
-                                       "catalog:fluorescence_variant": info["fluorescence_variant"]})
+                                       "catalog:fluorescence_variant": info["fluorescence_variant"],
+                                       "catalog:ev100": f"{info['ev100']:.4f}",
+                                       "catalog:white_balance": info["white_balance"]})
             grid[i * height:(i + 1) * height, j * width:(j + 1) * width] = pixels
             images.append({"fabric": preset.name, "light": light.name, "path": str(path),
-                           "fluorescence_variant": info["fluorescence_variant"]})
+                           "fluorescence_variant": info["fluorescence_variant"],
+                           "ev100": info["ev100"]})
             advance()
 
     try:
@@ -98,6 +149,9 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
     finally:
         renderer.release()
     grid_path = out_dir / "grid.png"
+    if labels:
+        grid = labelled_grid(grid, [f"{p.display_name} ({p.name})" for p in presets],
+                             [l.name for l in light_objects], (width, height))
     write_image(stage / grid_path.name, grid, {
         "ImageDescription": "rows: " + ", ".join(p.name for p in presets)
                             + "; columns: " + ", ".join(l.name for l in light_objects),
@@ -106,4 +160,5 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
     if not images:
         raise CatalogError("nothing rendered")
     return {"images": images, "grid": str(grid_path), "rows": [p.name for p in presets],
-            "columns": [l.name for l in light_objects], "size": list(size)}
+            "columns": [l.name for l in light_objects], "size": list(size), "labels": labels,
+            "label_offset_px": [LABEL_COLUMN_PX, LABEL_ROW_PX] if labels else [0, 0]}

@@ -52,6 +52,8 @@ class SnapshotRequest:
     pitch_deg: float = 0.0
     distance_m: float = 2.6
     exposure: float = 1.0
+    ev: float | None = None           # EV100; None: automatic exposure
+    white_balance: str = "room"
 
 
 def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str], *,
@@ -68,7 +70,10 @@ def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str], *,
     spec = oiio.ImageSpec(width, height, channels, kind)
     spec.channelnames = ("R", "G", "B")
     for key, value in metadata.items():
-        spec.attribute(key, str(value))
+        if key == "chromaticities":
+            spec.attribute(key, oiio.TypeDesc("float[8]"), tuple(value))
+        else:
+            spec.attribute(key, str(value))
 
     def verify(tmp: Path) -> None:
         back = oiio.ImageInput.open(str(tmp))
@@ -94,6 +99,24 @@ def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str], *,
         output.close()
         if not ok:
             raise OutputError(path, error or "the image writer failed")
+
+
+def exr_colour_metadata() -> dict:
+    """What tools need to show our EXR with a standard view (OpenColorIO's built-in config
+    ``ocio://default``: the interop ID of its colour space "Linear Rec.709 (sRGB)"; the EXR chromaticities of
+    sRGB / Rec.709 with the D65 white, from colour-science's tables)."""
+    from catalog.render import display  # noqa: PLC0415
+
+    t = display.tables()
+    m = np.linalg.inv(t["srgb_xyz_to_rgb"])  # RGB -> XYZ: the columns are the primaries
+    xy = [(col[0] / col.sum(), col[1] / col.sum()) for col in m.T]
+    white = tuple(float(v) for v in t["srgb_whitepoint_xy"])
+    return {"oiio:ColorSpace": OCIO_LINEAR_SPACE,
+            "chromaticities": tuple(float(v) for pair in xy for v in pair) + white}
+
+
+#: The name of our EXR's colour space in OpenColorIO's built-in config (ocio://default).
+OCIO_LINEAR_SPACE = "lin_rec709_scene"   # the interop ID; "Linear Rec.709 (sRGB)" there
 
 
 def read_metadata(path: str | Path) -> dict[str, str]:
@@ -124,6 +147,24 @@ def simulated_curtain(preset, frames: int):
     return mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices
 
 
+def check_display_choices(ev, white_balance, exposure=1.0) -> None:
+    """--ev, --white-balance and --exposure, refused in one line naming the option."""
+    import math  # noqa: PLC0415
+
+    from catalog.render import display  # noqa: PLC0415
+
+    if ev is not None:
+        try:
+            display.check_ev(ev)
+        except CatalogError as exc:
+            raise InputError(str(exc).split(": ", 1)[-1], field="--ev") from None
+    if white_balance not in display.WHITE_BALANCES:
+        raise InputError(f"{white_balance!r}: choose one of {', '.join(display.WHITE_BALANCES)}",
+                         field="--white-balance")
+    if not (math.isfinite(exposure) and exposure > 0):
+        raise InputError(f"{exposure!r} must be a positive number", field="--exposure")
+
+
 def validate(request: SnapshotRequest):
     """Everything that can be refused before a context exists: the preset, the light, the
     size, the output name. Returns (preset, light)."""
@@ -138,6 +179,7 @@ def validate(request: SnapshotRequest):
     if request.frame < 0:
         raise InputError(f"{request.frame} must be >= 0", field="--frame")
     band_lib.check_band_count(request.bands)
+    check_display_choices(request.ev, request.white_balance, request.exposure)
     preset = load_preset(find_preset(request.fabric))
     scene_lib.dye_transmittance(preset)
     scene_lib.fluorescent_material(preset)
@@ -166,6 +208,8 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.set_bands(request.bands)
         renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
         renderer.set_exposure(request.exposure)
+        renderer.set_ev(request.ev)
+        renderer.set_white_balance(request.white_balance)
         mesh_source = "static drape"
         if request.frame > 0:
             renderer.set_mesh(*simulated_curtain(preset, request.frame))
@@ -191,8 +235,15 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         "catalog:frame": str(request.frame),
         "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
                              if request.out.suffix.lower() == ".exr"
-                             else "sRGB, Reinhard luminance tone map"),
+                             else "sRGB; CAT16 white balance, Michaelis-Menten tone curve, "
+                                  "OKLab gamut compression (docs/display.md)"),
+        "catalog:ev100": f"{info['ev100']:.4f}",
+        "catalog:exposure_scale": repr(info["exposure"]),
+        "catalog:auto_exposure": str(info["auto_exposure"]).lower(),
+        "catalog:white_balance": info["white_balance"],
     }
+    if request.out.suffix.lower() == ".exr":
+        metadata.update(exr_colour_metadata())
     write_image(request.out, pixels, metadata)
     report = dict(info)
     report.update({"out": str(request.out), "frame": request.frame, "mesh": mesh_source,

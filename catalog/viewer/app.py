@@ -57,6 +57,9 @@ class ViewerOptions:
     paused: bool = False
     render_scale: float | None = None  # scene resolution / window resolution; None: auto
     fabric_dir: Path | None = None  # None: --fabrics / $CATALOG_FABRICS, then the built-in catalog
+    ev100: float | None = None  # fixed exposure; None: automatic
+    white_balance: str = "room"
+    compare_fluorescence: str | None = None  # the right half's fluorescence (None: the left's)
 
 
 def heavy_modules_loaded() -> dict[str, bool]:
@@ -75,7 +78,9 @@ class ViewerApp:
         if len(self.catalog) == 0:
             raise CatalogError(f"no presets (*.toml) in {self.catalog.where}")
         self.settings = ViewerSettings(fluorescence=options.fluorescence, bands=options.bands,
-                                       show_panel=options.panel, paused=options.paused)
+                                       show_panel=options.panel, paused=options.paused,
+                                       ev100=options.ev100, white_balance=options.white_balance,
+                                       compare_fluorescence=options.compare_fluorescence)
         if options.hour is not None:
             self.settings.sun_hour = options.hour
         if options.wind_m_s is not None:
@@ -149,6 +154,10 @@ class ViewerApp:
         self.panel = Panel()
         self._install_callbacks(imgui)
         self.panel_info = PanelInfo(cie_lights=self._cie_light_names())
+        from catalog.viewer.thumbnails import ThumbnailCache  # noqa: PLC0415
+
+        self.thumbnails = ThumbnailCache(self.ctx)
+        self.panel_info.thumbnails = self.thumbnails
 
         self.scene = CurtainScene(self.options.grid, backend=self.cloth_backend,
                                   wind_m_s=self.settings.wind_m_s, ctx=self.ctx)
@@ -194,12 +203,14 @@ class ViewerApp:
                     renderer.set_camera(self.camera.yaw_deg, self.camera.pitch_deg,
                                         self.camera.distance_m)
                     try:
+                        self._set_exposure(slot, renderer)
                         if self._scaled_fbos:
                             small = self._scaled_fbos[slot]
-                            renderer.render(fbo=small, viewport=(0, 0, *small.size))
+                            renderer.render(fbo=small, viewport=(0, 0, *small.size),
+                                            dt_s=frame_dt)
                             self._blit(small, viewport)
                         else:
-                            renderer.render(fbo=self._fbo, viewport=viewport)
+                            renderer.render(fbo=self._fbo, viewport=viewport, dt_s=frame_dt)
                         self.messages.pop(f"render{slot}", None)
                     except CatalogError as exc:  # e.g. no fabric loads: say so, keep running
                         self.messages[f"render{slot}"] = str(exc)
@@ -207,6 +218,8 @@ class ViewerApp:
                 self.ctx.finish()
 
             with self.timer.part("ui"):
+                if self.settings.show_panel:
+                    self._update_thumbnails()
                 self._update_panel_info()
                 self.gui.process_inputs()
                 imgui.new_frame()
@@ -239,9 +252,11 @@ class ViewerApp:
                        "grid": list(self.options.grid), "renderer": self.ctx.info["GL_RENDERER"],
                        "render_scale": self.render_scale, "cloth_backend": self.cloth_backend,
                        **{f"median_{k}_ms": round(v, 3)
-                          for k, v in self.timer.median_ms().items()}}
+                          for k, v in self.timer.median_ms().items()},
+                       **self._panel_summary()}
             print(json.dumps(summary), flush=True)
         self.gui.shutdown()
+        self.thumbnails.release()
         if self.options.frames is not None and self.frame_error is not None:
             raise self.frame_error  # one line on stderr, exit 2 (or 3 for the environment)
         return 0
@@ -441,9 +456,13 @@ class ViewerApp:
                     self.messages["light"] = str(exc)
                     self.frame_error = self.frame_error or exc
                 applied["light"] = light_key
-            if applied.get("fluorescence") != settings.fluorescence:
-                renderer.set_fluorescence(settings.fluorescence)
-                applied["fluorescence"] = settings.fluorescence
+            mode = settings.fluorescence if slot == 0 else settings.right_fluorescence
+            if applied.get("fluorescence") != mode:
+                renderer.set_fluorescence(mode)
+                applied["fluorescence"] = mode
+            if applied.get("white_balance") != settings.white_balance:
+                renderer.set_white_balance(settings.white_balance)
+                applied["white_balance"] = settings.white_balance
             if applied.get("bands") != settings.bands:
                 renderer.set_bands(settings.bands)
                 applied["bands"] = settings.bands
@@ -451,6 +470,56 @@ class ViewerApp:
             entry = self.catalog.load(settings.fabric_index)
             if entry.preset is not None:
                 self.scene.set_fabric(entry.preset)
+
+    def _set_exposure(self, slot: int, renderer) -> None:
+        """A fixed EV for every half; auto: the left half meters and adapts, the right half
+        shows at the left's exposure (a comparison at one exposure, e.g. fluorescence on |
+        off, shows the difference instead of metering it away)."""
+        if self.settings.ev100 is not None:
+            renderer.set_ev(self.settings.ev100)
+        elif slot == 0:
+            renderer.set_ev(None)
+        else:
+            left = self._renderers[0]
+            renderer.set_ev(left.metered_ev100 if left.ev100 is None and
+                            left.metered_ev100 is not None else None)
+
+    def _thumbnail_scene(self) -> tuple:
+        settings = self.settings
+        return (settings.light, settings.sun_hour if settings.light == SUN else None,
+                settings.fluorescence, settings.white_balance, settings.ev100)
+
+    def _update_thumbnails(self) -> None:
+        """Draw the thumbnails that are missing or stale (a few per frame)."""
+        settings = self.settings
+
+        def apply_scene(renderer) -> None:
+            if settings.light == SUN:
+                renderer.set_sun_hour(settings.sun_hour)
+            else:
+                renderer.set_light(settings.light)
+            renderer.set_fluorescence(settings.fluorescence)
+            renderer.set_white_balance(settings.white_balance)
+            renderer.set_ev(settings.ev100)
+
+        entries = [entry for entry in self.catalog.entries
+                   if settings.fabric_filter.matches(entry.facts)]
+        self.thumbnails.update(entries, self._thumbnail_scene(), apply_scene)
+
+    def _panel_summary(self) -> dict:
+        """What the panel showed at the end (the --stats summary; tests read it)."""
+        scene = self._thumbnail_scene()
+        thumbnails = {entry.name: [round(float(v), 3) for v in
+                                   self.thumbnails.get(entry.name).pixels.reshape(-1, 3).mean(axis=0)]
+                      for entry in self.catalog.entries
+                      if self.thumbnails.get(entry.name) is not None
+                      and self.thumbnails.is_current(entry, scene)}
+        return {"thumbnails": thumbnails, "thumbnail_renders": self.thumbnails.renders,
+                "facts": {entry.name: entry.facts.lines() for entry in self.catalog.entries
+                          if entry.facts is not None},
+                "labels": {entry.name: entry.label for entry in self.catalog.entries},
+                "ev100": [r.info().get("ev100") for r in self._renderers],
+                "fluorescence": [r.mode for r in self._renderers]}
 
     def _cie_light_names(self) -> list[str]:
         try:
@@ -475,6 +544,8 @@ class ViewerApp:
             except ValueError:
                 pass
         info.fluorescence_compiled = renderer_info.get("fluorescence_needed")
+        info.ev100 = renderer_info.get("ev100")
+        info.white_balance_adapted = renderer_info.get("white_balance_adapted")
         info.messages = list(self.messages.values())
         info.last_screenshot = self.last_screenshot
 
@@ -488,6 +559,8 @@ class ViewerApp:
             title += f" | {self.catalog.entries[self.settings.compare_index].label}"
         title += (f" - light {self.settings.light_label} - fluorescence "
                   f"{self.settings.fluorescence}")
+        if self.settings.compare_index is not None and self.settings.compare_fluorescence:
+            title += f" | {self.settings.compare_fluorescence}"
         if self.settings.paused:
             title += " (paused)"
         if title != getattr(self, "_title", None):
@@ -514,7 +587,9 @@ class ViewerApp:
     def _metadata(self) -> dict[str, str]:
         meta = {"catalog:fabric": self._shown_name(), "catalog:light": self.settings.light_label,
                 "catalog:fluorescence": self.settings.fluorescence,
-                "catalog:bands": str(self.settings.bands), "Software": "catalog view"}
+                "catalog:bands": str(self.settings.bands), "Software": "catalog view",
+                "catalog:white_balance": self.settings.white_balance,
+                "catalog:ev100": "auto" if self.settings.ev100 is None else str(self.settings.ev100)}
         compare = self.settings.compare_index
         if compare is not None and compare < len(self.catalog):
             meta["catalog:compare"] = self.catalog.entries[compare].name

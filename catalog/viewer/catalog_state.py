@@ -68,6 +68,64 @@ def swatch_srgb(preset: Preset) -> tuple[float, float, float]:
     return tuple(float(v) for v in _srgb_encode(linear))  # type: ignore[return-value]
 
 
+#: What a fabric's colour comes from (the panel's filter groups, in its order).
+KINDS = ("optical brightener", "fluorescent dye", "dye", "undyed")
+
+
+@dataclass(frozen=True)
+class FabricFacts:
+    """What the panel states about a preset, read from its file (nothing estimated)."""
+
+    openness_pct: float              # LD, the open-area see-through fraction, in per cent
+    kind: str                        # one of KINDS
+    weight_g_m2: float | None        # [cloth] areal_density_kg_m2 x 1000, where the file has it
+    weave: str | None                # [cloth] weave, where the file has it
+
+    def lines(self) -> list[str]:
+        parts = [f"open {self.openness_pct:.0f} %", self.kind]
+        if self.weight_g_m2 is not None:
+            parts.append(f"{self.weight_g_m2:.0f} g/m2")
+        if self.weave:
+            parts.append(self.weave)
+        return [", ".join(parts)]
+
+
+def fabric_facts(preset: Preset) -> FabricFacts:
+    """Openness (btdf.direct), brightener or dye ([fluorescence] with or without [dye]),
+    weight and weave ([cloth]) of a preset."""
+    has_dye = bool(preset.table("dye")) or isinstance(preset.table("btdf").get("rgb"), dict)
+    if preset.has_fluorescence:
+        kind = "fluorescent dye" if has_dye else "optical brightener"
+    else:
+        kind = "dye" if has_dye else "undyed"
+    cloth = preset.table("cloth")
+    density = cloth.get("areal_density_kg_m2")
+    weight = float(density) * 1000.0 if isinstance(density, (int, float)) and density > 0 else None
+    weave = cloth.get("weave") if isinstance(cloth.get("weave"), str) else None
+    return FabricFacts(openness_pct=100.0 * float(preset.btdf.direct), kind=kind,
+                       weight_g_m2=weight, weave=weave)
+
+
+@dataclass
+class FabricFilter:
+    """The panel's filter by facts: the kinds shown and an openness range (per cent)."""
+
+    kinds: set[str] | None = None               # None: every kind
+    openness_pct: tuple[float, float] = (0.0, 100.0)
+
+    def matches(self, facts: FabricFacts | None) -> bool:
+        if facts is None:
+            return True  # a broken preset stays listed (with its error)
+        if self.kinds is not None and facts.kind not in self.kinds:
+            return False
+        low, high = self.openness_pct
+        return low <= facts.openness_pct <= high
+
+    @property
+    def active(self) -> bool:
+        return self.kinds is not None or self.openness_pct != (0.0, 100.0)
+
+
 @dataclass
 class FabricEntry:
     """One preset file as the panel sees it."""
@@ -78,6 +136,7 @@ class FabricEntry:
     error: str | None = None
     loaded_mtime_ns: int | None = None  # the file version that ``preset``/``error`` describe
     swatch: tuple[float, float, float] | None = None
+    facts: FabricFacts | None = None
 
     @property
     def loaded(self) -> bool:
@@ -165,6 +224,7 @@ class FabricCatalog:
                 entry.error = None
                 entry.loaded_mtime_ns = None
                 entry.swatch = None
+                entry.facts = None
                 changed.append(name)
             entries.append(entry)
         changed.extend(name for name in old if name not in paths)
@@ -181,6 +241,7 @@ class FabricCatalog:
                 entry.preset = load_preset(entry.path)
                 entry.error = None
                 entry.swatch = swatch_srgb(entry.preset)
+                entry.facts = fabric_facts(entry.preset)
             except CatalogError as exc:
                 entry.preset = None
                 entry.error = str(exc)

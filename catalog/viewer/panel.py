@@ -1,5 +1,7 @@
-"""The on-screen panel (imgui-bundle): fabrics, light, fluorescence, bands, wind, curtain,
-frame time; and the help overlay.
+"""The on-screen panel (imgui-bundle): the fabrics as a catalog (a thumbnail rendered under
+the current light, the full name, the preset's facts, a filter by facts), compare, light,
+fluorescence (per half when comparing), bands, exposure and white balance, wind, curtain,
+frame time (the graphs behind a toggle); and the help overlay.
 
 Immediate mode: :meth:`Panel.draw` is called once per frame between ``imgui.new_frame()``
 and ``imgui.render()``; it reads and writes a :class:`ViewerSettings` and reads the
@@ -13,14 +15,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from imgui_bundle import imgui
 
-from catalog.viewer.catalog_state import FabricCatalog
+from catalog.viewer.catalog_state import KINDS, FabricCatalog
 from catalog.viewer.input import KEY_HELP
-from catalog.viewer.settings import (BAND_COUNTS, FLUORESCENCE_MODES, LED_LIGHTS, SUN,
-                                     SUN_HOUR_RANGE, UVA_LIGHT, WIND_RANGE_M_S,
-                                     ViewerSettings)
+from catalog.viewer.settings import (BAND_COUNTS, EV_SLIDER_RANGE, FLUORESCENCE_MODES,
+                                     LED_LIGHTS, SUN, SUN_HOUR_RANGE, UVA_LIGHT,
+                                     WHITE_BALANCES, WIND_RANGE_M_S, ViewerSettings)
 from catalog.viewer.timing import FrameTimer
 
-PANEL_WIDTH_PX = 330
+PANEL_WIDTH_PX = 360
+#: The thumbnails' size on the panel (px).
+THUMBNAIL_PX = (72, 54)
 ERROR_COLOUR = imgui.ImVec4(1.0, 0.42, 0.35, 1.0)
 DIM_COLOUR = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
 
@@ -35,6 +39,9 @@ class PanelInfo:
     cie_lights: list[str] = field(default_factory=list)  # CIE illuminant names for the combo
     messages: list[str] = field(default_factory=list)  # errors to show (light, fabric, save)
     last_screenshot: str | None = None
+    ev100: float | None = None       # the exposure the left half shows now (auto: adapted)
+    white_balance_adapted: bool | None = None
+    thumbnails: object = None        # catalog.viewer.thumbnails.ThumbnailCache, or None
 
 
 class Panel:
@@ -59,47 +66,99 @@ class Panel:
             flags = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                      | imgui.WindowFlags_.no_collapse)
             imgui.begin("Fabric catalog", None, flags)
-            self._fabrics(settings, catalog)
+            self._fabrics(settings, catalog, info)
             self._light(settings, info)
             self._fluorescence(settings, info)
+            self._display(settings, info)
             self._simulation(settings)
-            self._timing(timer)
+            self._timing(settings, timer)
             self._messages(info)
             imgui.end()
         if settings.show_help:
             self._help()
 
     # ------------------------------------------------------------------------------
-    def _fabrics(self, settings: ViewerSettings, catalog: FabricCatalog) -> None:
+    def _fabrics(self, settings: ViewerSettings, catalog: FabricCatalog, info: PanelInfo) -> None:
         imgui.separator_text("Fabric  (Left / Right)")
-        catalog.load_all()  # swatches for every preset; a file is read once per version
+        catalog.load_all()  # facts for every preset; a file is read once per version
+        self._filter(settings)
+        shown = 0
         for index, entry in enumerate(catalog.entries):
+            if not settings.fabric_filter.matches(entry.facts):
+                continue
+            shown += 1
             imgui.push_id(f"fabric-{entry.name}")
-            if entry.swatch is not None:
-                colour = imgui.ImVec4(*entry.swatch, 1.0)
-                imgui.color_button("swatch", colour, imgui.ColorEditFlags_.no_tooltip,
-                                   imgui.ImVec2(18, 18))
+            thumbnail = info.thumbnails.get(entry.name) if info.thumbnails is not None else None
+            size = imgui.ImVec2(*THUMBNAIL_PX)
+            if thumbnail is not None:
+                clicked = imgui.image_button("thumb", imgui.ImTextureRef(thumbnail.texture.glo), size)
+            elif entry.swatch is not None:  # until the renderer has drawn it
+                clicked = imgui.color_button("swatch", imgui.ImVec4(*entry.swatch, 1.0),
+                                             imgui.ColorEditFlags_.no_tooltip, size)
             else:
-                imgui.text_colored(ERROR_COLOUR, " ! ")
+                clicked = imgui.button(" ! ", size)
+            if clicked and entry.preset is not None:
+                settings.fabric_index = index
             imgui.same_line()
-            label = entry.label + ("  [FL]" if entry.fluorescent else "")
+            imgui.begin_group()
+            imgui.push_text_wrap_pos(self.width_px - 12)
             if entry.error is not None:
                 imgui.text_colored(ERROR_COLOUR, f"{entry.name}: broken preset")
             else:
-                clicked, _ = imgui.selectable(label, index == settings.fabric_index)
-                if clicked:
-                    settings.fabric_index = index
+                selected = index == settings.fabric_index
+                name = entry.label
+                if selected:
+                    imgui.text_colored(imgui.ImVec4(1.0, 0.85, 0.4, 1.0), "> " + name)
+                else:
+                    imgui.text_wrapped(name)
+                if entry.facts is not None:
+                    for line in entry.facts.lines():
+                        imgui.text_colored(DIM_COLOUR, line)
+            imgui.pop_text_wrap_pos()
+            imgui.end_group()
             imgui.pop_id()
+        if shown == 0:
+            imgui.text_colored(DIM_COLOUR, "no fabric has these facts")
         for error in catalog.errors():
             imgui.push_text_wrap_pos(self.width_px - 10)
             imgui.text_colored(ERROR_COLOUR, error)
             imgui.pop_text_wrap_pos()
 
+        imgui.separator_text("Compare (split screen)")
         names = ["(none)"] + [entry.name for entry in catalog.entries]
         current = 0 if settings.compare_index is None else settings.compare_index + 1
-        changed, current = imgui.combo("compare", current, names)
+        changed, current = imgui.combo("right half", current, names)
         if changed:
             settings.compare_index = None if current == 0 else current - 1
+        if imgui.button("this fabric: fluorescence on | off"):
+            settings.compare_index = settings.fabric_index
+            if settings.fluorescence == "off":
+                settings.fluorescence = "physical"
+            settings.compare_fluorescence = "off"
+        if settings.compare_index is not None:
+            modes = ["(as the left)", *FLUORESCENCE_MODES]
+            current = 0 if settings.compare_fluorescence is None \
+                else modes.index(settings.compare_fluorescence)
+            changed, current = imgui.combo("right fluorescence", current, modes)
+            if changed:
+                settings.compare_fluorescence = None if current == 0 else modes[current]
+
+    def _filter(self, settings: ViewerSettings) -> None:
+        fabric_filter = settings.fabric_filter
+        label = "Filter by facts" + ("  (on)" if fabric_filter.active else "")
+        if not imgui.collapsing_header(label):
+            return
+        kinds = set(KINDS) if fabric_filter.kinds is None else set(fabric_filter.kinds)
+        for kind in KINDS:
+            changed, on = imgui.checkbox(kind, kind in kinds)
+            if changed:
+                kinds = kinds | {kind} if on else kinds - {kind}
+                fabric_filter.kinds = None if kinds == set(KINDS) else kinds
+        low, high = fabric_filter.openness_pct
+        changed, low, high = imgui.drag_float_range2("openness", low, high, 0.5, 0.0, 100.0,
+                                                     "%.0f %%", "%.0f %%")
+        if changed:
+            fabric_filter.openness_pct = (max(0.0, low), min(100.0, max(low, high)))
 
     def _light(self, settings: ViewerSettings, info: PanelInfo) -> None:
         imgui.separator_text("Light  (L)")
@@ -169,6 +228,24 @@ class Panel:
             if imgui.radio_button(f"{bands}##bands", settings.bands == bands):
                 settings.bands = bands
 
+    def _display(self, settings: ViewerSettings, info: PanelInfo) -> None:
+        imgui.separator_text("Display")
+        auto = settings.ev100 is None
+        changed, auto = imgui.checkbox("auto exposure", auto)
+        if changed:
+            settings.ev100 = None if auto else (info.ev100 if info.ev100 is not None else 10.0)
+        shown = settings.ev100 if settings.ev100 is not None else (info.ev100 or 0.0)
+        changed, value = imgui.slider_float("exposure", shown, *EV_SLIDER_RANGE, "EV %.1f")
+        if changed:  # dragging the slider fixes the exposure
+            settings.ev100 = value
+        imgui.text("white balance")
+        for choice in WHITE_BALANCES:
+            imgui.same_line()
+            if imgui.radio_button(f"{choice}##wb", settings.white_balance == choice):
+                settings.white_balance = choice
+        if settings.white_balance == "room" and info.white_balance_adapted is False:
+            imgui.text_colored(DIM_COLOUR, "this light is no white: shown as D65")
+
     def _simulation(self, settings: ViewerSettings) -> None:
         imgui.separator_text("Curtain")
         changed, wind = imgui.slider_float("wind", settings.wind_m_s, *WIND_RANGE_M_S,
@@ -180,7 +257,7 @@ class Panel:
         imgui.same_line()
         _, settings.paused = imgui.checkbox("pause (Space)", settings.paused)
 
-    def _timing(self, timer: FrameTimer) -> None:
+    def _timing(self, settings: ViewerSettings, timer: FrameTimer) -> None:
         imgui.separator_text("Frame time")
         medians = timer.median_ms()
         if not medians:
@@ -189,6 +266,9 @@ class Panel:
         total = medians["total"]
         fps = 1e3 / total if total > 0 else float("inf")
         imgui.text(f"{total:6.1f} ms  ({fps:5.1f} fps), median of {len(timer.history)}")
+        _, settings.show_timing = imgui.checkbox("frame-time graphs", settings.show_timing)
+        if not settings.show_timing:
+            return
         imgui.text(f"simulation {medians['simulation']:5.1f} ms")
         imgui.text(f"shading    {medians['shading']:5.1f} ms")
         imgui.text(f"UI         {medians['ui']:5.1f} ms")

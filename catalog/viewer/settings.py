@@ -6,7 +6,9 @@ the lights in, the F key's cycle of modes). No GL, no window: tested directly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from catalog.viewer.catalog_state import FabricFilter
 
 #: The renderer's fluorescence modes, in the order the F key cycles them.
 FLUORESCENCE_MODES = ("off", "paper", "physical")
@@ -23,6 +25,10 @@ UVA_LIGHT = "UV-A"
 #: Hour-of-day slider range (local solar time, h) and its default: noon, the paper's scene.
 SUN_HOUR_RANGE = (6.0, 18.0)
 DEFAULT_SUN_HOUR = 12.0
+#: White balance choices (catalog/render/display.py) and the exposure slider's range (EV100).
+WHITE_BALANCES = ("room", "camera")
+EV_SLIDER_RANGE = (-2.0, 18.0)
+
 #: Wind slider range (m/s at the open window).
 WIND_RANGE_M_S = (0.0, 8.0)
 DEFAULT_WIND_M_S = 1.5
@@ -57,6 +63,15 @@ class ViewerSettings:
     paused: bool = False
     show_help: bool = False
     show_panel: bool = True
+    ev100: float | None = None  # fixed exposure (EV100); None: automatic, adapting over time
+    white_balance: str = "room"
+    compare_fluorescence: str | None = None  # the right half's mode (None: the left's)
+    show_timing: bool = False  # the developer frame-time graphs
+    fabric_filter: FabricFilter = field(default_factory=FabricFilter)
+
+    @property
+    def right_fluorescence(self) -> str:
+        return self.compare_fluorescence or self.fluorescence
 
     @property
     def light_label(self) -> str:
