@@ -17,8 +17,15 @@ register_folder(Path(__file__).resolve().parent / "shaders")
 #: beside the checkout. It is not part of the repository; CI has it.
 DATA_MISSING = data_missing_reason("bispectral") or data_missing_reason("brightener")
 
-#: Mark for a test that reads the validation data (skipped, with the reason, without it).
-needs_data = pytest.mark.skipif(DATA_MISSING is not None, reason=str(DATA_MISSING))
+
+def pytest_collection_modifyitems(config, items):
+    """``@pytest.mark.data`` tests are skipped, with the reason, without the validation data."""
+    if DATA_MISSING is None:
+        return
+    skip = pytest.mark.skip(reason=DATA_MISSING)
+    for item in items:
+        if item.get_closest_marker("data") is not None:
+            item.add_marker(skip)
 
 
 @pytest.fixture(scope="session")

@@ -148,7 +148,7 @@ def main(argv=None) -> int:
     extra_floors = {"floor + normal as colour (one varying)": "trivial_normal.frag",
                     "floor + least eq. 5-7 work (2 lights x 2 HG lobes, isotropic)": "trivial_lobes.frag"}
     variants += [(label, None, None, None) for label in extra_floors]
-    for mode in ("off", "paper", "physical"):
+    for mode in FLUORESCENCE_MODES:
         variants.append((f"rgb {mode}", mode, 3, True))
     variants.append(("rgb off, no see-through", "off", 3, False))
     variants.append(("rgb physical, scene values as uniforms (not specialised)", "physical", 3, True))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from catalog.core.constants import FLUORESCENT_MODES
+
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
@@ -20,7 +22,7 @@ def add_arguments(parser) -> None:
                              "presets (a folder is searched before the built-in catalog; default: "
                              "every preset, $CATALOG_FABRICS first)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
-    parser.add_argument("--mode", choices=("paper", "physical"), default="physical")
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical")
     parser.add_argument("--bands", type=int, default=3)
     add_display_arguments(parser)
     parser.add_argument("--no-labels", action="store_true",

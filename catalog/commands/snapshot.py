@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from catalog.core.constants import FLUORESCENT_MODES
+
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 INPUT_FILES = ("fabric",)
@@ -26,7 +28,7 @@ def add_arguments(parser) -> None:
                         help="cloth simulation frame (0: the static drape)")
     parser.add_argument("--out", required=True, help="FILE.exr (linear) or FILE.png (sRGB)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
-    parser.add_argument("--mode", choices=("paper", "physical"), default="physical",
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model (default physical)")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3 (RGB), 6, 9, 16")
     parser.add_argument("--yaw", type=number_type(-360.0, 360.0, unit="deg"), default=0.0, help="camera yaw, deg")

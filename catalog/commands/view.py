@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from catalog.core.constants import FLUORESCENCE_MODES as FLUORESCENCE_CHOICES
 from catalog.core.cliargs import wxh_type
 from catalog.commands.displayargs import add_display_arguments
 
@@ -14,7 +15,6 @@ INPUT_FILES = ("fabric", "compare")
 OUTPUT_FILES = ("screenshot",)
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
-FLUORESCENCE_CHOICES = ("off", "paper", "physical")
 BAND_CHOICES = (3, 6, 9, 16)
 
 
@@ -90,7 +90,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _forbid_scipy() -> None:
     """Mark scipy absent in the viewer's process.
 
-    Drawing a frame never needs scipy (architecture.md: render and viewer never import the
+    Drawing a frame never needs scipy (docs/architecture.md: render and viewer never import the
     tools' fitting code). numba's own import probes for scipy (a version check) and its CPU
     target then loads scipy.linalg's BLAS bindings, a few hundred ms of start-up for nothing;
     with scipy marked absent numba skips both, and an accidental scipy import anywhere in the

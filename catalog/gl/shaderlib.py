@@ -3,7 +3,9 @@
 After moderngl-window's program loader: sources are files (never strings in Python), an
 include is searched in the including file's folder and then in the registered folders, and
 nesting deeper than :data:`MAX_INCLUDE_DEPTH` is refused (which also catches cycles).
-Defines are written right after the ``#version`` line, so a variant is chosen at compile time.
+Defines are written right after the ``#version`` line, so a variant is chosen at compile time;
+the constants Python and GLSL share (:data:`catalog.core.constants.SHADER_DEFINES`) are
+defined in every program, so GLSL never repeats their values.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from pathlib import Path
 from typing import Mapping
 
 from catalog.core.resources import SHADER_DIR
+from catalog.core.constants import SHADER_DEFINES
 from catalog.core.errors import CatalogError, EnvironmentFailure
 
 #: Deeper nesting than this is an error (an include cycle always reaches it).
@@ -83,7 +86,7 @@ def load_source(name: str, defines: Mapping[str, object] | None = None) -> str:
     """
     path = find_shader(name)
     lines = _expand(path, 0, (path.name,))
-    extra = _define_lines(defines or {})
+    extra = _define_lines({**SHADER_DEFINES, **(defines or {})})
     for index, line in enumerate(lines):
         if _VERSION.match(line):
             return "\n".join(lines[:index + 1] + extra + lines[index + 1:]) + "\n"

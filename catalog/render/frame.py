@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from catalog.core.constants import FLUORESCENCE_MODES
 from catalog.core.errors import CatalogError
 from catalog.render import bands as band_lib
 from catalog.render import display as display_lib
@@ -31,7 +32,6 @@ from catalog.gl.shaderlib import create_program, glsl_literal
 
 #: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
 METER_MAX_SIDE_PX = 96
-FLUORESCENCE_MODES = ("off", "paper", "physical")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).

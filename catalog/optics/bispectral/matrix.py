@@ -141,7 +141,7 @@ def _axis(path: Path, line_no: int, start: float, stop: float, step: float, coun
 
 
 def read_bfc(path: str | Path) -> DonaldsonMatrix:
-    """Read a BFC-450 matrix file (the layout of ../shared/data/README.md).
+    """Read a BFC-450 matrix file (the layout in docs/formats.md, "Where files are found").
 
     Ten header lines (the second says ``BFC-450 Matrix File``, lines starting with ';'
     carry the file name, the description, operator, instrument modes, date and time);
