@@ -59,6 +59,7 @@ def _parse_grid(text: str) -> tuple[int, int]:
 
 
 def run(args: argparse.Namespace) -> int:
+    import contextlib
     import math
     import time
 
@@ -102,12 +103,28 @@ def run(args: argparse.Namespace) -> int:
 
     sequence = args.out is not None and "{frame" in args.out
     simulated = 0
-    start = time.perf_counter()
-    for frame in range(args.steps):
-        simulated += bool(sim.step(args.dt))
+    with contextlib.ExitStack() as stack:
         if sequence:
-            export_mesh(sim.mesh(), args.out.format(frame=frame))
-    seconds = time.perf_counter() - start
+            # every frame's file, or none: staged beside the folder, moved in at the end
+            from pathlib import Path
+
+            from catalog.core.atomic import staged_folder
+
+            try:
+                names = [Path(args.out.format(frame=f)) for f in (0, 1)]
+            except (ValueError, KeyError, IndexError) as exc:
+                raise CatalogError(f"--out: {args.out!r} is not a pattern with one "
+                                   f"{{frame}} field ({exc})") from None
+            if names[0].parent != names[1].parent or names[0] == names[1]:
+                raise CatalogError(f"--out: {args.out!r}: put {{frame}} in the file name, "
+                                   "not in a folder name")
+            stage = stack.enter_context(staged_folder(names[0].parent))
+        start = time.perf_counter()
+        for frame in range(args.steps):
+            simulated += bool(sim.step(args.dt))
+            if sequence:
+                export_mesh(sim.mesh(), stage / Path(args.out.format(frame=frame)).name)
+        seconds = time.perf_counter() - start
     if args.out is not None and not sequence:
         export_mesh(sim.mesh(), args.out)
 
