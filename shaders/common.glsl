@@ -133,6 +133,56 @@ vec3 background_terms(vec3 dir, vec3 to_sun, float sun_chord2_inner, float sun_c
     return vec3(1.0 - step(0.0, dir.z), step(0.0, dir.y), 1.0 - s * s * (3.0 - 2.0 * s));
 }
 
+// ---------------------------------------------------------------- the fabric's pattern
+// (model.md section 9; catalog/presets/patterns.py). u_pattern: RGBA, mipmapped, repeating: rgb = the
+// thread's unit normal in the cloth's tangent frame (x weft, y warp, z the cloth normal), a =
+// the thread coverage c in [0, 1]. The mip chain averages both: far away c -> mean(c) = 1 - LD
+// (the fit's see-through) and the normals average to a shorter vector about the cloth normal
+// (the first moment of LEAN mapping, Olano & Baker 2010), so highlights fade instead of
+// sparkling. The room's shadow pass can call thread_coverage(uv) for the holes' shadow.
+#ifdef PATTERN
+uniform sampler2D u_pattern;
+
+vec4 thread_texel(vec2 uv_repeats) {
+    return texture(u_pattern, uv_repeats);
+}
+
+// Thread coverage at uv (in pattern repeats), mip-filtered by the hardware's footprint.
+float thread_coverage(vec2 uv_repeats) {
+    return texture(u_pattern, uv_repeats).a;
+}
+
+// The shading normal: the cloth normal n tilted by the pattern's mip-averaged normal m in
+// the frame (t weft, n x t, n). |m| < 1 where the mip averages slopes: m is used unnormalised,
+// so the tilt shrinks with the filtered slope variance (Toksvig 2005's shortening).
+vec3 thread_normal(vec3 n, vec3 tangent, vec3 m) {
+    vec3 t = tangent - dot(tangent, n) * n;
+    float len2 = dot(t, t);
+    t = len2 > 1e-12 ? t * inversesqrt(len2) : vec3(0.0);
+    vec3 b = cross(n, t);
+    return normalize(m.x * t + m.y * b + m.z * n);
+}
+#endif
+
+// Weighted blended order-independent transparency (McGuire & Bavoil 2013, JCGT 2(2)): each
+// layer adds C a w and a w, and multiplies the revealage by (1 - a); nearer layers weigh more.
+// depth_m: view distance beyond the reference, clamped to [0, 3] m; 2^(-30 m^-1 depth) keeps the
+// weights normal in float32 (>= 2^-90).
+float oit_weight(float depth_m) {
+    return exp2(-30.0 * clamp(depth_m, 0.0, 3.0));
+}
+
+// The resolve of weighted blended OIT: (mean layer colour x (1 - revealage), revealage) to be
+// blended ONE, SRC_ALPHA over what is behind. accum = (sum C a w, prod (1 - a)), weight = sum a w.
+vec4 oit_resolve(vec4 accum, float weight) {
+    return vec4(accum.rgb / max(weight, 1e-30) * (1.0 - accum.a), accum.a);
+}
+
+// Luma of a display-encoded colour (ITU-R BT.601 weights, as FXAA uses): edge detection only.
+float display_luma(vec3 encoded) {
+    return dot(encoded, vec3(0.299, 0.587, 0.114));
+}
+
 // IEC 61966-2-1:1999 sRGB transfer function (the piecewise curve, not a 2.2 power).
 vec3 srgb_encode(vec3 linear) {
     vec3 c = clamp(linear, 0.0, 1.0);

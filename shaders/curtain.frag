@@ -11,8 +11,15 @@
 
 in vec3 v_view_ray;                // position - camera, world space
 in vec3 v_normal;
-#if defined(ANISOTROPIC) || defined(GBUFFER)
+#if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 in vec3 v_tangent;
+#endif
+#ifdef PATTERN
+in vec2 v_pattern_uv;              // in pattern repeats
+uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to the threads alone
+#endif
+#ifdef OIT
+uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
 #ifdef GBUFFER
 in vec3 v_position;
@@ -55,6 +62,9 @@ SCENE_VALUE(vec4, u_band_to_g[NV4], S_BAND_TO_G);
 SCENE_VALUE(vec4, u_band_to_b[NV4], S_BAND_TO_B);
 
 layout(location = 0) out vec4 out_radiance;
+#ifdef OIT
+layout(location = 1) out vec4 out_oit_weight;
+#endif
 #ifdef GBUFFER
 layout(location = 1) out vec4 out_position;
 layout(location = 2) out vec4 out_normal;
@@ -93,6 +103,12 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
 void main() {
     vec3 n = normalize(v_normal);
     vec3 ray = normalize(v_view_ray);
+#ifdef PATTERN
+    // the fabric's own structure (model.md section 9): thread coverage and the thread's
+    // normal, both mip-filtered (far away: c -> mean(c) = 1 - LD, the normal -> the cloth's)
+    vec4 thread = thread_texel(v_pattern_uv);
+    n = thread_normal(n, v_tangent, thread.xyz);
+#endif
 #ifdef ANISOTROPIC
     WovenView view = woven_view(-ray, n, v_tangent);
     float tan_key = dot(v_tangent, u_key_to_light);
@@ -142,7 +158,22 @@ void main() {
 #if NV4 > 3
     rgb += shade_chunk(3, g_key, g_fill, bg, effective);
 #endif
+#ifdef PATTERN
+    // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole
+    // cloth; its light leaves through the threads, a fraction mean(c) of the area); holes
+    // (1 - c) let the scene behind through undimmed (the OIT composite)
+    rgb *= u_inv_mean_coverage;
+    float alpha = thread.a;
+#else
+    float alpha = 1.0;
+#endif
+#ifdef OIT
+    float w = oit_weight(length(v_view_ray) - u_oit_depth_ref);
+    out_radiance = vec4(rgb * (alpha * w), alpha);
+    out_oit_weight = vec4(alpha * w, 0.0, 0.0, 0.0);
+#else
     out_radiance = vec4(rgb, 1.0);
+#endif
 #ifdef GBUFFER
     out_position = vec4(v_position, 1.0);
     out_normal = vec4(n, 1.0);

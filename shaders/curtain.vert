@@ -3,10 +3,16 @@
 // own frame has the rod elsewhere), normals and the weft tangent; shared by the shading pass,
 // the G-buffer variant and the trivial floor shader. The view ray (position - camera) is
 // linear in the position, so it is formed here and interpolated exactly: the fragment shader
-// then needs no per-frame uniform. The tangent travels only where it is used.
+// then needs no per-frame uniform. The tangent travels only where it is used. PATTERN: the
+// fabric's texture coordinates in pattern repeats (catalog/presets/patterns.py) for curtain.frag.
 in vec3 in_position;
 in vec3 in_normal;
 in vec3 in_tangent;
+#ifdef PATTERN
+in vec2 in_uv;                       // 0..1 across the fabric (u: weft), 0..1 along it (v: warp)
+uniform vec2 u_uv_to_repeats;        // fabric size / pattern repeat: uv -> pattern repeats
+out vec2 v_pattern_uv;
+#endif
 
 uniform mat4 u_view_proj;
 uniform vec3 u_mesh_offset;
@@ -14,7 +20,7 @@ uniform vec3 u_camera_position;
 
 out vec3 v_view_ray;
 out vec3 v_normal;
-#if defined(ANISOTROPIC) || defined(GBUFFER)
+#if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 out vec3 v_tangent;
 #endif
 #ifdef GBUFFER
@@ -25,8 +31,11 @@ void main() {
     vec3 position = in_position + u_mesh_offset;
     v_view_ray = position - u_camera_position;
     v_normal = in_normal;
-#if defined(ANISOTROPIC) || defined(GBUFFER)
+#if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
     v_tangent = in_tangent;
+#endif
+#ifdef PATTERN
+    v_pattern_uv = in_uv * u_uv_to_repeats;
 #endif
 #ifdef GBUFFER
     v_position = position;

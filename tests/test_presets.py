@@ -190,6 +190,7 @@ def test_unknown_keys_survive_a_round_trip(tmp_path):
     doc["notes"] = {"weaver": "test"}
     path = tmp_path / "lace-fwa.toml"
     (tmp_path / "measurements").symlink_to(FABRIC_DIR / "measurements")
+    (tmp_path / "patterns").symlink_to(FABRIC_DIR / "patterns")
     save_preset_dict(copy.deepcopy(doc), path)
     back = load_preset(path)
     assert back.raw["btdf"]["anisotropy"] == 0.1 and back.raw["notes"] == {"weaver": "test"}

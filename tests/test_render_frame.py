@@ -135,7 +135,13 @@ def test_front_lit_curtain_is_not_black(gl, make_preset):
 
 
 def test_see_through_pass_only_when_direct_is_positive(gl, make_preset):
+    """The flat cloth (no pattern, issue 12's ``patterned = False``) compiles the see-through
+    term only for a fabric with gaps; the patterned frame never does (its holes are the OIT
+    composite of the scene behind)."""
     renderer = _renderer(gl, make_preset(direct=0.0, fluorescent=False), "D65")
+    renderer.render()
+    assert all(v.get("PATTERN") and not v.get("SEE_THROUGH") for v in renderer.compiled_variants())
+    renderer.set_patterned(False)
     renderer.render()
     assert all(not v.get("SEE_THROUGH") for v in renderer.compiled_variants())
     renderer.set_fabric(make_preset("gappy", direct=0.2, fluorescent=False))

@@ -132,10 +132,10 @@ def test_sheet_every_fabric_and_light(gl, make_preset, tmp_path):
 
 
 def test_frame_n_renders_the_simulated_cloth(gl, make_preset, tmp_path):
-    """--frame N > 0 takes the cloth simulation's mesh (moved onto the scene's rod)."""
+    """--frame 0 is the settled drape, --frame N > 0 the simulation started from it."""
     preset = make_preset()
     still = render_snapshot(_request(preset, tmp_path / "f0.exr"), ctx=gl)
     moved = render_snapshot(_request(preset, tmp_path / "f3.exr", frame=3), ctx=gl)
-    assert still["mesh"] == "static drape" and moved["mesh"].startswith("cloth simulation")
+    assert still["mesh"] == "settled drape" and moved["mesh"].startswith("cloth simulation")
     assert still["mean_linear_rgb"] != moved["mean_linear_rgb"]
     assert all(v > 0 for v in moved["mean_linear_rgb"])

@@ -445,6 +445,7 @@ def _copy_fabrics(target: Path, names: list[str]) -> None:
         shutil.copy(FABRIC_DIR / f"{name}.toml", target / f"{name}.toml")
     # presets name their spectra relative to their folder: keep those reachable
     (target / "measurements").symlink_to(FABRIC_DIR / "measurements")
+    (target / "patterns").symlink_to(FABRIC_DIR / "patterns")   # and their [pattern] images
 
 
 def test_broken_preset_shows_an_error_and_the_others_render(xdisplay, tmp_path):
@@ -517,7 +518,8 @@ def test_preset_reloads_when_its_file_changes(xdisplay, tmp_path):
         viewer.wait_title(VOILE)
         before, _ = viewer.screenshot()
         edited = original.replace("display_name = ", 'display_name = "Edited voile" # ', 1)
-        edited = edited.replace("\ndirect = ", "\ndirect = 0.5 # was ", 1)
+        # a lobe, not LD: the [pattern]'s open area must keep matching btdf.direct (issue 12)
+        edited = edited.replace("\nk_d = ", "\nk_d = 1.5 # was ", 1)
         path.write_text(edited)
         viewer.wait_title("Edited voile")
         after, _ = viewer.screenshot()
@@ -554,8 +556,13 @@ def test_orbit_camera_clamps_and_wraps():
     assert camera.pitch_deg == camera.min_pitch_deg
     camera.zoom(1e3)
     assert camera.distance_m == camera.min_distance_m
-    camera.zoom(-1e3)
-    assert camera.distance_m == camera.max_distance_m
+    camera.zoom(-1e3)   # out as far as the room allows in this direction (issue 12)
+    from catalog.viewer.input import room_limit_m
+
+    assert camera.distance_m == min(camera.max_distance_m,
+                                    room_limit_m(camera.yaw_deg, camera.pitch_deg))
+    camera.reset()
+    assert (camera.yaw_deg, camera.pitch_deg, camera.distance_m) == (0.0, 0.0, 2.6)
     camera.drag(float("nan"), 1.0)
     camera.zoom(float("inf"))
     assert np.isfinite([camera.yaw_deg, camera.pitch_deg, camera.distance_m]).all()

@@ -69,7 +69,16 @@ def run_fit(argv: list[str]) -> dict:
 
 def make_presets(measurements: Path = MEASUREMENTS, out_dir: Path = OUT_DIR,
                  names=()) -> list[dict]:
-    return [run_fit(fit_argv(folder, out_dir)) for folder in measurement_folders(measurements, names)]
+    summaries = [run_fit(fit_argv(folder, out_dir))
+                 for folder in measurement_folders(measurements, names)]
+    # a fit writes the preset afresh: its [pattern] follows the new LD (tools/make_patterns.py)
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from make_patterns import PATTERNS, regenerate
+
+    for summary in summaries:
+        if summary["name"] in PATTERNS:
+            regenerate(summary["name"], out_dir)
+    return summaries
 
 
 def error_table(measurements: Path = MEASUREMENTS, names=()) -> str:
@@ -110,7 +119,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out-dir", type=Path, default=OUT_DIR)
     parser.add_argument("--table", type=Path, help="also write the HG vs CT error table")
     args = parser.parse_args(argv)
-    for summary in make_presets(args.measurements, args.out_dir, args.names):
+    summaries = make_presets(args.measurements, args.out_dir, args.names)
+    for summary in summaries:
         print(f"{summary['name']:15s} direct {summary['direct']:.3f}  g {summary['g_diff']:+.3f} "
               f"{summary['g_spec']:+.3f}  rmse HG {summary['rmse']:.3e} CT {summary['ct_rmse']:.3e}"
               f"  -> {summary['out']}")

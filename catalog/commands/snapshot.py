@@ -25,7 +25,7 @@ def add_arguments(parser) -> None:
                              "summer solstice, 34.7 N) behind the window")
     parser.add_argument("--size", default="1280x720", help="WIDTHxHEIGHT in pixels")
     parser.add_argument("--frame", type=int, default=0,
-                        help="cloth simulation frame (0: the static drape)")
+                        help="cloth simulation frame (0: the settled drape every simulation starts from)")
     parser.add_argument("--out", required=True, help="FILE.exr (linear) or FILE.png (sRGB)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from catalog.core.constants import FLUORESCENCE_MODES as FLUORESCENCE_CHOICES
@@ -67,8 +68,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="spectral bands (3 = RGB)")
     parser.add_argument("--hour", type=float, help="hour of day for the sun (6-18)")
     parser.add_argument("--wind", type=float, metavar="M_S", help="wind speed, m/s")
-    parser.add_argument("--grid", type=_grid, default=(48, 64), metavar="WxH",
-                        help="cloth particles across x down (default 48x64)")
+    parser.add_argument("--grid", type=_grid, default=(96, 56), metavar="WxH",
+                        help="cloth particles across x down (default 96x56: the fabric is "
+                             "fullness x the rod wide)")
+    parser.add_argument("--distance", type=float, default=2.6, metavar="M",
+                        help="camera distance from the curtain, m (0.2-4; the wheel zooms, "
+                             "R resets; default 2.6)")
     parser.add_argument("--cloth-backend", choices=("auto", "numpy", "cpu", "gpu"),
                         default="auto",
                         help="cloth simulation backend: gpu (compute shaders writing the "
@@ -116,6 +121,8 @@ def run(args: argparse.Namespace) -> int:
                            "in interactive use)")
     if args.hour is not None and not 0.0 <= args.hour <= 24.0:
         raise CatalogError(f"--hour: {args.hour:g} is not an hour of the day (0-24)")
+    if not (math.isfinite(args.distance) and 0.2 <= args.distance <= 4.0):
+        raise CatalogError(f"--distance: {args.distance:g} m is outside 0.2-4 m (the room)")
     if args.wind is not None and not 0.0 <= args.wind <= 50.0:
         raise CatalogError(f"--wind: {args.wind:g} m/s is outside 0-50 m/s")
     if not display_available():  # say so before any heavy import or preset read
@@ -132,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
         fabric=fabric, light=args.light, compare=args.compare, size=args.size,
         frames=args.frames, screenshot=args.screenshot, screenshot_dir=args.screenshot_dir,
         stats=args.stats, fluorescence=args.fluorescence, bands=args.bands, hour=args.hour,
-        wind_m_s=args.wind, grid=args.grid,
+        wind_m_s=args.wind, grid=args.grid, distance_m=args.distance,
         cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
         ev100=ev, white_balance=white_balance, compare_fluorescence=args.compare_fluorescence,

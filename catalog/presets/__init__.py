@@ -318,7 +318,8 @@ def preset_to_dict(preset: Preset) -> dict[str, Any]:
 def save_preset_dict(doc: dict[str, Any], path: str | Path) -> Preset:
     """Validate ``doc`` as a preset for ``path`` and write it atomically; return the preset.
 
-    Nothing is written when validation fails.
+    Nothing is written when validation fails, nor when a ``[pattern]`` table's coverage
+    misses ``btdf.direct`` by more than 1 % (:func:`catalog.presets.patterns.load_pattern`).
     """
     import tomli_w
 
@@ -326,6 +327,11 @@ def save_preset_dict(doc: dict[str, Any], path: str | Path) -> Preset:
 
     path = Path(path)
     preset = preset_from_dict(doc, path)
+    if preset.table("pattern"):
+        # the pattern's mean open area must equal the fit's LD within 1 % (model.md section 9)
+        from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+
+        load_pattern(preset)
     write_text_atomic(path, tomli_w.dumps(preset_to_dict(preset)))
     return preset
 

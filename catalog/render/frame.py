@@ -6,14 +6,22 @@ It never creates a GL context: it is handed one (:mod:`catalog.gl.context`).
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
 1. room props (room.vert/.frag): walls around the window, the curtain rod;
-2. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling;
-3. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
+2. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
    shades only the pixels nothing covers: the outside through the window (sky, ground, the
    sun's disc) or the room, per camera ray;
+3. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling, with the
+   fabric's pattern (catalog/presets/patterns.py): the threads' radiance (the fitted lobes over the
+   mean coverage) and coverage c into weighted blended OIT targets (McGuire & Bavoil 2013),
+   resolved over the room and background drawn in 1-2 (oit_composite.frag): the holes show
+   what is really behind, undimmed, and overlapping folds multiply their open fractions;
+   ``patterned = False`` draws the paper's flat cloth instead (opaque, LD times the
+   background by ray direction: the frame before issue 12, kept for comparison);
 4. display (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
    target): exposure (EV100, fixed or metered from a luminance histogram of this frame),
    white balance (CAT16), tone curve, gamut compression in OKLab, the sRGB curve
-   (:mod:`catalog.render.display`, docs/display.md).
+   (:mod:`catalog.render.display`, docs/display.md).; then FXAA
+   (fxaa.frag, issue 12) on the display image; ``set_antialiasing("off")`` displays straight
+   into the target.
 """
 
 from __future__ import annotations
@@ -32,8 +40,13 @@ from catalog.gl.shaderlib import create_program, glsl_literal
 
 #: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
 METER_MAX_SIDE_PX = 96
+#: Anti-aliasing of the display image: a post-process (shaders/fxaa.frag) or none.
+ANTIALIASING_MODES = ("fxaa", "off")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
+#: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
+PATTERN_UNIT = 3
+PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
 
@@ -98,6 +111,21 @@ def check_size(size, ctx=None) -> tuple[int, int]:
     return width, height
 
 
+def fabric_size_from_mesh(positions, uvs, indices) -> tuple[float, float]:
+    """The rest fabric's (width, length) in metres that uv 0..1 spans, measured on a grid
+    mesh: the median of |dP| / |du| over triangle edges along u (dv = 0), likewise along v."""
+    tri = np.asarray(indices).reshape(-1, 3)
+    a = np.concatenate([tri[:, 0], tri[:, 1], tri[:, 2]])
+    b = np.concatenate([tri[:, 1], tri[:, 2], tri[:, 0]])
+    dp = np.linalg.norm(positions[a].astype(np.float64) - positions[b], axis=1)
+    duv = np.abs(uvs[a].astype(np.float64) - uvs[b])
+    size = []
+    for along, across in ((0, 1), (1, 0)):
+        sel = (duv[:, along] > 1e-9) & (duv[:, across] < 1e-6 * duv[:, along] + 1e-12)
+        size.append(float(np.median(dp[sel] / duv[sel, along])) if sel.any() else 1.0)
+    return size[0], size[1]
+
+
 class FrameRenderer:
     """Renders the curtain scene with a given moderngl context at a given size (w, h)."""
 
@@ -117,7 +145,25 @@ class FrameRenderer:
         self._hdr_fbo = ctx.framebuffer([self._hdr], self._depth)
         self._ldr = ctx.texture((w, h), 4)
         self._ldr_fbo = ctx.framebuffer([self._ldr])
+        # the tone-mapped image before FXAA (read bilinearly by fxaa.frag)
+        self._pre = ctx.texture((w, h), 4)
+        self._pre.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self._pre.repeat_x = self._pre.repeat_y = False
+        self._pre_fbo = ctx.framebuffer([self._pre])
+        self.antialiasing = "fxaa"
         self._gbuffer = None
+        # weighted blended OIT: sum C a w | prod (1 - a), and sum a w; the scene's depth
+        self._oit_accum = ctx.texture((w, h), 4, dtype="f4")
+        self._oit_weight = ctx.texture((w, h), 1, dtype="f4")
+        for texture in (self._oit_accum, self._oit_weight):
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self._oit_fbo = ctx.framebuffer([self._oit_accum, self._oit_weight], self._depth)
+        self._oit_fbo.depth_mask = False  # the layers are tested against the room, not each other
+        self.patterned = True
+        self._pattern_texture = None
+        self._pattern_key = None
+        self._pattern = None
+        self._fabric_size_m = (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
         self._programs: dict[tuple, object] = {}
         self.specialise = bool(specialise)
         self._vaos: dict[tuple, object] = {}
@@ -145,6 +191,7 @@ class FrameRenderer:
         positions, normals = scene_lib.room_props()
         self._room_vbo = ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
         self._curtain_buffers = None
+        self._ring_vbo = None
         default = scene_lib.draped_curtain()
         self.set_mesh(default.positions, default.normals, default.uvs, default.tangents,
                       default.indices)
@@ -158,7 +205,82 @@ class FrameRenderer:
             preset = load_preset(find_preset(preset))
         scene_lib.dye_transmittance(preset)  # refuse a bad dye file now, not at render
         scene_lib.fluorescent_material(preset)
+        self._set_pattern(preset)
         self.preset = preset
+
+    def set_rings(self, xs_m) -> None:
+        """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
+        positions, normals = scene_lib.ring_mesh(xs_m)
+        if self._ring_vbo is not None:
+            self._ring_vbo.release()
+            self._ring_vbo = None
+            for key in [k for k in self._vaos if k[0] == "rings"]:
+                self._vaos.pop(key).release()
+        if len(positions):
+            self._ring_vbo = self.ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
+
+    def set_patterned(self, patterned: bool) -> None:
+        """True (default): the fabric's pattern, holes and layers (OIT); False: the flat,
+        opaque cloth of eq. 8 with LD times the background by ray direction."""
+        self.patterned = bool(patterned)
+
+    def _set_pattern(self, preset) -> None:
+        """The preset's pattern as a mipmapped RGBA32F texture (thread normal, coverage);
+        without a [pattern] a uniform coverage 1 - LD (one texel)."""
+        from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+
+        table = preset.table("pattern")
+        key = (str(preset.path), repr(sorted(table.items())), preset.btdf.direct)
+        if key == self._pattern_key:
+            return
+        pattern = load_pattern(preset)
+        if pattern is None:
+            texels = np.array([[[0.0, 0.0, 1.0, 1.0 - preset.btdf.direct]]], dtype=np.float32)
+            repeat = self._fabric_size_m
+        else:
+            texels = pattern.normal_map()
+            repeat = pattern.repeat_m
+        mgl = self._moderngl
+        if self._pattern_texture is not None:
+            self._pattern_texture.release()
+        h, w = texels.shape[:2]
+        texture = self.ctx.texture((w, h), 4, np.ascontiguousarray(texels).tobytes(), dtype="f4")
+        texture.repeat_x = texture.repeat_y = True
+        texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+        texture.build_mipmaps()
+        max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
+        texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
+        self._pattern_texture = texture
+        self._pattern = pattern
+        self._pattern_repeat_m = tuple(float(v) for v in repeat)
+        self._pattern_mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
+        self._pattern_key = key
+
+    def set_pattern_filtering(self, filtered: bool) -> None:
+        """True (default): trilinear mipmapped, anisotropic; False: nearest texel, no mips
+        (for measuring what the filtering buys: shimmer, the far limit)."""
+        mgl = self._moderngl
+        texture = self._pattern_texture
+        if filtered:
+            texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+            max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
+            texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
+        else:
+            texture.filter = (mgl.NEAREST, mgl.NEAREST)
+            texture.anisotropy = 1.0
+
+    @property
+    def pattern(self):
+        """The current fabric's :class:`catalog.presets.patterns.Pattern` (None: uniform coverage)."""
+        return self._pattern
+
+    def pattern_mip_level(self, level: int) -> np.ndarray:
+        """Level ``level`` of the pattern texture's mip chain as GL built it, (H, W, 4)."""
+        texture = self._pattern_texture
+        w = max(1, texture.width >> level)
+        h = max(1, texture.height >> level)
+        data = texture.read(level=level)
+        return np.frombuffer(data, dtype=np.float32).reshape(h, w, 4).copy()
 
     def set_light(self, light) -> None:
         """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.optics.lights.Light.
@@ -222,9 +344,11 @@ class FrameRenderer:
         self.white_balance = white_balance
 
     # ------------------------------------------------------------------ mesh
-    def set_mesh(self, positions, normals, uvs, tangents, indices) -> None:
+    def set_mesh(self, positions, normals, uvs, tangents, indices, fabric_size_m=None) -> None:
         """The curtain: float32 (V, 3) positions, normals, tangents (weft), (V, 2) uvs and
-        int32 triangle indices ((T, 3) or flat)."""
+        int32 triangle indices ((T, 3) or flat). ``fabric_size_m``: the rest fabric's width and
+        length (m) that uv 0..1 spans (the pattern's scale); default: measured on the mesh
+        (:func:`fabric_size_from_mesh`)."""
         positions = np.ascontiguousarray(positions, dtype="f4").reshape(-1, 3)
         count = positions.shape[0]
         normals = np.ascontiguousarray(normals, dtype="f4").reshape(-1, 3)
@@ -235,6 +359,9 @@ class FrameRenderer:
             raise CatalogError("curtain mesh arrays differ in vertex count")
         if indices.size == 0 or indices.size % 3 or indices.min() < 0 or indices.max() >= count:
             raise CatalogError("curtain mesh indices must be triangles of existing vertices")
+        if fabric_size_m is None:
+            fabric_size_m = fabric_size_from_mesh(positions, uvs, indices)
+        self._fabric_size_m = tuple(float(v) for v in fabric_size_m)
         self._release_own_buffers()
         self._curtain_buffers = {
             "position": self.ctx.buffer(positions.tobytes()),
@@ -354,6 +481,9 @@ class FrameRenderer:
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
                    "GBUFFER": gbuffer, "SPECIALISED": self.specialise,
                    "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
+        if self.patterned and not gbuffer:
+            # the holes are drawn by the OIT composite: no see-through term in the shader
+            defines.update({"PATTERN": True, "OIT": True, "SEE_THROUGH": False})
         return defines
 
     def scene_values(self) -> dict:
@@ -416,6 +546,8 @@ class FrameRenderer:
                     content.append((b["normal"], self._curtain_format, "in_normal"))
                 if "in_tangent" in program:
                     content.append((b["tangent"], "3f", "in_tangent"))
+            if "in_uv" in program:
+                content.append((b["uv"], "2f", "in_uv"))
             self._vaos[key] = self.ctx.vertex_array(program, content, index_buffer=b["index"],
                                                     index_element_size=4)
         return self._vaos[key]
@@ -511,6 +643,13 @@ class FrameRenderer:
             self._set(program, "u_view_proj", gl_bytes(view_proj))
             self._set(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
             self._set(program, "u_mesh_offset", self._mesh_offset)
+            if "u_pattern" in program:
+                self._pattern_texture.use(location=PATTERN_UNIT)
+                self._set(program, "u_pattern", PATTERN_UNIT)
+                self._set(program, "u_uv_to_repeats",
+                          tuple(f / r for f, r in zip(self._fabric_size_m, self._pattern_repeat_m)))
+                self._set(program, "u_inv_mean_coverage", 1.0 / max(self._pattern_mean_coverage, 1e-6))
+                self._set(program, "u_oit_depth_ref", self.oit_depth_reference_m())
             if not self.specialise:
                 for name, value in self.scene_values().items():
                     self._set(program, name, value)
@@ -545,6 +684,12 @@ class FrameRenderer:
         self._set(program, "u_room_rgb", colours["u_room_rgb"])
         self._set(program, "u_fill_rgb", colours["u_fill_rgb"])
         self._room_vao(program).render(self._moderngl.TRIANGLES)
+        if self._ring_vbo is not None:
+            key = ("rings", id(program))
+            if key not in self._vaos:
+                self._vaos[key] = self.ctx.vertex_array(
+                    program, [(self._ring_vbo, "3f 3f", "in_position", "in_normal")])
+            self._vaos[key].render(self._moderngl.TRIANGLES)
 
     def _viewport_size(self, viewport) -> tuple[int, int]:
         if viewport is None:
@@ -568,12 +713,54 @@ class FrameRenderer:
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<="
         self._draw_room(view_proj, inputs)
-        self.draw_curtain(view_proj)
-        # last, on the far plane: the depth test leaves only the pixels nothing covers
+        if not self.patterned:
+            self.draw_curtain(view_proj)
+        # on the far plane: the depth test leaves only the pixels nothing covers
         self._draw_background(view_proj, inputs)
+        if self.patterned:
+            self._draw_curtain_oit(view_proj, vw, vh)
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
+
+    def oit_depth_reference_m(self) -> float:
+        """The view distance (m) where the OIT depth weight is 1: just before the nearest
+        the curtain can be (the camera's distance to its target less a metre)."""
+        return max(0.0, self.camera.distance_m - 1.0)
+
+    def _draw_curtain_oit(self, view_proj, vw: int, vh: int) -> None:
+        """The curtain's layers into the OIT targets (depth-tested against the room, not
+        written), then resolved over the HDR target."""
+        mgl = self._moderngl
+        ctx = self.ctx
+        self._oit_fbo.use()
+        ctx.viewport = (0, 0, vw, vh)
+        ctx.clear(0.0, 0.0, 0.0, 1.0, viewport=(0, 0, vw, vh))   # accum: revealage 1
+        # clear() wrote (0, 0, 0, 1) into both targets: the weight target's alpha is unused
+        ctx.enable(mgl.BLEND)
+        ctx.blend_equation = mgl.FUNC_ADD
+        ctx.blend_func = (mgl.ONE, mgl.ONE, mgl.ZERO, mgl.ONE_MINUS_SRC_ALPHA)
+        self.draw_curtain(view_proj)
+        # resolve: average colour x (1 - revealage) + behind x revealage
+        self._hdr_fbo.use()
+        ctx.viewport = (0, 0, vw, vh)
+        ctx.disable(mgl.DEPTH_TEST)
+        ctx.blend_func = (mgl.ONE, mgl.SRC_ALPHA, mgl.ZERO, mgl.ONE)
+        program = self._program("fullscreen.vert", "oit_composite.frag")
+        self._oit_accum.use(location=0)
+        self._oit_weight.use(location=1)
+        self._set(program, "u_accum", 0)
+        self._set(program, "u_weight", 1)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        ctx.disable(mgl.BLEND)
+        ctx.blend_func = mgl.DEFAULT_BLENDING
+
+    def set_antialiasing(self, mode: str) -> None:
+        """``fxaa`` (default): the post-process on the display image (shaders/fxaa.frag);
+        ``off``: the tone-mapped image as it is."""
+        if mode not in ANTIALIASING_MODES:
+            raise CatalogError(f"anti-aliasing {mode!r}: choose one of {', '.join(ANTIALIASING_MODES)}")
+        self.antialiasing = mode
 
     def render(self, fbo=None, viewport=None, dt_s: float | None = None) -> None:
         """One frame: HDR passes, then the display pass into ``fbo`` (default: our RGBA8
@@ -589,8 +776,15 @@ class FrameRenderer:
     def display_pass(self, vw: int, vh: int, fbo=None, viewport=None) -> None:
         """The display transform of the HDR target's (vw, vh) corner (the benchmark times it)."""
         target = fbo if fbo is not None else self._ldr_fbo
-        target.use()
-        self.ctx.viewport = tuple(viewport) if (fbo is not None and viewport is not None) else (0, 0, vw, vh)
+        target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
+                           else (0, 0, vw, vh))
+        fxaa = self.antialiasing == "fxaa"
+        if fxaa:   # display into our copy, FXAA from it into the target
+            self._pre_fbo.use()
+            self.ctx.viewport = (0, 0, vw, vh)
+        else:
+            target.use()
+            self.ctx.viewport = target_viewport
         program = self._program("fullscreen.vert", "tonemap.frag",
                                 {"DISPLAY_STAGES": self.display_stages})
         self._hdr.use(location=0)
@@ -599,6 +793,15 @@ class FrameRenderer:
         for name, value in self.display_uniforms().items():
             self._set(program, name, value)
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
+        if fxaa:
+            target.use()
+            self.ctx.viewport = target_viewport
+            program = self._program("fullscreen.vert", "fxaa.frag")
+            self._pre.use(location=0)
+            self._set(program, "u_ldr", 0)
+            self._set(program, "u_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
+            self._set(program, "u_texel", (1.0 / self.size[0], 1.0 / self.size[1]))
+            self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
         self._last = (vw, vh, fbo, viewport)
 
     # ------------------------------------------------------------------ read back
@@ -677,13 +880,20 @@ class FrameRenderer:
 
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
-        ours = [self._hdr_fbo, self._ldr_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
+        ours = [self._hdr_fbo, self._ldr_fbo, self._oit_fbo, self._pre_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._release_vaos()
         self._release_own_buffers()
-        for obj in (self._hdr_fbo, self._hdr, self._depth, self._ldr_fbo, self._ldr, self._room_vbo):
+        for obj in (self._hdr_fbo, self._hdr, self._depth, self._ldr_fbo, self._ldr, self._room_vbo,
+                    self._oit_fbo, self._oit_accum, self._oit_weight, self._pre_fbo, self._pre):
             obj.release()
+        if self._pattern_texture is not None:
+            self._pattern_texture.release()
+            self._pattern_texture = None
+        if self._ring_vbo is not None:
+            self._ring_vbo.release()
+            self._ring_vbo = None
         if self._gbuffer is not None:
             for texture in self._gbuffer[0]:
                 texture.release()

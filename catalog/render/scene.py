@@ -134,6 +134,39 @@ def rod_triangles(radius_m: float, length_m: float, centre, sections: int = 16) 
     return np.array(tris)
 
 
+#: Curtain rings around the rod (m): the ring's radius (its bottom holds the heading at
+#: CURTAIN_TOP_Y) and the wire's radius.
+RING_RADIUS_M = 0.03
+RING_WIRE_M = 0.004
+ROD_Y = CURTAIN_TOP_Y + 0.03
+
+
+def ring_triangles(xs_m, sections: int = 16, wire_sections: int = 6) -> np.ndarray:
+    """Rings (tori in the y-z plane around the rod) at the given x positions, as triangles
+    (T, 3, 3), counter-clockwise from outside."""
+    xs_m = np.asarray(xs_m, dtype=np.float64).ravel()
+    if xs_m.size == 0:
+        return np.zeros((0, 3, 3))
+    a = np.linspace(0.0, 2 * math.pi, sections + 1)            # around the ring
+    b = np.linspace(0.0, 2 * math.pi, wire_sections + 1)       # around the wire
+    aa, bb = np.meshgrid(a, b, indexing="ij")
+    r = RING_RADIUS_M + RING_WIRE_M * np.cos(bb)
+    ring = np.stack([RING_WIRE_M * np.sin(bb), ROD_Y + r * np.cos(aa), CURTAIN_Z + r * np.sin(aa)], -1)
+    quads = []
+    for i in range(sections):
+        for j in range(wire_sections):
+            p00, p10 = ring[i, j], ring[i + 1, j]
+            p01, p11 = ring[i, j + 1], ring[i + 1, j + 1]
+            quads += [(p00, p10, p11), (p00, p11, p01)]
+    one = np.array(quads)
+    return np.concatenate([one + [x, 0.0, 0.0] for x in xs_m])
+
+
+def ring_mesh(xs_m) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`ring_triangles` flat-shaded: (positions, normals) float32 (3T, 3)."""
+    return _flat_shaded(ring_triangles(xs_m))
+
+
 def _room_parts() -> list[np.ndarray]:
     (x0, x1), (y0, y1), (z0, z1) = ROOM_BOX
     wx0, wx1, wy0, wy1 = WINDOW_RECT
@@ -149,7 +182,7 @@ def _room_parts() -> list[np.ndarray]:
         box_triangles(wx1, x1, y0, y1, z0 - t, z0),
         box_triangles(wx0, wx1, y0, wy0, z0 - t, z0),
         box_triangles(wx0, wx1, wy1, y1, z0 - t, z0),
-        rod_triangles(0.015, CURTAIN_WIDTH_M + 0.4, (0.0, CURTAIN_TOP_Y + 0.03, CURTAIN_Z)),
+        rod_triangles(0.015, CURTAIN_WIDTH_M + 0.4, (0.0, ROD_Y, CURTAIN_Z)),
     ]
 
 

@@ -117,7 +117,15 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
              for j, light in enumerate(light_objects)]
 
     def work(advance):
+        from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
+
+        shown = None
         for i, preset, j, light in pairs:
+            if shown is not preset:   # the drape catalog snapshot shows (its fullness, rings)
+                *mesh, fabric_size = simulated_curtain(preset, 0)
+                renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+                renderer.set_rings(ring_xs_m(preset))
+                shown = preset
             renderer.set_fabric(preset)
             renderer.set_light(light)
             renderer.render()

@@ -132,19 +132,30 @@ def read_metadata(path: str | Path) -> dict[str, str]:
 
 
 def simulated_curtain(preset, frames: int):
-    """The cloth simulation after ``frames`` frames, moved onto the scene's rod."""
+    """The curtain after ``frames`` frames of the cloth simulation started from the settled
+    drape (frame 0: the settled drape itself; catalog.cloth.drape), moved onto the scene's
+    rod. Returns (positions, normals, uv, tangents, indices, fabric size (w, h) m)."""
+    from catalog.cloth.drape import drape_params, rod_centre_x_m, settled_simulation  # noqa: PLC0415
     from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
-    from catalog.cloth.params import ClothParams  # noqa: PLC0415
-    from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
-    params = ClothParams.from_preset(preset)
-    simulation = ClothSimulation(params, backend="numpy")
+    params = drape_params(preset)
+    simulation = settled_simulation(params, backend="numpy")
     simulation.run(frames, FRAME_DT_S)
     mesh = CurtainMesh.from_grid(simulation.positions(), params)
-    offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - params.rod_y_m, scene_lib.CURTAIN_Z],
-                      dtype=np.float32)
-    return mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices
+    offset = np.array([-rod_centre_x_m(params), scene_lib.CURTAIN_TOP_Y - params.rod_y_m,
+                       scene_lib.CURTAIN_Z], dtype=np.float32)
+    return (mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices,
+            (params.width_m, params.height_m))
+
+
+def ring_xs_m(preset) -> list[float]:
+    """x of the curtain's rings on the scene's rod (m): the settled drape's ring columns."""
+    from catalog.cloth.drape import drape_params, rod_centre_x_m  # noqa: PLC0415
+    from catalog.cloth.state import ring_positions  # noqa: PLC0415
+
+    params = drape_params(preset)
+    return [float(x) - rod_centre_x_m(params) for x in ring_positions(params)[:, 0]]
 
 
 def check_display_choices(ev, white_balance, exposure=1.0) -> None:
@@ -210,10 +221,11 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.set_exposure(request.exposure)
         renderer.set_ev(request.ev)
         renderer.set_white_balance(request.white_balance)
-        mesh_source = "static drape"
-        if request.frame > 0:
-            renderer.set_mesh(*simulated_curtain(preset, request.frame))
-            mesh_source = f"cloth simulation, frame {request.frame}"
+        *mesh, fabric_size = simulated_curtain(preset, request.frame)
+        renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+        renderer.set_rings(ring_xs_m(preset))
+        mesh_source = ("settled drape" if request.frame == 0
+                       else f"cloth simulation from the settled drape, frame {request.frame}")
         start = time.perf_counter()
         renderer.render()
         pixels = (renderer.read_linear() if request.out.suffix.lower() == ".exr"

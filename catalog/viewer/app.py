@@ -51,7 +51,8 @@ class ViewerOptions:
     bands: int = 3
     hour: float | None = None
     wind_m_s: float | None = None
-    grid: tuple[int, int] = (48, 64)
+    grid: tuple[int, int] = (96, 56)
+    distance_m: float = 2.6  # the camera's home distance from the curtain (the R key returns)
     cloth_backend: str | None = None  # None: auto (see ViewerApp._choose_cloth_backend)
     panel: bool = True
     paused: bool = False
@@ -86,7 +87,8 @@ class ViewerApp:
         if options.wind_m_s is not None:
             self.settings.wind_m_s = options.wind_m_s
         self._choose_start(options)
-        self.camera = OrbitCamera()
+        self.camera = OrbitCamera(distance_m=options.distance_m, home_distance_m=options.distance_m)
+        self.camera.reset()
         self.timer = FrameTimer()
         self._actions: list[Action] = []
         self._quit = False
@@ -340,6 +342,8 @@ class ViewerApp:
                 settings.show_panel = not settings.show_panel
             elif action is Action.TOGGLE_CURTAIN:
                 settings.curtain_open = not settings.curtain_open
+            elif action is Action.RESET_VIEW:
+                self.camera.reset()
             elif action is Action.QUIT:
                 self._quit = True
 

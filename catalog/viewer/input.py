@@ -3,7 +3,7 @@
 Keys (glfw key codes -> actions; :data:`KEY_HELP` is the text of the help overlay):
 Left/Right previous/next fabric, L next light, F fluorescence off/paper/physical,
 Space pause, S screenshot (EXR and PNG), H help, Tab panel, C curtain open/close,
-Escape quit. Mouse: drag with the left button to orbit, wheel to zoom.
+R reset the view, Escape quit. Mouse: drag with the left button to orbit, wheel to zoom.
 
 The glfw module is imported for its key constants only (no window is needed to import it).
 """
@@ -27,6 +27,7 @@ class Action(enum.Enum):
     TOGGLE_HELP = "this help"
     TOGGLE_PANEL = "show / hide the panel"
     TOGGLE_CURTAIN = "open / close the curtain"
+    RESET_VIEW = "reset the view (the distance --distance gave)"
     QUIT = "quit"
 
 
@@ -41,11 +42,12 @@ KEY_ACTIONS: dict[int, tuple[Action, str]] = {
     glfw.KEY_H: (Action.TOGGLE_HELP, "H"),
     glfw.KEY_TAB: (Action.TOGGLE_PANEL, "Tab"),
     glfw.KEY_C: (Action.TOGGLE_CURTAIN, "C"),
+    glfw.KEY_R: (Action.RESET_VIEW, "R"),
     glfw.KEY_ESCAPE: (Action.QUIT, "Esc"),
 }
 
 KEY_HELP: list[tuple[str, str]] = [(name, action.value) for action, name in KEY_ACTIONS.values()]
-KEY_HELP += [("drag", "orbit the camera"), ("wheel", "zoom")]
+KEY_HELP += [("drag", "orbit the camera"), ("wheel", "zoom (down to 0.2 m: the threads)")]
 
 
 def action_for_key(key: int, action: int) -> Action | None:
@@ -66,7 +68,8 @@ class OrbitCamera:
 
     Yaw 0 looks at the curtain from the room side along its normal; pitch is clamped short
     of the poles so the view never flips; the distance stays between ``min_distance_m`` and
-    ``max_distance_m``.
+    ``max_distance_m`` and inside the room (:func:`room_limit_m`); :meth:`reset` returns to
+    the home view (yaw 0, pitch 0, ``home_distance_m``).
     """
 
     yaw_deg: float = 0.0
@@ -76,8 +79,20 @@ class OrbitCamera:
     zoom_per_step: float = 0.9  # distance factor per wheel step towards the curtain
     min_pitch_deg: float = -80.0
     max_pitch_deg: float = 80.0
-    min_distance_m: float = 0.4
+    min_distance_m: float = 0.2
     max_distance_m: float = 12.0
+    home_distance_m: float = 2.6
+
+    def reset(self) -> None:
+        """Back to the home view."""
+        self.yaw_deg = 0.0
+        self.pitch_deg = 0.0
+        self.distance_m = self.home_distance_m
+        self._keep_inside()
+
+    def _keep_inside(self) -> None:
+        limit = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg))
+        self.distance_m = min(limit, max(self.min_distance_m, self.distance_m))
 
     def drag(self, dx_px: float, dy_px: float) -> None:
         """Mouse moved by (dx, dy) pixels with the button held: orbit."""
@@ -86,13 +101,38 @@ class OrbitCamera:
         self.yaw_deg = (self.yaw_deg - dx_px * self.degrees_per_pixel + 180.0) % 360.0 - 180.0
         self.pitch_deg = min(self.max_pitch_deg, max(
             self.min_pitch_deg, self.pitch_deg + dy_px * self.degrees_per_pixel))
+        self._keep_inside()
 
     def zoom(self, steps: float) -> None:
         """Wheel turned by ``steps`` (positive = towards the curtain)."""
         if not math.isfinite(steps):
             return
-        self.distance_m = min(self.max_distance_m, max(
-            self.min_distance_m, self.distance_m * self.zoom_per_step ** steps))
+        self.distance_m *= self.zoom_per_step ** steps
+        self._keep_inside()
+
+
+#: The camera keeps this far (m) from the room's walls, floor and ceiling.
+ROOM_MARGIN_M = 0.15
+
+
+def room_limit_m(yaw_deg: float, pitch_deg: float) -> float:
+    """How far the orbit camera may be from its target in this direction and stay inside the
+    room (less ROOM_MARGIN_M): where the ray from the target leaves the room's box."""
+    from catalog.render.camera import OrbitCamera as RenderCamera  # noqa: PLC0415
+    from catalog.render.scene import ROOM_BOX  # noqa: PLC0415
+
+    yaw, pitch = math.radians(yaw_deg), math.radians(pitch_deg)
+    direction = (math.sin(yaw) * math.cos(pitch), math.sin(pitch), math.cos(yaw) * math.cos(pitch))
+    target = RenderCamera().target
+    limit = math.inf
+    for axis in range(3):
+        lo, hi = ROOM_BOX[axis]
+        d = direction[axis]
+        if d > 1e-9:
+            limit = min(limit, (hi - ROOM_MARGIN_M - target[axis]) / d)
+        elif d < -1e-9:
+            limit = min(limit, (lo + ROOM_MARGIN_M - target[axis]) / d)
+    return max(limit, 0.2)
 
 
 class MouseOrbit:

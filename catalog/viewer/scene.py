@@ -14,7 +14,7 @@ import numpy as np
 
 from catalog.presets import Preset
 
-#: Rings' span when the curtain is open (fraction of the rest width; 1 = closed).
+#: Rings' span when the curtain is open (fraction of the rod span they cover when closed).
 OPEN_FRACTION = 0.35
 
 
@@ -46,15 +46,20 @@ class CurtainScene:
 
         if preset.name == self.preset_name:
             return
-        fabric = ClothParams.from_preset(preset, grid_w=self.grid[0], grid_h=self.grid[1],
-                                         wind_speed_m_s=self.wind_m_s, opening=self.opening)
+        from catalog.cloth.drape import drape_params, fullness_of  # noqa: PLC0415
+
+        self.closed_opening = 1.0 / fullness_of(preset)
+        fabric = drape_params(preset, grid=self.grid, wind_speed_m_s=self.wind_m_s,
+                              opening=self.closed_opening * self.opening)
         if self.simulation is None:
-            from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
+            from catalog.cloth.drape import rod_centre_x_m, settled_simulation  # noqa: PLC0415
             from catalog.render import scene as scene_lib  # noqa: PLC0415
 
+            # the settled drape that catalog snapshot shows at frame 0
             options = {"ctx": self.ctx} if self.backend == "gpu" else {}
-            self.simulation = ClothSimulation(fabric, backend=self.backend, **options)
-            self._offset = np.array([0.0, scene_lib.CURTAIN_TOP_Y - fabric.rod_y_m,
+            self.simulation = settled_simulation(fabric, backend=self.backend, **options)
+            closed = fabric.with_changes(opening=self.closed_opening)
+            self._offset = np.array([-rod_centre_x_m(closed), scene_lib.CURTAIN_TOP_Y - fabric.rod_y_m,
                                      scene_lib.CURTAIN_Z], dtype=np.float32)
             self.mesh_version += 1
         else:
@@ -70,8 +75,9 @@ class CurtainScene:
 
     def set_open(self, is_open: bool) -> None:
         self.opening = OPEN_FRACTION if is_open else 1.0
-        if self.simulation is not None and self.opening != self.simulation.params.opening:
-            self.simulation.set_opening(self.opening)
+        target = self.opening * getattr(self, "closed_opening", 1.0)
+        if self.simulation is not None and target != self.simulation.params.opening:
+            self.simulation.set_opening(target)
 
     # -- per frame -----------------------------------------------------------------
     def step(self, frame_dt_s: float) -> bool:
@@ -97,7 +103,7 @@ class CurtainScene:
             # the mesh once (triangles, uvs), then the cloth's interleaved vertex buffer
             # drawn in place, moved onto the scene's rod in the vertex shader
             renderer.set_mesh(mesh.positions, mesh.normals, mesh.uv, mesh.tangents[:, :3],
-                              mesh.indices)
+                              mesh.indices, fabric_size_m=self._fabric_size())
             renderer.bind_cloth_vertex_buffer(self.simulation.backend.vertex_buffer,
                                               offset_m=tuple(float(v) for v in self._offset))
             self._uploaded[id(renderer)] = self.mesh_version
@@ -105,10 +111,14 @@ class CurtainScene:
         positions = mesh.positions + self._offset
         if have is None:
             renderer.set_mesh(positions, mesh.normals, mesh.uv, mesh.tangents[:, :3],
-                              mesh.indices)
+                              mesh.indices, fabric_size_m=self._fabric_size())
         else:
             renderer.update_positions(positions, mesh.normals)
         self._uploaded[id(renderer)] = self.mesh_version
+
+    def _fabric_size(self) -> tuple[float, float]:
+        params = self.simulation.params
+        return params.width_m, params.height_m
 
     def forget(self, renderer) -> None:
         """``renderer`` is gone (resized, closed): the next one gets a full mesh."""

@@ -1,0 +1,319 @@
+"""Make every catalog fabric's pattern (coverage + thread height) and its preset's [pattern].
+
+Each fabric's structure comes from a few named parameters (PATTERNS below): a hexagonal
+tulle net (cell = hole-to-hole distance), a lace motif on it, a plain or basket weave at a
+thread pitch, a damask of satin floats. One free parameter per kind (the net's thread width,
+the yarn width, the damask's interstice scale) is found by bisection so that the mean open
+area 1 - mean(c) equals the fitted ``btdf.direct`` (LD) of the preset (model.md section 9);
+the result is written as 16-bit grey PNGs under fabrics/patterns/ and the [pattern] table is
+added to fabrics/<name>.toml through catalog.presets.save_preset_dict (which refuses a
+pattern whose open area misses LD by more than 1 %).
+
+    .venv/bin/python tools/make_patterns.py [NAMES..] [--out-dir fabrics] [--check]
+
+``--check`` regenerates in memory and compares with the files on disk (exit 1 on a
+difference). Deterministic: no random numbers.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+FABRICS = ROOT / "fabrics"
+SQRT3 = math.sqrt(3.0)
+
+#: name -> the pattern's named parameters (lengths in mm). ``size`` = texture side in px.
+PATTERNS: dict[str, dict] = {
+    # lace: a six-petal rosette (cloth-stitch fill, a gimp cord around it) on a hexagonal
+    # tulle of 1 mm cells, repeat 0.1 m (100 cells across, 58 rows of cell pairs down)
+    "lace-fwa": {"kind": "lace", "cell_mm": 1.0, "cells_u": 100, "row_pairs_v": 58,
+                 "rosette_mm": 28.0, "petals": 6, "fill": 0.9, "cord_mm": 0.8, "size": 1024},
+    "net-grey": {"kind": "net", "cell_mm": 2.0, "cells_u": 8, "row_pairs_v": 5, "size": 256},
+    "safety-yellow": {"kind": "net", "cell_mm": 1.5, "cells_u": 8, "row_pairs_v": 5, "size": 256},
+    # woven sheers: pitch = thread spacing, the yarn width found from LD
+    "voile-white": {"kind": "plain", "pitch_mm": 1.0, "size": 64},  # a coarse (etamine) voile
+    "batiste-cream": {"kind": "plain", "pitch_mm": 0.3, "size": 64},
+    "organza-ivory": {"kind": "plain", "pitch_mm": 0.25, "size": 64},
+    "sheer-teal": {"kind": "plain", "pitch_mm": 0.5, "size": 64},
+    "fluoro-pink": {"kind": "plain", "pitch_mm": 0.5, "size": 64},
+    "linen-dense": {"kind": "basket", "pitch_mm": 0.6, "size": 128},
+    # damask: an 8-end satin ground (long floats, few interlacings: dense) and a medallion in
+    # a 3-end twill (short floats, many interlacings: lighter against the light); no holes
+    "jacquard-white": {"kind": "damask", "pitch_mm": 0.4, "threads": 250, "medallion_mm": 34.0,
+                       "ground_end": 8, "motif_end": 3, "size": 1024},
+}
+
+#: Soft edge of a thread (fraction of a pixel's width the coverage ramps over): 1 px.
+EDGE_PX = 1.0
+
+
+def _grid(size_u: int, size_v: int, repeat_u: float, repeat_v: float):
+    """Pixel centres in metres: x along u (image columns), y along v (image rows, down)."""
+    x = (np.arange(size_u) + 0.5) * (repeat_u / size_u)
+    y = (np.arange(size_v) + 0.5) * (repeat_v / size_v)
+    return np.meshgrid(x, y)
+
+
+def _ramp(distance, half_width, px):
+    """Coverage of a thread whose centre line is ``distance`` away: 1 inside half_width,
+    0 outside, a linear ramp one pixel wide across the edge."""
+    return np.clip(0.5 - (distance - half_width) / (EDGE_PX * px), 0.0, 1.0)
+
+
+def _hex_edge_distance(x, y, cell):
+    """Distance to the nearest edge of the hexagonal (Voronoi) cells around a triangular
+    lattice of hole centres with spacing ``cell`` (basis (cell, 0), (cell/2, cell sqrt3/2))."""
+    t = y / (cell * SQRT3 / 2)
+    s = x / cell - 0.5 * t
+    s0, t0 = np.floor(s), np.floor(t)
+    d = []
+    for ds in (-1, 0, 1, 2):
+        for dt in (-1, 0, 1, 2):
+            ps, pt = s0 + ds, t0 + dt
+            px = (ps + 0.5 * pt) * cell
+            py = pt * cell * SQRT3 / 2
+            d.append((x - px) ** 2 + (y - py) ** 2)
+    d = np.sort(np.stack(d), axis=0)
+    return (d[1] - d[0]) / (2 * cell)  # distance to the bisector of the two nearest centres
+
+
+def _bisect(mean_of, target, low, high, iterations=60):
+    """The parameter in [low, high] at which mean_of (increasing) equals target."""
+    for _ in range(iterations):
+        mid = 0.5 * (low + high)
+        if mean_of(mid) < target:
+            low = mid
+        else:
+            high = mid
+    return 0.5 * (low + high)
+
+
+def net_pattern(p, direct):
+    cell = p["cell_mm"] * 1e-3
+    ru, rv = p["cells_u"] * cell, p["row_pairs_v"] * cell * SQRT3
+    n = p["size"]
+    x, y = _grid(n, n, ru, rv)
+    edge = _hex_edge_distance(x, y, cell)
+    px = ru / n
+
+    def coverage(half):
+        return _ramp(edge, half, px)
+
+    half = _bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, cell / 2)
+    c = coverage(half)
+    height = np.clip(1.0 - (edge / max(half, 1e-9)) ** 2, 0.0, 1.0) ** 0.5 * c
+    return c, height, (ru, rv), {"thread_mm": round(2 * half * 1e3, 4),
+                                  "height_m": round(1.4 * half, 8)}
+
+
+def _rosette(x, y, centre, radius, petals):
+    """Signed distance-like field of a rosette: r / R(theta) - 1 (< 0 inside)."""
+    dx, dy = x - centre[0], y - centre[1]
+    r = np.hypot(dx, dy)
+    theta = np.arctan2(dy, dx)
+    shape = radius * (0.55 + 0.45 * np.abs(np.cos(0.5 * petals * theta)))
+    return r - shape, r
+
+
+def lace_pattern(p, direct):
+    cell = p["cell_mm"] * 1e-3
+    ru, rv = p["cells_u"] * cell, p["row_pairs_v"] * cell * SQRT3
+    n = p["size"]
+    x, y = _grid(n, n, ru, rv)
+    px = ru / n
+    edge = _hex_edge_distance(x, y, cell)
+    radius = p["rosette_mm"] * 1e-3
+    cord = p["cord_mm"] * 1e-3
+    # a rosette at the centre and one at the corners (a centred lattice tiles the repeat)
+    inside = np.full(x.shape, np.inf)
+    boundary = np.full(x.shape, np.inf)
+    ring = np.full(x.shape, np.inf)
+    for cx in (0.0, ru / 2, ru):
+        for cy in (0.0, rv / 2, rv):
+            if (cx == ru / 2) != (cy == rv / 2):
+                continue
+            field, r = _rosette(x, y, (cx, cy), radius, p["petals"])
+            inside = np.minimum(inside, field)
+            boundary = np.minimum(boundary, np.abs(field))
+            ring = np.minimum(ring, np.abs(r - 0.18 * radius))
+            # the eye of the rosette: an open centre (net only) inside the ring
+            inside = np.where(r < 0.18 * radius, np.maximum(inside, 1.0), inside)
+    # small spots (point d'esprit) at the middles of the repeat's edges
+    spot = np.full(x.shape, np.inf)
+    for cx, cy in ((ru / 2, 0.0), (ru / 2, rv), (0.0, rv / 2), (ru, rv / 2)):
+        spot = np.minimum(spot, np.hypot(x - cx, y - cy))
+    fill = p["fill"] * np.maximum(_ramp(inside, 0.0, px), _ramp(spot, 2.5e-3, px))
+    cords = np.maximum(_ramp(boundary, cord / 2, px), _ramp(ring, cord / 2, px))
+
+    def coverage(half):
+        net = _ramp(edge, half, px)
+        return np.maximum(np.maximum(net, fill), cords)
+
+    half = _bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, cell / 2)
+    c = coverage(half)
+    net_h = 0.35 * np.clip(1.0 - (edge / max(half, 1e-9)) ** 2, 0.0, 1.0) ** 0.5
+    # cloth stitch: a fine woven texture inside the motif (threads at the net's cell / 3)
+    weave = 0.5 + 0.25 * (np.cos(2 * math.pi * x / (cell / 3)) + np.cos(2 * math.pi * y / (cell / 3)))
+    cord_h = np.maximum(np.clip(1.0 - (boundary / (cord / 2)) ** 2, 0, 1),
+                        np.clip(1.0 - (ring / (cord / 2)) ** 2, 0, 1)) ** 0.5
+    height = np.maximum(np.maximum(net_h * _ramp(edge, half, px), 0.6 * fill * weave), cord_h)
+    return c, np.clip(height, 0, 1), (ru, rv), {"net_thread_mm": round(2 * half * 1e3, 4),
+                                                  "height_m": round(0.5 * cord, 8)}
+
+
+def weave_pattern(p, direct, basket=False):
+    pitch = p["pitch_mm"] * 1e-3
+    group = 2 if basket else 1
+    threads = 2 * group                 # threads per repeat in each direction
+    r = threads * pitch
+    n = p["size"]
+    x, y = _grid(n, n, r, r)
+    px = r / n
+    i = np.floor(x / pitch)             # warp index (vertical threads, spaced along x)
+    j = np.floor(y / pitch)             # weft index
+    dx = np.abs(x - (i + 0.5) * pitch)
+    dy = np.abs(y - (j + 0.5) * pitch)
+
+    def coverage(half):
+        return np.maximum(_ramp(dx, half, px), _ramp(dy, half, px))
+
+    half = _bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, pitch / 2)
+    c = coverage(half)
+    # over and under: warp i is up where it crosses weft j with (i//g + j//g) even
+    phase_warp = math.pi * (y / (group * pitch) - 0.5 / group) + math.pi * np.floor(i / group)
+    phase_weft = math.pi * (x / (group * pitch) - 0.5 / group) + math.pi * np.floor(j / group)
+    warp_centre = 0.5 + 0.3 * np.cos(phase_warp)
+    weft_centre = 0.5 - 0.3 * np.cos(phase_weft)
+    hw = max(half, 1e-9)
+    warp_h = (warp_centre + 0.2 * np.sqrt(np.clip(1 - (dx / hw) ** 2, 0, 1))) * _ramp(dx, half, px)
+    weft_h = (weft_centre + 0.2 * np.sqrt(np.clip(1 - (dy / hw) ** 2, 0, 1))) * _ramp(dy, half, px)
+    height = np.maximum(warp_h, weft_h)
+    return c, np.clip(height, 0, 1), (r, r), {"yarn_mm": round(2 * half * 1e3, 4),
+                                              "height_m": round(half, 8)}
+
+
+def damask_pattern(p, direct):
+    pitch = p["pitch_mm"] * 1e-3
+    r = p["threads"] * pitch
+    n = p["size"]
+    x, y = _grid(n, n, r, r)
+    px = r / n
+    radius = p["medallion_mm"] * 1e-3
+    motif = np.full(x.shape, np.inf)
+    for cx in (0.0, r / 2, r):
+        for cy in (0.0, r / 2, r):
+            if (cx == r / 2) != (cy == r / 2):
+                continue
+            dx, dy = x - cx, y - cy
+            rr = np.hypot(dx, dy)
+            theta = np.arctan2(dy, dx)
+            shape = radius * (0.6 + 0.4 * np.cos(4 * theta)) * (1.0 - 0.25 * np.cos(8 * theta))
+            motif = np.minimum(motif, rr - shape)
+    in_motif = _ramp(motif, 0.0, px)                  # 1 in the medallion (weft-faced twill)
+    i = np.floor(x / pitch)
+    j = np.floor(y / pitch)
+    # interlacing points: satin (ground) where (2 i - j) mod end == 0 (a sateen step of 2),
+    # twill (motif) where (i + j) mod end == 0; an interstice opens where threads interlace
+    ground_points = np.mod(2 * i - j, p["ground_end"]) == 0
+    motif_points = np.mod(i + j, p["motif_end"]) == 0
+    # an interstice opens where threads interlace: the open area of a region is in proportion
+    # to its interlacings per crossing (1 / end), spread over the crossings' corners so that
+    # the threads show at the thread scale
+    lx = (x / pitch) - i - 0.5
+    ly = (y / pitch) - j - 0.5
+    corner = np.exp(-((np.abs(lx) - 0.5) ** 2 + (np.abs(ly) - 0.5) ** 2) / (2 * 0.25 ** 2))
+    points = (1 - in_motif) * ground_points + in_motif * motif_points
+    density = (1 - in_motif) / p["ground_end"] + in_motif / p["motif_end"]
+    interstice = density * (0.6 + 0.4 * corner) * (0.7 + 0.3 * points)
+
+    def coverage(scale):
+        return 1.0 - np.clip(scale * interstice, 0.0, 0.9)
+
+    scale = _bisect(lambda s: -coverage(s).mean(), -(1.0 - direct), 0.0, 10.0)
+    c = coverage(scale)
+    # floats: warp-faced satin ground shows vertical ridges, the twill motif horizontal ones
+    ridges = (1 - in_motif) * (0.5 + 0.5 * np.cos(2 * math.pi * (x / pitch - 0.5))) \
+        + in_motif * (0.5 + 0.5 * np.cos(2 * math.pi * (y / pitch - 0.5)))
+    height = 0.2 + 0.7 * ridges
+    return c, np.clip(height, 0, 1), (r, r), {"interstice_scale": round(scale, 6),
+                                              "height_m": round(0.5 * pitch, 8)}
+
+
+def make_pattern(name: str, direct: float):
+    """(coverage, height, repeat (u, v) m, info) for a catalog fabric, before quantisation."""
+    p = PATTERNS[name]
+    kind = p["kind"]
+    if kind == "lace":
+        return lace_pattern(p, direct)
+    if kind == "net":
+        return net_pattern(p, direct)
+    if kind in ("plain", "basket"):
+        return weave_pattern(p, direct, basket=kind == "basket")
+    if kind == "damask":
+        return damask_pattern(p, direct)
+    raise ValueError(f"unknown pattern kind {kind!r}")
+
+
+def pattern_table(name: str, repeat) -> dict:
+    return {"coverage": f"patterns/{name}.png", "height": f"patterns/{name}-height.png",
+            "repeat_m": [round(repeat[0], 8), round(repeat[1], 8)],
+            "kind": PATTERNS[name]["kind"]}
+
+
+def regenerate(name: str, fabrics: Path = FABRICS, write: bool = True) -> dict:
+    """Make one fabric's pattern; write the PNGs and the preset's [pattern] (``write``), or
+    only return the quantised arrays and the table."""
+    from catalog.presets.patterns import Pattern, quantise16, write_pattern_images
+    from catalog.presets import load_preset, preset_to_dict, save_preset_dict
+
+    preset_path = fabrics / f"{name}.toml"
+    preset = load_preset(preset_path)
+    c, h, repeat, info = make_pattern(name, preset.btdf.direct)
+    c, h = quantise16(c), quantise16(h)
+    table = pattern_table(name, repeat)
+    table.update(info)
+    result = {"name": name, "coverage": c, "height": h, "table": table,
+              "open_area": 1.0 - float(c.mean(dtype=np.float64)), "direct": preset.btdf.direct}
+    if write:
+        (fabrics / "patterns").mkdir(exist_ok=True)
+        pattern = Pattern(c, h, tuple(repeat), 0.0, name)
+        write_pattern_images(pattern, fabrics / table["coverage"], fabrics / table["height"])
+        doc = preset_to_dict(preset)
+        doc["pattern"] = table
+        save_preset_dict(doc, preset_path)    # refuses when the open area misses LD by > 1 %
+    return result
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("names", nargs="*", help="fabrics (default: every one in PATTERNS)")
+    parser.add_argument("--out-dir", type=Path, default=FABRICS, help="the fabrics folder")
+    parser.add_argument("--check", action="store_true",
+                        help="compare with the files on disk instead of writing")
+    args = parser.parse_args(argv)
+    names = args.names or sorted(PATTERNS)
+    status = 0
+    for name in names:
+        result = regenerate(name, args.out_dir, write=not args.check)
+        line = (f"{name:15s} {result['table']['kind']:7s} open {result['open_area']:.5f} "
+                f"LD {result['direct']:.5f}  repeat {result['table']['repeat_m']} m")
+        if args.check:
+            from catalog.presets.patterns import read_image
+
+            on_disk = read_image(args.out_dir / result["table"]["coverage"])[..., 0]
+            same = on_disk.shape == result["coverage"].shape and np.array_equal(
+                np.round(on_disk * 65535.0), np.round(result["coverage"] * 65535.0))
+            line += "  same" if same else "  DIFFERS"
+            status |= 0 if same else 1
+        print(line)
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
