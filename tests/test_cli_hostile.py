@@ -172,7 +172,15 @@ _BAD_SIZES = st.one_of(st.sampled_from(["0x10", "10x0", "-5x5", "5x", "x5", "10x
                                         "1e3x10", "999999x999999", "100000x1", " ", "", "NaNxNaN",
                                         "3.5x2"]),
                        st.text(alphabet="0123456789x-. ", max_size=8)
-                       .filter(lambda s: not __import__("re").fullmatch(r"\s*\d+x\d+\s*", s)))
+                       .filter(lambda s: not _valid_size(s)))
+
+
+def _valid_size(text: str) -> bool:
+    """What catalog.core.cliargs.parse_wxh accepts (sides 1..4096 render here in seconds)."""
+    import re
+
+    match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+    return match is not None and all(1 <= int(g) for g in match.groups())
 
 
 @SETTINGS

@@ -152,56 +152,107 @@ def test_staged_folder_publishes_all_or_nothing(tmp_path):
 
 # --------------------------------------------------------------------------- real faults
 
-def test_full_disk_snapshot_keeps_the_old_image_and_says_so(tmp_path, gl_context):
+#: Every command that writes a file or a folder, with its output on the faulty disk ({out}).
+WRITERS = {
+    "snapshot": ["snapshot", "--fabric", "voile-white", "--size", "32x24", "--out", "{out}/x.png"],
+    "sheet": ["sheet", "--lights", "D65", "--size", "32x24", "--out", "{out}/sheet"],
+    "fit": ["fit", "--gonio", "{measurements}/voile-white/gonio.csv", "--name", "p",
+            "--out", "{out}/p.toml"],
+    "fit --plot": ["fit", "--gonio", "{measurements}/voile-white/gonio.csv", "--name", "p",
+                   "--out", "{tmp}/p.toml", "--plot", "{out}/p.png"],
+    "fluorescence --plot": ["fluorescence", "--excitation", "{measurements}/lace-fwa/excitation.csv",
+                            "--emission", "{measurements}/lace-fwa/emission.csv", "--light", "D65",
+                            "--plot", "{out}/f.png"],
+    "lights --plot": ["lights", "--plot", "{out}/l.png"],
+    "sun --plot": ["sun", "--plot", "{out}/s.png"],
+    "simulate --out": ["simulate", "--grid", "8x8", "--steps", "2", "--out", "{out}/c.obj"],
+    "simulate --out {frame}": ["simulate", "--grid", "8x8", "--steps", "2",
+                               "--out", "{out}/c_{frame}.obj"],
+    "bench --out": ["bench", "--quick", "--sections", "fit", "--out", "{out}/bench"],
+}
+
+
+def _writer_args(name: str, out: Path, tmp: Path, project_root: Path) -> list[str]:
+    measurements = project_root / "fabrics" / "measurements"
+    return [a.replace("{out}", str(out)).replace("{tmp}", str(tmp))
+            .replace("{measurements}", str(measurements)) for a in WRITERS[name]]
+
+
+def _fill(disk: Path) -> None:
+    """Fill a small file system to its last block."""
+    fd = os.open(disk / "filler", os.O_WRONLY | os.O_CREAT)
+    try:
+        with contextlib.suppress(OSError):
+            while True:
+                os.write(fd, b"\0" * 4096)
+    finally:
+        os.close(fd)
+
+
+@pytest.mark.parametrize("name", sorted(WRITERS))
+def test_full_disk_is_one_line_and_the_old_file_stays(tmp_path, name, project_root):
     disk = tmp_path / "disk"
-    with _tmpfs(disk, size="16k") as mounted:
+    with _tmpfs(disk, size="64k") as mounted:
         if not mounted:
             pytest.skip("this machine does not allow a tmpfs mount; the ENOSPC path is "
                         "covered by test_os_errors_become_one_output_error")
-        target = disk / "snap.png"
-        target.write_bytes(b"\x89PNG good old image")
-        result = _catalog("snapshot", "--fabric", "voile-white", "--size", "96x64",
-                          "--out", str(target))
+        old = disk / "x.png"
+        old.write_bytes(b"\x89PNG good old image")
+        _fill(disk)
+        result = _catalog(*_writer_args(name, disk, tmp_path, project_root))
         assert result.returncode == 2, result.stderr
         line = _one_error_line(result.stderr)
-        assert str(target) in line and ("no space" in line or "no room" in line), line
-        assert target.read_bytes() == b"\x89PNG good old image"
+        assert str(disk) in line and ("no space" in line or "no room" in line), line
+        assert old.read_bytes() == b"\x89PNG good old image"
         assert _litter(disk) == []
+        assert sorted(p.name for p in disk.iterdir()) == ["filler", "x.png"]
 
 
-def test_read_only_file_system_is_refused_before_the_work(tmp_path):
+@pytest.mark.parametrize("name", sorted(WRITERS))
+def test_read_only_file_system_is_refused_before_the_work(tmp_path, name, project_root):
     ro = tmp_path / "ro"
     with _tmpfs(ro, read_only=True) as mounted:
         if not mounted:
             pytest.skip("this machine does not allow a read-only tmpfs mount")
-        for args in (["lights", "--plot", str(ro / "l.png")],
-                     ["sheet", "--lights", "D65", "--size", "32x24", "--out", str(ro / "s")],
-                     ["snapshot", "--fabric", "voile-white", "--size", "32x24",
-                      "--out", str(ro / "x.png")]):
-            result = _catalog(*args)
-            assert result.returncode == 2, (args, result.stderr)
-            line = _one_error_line(result.stderr)
-            assert "read-only" in line and str(ro) in line, line
+        result = _catalog(*_writer_args(name, ro, tmp_path, project_root))
+        assert result.returncode == 2, result.stderr
+        line = _one_error_line(result.stderr)
+        assert "read-only" in line and str(ro) in line, line
+
+
+JSON_COMMANDS = {
+    "lights": ["lights", "--json"],
+    "fluorescence": ["fluorescence", "--excitation", "{measurements}/lace-fwa/excitation.csv",
+                     "--emission", "{measurements}/lace-fwa/emission.csv", "--light", "D65",
+                     "--json"],
+    "simulate": ["simulate", "--grid", "8x8", "--steps", "2", "--json"],
+    "snapshot": ["snapshot", "--fabric", "voile-white", "--size", "16x12", "--out", "{tmp}/s.png",
+                 "--json"],
+}
 
 
 @pytest.mark.parametrize("how", ["closed", "full"])
-def test_closed_or_full_stdout_is_one_line(how):
+@pytest.mark.parametrize("name", sorted(JSON_COMMANDS))
+def test_closed_or_full_stdout_is_one_line(tmp_path, project_root, how, name):
     if how == "full" and not Path("/dev/full").exists():
         pytest.skip("no /dev/full on this machine")
-    with open("/dev/full", "w") if how == "full" else contextlib.nullcontext() as sink:
-        stdout = sink if how == "full" else subprocess.DEVNULL
-        cmd = [sys.executable, "-m", "catalog", "lights", "--json"]
-        env = dict(os.environ, PYTHONPATH=str(ROOT))
-        if how == "closed":
-            # the child starts with file descriptor 1 closed, as `cmd >&-` does
-            result = subprocess.run(cmd, stdout=stdout, stderr=subprocess.PIPE, text=True,
-                                    env=env, timeout=120, preexec_fn=lambda: os.close(1))
-        else:
-            result = subprocess.run(cmd, stdout=stdout, stderr=subprocess.PIPE, text=True,
-                                    env=env, timeout=120)
+    measurements = project_root / "fabrics" / "measurements"
+    cmd = [sys.executable, "-m", "catalog"] + [
+        a.replace("{measurements}", str(measurements)).replace("{tmp}", str(tmp_path))
+        for a in JSON_COMMANDS[name]]
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    if how == "closed":
+        # the child starts with file descriptor 1 closed, as `cmd >&-` does
+        result = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                env=env, timeout=240, preexec_fn=lambda: os.close(1))
+    else:
+        with open("/dev/full", "w") as full:
+            result = subprocess.run(cmd, stdout=full, stderr=subprocess.PIPE, text=True,
+                                    env=env, timeout=240)
     assert result.returncode == 2, result.stderr
     line = _one_error_line(result.stderr)
     assert "stdout" in line and ("closed" in line or "no space" in line), line
+    assert _litter(tmp_path) == []
 
 
 def test_an_output_naming_the_input_is_refused_and_the_input_kept(tmp_path, project_root):

@@ -135,7 +135,7 @@ def check_target(path: str | Path, *, inputs: Iterable[str | Path] = (),
         raise OutputError(target, "read-only file system")
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise OutputError(target, f"folder {ancestor} is not writable")
-    if estimate_bytes:
+    with contextlib.suppress(OSError):
         free = shutil.disk_usage(ancestor).free
         if free < estimate_bytes + FREE_SPACE_MARGIN_BYTES:
             raise OutputError(target, f"no room: {free} bytes free, about "
