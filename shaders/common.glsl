@@ -191,4 +191,67 @@ vec3 srgb_encode(vec3 linear) {
     return mix(hi, lo, lessThanEqual(c, vec3(0.0031308)));
 }
 
+// ---- The room (issue 13, model.md section 9): catalog/render/room_light.py has the layout.
+// The room box's six inside faces, P(s, t) = origin + s axis_s + t axis_t, side by side in a
+// light-map atlas (face k covers u in [k / 6, (k + 1) / 6]). Face order: floor, ceiling, left,
+// right, back, window wall.
+const int ROOM_FACES = 6;
+
+// The face a room surface belongs to, by its normal's dominant axis (into the room).
+int room_face_of_normal(vec3 n) {
+    vec3 a = abs(n);
+    if (a.y >= a.x && a.y >= a.z) {
+        return n.y > 0.0 ? 0 : 1;
+    }
+    if (a.x >= a.z) {
+        return n.x > 0.0 ? 2 : 3;
+    }
+    return n.z < 0.0 ? 4 : 5;
+}
+
+// Atlas coordinates of world point p on face k (clamped half a texel inside the face).
+vec2 room_atlas_uv(int face, vec3 p, vec3 origin, vec3 axis_s, vec3 axis_t, float face_texels) {
+    vec3 d = p - origin;
+    float edge = 0.5 / face_texels;
+    float s = clamp(dot(d, axis_s) / dot(axis_s, axis_s), edge, 1.0 - edge);
+    float t = clamp(dot(d, axis_t) / dot(axis_t, axis_t), edge, 1.0 - edge);
+    return vec2((float(face) + s) / float(ROOM_FACES), t);
+}
+
+// A box mask in 2D with soft edges of half-width w (the penumbra): 1 inside, 0 outside.
+float soft_rect(vec2 q, vec4 box, float half_width) {
+    vec2 lo = smoothstep(box.xz - half_width, box.xz + half_width, q);
+    vec2 hi = 1.0 - smoothstep(box.yw - half_width, box.yw + half_width, q);
+    return lo.x * lo.y * hi.x * hi.y;
+}
+
+// The key light's beam through the window opening at room point p (to_light.z < 0: the light
+// is outside): the ray p + s to_light must cross the opening (x0, x1, y0, y1) = rect in both
+// the wall's inner plane z = wall_z.x and outer plane z = wall_z.y (the reveals shade). The
+// edge is soft by the penumbra of a source of angular radius atan(tan_radius) at the distance
+// travelled (PCSS's estimate for a distant disc).
+float room_window_beam(vec3 p, vec3 to_light, vec4 opening, vec2 wall_z, float tan_radius) {
+    float s_in = (wall_z.x - p.z) / to_light.z;
+    float s_out = (wall_z.y - p.z) / to_light.z;
+    vec2 q_in = p.xy + s_in * to_light.xy;
+    vec2 q_out = p.xy + s_out * to_light.xy;
+    return step(0.0, s_in) * soft_rect(q_in, opening, s_in * tan_radius + 1e-3)
+         * soft_rect(q_out, opening, s_out * tan_radius + 1e-3);
+}
+
+
+// ---- The clear sky (issue 13; catalog/sky.py is the float64 twin). Preetham, Shirley & Smits
+// 1999, the Perez et al. 1993 function F(theta, gamma) = (1 + A e^(B / cos theta))
+// (1 + C e^(D gamma) + E cos^2 gamma) for x, y and Y at once (columns of the coefficients).
+vec3 perez_xyY(float cos_theta, float gamma, vec3 a, vec3 b, vec3 c, vec3 d, vec3 e) {
+    float cos_gamma = cos(gamma);
+    return (1.0 + a * exp(b / max(cos_theta, 0.01)))
+         * (1.0 + c * exp(d * gamma) + e * (cos_gamma * cos_gamma));
+}
+
+// xyY -> XYZ.
+vec3 xyY_to_XYZ(vec3 xyY) {
+    return vec3(xyY.x * xyY.z / xyY.y, xyY.z, (1.0 - xyY.x - xyY.y) * xyY.z / xyY.y);
+}
+
 #endif

@@ -1,16 +1,76 @@
 #version 430
-// Room props: grey Lambertian surfaces lit by the room's diffuse light and the fill light.
+// Room props: grey Lambertian surfaces (albedo u_albedo), radiance = albedo / pi x irradiance.
+// ROOM_LIGHTING (issue 13, model.md section 9): the irradiance is
+//  - the key light's beam through the window opening and the curtain, per pixel: the
+//    transmittance shadow map (room_shadow.frag) filtered over the penumbra a source of the
+//    sun's angular radius casts at the receiver's distance from the curtain (PCSS with the
+//    blocker distance known: the curtain hangs in the plane u_curtain_z; the filter is the
+//    map's mip level of that width, one tap), times the opening's soft mask (room_window_beam);
+//  - the light map (room_lightmap.frag + room_bounce.frag): the curtain as an area light,
+//    lamps in the room, one bounce, ambient occlusion.
+// Without it, the earlier scene design: a constant fraction of the key plus the fill light.
 #include "common.glsl"
 
 in vec3 v_normal;
+in vec3 v_position;
 
 uniform vec3 u_room_rgb;          // radiance of the walls under the room's diffuse light
 uniform vec3 u_fill_rgb;          // radiance added by the fill light at normal incidence
 uniform vec3 u_fill_to_light;
 
+#ifdef ROOM_LIGHTING
+in vec2 v_atlas;                  // light-map atlas coordinates (room.vert)
+flat in vec4 v_atlas_box;
+uniform sampler2D u_lightmap;     // irradiance, linear sRGB (x pi cd m^-2)
+uniform sampler2D u_shadow;       // the key light's transmittance through the curtain
+uniform mat4 u_light_view_proj;
+uniform float u_shadow_texel_m;
+uniform vec3 u_key_to_light;
+uniform vec3 u_key_rgb;           // key light: normal irradiance as linear sRGB
+uniform vec4 u_window_rect;
+uniform vec2 u_wall_z;
+uniform float u_curtain_z;
+uniform float u_tan_sun_radius;
+uniform float u_albedo;
+
+#ifdef KEY_BEAM
+vec3 key_beam(vec3 p, vec3 n) {
+    float cos_key = dot(n, u_key_to_light);
+    if (cos_key <= 0.0) {
+        return vec3(0.0);
+    }
+    float beam = room_window_beam(p, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius);
+    if (beam <= 0.0) {
+        return vec3(0.0);
+    }
+    // penumbra radius at this receiver: its distance to the curtain along the beam x tan(radius)
+    float blocker = max((u_curtain_z - p.z) / u_key_to_light.z, 0.0);
+    float radius_m = max(blocker * u_tan_sun_radius, 0.5 * u_shadow_texel_m);
+    vec4 clip = u_light_view_proj * vec4(p, 1.0);
+    vec2 uv = clip.xy * 0.5 + 0.5;
+    // the penumbra as a prefiltered lookup: the mip level whose texel spans its diameter
+    // (one trilinear tap where PCF would take many; a CPU rasteriser pays per tap)
+    vec3 t = textureLod(u_shadow, uv, log2(max(2.0 * radius_m / u_shadow_texel_m, 1.0))).rgb;
+    return u_key_rgb * (cos_key * beam) * t;
+}
+#else
+// faces turned away from the key light (frame.py draws them apart: a CPU rasteriser runs
+// both sides of a branch, so the beam's arithmetic is compiled only where it can be lit)
+vec3 key_beam(vec3 p, vec3 n) {
+    return vec3(0.0);
+}
+#endif
+#endif
+
 layout(location = 0) out vec4 out_radiance;
 
 void main() {
     vec3 n = normalize(v_normal);
+#ifdef ROOM_LIGHTING
+    vec2 uv = clamp(v_atlas, v_atlas_box.xz, v_atlas_box.yw);
+    vec3 irradiance = texture(u_lightmap, uv).rgb + key_beam(v_position, n);
+    out_radiance = vec4((u_albedo / PI) * irradiance, 1.0);
+#else
     out_radiance = vec4(u_room_rgb + max(dot(n, u_fill_to_light), 0.0) * u_fill_rgb, 1.0);
+#endif
 }

@@ -57,6 +57,7 @@ def _frame(gl, fabric, light, *, ev=None, white_balance="room", mode="physical",
     renderer.set_fluorescence(mode)
     renderer.set_white_balance(white_balance)
     renderer.set_ev(ev)
+    renderer.set_bloom(False)  # the display pass is compared with the HDR frame it reads
     renderer.set_antialiasing("off")  # the display pass alone (issue 12's FXAA moves edge pixels)
     mask = renderer.render_gbuffer()["mask"]
     renderer.render()

@@ -98,6 +98,9 @@ def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset):
     renderer.set_fabric(make_preset("layer", direct=0.4, fluorescent=False))
     renderer.set_light("D65")
     renderer.set_camera(0.0, 0.0, 1.6)
+    # the room as a fixed backdrop: lit through the sheets (issue 13) it would change with them
+    renderer.set_room_lighting(False)
+    renderer.set_bloom(False)
     front = _quad(-0.5, 0.15, -0.3, 0.6, lambda x, y: np.full_like(x, 0.05))
     back = _quad(-0.15, 0.5, -0.3, 0.6, lambda x, y: -0.12 + 0.7 * (x - 0.5))
     far = _quad(50.0, 50.1, 0.0, 0.1, lambda x, y: np.full_like(x, 0.0))
@@ -332,6 +335,7 @@ def test_fxaa_brings_edges_closer_to_a_supersampled_frame(gl):
         renderer.set_fabric("lace-fwa")
         renderer.set_light("D65")
         renderer.set_antialiasing(mode)
+        renderer.set_bloom(False)  # the edges alone (the glare would blur both frames)
         renderer.render()
         image = renderer.read_srgb8().astype(np.float64)
         renderer.release()

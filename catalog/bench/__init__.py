@@ -17,7 +17,9 @@ optionally, ``plot(result, folder) -> list[Path]``:
 - ``stability``: every model's parameters swept to their edges
   (:mod:`catalog.bench.stability`);
 - ``startup``: import time and time to the first frame (:mod:`catalog.bench.startup`);
-- ``display``: each display transform's cost in the frame (:mod:`catalog.bench.display`).
+- ``display``: each display transform's cost in the frame (:mod:`catalog.bench.display`);
+- ``room``: the frame with the room lit through the curtain, the clear sky and the glare
+  against the frame without, each pass's share (:mod:`catalog.bench.room`).
 
 docs/bench.md has the figures and how to reproduce them.
 """
@@ -41,4 +43,5 @@ SECTIONS: dict[str, str] = {
     "stability": "catalog.bench.stability",
     "startup": "catalog.bench.startup",
     "display": "catalog.bench.display",
+    "room": "catalog.bench.room",
 }

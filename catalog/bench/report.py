@@ -132,6 +132,12 @@ def startup_md(result: dict) -> str:
         viewer_line(s["viewer_heavy_at_first_frame"]) + f" scipy loaded: {s['viewer_imports_scipy']}."])
 
 
+def room_md(result: dict) -> str:
+    from catalog.bench.room import markdown_tables  # noqa: PLC0415
+
+    return "\n\n".join(markdown_tables(result).values())
+
+
 def viewer_line(heavy: dict | None) -> str:
     if not heavy:
         return "The viewer's first frame was not measured."
@@ -152,6 +158,8 @@ SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "cloth": ("Cloth: substeps and backend against a small-step reference", cloth_md),
               "stability": ("Numerical stability at the parameters' edges", stability_md),
               "startup": ("Start-up", startup_md),
+              "room": ("The room lit through the curtain: frame with and without", room_md),
+
               "display": ("The display step's cost in the frame", display_md)}
 
 

@@ -48,12 +48,14 @@ def start_xvfb() -> tuple[subprocess.Popen, str]:
 
 
 def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backend: str,
-             fabric: str, light: str, render_scale: str) -> dict:
+             fabric: str, light: str, render_scale: str, room_light: bool = True) -> dict:
     env = dict(os.environ, DISPLAY=display)
     env.pop("WAYLAND_DISPLAY", None)
     cmd = [sys.executable, "-m", "catalog", "view", "--size", size, "--grid", grid,
            "--cloth-backend", backend, "--frames", str(frames + warmup), "--stats",
            "--wind", "2.0", "--fabric", fabric, "--light", light, "--render-scale", render_scale]
+    if not room_light:
+        cmd.append("--no-room-light")
     start = time.perf_counter()
     result = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=ROOT)
     wall = time.perf_counter() - start
@@ -87,6 +89,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--render-scale", default="auto",
                         help="scene resolution / window resolution, or auto (the viewer's default)")
     parser.add_argument("--display", help="use this X display instead of a private Xvfb")
+    parser.add_argument("--room-light", choices=("on", "off", "both"), default="on",
+                        help="the room lit through the curtain (issue 13); both: each case "
+                             "without and with, side by side")
     parser.add_argument("--json-out", type=Path, default=ROOT / "benchmarks" / "viewer.json")
     args = parser.parse_args(argv)
 
@@ -98,14 +103,18 @@ def main(argv: list[str] | None = None) -> int:
         rows = []
         for case in args.cases.split(","):
             size, grid = case.split(":")
-            rows.append(run_case(display, size, grid, args.frames, args.warmup, args.backend,
-                                 args.fabric, args.light, args.render_scale))
-            row = rows[-1]
-            print(f"{row['size']:>10} x{row['render_scale']} grid {row['grid']:>8}: "
-                  f"total {row['total_ms']:7.1f} ms ({row['fps']} fps) = simulation {row['simulation_ms']:6.1f} + shading "
-                  f"{row['shading_ms']:6.1f} + UI {row['ui_ms']:5.1f} + other "
-                  f"{row['other_ms']:5.1f}; first frame {row['first_frame_ms']} ms",
-                  flush=True)
+            settings = {"on": (True,), "off": (False,), "both": (False, True)}[args.room_light]
+            for room_light in settings:
+                rows.append(run_case(display, size, grid, args.frames, args.warmup, args.backend,
+                                     args.fabric, args.light, args.render_scale, room_light))
+                rows[-1]["room_light"] = room_light
+                row = rows[-1]
+                print(f"{row['size']:>10} x{row['render_scale']} grid {row['grid']:>8} room light "
+                      f"{'on ' if room_light else 'off'}: "
+                      f"total {row['total_ms']:7.1f} ms ({row['fps']} fps) = simulation "
+                      f"{row['simulation_ms']:6.1f} + shading {row['shading_ms']:6.1f} + UI "
+                      f"{row['ui_ms']:5.1f} + other {row['other_ms']:5.1f}; first frame "
+                      f"{row['first_frame_ms']} ms", flush=True)
     finally:
         if xvfb is not None:
             xvfb.terminate()

@@ -37,7 +37,32 @@ def add_arguments(parser) -> None:
     parser.add_argument("--exposure", type=number_type(0.0, 1e9, low_open=True), default=1.0,
                         help="exposure multiplier on top of --ev or the automatic exposure")
     add_display_arguments(parser)
+    parser.add_argument("--environment", metavar="FILE.exr", default=None,
+                        help="an HDR latitude-longitude image as the view behind the window "
+                             "(scaled to the light's sky; default: the procedural clear sky)")
+    parser.add_argument("--curtain", choices=("closed", "open"), default="closed",
+                        help="open: the curtain drawn aside (the room lit by the window alone)")
+    parser.add_argument("--lamp", action="append", default=[], metavar="LIGHT@X,Y,Z",
+                        help="a lamp placed in the room (e.g. A@0,1.2,2.5; metres, y up, the "
+                             "window at z = -0.2); up to 4")
+    parser.add_argument("--no-room-light", action="store_true",
+                        help="the earlier constant room instead of the room lit through the curtain")
+    parser.add_argument("--no-bloom", action="store_true", help="no glare before the tone map")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def parse_lamp(text: str) -> tuple[str, tuple[float, float, float]]:
+    """``LIGHT@X,Y,Z`` -> (light name, position m); refused in one line naming --lamp."""
+    from catalog.core.errors import InputError  # noqa: PLC0415
+
+    name, _, where = text.rpartition("@")
+    try:
+        position = tuple(float(v) for v in where.split(","))
+    except ValueError:
+        position = ()
+    if not name or len(position) != 3:
+        raise InputError(f"{text!r}: write LIGHT@X,Y,Z, e.g. A@0,1.2,2.5", field="--lamp")
+    return name, position
 
 
 def run(args) -> int:
@@ -52,7 +77,9 @@ def run(args) -> int:
         frame=args.frame, fluorescence="off" if args.no_fluorescence else args.mode,
         bands=args.bands, hour=args.hour, yaw_deg=args.yaw, pitch_deg=args.pitch,
         distance_m=args.distance, exposure=args.exposure, ev=ev,
-        white_balance=white_balance)
+        white_balance=white_balance, environment=args.environment,
+        curtain_open=args.curtain == "open", room_light=not args.no_room_light,
+        bloom=not args.no_bloom, lamps=tuple(parse_lamp(text) for text in args.lamp))
     report = render_snapshot(request)
     if args.json:
         print_json(report)

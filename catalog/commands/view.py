@@ -82,6 +82,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--render-scale", type=_render_scale, metavar="S|auto", default=None,
                         help="scene resolution relative to the window, 0.25-1 (default auto: "
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")
+    parser.add_argument("--no-room-light", action="store_true",
+                        help="the earlier constant room and flat sky, no glare (docs/room.md)")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
     parser.add_argument("--compare-fluorescence", choices=FLUORESCENCE_CHOICES, default=None,
@@ -143,5 +145,6 @@ def run(args: argparse.Namespace) -> int:
         cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
         ev100=ev, white_balance=white_balance, compare_fluorescence=args.compare_fluorescence,
+        room_light=not args.no_room_light,
         fabric_dir=fabric_dir)
     return ViewerApp(options).run()

@@ -5,10 +5,18 @@ It never creates a GL context: it is handed one (:mod:`catalog.gl.context`).
 
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
-1. room props (room.vert/.frag): walls around the window, the curtain rod;
+0. the room's light (issue 13, docs/room.md; when the scene, cloth or lamps changed): the key
+   light's transmittance shadow map through the curtain (room_shadow.*, the pattern's holes
+   projected), the window as the room sees it (the flat curtain's capture), the light map of
+   the room box (room_lightmap.frag: area light, lamps; room_bounce.frag: one bounce, ambient
+   occlusion);
+1. room props (room.vert/.frag): walls around the window, the curtain rod, lit by the light
+   map and the key's beam through the window and the curtain (or, switched off, the earlier
+   constant room);
 2. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
-   shades only the pixels nothing covers: the outside through the window (sky, ground, the
-   sun's disc) or the room, per camera ray;
+   shades only the pixels nothing covers: the outside through the window (the clear sky by
+   direction of catalog/optics/sun/sky.py or an environment image, the ground, the sun's
+   disc) or the room, per camera ray;
 3. the curtain (curtain.vert/.frag): eq. 8 in N bands, two-sided, no face culling, with the
    fabric's pattern (catalog/presets/patterns.py): the threads' radiance (the fitted lobes over the
    mean coverage) and coverage c into weighted blended OIT targets (McGuire & Bavoil 2013),
@@ -16,6 +24,7 @@ Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
    what is really behind, undimmed, and overlapping folds multiply their open fractions;
    ``patterned = False`` draws the paper's flat cloth instead (opaque, LD times the
    background by ray direction: the frame before issue 12, kept for comparison);
+3b. glare (bloom_down/glow/bloom.frag), energy-preserving, when on;
 4. display (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
    target): exposure (EV100, fixed or metered from a luminance histogram of this frame),
    white balance (CAT16), tone curve, gamut compression in OKLab, the sRGB curve
@@ -34,12 +43,17 @@ from catalog.core.constants import FLUORESCENCE_MODES
 from catalog.core.errors import CatalogError
 from catalog.render import bands as band_lib
 from catalog.render import display as display_lib
+from catalog.render import room_light
 from catalog.render import scene as scene_lib
 from catalog.render.camera import OrbitCamera, gl_bytes
 from catalog.gl.shaderlib import create_program, glsl_literal
 
 #: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
 METER_MAX_SIDE_PX = 96
+#: Glare (bloom.frag): the fraction of the frame's radiance spread into the blurs, and the
+#: blurs' weights (mip levels 1..6, wider blurs weighted less; normalised to sum 1).
+BLOOM_STRENGTH = 0.04
+BLOOM_LEVEL_WEIGHTS = (0.30, 0.24, 0.18, 0.13, 0.09, 0.06)
 #: Anti-aliasing of the display image: a post-process (shaders/fxaa.frag) or none.
 ANTIALIASING_MODES = ("fxaa", "off")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
@@ -109,6 +123,11 @@ def check_size(size, ctx=None) -> tuple[int, int]:
                            f"frame, more than the {budget >> 20} MiB this machine allows; "
                            "choose a smaller --size")
     return width, height
+
+
+def gl_bytes_mat3(matrix: np.ndarray) -> bytes:
+    """A 3x3 matrix (column-vector convention) as GLSL's column-major mat3."""
+    return np.ascontiguousarray(np.asarray(matrix, dtype=np.float32).T).tobytes()
 
 
 def fabric_size_from_mesh(positions, uvs, indices) -> tuple[float, float]:
@@ -187,6 +206,22 @@ class FrameRenderer:
         self._uniforms = None
         self._uniforms_key = None
         self._last = None  # (vw, vh, fbo, viewport)
+        #: issue 13: the room lit through the curtain (False: the earlier constant room)
+        self.room_lighting = True
+        self.curtain_open = False
+        self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
+        self._room_gl = None
+        #: the room's light (shadow map, capture, light map) is redrawn at once when the light,
+        #: fabric, curtain or lamps change, and every ``room_update_every`` frames while the
+        #: cloth moves (a cloth drawn from GPU buffers is taken as moving); 1: every frame
+        self.room_update_every = 1
+        self._room_key = None
+        self._room_frames = 0
+        self._mesh_version = 0
+        self.sky_model = True      # the clear sky of catalog/optics/sun/sky.py behind the window (a sun)
+        self.bloom = True          # glare before the tone map (bloom.frag)
+        self.environment = None    # (path, texture, upper-hemisphere illuminance) or None
+        self._bloom_gl = None
 
         positions, normals = scene_lib.room_props()
         self._room_vbo = ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
@@ -320,6 +355,56 @@ class FrameRenderer:
             raise CatalogError(f"fluorescence mode {mode!r}: choose one of {', '.join(FLUORESCENCE_MODES)}")
         self.mode = mode
 
+    def set_room_lighting(self, on: bool) -> None:
+        """Light the room through the curtain (shadow map, area light, bounce: issue 13) or
+        keep the earlier constant room (a fraction of the key light plus the fill light)."""
+        self.room_lighting = bool(on)
+
+    def set_curtain_open(self, open_: bool) -> None:
+        """Open: the curtain is drawn aside (not drawn, casts nothing, lights nothing)."""
+        self.curtain_open = bool(open_)
+
+    def set_room_lamps(self, lamps) -> None:
+        """Lamps placed in the room: (light name or Light, (x, y, z) m) pairs, at most
+        room_light.MAX_ROOM_LAMPS; each an isotropic point whose normal irradiance at 1 m is
+        the light's spectrum. They light the room (not the curtain's shading)."""
+        from catalog.optics.lights import get_light  # noqa: PLC0415
+
+        lamps = list(lamps)
+        if len(lamps) > room_light.MAX_ROOM_LAMPS:
+            raise CatalogError(f"at most {room_light.MAX_ROOM_LAMPS} room lamps, got {len(lamps)}")
+        self.room_lamps = [(get_light(light) if isinstance(light, str) else light,
+                            room_light.check_lamp_position(position)) for light, position in lamps]
+
+    def set_sky_model(self, on: bool) -> None:
+        """The clear sky by direction (catalog/optics/sun/sky.py) or the earlier flat sky and ground."""
+        self.sky_model = bool(on)
+        self._room_key = None  # the window's capture sees the sky
+
+    def set_environment(self, path) -> None:
+        """An HDR latitude-longitude image (EXR, ...) as the view behind the window, scaled to
+        the light's sky (catalog/render/environment.py); None: the procedural clear sky."""
+        from catalog.render import environment as env  # noqa: PLC0415
+
+        if self.environment is not None:
+            self.environment[1].release()
+            self.environment = None
+        self._room_key = None  # the window's capture sees the outside
+        if path is None:
+            return
+        pixels = env.load_environment(path)
+        h, w = pixels.shape[:2]
+        texture = self.ctx.texture((w, h), 3, data=np.ascontiguousarray(pixels[::-1]).tobytes(),
+                                   dtype="f4")
+        texture.filter = (self._moderngl.LINEAR, self._moderngl.LINEAR)
+        texture.repeat_x, texture.repeat_y = True, False
+        self.environment = (str(path), texture, env.upper_illuminance(pixels))
+        self._room_key = None
+
+    def set_bloom(self, on: bool) -> None:
+        """Glare before the tone map (energy-preserving, bloom.frag) on or off."""
+        self.bloom = bool(on)
+
     def set_bands(self, n_bands: int) -> None:
         self.n_bands = band_lib.check_band_count(n_bands)
 
@@ -370,12 +455,16 @@ class FrameRenderer:
             "uv": self.ctx.buffer(uvs.tobytes()),
             "index": self.ctx.buffer(indices.tobytes()),
         }
+        coarse = room_light.coarse_grid_indices(uvs)
+        if coarse is not None:  # the room's passes draw this coarser grid
+            self._curtain_buffers["coarse_index"] = self.ctx.buffer(coarse.tobytes())
         self._own_buffers = list(self._curtain_buffers.values())  # the cloth's are not ours
         self._curtain_format = "3f"
         self._mesh_offset = (0.0, 0.0, 0.0)
         self._vertex_count = count
         self._release_vaos()
         self.mesh_arrays = (positions, normals, tangents)
+        self._mesh_version = getattr(self, "_mesh_version", 0) + 1
 
     def update_positions(self, positions, normals) -> None:
         """New positions and normals for the same vertices (a simulation frame)."""
@@ -390,6 +479,7 @@ class FrameRenderer:
         self._curtain_buffers["position"].write(positions.tobytes())
         self._curtain_buffers["normal"].write(normals.tobytes())
         self.mesh_arrays = (positions, normals, self.mesh_arrays[2])
+        self._mesh_version += 1
 
     def bind_cloth_buffers(self, position_buffer, normal_buffer) -> None:
         """Read positions and normals straight from GPU buffers (vec4 per vertex, xyz used),
@@ -419,6 +509,7 @@ class FrameRenderer:
         self._curtain_buffers["interleaved"] = vertex_buffer
         if index_buffer is not None:
             self._curtain_buffers["index"] = index_buffer
+            self._curtain_buffers.pop("coarse_index", None)  # another mesh: no coarse grid
         self._vertex_count = count
         self._curtain_format = "interleaved"
         self.set_mesh_offset(offset_m)
@@ -460,7 +551,8 @@ class FrameRenderer:
         if key != self._inputs_key:
             self._inputs, self._decision = scene_lib.build_shading_inputs(
                 self.preset, self.light.irradiance_w_m2_nm, self._key_to_light,
-                is_sun=self._is_sun, fluorescence=self.mode, viewer_inside=self.viewer_inside)
+                is_sun=self._is_sun, fluorescence=self.mode, viewer_inside=self.viewer_inside,
+                paper_beam=self.light.name.startswith("sun:"))
             self._inputs_key = key
             self._uniforms_key = None
         return self._inputs
@@ -502,12 +594,27 @@ class FrameRenderer:
             values[name] = tuple(float(v) for v in value) if isinstance(value, tuple) else value
         return values
 
-    def _curtain_program(self, gbuffer: bool):
+    def _curtain_program(self, gbuffer: bool, overrides: dict | None = None):
         defines = self.variant_defines(gbuffer)
+        if overrides:
+            defines["ROOM_CAPTURE"] = True  # the room's window capture (issue 13), not the frame's
         if self.specialise:
-            for name, value in self.scene_values().items():
+            for name, value in self._scene_values_with(overrides).items():
                 defines["S_" + name[2:].upper()] = glsl_literal(value)
         return self._program("curtain.vert", "curtain.frag", defines)
+
+    def _scene_values_with(self, overrides: dict | None) -> dict:
+        values = self.scene_values()
+        if overrides:
+            values = {**values, **overrides}
+        return values
+
+    def _no_disc_overrides(self) -> dict:
+        """The curtain's values without the sun's disc seen through it (the luminaire capture:
+        the key light's beam reaches the room through the shadow map instead)."""
+        disc = self.scene_values()["u_sun_disc"]
+        return {"u_sun_disc": np.zeros_like(disc) if isinstance(disc, np.ndarray)
+                else tuple(0.0 for _ in disc)}
 
     def _program(self, vertex: str, fragment: str, defines: dict | None = None):
         key = (vertex, fragment, tuple(sorted((defines or {}).items())))
@@ -521,18 +628,22 @@ class FrameRenderer:
         specialised = [k for k in self._programs if dict(k[2]).get("SPECIALISED")]
         for key in specialised[:max(0, len(specialised) - MAX_SPECIALISED + 1)]:
             program = self._programs.pop(key)
-            vao = self._vaos.pop(("curtain", id(program)), None)
-            if vao is not None:
-                vao.release()
+            for vao_key in (("curtain", id(program)), ("curtain", id(program), "coarse")):
+                vao = self._vaos.pop(vao_key, None)
+                if vao is not None:
+                    vao.release()
             program.release()
 
     def compiled_variants(self) -> list[dict]:
-        """The switches of every curtain program compiled so far (for tests and reports)."""
+        """The switches of every curtain program compiled so far for the frame itself (for
+        tests and reports; the room's window capture, ROOM_CAPTURE, is left out)."""
         return [{k: v for k, v in k2[2] if not k.startswith("S_")}
-                for k2 in self._programs if k2[1] == "curtain.frag"]
+                for k2 in self._programs
+                if k2[1] == "curtain.frag" and not dict(k2[2]).get("ROOM_CAPTURE")]
 
-    def _curtain_vao(self, program):
-        key = ("curtain", id(program))
+    def _curtain_vao(self, program, coarse: bool = False):
+        coarse = coarse and "coarse_index" in self._curtain_buffers
+        key = ("curtain", id(program)) + (("coarse",) if coarse else ())
         if key not in self._vaos:
             b = self._curtain_buffers
             if self._curtain_format == "interleaved":
@@ -548,8 +659,9 @@ class FrameRenderer:
                     content.append((b["tangent"], "3f", "in_tangent"))
             if "in_uv" in program:
                 content.append((b["uv"], "2f", "in_uv"))
-            self._vaos[key] = self.ctx.vertex_array(program, content, index_buffer=b["index"],
-                                                    index_element_size=4)
+            self._vaos[key] = self.ctx.vertex_array(
+                program, content, index_buffer=b["coarse_index" if coarse else "index"],
+                index_element_size=4)
         return self._vaos[key]
 
     def _room_vao(self, program):
@@ -618,30 +730,35 @@ class FrameRenderer:
         return display_lib.meter_ev100(display_lib.luminance_histogram(display_lib.meter_signal(rgb)))
 
     # ------------------------------------------------------------------ passes
-    def _scene_uniforms(self, program, view_proj, inputs) -> None:
+    def _scene_uniforms(self, program, view_proj, inputs, camera_position=None) -> None:
         s = self._set
         s(program, "u_view_proj", gl_bytes(view_proj))
-        s(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
+        eye = self.camera.position if camera_position is None else camera_position
+        s(program, "u_camera_position", tuple(float(v) for v in eye))
         s(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_fill_to_light", tuple(float(v) for v in inputs.fill_to_light))
         s(program, "u_sun_direction", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_sun_chord2", tuple(float(v) for v in inputs.sun_chord2))
 
-    def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False) -> None:
+    def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False,
+                     camera_position=None, overrides: dict | None = None,
+                     coarse: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer (the benchmark times this).
 
         ``trivial``: True draws the same mesh with catalog/bench/shaders/trivial.frag (the benchmark's floor);
         a file name draws it with that fragment shader instead (the benchmark's other floors)."""
+        eye = tuple(float(v) for v in (self.camera.position if camera_position is None
+                                       else camera_position))
         if trivial:
             fragment = trivial if isinstance(trivial, str) else "trivial.frag"
             program = self._program("curtain.vert", fragment)
             self._set(program, "u_view_proj", gl_bytes(view_proj))
             self._set(program, "u_mesh_offset", self._mesh_offset)
-            self._set(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
+            self._set(program, "u_camera_position", eye)
         else:
-            program = self._curtain_program(gbuffer)
+            program = self._curtain_program(gbuffer, overrides)
             self._set(program, "u_view_proj", gl_bytes(view_proj))
-            self._set(program, "u_camera_position", tuple(float(v) for v in self.camera.position))
+            self._set(program, "u_camera_position", eye)
             self._set(program, "u_mesh_offset", self._mesh_offset)
             if "u_pattern" in program:
                 self._pattern_texture.use(location=PATTERN_UNIT)
@@ -651,10 +768,10 @@ class FrameRenderer:
                 self._set(program, "u_inv_mean_coverage", 1.0 / max(self._pattern_mean_coverage, 1e-6))
                 self._set(program, "u_oit_depth_ref", self.oit_depth_reference_m())
             if not self.specialise:
-                for name, value in self.scene_values().items():
+                for name, value in self._scene_values_with(overrides).items():
                     self._set(program, name, value)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
-        self._curtain_vao(program).render(self._moderngl.TRIANGLES)
+        self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
 
     def _display_colours(self, inputs) -> dict[str, tuple]:
         """Exact linear sRGB of the background and room radiances (once per scene change)."""
@@ -662,34 +779,348 @@ class FrameRenderer:
             spectra = {"u_sky_rgb": inputs.sky_radiance, "u_ground_rgb": inputs.ground_radiance,
                        "u_sun_disc_rgb": inputs.sun_disc_radiance,
                        "u_room_rgb": inputs.room_radiance,
-                       "u_fill_rgb": scene_lib.ROOM_ALBEDO * inputs.fill_irradiance / math.pi}
+                       "u_fill_rgb": scene_lib.ROOM_ALBEDO * inputs.fill_irradiance / math.pi,
+                       "u_key_rgb": inputs.key_irradiance,
+                       "key_dyed_rgb": inputs.key_irradiance * inputs.dye_transmittance}
             self._display = {name: tuple(float(v) for v in band_lib.spectrum_to_display_rgb(s))
                              for name, s in spectra.items()}
             self._display_key = self._inputs_key
         return self._display
 
-    def _draw_background(self, view_proj, inputs) -> None:
-        program = self._program("fullscreen.vert", "background.frag")
-        self._scene_uniforms(program, view_proj, inputs)
+    def sky_model_for(self, inputs):
+        """The clear sky behind the window (catalog/optics/sun/sky.py) with the irradiance and
+        colour of the curtain's own sky term (inputs.sky_radiance), so the two agree."""
+        from catalog.optics.sun.sky import sky_model  # noqa: PLC0415
+
+        return sky_model(inputs.key_to_light, diffuse_horizontal=math.pi * inputs.sky_radiance,
+                         ground_radiance=inputs.ground_radiance)
+
+    def _sky(self, inputs):
+        """The clear-sky model for a sun above the horizon (catalog/optics/sun/sky.py), else None."""
+        if not (self.sky_model and self._is_sun and inputs.key_to_light[1] > 1e-3):
+            return None
+        key = self._inputs_key
+        if getattr(self, "_sky_key", None) != key:
+            from catalog.optics.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
+            from catalog.optics.sun.sky import HAZE_RAD  # noqa: PLC0415
+
+            model = self.sky_model_for(inputs)
+            self._sky_value = {
+                "u_perez": np.asarray(model.perez, dtype="f4"),
+                "u_zenith_xyY": tuple(float(v) for v in model.zenith),
+                "u_perez_sun": tuple(float(v) for v in np.ravel(model.perez_sun)),
+                "u_sky_scale": tuple(float(v) for v in model.scale_rgb),
+                "u_xyz_to_rgb": gl_bytes_mat3(xyz_to_linear_srgb(np.eye(3)).T),
+                "u_haze_rad": HAZE_RAD,
+                "u_ground_rgb": tuple(float(v) for v in model.ground_rgb),
+            }
+            self._sky_key = key
+        return self._sky_value
+
+    def environment_scale(self, inputs) -> float:
+        """The environment image's factor: its upper hemisphere's horizontal illuminance made
+        the light's sky's, pi x Y(sky radiance) (the clear sky's diffuse illuminance for the
+        sun, the lit backdrop's for a lamp)."""
+        target = math.pi * float(np.dot(band_lib.spectrum_to_display_rgb(inputs.sky_radiance),
+                                        (0.2126, 0.7152, 0.0722)))
+        return target / self.environment[2]
+
+    def _draw_background(self, view_proj, inputs, camera_position=None, sun_disc=True) -> None:
+        sky = None if self.environment is not None else self._sky(inputs)
+        program = self._program("fullscreen.vert", "background.frag",
+                                {"SKY_MODEL": sky is not None,
+                                 "ENVIRONMENT": self.environment is not None})
+        self._scene_uniforms(program, view_proj, inputs, camera_position)
+        if self.environment is not None:
+            self.environment[1].use(location=5)
+            self._set(program, "u_environment", 5)
+            self._set(program, "u_environment_scale", self.environment_scale(inputs))
         self._set(program, "u_inverse_view_proj", gl_bytes(np.linalg.inv(view_proj)))
         colours = self._display_colours(inputs)
         for name in ("u_sky_rgb", "u_ground_rgb", "u_sun_disc_rgb", "u_room_rgb"):
             self._set(program, name, colours[name])
+        if sky is not None:
+            for name, value in sky.items():
+                self._set(program, name, value)
+        if not sun_disc:
+            self._set(program, "u_sun_disc_rgb", (0.0, 0.0, 0.0))
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
 
+    def _room_order(self, to_light) -> int:
+        """Reorder the room's triangles so that those facing the key light come first;
+        returns their vertex count (cached per key direction)."""
+        key = tuple(float(v) for v in to_light)
+        if getattr(self, "_room_order_key", None) != key:
+            positions, normals = scene_lib.room_props()
+            facing = (normals[0::3] @ np.asarray(to_light, dtype=np.float32)) > 0.0
+            order = np.concatenate([np.flatnonzero(facing), np.flatnonzero(~facing)])
+            tri_p = positions.reshape(-1, 3, 3)[order].reshape(-1, 3)
+            tri_n = normals.reshape(-1, 3, 3)[order].reshape(-1, 3)
+            self._room_vbo.write(np.hstack([tri_p, tri_n]).astype("f4").tobytes())
+            self._room_order_key = key
+            self._room_facing = 3 * int(facing.sum())
+        return self._room_facing
+
     def _draw_room(self, view_proj, inputs) -> None:
-        program = self._program("room.vert", "room.frag")
+        lit = self.room_lighting
+        if lit:
+            facing = self._room_order(inputs.key_to_light)
+            total = self._room_vbo.size // 24
+            self.ctx.enable(self._moderngl.CULL_FACE)
+            for beam, first, count in ((True, 0, facing), (False, facing, total - facing)):
+                if count:
+                    program = self._program("room.vert", "room.frag",
+                                            {"ROOM_LIGHTING": True, "KEY_BEAM": beam})
+                    self._room_lit_uniforms(program, view_proj, inputs)
+                    self._room_vao(program).render(self._moderngl.TRIANGLES, vertices=count,
+                                                   first=first)
+            self.ctx.disable(self._moderngl.CULL_FACE)
+            self._draw_rings(program)  # the last (beam-free) program
+            return
+        program = self._program("room.vert", "room.frag", {"ROOM_LIGHTING": False})
         self._scene_uniforms(program, view_proj, inputs)
         colours = self._display_colours(inputs)
         self._set(program, "u_room_rgb", colours["u_room_rgb"])
         self._set(program, "u_fill_rgb", colours["u_fill_rgb"])
+        self.ctx.enable(self._moderngl.CULL_FACE)
         self._room_vao(program).render(self._moderngl.TRIANGLES)
-        if self._ring_vbo is not None:
-            key = ("rings", id(program))
-            if key not in self._vaos:
-                self._vaos[key] = self.ctx.vertex_array(
-                    program, [(self._ring_vbo, "3f 3f", "in_position", "in_normal")])
-            self._vaos[key].render(self._moderngl.TRIANGLES)
+        self.ctx.disable(self._moderngl.CULL_FACE)
+        self._draw_rings(program)
+
+    def _draw_rings(self, program) -> None:
+        """The curtain's rings on the rod (issue 12), with the room's program (no culling)."""
+        if getattr(self, "_ring_vbo", None) is None:
+            return
+        key = ("rings", id(program))
+        if key not in self._vaos:
+            self._vaos[key] = self.ctx.vertex_array(
+                program, [(self._ring_vbo, "3f 3f", "in_position", "in_normal")])
+        self._vaos[key].render(self._moderngl.TRIANGLES)
+
+    def _room_lit_uniforms(self, program, view_proj, inputs) -> None:
+        self._scene_uniforms(program, view_proj, inputs)
+        gl = self._room_gl
+        self._room_common_uniforms(program, inputs)
+        self._set(program, "u_face_texels", float(room_light.FACE_TEXELS))
+        gl["lightmap"].use(location=1)
+        self._set(program, "u_lightmap", 1)
+        gl["shadow"].use(location=2)
+        self._set(program, "u_shadow", 2)
+        self._set(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light))
+        self._set(program, "u_curtain_z", scene_lib.CURTAIN_Z)
+
+    # ------------------------------------------------------------------ the room's light (issue 13)
+    def _room_resources(self) -> dict:
+        """The room lighting's GL objects, made on first use (docs/room.md)."""
+        if self._room_gl is None:
+            mgl, ctx = self._moderngl, self.ctx
+            n = room_light.SHADOW_TEXELS
+            shadow = ctx.texture((n, n), 4, dtype="f2")
+            shadow.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+            shadow.repeat_x = shadow.repeat_y = False
+            lw, lh = room_light.luminaire_capture_size()
+            luminaire = ctx.texture((lw, lh), 4, dtype="f4")
+            luminaire.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            luminaire_depth = ctx.depth_renderbuffer((lw, lh))
+            aw, ah = room_light.atlas_size()
+            direct = ctx.texture((aw, ah), 4, dtype="f4")
+            direct.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            beam = ctx.texture((aw, ah), 4, dtype="f4")
+            beam.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            lightmap = ctx.texture((aw, ah), 4, dtype="f4")
+            lightmap.filter = (mgl.LINEAR, mgl.LINEAR)
+            lightmap.repeat_x = lightmap.repeat_y = False
+            ao = ctx.texture((aw, ah), 4, data=room_light.ao_and_mask_texture().tobytes(), dtype="f4")
+            ao.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            ao.build_mipmaps()
+            self._room_gl = {
+                "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
+                "luminaire": luminaire, "luminaire_depth": luminaire_depth,
+                "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
+                "direct": direct, "beam": beam, "direct_fbo": ctx.framebuffer([direct, beam]),
+                "lightmap": lightmap, "lightmap_fbo": ctx.framebuffer([lightmap]), "ao": ao,
+            }
+        return self._room_gl
+
+    def _room_colours(self, inputs) -> dict:
+        """Linear sRGB of the key light (irradiance) and of the beam a thread passes: the
+        directional lobe's forward-scattered part, a_spec forward(g_spec), in the dye's colour
+        under the key light, per unit of thread coverage (mean coverage 1 - LD)."""
+        from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
+
+        colours = self._display_colours(inputs)
+        key = np.asarray(colours["u_key_rgb"])
+        dyed = np.asarray(colours["key_dyed_rgb"])
+        dye_rgb = np.where(key > 1e-6 * max(float(key.max()), 1e-30), dyed / np.where(key > 0, key, 1.0), 1.0)
+        coverage = max(1.0 - float(inputs.direct), 1e-6)
+        forward = hg_hemisphere_factors(float(inputs.g_spec))[0]
+        thread = np.clip(float(inputs.a_spec) * forward * dye_rgb / coverage, 0.0, 1.0)
+        return {"u_key_rgb": tuple(float(v) for v in key), "u_mean_coverage": 1.0 - float(inputs.direct),
+                "u_thread_beam_rgb": tuple(float(v) for v in thread)}
+
+    def _room_common_uniforms(self, program, inputs) -> None:
+        s = self._set
+        for name, value in room_light.face_uniforms().items():
+            s(program, name, value)
+        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+        z0 = scene_lib.ROOM_BOX[2][0]
+        s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
+        s(program, "u_wall_z", (z0, z0 - 0.1))
+        s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+        s(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
+        s(program, "u_key_rgb", self._room_colours(inputs)["u_key_rgb"])
+        s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
+        s(program, "u_albedo", scene_lib.ROOM_ALBEDO)
+
+    def _shadow_vao(self, program):
+        key = ("shadow", id(program))
+        if key not in self._vaos:
+            b = self._curtain_buffers
+            if self._curtain_format == "interleaved":
+                content = [(b["interleaved"], "3f 36x", "in_position")]
+            else:
+                content = [(b["position"], self._curtain_format, "in_position")]
+            if "in_uv" in program and "uv" in b and self._curtain_format != "interleaved":
+                content.append((b["uv"], "2f", "in_uv"))
+            self._vaos[key] = self.ctx.vertex_array(
+                program, content, index_buffer=b.get("coarse_index", b["index"]),
+                index_element_size=4)
+        return self._vaos[key]
+
+    def draw_room_shadow(self, inputs) -> None:
+        """Pass R1: the key light's transmittance through the curtain (room_shadow.frag)."""
+        mgl, gl = self._moderngl, self._room_resources()
+        n = room_light.SHADOW_TEXELS
+        gl["shadow_fbo"].use()
+        self.ctx.viewport = (0, 0, n, n)
+        gl["shadow_fbo"].clear(1.0, 1.0, 1.0, 1.0)
+        if not self.curtain_open:
+            # the fabric's pattern (issue 12's texture and scale, when this renderer has them
+            # and the mesh carries uvs) projects its holes; else the uniform mean coverage
+            pattern = getattr(self, "_pattern_texture", None)
+            patterned = (pattern is not None and getattr(self, "patterned", False)
+                         and self._curtain_format != "interleaved")
+            program = self._program("room_shadow.vert", "room_shadow.frag",
+                                    {"HAS_UV": True, "PATTERN": patterned})
+            if patterned:
+                pattern.use(location=3)
+                self._set(program, "u_pattern", 3)
+                self._set(program, "u_uv_to_repeats", tuple(
+                    f / r for f, r in zip(self._fabric_size_m, self._pattern_repeat_m)))
+            colours = self._room_colours(inputs)
+            self._set(program, "u_light_view_proj",
+                      gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+            self._set(program, "u_mesh_offset", self._mesh_offset)
+            self._set(program, "u_mean_coverage", colours["u_mean_coverage"])
+            self._set(program, "u_thread_beam_rgb", colours["u_thread_beam_rgb"])
+            self.ctx.disable(mgl.DEPTH_TEST)
+            self.ctx.disable(mgl.CULL_FACE)
+            self.ctx.enable(mgl.BLEND)
+            self.ctx.blend_func = (mgl.ZERO, mgl.SRC_COLOR)   # dst *= this layer's transmittance
+            self._shadow_vao(program).render(mgl.TRIANGLES)
+            self.ctx.blend_func = mgl.DEFAULT_BLENDING
+            self.ctx.disable(mgl.BLEND)
+        gl["shadow"].build_mipmaps()
+
+    def draw_room_luminaire(self, inputs) -> None:
+        """Pass R2: what the room sees in the window (the curtain's room-side radiance, or the
+        outside where it is open), one texel per window patch, the sun's disc left out."""
+        mgl, gl = self._moderngl, self._room_resources()
+        lw, lh = room_light.luminaire_capture_size()
+        gl["luminaire_fbo"].use()
+        self.ctx.viewport = (0, 0, lw, lh)
+        gl["luminaire_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<="
+        view_proj = room_light.luminaire_view_projection()
+        eye = room_light.LUMINAIRE_EYE
+        if not self.curtain_open:
+            # the flat cloth (the pattern averaged, model.md section 9): each capture texel is
+            # a 4x4 mean over a window patch anyway, and the flat variant draws in one pass
+            patterned = getattr(self, "patterned", None)
+            if patterned:
+                self.patterned = False
+            try:
+                self.draw_curtain(view_proj, camera_position=eye,
+                                  overrides=self._no_disc_overrides(), coarse=True)
+            finally:
+                if patterned:
+                    self.patterned = patterned
+        self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False)
+        self.ctx.depth_func = "<"
+        self.ctx.disable(mgl.DEPTH_TEST)
+        gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
+
+    def draw_room_lightmap(self, inputs) -> None:
+        """Passes R3 and R4: the light map's direct part (area light, beam, lamps), then one
+        bounce with ambient occlusion into the light map the room reads."""
+        mgl, gl = self._moderngl, self._room_resources()
+        aw, ah = room_light.atlas_size()
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        gl["direct_fbo"].use()
+        self.ctx.viewport = (0, 0, aw, ah)
+        program = self._program("fullscreen.vert", "room_lightmap.frag")
+        self._room_common_uniforms(program, inputs)
+        gl["luminaire"].use(location=1)
+        self._set(program, "u_luminaire", 1)
+        self._set(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)
+        self._set(program, "u_luminaire_level", room_light.LUMINAIRE_LEVEL)
+        self._set(program, "u_patch_area_m2", room_light.window_patch_area_m2())
+        gl["shadow"].use(location=2)
+        self._set(program, "u_shadow", 2)
+        (x0, x1), _, _ = scene_lib.ROOM_BOX
+        texel_m = (x1 - x0) / room_light.FACE_TEXELS
+        self._set(program, "u_shadow_lod",
+                  max(0.0, math.log2(texel_m / room_light.shadow_texel_m(inputs.key_to_light))))
+        self._set(program, "u_key_on", 1.0)
+        lamps = self.room_lamps
+        positions = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
+        rgbs = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
+        for k, (light, position) in enumerate(lamps):
+            positions[k] = position
+            rgbs[k] = band_lib.spectrum_to_display_rgb(light.irradiance_w_m2_nm)
+        self._set(program, "u_lamp_count", len(lamps))
+        self._set(program, "u_lamp_position", positions)
+        self._set(program, "u_lamp_rgb", rgbs)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        gl["direct"].build_mipmaps()
+        gl["beam"].build_mipmaps()
+
+        gl["lightmap_fbo"].use()
+        program = self._program("fullscreen.vert", "room_bounce.frag")
+        for name, value in room_light.face_uniforms().items():
+            self._set(program, name, value)
+        gl["direct"].use(location=1)
+        self._set(program, "u_direct", 1)
+        gl["ao"].use(location=2)
+        self._set(program, "u_ao_mask", 2)
+        gl["beam"].use(location=3)
+        self._set(program, "u_beam", 3)
+        self._set(program, "u_bounce_level", room_light.BOUNCE_LEVEL)
+        self._set(program, "u_coarse_texels", room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL)
+        self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+
+    def draw_room_light(self, inputs) -> None:
+        """All the room lighting's passes before the frame (R1-R4)."""
+        self.draw_room_shadow(inputs)
+        self.draw_room_luminaire(inputs)
+        self.draw_room_lightmap(inputs)
+
+    def read_room_shadow(self) -> np.ndarray:
+        """The last transmittance shadow map, float32 (N, N, 3), row 0 = the map's bottom."""
+        gl = self._room_resources()
+        n = room_light.SHADOW_TEXELS
+        data = gl["shadow"].read(level=0)
+        return np.frombuffer(data, dtype=np.float16).reshape(n, n, 4)[..., :3].astype(np.float32)
+
+    def read_room_lightmap(self) -> np.ndarray:
+        """The last light map (irradiance, linear sRGB), float32 (R, 6R, 3), row 0 = t = 0."""
+        gl = self._room_resources()
+        aw, ah = room_light.atlas_size()
+        data = gl["lightmap_fbo"].read(viewport=(0, 0, aw, ah), components=4, dtype="f4")
+        return np.frombuffer(data, dtype=np.float32).reshape(ah, aw, 4)[..., :3].copy()
 
     def _viewport_size(self, viewport) -> tuple[int, int]:
         if viewport is None:
@@ -700,28 +1131,87 @@ class FrameRenderer:
                                f"{self.size[0]}x{self.size[1]} HDR target")
         return vw, vh
 
-    def render_hdr(self, viewport=None) -> tuple[int, int]:
-        """Background, room and curtain into the HDR target; returns the size drawn."""
+    def _room_light_stale(self) -> bool:
+        """Whether the room's light must be redrawn this frame (see room_update_every)."""
+        key = (self._inputs_key, self.curtain_open, getattr(self, "patterned", None),
+               getattr(self, "_pattern_key", None),
+               tuple((light.name, position) for light, position in self.room_lamps))
+        self._room_frames += 1
+        moved = self._mesh_version != getattr(self, "_room_mesh_version", None) or (
+            self._curtain_format != "3f")  # a cloth on the GPU moves unseen
+        due = moved and self._room_frames >= self.room_update_every
+        if key != self._room_key or due or self._room_gl is None:
+            self._room_key = key
+            self._room_mesh_version = self._mesh_version
+            self._room_frames = 0
+            return True
+        return False
+
+    def invalidate_room_light(self) -> None:
+        """Redraw the room's light at the next frame (e.g. after the cloth moved on the GPU)."""
+        self._room_key = None
+
+    def _timed(self, profile, name, work) -> None:
+        """Run ``work()``; with a ``profile`` dict, finish the GL queue and add its wall time (s)."""
+        if profile is None:
+            work()
+            return
+        import time  # noqa: PLC0415
+
+        self.ctx.finish()
+        start = time.perf_counter()
+        work()
+        self.ctx.finish()
+        profile[name] = profile.get(name, 0.0) + time.perf_counter() - start
+
+    def render_hdr(self, viewport=None, profile: dict | None = None) -> tuple[int, int]:
+        """Background, room and curtain into the HDR target; returns the size drawn.
+        ``profile``: a dict that receives each pass's wall time (s), the GL queue finished
+        around each (the benchmark's per-pass shares; slower than a frame without it)."""
         mgl = self._moderngl
         inputs = self.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
+        if self.room_lighting and self._room_light_stale():
+            self._timed(profile, "room_shadow", lambda: self.draw_room_shadow(inputs))
+            self._timed(profile, "room_luminaire", lambda: self.draw_room_luminaire(inputs))
+            self._timed(profile, "room_lightmap", lambda: self.draw_room_lightmap(inputs))
         self._hdr_fbo.use()
         self.ctx.viewport = (0, 0, vw, vh)
         self._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
         self.ctx.disable(mgl.BLEND)
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<="
-        self._draw_room(view_proj, inputs)
-        if not self.patterned:
-            self.draw_curtain(view_proj)
+        if not self.curtain_open and not self.patterned:
+            # the opaque flat curtain first: the depth test then skips the room behind it
+            self._timed(profile, "curtain", lambda: self.draw_curtain(view_proj))
+        self._timed(profile, "room", lambda: self._draw_room(view_proj, inputs))
         # on the far plane: the depth test leaves only the pixels nothing covers
-        self._draw_background(view_proj, inputs)
-        if self.patterned:
-            self._draw_curtain_oit(view_proj, vw, vh)
+        self._timed(profile, "background", lambda: self._draw_background(view_proj, inputs))
+        if not self.curtain_open and self.patterned:
+            self._timed(profile, "curtain", lambda: self._draw_curtain_oit(view_proj, vw, vh))
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
+
+    def _bloom_resources(self) -> dict:
+        if self._bloom_gl is None:
+            mgl, ctx = self._moderngl, self.ctx
+            w, h = self.size
+            # float32: the sun's disc (~1e9 cd m^-2) overflows half floats
+            half = ctx.texture((max(1, (w + 1) // 2), max(1, (h + 1) // 2)), 4, dtype="f4")
+            half.filter = (mgl.LINEAR_MIPMAP_NEAREST, mgl.LINEAR)  # whole levels: bilinear taps
+            half.repeat_x = half.repeat_y = False
+            glow = ctx.texture((max(1, (half.size[0] + 1) // 2), max(1, (half.size[1] + 1) // 2)),
+                               4, dtype="f4")   # quarter size: the glow is wide
+            glow.filter = (mgl.LINEAR, mgl.LINEAR)
+            glow.repeat_x = glow.repeat_y = False
+            out = ctx.texture((w, h), 4, dtype="f4")
+            out.filter = (mgl.NEAREST, mgl.NEAREST)
+            self._bloom_gl = {"half": half, "half_fbo": ctx.framebuffer([half]),
+                              "glow": glow, "glow_fbo": ctx.framebuffer([glow]),
+                              "out": out, "out_fbo": ctx.framebuffer([out])}
+        return self._bloom_gl
 
     def oit_depth_reference_m(self) -> float:
         """The view distance (m) where the OIT depth weight is 1: just before the nearest
@@ -762,19 +1252,71 @@ class FrameRenderer:
             raise CatalogError(f"anti-aliasing {mode!r}: choose one of {', '.join(ANTIALIASING_MODES)}")
         self.antialiasing = mode
 
-    def render(self, fbo=None, viewport=None, dt_s: float | None = None) -> None:
-        """One frame: HDR passes, then the display pass into ``fbo`` (default: our RGBA8
-        target) at ``viewport`` (x, y, w, h; default the whole renderer size).
+    def draw_bloom(self, vw: int, vh: int) -> object:
+        """Glare: the HDR frame with BLOOM_STRENGTH of it spread over wide blurs
+        (bloom_down.frag, then bloom.frag); returns the texture the tone map reads."""
+        mgl, gl = self._moderngl, self._bloom_resources()
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        hw, hh = (vw + 1) // 2, (vh + 1) // 2
+        gl["half_fbo"].use()
+        self.ctx.viewport = (0, 0, hw, hh)
+        program = self._program("fullscreen.vert", "bloom_down.frag")
+        self._hdr.use(location=0)
+        self._set(program, "u_hdr", 0)
+        self._set(program, "u_hdr_size", (vw, vh))
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        gl["half"].build_mipmaps()
+        full_w, full_h = gl["half"].size
+        rect = (0.0, 0.0, hw / full_w, hh / full_h)
+        gw, gh = gl["glow"].size
+        qw, qh = (hw + 1) // 2, (hh + 1) // 2
+        gl["glow_fbo"].use()
+        self.ctx.viewport = (0, 0, qw, qh)
+        program = self._program("fullscreen.vert", "bloom_glow.frag",
+                                {"BLOOM_LEVELS": len(BLOOM_LEVEL_WEIGHTS)})
+        gl["half"].use(location=1)
+        self._set(program, "u_half", 1)
+        self._set(program, "u_half_rect", rect)
+        weights = np.asarray(BLOOM_LEVEL_WEIGHTS, dtype="f4")
+        self._set(program, "u_level_weight", weights / weights.sum())
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        gl["out_fbo"].use()
+        self.ctx.viewport = (0, 0, vw, vh)
+        program = self._program("fullscreen.vert", "bloom.frag")
+        self._hdr.use(location=0)
+        self._set(program, "u_hdr", 0)
+        gl["glow"].use(location=1)
+        self._set(program, "u_glow", 1)
+        self._set(program, "u_glow_rect", (0.0, 0.0, qw / gw, qh / gh))
+        self._set(program, "u_strength", BLOOM_STRENGTH)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        return gl["out"]
 
-        Auto exposure (no :meth:`set_ev`): this frame is metered; ``dt_s`` (the viewer's frame
-        time) adapts the exposure toward it over display.ADAPTATION_TAU_S, None jumps."""
-        vw, vh = self.render_hdr(viewport)
+    def render(self, fbo=None, viewport=None, dt_s: float | None = None,
+               profile: dict | None = None) -> None:
+        """One frame: HDR passes, the glare (bloom, when on), then the display pass into
+        ``fbo`` (default: our RGBA8 target) at ``viewport`` (x, y, w, h; default the whole
+        renderer size).
+
+        Auto exposure (no :meth:`set_ev`): this frame is metered (before the glare); ``dt_s``
+        (the viewer's frame time) adapts the exposure toward it over
+        display.ADAPTATION_TAU_S, None jumps. ``profile``: see :meth:`render_hdr` (adds
+        "meter", "bloom" and "display")."""
+        vw, vh = self.render_hdr(viewport, profile)
         if self.ev100 is None:
-            self.metered_ev100 = display_lib.adapt_ev(self.metered_ev100, self.meter(vw, vh), dt_s)
-        self.display_pass(vw, vh, fbo, viewport)
+            self._timed(profile, "meter", lambda: setattr(
+                self, "metered_ev100",
+                display_lib.adapt_ev(self.metered_ev100, self.meter(vw, vh), dt_s)))
+        source = {"texture": self._hdr}
+        if self.bloom:
+            self._timed(profile, "bloom", lambda: source.update(texture=self.draw_bloom(vw, vh)))
+        self._timed(profile, "display",
+                    lambda: self.display_pass(vw, vh, fbo, viewport, source["texture"]))
 
-    def display_pass(self, vw: int, vh: int, fbo=None, viewport=None) -> None:
-        """The display transform of the HDR target's (vw, vh) corner (the benchmark times it)."""
+    def display_pass(self, vw: int, vh: int, fbo=None, viewport=None, hdr=None) -> None:
+        """The display transform of the HDR target's (vw, vh) corner (the benchmark times it);
+        ``hdr``: the texture to show (default the HDR target; the glare's output when on)."""
         target = fbo if fbo is not None else self._ldr_fbo
         target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
                            else (0, 0, vw, vh))
@@ -787,7 +1329,7 @@ class FrameRenderer:
             self.ctx.viewport = target_viewport
         program = self._program("fullscreen.vert", "tonemap.frag",
                                 {"DISPLAY_STAGES": self.display_stages})
-        self._hdr.use(location=0)
+        (hdr if hdr is not None else self._hdr).use(location=0)
         self._set(program, "u_hdr", 0)
         self._set(program, "u_hdr_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
         for name, value in self.display_uniforms().items():
@@ -876,11 +1418,17 @@ class FrameRenderer:
             "white_balance": self.white_balance,
             "white_balance_adapted": not np.allclose(self.white_balance_matrix(), np.eye(3)),
             "size": list(self.size),
+            "room_lighting": self.room_lighting, "curtain_open": self.curtain_open,
+            "sky_model": self.sky_model, "bloom": self.bloom,
+            "environment": None if self.environment is None else self.environment[0],
+            "room_lamps": [[light.name, list(position)] for light, position in self.room_lamps],
         }
 
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
         ours = [self._hdr_fbo, self._ldr_fbo, self._oit_fbo, self._pre_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
+        ours += [obj for name, obj in list((self._room_gl or {}).items())
+                 + list((self._bloom_gl or {}).items()) if name.endswith("_fbo")]
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._release_vaos()
@@ -902,3 +1450,10 @@ class FrameRenderer:
         for program in self._programs.values():
             program.release()
         self._programs.clear()
+        for obj in list((self._room_gl or {}).values()) + list((self._bloom_gl or {}).values()):
+            obj.release()
+        self._room_gl = None
+        self._bloom_gl = None
+        if self.environment is not None:
+            self.environment[1].release()
+            self.environment = None

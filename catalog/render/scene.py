@@ -10,8 +10,9 @@ Lighting model (the numbers are scene design, stated once here; the physics is e
 
 - key: the light the user picks, as a distant source behind the window (the sun's disc
   size, 0.2666 deg), normal irradiance = the light's spectrum;
-- sky: outside above the horizon, radiance SKY_FRACTION E / pi, tinted (550 / l)^4 for
-  the sun (Rayleigh) and untinted for a lamp (a lit backdrop); ground below: albedo
+- sky: for the sun, the clear sky of the same atmosphere (:func:`outside_radiances`,
+  catalog/optics/sun/sky.py for its distribution over directions); for a lamp, outside above the
+  horizon, radiance SKY_FRACTION E / pi (a lit backdrop); ground below: albedo
   GROUND_ALBEDO under the key light's horizontal irradiance;
 - fill: the light bounced into the room, a directional light on the viewer's side with
   FILL_FRACTION of the key's spectrum (so a front-lit curtain is not black);
@@ -267,12 +268,21 @@ def sun_at_hour(hour: float) -> SunAtHour:
 
 
 def key_elevation_for(light_name: str) -> float:
-    """Elevation (deg) of the key light: the sun's from its path length, a lamp's fixed."""
+    """Elevation (deg) of the key light: the sun's from its path length (``sun:PATH``,
+    ``sun-clear:PATH``) or from its date, time and place (``sun@WHEN,LAT[,LON]``), so that the
+    sky behind the window (catalog/optics/sun/sky.py) is the one of that sun; a lamp's fixed."""
     if light_name.startswith(("sun:", "sun-clear:")):
         from catalog.optics.sun.model import zenith_deg_from_path  # noqa: PLC0415
 
         path = float(light_name.split(":", 1)[1])
         return 90.0 - zenith_deg_from_path(path)
+    if light_name.startswith("sun@"):
+        from catalog.optics.sun.model import sun_position  # noqa: PLC0415
+
+        parts = [p.strip() for p in light_name[4:].split(",")]
+        position = sun_position(parts[0], float(parts[1]),
+                                float(parts[2]) if len(parts) > 2 else 0.0)
+        return 90.0 - position.zenith_deg
     return LAMP_ELEVATION_DEG
 
 
@@ -380,8 +390,40 @@ def decide_fluorescence(preset, irradiance: np.ndarray, requested: str) -> Fluor
     return FluorescenceDecision(requested, requested if needed else "off", needed, delta_e)
 
 
+def outside_radiances(key_irradiance: np.ndarray, to_light: np.ndarray, is_sun: bool,
+                      paper_beam: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Mean radiance spectra of the sky and the ground outside the window.
+
+    The sun above the horizon: the clear sky of the same atmosphere (catalog.optics.sun.model
+    clear_sky at the sun's zenith): sky = diffuse horizontal / pi (a uniform sky with the same
+    irradiance; catalog/optics/sun/sky.py spreads it over the sky by Preetham's distribution),
+    ground = albedo x global horizontal / pi. ``paper_beam`` (the ``sun:PATH`` lights, the
+    paper's beam after Rayleigh scattering alone): that atmosphere's sky has the colour of
+    the same beam Rayleigh-scattered, key x (550 / l)^4, at the clear sky's luminance, and the
+    ground is lit by that beam and sky. A lamp (or the sun at or below the horizon): the scene
+    design of the module docstring (a lit backdrop, SKY_FRACTION of the key)."""
+    tint = (550.0 / GRID_NM) ** 4
+    if is_sun and to_light[1] > 1e-3:
+        from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
+        from catalog.optics.sun.model import Atmosphere, clear_sky  # noqa: PLC0415
+
+        zenith = min(math.degrees(math.acos(min(float(to_light[1]), 1.0))), 89.5)
+        clear = clear_sky(zenith)
+        albedo = Atmosphere().ground_albedo
+        if not paper_beam:
+            return clear.diffuse_horizontal / math.pi, albedo * clear.global_horizontal / math.pi
+        ybar = cmfs(GRID_NM)[:, 1]
+        shape = key_irradiance * tint
+        scale = float(clear.diffuse_horizontal @ ybar) / max(float(shape @ ybar), 1e-300)
+        diffuse = shape * scale
+        cos_z = math.cos(math.radians(zenith))
+        return diffuse / math.pi, albedo * (key_irradiance * cos_z + diffuse) / math.pi
+    return (SKY_FRACTION * key_irradiance * (tint if is_sun else 1.0) / math.pi,
+            GROUND_ALBEDO * key_irradiance * max(to_light[1], 0.0) / math.pi)
+
+
 def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.ndarray, *,
-                         is_sun: bool, fluorescence: str = "physical",
+                         is_sun: bool, fluorescence: str = "physical", paper_beam: bool = False,
                          viewer_inside: bool = True) -> tuple[ShadingInputs, FluorescenceDecision]:
     """The spectral description of the scene's light on the curtain for a preset."""
     from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
@@ -390,9 +432,7 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
     key = np.asarray(key_irradiance, dtype=np.float64)
     to_light = np.asarray(key_to_light, dtype=np.float64)
     to_light = to_light / np.linalg.norm(to_light)
-    tint = (550.0 / GRID_NM) ** 4 if is_sun else np.ones(GRID_NM.size)
-    sky = SKY_FRACTION * key * tint / math.pi
-    ground = GROUND_ALBEDO * key * max(to_light[1], 0.0) / math.pi
+    sky, ground = outside_radiances(key, to_light, is_sun, paper_beam)
     fill = FILL_FRACTION * key
     room = ROOM_ALBEDO * ROOM_FRACTION * key / math.pi
     disc = key / (math.pi * SUN_RADIUS_RAD ** 2)

@@ -54,6 +54,11 @@ class SnapshotRequest:
     exposure: float = 1.0
     ev: float | None = None           # EV100; None: automatic exposure
     white_balance: str = "room"
+    environment: str | None = None    # FILE.exr behind the window (issue 13)
+    curtain_open: bool = False
+    room_light: bool = True
+    bloom: bool = True
+    lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
 
 
 def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str], *,
@@ -195,6 +200,21 @@ def validate(request: SnapshotRequest):
     scene_lib.dye_transmittance(preset)
     scene_lib.fluorescent_material(preset)
     light = get_light(request.light) if request.hour is None else None
+    if request.environment is not None:
+        from catalog.render.environment import load_environment  # noqa: PLC0415
+
+        load_environment(request.environment)  # refused now, before a context exists
+    from catalog.render import room_light  # noqa: PLC0415
+
+    if len(request.lamps) > room_light.MAX_ROOM_LAMPS:
+        raise InputError(f"at most {room_light.MAX_ROOM_LAMPS} lamps, got {len(request.lamps)}",
+                         field="--lamp")
+    for name, position in request.lamps:
+        get_light(name)
+        try:
+            room_light.check_lamp_position(position)
+        except CatalogError as exc:
+            raise InputError(str(exc), field="--lamp") from None
     return preset, light
 
 
@@ -221,6 +241,12 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.set_exposure(request.exposure)
         renderer.set_ev(request.ev)
         renderer.set_white_balance(request.white_balance)
+        renderer.set_curtain_open(request.curtain_open)
+        renderer.set_room_lighting(request.room_light)
+        renderer.set_bloom(request.bloom)
+        if request.environment is not None:
+            renderer.set_environment(request.environment)
+        renderer.set_room_lamps(request.lamps)
         *mesh, fabric_size = simulated_curtain(preset, request.frame)
         renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
         renderer.set_rings(ring_xs_m(preset))

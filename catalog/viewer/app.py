@@ -30,6 +30,10 @@ FIXED_FRAME_DT_S = 1.0 / 60.0
 #: Scene resolution on a software rasteriser (llvmpipe): a quarter of the pixels, upscaled.
 SOFTWARE_RENDER_SCALE = 0.5
 SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "SWR")
+#: On a software rasteriser the room's light (issue 13) follows a moving cloth every this many
+#: frames, and the glare (bloom) is off: docs/room.md has their cost.
+SOFTWARE_ROOM_UPDATE_EVERY = 4
+SOFTWARE_BLOOM = False
 #: Bounds on the simulated time per frame in interactive use (slow machines run slow motion
 #: rather than let the cloth take huge steps), s.
 MIN_FRAME_DT_S, MAX_FRAME_DT_S = 1.0 / 240.0, 1.0 / 15.0
@@ -57,6 +61,7 @@ class ViewerOptions:
     panel: bool = True
     paused: bool = False
     render_scale: float | None = None  # scene resolution / window resolution; None: auto
+    room_light: bool = True  # the room lit through the curtain, the clear sky, glare (issue 13)
     fabric_dir: Path | None = None  # None: --fabrics / $CATALOG_FABRICS, then the built-in catalog
     ev100: float | None = None  # fixed exposure; None: automatic
     white_balance: str = "room"
@@ -148,6 +153,15 @@ class ViewerApp:
         self.ctx: moderngl.Context = wrap_window_context()
         self.render_scale = self._choose_render_scale()
         self.cloth_backend = self._choose_cloth_backend()
+        self.room_settings = self._choose_room_settings()
+        if self._software_gl() and self.options.room_light:
+            import sys  # noqa: PLC0415
+
+            print(f"catalog view: software rasteriser ({self.ctx.info.get('GL_RENDERER', '?')}): "
+                  f"render scale {self.render_scale:g}, {self.cloth_backend} cloth, the room's "
+                  f"light every {self.room_settings['room_update_every']} frames while the cloth "
+                  f"moves, bloom {'on' if self.room_settings['bloom'] else 'off'}",
+                  file=sys.stderr, flush=True)
         glfw.swap_interval(0 if self.options.frames is not None else 1)
 
         imgui.create_context()
@@ -253,6 +267,7 @@ class ViewerApp:
             summary = {"summary": True, "frames": frame, "size": list(self._fbo.size),
                        "grid": list(self.options.grid), "renderer": self.ctx.info["GL_RENDERER"],
                        "render_scale": self.render_scale, "cloth_backend": self.cloth_backend,
+                       **self.room_settings,
                        **{f"median_{k}_ms": round(v, 3)
                           for k, v in self.timer.median_ms().items()},
                        **self._panel_summary()}
@@ -390,13 +405,28 @@ class ViewerApp:
                 size = (max(1, round(size[0] * self.render_scale)),
                         max(1, round(size[1] * self.render_scale)))
                 self._scaled_fbos.append(self.ctx.simple_framebuffer(size, components=4))
-            self._renderers.append(FrameRenderer(self.ctx, size))
+            renderer = FrameRenderer(self.ctx, size)
+            renderer.set_bloom(self.room_settings["bloom"])
+            renderer.set_room_lighting(self.room_settings["room_light"])
+            renderer.set_sky_model(self.room_settings["room_light"])
+            renderer.room_update_every = self.room_settings["room_update_every"]
+            self._renderers.append(renderer)
 
     def _choose_render_scale(self) -> float:
         """The option's scale, or on a software rasteriser SOFTWARE_RENDER_SCALE, else 1."""
         if self.options.render_scale is not None:
             return float(self.options.render_scale)
         return SOFTWARE_RENDER_SCALE if self._software_gl() else 1.0
+
+    def _choose_room_settings(self) -> dict:
+        """The room lighting's cheaper settings on a software rasteriser (the frame budget:
+        docs/room.md), the full ones on a GPU."""
+        if not self.options.room_light:
+            return {"room_light": False, "bloom": False, "room_update_every": 1}
+        if self._software_gl():
+            return {"room_light": True, "bloom": SOFTWARE_BLOOM,
+                    "room_update_every": SOFTWARE_ROOM_UPDATE_EVERY}
+        return {"room_light": True, "bloom": True, "room_update_every": 1}
 
     def _software_gl(self) -> bool:
         renderer = self.ctx.info.get("GL_RENDERER", "")

@@ -1,0 +1,408 @@
+"""The room lit through the curtain (issue 13, model.md section 9): the static room's geometry
+as a light-map atlas, its precomputed ambient occlusion, the light-space frame of the key
+light's transmittance shadow map and the window's luminaire grid. No GL here: numpy arrays
+and matrices the renderer (:mod:`catalog.render.frame`) uploads.
+
+The room is the box ``scene.ROOM_BOX`` with the window opening ``scene.WINDOW_RECT`` in its
+wall z = WINDOW_Z. Its six inside faces are parametrised as
+``P(s, t) = origin + s * axis_s + t * axis_t`` (s, t in [0, 1]); the light-map atlas holds
+them side by side, FACE_TEXELS x FACE_TEXELS each (face k at columns k R .. (k + 1) R - 1).
+Irradiance (linear sRGB, the renderer's cd m^-2 scale times pi) is stored per texel:
+
+- direct: the curtain (and the sky through the window) as an area light, one patch per
+  texel of the luminaire capture (:data:`LUMINAIRE_TEXELS`), ``E = sum L cos_p cos_r A / r^2``;
+  the key light's beam through the window and the curtain (the transmittance shadow map);
+  lamps placed in the room (isotropic points, ``E = I cos_r / r^2``);
+- bounce: one diffuse bounce, ``E_1(x) = sum_j rho E_j / pi cos_x cos_j A_j / r^2`` over the
+  coarse patches of the direct map (the room is a convex box: every patch sees every other),
+  times the ambient occlusion below.
+
+Ambient occlusion (precomputed once, the room is static): the cosine-weighted fraction of
+the hemisphere over a texel that is free of room geometry within AO_RADIUS_M (obscurance:
+corners and the window reveals darken), by ray casting against the room's boxes in numpy.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from catalog.render import scene as scene_lib
+
+#: Light-map texels per side of each room face.
+FACE_TEXELS = 16
+#: Faces of the room, in atlas order.
+FACE_NAMES = ("floor", "ceiling", "left", "right", "back", "window_wall")
+#: Coarse mip level of the direct light map used as the bounce's sources (16 -> 4 per side).
+BOUNCE_LEVEL = 2
+#: The luminaire capture: patches across and down the window opening, each the mean of
+#: 2^LUMINAIRE_LEVEL x 2^LUMINAIRE_LEVEL samples (the capture's mip level), so that a fold
+#: moving across a patch changes its radiance smoothly (no shimmer in the room's light).
+LUMINAIRE_TEXELS = (12, 9)
+LUMINAIRE_LEVEL = 2
+#: Where the luminaire capture looks from (metres): the middle of the room, eye height.
+LUMINAIRE_EYE = (0.0, 0.2, 2.0)
+#: The transmittance shadow map's side (texels).
+SHADOW_TEXELS = 256
+#: Ambient occlusion: rays per texel and the distance within which geometry occludes.
+AO_RAYS = 96
+AO_RADIUS_M = 0.6
+#: Room lamps: at most this many (uniform arrays in room_lightmap.frag).
+MAX_ROOM_LAMPS = 4
+
+
+@dataclass(frozen=True)
+class Face:
+    name: str
+    origin: np.ndarray
+    axis_s: np.ndarray
+    axis_t: np.ndarray
+    normal: np.ndarray   # into the room
+
+    @property
+    def area_m2(self) -> float:
+        return float(np.linalg.norm(np.cross(self.axis_s, self.axis_t)))
+
+
+@functools.lru_cache(maxsize=1)
+def room_faces() -> tuple[Face, ...]:
+    """The six inside faces of the room box (normals into the room), in FACE_NAMES order."""
+    (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
+    a = np.array
+    dx, dy, dz = x1 - x0, y1 - y0, z1 - z0
+    return (
+        Face("floor", a([x0, y0, z0]), a([dx, 0, 0]), a([0, 0, dz]), a([0.0, 1, 0])),
+        Face("ceiling", a([x0, y1, z0]), a([dx, 0, 0]), a([0, 0, dz]), a([0.0, -1, 0])),
+        Face("left", a([x0, y0, z0]), a([0, 0, dz]), a([0, dy, 0]), a([1.0, 0, 0])),
+        Face("right", a([x1, y0, z0]), a([0, 0, dz]), a([0, dy, 0]), a([-1.0, 0, 0])),
+        Face("back", a([x0, y0, z1]), a([dx, 0, 0]), a([0, dy, 0]), a([0.0, 0, -1])),
+        Face("window_wall", a([x0, y0, z0]), a([dx, 0, 0]), a([0, dy, 0]), a([0.0, 0, 1])),
+    )
+
+
+def face_uniforms() -> dict[str, np.ndarray]:
+    """The face table as the shaders' uniform arrays (float32 (6, 3) each)."""
+    faces = room_faces()
+    return {"u_face_origin": np.array([f.origin for f in faces], dtype="f4"),
+            "u_face_s": np.array([f.axis_s for f in faces], dtype="f4"),
+            "u_face_t": np.array([f.axis_t for f in faces], dtype="f4"),
+            "u_face_normal": np.array([f.normal for f in faces], dtype="f4")}
+
+
+def atlas_size(face_texels: int = FACE_TEXELS) -> tuple[int, int]:
+    return len(FACE_NAMES) * face_texels, face_texels
+
+
+def texel_points(face_texels: int = FACE_TEXELS) -> tuple[np.ndarray, np.ndarray]:
+    """World positions and normals of every atlas texel centre, (R, 6R, 3) each (row = t)."""
+    r = face_texels
+    centres = (np.arange(r) + 0.5) / r
+    s, t = np.meshgrid(centres, centres)  # (R rows = t, R cols = s)
+    positions, normals = [], []
+    for face in room_faces():
+        positions.append(face.origin + s[..., None] * face.axis_s + t[..., None] * face.axis_t)
+        normals.append(np.broadcast_to(face.normal, s.shape + (3,)))
+    return np.concatenate(positions, axis=1), np.concatenate(normals, axis=1)
+
+
+def surface_mask(positions: np.ndarray) -> np.ndarray:
+    """1 where a texel lies on a wall, 0 inside the window opening (no surface there)."""
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    p = positions
+    on_window_wall = np.isclose(p[..., 2], scene_lib.ROOM_BOX[2][0])
+    in_opening = (p[..., 0] > wx0) & (p[..., 0] < wx1) & (p[..., 1] > wy0) & (p[..., 1] < wy1)
+    return np.where(on_window_wall & in_opening, 0.0, 1.0)
+
+
+def _occluder_boxes() -> np.ndarray:
+    """Axis-aligned boxes (B, 2, 3) that occlude inside the room: the window wall's parts
+    around the opening (its reveals) and the rod's bounding box; the room's own faces are
+    handled as the box the rays leave."""
+    (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    t = 0.1
+    rod_y = scene_lib.CURTAIN_TOP_Y + 0.03
+    half = (scene_lib.CURTAIN_WIDTH_M + 0.4) / 2
+    return np.array([
+        [[x0, y0, z0 - t], [wx0, y1, z0]], [[wx1, y0, z0 - t], [x1, y1, z0]],
+        [[wx0, y0, z0 - t], [wx1, wy0, z0]], [[wx0, wy1, z0 - t], [wx1, y1, z0]],
+        [[-half, rod_y - 0.015, scene_lib.CURTAIN_Z - 0.015],
+         [half, rod_y + 0.015, scene_lib.CURTAIN_Z + 0.015]],
+    ])
+
+
+def _cosine_directions(count: int, seed: int = 13) -> np.ndarray:
+    """Cosine-distributed unit directions around +z (stratified, fixed seed: reproducible)."""
+    rng = np.random.default_rng(seed)
+    side = int(math.ceil(math.sqrt(count)))
+    i, j = np.meshgrid(np.arange(side), np.arange(side))
+    u1 = ((i.ravel() + rng.random(side * side)) / side)[:count]
+    u2 = ((j.ravel() + rng.random(side * side)) / side)[:count]
+    r, phi = np.sqrt(u1), 2 * math.pi * u2
+    return np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1 - u1)], axis=-1)
+
+
+def _frame(normal: np.ndarray) -> np.ndarray:
+    """(3, 3) rows (tangent, bitangent, normal) for a unit normal."""
+    helper = np.array([0.0, 1.0, 0.0]) if abs(normal[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    tangent = np.cross(helper, normal)
+    tangent /= np.linalg.norm(tangent)
+    return np.stack([tangent, np.cross(normal, tangent), normal])
+
+
+@functools.lru_cache(maxsize=2)
+def ambient_occlusion(face_texels: int = FACE_TEXELS, rays: int = AO_RAYS,
+                      radius_m: float = AO_RADIUS_M) -> np.ndarray:
+    """Obscurance per atlas texel, (R, 6R) float32 in [0, 1]: the cosine-weighted fraction of
+    rays that travel ``radius_m`` without meeting the room's faces or the occluder boxes."""
+    positions, normals = texel_points(face_texels)
+    (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
+    lo_room, hi_room = np.array([x0, y0, z0]), np.array([x1, y1, z1])
+    boxes = _occluder_boxes()
+    local = _cosine_directions(rays)
+    out = np.empty(positions.shape[:2], dtype=np.float32)
+    for k, face in enumerate(room_faces()):
+        cols = slice(k * face_texels, (k + 1) * face_texels)
+        p = positions[:, cols].reshape(-1, 1, 3) + 1e-4 * face.normal
+        d = (local @ _frame(face.normal))[None, :, :]  # (1, rays, 3)
+        d = np.where(np.abs(d) < 1e-9, 1e-9, d)
+        # leaving the room box: the nearest exit distance
+        exit_t = np.min(np.maximum((lo_room - p) / d, (hi_room - p) / d), axis=-1)
+        hit = np.minimum(exit_t, np.inf)
+        for lo, hi in boxes:
+            t_near = np.max(np.minimum((lo - p) / d, (hi - p) / d), axis=-1)
+            t_far = np.min(np.maximum((lo - p) / d, (hi - p) / d), axis=-1)
+            enters = (t_far >= np.maximum(t_near, 0.0)) & (t_far > 0)
+            hit = np.where(enters, np.minimum(hit, np.maximum(t_near, 0.0)), hit)
+        free = (hit >= radius_m).mean(axis=-1)
+        out[:, cols] = free.reshape(face_texels, face_texels)
+    return out
+
+
+#: The precomputed occlusion (tools/make_room_ao.py writes it; the room is static).
+AO_TABLE_PATH = Path(__file__).resolve().parent / "data" / "room_ao.npz"
+
+
+def ao_table_key(face_texels: int = FACE_TEXELS) -> np.ndarray:
+    """What the stored table was computed for: texels, rays, radius, the room's geometry."""
+    return np.array([face_texels, AO_RAYS, AO_RADIUS_M, *np.ravel(scene_lib.ROOM_BOX),
+                     *scene_lib.WINDOW_RECT, scene_lib.CURTAIN_TOP_Y, scene_lib.CURTAIN_Z,
+                     scene_lib.CURTAIN_WIDTH_M], dtype=np.float64)
+
+
+def write_ao_table(path: Path = AO_TABLE_PATH) -> None:
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+
+    with atomic_path(path, suffix=".npz") as tmp:
+        np.savez_compressed(tmp, key=ao_table_key(), ao=ambient_occlusion())
+
+
+def stored_ambient_occlusion(face_texels: int = FACE_TEXELS) -> np.ndarray:
+    """The stored table when it was made for this room and these settings, else computed
+    (~1 s of numpy; the table spares the first frame that)."""
+    if face_texels == FACE_TEXELS and AO_TABLE_PATH.is_file():
+        with np.load(AO_TABLE_PATH, allow_pickle=False) as data:
+            if np.array_equal(data["key"], ao_table_key(face_texels)):
+                return data["ao"].astype(np.float32)
+    return ambient_occlusion(face_texels)
+
+
+def ao_and_mask_texture(face_texels: int = FACE_TEXELS) -> np.ndarray:
+    """(R, 6R, 4) float32: AO, surface mask, 0, 1 (row 0 = t = 0, as GL stores it)."""
+    positions, _ = texel_points(face_texels)
+    out = np.zeros(positions.shape[:2] + (4,), dtype=np.float32)
+    out[..., 0] = stored_ambient_occlusion(face_texels)
+    out[..., 1] = surface_mask(positions)
+    out[..., 3] = 1.0
+    return out
+
+
+# --------------------------------------------------------------------------- the key's shadow map
+
+def light_view_projection(to_light: np.ndarray, margin_m: float = 0.05) -> np.ndarray:
+    """Orthographic view-projection looking along the key light's travel (-to_light), framing
+    the window opening and the curtain's space in front of it (what can cast a shadow)."""
+    to_light = np.asarray(to_light, dtype=np.float64)
+    to_light = to_light / np.linalg.norm(to_light)
+    forward = -to_light
+    helper = np.array([0.0, 1.0, 0.0]) if abs(forward[1]) < 0.95 else np.array([1.0, 0.0, 0.0])
+    right = np.cross(forward, helper)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    z0 = scene_lib.ROOM_BOX[2][0]
+    half_w = scene_lib.CURTAIN_WIDTH_M / 2 + 0.15
+    corners = np.array([[x, y, z] for x in (min(wx0, -half_w), max(wx1, half_w))
+                        for y in (wy0, max(wy1, scene_lib.CURTAIN_TOP_Y + 0.1))
+                        for z in (z0 - 0.1, scene_lib.CURTAIN_Z + 0.35)])
+    view = np.eye(4)
+    view[0, :3], view[1, :3], view[2, :3] = right, up, -forward
+    local = corners @ view[:3, :3].T
+    lo, hi = local.min(axis=0) - margin_m, local.max(axis=0) + margin_m
+    proj = np.eye(4)
+    proj[0, 0], proj[0, 3] = 2 / (hi[0] - lo[0]), -(hi[0] + lo[0]) / (hi[0] - lo[0])
+    proj[1, 1], proj[1, 3] = 2 / (hi[1] - lo[1]), -(hi[1] + lo[1]) / (hi[1] - lo[1])
+    # view space looks down -z: depth from -hi.z (near) to -lo.z (far)
+    near, far = -hi[2], -lo[2]
+    proj[2, 2], proj[2, 3] = -2 / (far - near), -(far + near) / (far - near)
+    return proj @ view
+
+
+def shadow_texel_m(to_light: np.ndarray) -> float:
+    """World size (m) of one shadow-map texel (the larger of the two axes)."""
+    m = light_view_projection(to_light)
+    return float(2.0 / min(m[0, :3] @ m[0, :3], m[1, :3] @ m[1, :3]) ** 0.5 / SHADOW_TEXELS)
+
+
+# --------------------------------------------------------------------------- the luminaire capture
+
+def luminaire_view_projection(eye=LUMINAIRE_EYE) -> np.ndarray:
+    """Off-axis perspective from ``eye`` whose frustum is exactly the window opening (its
+    near rectangle in the wall plane z = WINDOW_Z): texel (i, j) of the capture is the radiance
+    of the window patch (i, j) towards the room."""
+    eye = np.asarray(eye, dtype=np.float64)
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    z0 = scene_lib.ROOM_BOX[2][0]
+    dist = eye[2] - z0
+    near, far = 0.05, 60.0
+    scale = near / dist
+    left, right = (wx0 - eye[0]) * scale, (wx1 - eye[0]) * scale
+    bottom, top = (wy0 - eye[1]) * scale, (wy1 - eye[1]) * scale
+    proj = np.zeros((4, 4))
+    proj[0, 0] = 2 * near / (right - left)
+    proj[0, 2] = (right + left) / (right - left)
+    proj[1, 1] = 2 * near / (top - bottom)
+    proj[1, 2] = (top + bottom) / (top - bottom)
+    proj[2, 2] = -(far + near) / (far - near)
+    proj[2, 3] = -2 * far * near / (far - near)
+    proj[3, 2] = -1.0
+    view = np.eye(4)
+    view[:3, 3] = -eye  # axes aligned with the world: looking down -z
+    return proj @ view
+
+
+def luminaire_capture_size() -> tuple[int, int]:
+    """The capture's render size: LUMINAIRE_TEXELS supersampled by 2^LUMINAIRE_LEVEL."""
+    return LUMINAIRE_TEXELS[0] << LUMINAIRE_LEVEL, LUMINAIRE_TEXELS[1] << LUMINAIRE_LEVEL
+
+
+def window_patch_area_m2() -> float:
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    return (wx1 - wx0) * (wy1 - wy0) / (LUMINAIRE_TEXELS[0] * LUMINAIRE_TEXELS[1])
+
+
+#: The room's passes (shadow map, capture) draw the curtain from a grid with at most this many
+#: vertices a side: on a CPU rasteriser a draw costs per triangle, and the beam's pattern
+#: needs the folds (5.5 across), not every vertex.
+COARSE_GRID_SIDE = 40
+
+
+def coarse_grid_indices(uvs: np.ndarray, max_side: int = COARSE_GRID_SIDE) -> np.ndarray | None:
+    """Triangles (int32, flat) over every k-th row and column of a row-major grid mesh, or
+    None when the vertices are not such a grid (u running 0..1 along each row, v constant in
+    it) or the grid is small already. The last row and column are always kept."""
+    uvs = np.asarray(uvs, dtype=np.float64).reshape(-1, 2)
+    n = uvs.shape[0]
+    starts = np.flatnonzero(np.abs(uvs[:, 0]) < 1e-9)
+    if starts.size < 2:
+        return None
+    columns = int(starts[1] - starts[0])
+    if columns < 2 or n % columns:
+        return None
+    rows = n // columns
+    grid = uvs.reshape(rows, columns, 2)
+    if not (np.allclose(grid[:, :, 0], np.linspace(0.0, 1.0, columns)[None, :], atol=1e-6)
+            and np.allclose(grid[:, :, 1], grid[:, :1, 1], atol=1e-9)):
+        return None
+    step = int(math.ceil(max(rows, columns) / max_side))
+    if step <= 1:
+        return None
+
+    def keep(count):
+        picks = list(range(0, count, step))
+        return picks if picks[-1] == count - 1 else picks + [count - 1]
+
+    r, c = np.array(keep(rows)), np.array(keep(columns))
+    index = r[:, None] * columns + c[None, :]
+    a, b = index[:-1, :-1].ravel(), index[:-1, 1:].ravel()
+    cc, d = index[1:, :-1].ravel(), index[1:, 1:].ravel()
+    return np.concatenate([np.stack([a, cc, b], 1), np.stack([b, cc, d], 1)]).astype(np.int32).ravel()
+
+
+@dataclass(frozen=True)
+class RoomLamp:
+    """A lamp in the room: a light of the library at ``position_m``, isotropic, its normal
+    irradiance at 1 m equal to the light's spectrum (intensity = E(1 m) x 1 m^2)."""
+
+    light: str
+    position_m: tuple[float, float, float]
+
+
+def check_lamp_position(position_m) -> tuple[float, float, float]:
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+
+    p = tuple(float(v) for v in position_m)
+    (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
+    if len(p) != 3 or not (x0 < p[0] < x1 and y0 < p[1] < y1 and z0 < p[2] < z1):
+        raise CatalogError(f"room lamp position {position_m!r} must lie inside the room "
+                           f"x {x0}..{x1}, y {y0}..{y1}, z {z0}..{z1} m")
+    return p
+
+
+# --------------------------------------------------------------------------- regions of a view
+
+#: Names of the regions :func:`view_regions` returns (the tests and the path-traced
+#: comparison of the same scene use the same masks).
+REGION_NAMES = ("floor_patch", "floor_away", "window_wall_strips")
+
+
+def view_regions(view_projection: np.ndarray, eye, size, to_light) -> dict[str, np.ndarray]:
+    """Boolean (H, W) masks of a view (row 0 = top), found by geometry, not by shading:
+
+    - ``floor_patch``: floor pixels the key's beam reaches through the hanging curtain
+      (margins of 0.08 m inside the opening and 0.1-0.15 m inside the curtain);
+    - ``floor_away``: floor pixels whose beam would cross the wall 0.3 m or more outside
+      the opening;
+    - ``window_wall_strips``: the outer fifths of the frame (the wall beside the window in
+      the default view).
+    """
+    w, h = size
+    inv = np.linalg.inv(np.asarray(view_projection, dtype=np.float64))
+    ys, xs = np.mgrid[0:h, 0:w]
+    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)),
+                    np.ones((h, w))], -1)
+    far = ndc @ inv.T
+    eye = np.asarray(eye, dtype=np.float64)
+    d = far[..., :3] / far[..., 3:] - eye
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    (x0, x1), (y0, _), (z0, z1) = scene_lib.ROOM_BOX
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (y0 - eye[1]) / d[..., 1]
+    p = eye + t[..., None] * d
+    floor = (t > 0) & (p[..., 0] > x0 + 0.2) & (p[..., 0] < x1 - 0.2) & (p[..., 2] > z0 + 0.4) & (p[..., 2] < z1 - 0.2)
+    to_light = np.asarray(to_light, dtype=np.float64)
+
+    def crossing(z):
+        s = (z - p[..., 2]) / to_light[2]
+        return p[..., :2] + s[..., None] * to_light[:2]
+
+    q = crossing(z0)
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    m = 0.08
+    in_window = (q[..., 0] > wx0 + m) & (q[..., 0] < wx1 - m) & (q[..., 1] > wy0 + m) & (q[..., 1] < wy1 - m)
+    qc = crossing(scene_lib.CURTAIN_Z)
+    half = scene_lib.CURTAIN_WIDTH_M / 2
+    through = ((np.abs(qc[..., 0]) < half - 0.1) & (qc[..., 1] < scene_lib.CURTAIN_TOP_Y - 0.1)
+               & (qc[..., 1] > scene_lib.CURTAIN_TOP_Y - scene_lib.CURTAIN_HEIGHT_M + 0.15))
+    away = ((q[..., 0] < wx0 - 0.3) | (q[..., 0] > wx1 + 0.3) | (q[..., 1] < wy0 - 0.3)
+            | (q[..., 1] > wy1 + 0.3))
+    strips = np.zeros((h, w), dtype=bool)
+    strips[:, : w // 5] = True
+    strips[:, w - w // 5:] = True
+    return {"floor_patch": floor & in_window & through, "floor_away": floor & away,
+            "window_wall_strips": strips}
+

@@ -1,0 +1,62 @@
+#version 430
+// The room's light map, one diffuse bounce (issue 13): per atlas texel, the direct light map
+// adds the light that the room's own walls reflect onto it, gathered from its coarse mip
+// level, the key's beam included (patches of face area / RC^2): E_1 = sum_j (rho / pi) E_j m_j cos_r cos_j A_j / max(r^2, A_j),
+// with m_j the patch's wall fraction (0 in the window opening). The room is a convex box, so
+// every patch sees every other; the precomputed ambient occlusion (corners, the window's
+// reveals) scales the bounce.
+#include "common.glsl"
+
+in vec2 v_ndc;
+in vec2 v_uv;
+
+uniform vec3 u_face_origin[6];
+uniform vec3 u_face_s[6];
+uniform vec3 u_face_t[6];
+uniform vec3 u_face_normal[6];
+
+uniform sampler2D u_direct;          // the direct light map (area light, lamps), mipmapped
+uniform sampler2D u_beam;            // the key's beam at the light map's texels, mipmapped
+uniform sampler2D u_ao_mask;         // r: ambient occlusion, g: wall fraction; mipmapped
+uniform int u_bounce_level;          // the mip level gathered
+uniform int u_coarse_texels;         // face texels at that level
+uniform float u_albedo;
+
+layout(location = 0) out vec4 out_irradiance;
+
+void main() {
+    float x = v_uv.x * float(ROOM_FACES);
+    int face = min(int(floor(x)), ROOM_FACES - 1);
+    vec3 p = u_face_origin[face] + fract(x) * u_face_s[face] + v_uv.y * u_face_t[face];
+    vec3 n = u_face_normal[face];
+    ivec2 own = ivec2(v_uv * vec2(textureSize(u_direct, 0)));
+    vec3 direct = texelFetch(u_direct, own, 0).rgb;
+    float ao = texelFetch(u_ao_mask, own, 0).r;
+
+    vec3 bounce = vec3(0.0);
+    float rc = float(u_coarse_texels);
+    for (int f = 0; f < ROOM_FACES; ++f) {
+        if (f == face) {
+            continue;  // a flat face does not light itself
+        }
+        vec3 nf = u_face_normal[f];
+        float area = length(cross(u_face_s[f], u_face_t[f])) / (rc * rc);
+        for (int v = 0; v < u_coarse_texels; ++v) {
+            for (int u = 0; u < u_coarse_texels; ++u) {
+                ivec2 texel = ivec2(f * u_coarse_texels + u, v);
+                vec3 q = u_face_origin[f] + ((float(u) + 0.5) / rc) * u_face_s[f]
+                       + ((float(v) + 0.5) / rc) * u_face_t[f];
+                vec3 d = q - p;
+                float r2 = dot(d, d);
+                float inv_r = inversesqrt(r2);
+                float geometry = max(dot(n, d) * inv_r, 0.0) * max(-dot(nf, d) * inv_r, 0.0)
+                               * area / max(r2, area);
+                float wall = texelFetch(u_ao_mask, texel, u_bounce_level).g;
+                vec3 source = texelFetch(u_direct, texel, u_bounce_level).rgb
+                            + texelFetch(u_beam, texel, u_bounce_level).rgb;
+                bounce += source * (wall * geometry);
+            }
+        }
+    }
+    out_irradiance = vec4(direct + ao * (u_albedo / PI) * bounce, 1.0);
+}

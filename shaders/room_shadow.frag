@@ -1,0 +1,38 @@
+#version 430
+// The transmittance shadow map (issue 13, model.md section 9): each layer of cloth the key
+// light's beam crosses multiplies it by its transmittance (blending dst *= src, cleared to 1;
+// folds and layers multiply). Per layer, with thread coverage c(uv) (mean 1 - LD):
+//   T = (1 - c) + c * u_thread_beam_rgb,
+// the holes pass the beam undimmed, a thread passes the forward-scattered part of the
+// directional lobe (a_spec x forward(g_spec) x the dye's colour under the key light, divided
+// by the mean coverage so that the average over a repeat is the fitted cloth: LD + a_spec fwd).
+#include "common.glsl"
+
+in vec2 v_uv;
+
+uniform float u_mean_coverage;       // 1 - LD
+uniform vec3 u_thread_beam_rgb;      // per thread: a_spec forward(g_spec) dye / (1 - LD)
+
+layout(location = 0) out vec4 out_transmittance;
+
+// THE PATTERN HOOK: thread coverage at cloth coordinate uv (0..1 across the fabric). With
+// PATTERN (the fabric's [pattern] coverage map of issue 12: u_pattern and thread_coverage in
+// common.glsl, uv scaled to pattern repeats by u_uv_to_repeats), the holes are projected and
+// the texture's mip level follows this pass's footprint (motifs larger than a shadow-map texel
+// show, single threads average to the mean). Without it the cloth is uniform: every point has
+// the mean coverage, so the patch is dimmed and tinted, patterned only by folds and layers.
+#ifdef PATTERN
+uniform vec2 u_uv_to_repeats;
+float curtain_coverage(vec2 uv) {
+    return thread_coverage(uv * u_uv_to_repeats);
+}
+#else
+float curtain_coverage(vec2 uv) {
+    return u_mean_coverage;
+}
+#endif
+
+void main() {
+    float c = curtain_coverage(v_uv);
+    out_transmittance = vec4(vec3(1.0 - c) + c * u_thread_beam_rgb, 1.0);
+}

@@ -1,0 +1,359 @@
+"""The room lit through the curtain (issue 13), on read-back pixels.
+
+A view from the back of the room looking down at the floor in front of the window; the key
+light stands at 45 deg elevation so that its beam through the window lands on the visible
+floor. The floor patch "through the curtain" is found by geometry in numpy (camera ray ->
+floor -> along the key direction -> inside the window opening and inside the hanging
+curtain, with margins), independently of the shaders. Bounds are stated with their reason.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from catalog.optics.shading_reference import hg_hemisphere_factors
+from catalog.render import room_light
+from catalog.render import scene as scene_lib
+from catalog.render.bands import spectrum_to_display_rgb
+from catalog.render.frame import FrameRenderer
+
+pytestmark = pytest.mark.gl
+
+SIZE = (160, 90)
+LUMA = np.array([0.2126, 0.7152, 0.0722])
+
+
+def _luma(rgb):
+    return np.asarray(rgb) @ LUMA
+
+
+def _renderer(gl, fabric="lace-fwa", light="sun:60", azimuth_deg=15.0):
+    r = FrameRenderer(gl, SIZE)
+    r.set_fabric(fabric)
+    r.set_light(light)
+    r.set_key_direction(45.0, azimuth_deg)
+    r.set_camera(0.0, 18.0, 4.3)
+    return r
+
+
+def _floor_regions(r):
+    """(patch, away): room_light.view_regions' floor masks for this renderer's view."""
+    regions = room_light.view_regions(r.camera.view_projection(SIZE[0] / SIZE[1]),
+                                      r.camera.position, SIZE, r.shading_inputs().key_to_light)
+    return regions["floor_patch"], regions["floor_away"]
+
+
+def _frame(r, curtain_open):
+    r.set_curtain_open(curtain_open)
+    r.render()
+    return r.read_linear()
+
+
+def _beam_transmittance(inputs):
+    """Independent of the shaders: LD + a_spec forward(g_spec) (model.md eq. 5-7, the
+    directional lobe's forward-scattered part kept in the beam; undyed cloth)."""
+    return inputs.direct + inputs.a_spec * hg_hemisphere_factors(inputs.g_spec)[0]
+
+
+def test_open_window_beam_is_the_key_irradiance(gl):
+    """Curtain open: the patch's excess over the floor away from it is the Lambertian floor
+    under the key light, rho / pi * E * cos(theta) (E the key's illuminance as linear sRGB Y).
+    Bound 5 %: the area light and the bounce differ a little between the two regions."""
+    r = _renderer(gl)
+    patch, away = _floor_regions(r)
+    assert patch.sum() > 200 and away.sum() > 200
+    img = _frame(r, True)
+    inputs = r.shading_inputs()
+    expected = (scene_lib.ROOM_ALBEDO / math.pi * _luma(spectrum_to_display_rgb(inputs.key_irradiance))
+                * inputs.key_to_light[1])
+    excess = _luma(img[patch]).mean() - _luma(img[away]).mean()
+    assert excess == pytest.approx(expected, rel=0.05)
+    r.release()
+
+
+def test_closing_the_lace_dims_the_patch_by_its_transmittance(gl):
+    """Closing lace-fwa leaves the beam's transmittance LD + a_spec fwd(g_spec) (0.65): the
+    patch's closed/open ratio is at least that and at most 0.08 above it (the glowing curtain
+    lights the patch a little more than the open window's sky)."""
+    r = _renderer(gl)
+    patch, _ = _floor_regions(r)
+    open_y = _luma(_frame(r, True)[patch]).mean()
+    closed_y = _luma(_frame(r, False)[patch]).mean()
+    t = _beam_transmittance(r.shading_inputs())
+    assert t <= closed_y / open_y <= t + 0.08
+    r.release()
+
+
+def _patch_ratio_cv(gl, azimuth_deg, patterned):
+    r = _renderer(gl, azimuth_deg=azimuth_deg)
+    r.set_patterned(patterned)
+    patch, _ = _floor_regions(r)
+    ratio = _luma(_frame(r, False)[patch]) / _luma(_frame(r, True)[patch])
+    r.release()
+    return ratio.std() / ratio.mean()
+
+
+def test_folds_pattern_the_patch(gl):
+    """The flat cloth (the fabric's pattern off): with the key 50 deg to the side its beam
+    crosses the deepest folds twice (the fold's slope, up to 55 deg, is steeper than the ray's
+    in the x-z plane): those stripes pass T^2, the rest T, so the closed/open ratio varies
+    across the patch (coefficient of variation above 3 %); with the key 15 deg to the side (one
+    crossing everywhere) it is flat within 1 %."""
+    assert _patch_ratio_cv(gl, 50.0, patterned=False) > 0.03
+    assert _patch_ratio_cv(gl, 15.0, patterned=False) < 0.01
+
+
+def test_the_lace_pattern_patterns_the_patch(gl):
+    """lace-fwa's [pattern] (holes and threads, 10 cm repeat) projected through the shadow map:
+    with the key 15 deg to the side, where the flat cloth leaves the patch flat within 1 %,
+    the patterned lace varies it by more than 3 % (coefficient of variation of closed/open)."""
+    assert _patch_ratio_cv(gl, 15.0, patterned=True) > 0.03
+
+
+def test_safety_yellow_tints_the_patch(gl):
+    """Yellowness (R + G) / 2B of the patch: the yellow dye scatters yellow light into the beam,
+    so closing safety-yellow raises it by more than 30 %; undyed lace-fwa changes it by less
+    than 3 %."""
+    for fabric, tinted in (("safety-yellow", True), ("lace-fwa", False)):
+        r = _renderer(gl, fabric)
+        patch, _ = _floor_regions(r)
+        ratios = []
+        for curtain_open in (True, False):
+            rgb = _frame(r, curtain_open)[patch].mean(axis=0)
+            ratios.append((rgb[0] + rgb[1]) / (2 * rgb[2]))
+        change = ratios[1] / ratios[0]
+        if tinted:
+            assert change > 1.3
+        else:
+            assert abs(change - 1.0) < 0.03
+        r.release()
+
+
+def _wall_strips(img):
+    """The window wall beside the window in the default view: the outer fifths of the frame."""
+    w = img.shape[1]
+    return np.concatenate([img[:, : w // 5].reshape(-1, 3), img[:, -(w // 5):].reshape(-1, 3)])
+
+
+def test_uv_fluorescence_raises_the_rooms_blue(gl):
+    """Under UV-A, lace-fwa's brightener emits blue from the curtain into the room: the wall's
+    blue rises by more than 20 % against the same scene without fluorescence, and more than
+    its red."""
+    r = FrameRenderer(gl, SIZE)
+    r.set_fabric("lace-fwa")
+    r.set_light("UV-A")
+    walls = {}
+    for mode in ("off", "physical"):
+        r.set_fluorescence(mode)
+        r.render()
+        walls[mode] = _wall_strips(r.read_linear()).mean(axis=0)
+    gain = walls["physical"] / np.maximum(walls["off"], 1e-12)
+    assert gain[2] > 1.2
+    assert gain[2] > gain[0]
+    r.release()
+
+
+def test_walls_differ_between_fabrics(gl):
+    """Default view, D65: with the room lit through the curtain, the window wall's mean colour
+    differs between every two of the ten fabrics (by more than 0.3 % in some channel of linear
+    sRGB) and its luminance spans more than 1.2x; the earlier constant room gave all ten the
+    same colour."""
+    from catalog.presets import list_presets
+
+    names = sorted(p.stem for p in list_presets())
+    assert len(names) >= 10
+    r = FrameRenderer(gl, (96, 54))
+    r.set_light("D65")
+    lit, constant = [], []
+    for name in names:
+        r.set_fabric(name)
+        r.set_room_lighting(True)
+        r.render()
+        lit.append(_wall_strips(r.read_linear()).mean(axis=0))
+        r.set_room_lighting(False)
+        r.render()
+        constant.append(_wall_strips(r.read_linear()).mean(axis=0))
+    lit = np.array(lit)
+    for a in range(len(names)):
+        for b in range(a + 1, len(names)):
+            change = np.abs(lit[a] - lit[b]) / np.maximum(lit[a], lit[b])
+            assert change.max() > 0.003, (names[a], names[b], change)
+    luma = _luma(lit)
+    assert luma.max() / luma.min() > 1.2
+    assert np.ptp(np.array(constant), axis=0).max() == 0.0
+    r.release()
+
+
+def test_layers_multiply_in_the_shadow_map(gl):
+    """Two parallel sheets across the window, facing the key: the shadow map passes T^2 where
+    one sheet passes T (half-float storage: 2e-3); the flat cloth, so that T is uniform."""
+    r = _renderer(gl, "lace-fwa")
+    r.set_patterned(False)
+    quads = []
+    for z in (-0.15, 0.05):
+        quads.append([[-1.2, -1.2, z], [1.2, -1.2, z], [1.2, 1.6, z], [-1.2, 1.6, z]])
+    positions = np.array(quads, dtype="f4").reshape(-1, 3)
+    normals = np.tile([0.0, 0.0, 1.0], (8, 1)).astype("f4")
+    tangents = np.tile([1.0, 0.0, 0.0], (8, 1)).astype("f4")
+    uvs = np.tile([[0, 0], [1, 0], [1, 1], [0, 1]], (2, 1)).astype("f4")
+    indices = np.array([0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7], dtype="i4")
+    r.set_mesh(positions, normals, uvs, tangents, indices)
+    r.draw_room_shadow(r.shading_inputs())
+    shadow = r.read_room_shadow()
+    n = shadow.shape[0]
+    centre = shadow[n // 2 - 4: n // 2 + 4, n // 2 - 4: n // 2 + 4].reshape(-1, 3)
+    t = _beam_transmittance(r.shading_inputs())
+    assert np.allclose(centre, t * t, atol=2e-3)
+    r.release()
+
+
+def test_room_lamp_lights_the_floor_by_inverse_square(gl):
+    """A lamp 1.5 m above a floor texel's centre in the middle of the room adds at least
+    I / h^2 there (the light map, read back) and at most 25 % more: its light bounced off the
+    walls, by the integrating-sphere estimate rho 4 pi I / A_room ~ 18 % of I / h^2 here."""
+    r = _renderer(gl)
+    faces = room_light.room_faces()
+    floor = faces[0]
+    k = room_light.FACE_TEXELS
+    i, j = k // 2, k // 2  # a floor texel in the middle of the room
+    centre = floor.origin + (i + 0.5) / k * floor.axis_s + (j + 0.5) / k * floor.axis_t
+    lamp = (float(centre[0]), float(centre[1] + 1.5), float(centre[2]))
+    r.set_curtain_open(False)
+    r.render()
+    before = r.read_room_lightmap()[j, i]
+    r.set_room_lamps([("A", lamp)])
+    r.render()
+    after = r.read_room_lightmap()[j, i]
+    intensity = _luma(spectrum_to_display_rgb(r.room_lamps[0][0].irradiance_w_m2_nm))
+    added = _luma(after) - _luma(before)
+    assert intensity / 1.5 ** 2 <= added <= 1.25 * intensity / 1.5 ** 2
+    r.release()
+
+
+def test_room_lamp_outside_the_room_is_refused(gl):
+    from catalog.core.errors import CatalogError
+
+    r = FrameRenderer(gl, (16, 16))
+    with pytest.raises(CatalogError, match="inside the room"):
+        r.set_room_lamps([("A", (0.0, 5.0, 1.0))])
+    r.release()
+
+
+def test_room_light_is_stable_as_the_cloth_moves(gl):
+    """The drape slid sideways 2 cm at a time (folds 31 cm apart): no texel of the room's light
+    map changes by more than 5 % a step. Each window patch is the mean of 4 x 4 capture samples;
+    a 12 x 9 point capture changes by ~22 % (folds flickering through its samples)."""
+    r = FrameRenderer(gl, (64, 36))
+    r.set_fabric("lace-fwa")
+    r.set_light("sun:60")
+    mesh = scene_lib.draped_curtain()
+    previous, worst = None, 0.0
+    for step in range(5):
+        shift = np.array([0.02 * step, 0.0, 0.0], dtype="f4")
+        r.set_mesh(mesh.positions + shift, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices)
+        r.render()
+        light = _luma(r.read_room_lightmap())
+        if previous is not None:
+            worst = max(worst, float((np.abs(light - previous) / previous).max()))
+        previous = light
+    assert worst < 0.05
+    r.release()
+
+
+@pytest.mark.parametrize("lamp, needle", [("A@0,9,2.5", "inside the room"),
+                                          ("A0,1,2", "LIGHT@X,Y,Z"),
+                                          ("NOPE@0,1,2", "NOPE")])
+def test_cli_refuses_a_bad_lamp_in_one_line(tmp_path, lamp, needle):
+    import subprocess
+    import sys
+
+    out = tmp_path / "x.png"
+    run = subprocess.run([sys.executable, "-m", "catalog", "snapshot", "--fabric", "lace-fwa",
+                          "--size", "32x24", "--lamp", lamp, "--out", str(out)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and run.stdout == ""
+    assert len(run.stderr.strip().splitlines()) == 1 and needle in run.stderr
+    assert not out.exists()
+
+
+def test_stored_ambient_occlusion_is_the_computed_one():
+    """catalog/render/data/room_ao.npz (tools/make_room_ao.py) is what ambient_occlusion computes for
+    this room; corners are occluded (< 0.7) and the middle of the floor is open (1)."""
+    assert room_light.AO_TABLE_PATH.is_file()
+    stored = room_light.stored_ambient_occlusion()
+    computed = room_light.ambient_occlusion()
+    assert np.array_equal(stored, computed)
+    k = room_light.FACE_TEXELS
+    floor = computed[:, :k]
+    assert floor[0, 0] < 0.7 and floor[k // 2, k // 2] == 1.0
+
+
+def test_room_benchmark_quick_runs_and_tabulates(gl):
+    """The benchmark's quick run: every configuration timed, finite ratios, each pass's
+    share summing to 1, and both generated tables."""
+    from catalog.bench import room as bench
+
+    result = bench.run(quick=True, ctx=gl, repeats=1)
+    assert [row["config"] for row in result["rows"]] == [name for name, _ in bench.CONFIGS]
+    for row in result["rows"]:
+        assert np.isfinite(row["frame_ms"]) and row["frame_ms"] > 0
+        assert sum(p["share"] for p in row["passes"].values()) == pytest.approx(1.0)
+    moving = result["rows"][3]["passes"]
+    assert {"room_shadow", "room_luminaire", "room_lightmap"} <= set(moving)
+    tables = bench.markdown_tables(result)
+    assert set(tables) == {"room_frame", "room_passes"} and "room+sky" in tables["room_frame"]
+
+
+def test_coarse_grid_covers_the_same_cloth():
+    """The room passes' coarser grid of the drape: every 3rd row and column (the last kept),
+    about 9x fewer triangles, the same flat area; a mesh that is not a row-major grid gets none."""
+    mesh = scene_lib.draped_curtain(columns=120, rows=80, depth_m=0.0)
+    coarse = room_light.coarse_grid_indices(mesh.uvs)
+    full = mesh.indices.ravel()
+
+    def area(indices):
+        tri = mesh.positions.astype(np.float64)[indices.reshape(-1, 3)]
+        return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+
+    assert 8 < full.size / coarse.size < 10
+    assert area(coarse) == pytest.approx(area(full), rel=1e-9)
+    shuffled = mesh.uvs[::-1].copy()
+    assert room_light.coarse_grid_indices(shuffled) is None
+    small = scene_lib.draped_curtain(columns=30, rows=20)
+    assert room_light.coarse_grid_indices(small.uvs) is None
+
+
+ES_VARIANTS = [
+    ("room.vert", {"ROOM_LIGHTING": True}), ("room.vert", {}),
+    ("room.frag", {"ROOM_LIGHTING": True, "KEY_BEAM": True}),
+    ("room.frag", {"ROOM_LIGHTING": True}), ("room.frag", {}),
+    ("room_shadow.vert", {"HAS_UV": True}), ("room_shadow.frag", {}),
+    ("room_lightmap.frag", {}), ("room_bounce.frag", {}),
+    ("background.frag", {"SKY_MODEL": True}), ("background.frag", {"ENVIRONMENT": True}),
+    ("background.frag", {}),
+    ("bloom_down.frag", {}), ("bloom_glow.frag", {"BLOOM_LEVELS": 6}), ("bloom.frag", {}),
+]
+
+
+@pytest.mark.parametrize("name, defines", ES_VARIANTS)
+def test_room_shaders_compile_as_glsl_es_300(tmp_path, name, defines):
+    """The web page compiles the same sources as GLSL ES 3.00: every room, sky and glare
+    shader variant, with the #version line swapped, passes glslangValidator."""
+    import shutil
+    import subprocess
+
+    from catalog.gl.shaderlib import load_source
+
+    validator = shutil.which("glslangValidator")
+    if validator is None:
+        pytest.fail("glslangValidator missing: tools/setup.sh installs glslang-tools")
+    lines = load_source(name, defines).splitlines()
+    assert lines[0].startswith("#version")
+    path = tmp_path / f"es.{name.rsplit('.', 1)[1]}"
+    path.write_text("\n".join(["#version 300 es", "precision highp float;", "precision highp int;",
+                               *lines[1:]]) + "\n")
+    result = subprocess.run([validator, str(path)], capture_output=True, text=True)
+    assert result.returncode == 0, f"{name} {defines}: {result.stdout}"

@@ -1,0 +1,134 @@
+"""The outside (issue 13): the clear sky by direction against its float64 twin (catalog/optics/sun/sky.py),
+its illuminance against the atmosphere's (catalog.optics.sun.model.clear_sky), no seam at the horizon;
+and the glare (bloom) keeps the frame's energy."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from catalog.optics.sun import sky
+from catalog.optics.shading_reference import spectral_to_linear_srgb
+from catalog.render import scene as scene_lib
+from catalog.render.frame import FrameRenderer
+
+pytestmark = pytest.mark.gl
+
+SIZE = (96, 64)
+
+
+def _rays(r):
+    w, h = r.size
+    inv = np.linalg.inv(r.camera.view_projection(w / h))
+    ys, xs = np.mgrid[0:h, 0:w]
+    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)), np.ones((h, w))], -1)
+    far = ndc @ inv.T
+    d = far[..., :3] / far[..., 3:] - r.camera.position
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def test_sky_illuminance_is_the_atmospheres_diffuse():
+    """The sky's radiance integrated with cos(theta) over the upper hemisphere equals the
+    diffuse horizontal irradiance of catalog.optics.sun.model.clear_sky at the same zenith, per linear
+    sRGB channel, within 0.5 % (the midpoint rule on 96 x 192 cells; the scale is fitted on the
+    same grid, so a finer grid checks the quadrature: 1 %)."""
+    to_sun = scene_lib.key_direction(35.0, 20.0)
+    model = sky.sky_model(to_sun)
+    from catalog.optics.sun.model import clear_sky
+
+    expected = spectral_to_linear_srgb(clear_sky(55.0).diffuse_horizontal)
+    got = sky.horizontal_irradiance_rgb(model.radiance, n_theta=192)
+    assert np.allclose(got, expected, rtol=0.01)
+
+
+def test_sky_is_brighter_towards_the_sun_and_bluer_at_the_zenith():
+    """Preetham's shape: the circumsolar sky is brighter than the sky opposite the sun, and the
+    zenith's blue / red exceeds the horizon's below the sun."""
+    to_sun = scene_lib.key_direction(30.0, 0.0)
+    model = sky.sky_model(to_sun)
+    near = np.array([0.0, math.sin(math.radians(40)), -math.cos(math.radians(40))])
+    opposite = np.array([0.0, math.sin(math.radians(40)), math.cos(math.radians(40))])
+    lum = np.array([0.2126, 0.7152, 0.0722])
+    assert model.radiance(near[None])[0] @ lum > 2.0 * (model.radiance(opposite[None])[0] @ lum)
+    zenith = model.radiance(np.array([[0.0, 1.0, 0.0]]))[0]
+    horizon = model.radiance(np.array([[0.0, 0.02, -1.0]]) / np.linalg.norm([0.0, 0.02, -1.0]))[0]
+    assert zenith[2] / zenith[0] > horizon[2] / horizon[0]
+
+
+def test_no_seam_at_the_horizon():
+    """Just above and just below the horizon (0.1 deg apart) the radiance differs by less
+    than 2 %; the old flat model jumped from sky to ground there."""
+    model = sky.sky_model(scene_lib.key_direction(25.0))
+    for azimuth in (-60.0, 0.0, 45.0):
+        a = math.radians(azimuth)
+        up = np.array([math.sin(a), math.sin(math.radians(0.05)), -math.cos(a)])
+        down = np.array([math.sin(a), -math.sin(math.radians(0.05)), -math.cos(a)])
+        hi, lo = model.radiance(up[None])[0], model.radiance(down[None])[0]
+        assert np.all(np.abs(hi - lo) <= 0.02 * np.abs(hi))
+
+
+def test_background_pixels_match_the_sky_model(gl):
+    """Curtain open, looking out of the window under the sun: every pixel whose ray leaves
+    through the opening (10 cm inside its edge, off the sun's disc) equals the float64 sky
+    within 0.3 % (float32 exp and acos)."""
+    r = FrameRenderer(gl, SIZE)
+    r.set_fabric("lace-fwa")
+    r.set_light("sun:60")
+    r.set_curtain_open(True)
+    r.set_bloom(False)
+    r.set_camera(0.0, 5.0, 1.0)
+    r.render()
+    img = r.read_linear()
+    d = _rays(r)
+    eye = r.camera.position
+    z0 = scene_lib.ROOM_BOX[2][0]
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    ok = np.ones(d.shape[:2], dtype=bool)
+    for z in (z0, z0 - 0.1):
+        s = (z - eye[2]) / d[..., 2]
+        q = eye[:2] + s[..., None] * d[..., :2]
+        ok &= (q[..., 0] > wx0 + 0.1) & (q[..., 0] < wx1 - 0.1) & (q[..., 1] > wy0 + 0.1) & (q[..., 1] < wy1 - 0.1)
+    to_sun = r.shading_inputs().key_to_light
+    ok &= np.linalg.norm(d - to_sun, axis=-1) > 0.05
+    assert ok.sum() > 0.3 * ok.size
+    model = r.sky_model_for(r.shading_inputs())
+    expected = model.radiance(d[ok])
+    assert np.allclose(img[ok], expected, rtol=3e-3, atol=1e-3 * np.abs(expected).max())
+    r.release()
+
+
+def test_bloom_keeps_the_frames_energy_and_glows_around_the_sun(gl):
+    """The bloomed frame's total radiance equals the unbloomed frame's within 1 % (box blurs
+    keep the integral; the edges lose a little), and pixels a few degrees from the sun's disc
+    brighten by more than 5 %."""
+    r = FrameRenderer(gl, (256, 192))   # 0.26 deg a pixel: the sun's disc (0.53 deg) is drawn
+    r.set_fabric("lace-fwa")
+    r.set_light("sun:60")
+    r.set_curtain_open(True)
+    r.set_camera(0.0, -10.0, 1.0)   # looking up at the sun through the window
+    r.set_bloom(True)
+    r.render()
+    sharp = r.read_linear()
+    w, h = r.size
+    data = r._bloom_gl["out_fbo"].read(viewport=(0, 0, w, h), components=4, dtype="f4")
+    bloomed = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1, :, :3]
+    assert bloomed.sum() == pytest.approx(sharp.sum(), rel=0.01)
+    d = _rays(r)
+    angle = np.degrees(np.arccos(np.clip(d @ r.shading_inputs().key_to_light, -1, 1)))
+    ring = (angle > 2.0) & (angle < 6.0)
+    assert ring.sum() > 10
+    assert bloomed[ring].sum() > 1.05 * sharp[ring].sum()
+    r.release()
+
+
+def test_a_dated_sun_stands_where_it_stands_then():
+    """sun@WHEN,LAT,LON: the key light (and so the sky behind the window) at the elevation
+    catalog.optics.sun.model.sun_position gives for that time and place (it stood at a lamp's 25 deg)."""
+    from catalog.optics.sun.model import sun_position
+
+    name = "sun@2026-12-21T12:00,34.7,135.5"
+    expected = 90.0 - sun_position("2026-12-21T12:00", 34.7, 135.5).zenith_deg
+    assert scene_lib.key_elevation_for(name) == pytest.approx(expected, abs=1e-9)
+    assert abs(expected - scene_lib.LAMP_ELEVATION_DEG) > 5.0
