@@ -499,7 +499,9 @@ def test_a_failed_frame_fails_a_frames_run(xdisplay, tmp_path):
                       xdisplay, tmp_path, timeout=120)
     assert result.returncode == 2, result.stderr
     assert "no-such-dye.csv" in result.stderr
-    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+    # one error line (the viewer's start-up note on llvmpipe's cheaper settings may precede it)
+    errors = [ln for ln in result.stderr.strip().splitlines() if "error:" in ln]
+    assert len(errors) == 1 and "Traceback" not in result.stderr, result.stderr
     assert not (tmp_path / "x.png").exists()
 
 

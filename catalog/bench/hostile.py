@@ -31,6 +31,10 @@ from pathlib import Path
 from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
 
 GOOD_SPECTRA = FABRIC_DIR / "measurements" / "lace-fwa"
+#: A file outside any fabric folder that a hostile preset may name (absolute), and a climb
+#: out of the preset's folder to the root (joined with it, the same file relatively).
+OUTSIDE = str(Path(os.__file__).resolve())
+_CLIMB = "/".join([".."] * 12)
 GOOD_PRESET = """schema = 1
 name = "{name}"
 display_name = "test"
@@ -121,10 +125,11 @@ def _preset_cases() -> list[Case]:
         "not TOML": good[:40] + "\n[[[",
         "quantum yield 5": good + '[fluorescence]\nxyz = [1.0, 1.0, 1.0]\nrgb = [1.0, 1.0, 1.0]\n'
                            'excitation = "e.csv"\nemission = "e.csv"\nquantum_yield = 5.0\n',
+        # OUTSIDE: a file of the machine's, named by an absolute path and by climbing up
         "spectrum outside its folder": good + '[fluorescence]\nxyz = [1.0, 1.0, 1.0]\n'
-                                       'rgb = [1.0, 1.0, 1.0]\nexcitation = "../../../etc/passwd"\n'
-                                       'emission = "../../../etc/passwd"\n',
-        "dye outside its folder": good + '[dye]\ntransmittance = "/etc/hostname"\n',
+                                       f'rgb = [1.0, 1.0, 1.0]\nexcitation = "{OUTSIDE}"\n'
+                                       f'emission = "{OUTSIDE}"\n',
+        "dye outside its folder": good + f'[dye]\ntransmittance = "{_CLIMB}{OUTSIDE}"\n',
         "fit NaN": good + "[fit]\nrmse = nan\n",
     }
     return [Case("preset TOML", label, ("snapshot", "--fabric", "{bad}", "--size", "8x8",

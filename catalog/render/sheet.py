@@ -102,7 +102,7 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
                  bands, progress, ctx, ev, white_balance, labels) -> dict:
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
-    from catalog.render.snapshot import write_image  # noqa: PLC0415
+    from catalog.render.imagefile import write_image  # noqa: PLC0415
 
     ctx = ctx or create_headless_context()
     renderer = FrameRenderer(ctx, size)
