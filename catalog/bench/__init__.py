@@ -10,6 +10,8 @@ optionally, ``plot(result, folder) -> list[Path]``:
 - ``fluorescence``: representations of fluorescence in an RGB engine on the measured
   Donaldson matrices (:mod:`catalog.bench.fluorescence_rgb`, with the reduced
   re-radiation matrices of :mod:`catalog.bench.reduction`);
+- ``uv``: fluorescence under UV and violet light: the matrices' noise floor and the
+  banded model chosen on selection lights (:mod:`catalog.bench.uv_fluorescence`);
 - ``fit``: Levenberg-Marquardt on 79 and 4800 gonio points against differential
   evolution (:mod:`catalog.bench.fit`);
 - ``cloth``: substeps and backends against a small-step reference run
@@ -38,6 +40,7 @@ register_folder(SHADER_DIR)
 SECTIONS: dict[str, str] = {
     "colour": "catalog.bench.colour",
     "fluorescence": "catalog.bench.fluorescence_rgb",
+    "uv": "catalog.bench.uv_fluorescence",
     "fit": "catalog.bench.fit",
     "cloth": "catalog.bench.cloth",
     "stability": "catalog.bench.stability",

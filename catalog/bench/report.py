@@ -146,6 +146,12 @@ def viewer_line(heavy: dict | None) -> str:
             f"{loaded}.")
 
 
+def uv_md(section: dict) -> str:
+    from catalog.bench.uv_fluorescence import markdown_tables  # noqa: PLC0415
+
+    return "\n\n".join(markdown_tables(section).values())
+
+
 def display_md(result: dict) -> str:
     from catalog.bench.display import markdown_tables  # noqa: PLC0415
 
@@ -154,6 +160,7 @@ def display_md(result: dict) -> str:
 
 SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "fluorescence": ("Fluorescence in an RGB engine (measured Donaldson matrices)", fluorescence_md),
+              "uv": ("Fluorescence under UV and violet light: noise floor and banded model", uv_md),
               "fit": ("Eq. 7 fit: accuracy against time", fit_md),
               "cloth": ("Cloth: substeps and backend against a small-step reference", cloth_md),
               "stability": ("Numerical stability at the parameters' edges", stability_md),

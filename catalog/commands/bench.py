@@ -27,7 +27,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
                         help=f"folder for bench.md, bench.json and the plots (default {DEFAULT_OUT})")
     parser.add_argument("--sections", metavar="NAME,NAME",
-                        help="run only these sections (default: all): colour, fluorescence, "
+                        help="run only these sections (default: all): colour, fluorescence, uv, "
                              "fit, cloth, stability, startup, display")
 
 

@@ -24,17 +24,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="a BFC-450 matrix file, or the name of one in the validation data (CIBA12)")
     parser.add_argument("--lights", metavar="NAME,NAME..",
                         help="lights of the Delta E table (default: D65,A,FL2,FL11,LED-B4,UV-A,"
-                             "sun:22,sun:500)")
+                             "sun:22,sun:500); any library name or planck:K. With --json, "
+                             "'lights' gives per light the exact XYZ, the XYZ of the banded "
+                             "model the renderer carries, and their Delta E 2000")
     parser.add_argument("--export", metavar="DIR",
                         help="write excitation.csv, emission.csv, reflectance.csv into DIR")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead")
 
 
 def run(args: argparse.Namespace) -> int:
-    from catalog.optics.bispectral import matrix as bispectral
-    from catalog.optics.bispectral import study
+    from catalog.optics.bispectral import bands as bispectral_bands, matrix as bispectral, study
     from catalog.core.errors import InputError
-    from catalog.optics.lights import get_light
 
     path = bispectral.find_bfc(args.file)
     matrix = bispectral.read_bfc(path)
@@ -44,13 +44,15 @@ def run(args: argparse.Namespace) -> int:
         if not lights:
             raise InputError("no light named", field="--lights")
         for name in lights:
-            get_light(name)  # refuses an unknown name, listing close ones
+            bispectral.training_light(name)  # refuses an unknown name or temperature now
     fit = bispectral.fit_separable(matrix)
     models = study.prepare(matrix, fit)
     # eq. 8's one-k scale is set on the eight reference matrices plus this one
     reference = [m for m in study.reference_models() if m.matrix.name != matrix.name]
     models = study.with_global_paper_scale(reference + [models])[-1]
     rows = study.study_material(models, lights)
+    banded = bispectral_bands.fit_banded(matrix, base=fit)
+    per_light = banded_colours(matrix, banded, lights)
     exported = {}
     if args.export:
         from pathlib import Path  # noqa: PLC0415
@@ -75,6 +77,10 @@ def run(args: argparse.Namespace) -> int:
                     "paper_scale": models.paper_scale,
                     "paper_scale_global": models.paper_scale_global,
                     "delta_e_2000": rows, "methods": list(study.METHODS),
+                    "lights": per_light, "model": {
+                        "name": bispectral_bands.CHOSEN,
+                        "excitation_band_edges_nm": list(banded.edges_nm),
+                        "white": WHITE_POINT},
                     "diagnostics": list(study.DIAGNOSTICS), "exported": exported})
         return 0
 
@@ -94,6 +100,38 @@ def run(args: argparse.Namespace) -> int:
     print("  " + f"{'light':<9}" + "".join(f"{c[:14]:>15}" for c in columns))
     for row in rows:
         print("  " + f"{row['light']:<9}" + "".join(f"{row[c]:>15.2f}" for c in columns))
+    print(f"\n  banded model ({bispectral_bands.CHOSEN}, what the renderer carries) "
+          "against the exact matrix result")
+    for name, entry in per_light.items():
+        print(f"  {name:<18} Delta E 2000 {entry['delta_e_2000']:6.2f}")
     for name, file in exported.items():
         print(f"  wrote {name}: {file}")
     return 0
+
+
+#: The white of every Delta E 2000 here (catalog.optics.bispectral.study.white_xyz).
+WHITE_POINT = ("the light's own XYZ (a perfect white diffuser under it); when the sample is "
+               "brighter than that, the D65 chromaticity at the sample's Y; XYZ absolute "
+               "(683 lm/W x CIE 1931 2 deg at 1 nm: Y in lm m^-2)")
+
+
+def banded_colours(matrix, banded, lights) -> dict:
+    """Per light: exact XYZ (the whole matrix), the banded model's XYZ as the renderer
+    pre-integrates it (one effective fluorophore per light), Delta E 2000 between them."""
+    from catalog.optics.bispectral import study as study  # noqa: PLC0415
+    from catalog.optics.bispectral.matrix import exact_exitance_on_grid, training_light  # noqa: PLC0415
+    from catalog.optics.colorimetry import delta_e_2000  # noqa: PLC0415
+    from catalog.optics.fluorescence import emitted_exitance_w_m2_nm  # noqa: PLC0415
+
+    out = {}
+    for name in lights:
+        light = training_light(name)
+        exact = study._xyz(exact_exitance_on_grid(matrix, light))
+        effective = banded.effective_material(light)
+        emitted = emitted_exitance_w_m2_nm(effective, light) if effective is not None else 0.0
+        model = study._xyz(banded.reflectance_on_grid() * light + emitted)
+        white = study.white_xyz(light, exact)
+        out[name] = {"xyz_exact": exact.tolist(), "xyz_model": model.tolist(),
+                     "delta_e_2000": float(delta_e_2000(model, exact, white)),
+                     "white_xyz": white.tolist()}
+    return out

@@ -48,7 +48,8 @@ def _render_scale(text: str) -> float | None:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fabric", help="fabric to show first (preset name or .toml)")
     parser.add_argument("--light", help="light to start with: 'sun' (hour slider), a CIE "
-                        "illuminant (D65, A, FL2, LED-B4, ...), UV-A, LED-warm, sun:PATH_KM")
+                        "illuminant (D65, A, FL2, LED-B4, ...), UV-A, UV-385, LED-405, "
+                        "LED-violet-white, LED-warm, sun:PATH_KM")
     parser.add_argument("--compare", metavar="NAME",
                         help="split screen: this fabric on the right, same light")
     parser.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",

@@ -161,6 +161,44 @@ def emitted_exitance_w_m2_nm(material: FluorescentMaterial,
     return emitted * material.emission_pdf_per_nm * photon_energy_j(GRID_NM)
 
 
+def combine_under_light(materials, irradiance_w_m2_nm: np.ndarray):
+    """ONE fluorophore that emits under this light what ``materials`` (the excitation bands
+    of one surface, docs/bispectral.md) emit together: the per-(material, light)
+    pre-integration the renderer does once per light, so a banded material costs the
+    shader nothing more than a single one.
+
+    absorptance: the bands' sum (where that exceeds 1, overlapping bands: the photon yield
+    spectrum sum phi_k a_k, scaled to a peak of at most 1); emission pdf: the bands' pdfs
+    weighted by the photons each emits, phi_k N_abs,k; quantum yield: emitted over absorbed
+    photons of that absorptance (<= 1). Without saturation the emitted exitance equals the
+    sum of the bands' exactly for this light and any light proportional to it (unless the
+    bands emit more photons than arrive, which no physical fit does). Saturation: the first
+    material's. Returns None when the light excites none of them.
+    """
+    materials = tuple(materials)
+    if len(materials) == 1:
+        return materials[0]
+    emitted = np.array([m.quantum_yield * absorbed_photon_irradiance(m, irradiance_w_m2_nm)
+                        for m in materials])
+    total = float(np.sum(emitted))
+    if not total > 0:
+        return None
+    pdf = sum(e * m.emission_pdf_per_nm for e, m in zip(emitted, materials)) / total
+    pdf = pdf / (float(np.sum(pdf)) * GRID_STEP_NM)
+    absorptance = sum(m.absorptance for m in materials)
+    if float(np.max(absorptance)) > 1.0:
+        # overlapping bands absorb "more than everything": carry the photon yield spectrum
+        # sum phi_k a_k instead (emitted photons per incident photon), quantum yield 1
+        absorptance = sum(m.quantum_yield * m.absorptance for m in materials)
+        absorptance = absorptance / max(1.0, float(np.max(absorptance)))
+    probe = FluorescentMaterial(absorptance=absorptance, emission_pdf_per_nm=pdf,
+                                quantum_yield=1.0)
+    absorbed = absorbed_photon_irradiance(probe, irradiance_w_m2_nm)
+    return FluorescentMaterial(absorptance=absorptance, emission_pdf_per_nm=pdf,
+                               quantum_yield=min(1.0, total / absorbed),
+                               saturation_photon_irradiance=materials[0].saturation_photon_irradiance)
+
+
 def light_xyz(irradiance_w_m2_nm: np.ndarray) -> np.ndarray:
     """Absolute XYZ of an irradiance on GRID_NM: Y is the illuminance in lux."""
     irradiance = _irradiance_on_grid(irradiance_w_m2_nm)

@@ -8,6 +8,11 @@ Names (:func:`light_names` lists the library for menus):
   interpolation of illuminant tables) and set them to zero where colour has no data (the FL,
   HP and LED tables start at 380 nm, B at 320, E at 360: no UV from those);
 - ``UV-A``: a 365 nm blacklight (see :func:`uva_lamp_relative`);
+- ``UV-385``: a 385 nm UV LED lamp, ``LED-405``: a 405 nm violet LED (one Gaussian band each,
+  see :data:`NARROW_LAMPS`);
+- ``LED-violet-white``: a violet-pumped "full spectrum" white LED (a 405 nm pump and three
+  phosphors; the shape is shipped as data, ``catalog/optics/data/led_violet_white.csv``, made by
+  ``tools/make_violet_led.py``, whose header names its source);
 - ``LED-warm``: a warm-white phosphor LED with no UV (see :func:`warm_led_relative`);
 - the sun (:mod:`catalog.optics.sun.model`): ``sun:PATH_KM`` is the paper's direct beam after Rayleigh
   scattering along PATH_KM of a uniform 22 km layer (Fig. 10), absolute;
@@ -17,8 +22,8 @@ Names (:func:`light_names` lists the library for menus):
 
 Absolute levels (physical-mode fluorescence scales with irradiance): daylight illuminants
 (D*, ID*, B, C and the ISO 7589 daylights) are scaled to 10 000 lx; every other table
-(A, E, FL*, HP*, LED-*, the ISO 7589 lamps) and LED-warm to 1 000 lx; UV-A to 10 W m^-2 in
-all; the sun is absolute. ``get_light(name, illuminance_lx=...)`` rescales to any level.
+(A, E, FL*, HP*, LED-*, the ISO 7589 lamps), LED-warm and LED-violet-white to 1 000 lx;
+UV-A, UV-385 and LED-405 to 10 W m^-2 in all; the sun is absolute. ``get_light(name, illuminance_lx=...)`` rescales to any level.
 """
 
 from __future__ import annotations
@@ -219,6 +224,47 @@ def _warm_led_light() -> Light:
     return _make("LED-warm", description, relative * (LAMP_LX / illuminance_lx(relative)))
 
 
+#: Narrow-band lamps: name -> (centre nm, FWHM nm, description). One Gaussian band each,
+#: 10 W m^-2 in all like UV-A. 385 nm UV LEDs have about 10 nm FWHM, 405 nm violet LEDs
+#: (the InGaN pumps of violet-pumped white LEDs and of "UV" torches) about 15 nm.
+NARROW_LAMPS = {
+    "UV-385": (385.0, 10.0, "385 nm UV LED lamp (Gaussian, 10 nm FWHM)"),
+    "LED-405": (405.0, 15.0, "405 nm violet LED (Gaussian, 15 nm FWHM)"),
+}
+#: The violet-pumped white LED's spectrum, shipped with the package (relative, 1 nm).
+VIOLET_WHITE_FILE = "led_violet_white.csv"
+
+
+def _narrow_lamp(name: str) -> Light:
+    centre, fwhm, what = NARROW_LAMPS[name]
+    relative = _gaussian(centre, fwhm)
+    relative = relative / (np.sum(relative) * _STEP_NM)
+    return _make(name, f"{what}; {UVA_TOTAL_W_M2:g} W/m2 in all", relative * UVA_TOTAL_W_M2)
+
+
+def violet_white_relative() -> tuple[np.ndarray, str]:
+    """LED-violet-white's relative spectrum on GRID_NM and its source line (from the CSV)."""
+    from importlib import resources  # noqa: PLC0415
+
+    from catalog.optics.spectra import read_spectrum  # noqa: PLC0415
+
+    ref = resources.files("catalog.optics") / "data" / VIOLET_WHITE_FILE
+    with resources.as_file(ref) as path:
+        spectrum = read_spectrum(path)
+        source = next((ln[1:].strip() for ln in path.read_text().splitlines()
+                       if ln.startswith("# source:")), "")
+    return spectrum.resample(GRID_NM), source
+
+
+def _violet_white_light() -> Light:
+    relative, source = violet_white_relative()
+    description = ("violet-pumped white LED ('full spectrum'): 405 nm pump + blue, green and "
+                   f"red phosphors, 4000 K; {source or 'see ' + VIOLET_WHITE_FILE}; scaled to "
+                   f"{LAMP_LX:,.0f} lx")
+    return _make("LED-violet-white", description,
+                 relative * (LAMP_LX / illuminance_lx(relative)))
+
+
 # --------------------------------------------------------------------------------------
 # The sun
 
@@ -299,11 +345,11 @@ def _sun_at_light(name: str, spec: str) -> Light:
 
 @functools.lru_cache(maxsize=1)
 def _own_names() -> tuple[str, ...]:
-    return ("UV-A", "LED-warm")
+    return ("UV-A", "UV-385", "LED-405", "LED-warm", "LED-violet-white")
 
 
 def light_names() -> list[str]:
-    """Every light of the library, for menus: CIE tables, UV-A, LED-warm, sun samples."""
+    """Every light of the library, for menus: CIE tables, our lamps, sun samples."""
     return [*cie_names(), *_own_names(), *SUN_MENU]
 
 
@@ -313,6 +359,10 @@ def _base_light(name: str) -> Light:
         return _uva_light()
     if name == "LED-warm":
         return _warm_led_light()
+    if name in NARROW_LAMPS:
+        return _narrow_lamp(name)
+    if name == "LED-violet-white":
+        return _violet_white_light()
     if name.startswith("sun:"):
         return _sun_direct_light(name, _parse_path(name, name[len("sun:"):]))
     if name.startswith("sun-clear:"):

@@ -330,8 +330,15 @@ def _material_cached(excitation_path: str, emission_path: str, peak_absorptance:
                                  saturation_photon_irradiance=saturation)
 
 
-def fluorescent_material(preset):
-    """The physical-mode material of a preset with a ``[fluorescence]`` table (else None)."""
+def fluorescent_material(preset, irradiance: np.ndarray | None = None):
+    """The physical-mode material of a preset with a ``[fluorescence]`` table (else None).
+
+    A preset whose ``[fluorescence]`` has ``bands`` (extra excitation bands, each with its
+    own excitation, emission, quantum_yield and peak_absorptance; docs/bispectral.md) is
+    collapsed under ``irradiance`` into one fluorophore
+    (:func:`catalog.optics.fluorescence.combine_under_light`): pre-integrated per (material,
+    light), so the shader's work is the same. Without ``irradiance`` the main band is
+    returned (and every band's files are checked)."""
     from catalog.optics import fluorescence as fl  # noqa: PLC0415
 
     if preset.fluorescence is None:
@@ -340,11 +347,42 @@ def fluorescent_material(preset):
     for path in (preset.fluorescence.excitation, preset.fluorescence.emission):
         if not path.is_file():
             raise InputError("fluorescence spectrum file not found", path=path)
-    return _material_cached(str(preset.fluorescence.excitation), str(preset.fluorescence.emission),
+    saturation = float(extra.get("saturation_photon_irradiance",
+                                 fl.DEFAULT_SATURATION_PHOTON_IRRADIANCE))
+    main = _material_cached(str(preset.fluorescence.excitation), str(preset.fluorescence.emission),
                             float(extra.get("peak_absorptance", fl.DEFAULT_PEAK_ABSORPTANCE)),
                             float(extra.get("quantum_yield", fl.DEFAULT_QUANTUM_YIELD)),
-                            float(extra.get("saturation_photon_irradiance",
-                                            fl.DEFAULT_SATURATION_PHOTON_IRRADIANCE)))
+                            saturation)
+    bands = extra.get("bands") or []
+    if not bands:
+        return main
+    base = preset.path.parent if preset.path is not None else preset.fluorescence.excitation.parent
+    materials = [main]
+    for i, band in enumerate(bands):
+        where = f"fluorescence.bands[{i}]"
+        if not isinstance(band, dict):
+            raise InputError("must be a table", path=preset.path, field=where)
+        paths = []
+        for key in ("excitation", "emission"):
+            rel = band.get(key)
+            if not isinstance(rel, str) or not rel:
+                raise InputError("must be a path string", path=preset.path, field=f"{where}.{key}")
+            path = (base / rel).resolve()
+            if not path.is_file():
+                raise InputError("fluorescence spectrum file not found", path=path,
+                                 field=f"{where}.{key}")
+            paths.append(str(path))
+        numbers = []
+        for key in ("peak_absorptance", "quantum_yield"):
+            value = band.get(key)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value <= 1:
+                raise InputError(f"must be a number in (0, 1], not {value!r}", path=preset.path,
+                                 field=f"{where}.{key}")
+            numbers.append(float(value))
+        materials.append(_material_cached(*paths, *numbers, saturation))
+    if irradiance is None:
+        return main
+    return fl.combine_under_light(materials, np.asarray(irradiance, dtype=np.float64))
 
 
 def paper_emission_shape(preset) -> np.ndarray:
@@ -382,7 +420,7 @@ def decide_fluorescence(preset, irradiance: np.ndarray, requested: str) -> Fluor
 
     if requested not in FLUORESCENCE_MODES:
         raise CatalogError(f"fluorescence mode {requested!r}: choose off, paper or physical")
-    material = fluorescent_material(preset)
+    material = fluorescent_material(preset, irradiance)
     if requested == "off" or material is None:
         return FluorescenceDecision(requested, "off", None, None)
     delta_e = fluorescence_delta_e(material, irradiance)
@@ -475,7 +513,7 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         absorbed_photons=absorbed, saturation_photons=saturation,
         emission_per_photon=emission_per_photon)
     if decision.used == "physical":
-        inputs = with_physical_emission(inputs, fluorescent_material(preset))
+        inputs = with_physical_emission(inputs, fluorescent_material(preset, key))
     return inputs, decision
 
 

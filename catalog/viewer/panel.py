@@ -18,7 +18,7 @@ from imgui_bundle import imgui
 from catalog.viewer.catalog_state import KINDS, FabricCatalog
 from catalog.viewer.input import KEY_HELP
 from catalog.viewer.settings import (BAND_COUNTS, EV_SLIDER_RANGE, FLUORESCENCE_MODES,
-                                     LED_LIGHTS, SUN, SUN_HOUR_RANGE, UVA_LIGHT,
+                                     LED_LIGHTS, SUN, SUN_HOUR_RANGE, UV_LIGHTS, UVA_LIGHT,
                                      WHITE_BALANCES, WIND_RANGE_M_S, ViewerSettings)
 from catalog.viewer.timing import FrameTimer
 
@@ -173,7 +173,7 @@ class Panel:
         if imgui.radio_button("LED", kind == "led"):
             settings.light = LED_LIGHTS[0]
         imgui.same_line()
-        if imgui.radio_button("UV-A lamp", kind == "uva"):
+        if imgui.radio_button("UV lamp", kind == "uva"):
             settings.light = UVA_LIGHT
 
         kind = self._light_kind(settings.light, info)
@@ -198,6 +198,11 @@ class Panel:
             changed, current = imgui.combo("LED", current, list(LED_LIGHTS))
             if changed:
                 settings.light = LED_LIGHTS[current]
+        elif kind == "uva":
+            current = UV_LIGHTS.index(settings.light) if settings.light in UV_LIGHTS else 0
+            changed, current = imgui.combo("UV", current, list(UV_LIGHTS))
+            if changed:
+                settings.light = UV_LIGHTS[current]
         elif kind == "other":
             imgui.text(f"light {settings.light}")
 
@@ -205,7 +210,7 @@ class Panel:
     def _light_kind(light: str, info: PanelInfo) -> str:
         if light == SUN or light.startswith("sun"):
             return "sun"
-        if light == UVA_LIGHT:
+        if light in UV_LIGHTS:
             return "uva"
         if light in LED_LIGHTS:
             return "led"

@@ -15,12 +15,16 @@ from catalog.core.constants import FLUORESCENCE_MODES
 #: Band counts the renderer compiles (3 = RGB).
 BAND_COUNTS = (3, 6, 9, 16)
 #: The lights the L key steps through: the sun (hour slider), CIE daylight and tungsten,
-#: two fluorescent tubes, two LEDs and the UV-A lamp. The panel offers every CIE table too.
+#: two fluorescent tubes, the LEDs (a violet-pumped white and a 405 nm violet one among
+#: them) and the UV lamps. The panel offers every CIE table too.
 SUN = "sun"
-LIGHT_CYCLE = (SUN, "D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "UV-A")
+LIGHT_CYCLE = (SUN, "D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "LED-violet-white",
+               "LED-405", "UV-385", "UV-A")
 #: The LED lights of the panel's LED group.
-LED_LIGHTS = ("LED-B4", "LED-warm")
+LED_LIGHTS = ("LED-B4", "LED-warm", "LED-violet-white", "LED-405")
 UVA_LIGHT = "UV-A"
+#: The UV lamps of the panel's UV group (365 nm blacklight first).
+UV_LIGHTS = (UVA_LIGHT, "UV-385")
 
 #: Hour-of-day slider range (local solar time, h) and its default: noon, the paper's scene.
 SUN_HOUR_RANGE = (6.0, 18.0)

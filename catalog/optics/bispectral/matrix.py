@@ -556,11 +556,23 @@ def _assemble(matrix: DonaldsonMatrix, u: np.ndarray, v: np.ndarray,
 # --------------------------------------------------------------- colour refinement
 
 def training_light(name: str) -> np.ndarray:
-    """A training light's spectral irradiance on GRID_NM (``planck:K`` or a library name)."""
-    from catalog.optics.lights import get_light, planck_w_m2_nm
+    """A training light's spectral irradiance on GRID_NM (``planck:K`` or a library name).
+
+    ``planck:K`` is a Planckian radiator at K kelvin (500-50000) at 1 000 lx, the level of
+    the library's lamps; a bad temperature or an unknown name raises InputError."""
+    from catalog.optics.lights import LAMP_LX, get_light, illuminance_lx, planck_w_m2_nm
 
     if name.startswith("planck:"):
-        return planck_w_m2_nm(float(name.split(":", 1)[1]))
+        text = name.split(":", 1)[1]
+        try:
+            kelvin = float(text)
+        except ValueError:
+            kelvin = math.nan
+        if not (math.isfinite(kelvin) and 500.0 <= kelvin <= 50000.0):
+            raise InputError(f"temperature {text!r} is not a number of kelvin in 500-50000 "
+                             "(write e.g. 'planck:2000')", field=f"light {name!r}")
+        shape = planck_w_m2_nm(kelvin)
+        return shape * (LAMP_LX / illuminance_lx(shape))  # a lamp's level, as the library's
     return np.asarray(get_light(name).irradiance_w_m2_nm, dtype=np.float64)
 
 

@@ -94,10 +94,11 @@ def _xyz(spectrum: np.ndarray) -> np.ndarray:
 
 
 def light_irradiance(name: str) -> np.ndarray:
-    """The light's spectral irradiance on GRID_NM from the project's light library."""
-    from catalog.optics.lights import get_light
+    """The light's spectral irradiance on GRID_NM from the project's light library, or a
+    Planckian radiator ``planck:K`` (:func:`catalog.optics.bispectral.matrix.training_light`)."""
+    from catalog.optics.bispectral.matrix import training_light
 
-    return np.asarray(get_light(name).irradiance_w_m2_nm, dtype=np.float64)
+    return training_light(name)
 
 
 def white_xyz(light: np.ndarray, exact_xyz: np.ndarray) -> np.ndarray:
