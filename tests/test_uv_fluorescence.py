@@ -14,15 +14,15 @@ import sys
 import numpy as np
 import pytest
 
-from catalog.core.resources import PROJECT_ROOT, SHARED_DATA_DIR
+from catalog.core.resources import PROJECT_ROOT, data_dir_candidate, data_missing_reason
 from catalog.core.errors import InputError
 from catalog.optics.spectra import GRID_NM
 
 colour = pytest.importorskip("colour")
 
-HAS_MATRICES = (SHARED_DATA_DIR / "bispectral" / "CIBA12.BFC").is_file()
-needs_matrices = pytest.mark.skipif(not HAS_MATRICES, reason="measured matrices absent "
-                                    "(../shared/data/bispectral is not shipped)")
+HAS_MATRICES = data_missing_reason("bispectral") is None
+needs_matrices = pytest.mark.skipif(not HAS_MATRICES,
+                                    reason=str(data_missing_reason("bispectral")))
 
 
 # ----------------------------------------------------------------------------- lights

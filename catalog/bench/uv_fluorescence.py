@@ -3,7 +3,7 @@
     .venv/bin/python -m catalog.bench.uv_fluorescence [--quick] [--no-frame] [--out benchmarks/bench_uv.json]
 
 (also ``catalog bench --sections uv``). Needs the eight measured matrices
-(../shared/data/bispectral); docs/bispectral.md reads the tables it makes.
+(the validation data's bispectral/ folder, --data or $CATALOG_DATA); docs/bispectral.md reads the tables it makes.
 
 1. **Noise floor** (per matrix and TEST light): how far the exact colour itself moves
    under the data's own uncertainty: (a) the off-diagonal noise re-drawn at the matrix's
