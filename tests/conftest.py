@@ -105,3 +105,16 @@ def make_preset(tmp_path):
         return path
 
     return make
+
+
+# --- the web catalog (tests/test_web*.py): one small site shared by its tests ----------
+
+@pytest.fixture(scope="session")
+def web_site(tmp_path_factory):
+    """(folder, report) of `catalog web` for two fabrics (one fluorescent, one dyed, with
+    different cloth) under D65, UV-A and the sun by hour."""
+    from catalog.web.site import build_site
+
+    out = tmp_path_factory.mktemp("web") / "site"
+    report = build_site(out, fabrics="fluoro-pink,linen-dense", lights="D65,UV-A,sun-by-hour")
+    return out, report

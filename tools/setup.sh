@@ -8,8 +8,10 @@ cd "$(dirname "$0")/.."
 need_apt=()
 have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 # Mesa's EGL + llvmpipe (headless GL 4.5), GLX for windows, Xvfb and xdotool for window tests,
-# glslang-tools (glslangValidator) to check the display shader compiles as GLSL ES 3.00 (the web page).
-for pkg in libegl1 libegl-mesa0 libgl1-mesa-dri libglx-mesa0 libgl1 xvfb xauth xdotool glslang-tools; do
+# glslang-tools (glslangValidator) to check the display shader compiles as GLSL ES 3.00;
+# Chromium and its WebDriver for the web catalog's browser tests (WebGL2 through SwiftShader).
+for pkg in libegl1 libegl-mesa0 libgl1-mesa-dri libglx-mesa0 libgl1 xvfb xauth xdotool glslang-tools \
+           chromium chromium-driver; do
   have_pkg "$pkg" || need_apt+=("$pkg")
 done
 if ((${#need_apt[@]})); then

@@ -42,6 +42,7 @@ COMMANDS: dict[str, str] = {
     "view": "catalog.commands.view",
     "simulate": "catalog.commands.simulate",
     "bench": "catalog.commands.bench",
+    "web": "catalog.commands.web",
 }
 
 

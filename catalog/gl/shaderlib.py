@@ -6,6 +6,11 @@ nesting deeper than :data:`MAX_INCLUDE_DEPTH` is refused (which also catches cyc
 Defines are written right after the ``#version`` line, so a variant is chosen at compile time;
 the constants Python and GLSL share (:data:`catalog.core.constants.SHADER_DEFINES`) are
 defined in every program, so GLSL never repeats their values.
+
+Dialects: the files are written for desktop GLSL 4.30 (``core``); :data:`DIALECTS` ``"es300"``
+emits the GLSL ES 3.00 variant of the same files for WebGL2 (the web catalog): the version line
+names version 300 es and default precisions (highp) follow the defines. Nothing else
+differs, so a change to a shader file reaches the desktop and the web page alike.
 """
 
 from __future__ import annotations
@@ -78,18 +83,31 @@ def _define_lines(defines: Mapping[str, object]) -> list[str]:
     return out
 
 
-def load_source(name: str, defines: Mapping[str, object] | None = None) -> str:
+#: Shader dialects: name -> (version of the version line, lines after the defines).
+DIALECTS: dict[str, tuple[str | None, tuple[str, ...]]] = {
+    "core": (None, ()),  # the file's own version line (430)
+    "es300": ("300 es", ("precision highp float;", "precision highp int;",
+                                  "precision highp sampler2D;")),
+}
+
+
+def load_source(name: str, defines: Mapping[str, object] | None = None,
+                dialect: str = "core") -> str:
     """The full source of shader file ``name``: includes expanded, ``defines`` injected.
 
     ``defines`` maps a name to a value (``N_BANDS=6``), or to None/True for a bare
-    ``#define NAME``; False leaves it out.
+    ``#define NAME``; False leaves it out. ``dialect``: a key of :data:`DIALECTS`.
     """
+    if dialect not in DIALECTS:
+        raise CatalogError(f"unknown shader dialect {dialect!r}; known: {', '.join(DIALECTS)}")
+    version, preamble = DIALECTS[dialect]
     path = find_shader(name)
     lines = _expand(path, 0, (path.name,))
-    extra = _define_lines({**SHADER_DEFINES, **(defines or {})})
+    extra = _define_lines({**SHADER_DEFINES, **(defines or {})}) + list(preamble)
     for index, line in enumerate(lines):
         if _VERSION.match(line):
-            return "\n".join(lines[:index + 1] + extra + lines[index + 1:]) + "\n"
+            head = [f"#version {version}"] if version is not None else lines[index:index + 1]
+            return "\n".join(lines[:index] + head + extra + lines[index + 1:]) + "\n"
     raise CatalogError(f"shader file {path} has no #version line")
 
 
@@ -125,6 +143,9 @@ def create_program(ctx, vertex: str, fragment: str | None = None,
     EnvironmentFailures (the installed shaders or the driver are at fault, exit 3)."""
     import moderngl  # noqa: PLC0415
 
+    recipe_sink = getattr(ctx, "program_recipe_sink", None)
+    if recipe_sink is not None:  # a recording context (catalog.web.record) notes the recipe
+        recipe_sink(vertex, fragment, dict(defines or {}))
     sources = {"vertex_shader": load_source(vertex, defines)}
     if fragment is not None:
         sources["fragment_shader"] = load_source(fragment, defines)

@@ -1,0 +1,31 @@
+"""``catalog web``: write the static web catalog (no install, no network at run time)."""
+
+from __future__ import annotations
+
+HELP = "write a static web catalog (WebGL2, same shaders and light) that opens from file://"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--out", required=True,
+                        help="folder of the site (DIR/index.html); built beside it and renamed "
+                             "when complete; replaces only an earlier site or an empty folder")
+    parser.add_argument("--fabrics", default=None,
+                        help="comma-separated preset names (default: every preset in fabrics/)")
+    parser.add_argument("--lights", default=None,
+                        help="comma-separated lamps of the light library, and 'sun-by-hour' for "
+                             "the sun slider (default: D65,A,FL2,LED-B4,LED-warm,UV-A,sun-by-hour)")
+    parser.add_argument("--json", action="store_true", help="print the report as one JSON object")
+
+
+def run(args) -> int:
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.web.site import build_site  # noqa: PLC0415
+
+    report = build_site(args.out, fabrics=args.fabrics, lights=args.lights)
+    if args.json:
+        print_json(report)
+    else:
+        print(f"wrote {report['out']}/index.html: {len(report['fabrics'])} fabrics, "
+              f"{len(report['lights'])} lights, {report['scenes']} scenes, "
+              f"{report['total_bytes'] / 1e6:.2f} MB ({report['build_s']:.1f} s)")
+    return 0

@@ -1,0 +1,613 @@
+// The web catalog: replays the desktop frame recorded by catalog/web/export.py with WebGL2 and
+// the GLSL ES variant of the project's shader files (data.js). docs/web.md describes the data.
+// No network: data.js and anim/*.js are loaded by <script> tags (works from file://).
+'use strict';
+(function () {
+  const D = window.CATALOG_DATA;
+  const RW = D.record_size[0], RH = D.record_size[1];
+
+  function b64bytes(text) {
+    const s = atob(text);
+    const out = new Uint8Array(s.length);
+    for (let i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
+    return out;
+  }
+
+  // ---------------------------------------------------------------- camera
+  // The orbit camera of catalog/render/camera.py (float64 here, float32 on upload).
+  const Camera = {
+    position(c) {
+      const yaw = c.yaw_deg * Math.PI / 180, pitch = c.pitch_deg * Math.PI / 180, t = D.camera.target;
+      return [t[0] + c.distance_m * Math.sin(yaw) * Math.cos(pitch),
+              t[1] + c.distance_m * Math.sin(pitch),
+              t[2] + c.distance_m * Math.cos(yaw) * Math.cos(pitch)];
+    },
+    view(c) {  // row-major 4x4
+      const eye = this.position(c), t = D.camera.target;
+      const f = norm([t[0] - eye[0], t[1] - eye[1], t[2] - eye[2]]);
+      const r = norm(cross(f, [0, 1, 0]));
+      const u = cross(r, f);
+      const m = [r[0], r[1], r[2], 0, u[0], u[1], u[2], 0, -f[0], -f[1], -f[2], 0, 0, 0, 0, 1];
+      for (let i = 0; i < 3; i++) m[i * 4 + 3] = -(m[i * 4] * eye[0] + m[i * 4 + 1] * eye[1] + m[i * 4 + 2] * eye[2]);
+      return m;
+    },
+    projection(aspect) {
+      const f = 1 / Math.tan(D.camera.fov_y_deg * Math.PI / 360), n = D.camera.near_m, fa = D.camera.far_m;
+      const m = new Array(16).fill(0);
+      m[0] = f / aspect; m[5] = f; m[10] = (fa + n) / (n - fa); m[11] = 2 * fa * n / (n - fa); m[14] = -1;
+      return m;
+    },
+    viewProjection(c, aspect) { return matmul(this.projection(aspect), this.view(c)); },
+  };
+  function norm(v) { const l = Math.hypot(v[0], v[1], v[2]); return [v[0] / l, v[1] / l, v[2] / l]; }
+  function cross(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
+  function matmul(a, b) {
+    const m = new Array(16).fill(0);
+    for (let i = 0; i < 4; i++) for (let j = 0; j < 4; j++) for (let k = 0; k < 4; k++) m[i * 4 + j] += a[i * 4 + k] * b[k * 4 + j];
+    return m;
+  }
+  function invert(m) {  // Gauss-Jordan with partial pivoting, row-major
+    const a = m.slice(), inv = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+    for (let c = 0; c < 4; c++) {
+      let p = c;
+      for (let r = c + 1; r < 4; r++) if (Math.abs(a[r * 4 + c]) > Math.abs(a[p * 4 + c])) p = r;
+      for (let k = 0; k < 4; k++) {
+        [a[c * 4 + k], a[p * 4 + k]] = [a[p * 4 + k], a[c * 4 + k]];
+        [inv[c * 4 + k], inv[p * 4 + k]] = [inv[p * 4 + k], inv[c * 4 + k]];
+      }
+      const d = a[c * 4 + c];
+      for (let k = 0; k < 4; k++) { a[c * 4 + k] /= d; inv[c * 4 + k] /= d; }
+      for (let r = 0; r < 4; r++) if (r !== c) {
+        const f = a[r * 4 + c];
+        for (let k = 0; k < 4; k++) { a[r * 4 + k] -= f * a[c * 4 + k]; inv[r * 4 + k] -= f * inv[c * 4 + k]; }
+      }
+    }
+    return inv;
+  }
+  function columnMajor(m) { const o = new Array(16); for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) o[c * 4 + r] = m[r * 4 + c]; return o; }
+  function cameraUniforms(c, aspect) {
+    const vp = Camera.viewProjection(c, aspect);
+    return { view_proj: columnMajor(vp), inverse_view_proj: columnMajor(invert(vp)), camera_position: Camera.position(c) };
+  }
+
+  // ---------------------------------------------------------------- baked cloth
+  const animations = {};  // key -> Promise of {frames, positions[], normals[], tangents[], indices, ...}
+  async function inflate(bytes) {
+    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+  function loadScript(src) {
+    return new Promise((resolve, reject) => {
+      const s = document.createElement('script');
+      s.src = src; s.onload = resolve; s.onerror = () => reject(new Error('cannot load ' + src));
+      document.head.appendChild(s);
+    });
+  }
+  // The decoder of catalog/web/bake.py (decode_frames): deltas summed mod 2^16 / 2^8,
+  // positions (lo + q step) + offset in float64 then float32, normals and tangents int8 / 127.
+  async function decodeAnimation(entry) {
+    const m = entry.manifest, V = m.vertex_count, n = 3 * V;
+    const planes = await inflate(b64bytes(entry.payload));
+    const q = new Int32Array(n), qn = new Int32Array(n), qt = new Int32Array(n);
+    const positions = [], normals = [], tangents = [];
+    for (let f = 0; f < m.frames; f++) {
+      const base = f * 12 * V;
+      const p = new Float32Array(n), nn = new Float32Array(n), tt = new Float32Array(n);
+      for (let i = 0; i < n; i++) {
+        const c = i % 3;
+        q[i] = (q[i] + (planes[base + i] | (planes[base + n + i] << 8))) & 0xFFFF;
+        p[i] = (m.lo_m[c] + q[i] * m.step_m) + m.offset_m[c];
+        qn[i] = (qn[i] + planes[base + 2 * n + i]) & 0xFF;
+        qt[i] = (qt[i] + planes[base + 3 * n + i]) & 0xFF;
+        nn[i] = (qn[i] > 127 ? qn[i] - 256 : qn[i]) / 127;
+        tt[i] = (qt[i] > 127 ? qt[i] - 256 : qt[i]) / 127;
+      }
+      positions.push(p); normals.push(nn); tangents.push(tt);
+    }
+    const indices = new Uint32Array(b64bytes(entry.indices).buffer);
+    const uv = new Float32Array(b64bytes(entry.uv).buffer);
+    return { manifest: m, frames: m.frames, fps: m.fps, positions, normals, tangents, indices, uv };
+  }
+  function animation(key) {
+    if (!animations[key]) {
+      animations[key] = loadScript('anim/' + key + '.js')
+        .then(() => decodeAnimation(window.CATALOG_ANIMATIONS[key]));
+    }
+    return animations[key];
+  }
+  // The curtain at time t (frames, wrapping): exact baked frames at whole numbers, linear between.
+  function curtainAt(anim, t) {
+    const f = ((t % anim.frames) + anim.frames) % anim.frames, k0 = Math.floor(f), k1 = (k0 + 1) % anim.frames, w = f - k0;
+    if (w === 0) return { position: anim.positions[k0], normal: anim.normals[k0], tangent: anim.tangents[k0] };
+    const mix = (a, b) => { const o = new Float32Array(a.length); for (let i = 0; i < a.length; i++) o[i] = a[i] + w * (b[i] - a[i]); return o; };
+    return { position: mix(anim.positions[k0], anim.positions[k1]), normal: mix(anim.normals[k0], anim.normals[k1]),
+             tangent: mix(anim.tangents[k0], anim.tangents[k1]) };
+  }
+
+  // ---------------------------------------------------------------- the replayer
+  const DEPTH_FUNCS = { '<': 'LESS', '<=': 'LEQUAL', '>': 'GREATER', '>=': 'GEQUAL', '==': 'EQUAL', '!=': 'NOTEQUAL' };
+
+  class Replayer {
+    constructor(canvas) {
+      this.canvas = canvas;
+      const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: true, alpha: false, depth: false });
+      if (!gl) throw new Error('this browser has no WebGL2');
+      if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('WebGL2 without EXT_color_buffer_float: cannot render into float targets');
+      this.gl = gl;
+      this.floatLinear = !!gl.getExtension('OES_texture_float_linear');
+      gl.getExtension('EXT_float_blend');  // blending into float targets (layered cloth)
+      this.shaders = {}; this.programs = {}; this.buffers = {}; this.vaos = {}; this.targets = null;
+      this.size = [0, 0]; this.curtainCount = 0; this.curtainAnim = null;
+    }
+    program(rid) {
+      const gl = this.gl, index = D.programs[rid];
+      if (this.shaders[index]) return this.shaders[index];
+      const src = D.shaders[index];
+      const compile = (type, text, file) => {
+        const s = gl.createShader(type); gl.shaderSource(s, text); gl.compileShader(s);
+        if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(file + ': ' + gl.getShaderInfoLog(s));
+        return s;
+      };
+      const p = gl.createProgram();
+      gl.attachShader(p, compile(gl.VERTEX_SHADER, src.vertex, src.files[0]));
+      gl.attachShader(p, compile(gl.FRAGMENT_SHADER, src.fragment, src.files[1]));
+      gl.linkProgram(p);
+      if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(src.files.join('+') + ': ' + gl.getProgramInfoLog(p));
+      const uniforms = {};
+      for (let i = 0; i < gl.getProgramParameter(p, gl.ACTIVE_UNIFORMS); i++) {
+        const info = gl.getActiveUniform(p, i);
+        uniforms[info.name.replace(/\[0\]$/, '')] = { loc: gl.getUniformLocation(p, info.name), type: info.type, size: info.size };
+      }
+      return (this.shaders[index] = { program: p, uniforms });
+    }
+    buffer(rid) {
+      if (this.buffers[rid]) return this.buffers[rid];
+      const gl = this.gl, desc = D.buffers[rid], b = gl.createBuffer();
+      const target = desc.curtain === 'index' ? gl.ELEMENT_ARRAY_BUFFER : gl.ARRAY_BUFFER;
+      gl.bindBuffer(target, b);
+      if (desc.data) { const bytes = b64bytes(desc.data); gl.bufferData(target, bytes, gl.STATIC_DRAW); b.bytes = bytes.length; }
+      b.curtain = desc.curtain; b.target = target;
+      return (this.buffers[rid] = b);
+    }
+    setCurtain(anim, t) {
+      const gl = this.gl, c = curtainAt(anim, t);
+      for (const rid of Object.keys(D.buffers)) {
+        const tag = D.buffers[rid].curtain;
+        if (!tag) continue;
+        const b = this.buffer(rid);
+        const data = tag === 'index' ? anim.indices : tag === 'uv' ? anim.uv : c[tag];
+        if (tag === 'index') gl.bindVertexArray(null);
+        gl.bindBuffer(b.target, b);
+        if (tag === 'index' || tag === 'uv') {
+          if (this.curtainAnim === anim) continue;
+          gl.bufferData(b.target, data, gl.STATIC_DRAW);
+        } else if (b.bytes === data.byteLength) {
+          gl.bufferSubData(b.target, 0, data);
+        } else {
+          gl.bufferData(b.target, data, gl.DYNAMIC_DRAW);
+        }
+        b.bytes = data.byteLength;
+      }
+      this.curtainAnim = anim; this.curtainCount = anim.indices.length;
+    }
+    vao(rid) {
+      if (this.vaos[rid]) return this.vaos[rid];
+      const gl = this.gl, desc = D.vertex_arrays[rid], prog = this.program(desc.program).program;
+      const vao = gl.createVertexArray();
+      gl.bindVertexArray(vao);
+      vao.count = 0; vao.indexed = desc.index_buffer != null; vao.content = [];
+      for (const entry of desc.content) {
+        const b = this.buffer(entry.buffer);
+        gl.bindBuffer(gl.ARRAY_BUFFER, b);
+        const tokens = entry.layout.trim().split(/\s+/), parts = [];
+        let stride = 0;
+        for (const tok of tokens) {  // moderngl formats: "3f", "3f 4x", "16x" ...
+          const m = /^(\d*)(f4?|x)$/.exec(tok);
+          if (!m) throw new Error('vertex format ' + entry.layout + ' is not supported');
+          const n = m[1] ? +m[1] : 1;
+          if (m[2] === 'x') { stride += n; continue; }
+          parts.push({ n, offset: stride }); stride += 4 * n;
+        }
+        parts.forEach((part, i) => {
+          const loc = gl.getAttribLocation(prog, entry.attributes[i]);
+          if (loc < 0) return;
+          gl.enableVertexAttribArray(loc);
+          gl.vertexAttribPointer(loc, part.n, gl.FLOAT, false, stride, part.offset);
+        });
+        vao.content.push({ buffer: b, stride });
+      }
+      if (vao.indexed) { const ib = this.buffer(desc.index_buffer); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib); vao.indexBuffer = ib; }
+      gl.bindVertexArray(null);
+      return (this.vaos[rid] = vao);
+    }
+    resize() {
+      const gl = this.gl, w = this.canvas.width, h = this.canvas.height;
+      if (this.targets && this.size[0] === w && this.size[1] === h) return;
+      for (const t of Object.values(this.targets || {})) (t.tex ? gl.deleteTexture(t.tex) : null, t.rb ? gl.deleteRenderbuffer(t.rb) : null, t.fbo ? gl.deleteFramebuffer(t.fbo) : null);
+      this.size = [w, h];
+      const sized = (s) => (s[0] === RW && s[1] === RH ? [w, h] : s);
+      const textures = {}, renderbuffers = {};
+      for (const [rid, t] of Object.entries(D.textures)) {
+        const tex = gl.createTexture(), s = sized(t.size);
+        gl.bindTexture(gl.TEXTURE_2D, tex);
+        const float = t.dtype === 'f4', c = t.components - 1;
+        const formats = [gl.RED, gl.RG, gl.RGB, gl.RGBA];
+        const internal = float ? [gl.R32F, gl.RG32F, gl.RGB32F, gl.RGBA32F] : [gl.R8, gl.RG8, gl.RGB8, gl.RGBA8];
+        let texels = null;
+        if (t.data) {  // a texture the frame filled (e.g. a pattern): its texels as recorded
+          const bytes = b64bytes(t.data);
+          texels = float ? new Float32Array(bytes.buffer) : bytes;
+        }
+        gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+        gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
+        // float textures filter linearly only with OES_texture_float_linear
+        const linearOk = !float || this.floatLinear;
+        const pick = (f) => (linearOk ? f : (f === gl.LINEAR || f === gl.LINEAR_MIPMAP_LINEAR || f === gl.LINEAR_MIPMAP_NEAREST || f === gl.NEAREST_MIPMAP_LINEAR ? gl.NEAREST : f));
+        const filter = t.filter || [gl.LINEAR, gl.LINEAR];
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, t.mipmaps ? pick(filter[0]) : pick(filter[0] === gl.LINEAR_MIPMAP_LINEAR ? gl.LINEAR : filter[0]));
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, pick(filter[1]));
+        // moderngl's default is repeat (GL's); the frame says where it wants clamping
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, t.repeat_x === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, t.repeat_y === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
+        if (t.mipmaps) gl.generateMipmap(gl.TEXTURE_2D);
+        textures[rid] = { tex };
+      }
+      for (const [rid, r] of Object.entries(D.renderbuffers)) {
+        const rb = gl.createRenderbuffer(), s = sized(r.size);
+        gl.bindRenderbuffer(gl.RENDERBUFFER, rb);
+        gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, s[0], s[1]);
+        renderbuffers[rid] = { rb };
+      }
+      const targets = { ...textures, ...renderbuffers };
+      for (const [rid, f] of Object.entries(D.framebuffers)) {
+        const fbo = gl.createFramebuffer();
+        gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+        f.colour.forEach((t, i) => gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + i, gl.TEXTURE_2D, textures[t].tex, 0));
+        gl.drawBuffers(f.colour.map((_, i) => gl.COLOR_ATTACHMENT0 + i));
+        if (f.depth != null) gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, renderbuffers[f.depth].rb);
+        targets['fbo' + rid] = { fbo };
+      }
+      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      this.targets = targets;
+    }
+    setUniform(u, value) {
+      const gl = this.gl, v = Array.isArray(value) ? value : [value];
+      switch (u.type) {
+        case gl.FLOAT: gl.uniform1fv(u.loc, v); break;
+        case gl.FLOAT_VEC2: gl.uniform2fv(u.loc, v); break;
+        case gl.FLOAT_VEC3: gl.uniform3fv(u.loc, v); break;
+        case gl.FLOAT_VEC4: gl.uniform4fv(u.loc, v); break;
+        case gl.FLOAT_MAT2: gl.uniformMatrix2fv(u.loc, false, v); break;
+        case gl.FLOAT_MAT3: gl.uniformMatrix3fv(u.loc, false, v); break;
+        case gl.FLOAT_MAT4: gl.uniformMatrix4fv(u.loc, false, v); break;
+        case gl.INT_VEC2: gl.uniform2iv(u.loc, v.map(Math.round)); break;
+        case gl.INT_VEC3: gl.uniform3iv(u.loc, v.map(Math.round)); break;
+        case gl.INT_VEC4: gl.uniform4iv(u.loc, v.map(Math.round)); break;
+        case gl.INT: case gl.SAMPLER_2D: case gl.BOOL: gl.uniform1iv(u.loc, v.map(Math.round)); break;
+        default: throw new Error('uniform type ' + u.type + ' is not supported');
+      }
+    }
+    // One frame of a scene: the recorded structure with the scene's values, our camera.
+    render(scene, camera) {
+      const gl = this.gl, structure = D.structures[scene.structure];
+      this.resize();
+      const [w, h] = this.size;
+      const cam = cameraUniforms(camera, w / h);
+      let screen = null;
+      for (const c of structure) if (c.op === 'framebuffer') screen = c.framebuffer;
+      let current = null;
+      const full = (v) => v && v[0] === 0 && v[1] === 0 && v[2] === RW && v[3] === RH;
+      for (const c of structure) {
+        switch (c.op) {
+          case 'framebuffer':
+            gl.bindFramebuffer(gl.FRAMEBUFFER, c.framebuffer === screen ? null : this.targets['fbo' + c.framebuffer].fbo);
+            break;
+          case 'viewport':
+            gl.viewport(...(full(c.viewport) ? [0, 0, w, h] : c.viewport)); break;
+          case 'clear':
+            gl.bindFramebuffer(gl.FRAMEBUFFER, c.framebuffer === screen ? null : this.targets['fbo' + c.framebuffer].fbo);
+            gl.clearColor(...c.colour); gl.clearDepth(c.depth); gl.depthMask(true);
+            gl.clear(gl.COLOR_BUFFER_BIT | (D.framebuffers[c.framebuffer].depth != null ? gl.DEPTH_BUFFER_BIT : 0));
+            break;
+          case 'enable': for (const f of c.flags) gl.enable(gl[f]); break;
+          case 'disable': for (const f of c.flags) gl.disable(gl[f]); break;
+          case 'depth_func': gl.depthFunc(gl[DEPTH_FUNCS[c.func]]); break;
+          case 'blend_equation': c.modes.length === 2 ? gl.blendEquationSeparate(...c.modes) : gl.blendEquation(c.modes[0]); break;
+          case 'blend_func': c.factors.length === 4 ? gl.blendFuncSeparate(...c.factors) : gl.blendFunc(...c.factors); break;
+          case 'texture':
+            gl.activeTexture(gl.TEXTURE0 + c.unit); gl.bindTexture(gl.TEXTURE_2D, this.targets[c.texture].tex); break;
+          case 'uniform': {
+            const p = this.program(c.program);
+            if (current !== p.program) { gl.useProgram(p.program); current = p.program; }
+            const u = p.uniforms[c.name];
+            if (!u) break;
+            const which = D.camera_uniforms[c.name];
+            const canvas = c.canvas === 'texel' ? [1 / w, 1 / h] : c.canvas === 'size' ? [w, h] : null;
+            this.setUniform(u, which ? cam[which] : canvas || scene.values[c.slot]);
+            break;
+          }
+          case 'draw': {
+            const vao = this.vao(c.vertex_array), desc = D.vertex_arrays[c.vertex_array];
+            const p = this.program(desc.program);
+            if (current !== p.program) { gl.useProgram(p.program); current = p.program; }
+            gl.bindVertexArray(vao);
+            if (vao.indexed) {
+              const count = c.vertices >= 0 ? c.vertices : (vao.indexBuffer.curtain ? this.curtainCount : vao.indexBuffer.bytes / 4);
+              gl.drawElements(c.mode, count, gl.UNSIGNED_INT, 0);
+            } else {
+              const count = c.vertices >= 0 ? c.vertices : vao.content[0].buffer.bytes / vao.content[0].stride;
+              gl.drawArrays(c.mode, 0, count);
+            }
+            gl.bindVertexArray(null);
+            break;
+          }
+          default: throw new Error('unknown recorded command ' + c.op);
+        }
+      }
+    }
+  }
+
+  // ---------------------------------------------------------------- the app
+  const $ = (id) => document.getElementById(id);
+  const fabricByName = Object.fromEntries(D.fabrics.map((f) => [f.name, f]));
+  const lamps = D.lights.filter((l) => l.kind === 'lamp');
+  const suns = D.lights.filter((l) => l.kind === 'sun');
+  const lim = D.camera.limits;
+  const clamp = (x, r) => Math.min(r[1], Math.max(r[0], x));
+  const state = {
+    view: 'grid', fabric: D.fabrics[0].name, light: D.lights[0].id, fluorescence: 'on', compare: '',
+    yaw_deg: D.camera.yaw_deg, pitch_deg: D.camera.pitch_deg, distance_m: D.camera.distance_m,
+    t: 0, playing: true, size: null,
+  };
+  const stats = { loadStartMs: performance.timeOrigin ? 0 : 0, firstFrameMs: null, frames: 0, errors: [] };
+  let panes = null, dirty = true, lastTime = null, readyResolve, ready = new Promise((r) => (readyResolve = r));
+
+  function sceneKey(fabric) { return fabric + '|' + state.light + '|' + state.fluorescence; }
+  function lightOf(id) { return D.lights.find((l) => l.id === id); }
+
+  function buildGrid() {
+    const ul = $('grid');
+    for (const f of D.fabrics) {
+      const li = document.createElement('li');
+      li.className = 'card'; li.tabIndex = 0; li.dataset.fabric = f.name;
+      li.setAttribute('role', 'button');
+      li.innerHTML = '<img alt=""><h2></h2><p></p>';
+      li.querySelector('img').src = 'data:image/png;base64,' + f.swatch;
+      li.querySelector('img').alt = f.display_name + ' under D65';
+      li.querySelector('h2').textContent = f.display_name;
+      li.querySelector('p').textContent = factsLine(f.facts);
+      const open = () => set({ view: 'viewer', fabric: f.name });
+      li.addEventListener('click', open);
+      li.addEventListener('keydown', (e) => { if (e.key === 'Enter' || e.key === ' ') { e.preventDefault(); open(); } });
+      ul.appendChild(li);
+    }
+  }
+  function factsLine(x) {
+    return x.openness_pct + '% open' + (x.brightener ? ', optical brightener' : '') + (x.dye ? ', dyed' : '') + (x.weave ? ', ' + x.weave : '');
+  }
+  function buildControls() {
+    const fab = $('fabric'), cmp = $('compare'), light = $('light');
+    for (const f of D.fabrics) { fab.add(new Option(f.display_name, f.name)); cmp.add(new Option(f.display_name, f.name)); }
+    for (const l of lamps) light.add(new Option(l.label, l.id));
+    if (suns.length) light.add(new Option('Sun by hour', 'sun'));
+    if (suns.length) { $('hour').min = suns[0].hour; $('hour').max = suns[suns.length - 1].hour; }
+    fab.onchange = () => set({ fabric: fab.value });
+    cmp.onchange = () => set({ compare: cmp.value });
+    light.onchange = () => set({ light: light.value === 'sun' ? sunNearest(12).id : light.value });
+    $('hour').oninput = () => set({ light: sunNearest(+$('hour').value).id });
+    $('fluorescence').onchange = () => set({ fluorescence: $('fluorescence').checked ? 'on' : 'off' });
+    $('play').onclick = () => set({ playing: !state.playing });
+    $('back').onclick = () => set({ view: 'grid' });
+    $('home').onclick = (e) => { e.preventDefault(); set({ view: 'grid' }); };
+    $('reset-view').onclick = resetView;
+  }
+  function sunNearest(h) { return suns.reduce((a, b) => (Math.abs(b.hour - h) < Math.abs(a.hour - h) ? b : a)); }
+  function resetView() { set({ yaw_deg: D.camera.yaw_deg, pitch_deg: D.camera.pitch_deg, distance_m: D.camera.distance_m }); }
+  function cycleLight(step) {
+    const ids = lamps.map((l) => l.id).concat(suns.length ? ['sun'] : []);
+    const cur = lightOf(state.light).kind === 'sun' ? 'sun' : state.light;
+    const next = ids[(ids.indexOf(cur) + step + ids.length) % ids.length];
+    set({ light: next === 'sun' ? sunNearest(12).id : next });
+  }
+  function cycleFabric(step) {
+    const i = D.fabrics.findIndex((f) => f.name === state.fabric);
+    set({ fabric: D.fabrics[(i + step + D.fabrics.length) % D.fabrics.length].name });
+  }
+
+  function showFacts() {
+    const f = fabricByName[state.fabric], x = f.facts, dl = $('facts');
+    const rows = [['Fabric', f.display_name + ' (' + f.name + ')'], ['Openness', x.openness_pct + ' % see-through'],
+      ['Optical brightener', x.brightener ? 'yes, quantum yield ' + x.brightener.quantum_yield + ', peak absorptance ' + x.brightener.peak_absorptance : 'none'],
+      ['Dye', x.dye ? 'transmittance ' + x.dye.mean_transmittance_pct + ' % mean, ' + x.dye.min_transmittance_pct + ' % least' : 'undyed'],
+      ['Weave', (x.weave || '?') + (x.areal_density_g_m2 ? ', ' + x.areal_density_g_m2 + ' g/m²' : '')]];
+    const scene = D.scenes[sceneKey(state.fabric)];
+    rows.push(['Light', lightOf(state.light).label + ' (' + Math.round(scene.illuminance_lx) + ' lx)']);
+    rows.push(['Fluorescence', state.fluorescence === 'on' ? 'on (' + scene.fluorescence_variant + ')' : 'off']);
+    dl.replaceChildren(...rows.flatMap(([k, v]) => { const dt = document.createElement('dt'), dd = document.createElement('dd'); dt.textContent = k; dd.textContent = v; return [dt, dd]; }));
+  }
+
+  function syncUI() {
+    $('grid-view').hidden = state.view !== 'grid';
+    $('viewer-view').hidden = state.view !== 'viewer';
+    $('fabric').value = state.fabric;
+    $('compare').value = state.compare;
+    const l = lightOf(state.light);
+    $('light').value = l.kind === 'sun' ? 'sun' : l.id;
+    $('hour-label').hidden = l.kind !== 'sun';
+    if (l.kind === 'sun') { $('hour').value = l.hour; $('hour-out').textContent = String(l.hour).padStart(2, '0') + ':00'; }
+    $('fluorescence').checked = state.fluorescence === 'on';
+    $('play').textContent = state.playing ? 'Pause' : 'Play';
+    $('pane-b').hidden = !state.compare;
+    $('caption-a').textContent = fabricByName[state.fabric].display_name;
+    $('caption-b').textContent = state.compare ? fabricByName[state.compare].display_name : '';
+    showFacts();
+  }
+  function writeHash() {
+    const h = new URLSearchParams({ view: state.view, fabric: state.fabric, light: state.light, fluorescence: state.fluorescence });
+    if (state.compare) h.set('compare', state.compare);
+    history.replaceState(null, '', '#' + h.toString());
+  }
+  function readHash() {
+    const h = new URLSearchParams(location.hash.slice(1)), p = {};
+    if (h.get('fabric') && fabricByName[h.get('fabric')]) p.fabric = h.get('fabric');
+    if (h.get('light') && lightOf(h.get('light'))) p.light = h.get('light');
+    if (h.get('fluorescence') === 'off') p.fluorescence = 'off';
+    if (h.get('compare') && fabricByName[h.get('compare')]) p.compare = h.get('compare');
+    if (h.get('view') === 'viewer') p.view = 'viewer';
+    if (h.get('frame') !== null) { p.t = +h.get('frame'); p.playing = false; }
+    for (const k of ['yaw_deg', 'pitch_deg', 'distance_m']) if (h.get(k) !== null && isFinite(+h.get(k))) p[k] = +h.get(k);
+    const size = /^(\d+)x(\d+)$/.exec(h.get('size') || '');
+    if (size) p.size = [+size[1], +size[2]];
+    return p;
+  }
+
+  function set(partial) {
+    Object.assign(state, partial);
+    state.yaw_deg = clamp(state.yaw_deg, lim.yaw_deg); state.pitch_deg = clamp(state.pitch_deg, lim.pitch_deg);
+    state.distance_m = clamp(state.distance_m, lim.distance_m);
+    if (state.compare === state.fabric) state.compare = '';
+    syncUI(); writeHash(); dirty = true;
+    if (state.view === 'viewer') ensurePanes();
+  }
+
+  function ensurePanes() {
+    if (!panes) {
+      try {
+        panes = [new Replayer($('canvas-a')), null];
+      } catch (e) { fail(e); return; }
+      installInput($('canvas-a'));
+    }
+    if (state.compare && !panes[1]) {
+      try { panes[1] = new Replayer($('canvas-b')); installInput($('canvas-b')); } catch (e) { fail(e); }
+    }
+  }
+  function fail(e) { stats.errors.push(String(e)); $('status').textContent = String(e.message || e); console.error(e); }
+
+  function sizeCanvas(canvas) {
+    if (state.size) { canvas.width = state.size[0]; canvas.height = state.size[1]; canvas.style.width = state.size[0] + 'px'; return; }
+    const dpr = Math.min(window.devicePixelRatio || 1, 2), rect = canvas.getBoundingClientRect();
+    const w = Math.max(1, Math.round(rect.width * dpr)), h = Math.max(1, Math.round(rect.width * 0.75 * dpr));
+    if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
+  }
+
+  let pendingLoads = 0;
+  function drawPanes() {
+    const jobs = [[panes[0], state.fabric]];
+    if (state.compare && panes[1]) jobs.push([panes[1], state.compare]);
+    for (const [pane, fabric] of jobs) {
+      const key = fabricByName[fabric].animation;
+      const p = animations[key] && animations[key].done ? animations[key].value : null;
+      if (!p) {
+        if (!animations[key] || !animations[key].pending) {
+          pendingLoads++;
+          animation(key).then((a) => { animations[key].done = true; animations[key].value = a; pendingLoads--; dirty = true; },
+            (e) => { pendingLoads--; fail(e); });
+          animations[key].pending = true;
+        }
+        return false;
+      }
+      sizeCanvas(pane.canvas);
+      pane.setCurtain(p, state.t);
+      pane.render(D.scenes[sceneKey(fabric)], state);
+    }
+    return true;
+  }
+
+  function frame(now) {
+    requestAnimationFrame(frame);
+    if (state.view !== 'viewer' || !panes) { lastTime = now; dirty = false; return; }
+    const anim = animations[fabricByName[state.fabric].animation];
+    if (state.playing && lastTime !== null && anim && anim.done) { state.t += (now - lastTime) / 1000 * anim.value.fps; dirty = true; }
+    lastTime = now;
+    if (!dirty) return;
+    let drawn = false;
+    try { drawn = drawPanes(); } catch (e) { fail(e); state.playing = false; }
+    drawn.then ? drawn.then(done) : done(drawn);
+  }
+  function done(drawn) {
+    if (!drawn) return;
+    dirty = false; stats.frames++;
+    if (stats.firstFrameMs === null) { stats.firstFrameMs = performance.now(); readyResolve(); }
+    if (!state.playing) readyResolve();
+  }
+
+  // ---------------------------------------------------------------- input
+  function installInput(canvas) {
+    const pointers = new Map();
+    let pinch = null;
+    canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, [e.clientX, e.clientY]); canvas.focus(); });
+    const up = (e) => { pointers.delete(e.pointerId); pinch = null; };
+    canvas.addEventListener('pointerup', up); canvas.addEventListener('pointercancel', up);
+    canvas.addEventListener('pointermove', (e) => {
+      if (!pointers.has(e.pointerId)) return;
+      const [x0, y0] = pointers.get(e.pointerId);
+      pointers.set(e.pointerId, [e.clientX, e.clientY]);
+      if (pointers.size === 1) {
+        set({ yaw_deg: state.yaw_deg - (e.clientX - x0) * 0.3, pitch_deg: state.pitch_deg + (e.clientY - y0) * 0.3 });
+      } else if (pointers.size === 2) {
+        const [a, b] = [...pointers.values()], d = Math.hypot(a[0] - b[0], a[1] - b[1]);
+        if (pinch) set({ distance_m: state.distance_m * pinch / d });
+        pinch = d;
+      }
+    });
+    canvas.addEventListener('wheel', (e) => { e.preventDefault(); set({ distance_m: state.distance_m * Math.exp(e.deltaY * 0.001) }); }, { passive: false });
+  }
+  function onKey(e) {
+    if (e.target.tagName === 'SELECT' || e.target.tagName === 'INPUT') { if (e.key !== 'Escape') return; }
+    if (state.view !== 'viewer') return;
+    const k = e.key, hour = lightOf(state.light).hour;
+    const actions = {
+      ArrowLeft: () => set({ yaw_deg: state.yaw_deg - 5 }), ArrowRight: () => set({ yaw_deg: state.yaw_deg + 5 }),
+      ArrowUp: () => set({ pitch_deg: state.pitch_deg + 5 }), ArrowDown: () => set({ pitch_deg: state.pitch_deg - 5 }),
+      '+': () => set({ distance_m: state.distance_m / 1.1 }), '=': () => set({ distance_m: state.distance_m / 1.1 }),
+      '-': () => set({ distance_m: state.distance_m * 1.1 }),
+      l: () => cycleLight(1), L: () => cycleLight(-1),
+      '[': () => suns.length && set({ light: sunNearest((hour ?? 13) - 1).id }), ']': () => suns.length && set({ light: sunNearest((hour ?? 11) + 1).id }),
+      f: () => set({ fluorescence: state.fluorescence === 'on' ? 'off' : 'on' }),
+      c: () => { const names = ['', ...D.fabrics.map((f) => f.name).filter((n) => n !== state.fabric)]; set({ compare: names[(names.indexOf(state.compare) + 1) % names.length] }); },
+      n: () => cycleFabric(1), p: () => cycleFabric(-1), ' ': () => set({ playing: !state.playing }),
+      r: resetView, Escape: () => set({ view: 'grid' }),
+    };
+    if (actions[k]) { e.preventDefault(); actions[k](); }
+  }
+
+  // ---------------------------------------------------------------- test and benchmark hooks
+  // window.catalogApp: the browser tests and the benchmark drive the page through these.
+  window.catalogApp = {
+    state, stats, set,
+    // resolves when the current state has been drawn (animations loaded)
+    settle() {
+      return new Promise((resolve) => {
+        const poll = () => (!dirty && pendingLoads === 0 ? resolve(true) : setTimeout(poll, 20));
+        dirty = true; poll();
+      });
+    },
+    // median milliseconds of n frames drawn back to back (readPixels forces completion)
+    benchmark(n) {
+      // cpu_ms: until the frame's commands are issued (curtain interpolation and upload, the
+      // replay); frame_ms: until its pixels can be read (readPixels waits for the rasteriser)
+      const frame = [], cpu = [], px = new Uint8Array(4), gl = panes[0].gl;
+      for (let i = 0; i < n; i++) {
+        const t0 = performance.now();
+        state.t += 1.0 / 3;  // a new interpolated curtain each frame, as when playing
+        drawPanes();
+        const t1 = performance.now();
+        gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+        const t2 = performance.now();
+        cpu.push(t1 - t0); frame.push(t2 - t0);
+      }
+      const median = (a) => { a.sort((x, y) => x - y); return a.length % 2 ? a[(a.length - 1) / 2] : (a[a.length / 2 - 1] + a[a.length / 2]) / 2; };
+      return { frame_ms: median(frame.slice()), cpu_ms: median(cpu.slice()), frames: n,
+               frame_samples_ms: frame, cpu_samples_ms: cpu,
+               size: [panes[0].canvas.width, panes[0].canvas.height] };
+    },
+  };
+
+  try {
+    buildGrid(); buildControls();
+    document.addEventListener('keydown', onKey);
+    window.addEventListener('resize', () => (dirty = true));
+    set(readHash());
+    requestAnimationFrame(frame);
+  } catch (e) { fail(e); }
+})();

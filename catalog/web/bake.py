@@ -1,0 +1,193 @@
+"""Baked cloth animation for the web page (WebGL2 has no compute shaders for the simulation).
+
+The project's cloth simulation (:mod:`catalog.cloth`, the numba backend) runs a curtain in a
+gentle gusty wind; after it settles, :data:`LOOP_S` seconds are sampled at :data:`BAKE_FPS`
+and made to loop by cross-fading the last :data:`CROSSFADE_FRAMES` frames into the frames
+just before the loop's start (so the last frame leads into the first). Normals and weft
+tangents are recomputed from the blended grid by the project's mesh code.
+
+Encoding (docs/web.md): per vertex, positions as uint16 steps of :data:`POSITION_STEP_M` above
+the animation's bounding-box corner, normals and tangents as int8 (x / 127, the shaders
+normalise); each frame is stored as its difference from the frame before (mod 2^16 and 2^8;
+frame 0 as itself), the bytes of a frame in planes (position low bytes, high bytes, normals,
+tangents), then zlib, which the page inflates with the browser's DecompressionStream. :func:`decode_frame` is
+the reference decoder; the page's decoder (assets/app.js) must give the same float32 arrays.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import zlib
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Sampling rate of the baked frames (the page interpolates between them), frames per second.
+BAKE_FPS = 12
+#: Length of the loop, s.
+LOOP_S = 4.0
+#: Frames at the loop's end blended into the frames before its start.
+CROSSFADE_FRAMES = 12
+#: Simulated time before the loop starts (the curtain settles into the wind), s.
+SETTLE_S = 3.0
+#: Mean wind from the window, m/s, and its gust strength (relative).
+WIND_M_S = 0.6
+GUST_STRENGTH = 0.6
+#: uint16 positions, int8 normal and tangent: bytes per vertex and frame.
+BYTES_PER_VERTEX = 12
+#: Position quantum, m (0.1 mm: far below a pixel at any zoom the page allows).
+POSITION_STEP_M = 1e-4
+
+
+@dataclass(frozen=True)
+class BakedAnimation:
+    """An encoded looping animation and what is needed to decode it."""
+
+    key: str                 # a hash of the cloth parameters (fabrics with equal ones share it)
+    frames: int
+    fps: float
+    vertex_count: int
+    indices: np.ndarray      # uint32 triangles (flat)
+    uv: np.ndarray           # float32 (V, 2)
+    offset_m: tuple[float, float, float]  # cloth frame -> scene
+    lo_m: np.ndarray         # float64 (3,) bounding box low corner
+    payload: bytes           # zlib of the shuffled, delta-coded frames
+
+    def manifest(self) -> dict:
+        return {"key": self.key, "frames": self.frames, "fps": self.fps,
+                "vertex_count": self.vertex_count,
+                "offset_m": list(self.offset_m),
+                "lo_m": [float(v) for v in self.lo_m], "step_m": POSITION_STEP_M,
+                "index_count": int(self.indices.size),
+                "encoded_bytes": len(self.payload),
+                "raw_bytes": self.frames * self.vertex_count * BYTES_PER_VERTEX}
+
+    def script(self) -> str:
+        """The animation as a script the page loads with a <script> tag (file:// allows no
+        fetch): registers base64 payload, indices and uvs under its key."""
+        import json  # noqa: PLC0415
+
+        data = {"manifest": self.manifest(),
+                "payload": base64.b64encode(self.payload).decode("ascii"),
+                "indices": base64.b64encode(self.indices.astype("<u4").tobytes()).decode("ascii"),
+                "uv": base64.b64encode(self.uv.astype("<f4").tobytes()).decode("ascii")}
+        return ("(window.CATALOG_ANIMATIONS = window.CATALOG_ANIMATIONS || {})"
+                f"[{json.dumps(self.key)}] = {json.dumps(data)};\n")
+
+
+def read_script(path) -> BakedAnimation:
+    """The animation written by :meth:`BakedAnimation.script` (for tests and benchmarks)."""
+    import json  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    text = Path(path).read_text(encoding="utf-8")
+    data = json.loads(text[text.index("] = ") + len("] = "):].rstrip().rstrip(";"))
+    m = data["manifest"]
+    return BakedAnimation(
+        key=m["key"], frames=m["frames"], fps=m["fps"], vertex_count=m["vertex_count"],
+        indices=np.frombuffer(base64.b64decode(data["indices"]), dtype="<u4"),
+        uv=np.frombuffer(base64.b64decode(data["uv"]), dtype="<f4").reshape(-1, 2),
+        offset_m=tuple(m["offset_m"]), lo_m=np.array(m["lo_m"], dtype=np.float64),
+        payload=base64.b64decode(data["payload"]))
+
+
+def cloth_key(params) -> str:
+    text = repr(sorted((k, v) for k, v in vars(params).items() if k != "extra"))
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def simulate_loop(params, fps: float = BAKE_FPS, loop_s: float = LOOP_S,
+                  crossfade: int = CROSSFADE_FRAMES, settle_s: float = SETTLE_S):
+    """(frames, H, W, 3) float64 grid positions of a seamless loop, cloth frame, metres."""
+    from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
+
+    params = params.with_changes(wind_speed_m_s=WIND_M_S, gust_strength=GUST_STRENGTH)
+    simulation = ClothSimulation(params, backend="cpu")
+    dt = 1.0 / fps
+    settle = int(round(settle_s * fps))
+    loop = int(round(loop_s * fps))
+    if settle < crossfade:
+        raise ValueError("the settling time must cover the cross-fade")
+    history = []
+    for _ in range(settle + loop):
+        simulation.step(dt)
+        history.append(np.array(simulation.positions(), dtype=np.float64))
+    if not simulation.finite:
+        from catalog.core.errors import CatalogError  # noqa: PLC0415
+        raise CatalogError("the cloth simulation diverged while baking the web animation")
+    frames = np.stack(history[settle:])
+    before = np.stack(history[settle - crossfade:settle])
+    for j in range(crossfade):
+        w = (j + 1) / (crossfade + 1)
+        frames[loop - crossfade + j] = (1 - w) * frames[loop - crossfade + j] + w * before[j]
+    return frames, params
+
+
+def encode(frames_p, frames_n, frames_t):
+    """(lo_m, zlib payload) of (F, V, 3) float positions (m), normals and tangents."""
+    lo = frames_p.reshape(-1, 3).min(axis=0)
+    q = np.rint((frames_p - lo) / POSITION_STEP_M).astype(np.int64)
+    if q.max() > 65535:
+        from catalog.core.errors import CatalogError  # noqa: PLC0415
+        raise CatalogError("the baked curtain spans more than 6.5 m: uint16 positions overflow")
+    qn = np.clip(np.rint(frames_n * 127.0), -127, 127).astype(np.int64)
+    qt = np.clip(np.rint(frames_t * 127.0), -127, 127).astype(np.int64)
+    f = q.shape[0]
+
+    def delta(x, modulus):
+        d = x - np.roll(x, 1, axis=0)
+        d[0] = x[0]
+        return (d % modulus).reshape(f, -1)
+
+    dp = delta(q, 65536)
+    planes = np.concatenate([dp & 0xFF, dp >> 8, delta(qn, 256), delta(qt, 256)],
+                            axis=1).astype("u1")
+    return lo, zlib.compress(planes.tobytes(), 9)
+
+
+def bake(preset, fps: float = BAKE_FPS, loop_s: float = LOOP_S) -> BakedAnimation:
+    """Simulate and encode the looping curtain of a preset (its ``[cloth]`` table)."""
+    from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
+    from catalog.cloth.params import ClothParams  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    params = ClothParams.from_preset(preset)
+    grids, params = simulate_loop(params, fps, loop_s)
+    meshes = [CurtainMesh.from_grid(g, params) for g in grids]
+    frames_p = np.stack([m.positions.astype(np.float64) for m in meshes])
+    frames_n = np.stack([m.normals for m in meshes])
+    frames_t = np.stack([m.tangents[:, :3] for m in meshes])
+    lo, payload = encode(frames_p, frames_n, frames_t)
+    offset = (0.0, scene_lib.CURTAIN_TOP_Y - params.rod_y_m, scene_lib.CURTAIN_Z)
+    return BakedAnimation(key=cloth_key(params), frames=len(meshes), fps=float(fps),
+                          vertex_count=meshes[0].positions.shape[0],
+                          indices=meshes[0].indices.astype(np.uint32).ravel(),
+                          uv=meshes[0].uv, offset_m=offset, lo_m=lo,
+                          payload=payload)
+
+
+def decode_frames(animation: BakedAnimation):
+    """Every frame as the page builds it: float32 (F, V, 3) positions in the scene
+    ((lo + q step) + offset, in float64, then rounded to float32), normals and tangents
+    (int8 / 127, not renormalised: the shaders normalise)."""
+    f, v = animation.frames, animation.vertex_count
+    planes = np.frombuffer(zlib.decompress(animation.payload), dtype="u1").reshape(f, 12 * v)
+    n = 3 * v
+    dp = planes[:, :n].astype(np.int64) | (planes[:, n:2 * n].astype(np.int64) << 8)
+    q = np.cumsum(dp, axis=0) % 65536
+    qn = (np.cumsum(planes[:, 2 * n:3 * n].astype(np.int64), axis=0) % 256).astype("u1").view("i1")
+    qt = (np.cumsum(planes[:, 3 * n:4 * n].astype(np.int64), axis=0) % 256).astype("u1").view("i1")
+    lo = np.tile(animation.lo_m, v)
+    offset = np.tile(np.asarray(animation.offset_m, dtype=np.float64), v)
+    positions = ((lo + q * POSITION_STEP_M) + offset).astype(np.float32).reshape(f, v, 3)
+    normals = (qn.astype(np.float64) / 127.0).astype(np.float32).reshape(f, v, 3)
+    tangents = (qt.astype(np.float64) / 127.0).astype(np.float32).reshape(f, v, 3)
+    return positions, normals, tangents
+
+
+def decode_frame(animation: BakedAnimation, frame: int):
+    """Frame ``frame`` (wrapping) of :func:`decode_frames`: positions, normals, tangents."""
+    positions, normals, tangents = decode_frames(animation)
+    k = frame % animation.frames
+    return positions[k], normals[k], tangents[k]

@@ -1,0 +1,367 @@
+"""What the web page needs, taken from the desktop frame itself.
+
+For every fabric x light x fluorescence (on = the desktop's default ``physical`` mode, off),
+the desktop :class:`~catalog.render.frame.FrameRenderer` renders one small frame through a
+:class:`~catalog.web.record.RecordingContext`; the recorded commands become a *structure*
+(passes, programs, GL state; shared by the scenes that have the same one) and a list of
+*values* (every uniform the frame set, in order). The page replays the structure with the
+scene's values, replacing only the camera's uniforms (:data:`CAMERA_UNIFORMS`, which it
+computes from its orbit camera like :class:`catalog.render.camera.OrbitCamera`) and the
+curtain's vertex buffers (the baked animation, :mod:`catalog.web.bake`). The programs are the
+GLSL ES variant of the same shader files with the same ``#define``s
+(:func:`catalog.gl.shaderlib.load_source` with ``dialect="es300"``).
+
+The renderer runs unspecialised (scene values as uniforms, not compiled-in constants): a
+light switch on the page then sets uniforms instead of compiling a program.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import json
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from catalog.core.errors import CatalogError, InputError
+
+#: The lamps of the light switch when ``--lights`` is not given.
+DEFAULT_LAMPS = ("D65", "A", "FL2", "LED-B4", "LED-warm", "UV-A")
+#: Short names of the light switch (others show their library name).
+LAMP_LABELS = {"D65": "Daylight D65", "A": "Incandescent A", "FL2": "Fluorescent tube FL2",
+               "LED-B4": "LED (CIE LED-B4)", "LED-warm": "Warm LED", "UV-A": "UV-A lamp"}
+#: ``--lights`` token for the sun by hour (local solar time, summer solstice, see scene.py).
+SUN_TOKEN = "sun-by-hour"
+#: The hours of the sun slider.
+SUN_HOURS = tuple(range(6, 19))
+#: Uniforms that depend on the camera: the page computes them (name -> what).
+CAMERA_UNIFORMS = {"u_view_proj": "view_proj", "u_inverse_view_proj": "inverse_view_proj",
+                   "u_camera_position": "camera_position"}
+#: The size of the recorded frame: the page replaces it by its canvas size wherever it
+#: appears (targets, viewports). Odd numbers nothing else in the frame is equal to.
+RECORD_SIZE = (67, 43)
+#: Fluorescence switch: on = the desktop's default mode.
+FLUORESCENCE = {"on": "physical", "off": "off"}
+#: The orbit limits of the page: the camera stays in the room (in front of the window).
+ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_m": [1.2, 4.0]}
+#: The desktop frame's modes the page shows. Not on the page yet (docs/web.md): the thread
+#: patterns (issue 12: per-fabric normal/coverage maps up to 1024^2 float texels, the
+#: layers' order-independent transparency), the room lit through the curtain (issue 13:
+#: shadow map, luminaire, bounce, recomputed when the scene changes) and the glare. The page
+#: shows the desktop frame with these off (its flat-cloth, constant-room modes), and the
+#: browser test compares against the same modes.
+DESKTOP_MODES = {"patterned": False, "room_lighting": False, "bloom": False}
+
+
+def configure_desktop_frame(renderer) -> None:
+    """Put a FrameRenderer in the modes the page shows (:data:`DESKTOP_MODES`)."""
+    for name, value in DESKTOP_MODES.items():
+        setter = getattr(renderer, f"set_{name}", None)
+        if setter is not None:  # a mode this frame does not have is off anyway
+            setter(value)
+#: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
+#: the page shows each scene at the EV100 a desktop frame of this size meters at the default
+#: camera (fixed while orbiting, like a photograph's), recorded as an ordinary uniform. The
+#: fluorescence switch keeps the exposure of "on" (as the desktop viewer's comparison does),
+#: so that switching shows the brightener's light, not a new exposure.
+METER_SIZE = (160, 120)
+#: The swatch of the catalog grid: a small desktop frame (EGL), px.
+SWATCH_SIZE = (120, 90)
+
+
+#: Vertex format tokens the page reads (moderngl: "3f", "4x" padding bytes).
+_VERTEX_TOKEN = re.compile(r"^\d*(f4?|x)$")
+
+
+@dataclass(frozen=True)
+class LightChoice:
+    id: str          # the scene key part: a library light name or "sun@HOUR"
+    label: str
+    kind: str        # "lamp" | "sun"
+    hour: float | None = None
+
+
+def parse_fabrics(text: str | None) -> list[str]:
+    from catalog.core.resources import FABRIC_DIR  # noqa: PLC0415
+    from catalog.presets import list_presets  # noqa: PLC0415
+
+    known = [p.stem for p in list_presets(FABRIC_DIR)]
+    if not text:
+        return known
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise InputError("no fabric named", field="--fabrics")
+    for name in names:
+        if name not in known:
+            raise InputError(f"unknown fabric {name!r}; known: {', '.join(known)}",
+                             field="--fabrics")
+    if len(set(names)) != len(names):
+        raise InputError("a fabric is named twice", field="--fabrics")
+    return names
+
+
+def parse_lights(text: str | None) -> list[LightChoice]:
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+
+    names = [n.strip() for n in (text.split(",") if text else [*DEFAULT_LAMPS, SUN_TOKEN])
+             if n.strip()]
+    if not names:
+        raise InputError("no light named", field="--lights")
+    choices: list[LightChoice] = []
+    for name in names:
+        if name == SUN_TOKEN:
+            choices += [LightChoice(f"sun@{h}", f"Sun {h:02d}:00", "sun", float(h))
+                        for h in SUN_HOURS]
+            continue
+        try:
+            light = get_light(name)
+        except CatalogError:
+            import difflib  # noqa: PLC0415
+
+            from catalog.optics.lights import light_names  # noqa: PLC0415
+            close = difflib.get_close_matches(name, light_names(), n=3, cutoff=0.5)
+            hint = f" (close: {', '.join(close)})" if close else ""
+            raise InputError(f"unknown light {name!r}{hint}; `catalog lights` lists the "
+                             f"library, {SUN_TOKEN!r} adds the sun by hour",
+                             field="--lights") from None
+        choices.append(LightChoice(light.name, LAMP_LABELS.get(light.name, light.name), "lamp"))
+    ids = [c.id for c in choices]
+    if len(set(ids)) != len(ids):
+        raise InputError("a light is named twice", field="--lights")
+    return choices
+
+
+def _f32(value: float) -> float:
+    """A float32 value as the shortest decimal that gives it back (9 significant digits)."""
+    x = float(np.float32(value))
+    if not math.isfinite(x):
+        raise CatalogError(f"a recorded uniform is not finite ({value!r})")
+    return float(f"{x:.9g}")
+
+
+def _clean(value):
+    if isinstance(value, list):
+        return [_clean(v) for v in value]
+    if isinstance(value, float):
+        return _f32(value)
+    return value
+
+
+def split_commands(commands: list[dict]) -> tuple[list[dict], list]:
+    """(structure, values): every uniform command's value moved into ``values`` (in order)."""
+    structure, values = [], []
+    inverse = [_f32(1.0 / RECORD_SIZE[0]), _f32(1.0 / RECORD_SIZE[1])]
+    for command in commands:
+        if command["op"] == "uniform":
+            entry = {"op": "uniform", "program": command["program"], "name": command["name"],
+                     "slot": len(values)}
+            value = _clean(command["value"])
+            # a value that is the recorded frame's size or texel size: the page puts its own
+            if value == inverse:
+                entry["canvas"] = "texel"
+            elif value == [float(v) for v in RECORD_SIZE]:
+                entry["canvas"] = "size"
+            structure.append(entry)
+            values.append(value)
+        else:
+            structure.append(command)
+    return structure, values
+
+
+def _b64(data: bytes) -> str:
+    return base64.b64encode(data).decode("ascii")
+
+
+def fabric_facts(preset) -> dict:
+    """What the page shows of a fabric: openness, brightener, dye, weave."""
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    dye = scene_lib.dye_transmittance(preset)
+    cloth = preset.table("cloth")
+    fluorescence = preset.fluorescence
+    return {
+        "openness_pct": round(100.0 * float(preset.btdf.direct), 1),
+        "brightener": None if fluorescence is None else {
+            key: float(fluorescence.extra[key]) for key in ("quantum_yield", "peak_absorptance")
+            if key in fluorescence.extra},
+        "dye": None if preset.table("dye").get("transmittance") is None else {
+            "mean_transmittance_pct": round(100.0 * float(np.mean(dye)), 1),
+            "min_transmittance_pct": round(100.0 * float(np.min(dye)), 1)},
+        "weave": cloth.get("weave"),
+        "areal_density_g_m2": (round(1000.0 * float(cloth["areal_density_kg_m2"]), 1)
+                               if "areal_density_kg_m2" in cloth else None),
+        "g_spec": float(preset.btdf.g_spec),
+    }
+
+
+class SiteExporter:
+    """Records the desktop frame for each scene (see the module docstring)."""
+
+    def __init__(self, ctx=None):
+        from catalog.gl.context import create_headless_context  # noqa: PLC0415
+        from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+        from catalog.web.record import RecordingContext  # noqa: PLC0415
+
+        real = ctx or create_headless_context()
+        self.ctx = RecordingContext(real)
+        self.renderer = FrameRenderer(self.ctx, RECORD_SIZE, specialise=False)
+        self.meter = FrameRenderer(real, METER_SIZE)  # not recorded: meters the exposure
+        for renderer in (self.renderer, self.meter):
+            configure_desktop_frame(renderer)
+        self.structures: list[list[dict]] = []
+        self._structure_index: dict[str, int] = {}
+        self.curtain_tags: dict[int, str] = {}
+
+    # -- the curtain's buffers: found by their bytes after set_mesh
+    def use_mesh(self, positions, normals, uvs, tangents, indices) -> None:
+        arrays = {"position": positions, "normal": normals, "tangent": tangents, "uv": uvs}
+        for renderer in (self.renderer, self.meter):
+            renderer.set_mesh(positions, normals, uvs, tangents, indices)
+            renderer.set_mesh_offset((0.0, 0.0, 0.0))
+        wanted = {np.ascontiguousarray(a, dtype="f4").tobytes(): tag for tag, a in arrays.items()}
+        wanted[np.ascontiguousarray(indices, dtype="i4").ravel().tobytes()] = "index"
+        self.curtain_tags = {}
+        buffers = self.ctx.recording.buffers
+        for rid in sorted(buffers, reverse=True):  # the newest buffers are the mesh's
+            tag = wanted.get(buffers[rid])
+            if tag is not None and tag not in self.curtain_tags.values():
+                self.curtain_tags[rid] = tag
+
+    def record(self, preset, light: LightChoice, fluorescence: str,
+               ev100: float | None = None) -> dict:
+        """One scene's structure index and values; ``ev100``: its exposure (None: metered by
+        a METER_SIZE desktop frame at the default camera)."""
+        for r in (self.meter, self.renderer):
+            r.set_fabric(preset)
+            if light.kind == "sun":
+                r.set_sun_hour(light.hour)
+            else:
+                r.set_light(light.id)
+            r.set_fluorescence(FLUORESCENCE[fluorescence])
+        if ev100 is None:
+            self.meter.set_ev(None)
+            self.meter.render()
+            ev100 = self.meter.current_ev100()
+        r = self.renderer
+        r.set_ev(ev100)
+        rec = self.ctx.recording
+        rec.start()
+        r.render()
+        structure, values = split_commands(rec.stop())
+        key = hashlib.sha256(json.dumps(structure, sort_keys=True).encode()).hexdigest()
+        if key not in self._structure_index:
+            self._structure_index[key] = len(self.structures)
+            self.structures.append(structure)
+        info = r.info()
+        return {"structure": self._structure_index[key], "values": values,
+                "ev100": round(float(ev100), 6),
+                "fluorescence_variant": info["fluorescence_variant"],
+                "illuminance_lx": info["illuminance_lx"]}
+
+    def check_camera_uniforms(self, preset, light: LightChoice) -> None:
+        """Refuse a desktop frame whose other uniforms depend on the camera: the page would
+        not follow them (it computes only CAMERA_UNIFORMS)."""
+        r = self.renderer
+        saved = r.camera
+        first = self.record(preset, light, "on")
+        r.set_camera(saved.yaw_deg + 30.0, saved.pitch_deg + 20.0, saved.distance_m * 0.8)
+        second = self.record(preset, light, "on")
+        r.camera = saved
+        structure = self.structures[first["structure"]]
+        if first["structure"] != second["structure"]:
+            raise CatalogError("the desktop frame's passes change with the camera; the web "
+                               "page cannot replay that")
+        for command in structure:
+            if command["op"] == "uniform" and command["name"] not in CAMERA_UNIFORMS:
+                if first["values"][command["slot"]] != second["values"][command["slot"]]:
+                    raise CatalogError(f"uniform {command['name']} depends on the camera; the "
+                                       "web page computes only "
+                                       f"{', '.join(CAMERA_UNIFORMS)}")
+
+    def objects(self) -> dict:
+        """The GL objects the recorded structures use, as the page creates them."""
+        from catalog.gl.shaderlib import load_source  # noqa: PLC0415
+
+        rec = self.ctx.recording
+        used_vaos, used_programs, used_fbos, used_textures = set(), set(), set(), set()
+        for structure in self.structures:
+            for c in structure:
+                if c["op"] == "draw":
+                    used_vaos.add(c["vertex_array"])
+                elif c["op"] == "uniform":
+                    used_programs.add(c["program"])
+                elif c["op"] in ("framebuffer", "clear"):
+                    used_fbos.add(c["framebuffer"])
+                elif c["op"] == "texture":
+                    used_textures.add(c["texture"])
+        vaos = {rid: rec.vertex_arrays[rid] for rid in sorted(used_vaos)}
+        for vao in vaos.values():
+            for entry in vao["content"]:
+                if not all(_VERTEX_TOKEN.match(t) for t in entry["layout"].split()):
+                    raise CatalogError(f"vertex format {entry['layout']!r} of the desktop frame: "
+                                       "the web page reads only float attributes and padding")
+            if vao["index_buffer"] is not None and vao["index_element_size"] != 4:
+                raise CatalogError("the web page draws only 32-bit indices")
+        used_programs |= {v["program"] for v in vaos.values()}
+        used_buffers = {e["buffer"] for v in vaos.values() for e in v["content"]}
+        used_buffers |= {v["index_buffer"] for v in vaos.values() if v["index_buffer"]}
+        for rid in used_fbos:
+            fbo = rec.framebuffers[rid]
+            used_textures |= set(fbo["colour"])
+        sources: dict[str, dict] = {}
+        programs = {}
+        for rid in sorted(used_programs):
+            recipe = rec.programs[rid]
+            source_key = json.dumps(recipe, sort_keys=True)
+            if source_key not in sources:
+                sources[source_key] = {
+                    "vertex": load_source(recipe["vertex"], recipe["defines"], dialect="es300"),
+                    "fragment": load_source(recipe["fragment"], recipe["defines"], dialect="es300"),
+                    "files": [recipe["vertex"], recipe["fragment"]],
+                    "defines": {k: v for k, v in recipe["defines"].items()}}
+            programs[rid] = list(sources).index(source_key)
+        buffers = {}
+        for rid in sorted(used_buffers):
+            tag = self.curtain_tags.get(rid)
+            buffers[rid] = {"curtain": tag} if tag else {"data": _b64(rec.buffers[rid])}
+        return {
+            "shaders": list(sources.values()),
+            "programs": programs,
+            "buffers": buffers,
+            "textures": {rid: dict(rec.textures[rid], **({"data": _b64(rec.texture_data[rid])}
+                                                          if rid in rec.texture_data else {}))
+                         for rid in sorted(used_textures)},
+            "renderbuffers": {rid: rec.renderbuffers[rid] for rid in
+                              sorted({rec.framebuffers[f]["depth"] for f in used_fbos} - {None})},
+            "framebuffers": {rid: rec.framebuffers[rid] for rid in sorted(used_fbos)},
+            "vertex_arrays": vaos,
+        }
+
+    def release(self) -> None:
+        self.renderer.release()
+        self.meter.release()
+
+
+def swatch_png(ctx, preset, size=SWATCH_SIZE) -> bytes:
+    """A small desktop frame of the fabric under D65 (the grid's swatch), PNG bytes."""
+    import io  # noqa: PLC0415
+
+    from PIL import Image  # noqa: PLC0415
+
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    renderer = FrameRenderer(ctx, size)
+    try:
+        renderer.set_fabric(preset)
+        renderer.set_light("D65")
+        renderer.set_camera(0.0, 0.0, 1.9)
+        renderer.render()
+        pixels = renderer.read_srgb8()
+    finally:
+        renderer.release()
+    out = io.BytesIO()
+    Image.fromarray(pixels).save(out, format="PNG", optimize=True)
+    return out.getvalue()

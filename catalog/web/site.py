@@ -1,0 +1,206 @@
+"""``catalog web``: write the static catalog site, whole or not at all.
+
+The site (docs/web.md)::
+
+    DIR/index.html     the page (assets/index.html)
+    DIR/app.js         the WebGL2 replayer, camera, animation decoder and controls
+    DIR/style.css
+    DIR/data.js        window.CATALOG_DATA: shaders (GLSL ES variant), recorded frame
+                       structures and per-scene uniform values, fabrics, lights, swatches
+    DIR/anim/KEY.js    one baked cloth animation per distinct cloth parameter set, loaded
+                       by a <script> tag when a fabric is first shown
+
+Everything is a plain file read with <script>/<link> tags: it works from ``file://`` (no
+fetch of local files) and from any static host, with no network access at run time.
+It is built in a temporary folder beside ``DIR`` and renamed onto it when complete; an
+existing ``DIR`` is replaced only if it is an earlier catalog site or empty.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import tempfile
+import time
+from importlib import resources
+from pathlib import Path
+
+from catalog.core.errors import CatalogError, InputError
+
+#: The page's own files (catalog/web/assets), copied as they are.
+ASSET_FILES = ("index.html", "app.js", "style.css")
+#: A file every site has: marks a folder as ours (safe to replace).
+MARKER = "catalog-web-site.json"
+FORMAT_VERSION = 1
+
+
+def _check_out(out: Path) -> Path:
+    out = Path(out)
+    parent = out.resolve().parent
+    existing = parent
+    while not existing.exists():  # missing folders above DIR are made (and removed on failure)
+        existing = existing.parent
+    if not existing.is_dir():
+        raise InputError(f"{str(existing)!r} is a file, not a folder", field="--out")
+    if out.exists():
+        if not out.is_dir():
+            raise InputError(f"{str(out)!r} is a file, not a folder", field="--out")
+        if any(out.iterdir()) and not (out / MARKER).is_file():
+            raise InputError(f"{str(out)!r} exists and is not a catalog site; refusing to "
+                             "replace it", field="--out")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(f"folder {str(existing)!r} is not writable", field="--out")
+    return out
+
+
+@contextlib.contextmanager
+def staged_folder(out: Path):
+    """A temporary folder beside ``out``, renamed onto ``out`` when the block succeeds."""
+    parent = out.resolve().parent
+    made = []
+    folder = parent
+    while not folder.exists():
+        made.append(folder)
+        folder = folder.parent
+    try:
+        for folder in reversed(made):
+            folder.mkdir()
+        stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
+    except OSError as exc:
+        _remove_empty(made)
+        raise InputError(f"cannot write in {str(parent)!r}: {exc.strerror}", field="--out") from None
+    try:
+        yield stage
+        os.chmod(stage, 0o755 & ~_umask())
+        old = None
+        if out.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=parent))
+            os.replace(out, old / "site")
+        os.replace(stage, out)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        _remove_empty(made)
+        raise
+
+
+def _remove_empty(folders) -> None:
+    """Remove the folders we made above DIR (deepest first) when nothing was written."""
+    for folder in folders:
+        with contextlib.suppress(OSError):
+            folder.rmdir()
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _asset(name: str) -> bytes:
+    return resources.files("catalog.web").joinpath("assets", name).read_bytes()
+
+
+def build_site(out: str | Path, fabrics: str | None = None, lights: str | None = None,
+               ctx=None) -> dict:
+    """Write the site into ``out``; returns a report (sizes, counts, seconds)."""
+    import base64  # noqa: PLC0415
+
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.web import bake as bake_lib  # noqa: PLC0415
+    from catalog.web import export  # noqa: PLC0415
+
+    start = time.perf_counter()
+    out = Path(out)
+    names = export.parse_fabrics(fabrics)
+    choices = export.parse_lights(lights)
+    out = _check_out(out)
+    presets = [load_preset(find_preset(n)) for n in names]
+    for preset in presets:  # refuse a bad preset before any work
+        scene_lib.dye_transmittance(preset)
+        scene_lib.fluorescent_material(preset)
+
+    with staged_folder(out) as stage:
+        timings = {}
+        t = time.perf_counter()
+        animations = {}
+        fabric_animation = {}
+        for preset in presets:
+            from catalog.cloth.params import ClothParams  # noqa: PLC0415
+            key = bake_lib.cloth_key(ClothParams.from_preset(preset).with_changes(
+                wind_speed_m_s=bake_lib.WIND_M_S, gust_strength=bake_lib.GUST_STRENGTH))
+            if key not in animations:
+                animations[key] = bake_lib.bake(preset)
+            fabric_animation[preset.name] = animations[key].key
+        timings["bake_s"] = time.perf_counter() - t
+
+        t = time.perf_counter()
+        exporter = export.SiteExporter(ctx)
+        try:
+            first = next(iter(animations.values()))
+            positions, normals, tangents = bake_lib.decode_frame(first, 0)
+            exporter.use_mesh(positions, normals, first.uv, tangents, first.indices)
+            exporter.check_camera_uniforms(presets[0], choices[0])
+            scenes = {}
+            for preset in presets:
+                for choice in choices:
+                    on = exporter.record(preset, choice, "on")
+                    scenes[f"{preset.name}|{choice.id}|on"] = on
+                    # the switch keeps the exposure: it shows the brightener's light
+                    scenes[f"{preset.name}|{choice.id}|off"] = exporter.record(
+                        preset, choice, "off", ev100=on["ev100"])
+            objects = exporter.objects()
+            swatches = {p.name: base64.b64encode(export.swatch_png(exporter.ctx._ctx, p))
+                        .decode("ascii") for p in presets}
+        finally:
+            exporter.release()
+        timings["record_s"] = time.perf_counter() - t
+
+        camera = exporter.renderer.camera
+        data = {
+            "format": FORMAT_VERSION,
+            "record_size": list(export.RECORD_SIZE),
+            "camera": {"target": list(camera.target), "fov_y_deg": camera.fov_y_deg,
+                       "near_m": camera.near_m, "far_m": camera.far_m,
+                       "yaw_deg": camera.yaw_deg, "pitch_deg": camera.pitch_deg,
+                       "distance_m": camera.distance_m, "limits": export.ORBIT_LIMITS},
+            "camera_uniforms": export.CAMERA_UNIFORMS,
+            **objects,
+            "structures": exporter.structures,
+            "scenes": scenes,
+            "fabrics": [{"name": p.name, "display_name": p.display_name,
+                         "facts": export.fabric_facts(p), "swatch": swatches[p.name],
+                         "animation": fabric_animation[p.name]} for p in presets],
+            "lights": [{"id": c.id, "label": c.label, "kind": c.kind, "hour": c.hour}
+                       for c in choices],
+            "fluorescence": list(export.FLUORESCENCE),
+            "animations": {k: a.manifest() for k, a in animations.items()},
+        }
+        text = "window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n"
+        (stage / "data.js").write_text(text, encoding="utf-8")
+        (stage / "anim").mkdir()
+        for animation in animations.values():
+            (stage / "anim" / f"{animation.key}.js").write_text(animation.script(), encoding="utf-8")
+        for name in ASSET_FILES:
+            (stage / name).write_bytes(_asset(name))
+        sizes = {p.relative_to(stage).as_posix(): p.stat().st_size
+                 for p in sorted(stage.rglob("*")) if p.is_file()}
+        report = {"out": str(out), "fabrics": names, "lights": [c.id for c in choices],
+                  "scenes": len(scenes), "structures": len(exporter.structures),
+                  "shader_programs": len(objects["shaders"]),
+                  "animations": {k: a.manifest() for k, a in animations.items()},
+                  "bytes": sizes, "total_bytes": sum(sizes.values()),
+                  "first_view_bytes": sum(v for k, v in sizes.items() if not k.startswith("anim/"))
+                  + max(a.stat().st_size for a in (stage / "anim").iterdir()),
+                  **{k: round(v, 3) for k, v in timings.items()}}
+        (stage / MARKER).write_text(json.dumps({"format": FORMAT_VERSION, "fabrics": names,
+                                                "lights": report["lights"]}, indent=1) + "\n",
+                                    encoding="utf-8")
+    report["build_s"] = round(time.perf_counter() - start, 3)
+    if not (out / "index.html").is_file():
+        raise CatalogError(f"{out}: the site was not written")
+    return report

@@ -1,0 +1,274 @@
+"""The web catalog's Python side: the GLSL ES variant, the baked cloth codec, the recorded
+frame, the site command and its refusals. The page itself is tested in test_web_browser.py."""
+
+from __future__ import annotations
+
+import json
+import os
+import stat
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from catalog.gl import shaderlib
+
+
+# ---------------------------------------------------------------- the ES variant
+def test_es_variant_is_the_same_file_with_another_version_line():
+    """Every line of the desktop source is in the ES source, in order; only the version line
+    is replaced and the precision lines added after the defines."""
+    defines = {"N_BANDS": 3, "NV4": 1, "FLUORESCENCE_PHYSICAL": True, "SEE_THROUGH": True}
+    core = shaderlib.load_source("curtain.frag", defines).splitlines()
+    es = shaderlib.load_source("curtain.frag", defines, dialect="es300").splitlines()
+    assert core[0].startswith("#version 430") and es[0] == "#version 300 es"
+    added = [line for line in es[1:] if line not in core]
+    assert added == ["precision highp float;", "precision highp int;", "precision highp sampler2D;"]
+    assert [line for line in es[1:] if line not in added] == core[1:]
+    # the precision lines follow the defines (so a define can never be hidden by them)
+    assert es.index("#define N_BANDS 3") < es.index("precision highp float;")
+
+
+def test_es_variant_of_every_frame_shader_has_no_include_left():
+    for name in ("curtain.vert", "curtain.frag", "room.vert", "room.frag", "fullscreen.vert",
+                 "background.frag", "tonemap.frag"):
+        source = shaderlib.load_source(name, dialect="es300")
+        directives = [line.strip() for line in source.splitlines() if line.strip().startswith("#")]
+        assert not any(d.startswith("#include") for d in directives)
+        assert [d for d in directives if d.startswith("#version")] == ["#version 300 es"]
+
+
+def test_unknown_dialect_is_refused():
+    from catalog.core.errors import CatalogError
+
+    with pytest.raises(CatalogError, match="dialect"):
+        shaderlib.load_source("room.frag", dialect="es100")
+
+
+# ---------------------------------------------------------------- baked cloth codec
+def test_bake_codec_round_trip_within_its_quanta():
+    """encode -> decode_frames gives back positions within half a quantum (0.05 mm) and
+    normals/tangents within half of 1/127, for a synthetic moving grid (no simulation)."""
+    from catalog.web import bake
+
+    rng = np.random.default_rng(3)
+    f, v = 7, 50
+    p = rng.uniform(-0.7, 1.5, size=(f, v, 3))
+    n = rng.normal(size=(f, v, 3))
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    t = rng.normal(size=(f, v, 3))
+    t /= np.linalg.norm(t, axis=-1, keepdims=True)
+    lo, payload = bake.encode(p, n, t)
+    animation = bake.BakedAnimation(key="x", frames=f, fps=12.0, vertex_count=v,
+                                    indices=np.arange(3, dtype=np.uint32), uv=np.zeros((v, 2)),
+                                    offset_m=(0.1, -1.0, 0.2), lo_m=lo, payload=payload)
+    positions, normals, tangents = bake.decode_frames(animation)
+    assert positions.dtype == np.float32
+    offset = np.array([0.1, -1.0, 0.2])
+    assert np.max(np.abs(positions - (p + offset))) <= 0.5 * bake.POSITION_STEP_M + 1e-6
+    assert np.max(np.abs(normals - n)) <= 0.5 / 127 + 1e-7
+    assert np.max(np.abs(tangents - t)) <= 0.5 / 127 + 1e-7
+
+
+@pytest.mark.slow
+def test_baked_loop_is_seamless_and_small():
+    """The last frame leads into the first: its step to frame 0 is no larger than the largest
+    step inside the loop; and the encoding is at most 60 % of the raw 12 B per vertex."""
+    from catalog.presets import find_preset, load_preset
+    from catalog.web import bake
+
+    animation = bake.bake(load_preset(find_preset("voile-white")))
+    positions, _, _ = bake.decode_frames(animation)
+    steps = np.abs(np.diff(positions, axis=0)).max(axis=(1, 2))
+    wrap = np.abs(positions[0] - positions[-1]).max()
+    assert wrap <= steps.max()
+    manifest = animation.manifest()
+    assert manifest["encoded_bytes"] <= 0.6 * manifest["raw_bytes"]
+
+
+# ---------------------------------------------------------------- the recorded frame
+@pytest.mark.gl
+def test_recording_context_changes_nothing_of_the_desktop_frame(gl):
+    """The frame rendered through the recording proxy is bit-identical to the plain one, and
+    the recorded programs are the frame's files with their defines."""
+    from catalog.render.frame import FrameRenderer
+    from catalog.web.record import RecordingContext
+
+    images = []
+    for ctx in (gl, RecordingContext(gl)):
+        renderer = FrameRenderer(ctx, (48, 36), specialise=False)
+        try:
+            renderer.set_fabric("lace-fwa")
+            renderer.set_light("UV-A")
+            renderer.render()
+            images.append(renderer.read_srgb8())
+        finally:
+            renderer.release()
+    assert np.array_equal(images[0], images[1])
+    recipes = list(ctx.recording.programs.values())
+    assert {(r["vertex"], r["fragment"]) for r in recipes} >= {
+        ("curtain.vert", "curtain.frag"), ("room.vert", "room.frag"),
+        ("fullscreen.vert", "background.frag"), ("fullscreen.vert", "tonemap.frag")}
+
+
+@pytest.mark.gl
+def test_recording_context_refuses_what_the_page_cannot_replay(gl):
+    """A context call the page has no command for fails loudly (never a silent difference);
+    texels a frame gives a texture are kept for the page."""
+    from catalog.core.errors import CatalogError
+    from catalog.web.record import RecordingContext
+
+    ctx = RecordingContext(gl)
+    with pytest.raises(CatalogError, match="copy_framebuffer"):
+        ctx.copy_framebuffer(None, None)
+    with pytest.raises(CatalogError, match="wireframe"):
+        ctx.wireframe = True
+    texels = bytes(range(16))
+    texture = ctx.texture((2, 2), 4, texels)
+    assert ctx.recording.texture_data[texture.rid] == texels
+    texture.release()
+
+
+@pytest.mark.gl
+def test_split_commands_keeps_every_uniform_value_in_order(gl):
+    from catalog.render.frame import FrameRenderer
+    from catalog.web.export import split_commands
+    from catalog.web.record import RecordingContext
+
+    ctx = RecordingContext(gl)
+    renderer = FrameRenderer(ctx, (16, 12), specialise=False)
+    try:
+        renderer.set_fabric("fluoro-pink")
+        renderer.set_light("D65")
+        ctx.recording.start()
+        renderer.render()
+        commands = ctx.recording.stop()
+    finally:
+        renderer.release()
+    structure, values = split_commands(commands)
+    uniforms = [c for c in commands if c["op"] == "uniform"]
+    assert len(values) == len(uniforms) > 20
+    assert [c["slot"] for c in structure if c["op"] == "uniform"] == list(range(len(values)))
+    # float32-exact: 9 significant digits give the same float32
+    for command, value in zip(uniforms, values):
+        assert np.array_equal(np.float32(command["value"]), np.float32(value))
+    # every other command kept as it was, in order (room, curtain, background, display ...)
+    assert [c for c in structure if c["op"] != "uniform"] == \
+        [c for c in commands if c["op"] != "uniform"]
+    assert sum(c["op"] == "draw" for c in structure) >= 4
+
+
+# ---------------------------------------------------------------- the command
+def _run_web(*args, env=None):
+    return subprocess.run([sys.executable, "-m", "catalog", "web", *args], capture_output=True,
+                          text=True, env=env, timeout=600)
+
+
+def test_unknown_fabric_one_line_exit_2_nothing_written(tmp_path):
+    out = tmp_path / "site"
+    result = _run_web("--out", str(out), "--fabrics", "no-such-cloth")
+    assert result.returncode == 2
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert "no-such-cloth" in result.stderr and "--fabrics" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unknown_light_one_line_exit_2_nothing_written(tmp_path):
+    out = tmp_path / "site"
+    result = _run_web("--out", str(out), "--fabrics", "voile-white", "--lights", "D65,D99")
+    assert result.returncode == 2
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert "D99" in result.stderr and "--lights" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_unwritable_folder_one_line_exit_2(tmp_path):
+    parent = tmp_path / "ro"
+    parent.mkdir()
+    parent.chmod(stat.S_IRUSR | stat.S_IXUSR)
+    try:
+        result = _run_web("--out", str(parent / "site"), "--fabrics", "voile-white")
+    finally:
+        parent.chmod(stat.S_IRWXU)
+    assert result.returncode == 2
+    assert len(result.stderr.strip().splitlines()) == 1 and "not writable" in result.stderr
+    assert list(parent.iterdir()) == []
+
+
+def test_unwritable_folder_refused_before_any_work(tmp_path, monkeypatch):
+    """The same refusal through the library, where the test runs as root: the writability
+    check is made (os.access says no) before anything is baked or written."""
+    from catalog.core.errors import InputError
+    from catalog.web import site
+
+    real_access = os.access
+    monkeypatch.setattr(site.os, "access",
+                        lambda p, mode: False if str(p) == str(tmp_path) else real_access(p, mode))
+    with pytest.raises(InputError, match="not writable"):
+        site.build_site(tmp_path / "site", fabrics="voile-white", lights="D65")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_foreign_folder_is_not_replaced(tmp_path):
+    out = tmp_path / "photos"
+    out.mkdir()
+    (out / "holiday.jpg").write_bytes(b"x")
+    result = _run_web("--out", str(out), "--fabrics", "voile-white", "--lights", "D65")
+    assert result.returncode == 2 and "not a catalog site" in result.stderr
+    assert [p.name for p in out.iterdir()] == ["holiday.jpg"]
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_failure_midway_leaves_no_site_and_no_stage(tmp_path, monkeypatch):
+    """An error after the work began (here: while recording) leaves neither DIR, nor the
+    staging folder beside it, nor the missing folders above DIR that the build made."""
+    from catalog.core.errors import CatalogError
+    from catalog.web import export, site
+
+    def broken(*args, **kw):
+        raise CatalogError("recording failed")
+
+    monkeypatch.setattr(export.SiteExporter, "record", broken)
+    with pytest.raises(CatalogError, match="recording failed"):
+        site.build_site(tmp_path / "made" / "for it" / "site", fabrics="voile-white",
+                        lights="D65")
+    assert list(tmp_path.iterdir()) == []  # the folders made above DIR are gone too
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_a_second_build_replaces_an_earlier_site_whole(tmp_path):
+    from catalog.web import site
+
+    out = tmp_path / "site"
+    site.build_site(out, fabrics="voile-white", lights="D65")
+    (out / "stale.txt").write_text("from the first build")
+    report = site.build_site(out, fabrics="voile-white", lights="A")
+    assert not (out / "stale.txt").exists()
+    assert json.loads((out / site.MARKER).read_text())["lights"] == ["A"] == report["lights"]
+    assert [p.name for p in tmp_path.iterdir()] == ["site"]  # no stage or old copy left
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_site_is_whole(web_site):
+    """index.html, app.js, data.js, one animation per cloth parameter set; data.js holds
+    every fabric x light x fluorescence scene and only ES shaders."""
+    out, report = web_site
+    names = {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()}
+    assert {"index.html", "app.js", "style.css", "data.js", "catalog-web-site.json"} <= names
+    text = (out / "data.js").read_text()
+    assert text.startswith("window.CATALOG_DATA = ")
+    data = json.loads(text[len("window.CATALOG_DATA = "):].rstrip().rstrip(";"))
+    assert len(data["scenes"]) == len(report["fabrics"]) * len(report["lights"]) * 2
+    for shader in data["shaders"]:
+        assert shader["vertex"].startswith("#version 300 es")
+        assert shader["fragment"].startswith("#version 300 es")
+    for fabric in data["fabrics"]:
+        assert (out / "anim" / f"{fabric['animation']}.js").is_file()
+    # no reference to the network or to fetch in the page's code
+    page = (out / "app.js").read_text() + (out / "index.html").read_text()
+    assert "http://" not in page and "https://" not in page and "fetch(" not in page
