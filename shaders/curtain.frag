@@ -8,21 +8,24 @@
 // share one division; constants are summed at compile time (SPECIALISED). docs/render.md has
 // the measured cost of each step.
 #include "common.glsl"
+#ifndef INTERPOLATION
+#define INTERPOLATION              // centroid on the MSAA path (curtain.vert says why)
+#endif
 
-in vec3 v_view_ray;                // position - camera, world space
-in vec3 v_normal;
+INTERPOLATION in vec3 v_view_ray;                // position - camera, world space
+INTERPOLATION in vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
-in vec3 v_tangent;
+INTERPOLATION in vec3 v_tangent;
 #endif
 #ifdef PATTERN
-in vec2 v_pattern_uv;              // in pattern repeats
+INTERPOLATION in vec2 v_pattern_uv;              // in pattern repeats
 uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to the threads alone
 #endif
 #ifdef OIT
 uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
 #ifdef GBUFFER
-in vec3 v_position;
+INTERPOLATION in vec3 v_position;
 #endif
 
 // The scene's values, fixed until the light, fabric, mode or band count changes. SPECIALISED:

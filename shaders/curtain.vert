@@ -5,26 +5,32 @@
 // linear in the position, so it is formed here and interpolated exactly: the fragment shader
 // then needs no per-frame uniform. The tangent travels only where it is used. PATTERN: the
 // fabric's texture coordinates in pattern repeats (catalog/presets/patterns.py) for curtain.frag.
+// INTERPOLATION: empty, or ``centroid`` on the MSAA path (frame.py), where a pixel whose centre
+// lies outside the triangle is shaded once for its covered samples: its attributes must
+// come from inside the triangle, not extrapolated past a fold's silhouette.
+#ifndef INTERPOLATION
+#define INTERPOLATION
+#endif
 in vec3 in_position;
 in vec3 in_normal;
 in vec3 in_tangent;
 #ifdef PATTERN
 in vec2 in_uv;                       // 0..1 across the fabric (u: weft), 0..1 along it (v: warp)
 uniform vec2 u_uv_to_repeats;        // fabric size / pattern repeat: uv -> pattern repeats
-out vec2 v_pattern_uv;
+INTERPOLATION out vec2 v_pattern_uv;
 #endif
 
 uniform mat4 u_view_proj;
 uniform vec3 u_mesh_offset;
 uniform vec3 u_camera_position;
 
-out vec3 v_view_ray;
-out vec3 v_normal;
+INTERPOLATION out vec3 v_view_ray;
+INTERPOLATION out vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
-out vec3 v_tangent;
+INTERPOLATION out vec3 v_tangent;
 #endif
 #ifdef GBUFFER
-out vec3 v_position;
+INTERPOLATION out vec3 v_position;
 #endif
 
 void main() {

@@ -85,7 +85,8 @@ def test_mip_far_limit_is_the_fitted_open_area(gl, path):
 
 # --- layers: weighted blended OIT against sorted compositing --------------------------------
 
-def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset):
+@pytest.mark.parametrize("antialiasing", ["auto", "msaa"])
+def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, antialiasing):
     """Two overlapping layers of a flat cloth (coverage a = 1 - LD = 0.6 each), the back one
     tilted 35 deg so the layers' radiances C1, C2 differ. Sorted compositing gives
     I = a C1 + (1 - a)(a C2 + (1 - a) B). Weighted blended OIT gives the layers' weighted
@@ -93,8 +94,12 @@ def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset):
     a (1 - a)(C1 - C2) when the front layer's weight dominates; the depth weight lies
     between, so (docs/pattern.md) |I_oit - I_sorted| <= max(a^2 / 2, a (1 - a)) |C1 - C2|
     + 1e-3 I_sorted per pixel and channel; and the open fraction behind two layers is
-    (1 - a)^2 within 1e-5."""
+    (1 - a)^2 within 1e-5. ``msaa``: the same with the HDR and OIT targets multisampled
+    (resolved before the composite: the interior's samples agree, so the same bounds)."""
+    if antialiasing == "msaa" and int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
+        pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
     renderer = FrameRenderer(gl, (96, 72))
+    renderer.set_antialiasing(antialiasing)
     renderer.set_fabric(make_preset("layer", direct=0.4, fluorescent=False))
     renderer.set_light("D65")
     renderer.set_camera(0.0, 0.0, 1.6)
@@ -323,11 +328,13 @@ def test_a_slow_dolly_does_not_shimmer(gl):
 
 # --- anti-aliasing ----------------------------------------------------------------------------
 
-def test_fxaa_brings_edges_closer_to_a_supersampled_frame(gl):
-    """The lace's frame at 96x72 with FXAA and without, against the same frame rendered at
-    4x4 the pixels and box-filtered down in linear light (the supersampled reference). On
-    the pixels where aliasing shows (the unfiltered frame differs from the reference by more
-    than 8 levels of 255), FXAA's mean error is at most 0.8 times the unfiltered one."""
+@pytest.mark.parametrize("mode", ["fxaa", "msaa"])
+def test_antialiasing_brings_edges_closer_to_a_supersampled_frame(gl, mode):
+    """The lace's frame at 96x72 with FXAA (or MSAA 4x: HDR and OIT targets multisampled)
+    and without, against the same frame rendered at 4x4 the pixels and box-filtered down in
+    linear light (the supersampled reference). On the pixels where aliasing shows (the
+    unfiltered frame differs from the reference by more than 8 levels of 255), the
+    anti-aliased frame's mean error is at most 0.8 times the unfiltered one."""
     from catalog.optics.colorimetry import srgb_encode
 
     def frame(size, mode):
@@ -345,11 +352,124 @@ def test_fxaa_brings_edges_closer_to_a_supersampled_frame(gl):
     linear = srgb_decode(big / 255.0).reshape(72, 4, 96, 4, 3).mean(axis=(1, 3))
     reference = 255.0 * srgb_encode(linear)
     plain = frame((96, 72), "off")
-    fxaa = frame((96, 72), "fxaa")
+    if mode == "msaa" and int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
+        pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
+    fxaa = frame((96, 72), mode)
     edges = np.abs(plain - reference).max(axis=-1) > 8.0
     assert edges.sum() > 50
     error_plain = float(np.abs(plain - reference)[edges].mean())
     error_fxaa = float(np.abs(fxaa - reference)[edges].mean())
     print(f"edge pixels {int(edges.sum())}: mean error {error_plain:.2f} levels without, "
-          f"{error_fxaa:.2f} with FXAA")
+          f"{error_fxaa:.2f} with {mode}")
     assert error_fxaa <= 0.8 * error_plain
+
+
+def test_auto_antialiasing_takes_msaa_on_a_gpu_and_fxaa_on_a_cpu_rasteriser(gl):
+    """The rule of choose_antialiasing: MSAA needs 4 samples and a GPU (multisampling on a
+    CPU rasteriser shades and blends every sample: benchmarks/bench_pattern.json)."""
+    from catalog.render.frame import choose_antialiasing
+
+    assert choose_antialiasing({"GL_RENDERER": "NVIDIA H200/PCIe/SSE2", "GL_MAX_SAMPLES": 32}) == "msaa"
+    assert choose_antialiasing({"GL_RENDERER": "NVIDIA H200/PCIe/SSE2", "GL_MAX_SAMPLES": 2}) == "fxaa"
+    assert choose_antialiasing({"GL_RENDERER": "llvmpipe (LLVM 15.0.6, 256 bits)",
+                                "GL_MAX_SAMPLES": 4}) == "fxaa"
+    renderer = FrameRenderer(gl, (32, 24))
+    assert renderer.antialiasing == choose_antialiasing(gl.info)
+    renderer.release()
+
+
+def test_msaa_keeps_the_curtain_interior_and_the_layers(gl):
+    """MSAA changes edges only: over the curtain's interior (pixels whose 3x3 neighbourhood
+    is curtain in the G-buffer mask) the resolved HDR radiance equals the one-sample frame's
+    within 2 % (mean relative difference; the composite after the resolve is the same
+    equation on per-pixel means)."""
+    if int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
+        pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
+    renderer = FrameRenderer(gl, (96, 72))
+    renderer.set_fabric("voile-white")
+    renderer.set_light("D65")
+    renderer.set_ev(10.0)
+    mask = renderer.render_gbuffer()["mask"]
+    interior = mask.copy()
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            interior &= np.roll(np.roll(mask, dy, axis=0), dx, axis=1)
+    assert interior.sum() > 500
+    images = {}
+    for mode in ("off", "msaa"):
+        renderer.set_antialiasing(mode)
+        renderer.render()
+        images[mode] = renderer.read_linear().astype(np.float64)
+    y = {k: v @ [0.2126, 0.7152, 0.0722] for k, v in images.items()}
+    rel = np.abs(y["msaa"] - y["off"])[interior] / np.maximum(y["off"][interior], 1e-9)
+    print(f"MSAA vs 1 sample over {int(interior.sum())} interior pixels: mean relative "
+          f"difference {rel.mean():.4f}")
+    assert rel.mean() < 0.02
+    renderer.release()
+
+
+def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl):
+    """The settled lace at 320x180, MSAA against one sample, over the curtain's interior
+    (pixels whose 5x5 neighbourhood is curtain in the G-buffer mask: the folds' silhouettes
+    inside it, not its outline against the room, where coverage alone may differ by a
+    column): a resolved pixel averages samples that each see what the one-sample frame sees
+    within a pixel, so its luma stays below the one-sample frame's 3x3 neighbourhood maximum
+    + 10 levels of 255 (margin for sub-pixel detail and the tone curve). Attributes
+    extrapolated past a fold's silhouette (a pixel centre outside the triangle, without
+    ``centroid``) broke this: 17 pixels, up to +28."""
+    if int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
+        pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
+    from catalog.render.snapshot import simulated_curtain
+
+    preset = load_preset(FABRIC_DIR / "lace-fwa.toml")
+    *settled, fabric_size = simulated_curtain(preset, 0)
+    luma = {}
+    mask = None
+    for mode in ("off", "msaa"):
+        renderer = FrameRenderer(gl, (320, 180))
+        try:
+            renderer.set_fabric(preset)
+            renderer.set_light("D65")
+            renderer.set_mesh(*settled, fabric_size_m=fabric_size)
+            renderer.set_ev(11.5)
+            renderer.set_antialiasing(mode)
+            if mask is None:
+                mask = renderer.render_gbuffer()["mask"]
+            renderer.render()
+            luma[mode] = renderer.read_srgb8().astype(np.float64) @ [0.2126, 0.7152, 0.0722]
+        finally:
+            renderer.release()
+    inner = mask.copy()
+    for dy in range(-2, 3):
+        for dx in range(-2, 3):
+            inner &= np.roll(np.roll(mask, dy, axis=0), dx, axis=1)
+    assert inner.sum() > 5000
+    pad = np.pad(luma["off"], 1, mode="edge")
+    h, w = luma["off"].shape
+    ceiling = np.max([pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w]
+                      for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+    excess = (luma["msaa"] - ceiling)[inner]
+    print(f"MSAA above the one-sample 3x3 maximum over {int(inner.sum())} interior pixels: "
+          f"at most {excess.max():.1f} levels")
+    assert excess.max() < 10.0
+
+
+def test_fxaa_and_the_msaa_curtain_vertex_shader_compile_as_glsl_es_300(tmp_path):
+    """fxaa.frag (texel fetches, the blend in the shader) and curtain.vert's MSAA variant
+    (centroid outputs), with the #version line swapped for ES 3.00, pass glslangValidator."""
+    import shutil
+    import subprocess
+
+    from catalog.gl.shaderlib import load_source
+
+    validator = shutil.which("glslangValidator")
+    if validator is None:
+        pytest.fail("glslangValidator missing: tools/setup.sh installs glslang-tools")
+    for name, defines in (("fxaa.frag", {}),
+                          ("curtain.vert", {"INTERPOLATION": "centroid", "PATTERN": True})):
+        lines = load_source(name, defines).splitlines()
+        path = tmp_path / f"es_{name}"
+        path.write_text("\n".join(["#version 300 es", "precision highp float;",
+                                   "precision highp int;", *lines[1:]]) + "\n")
+        result = subprocess.run([validator, str(path)], capture_output=True, text=True)
+        assert result.returncode == 0, f"{name}: {result.stdout}"

@@ -1,17 +1,24 @@
 """Issue 12's frame cost: patterns, layers (OIT) and anti-aliasing against the frame before.
 
 Side by side in one run, on the same context, medians of interleaved repeats (GL finished
-before each clock read):
+before each clock read); issue 13's room light, sky model and glare are off on every side
+(``catalog.bench.room`` measures those):
 
 - ``before``: the flat cloth (``patterned = False``: opaque, LD x background by ray
   direction), no anti-aliasing, the static sinusoidal drape: the frame as it was;
 - ``patterned (static drape)``: the same mesh with the pattern texture, OIT and FXAA;
 - ``patterned (settled drape)``: what ``catalog snapshot`` now draws: the pleated drape
   (96 x 56 grid), pattern, OIT, FXAA;
+- ``patterned + OIT + MSAA 4x (settled drape)``: the MSAA path (HDR, depth and both OIT
+  targets at 4 samples, resolved before the composite) instead of FXAA: the two
+  anti-aliasing paths side by side, and ``choice``: what ``auto`` takes on this context;
 - ``MSAA 4x (flat)`` against ``1x (flat)``: the HDR passes of the flat frame into a 4-sample
   float target and resolved, against one sample: what multisampling costs llvmpipe before
-  any OIT target is multisampled (the reason FXAA was chosen);
-- ``FXAA pass``: the post-process alone (frame with FXAA minus frame without).
+  any OIT target is multisampled;
+- ``FXAA pass``: the post-process alone (frame with FXAA minus frame without);
+- ``... with the first FXAA``: the settled frame with issue 12's first FXAA shader (six
+  bilinear reads, catalog/bench/shaders/fxaa_filtered.frag) instead of today's (five texel
+  fetches, the blend in the shader): what that rewrite saved, in the same run.
 
 :func:`markdown_tables` renders the JSON as the tables of docs/pattern.md and BENCHMARKS.md.
 """
@@ -39,12 +46,12 @@ def _clock(ctx, draw, repeats: int) -> list[float]:
 def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = None) -> dict:
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
-    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.frame import MSAA_SAMPLES, FrameRenderer, choose_antialiasing  # noqa: PLC0415
     from catalog.render.scene import draped_curtain  # noqa: PLC0415
     from catalog.render.snapshot import simulated_curtain  # noqa: PLC0415
 
     ctx = ctx or create_headless_context()
-    repeats = repeats or (3 if quick else 7)
+    repeats = repeats or (3 if quick else 11)
     if quick:
         size = (320, 180)
     preset = load_preset(find_preset(FABRIC))
@@ -53,10 +60,16 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     renderer = FrameRenderer(ctx, size)
     renderer.set_fabric(preset)
     renderer.set_light(LIGHT)
+    # issue 13's room light, sky and glare off on both sides: issue 12's additions alone
+    # (catalog.bench.room measures those against the frame without them)
+    renderer.set_room_lighting(False)
+    renderer.set_sky_model(False)
+    renderer.set_bloom(False)
 
     def configure(patterned, aa, mesh):
         renderer.set_patterned(patterned)
-        renderer.set_antialiasing(aa)
+        renderer.fxaa_shader = "fxaa_filtered.frag" if aa == "fxaa-filtered" else "fxaa.frag"
+        renderer.set_antialiasing("fxaa" if aa == "fxaa-filtered" else aa)
         if mesh == "static":
             renderer.set_mesh(static.positions, static.normals, static.uvs, static.tangents,
                               static.indices)
@@ -68,7 +81,11 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
         "patterned + OIT, no AA (static drape)": (True, "off", "static"),
         "patterned + OIT + FXAA (static drape)": (True, "fxaa", "static"),
         "patterned + OIT + FXAA (settled drape)": (True, "fxaa", "settled"),
+        "... with the first FXAA (6 filtered reads)": (True, "fxaa-filtered", "settled"),
     }
+    msaa_case = "patterned + OIT + MSAA 4x (settled drape)"
+    if int(ctx.info.get("GL_MAX_SAMPLES", 0) or 0) >= MSAA_SAMPLES:
+        cases[msaa_case] = (True, "msaa", "settled")
     samples: dict[str, list[float]] = {name: [] for name in cases}
     for name, case in cases.items():       # warm-up: compile every program once
         configure(*case)
@@ -104,37 +121,58 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
         msaa_samples["1x (flat HDR passes)"] += _clock(ctx, hdr_single, 1)
         msaa_samples["MSAA 4x (flat HDR passes + resolve)"] += _clock(ctx, hdr_msaa, 1)
     renderer._hdr_fbo = single_fbo
+    single_fbo.use()   # never leave a released framebuffer bound (the context is the caller's)
     for obj in (msaa_fbo, msaa_colour, msaa_depth):
         obj.release()
     renderer.release()
     del moderngl
 
-    def row(name, times, base):
+    def row(name, times, base, base_times=None):
         median = statistics.median(times)
-        return {"case": name, "median_ms": round(1e3 * median, 2),
-                "best_ms": round(1e3 * min(times), 2),
-                "ratio_to_before": round(median / base, 3)}
+        out = {"case": name, "median_ms": round(1e3 * median, 2),
+               "best_ms": round(1e3 * min(times), 2),
+               "ratio_to_before": round(median / base, 3)}
+        if base_times is not None:   # each round's own ratio (same load), their median
+            out["round_ratio"] = round(statistics.median(
+                t / b for t, b in zip(times, base_times)), 3)
+        return out
 
     base = statistics.median(samples["before (flat, no AA, static drape)"])
-    rows = [row(name, times, base) for name, times in samples.items()]
+    before_times = samples["before (flat, no AA, static drape)"]
+    rows = [row(name, times, base, before_times) for name, times in samples.items()]
+    by_case = {r["case"]: r for r in rows}
+    fxaa_row = by_case["patterned + OIT + FXAA (settled drape)"]
     msaa_base = statistics.median(msaa_samples["1x (flat HDR passes)"])
     msaa_rows = [row(name, times, msaa_base) for name, times in msaa_samples.items()]
     fxaa_ms = (statistics.median(samples["patterned + OIT + FXAA (static drape)"])
                - statistics.median(samples["patterned + OIT, no AA (static drape)"])) * 1e3
+    msaa_row = by_case.get(msaa_case)
     return {"size": list(size), "repeats": repeats, "fabric": FABRIC, "light": LIGHT,
             "gl": describe(ctx), "rows": rows, "msaa_rows": msaa_rows,
-            "summary": {"frame_ratio": rows[-1]["ratio_to_before"],
+            "summary": {"frame_ratio": fxaa_row["ratio_to_before"],
+                        "frame_round_ratio": fxaa_row["round_ratio"],
+                        "frame_ratio_best": round(fxaa_row["best_ms"] / by_case[
+                            "before (flat, no AA, static drape)"]["best_ms"], 3),
+                        "msaa_frame_ratio": msaa_row["ratio_to_before"] if msaa_row else None,
                         "msaa_ratio": msaa_rows[1]["ratio_to_before"],
-                        "fxaa_ms": round(fxaa_ms, 2)}}
+                        "fxaa_ms": round(fxaa_ms, 2),
+                        "choice": choose_antialiasing(dict(ctx.info))}}
 
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """``pattern_cost`` and ``pattern_msaa``: NAME -> markdown table."""
     w, h = result["size"]
     lines = [f"| frame at {w}x{h} ({result['fabric']}, {result['light']}) | median ms | best ms "
-             f"| / before |", "|---|---|---|---|"]
+             f"| / before (medians) | / before (median of rounds) |", "|---|---|---|---|---|"]
     lines += [f"| {r['case']} | {r['median_ms']:.1f} | {r['best_ms']:.1f} | "
-              f"{r['ratio_to_before']:.2f} |" for r in result["rows"]]
+              f"{r['ratio_to_before']:.2f} | {r.get('round_ratio', float('nan')):.2f} |"
+              for r in result["rows"]]
+    summary = result["summary"]
+    lines.append("")
+    lines.append(f"Whole frame / before: {summary.get('frame_round_ratio', float('nan')):.2f} "
+                 f"(median of the rounds' ratios), {summary['frame_ratio']:.2f} (medians), "
+                 f"{summary.get('frame_ratio_best', float('nan')):.2f} (best rounds); "
+                 f"`auto` anti-aliasing takes **{summary.get('choice', 'fxaa')}** on this context.")
     msaa = ["| HDR passes of the flat frame | median ms | / 1x |", "|---|---|---|"]
     msaa += [f"| {r['case']} | {r['median_ms']:.1f} | {r['ratio_to_before']:.2f} |"
              for r in result["msaa_rows"]]

@@ -28,9 +28,13 @@ Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 4. display (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
    target): exposure (EV100, fixed or metered from a luminance histogram of this frame),
    white balance (CAT16), tone curve, gamut compression in OKLab, the sRGB curve
-   (:mod:`catalog.render.display`, docs/display.md).; then FXAA
-   (fxaa.frag, issue 12) on the display image; ``set_antialiasing("off")`` displays straight
-   into the target.
+   (:mod:`catalog.render.display`, docs/display.md); then FXAA (fxaa.frag, issue 12) on
+   the display image; ``set_antialiasing("off")`` displays straight into the target.
+
+Anti-aliasing (:meth:`FrameRenderer.set_antialiasing`, default ``auto``): FXAA (step 4), or
+MSAA where the context has MSAA_SAMPLES samples and is a GPU (:func:`choose_antialiasing`):
+steps 1-3 then draw into multisampled targets (the OIT targets too), resolved before the
+OIT composite.
 """
 
 from __future__ import annotations
@@ -54,8 +58,16 @@ METER_MAX_SIDE_PX = 96
 #: blurs' weights (mip levels 1..6, wider blurs weighted less; normalised to sum 1).
 BLOOM_STRENGTH = 0.04
 BLOOM_LEVEL_WEIGHTS = (0.30, 0.24, 0.18, 0.13, 0.09, 0.06)
-#: Anti-aliasing of the display image: a post-process (shaders/fxaa.frag) or none.
-ANTIALIASING_MODES = ("fxaa", "off")
+#: Anti-aliasing: a post-process on the display image (shaders/fxaa.frag), multisampling of
+#: the HDR passes (the OIT targets too, resolved before the composite), none, or ``auto``
+#: (:func:`choose_antialiasing`: by the context's GL_MAX_SAMPLES and the cost rule).
+ANTIALIASING_MODES = ("auto", "fxaa", "msaa", "off")
+#: Samples per pixel of the MSAA path.
+MSAA_SAMPLES = 4
+#: Renderer strings of CPU rasterisers: there MSAA multiplies the HDR passes' cost (each
+#: sample shaded and blended in float: 3.5x the flat frame's HDR passes on llvmpipe, where
+#: FXAA costs a fifth of the frame; benchmarks/bench_pattern.json), so ``auto`` takes FXAA.
+SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "swrast", "lavapipe", "swiftshader")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
 #: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
@@ -102,6 +114,18 @@ def gl_size_limit(ctx) -> int:
     if dims:
         limit = min(limit, *(int(d) for d in dims))
     return limit
+
+
+def choose_antialiasing(info: dict) -> str:
+    """``auto``'s choice for a context (``ctx.info`` plus ``GL_RENDERER``): ``msaa`` where
+    the context multisamples float targets with at least MSAA_SAMPLES samples
+    (GL_MAX_SAMPLES) on a GPU, where multisampling is paid in bandwidth, not shading;
+    ``fxaa`` on CPU rasterisers (the measured cost rule) and where samples are lacking."""
+    renderer = str(info.get("GL_RENDERER", "")).lower()
+    samples = int(info.get("GL_MAX_SAMPLES", 0) or 0)
+    if samples < MSAA_SAMPLES or any(name in renderer for name in SOFTWARE_RASTERISERS):
+        return "fxaa"
+    return "msaa"
 
 
 def check_size(size, ctx=None) -> tuple[int, int]:
@@ -164,12 +188,16 @@ class FrameRenderer:
         self._hdr_fbo = ctx.framebuffer([self._hdr], self._depth)
         self._ldr = ctx.texture((w, h), 4)
         self._ldr_fbo = ctx.framebuffer([self._ldr])
-        # the tone-mapped image before FXAA (read bilinearly by fxaa.frag)
+        # the tone-mapped image before FXAA (fxaa.frag reads texels; LINEAR for the
+        # benchmark's earlier FXAA of filtered reads, FXAA_SHADER)
         self._pre = ctx.texture((w, h), 4)
         self._pre.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self._pre.repeat_x = self._pre.repeat_y = False
         self._pre_fbo = ctx.framebuffer([self._pre])
         self.antialiasing = "fxaa"
+        self.fxaa_shader = "fxaa.frag"   # the benchmark swaps in its earlier version
+        self._msaa = None                # the multisampled targets, made on first use
+        self.set_antialiasing("auto")
         self._gbuffer = None
         # weighted blended OIT: sum C a w | prod (1 - a), and sum a w; the scene's depth
         self._oit_accum = ctx.texture((w, h), 4, dtype="f4")
@@ -573,6 +601,8 @@ class FrameRenderer:
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
                    "GBUFFER": gbuffer, "SPECIALISED": self.specialise,
                    "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
+        if self.antialiasing == "msaa" and not gbuffer:
+            defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
             # the holes are drawn by the OIT composite: no see-through term in the shader
             defines.update({"PATTERN": True, "OIT": True, "SEE_THROUGH": False})
@@ -1176,9 +1206,11 @@ class FrameRenderer:
             self._timed(profile, "room_shadow", lambda: self.draw_room_shadow(inputs))
             self._timed(profile, "room_luminaire", lambda: self.draw_room_luminaire(inputs))
             self._timed(profile, "room_lightmap", lambda: self.draw_room_lightmap(inputs))
-        self._hdr_fbo.use()
+        msaa = self._msaa_targets() if self.antialiasing == "msaa" else None
+        hdr_fbo = msaa["hdr_fbo"] if msaa else self._hdr_fbo
+        hdr_fbo.use()
         self.ctx.viewport = (0, 0, vw, vh)
-        self._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
+        hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0, viewport=(0, 0, vw, vh))
         self.ctx.disable(mgl.BLEND)
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<="
@@ -1189,7 +1221,9 @@ class FrameRenderer:
         # on the far plane: the depth test leaves only the pixels nothing covers
         self._timed(profile, "background", lambda: self._draw_background(view_proj, inputs))
         if not self.curtain_open and self.patterned:
-            self._timed(profile, "curtain", lambda: self._draw_curtain_oit(view_proj, vw, vh))
+            self._timed(profile, "curtain", lambda: self._draw_curtain_oit(view_proj, vw, vh, msaa))
+        elif msaa:
+            self.ctx.copy_framebuffer(self._hdr_fbo, msaa["hdr_fbo"])   # resolve
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
@@ -1218,12 +1252,42 @@ class FrameRenderer:
         the curtain can be (the camera's distance to its target less a metre)."""
         return max(0.0, self.camera.distance_m - 1.0)
 
-    def _draw_curtain_oit(self, view_proj, vw: int, vh: int) -> None:
+    def _msaa_targets(self) -> dict:
+        """The MSAA path's targets (MSAA_SAMPLES float renderbuffers: HDR, depth, the two OIT
+        targets) and single-target framebuffers to resolve them from, made once."""
+        if self._msaa is None:
+            ctx, size, n = self.ctx, self.size, MSAA_SAMPLES
+            hdr = ctx.renderbuffer(size, 4, samples=n, dtype="f4")
+            depth = ctx.depth_renderbuffer(size, samples=n)
+            accum = ctx.renderbuffer(size, 4, samples=n, dtype="f4")
+            weight = ctx.renderbuffer(size, 1, samples=n, dtype="f4")
+            oit_fbo = ctx.framebuffer([accum, weight], depth)
+            oit_fbo.depth_mask = False
+            self._msaa = {
+                "objects": [hdr, depth, accum, weight],
+                "hdr_fbo": ctx.framebuffer([hdr], depth), "oit_fbo": oit_fbo,
+                "accum_src": ctx.framebuffer([accum]), "weight_src": ctx.framebuffer([weight]),
+                "accum_dst": ctx.framebuffer([self._oit_accum]),
+                "weight_dst": ctx.framebuffer([self._oit_weight]),
+            }
+        return self._msaa
+
+    def _release_msaa(self) -> None:
+        if self._msaa is not None:
+            for name in ("hdr_fbo", "oit_fbo", "accum_src", "weight_src", "accum_dst", "weight_dst"):
+                self._msaa[name].release()
+            for obj in self._msaa["objects"]:
+                obj.release()
+            self._msaa = None
+
+    def _draw_curtain_oit(self, view_proj, vw: int, vh: int, msaa: dict | None = None) -> None:
         """The curtain's layers into the OIT targets (depth-tested against the room, not
-        written), then resolved over the HDR target."""
+        written), then resolved over the HDR target. ``msaa``: into the multisampled targets,
+        each resolved (averaged over the samples) before the composite: at an edge pixel the
+        composite takes the samples' mean layer colour, revealage and background."""
         mgl = self._moderngl
         ctx = self.ctx
-        self._oit_fbo.use()
+        (msaa["oit_fbo"] if msaa else self._oit_fbo).use()
         ctx.viewport = (0, 0, vw, vh)
         ctx.clear(0.0, 0.0, 0.0, 1.0, viewport=(0, 0, vw, vh))   # accum: revealage 1
         # clear() wrote (0, 0, 0, 1) into both targets: the weight target's alpha is unused
@@ -1231,6 +1295,13 @@ class FrameRenderer:
         ctx.blend_equation = mgl.FUNC_ADD
         ctx.blend_func = (mgl.ONE, mgl.ONE, mgl.ZERO, mgl.ONE_MINUS_SRC_ALPHA)
         self.draw_curtain(view_proj)
+        if msaa:
+            ctx.disable(mgl.BLEND)
+            for src, dst in (("hdr_fbo", None), ("accum_src", "accum_dst"),
+                             ("weight_src", "weight_dst")):
+                ctx.copy_framebuffer(self._hdr_fbo if dst is None else msaa[dst], msaa[src])
+            ctx.enable(mgl.BLEND)
+            ctx.blend_equation = mgl.FUNC_ADD
         # resolve: average colour x (1 - revealage) + behind x revealage
         self._hdr_fbo.use()
         ctx.viewport = (0, 0, vw, vh)
@@ -1246,10 +1317,21 @@ class FrameRenderer:
         ctx.blend_func = mgl.DEFAULT_BLENDING
 
     def set_antialiasing(self, mode: str) -> None:
-        """``fxaa`` (default): the post-process on the display image (shaders/fxaa.frag);
-        ``off``: the tone-mapped image as it is."""
+        """``auto`` (default): :func:`choose_antialiasing` for this context (FXAA on llvmpipe);
+        ``fxaa``: the post-process on the display image (shaders/fxaa.frag); ``msaa``:
+        MSAA_SAMPLES samples per pixel in the HDR passes (refused where the context has
+        fewer); ``off``: the tone-mapped image as it is. :attr:`antialiasing` holds the
+        mode in use (never ``auto``)."""
         if mode not in ANTIALIASING_MODES:
             raise CatalogError(f"anti-aliasing {mode!r}: choose one of {', '.join(ANTIALIASING_MODES)}")
+        info = dict(self.ctx.info)   # GL_RENDERER, GL_MAX_SAMPLES
+        if mode == "auto":
+            mode = choose_antialiasing(info)
+        if mode == "msaa" and int(info.get("GL_MAX_SAMPLES", 0) or 0) < MSAA_SAMPLES:
+            raise CatalogError(f"anti-aliasing msaa: this context has fewer than "
+                               f"{MSAA_SAMPLES} samples (GL_MAX_SAMPLES); use fxaa")
+        if mode != "msaa":
+            self._release_msaa()
         self.antialiasing = mode
 
     def draw_bloom(self, vw: int, vh: int) -> object:
@@ -1338,9 +1420,10 @@ class FrameRenderer:
         if fxaa:
             target.use()
             self.ctx.viewport = target_viewport
-            program = self._program("fullscreen.vert", "fxaa.frag")
+            program = self._program("fullscreen.vert", self.fxaa_shader)
             self._pre.use(location=0)
             self._set(program, "u_ldr", 0)
+            self._set(program, "u_size_px", (float(vw), float(vh)))
             self._set(program, "u_rect", (0.0, 0.0, vw / self.size[0], vh / self.size[1]))
             self._set(program, "u_texel", (1.0 / self.size[0], 1.0 / self.size[1]))
             self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
@@ -1427,10 +1510,13 @@ class FrameRenderer:
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
         ours = [self._hdr_fbo, self._ldr_fbo, self._oit_fbo, self._pre_fbo] + ([self._gbuffer[1]] if self._gbuffer else [])
+        if self._msaa is not None:
+            ours += [self._msaa["hdr_fbo"], self._msaa["oit_fbo"]]
         ours += [obj for name, obj in list((self._room_gl or {}).items())
                  + list((self._bloom_gl or {}).items()) if name.endswith("_fbo")]
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
+        self._release_msaa()
         self._release_vaos()
         self._release_own_buffers()
         for obj in (self._hdr_fbo, self._hdr, self._depth, self._ldr_fbo, self._ldr, self._room_vbo,

@@ -240,7 +240,8 @@ class ViewerApp:
                 self.gui.process_inputs()
                 imgui.new_frame()
                 self.panel.draw(self.settings, self.catalog, self.timer, self.panel_info,
-                                tuple(self.glfw.get_window_size(self.window)))
+                                tuple(self.glfw.get_window_size(self.window)),
+                                camera=self.camera)
                 imgui.render()
                 self._fbo.use()
                 self.gui.render(imgui.get_draw_data())

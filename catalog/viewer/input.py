@@ -103,6 +103,18 @@ class OrbitCamera:
             self.min_pitch_deg, self.pitch_deg + dy_px * self.degrees_per_pixel))
         self._keep_inside()
 
+    def distance_limits_m(self) -> tuple[float, float]:
+        """The nearest and farthest distance (m) allowed in the current direction."""
+        far = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg))
+        return self.min_distance_m, max(self.min_distance_m, far)
+
+    def set_distance(self, distance_m: float) -> None:
+        """The panel's zoom: this distance (m), kept within the limits and inside the room."""
+        if not math.isfinite(distance_m):
+            return
+        self.distance_m = float(distance_m)
+        self._keep_inside()
+
     def zoom(self, steps: float) -> None:
         """Wheel turned by ``steps`` (positive = towards the curtain)."""
         if not math.isfinite(steps):

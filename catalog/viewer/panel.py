@@ -1,7 +1,8 @@
 """The on-screen panel (imgui-bundle): the fabrics as a catalog (a thumbnail rendered under
 the current light, the full name, the preset's facts, a filter by facts), compare, light,
-fluorescence (per half when comparing), bands, exposure and white balance, wind, curtain,
-frame time (the graphs behind a toggle); and the help overlay.
+fluorescence (per half when comparing), bands, exposure and white balance, the view (a zoom
+slider for the camera's distance and a reset button, beside the wheel and the R key), wind,
+curtain, frame time (the graphs behind a toggle); and the help overlay.
 
 Immediate mode: :meth:`Panel.draw` is called once per frame between ``imgui.new_frame()``
 and ``imgui.render()``; it reads and writes a :class:`ViewerSettings` and reads the
@@ -50,6 +51,8 @@ class Panel:
     def __init__(self, width_px: int = PANEL_WIDTH_PX):
         self.preferred_width_px = width_px
         self.width_px = width_px
+        self.zoom_rect_px = None    # ((x0, y0), (x1, y1)) of the zoom slider, last frame
+        self.reset_rect_px = None   # ... of the reset button
 
     def width_for(self, window_width_px: int) -> int:
         """The strip the panel takes in a window this wide: at most half of it."""
@@ -57,7 +60,9 @@ class Panel:
 
     # ------------------------------------------------------------------------------
     def draw(self, settings: ViewerSettings, catalog: FabricCatalog, timer: FrameTimer,
-             info: PanelInfo, window_size_px: tuple[int, int]) -> None:
+             info: PanelInfo, window_size_px: tuple[int, int], camera=None) -> None:
+        """``camera``: the viewer's :class:`catalog.viewer.input.OrbitCamera` (the View
+        section's zoom moves it; None: no View section)."""
         self.width_px = self.width_for(window_size_px[0])
         window_height_px = window_size_px[1]
         if settings.show_panel:
@@ -70,6 +75,8 @@ class Panel:
             self._light(settings, info)
             self._fluorescence(settings, info)
             self._display(settings, info)
+            if camera is not None:
+                self._view(camera)
             self._simulation(settings)
             self._timing(settings, timer)
             self._messages(info)
@@ -250,6 +257,25 @@ class Panel:
                 settings.white_balance = choice
         if settings.white_balance == "room" and info.white_balance_adapted is False:
             imgui.text_colored(DIM_COLOUR, "this light is no white: shown as D65")
+
+    def _view(self, camera) -> None:
+        """Zoom: the camera's distance to the curtain on a logarithmic slider (0.2 m shows
+        the threads), clamped as the wheel is (inside the room); reset = the R key."""
+        imgui.separator_text("View")
+        near, far = camera.distance_limits_m()
+        slider_width_px = imgui.calc_item_width()   # the slider's frame, left of its label
+        changed, value = imgui.slider_float("distance", float(camera.distance_m), near, far,
+                                            "%.2f m", imgui.SliderFlags_.logarithmic)
+        top_left, bottom_right = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+        self.zoom_rect_px = ((top_left.x, top_left.y), (top_left.x + slider_width_px, bottom_right.y))
+        if changed:
+            camera.set_distance(value)
+        if imgui.button("reset view (R)"):
+            camera.reset()
+        top_left, bottom_right = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+        self.reset_rect_px = ((top_left.x, top_left.y), (bottom_right.x, bottom_right.y))
+        imgui.same_line()
+        imgui.text_colored(DIM_COLOUR, "wheel: zoom, drag: orbit")
 
     def _simulation(self, settings: ViewerSettings) -> None:
         imgui.separator_text("Curtain")

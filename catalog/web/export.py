@@ -53,7 +53,10 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: shadow map, luminaire, bounce, recomputed when the scene changes) and the glare. The page
 #: shows the desktop frame with these off (its flat-cloth, constant-room modes), and the
 #: browser test compares against the same modes.
-DESKTOP_MODES = {"patterned": False, "room_lighting": False, "bloom": False}
+#: ``antialiasing``: FXAA, a pass the page replays (the renderer's ``auto`` would take MSAA
+#: on a GPU: multisampled renderbuffers and resolves the recording refuses).
+DESKTOP_MODES = {"patterned": False, "room_lighting": False, "bloom": False,
+                 "antialiasing": "fxaa"}
 
 
 def configure_desktop_frame(renderer) -> None:
