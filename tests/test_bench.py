@@ -46,6 +46,7 @@ def _numbers_all_finite(obj, path="") -> list[str]:
 # --------------------------------------------------------------------------- the command
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_quick_json_has_every_requested_section_with_finite_numbers(tmp_path):
     # colour and startup are smoked below on tiny inputs (together they take ~90 s here)
     sections = ["fluorescence", "fit", "cloth", "stability"]
@@ -197,6 +198,7 @@ def test_cloth_runs_are_deterministic_and_deviation_is_a_distance():
     assert rms == pytest.approx(0.003) and worst == pytest.approx(0.003)
 
 
+@pytest.mark.slow
 def test_startup_section_without_first_frames():
     from catalog.bench import startup
 

@@ -457,6 +457,7 @@ def test_rgb_product_is_worse_than_pre_integration(study_rows):
 
 
 @pytest.mark.data
+@pytest.mark.slow
 def test_table_tool_prints_markdown_and_json(tmp_path):
     import json
     import subprocess

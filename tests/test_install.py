@@ -112,3 +112,33 @@ def test_help_texts_point_inside_the_repository():
                              "print(p.format_help()); [print(s.format_help()) for s in subs.values()]"],
                             capture_output=True, text=True, timeout=60, check=True)
     assert "../" not in result.stdout and "shared/spec" not in result.stdout
+
+
+def test_dependency_groups_keep_the_viewer_and_the_offline_tools_apart():
+    """The offline tools' group pulls no window or GL; the viewer's (with what it includes)
+    pulls no scipy, colour-science or pvlib; `all` is both; setup installs all and test."""
+    import tomllib
+
+    project = tomllib.loads((PROJECT_ROOT / "pyproject.toml").read_text())["project"]
+    groups = project["optional-dependencies"]
+
+    def names(requirements: list[str]) -> set[str]:
+        out = set()
+        for req in requirements:
+            name = re.split(r"[<>=\[ ;]", req, maxsplit=1)[0].lower()
+            if name == project["name"]:  # fabric-catalog[render]: expand the named groups
+                for group in re.search(r"\[(.*)\]", req).group(1).split(","):
+                    out |= names(groups[group.strip()])
+            else:
+                out.add(name)
+        return out
+
+    base = names(project["dependencies"])
+    offline, viewer, everything = (names(groups[g]) | base for g in ("offline", "viewer", "all"))
+    window_and_gl = {"glfw", "imgui-bundle", "pyopengl", "moderngl"}
+    assert not offline & window_and_gl
+    assert not viewer & {"scipy", "colour-science", "pvlib", "matplotlib", "pandas"}
+    assert everything == offline | viewer
+    assert "scipy" not in base and "moderngl" not in base
+    setup = (PROJECT_ROOT / "tools" / "setup.sh").read_text()
+    assert '-e ".[all,test' in setup

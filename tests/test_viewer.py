@@ -131,6 +131,7 @@ def test_unreachable_display_says_so_in_one_line(tmp_path):
 # ----------------------------------------------------------------------------------
 # Screenshots of N frames
 
+@pytest.mark.slow
 def test_screenshot_is_the_curtain_in_the_fabrics_colour(xdisplay, tmp_path):
     """--frames N --screenshot: the window shows the curtain, coloured by its fabric.
 
@@ -230,6 +231,7 @@ def test_split_screen_shows_two_fabrics(xdisplay, tmp_path):
     assert right_teal[0] / right_teal[1] < 0.8 * right_lace[0] / right_lace[1]
 
 
+@pytest.mark.slow
 def test_gpu_cloth_draws_the_same_curtain_as_the_cpu_cloth(xdisplay, tmp_path):
     """--cloth-backend gpu: the compute shader writes the vertex buffer the renderer draws
     (moved onto the rod in the vertex shader). After 20 windy frames its picture matches
@@ -262,10 +264,14 @@ class Viewer:
             pytest.fail("xdotool is not installed (tools/setup.sh installs it)")
         self.display = display
         self.shots = cwd / "shots"
+        # stdout into a file, not a pipe: --stats prints a line a frame, and a pipe nobody
+        # reads until the end fills (64 KiB) and blocks the viewer before it sees Escape
+        self._stdout_path = cwd / "viewer-stdout.jsonl"
+        self._stdout = open(self._stdout_path, "w", encoding="utf-8")
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "catalog", "view", *QUICK, "--screenshot-dir",
              str(self.shots), "--frames", "100000", *args],
-            env=_env(display), cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+            env=_env(display), cwd=cwd, stdout=self._stdout, stderr=subprocess.PIPE,
             text=True)
         self.window = self._find_window()
 
@@ -345,10 +351,16 @@ class Viewer:
             if self.proc.poll() is None:
                 self.proc.kill()
 
+    def stdout_text(self) -> str:
+        """What the viewer printed on stdout so far."""
+        self._stdout.flush()
+        return self._stdout_path.read_text(encoding="utf-8")
+
     def close(self) -> None:
         if self.proc.poll() is None:
             self.proc.kill()
             self.proc.wait()
+        self._stdout.close()
 
 
 def _blue_share(image: np.ndarray, mask: np.ndarray) -> float:

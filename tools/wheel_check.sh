@@ -12,7 +12,8 @@ PY=${PYTHON:-python3}
 echo "wheel_check: building the wheel"
 "$ROOT/.venv/bin/python" -m pip wheel -q --no-deps -w "$WORK/wheel" "$ROOT"
 "$PY" -m venv "$WORK/venv"
-"$WORK/venv/bin/python" -m pip install -q "$WORK"/wheel/*.whl
+WHEEL=$(ls "$WORK"/wheel/*.whl)
+"$WORK/venv/bin/python" -m pip install -q "$WHEEL[all]"
 CATALOG="$WORK/venv/bin/catalog"
 
 cd "$WORK/run"  # outside the checkout: only what the wheel carries is found

@@ -77,7 +77,9 @@ def time_draws(ctx, draw, repeats: int, draws: int, clock=time.perf_counter) -> 
     return statistics.median(samples)
 
 
-def curtain_timer(renderer, trivial: bool | str):
+def curtain_timer(renderer, fragment: str | None):
+    """Draws the curtain pass; ``fragment``: a floor's fragment shader (bench/shaders/),
+    None for the curtain's own."""
     import moderngl
 
     ctx = renderer.ctx
@@ -88,7 +90,7 @@ def curtain_timer(renderer, trivial: bool | str):
         ctx.viewport = (0, 0, *renderer.size)
         renderer._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
-        renderer.draw_curtain(view_proj, trivial=trivial)
+        renderer.draw_curtain(view_proj, fragment=fragment)
 
     return draw
 
@@ -164,7 +166,7 @@ def main(argv=None) -> int:
     defines_of = {}
     for label, mode, n_bands, see_through in variants:
         if mode is None:
-            drawers[label] = curtain_timer(renderer, trivial=extra_floors.get(label, True))
+            drawers[label] = curtain_timer(renderer, extra_floors.get(label, "trivial.frag"))
             continue
         direct = base.btdf.direct if see_through else 0.0
         if see_through and direct == 0.0:
@@ -175,7 +177,7 @@ def main(argv=None) -> int:
         variant_renderer.set_fluorescence(mode)
         variant_renderer.set_bands(n_bands)
         defines_of[label] = {k: v for k, v in variant_renderer.variant_defines().items() if v}
-        drawers[label] = curtain_timer(variant_renderer, trivial=False)
+        drawers[label] = curtain_timer(variant_renderer, None)
     renderer.set_fluorescence("physical")
     renderer.set_bands(3)
     frame_label = "whole frame (rgb physical: background, room, curtain, tone map)"

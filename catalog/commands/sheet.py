@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
+from catalog.commands.displayargs import add_display_arguments, display_choices
 from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
-
-from catalog.commands.displayargs import add_display_arguments, display_choices
-
 HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
 

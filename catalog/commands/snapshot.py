@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
+from catalog.commands.displayargs import add_display_arguments, display_choices
 from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 INPUT_FILES = ("fabric",)
 OUTPUT_FILES = ("out",)
-
-from catalog.commands.displayargs import add_display_arguments, display_choices
-
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
 
 

@@ -770,17 +770,21 @@ class FrameRenderer:
         s(program, "u_sun_direction", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_sun_chord2", tuple(float(v) for v in inputs.sun_chord2))
 
-    def draw_curtain(self, view_proj, trivial: bool | str = False, gbuffer: bool = False,
+    def draw_curtain(self, view_proj, fragment: str | None = None, gbuffer: bool = False,
                      camera_position=None, overrides: dict | None = None,
                      coarse: bool = False) -> None:
-        """The curtain pass alone into the bound framebuffer (the benchmark times this).
+        """The curtain pass alone into the bound framebuffer.
 
-        ``trivial``: True draws the same mesh with catalog/bench/shaders/trivial.frag (the benchmark's floor);
-        a file name draws it with that fragment shader instead (the benchmark's other floors)."""
+        ``fragment``: draw the same mesh (same vertex shader and uniforms of the mesh and
+        camera) with this fragment shader file instead of the curtain's: how a benchmark
+        measures the rasteriser's floor with shaders of its own (catalog/bench/shaders/).
+        ``camera_position``: the eye for the view-dependent terms (default the camera's; the
+        room's passes draw the curtain as seen from the key light or the room);
+        ``overrides``: scene values replaced for this draw; ``coarse``: the coarser grid the
+        room's passes use."""
         eye = tuple(float(v) for v in (self.camera.position if camera_position is None
                                        else camera_position))
-        if trivial:
-            fragment = trivial if isinstance(trivial, str) else "trivial.frag"
+        if fragment is not None:
             program = self._program("curtain.vert", fragment)
             self._set(program, "u_view_proj", gl_bytes(view_proj))
             self._set(program, "u_mesh_offset", self._mesh_offset)
