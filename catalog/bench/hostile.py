@@ -263,6 +263,9 @@ def run_suite(cases: list[Case] | None = None) -> dict:
     return {"categories": rows, "total": total, "cases": len(cases), "failures": failures}
 
 
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
+RESULT_JSON = "benchmarks/hostile_inputs.json"
+
 def markdown_tables(result: dict) -> dict[str, str]:
     head = "| category | cases | " + " | ".join(OUTCOMES) + " |\n|---|---|" + "---|" * len(OUTCOMES)
     lines = [head]

@@ -258,6 +258,9 @@ def _f(x: float) -> str:
     return f"{x:.2f}"
 
 
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
+RESULT_JSON = "benchmarks/bench_uv.json"
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks: ``uv-noise-floor``, ``uv-models``, ``uv-cases``."""
     s = result["summary"]
