@@ -39,9 +39,13 @@ G_ISOTROPIC = 1e-3
 
 
 def hg_from_chords(dr, chord2, anti2, g: float):
-    """Eq. 6 from chord2 = |view - travel|^2 and anti2 = |view + travel|^2 (Dr.Jit arrays)."""
-    if g >= 0:  # chord2 / 2 = 1 - cos theta, held in [0, 2] as catalog.optics.btdf does
-        d = (1.0 - g) * (1.0 - g) + g * dr.clip(chord2, 0.0, 4.0)
+    """Eq. 6 from chord2 = |view - travel|^2 and anti2 = |view + travel|^2 (Dr.Jit arrays),
+    the forward or the mirrored form on the threshold the shaders and the float64
+    reference use (catalog.core.constants.HG_MIRROR_BELOW)."""
+    from catalog.core.constants import HG_MIRROR_BELOW  # noqa: PLC0415
+
+    if g >= HG_MIRROR_BELOW:
+        d = (1.0 - g) * (1.0 - g) + g * chord2
     else:
         d = (1.0 + g) * (1.0 + g) - g * anti2
     d = dr.maximum(d, 1e-12)
