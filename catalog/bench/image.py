@@ -67,6 +67,8 @@ ABSENT_OPTIONS = ("shadow map size (catalog.render.room_light.SHADOW_TEXELS, not
 #: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
 #: curtain (noise falls as 1 / sqrt(spp): the spp that reaches it is spp (noise / 1 %)^2).
 NOISE_TARGET = 0.01
+#: The committed figures (tools/docs_figures.py): {"runs": {"baseline": section, "after_12_16": section}}.
+RESULT_JSON = "benchmarks/bench_image.json"
 GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
 REGIONS = ("curtain", "floor", "walls")
 #: The hour of "noon sun" (local solar time, the scene's date and latitude).
@@ -317,9 +319,31 @@ def spp_for_noise(spp: int, noise: float, target: float = NOISE_TARGET) -> float
     return spp * (noise / target) ** 2
 
 
+def _cell(value) -> str:
+    """3 significant digits, e-notation when small or large (catalog.bench.report's rule;
+    not imported: report imports this module for its section)."""
+    if isinstance(value, float) and math.isfinite(value) and value != 0:
+        return f"{value:.2e}" if (abs(value) < 1e-3 or abs(value) >= 1e5) else f"{value:.3g}"
+    return "0" if isinstance(value, float) and value == 0 else str(value)
+
+
+def table(rows: list[dict], columns: list[str], headers: list[str]) -> str:
+    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(_cell(row.get(c, "")) for c in columns) + " |" for row in rows]
+    return "\n".join(lines)
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
-    """Generated blocks for BENCHMARKS.md / docs: ``image`` (per scene), ``image-options``."""
-    from catalog.bench.report import table  # noqa: PLC0415
+    """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run; of the
+    committed JSON (``{"runs": {...}}``) the baseline's, and ``image-after`` the run after
+    issues 12-16 (its table, its options and its error maps)."""
+    if "runs" in result:
+        blocks = markdown_tables(result["runs"]["baseline"])
+        after = markdown_tables(result["runs"]["after_12_16"])
+        blocks["image-after"] = (after["image"] + "\n\nReal-time options:\n\n" + after["image-options"]
+                                 + "\n\n![six scenes after issues 12-16: real-time | reference | FLIP]"
+                                 "(img/pathtrace_scenes_after_13.png)")
+        return blocks
 
     s = result["summary"]
     rows = [dict(r, spp_for_1pct=spp_for_noise(r["spp"], r["reference_noise_curtain_rel"]))
