@@ -138,6 +138,13 @@ def room_md(result: dict) -> str:
     return "\n\n".join(markdown_tables(result).values())
 
 
+def image_md(result: dict) -> str:
+    from catalog.bench.image import markdown_tables  # noqa: PLC0415
+
+    blocks = markdown_tables(result)
+    return blocks["image"] + "\n\nReal-time options (image-pareto.png):\n\n" + blocks["image-options"]
+
+
 def viewer_line(heavy: dict | None) -> str:
     if not heavy:
         return "The viewer's first frame was not measured."
@@ -166,8 +173,8 @@ SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "stability": ("Numerical stability at the parameters' edges", stability_md),
               "startup": ("Start-up", startup_md),
               "room": ("The room lit through the curtain: frame with and without", room_md),
-
-              "display": ("The display step's cost in the frame", display_md)}
+              "display": ("The display step's cost in the frame", display_md),
+              "image": ("The real-time frame against the path-traced reference", image_md)}
 
 
 def markdown(report: dict) -> str:

@@ -43,6 +43,7 @@ COMMANDS: dict[str, str] = {
     "simulate": "catalog.commands.simulate",
     "bench": "catalog.commands.bench",
     "web": "catalog.commands.web",
+    "reference": "catalog.commands.reference",
 }
 
 
