@@ -15,9 +15,9 @@ const float PI = 3.14159265358979;
 // 1 + g^2 - 2 g cos(theta) = (1 - g)^2 + 2 g (1 - cos theta) with 1 - cos theta = chord2 / 2, and
 // = (1 + g)^2 - 2 g (1 + cos theta) with 1 + cos theta = anti2 / 2 for g < 0 (no cancellation
 // near g = -1); the power 1.5 as d * sqrt(d). chord2 = |w_view - w_travel|^2, anti2 = |w_view + w_travel|^2.
+float hg_d(float chord2, float anti2, float g);  // below: the one choice of form
 float hg_phase_robust(float chord2, float anti2, float g) {
-    float d = (g >= 0.0) ? (1.0 - g) * (1.0 - g) + g * chord2
-                         : (1.0 + g) * (1.0 + g) - g * anti2;
+    float d = hg_d(chord2, anti2, g);
     // (1 - g)(1 + g) rather than 1 - g^2: exact in float32 for g near +-1
     return (1.0 - g) * (1.0 + g) / (4.0 * PI * d * sqrt(d));
 }
@@ -37,7 +37,7 @@ float woven_chord2(vec3 delta, vec3 t, vec3 b, vec3 n, float anisotropy) {
 // (1 - g)^2 + g chord2 loses at most |g| * 5e-7 / (1 + g)^2 < 3e-7 (relative) to the rounding of a
 // chord2 near 4 (theta near pi), so the anti-chord is only formed for a strongly backward lobe.
 // With the scene's g compiled in as constants (SPECIALISED), the choice costs nothing.
-const float HG_MIRROR_BELOW = -0.2;
+// HG_MIRROR_BELOW is injected as a #define from catalog/core/constants.py (Python uses it too).
 float hg_d(float chord2, float anti2, float g) {
     return (g >= HG_MIRROR_BELOW) ? (1.0 - g) * (1.0 - g) + g * chord2
                                   : (1.0 + g) * (1.0 + g) - g * anti2;

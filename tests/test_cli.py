@@ -68,3 +68,84 @@ def test_wxh_values_are_parsed_and_refused_by_one_rule():
         with pytest.raises(InputError) as err:
             parse_wxh(text, "--opt", low, high)
         assert str(err.value).startswith("--opt: ")
+
+
+# ---- exit codes: 2 the input, 3 the environment; with --json the error is one object ---
+
+def test_missing_shader_is_an_environment_failure_with_a_json_error(gl, tmp_path, monkeypatch,
+                                                                    capsys, fabric_dir):
+    """A shader file missing from the installation: exit 3, one line on stderr, and with
+    --json one JSON object on stdout; no image written."""
+    from catalog.commands.cli import main
+    from catalog.gl import shaderlib
+
+    monkeypatch.setattr(shaderlib, "SEARCH_PATH", [tmp_path])  # an installation without shaders
+    out = tmp_path / "x.png"
+    code = main(["snapshot", "--fabric", "voile-white", "--light", "D65", "--size", "32x24",
+                 "--out", str(out), "--json"])
+    captured = capsys.readouterr()
+    assert code == 3
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and "not found" in err[0]
+    report = json.loads(captured.out)
+    assert report["exit_code"] == 3 and "not found" in report["error"]
+    assert not out.exists()
+
+
+def test_bad_input_with_json_is_one_json_object(tmp_path, capsys):
+    from catalog.commands.cli import main
+
+    code = main(["snapshot", "--fabric", "no-such-fabric", "--light", "D65",
+                 "--out", str(tmp_path / "x.png"), "--json"])
+    captured = capsys.readouterr()
+    assert code == 2
+    report = json.loads(captured.out)  # exactly one object: json.loads refuses anything more
+    assert report["exit_code"] == 2 and "no-such-fabric" in report["error"]
+    assert len(captured.err.strip().splitlines()) == 1
+
+
+def test_user_fabric_folder_is_searched_before_the_built_in_catalog(tmp_path, monkeypatch,
+                                                                    fabric_dir):
+    """--fabrics DIR (and $CATALOG_FABRICS): a name found there wins over the built-in one;
+    other names still come from the built-in catalog; a missing folder is refused."""
+    import pytest
+
+    from catalog.core import resources
+    from catalog.core.errors import InputError
+    from catalog.presets import find_preset, list_presets
+
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "voile-white.toml").write_text((fabric_dir / "voile-white.toml").read_text())
+    (mine / "my-own.toml").write_text((fabric_dir / "voile-white.toml").read_text())
+    monkeypatch.setattr(resources, "_user_fabrics", None)
+    monkeypatch.setenv(resources.FABRICS_ENV, str(mine))
+    assert find_preset("voile-white") == mine / "voile-white.toml"
+    assert find_preset("lace-fwa") == fabric_dir / "lace-fwa.toml"
+    names = [p.stem for p in list_presets()]
+    assert "my-own" in names and names.count("voile-white") == 1
+    monkeypatch.delenv(resources.FABRICS_ENV)
+    assert find_preset("voile-white") == fabric_dir / "voile-white.toml"
+    resources.use_fabrics([mine])  # what --fabrics DIR does
+    assert find_preset("my-own") == mine / "my-own.toml"
+    with pytest.raises(InputError, match="--fabrics"):
+        resources.use_fabrics([tmp_path / "nowhere"])
+    resources.use_fabrics(None)
+
+
+def test_missing_validation_data_is_one_line_exit_2(tmp_path):
+    """Without the validation data, commands that need it say so in one line (exit 2)."""
+    import os
+
+    env = {**os.environ, "CATALOG_DATA": str(tmp_path / "no-data")}
+    for argv in (["bispectral", "CIBA12"], ["bench", "--sections", "fluorescence", "--out",
+                                            str(tmp_path / "b")]):
+        proc = subprocess.run([sys.executable, "-m", "catalog", *argv], env=env,
+                              capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2, proc.stderr
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and "validation data not found" in lines[0], proc.stderr
+    proc = subprocess.run([sys.executable, "-m", "catalog", "bispectral", "CIBA12", "--data",
+                           str(tmp_path / "elsewhere")], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 2 and str(tmp_path / "elsewhere") in proc.stderr

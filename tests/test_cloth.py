@@ -197,6 +197,7 @@ def test_gusty_wind_stays_finite_and_limited(stiffness):
     assert sim.finite and sim.kinetic_energy > 0.0 and not sim.sleeping
 
 
+@pytest.mark.slow
 def test_hundred_thousand_steps_stay_finite():
     p = ClothParams(grid_w=4, grid_h=4, wind_speed_m_s=2.0, stretch_stiffness_n_m=1e6)
     sim = ClothSimulation(p, "cpu", monitor_every=1000)
@@ -332,3 +333,23 @@ def test_export_refuses_unknown_format(tmp_path):
     with pytest.raises(InputError, match="unsupported mesh format"):
         export_mesh(curtain_mesh(ClothParams(grid_w=4, grid_h=4)), tmp_path / "c.stl")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_every_backend_follows_the_declared_protocol():
+    """The backends implement catalog.cloth.backend's protocol; only the GPU one is a
+    device backend (loaded once, ring targets uploaded, a vertex buffer to draw)."""
+    from catalog.cloth.backend import ClothBackend, DeviceBackend
+    from catalog.cloth.backend_gpu import GpuBackend
+    from catalog.cloth.backend_numba import NumbaBackend
+    from catalog.cloth.backend_numpy import NumpyBackend
+    from catalog.cloth.simulation import BACKENDS
+
+    for cls in (NumpyBackend, NumbaBackend, GpuBackend):
+        assert cls.name in BACKENDS
+        assert all(callable(getattr(cls, m, None)) for m in ("set_params", "advance", "sync"))
+    assert all(callable(getattr(GpuBackend, m, None))
+               for m in ("load", "set_ring_targets", "bind_to_vertex_array"))
+    backend = NumpyBackend(ClothParams(grid_w=4, grid_h=4))
+    assert isinstance(backend, ClothBackend) and not isinstance(backend, DeviceBackend)
+    backend.set_params(ClothParams(grid_w=4, grid_h=4, wind_speed_m_s=3.0))
+    assert backend.params.wind_speed_m_s == 3.0 and backend.constants is not None

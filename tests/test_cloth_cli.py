@@ -56,7 +56,8 @@ def test_simulate_refuses_bad_options(argv, option, capsys, tmp_path, monkeypatc
     code = main(["simulate", "--steps", "2", "--json", *argv])
     captured = capsys.readouterr()
     assert code == 2
-    assert captured.out == ""
+    assert json.loads(captured.out) == {"error": captured.err.strip().split("error: ", 1)[1],
+                                        "exit_code": 2}  # --json: the error as one object
     err = captured.err.strip().splitlines()
     assert len(err) == 1 and option in err[0]
     assert list(tmp_path.iterdir()) == []  # nothing half-written

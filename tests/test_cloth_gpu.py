@@ -34,6 +34,7 @@ def test_gpu_follows_the_reference_for_one_second(gl):
     assert abs(gpu.kinetic_energy - cpu.kinetic_energy) < 0.5 * cpu.kinetic_energy
 
 
+@pytest.mark.slow
 def test_rings_and_sleep_on_the_gpu(gl):
     params = ClothParams(grid_w=10, grid_h=10, opening=1.0, ring_speed_m_s=2.0,
                          sleep_frames=10, sleep_speed_m_s=0.02)

@@ -11,7 +11,7 @@ from catalog.core.resources import PROJECT_ROOT
 
 
 @pytest.fixture(scope="module")
-def tables():
+def tables(shared_data):  # the measured brightener is one of the emissions studied
     spec = importlib.util.spec_from_file_location(
         "fluorescence_tables", PROJECT_ROOT / "tools" / "fluorescence_tables.py")
     module = importlib.util.module_from_spec(spec)

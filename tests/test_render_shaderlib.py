@@ -23,7 +23,8 @@ def test_include_is_expanded_and_defines_follow_version(shader_folder):
     source = shaderlib.load_source("a.frag", {"N_BANDS": 6, "SEE_THROUGH": True, "OFF": False})
     lines = source.splitlines()
     assert lines[0] == "#version 430"
-    assert lines[1:3] == ["#define N_BANDS 6", "#define SEE_THROUGH"]
+    # the shared constants (catalog/core/constants.py) are defined in every program, sorted in
+    assert lines[1:4] == ["#define HG_MIRROR_BELOW -0.2", "#define N_BANDS 6", "#define SEE_THROUGH"]
     assert "float b() { return 1.0; }" in lines
     assert "#define OFF" not in source
     assert "#include" not in source
@@ -67,3 +68,18 @@ def test_no_glsl_source_in_python():
     offenders = [str(p.relative_to(PROJECT_ROOT)) for p in (PROJECT_ROOT / "catalog").rglob("*.py")
                  if pattern.search(p.read_text(encoding="utf-8"))]
     assert offenders == []
+
+
+def test_shared_constants_come_from_python_only():
+    """A constant GLSL and Python share is written once, in catalog/core/constants.py: no
+    shader assigns HG_MIRROR_BELOW a value of its own, and the compiled source has the
+    Python value."""
+    from catalog.core.constants import HG_MIRROR_BELOW, SHADER_DEFINES
+
+    for path in SHADER_DIR.rglob("*"):
+        if path.suffix in (".glsl", ".frag", ".vert", ".comp"):
+            text = path.read_text(encoding="utf-8")
+            for name in SHADER_DEFINES:
+                assert not re.search(rf"(const\s+\w+\s+{name}\s*=|#define\s+{name}\b)", text), path
+    source = shaderlib.load_source("curtain.frag", {"N_BANDS": 3, "NV4": 1})
+    assert f"#define HG_MIRROR_BELOW {HG_MIRROR_BELOW}" in source

@@ -121,6 +121,7 @@ def test_thumbnail_cache_renders_once_per_scene_and_again_on_change(gl):
     cache.release()
 
 
+@pytest.mark.slow
 def test_thumbnails_are_drawn_again_when_the_light_changes(xdisplay, tmp_path):
     """The L key (D65 -> A) in a running viewer: every thumbnail is drawn again for the new
     light (a few per frame), and the panel's summary lists them all as current for A."""
@@ -133,7 +134,7 @@ def test_thumbnails_are_drawn_again_when_the_light_changes(xdisplay, tmp_path):
         viewer.wait_title("light A ")
         time.sleep(4.0)
         assert viewer.quit() == 0
-        summary = [r for r in _stats_records(viewer.proc.stdout.read()) if r.get("summary")][0]
+        summary = [r for r in _stats_records(viewer.stdout_text()) if r.get("summary")][0]
     finally:
         viewer.close()
     assert summary["thumbnail_renders"] >= 2 * count

@@ -1,5 +1,5 @@
 """The colour-error table of docs/bispectral.md: fluorescence models against the measured
-Donaldson matrices of ../shared/data/bispectral (catalog.optics.bispectral.study).
+Donaldson matrices of the validation data's bispectral/ folder (catalog.optics.bispectral.study).
 
     .venv/bin/python tools/bispectral_table.py                       # markdown on stdout
     .venv/bin/python tools/bispectral_table.py --json out.json       # also the rows as JSON

@@ -22,7 +22,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from catalog.core.resources import SHARED_DATA_DIR  # noqa: E402
+from catalog.core.resources import data_dir  # noqa: E402
 from catalog.optics import fluorescence as fl  # noqa: E402
 from catalog.optics.colorimetry import delta_e_2000, xyz_to_linear_srgb  # noqa: E402
 from catalog.optics.lights import get_light  # noqa: E402
@@ -48,7 +48,7 @@ def fabric_material(name: str) -> tuple[fl.FluorescentMaterial, object, object]:
 
 
 def calcofluor_material() -> fl.FluorescentMaterial:
-    folder = SHARED_DATA_DIR / "brightener"
+    folder = data_dir("brightener")
     excitation = read_spectrum(folder / "calcofluor_white_excitation.csv", normalise=True)
     emission = read_spectrum(folder / "calcofluor_white_emission.csv", normalise=True)
     return fl.material_from_spectra(excitation, emission, **FABRIC_PARAMETERS["lace-fwa"])

@@ -135,8 +135,6 @@ def file_sha256(path: Path) -> str:
 def write_durable(target: Path, pixels: np.ndarray, metadata: dict[str, str]) -> tuple[str, int]:
     """Encode ``pixels`` into a temporary file beside ``target``, fsync it, rename it onto
     ``target``, fsync the folder. Returns (sha256 of the file, its size in bytes)."""
-    from catalog.render.snapshot import encode_image  # noqa: PLC0415
-
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, name = tempfile.mkstemp(prefix=f".{target.stem}{PART_MARK}", suffix=target.suffix,
                                 dir=target.parent)
@@ -161,6 +159,30 @@ def write_durable(target: Path, pixels: np.ndarray, metadata: dict[str, str]) ->
     finally:
         os.close(folder)
     return digest, size
+
+
+def encode_image(path: Path, pixels: np.ndarray, metadata: dict) -> None:
+    """(H, W, 3) pixels into ``path`` with OpenImageIO (float32 -> EXR, uint8 -> PNG, by the
+    suffix), in place: :func:`write_durable` gives it a temporary path."""
+    import OpenImageIO as oiio  # noqa: PLC0415
+
+    height, width, channels = pixels.shape
+    kind = oiio.FLOAT if pixels.dtype == np.float32 else oiio.UINT8
+    spec = oiio.ImageSpec(width, height, channels, kind)
+    spec.channelnames = ("R", "G", "B")
+    for key, value in metadata.items():
+        if key == "chromaticities":
+            spec.attribute(key, oiio.TypeDesc("float[8]"), tuple(value))
+        else:
+            spec.attribute(key, str(value))
+    output = oiio.ImageOutput.create(str(path))
+    if output is None:
+        raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
+    ok = output.open(str(path), spec) and output.write_image(np.ascontiguousarray(pixels))
+    error = output.geterror()
+    output.close()
+    if not ok:
+        raise CatalogError(f"cannot write {path}: {error}")
 
 
 def existing_key(path: Path) -> str | None:

@@ -18,6 +18,10 @@ STAGES = ("exposure + sRGB curve", "+ white balance", "+ tone curve", "+ gamut c
 SCENES = (("lace-fwa", "D65"), ("lace-fwa", "UV-A"), ("fluoro-pink", "sun:500"))
 
 
+#: The committed result tools/docs_figures.py makes this module's tables from.
+RESULT_JSON = "benchmarks/bench_display.json"
+
+
 def run(quick: bool = False, ctx=None, size=(640, 360)) -> dict:
     from catalog.bench.timing import median_seconds  # noqa: PLC0415
     from catalog.gl.context import create_headless_context  # noqa: PLC0415

@@ -1,6 +1,6 @@
 """Fluorescence in an RGB engine against the state of the art, on measured Donaldson matrices.
 
-For each of the eight shared matrices (../shared/data/bispectral, catalog.optics.bispectral.matrix) and
+For each of the eight shared matrices (the validation data's bispectral/, catalog.optics.bispectral.matrix) and
 every light of the library (catalog.optics.lights.light_names), the colour each representation
 gives is compared by CIEDE2000 with the exact spectral result of the matrix (the ground
 truth and white of catalog/optics/bispectral/study.py, which also supplies the paper-mode, the
@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 
+from catalog.core.constants import LUMINOUS_EFFICACY_LM_W as LM_PER_W
 from catalog.bench.timing import median_seconds
 
 #: method -> (label, numbers the shader carries, recomputed per light?)
@@ -43,7 +44,6 @@ METHODS = {
 }
 STUDY_METHODS = ("ignore", "paper", "paper_global", "physical", "physical_rgb", "rgb_product")
 BAND_COUNTS = (6, 9, 16)
-LM_PER_W = 683.0
 
 
 def bands_xyz(models, light: np.ndarray, n_bands: int) -> np.ndarray:

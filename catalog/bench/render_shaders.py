@@ -77,7 +77,9 @@ def time_draws(ctx, draw, repeats: int, draws: int, clock=time.perf_counter) -> 
     return statistics.median(samples)
 
 
-def curtain_timer(renderer, trivial: bool | str):
+def curtain_timer(renderer, fragment: str | None):
+    """Draws the curtain pass; ``fragment``: a floor's fragment shader (bench/shaders/),
+    None for the curtain's own."""
     import moderngl
 
     ctx = renderer.ctx
@@ -88,7 +90,7 @@ def curtain_timer(renderer, trivial: bool | str):
         ctx.viewport = (0, 0, *renderer.size)
         renderer._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
-        renderer.draw_curtain(view_proj, trivial=trivial)
+        renderer.draw_curtain(view_proj, fragment=fragment)
 
     return draw
 
@@ -148,7 +150,7 @@ def main(argv=None) -> int:
     extra_floors = {"floor + normal as colour (one varying)": "trivial_normal.frag",
                     "floor + least eq. 5-7 work (2 lights x 2 HG lobes, isotropic)": "trivial_lobes.frag"}
     variants += [(label, None, None, None) for label in extra_floors]
-    for mode in ("off", "paper", "physical"):
+    for mode in FLUORESCENCE_MODES:
         variants.append((f"rgb {mode}", mode, 3, True))
     variants.append(("rgb off, no see-through", "off", 3, False))
     variants.append(("rgb physical, scene values as uniforms (not specialised)", "physical", 3, True))
@@ -164,7 +166,7 @@ def main(argv=None) -> int:
     defines_of = {}
     for label, mode, n_bands, see_through in variants:
         if mode is None:
-            drawers[label] = curtain_timer(renderer, trivial=extra_floors.get(label, True))
+            drawers[label] = curtain_timer(renderer, extra_floors.get(label, "trivial.frag"))
             continue
         direct = base.btdf.direct if see_through else 0.0
         if see_through and direct == 0.0:
@@ -175,7 +177,7 @@ def main(argv=None) -> int:
         variant_renderer.set_fluorescence(mode)
         variant_renderer.set_bands(n_bands)
         defines_of[label] = {k: v for k, v in variant_renderer.variant_defines().items() if v}
-        drawers[label] = curtain_timer(variant_renderer, trivial=False)
+        drawers[label] = curtain_timer(variant_renderer, None)
     renderer.set_fluorescence("physical")
     renderer.set_bands(3)
     frame_label = "whole frame (rgb physical: background, room, curtain, tone map)"

@@ -63,6 +63,10 @@ class NumpyBackend:
     name = "numpy"
 
     def __init__(self, params: ClothParams):
+        self.set_params(params)
+
+    def set_params(self, params: ClothParams) -> None:
+        """Recompute the constants (cheap: the grid stays)."""
         self.params = params
         self.constants = SolverConstants.from_params(params)
         w, h = params.grid_w, params.grid_h

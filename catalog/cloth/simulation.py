@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from catalog.cloth.backend import ClothBackend, DeviceBackend
 from catalog.cloth.params import ClothParams
 from catalog.cloth.state import ClothState, inverse_mass, ring_positions
 from catalog.cloth.topology import FAMILIES, rest_lengths_m
@@ -25,8 +26,8 @@ from catalog.core.errors import CatalogError, InputError
 BACKENDS = ("numpy", "cpu", "gpu")
 
 
-def make_backend(name: str, params: ClothParams, **options: Any):
-    """The backend object for a name of BACKENDS."""
+def make_backend(name: str, params: ClothParams, **options: Any) -> ClothBackend:
+    """The backend object for a name of BACKENDS (the protocol of :mod:`.backend`)."""
     if name == "numpy":
         from catalog.cloth.backend_numpy import NumpyBackend
         return NumpyBackend(params)
@@ -80,7 +81,7 @@ class ClothSimulation:
         self.state = ClothState.at_rest(params)
         self.backend_name = backend
         self.backend = make_backend(backend, params, **backend_options)
-        if hasattr(self.backend, "load"):
+        if isinstance(self.backend, DeviceBackend):
             self.backend.load(self.state)
         # checks (finite, stretch, energy, sleep) need the state on the CPU: every frame
         # for the CPU backends, every few frames for the GPU one (a small download)
@@ -114,12 +115,9 @@ class ClothSimulation:
         if (new.grid_w, new.grid_h) != (self.params.grid_w, self.params.grid_h):
             raise CatalogError("the grid size cannot change on a running simulation")
         self.params = new
-        if hasattr(self.backend, "set_params"):
-            self.backend.set_params(new)
-        else:
-            self.backend = make_backend(self.backend_name, new)
+        self.backend.set_params(new)
         self.state.ring_targets_m = ring_positions(new)
-        if hasattr(self.backend, "set_ring_targets"):
+        if isinstance(self.backend, DeviceBackend):
             self.backend.set_ring_targets(self.state.ring_targets_m)
         self.wake()
 

@@ -1,7 +1,9 @@
 """``catalog bispectral FILE.BFC``: the separable fit of a measured Donaldson matrix and the
 colour error (Delta E 2000) of each fluorescence model against the exact matrix result.
 
-FILE is a BFC-450 matrix file, or the name of one in ../shared/data/bispectral (``CIBA12``).
+FILE is a BFC-450 matrix file, or the name of one in the validation data's bispectral/ folder
+(``CIBA12``; ``--data DIR``). The eight measured matrices there also set eq. 8's global scale,
+so the command needs the validation data (docs/formats.md).
 ``--export DIR`` writes excitation.csv, emission.csv and reflectance.csv there, so the
 measured material can become a catalog fabric (docs/bispectral.md).
 """
@@ -10,12 +12,16 @@ from __future__ import annotations
 
 import argparse
 
+RESOURCES = ("data",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("file",)
+OUTPUT_FOLDERS = ("export",)
 HELP = "fit a bispectral (Donaldson) matrix and show the colour error of each fluorescence model"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", metavar="FILE.BFC",
-                        help="a BFC-450 matrix file, or a name in ../shared/data/bispectral (CIBA12)")
+                        help="a BFC-450 matrix file, or the name of one in the validation data (CIBA12)")
     parser.add_argument("--lights", metavar="NAME,NAME..",
                         help="lights of the Delta E table (default: D65,A,FL2,FL11,LED-B4,UV-A,"
                              "sun:22,sun:500); any library name or planck:K. With --json, "
@@ -49,7 +55,13 @@ def run(args: argparse.Namespace) -> int:
     per_light = banded_colours(matrix, banded, lights)
     exported = {}
     if args.export:
-        exported = {k: str(v) for k, v in bispectral.to_fabric_measurements(matrix, args.export, fit).items()}
+        from pathlib import Path  # noqa: PLC0415
+
+        from catalog.core.atomic import staged_folder  # noqa: PLC0415
+
+        with staged_folder(args.export) as stage:  # all three files, or none
+            written = bispectral.to_fabric_measurements(matrix, stage, fit)
+        exported = {k: str(Path(args.export) / Path(v).name) for k, v in written.items()}
 
     fit_info = {"yield_absorptance": fit.yield_absorptance, "quantum_yield": fit.quantum_yield,
                 "peak_absorptance": fit.peak_absorptance,

@@ -10,6 +10,11 @@ from __future__ import annotations
 
 import argparse
 
+from catalog.core.constants import FLUORESCENT_MODES
+
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("excitation", "emission")
+OUTPUT_FILES = ("plot",)
 HELP = "fluorescence colour (eq. 1-3) and intensity (eq. 4 or physical) of a material under a light"
 
 
@@ -50,7 +55,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--light", required=True, metavar="NAME",
                         help="light name: D65, A, FL2, LED-B4, UV-A, LED-warm, sun:22, ... "
                              "(see `catalog lights`)")
-    parser.add_argument("--mode", choices=("paper", "physical"), default="physical",
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="paper: eq. 1-4 exactly; physical (default): photons over 300-780 nm")
     parser.add_argument("--illuminance", type=_positive, metavar="LX",
                         help="rescale the light to this illuminance (default: the library level)")

@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 from catalog.commands.displayargs import add_display_arguments, display_choices
+from catalog.core.constants import FLUORESCENT_MODES
 
+RESOURCES = ("fabrics",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+OUTPUT_FOLDERS = ("out",)
 HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
 
@@ -12,9 +16,11 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--size", default="320x240", help="WIDTHxHEIGHT of each image")
     parser.add_argument("--fabrics", default=None,
-                        help="comma-separated preset names or .toml paths (default: every fabrics/*.toml)")
+                        help="comma-separated preset names, .toml paths or folders of your own "
+                             "presets (a folder is searched before the built-in catalog; default: "
+                             "every preset, $CATALOG_FABRICS first)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
-    parser.add_argument("--mode", choices=("paper", "physical"), default="physical")
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical")
     parser.add_argument("--bands", type=int, default=3)
     add_display_arguments(parser)
     parser.add_argument("--no-labels", action="store_true",
@@ -25,13 +31,19 @@ def add_arguments(parser) -> None:
 def run(args) -> int:
     from pathlib import Path  # noqa: PLC0415
 
+    from catalog.core.errors import InputError  # noqa: PLC0415
     from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.sheet import render_sheet  # noqa: PLC0415
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
     ev, white_balance = display_choices(args)
-    lights = [name.strip() for name in args.lights.split(",") if name.strip()]
-    fabrics = None if args.fabrics is None else [f.strip() for f in args.fabrics.split(",") if f.strip()]
+    names = [name.strip() for name in args.lights.split(",")]
+    if any(not name for name in names) and any(names):
+        raise InputError(f"{args.lights!r}: an empty light name between commas", field="--lights")
+    lights = [name for name in names if name]
+    from catalog.core.cliargs import fabric_list  # noqa: PLC0415
+
+    fabrics = fabric_list(args.fabrics)  # folders join the search path, names select
     report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=fabrics,
                           fluorescence="off" if args.no_fluorescence else args.mode,
                           bands=args.bands, progress=not args.json, ev=ev,

@@ -6,12 +6,16 @@ import argparse
 import math
 from pathlib import Path
 
+from catalog.core.constants import FLUORESCENCE_MODES as FLUORESCENCE_CHOICES
 from catalog.core.cliargs import wxh_type
 from catalog.commands.displayargs import add_display_arguments
 
+RESOURCES = ("fabrics",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("fabric", "compare")
+OUTPUT_FILES = ("screenshot",)
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
-FLUORESCENCE_CHOICES = ("off", "paper", "physical")
 BAND_CHOICES = (3, 6, 9, 16)
 
 
@@ -94,7 +98,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _forbid_scipy() -> None:
     """Mark scipy absent in the viewer's process.
 
-    Drawing a frame never needs scipy (architecture.md: render and viewer never import the
+    Drawing a frame never needs scipy (docs/architecture.md: render and viewer never import the
     tools' fitting code). numba's own import probes for scipy (a version check) and its CPU
     target then loads scipy.linalg's BLAS bindings, a few hundred ms of start-up for nothing;
     with scipy marked absent numba skips both, and an accidental scipy import anywhere in the
@@ -107,10 +111,10 @@ def _forbid_scipy() -> None:
 
 def run(args: argparse.Namespace) -> int:
     _forbid_scipy()
-    from catalog.core.resources import FABRIC_DIR
     from catalog.core.errors import CatalogError
     from catalog.viewer.app import ViewerApp, ViewerOptions
-    from catalog.viewer.window import NO_DISPLAY_HINT, display_available, init_glfw
+    from catalog.viewer.window import (NO_DISPLAY_HINT, NoDisplayError, display_available,
+                                       init_glfw)
 
     from catalog.commands.displayargs import display_choices
 
@@ -125,8 +129,8 @@ def run(args: argparse.Namespace) -> int:
     if args.wind is not None and not 0.0 <= args.wind <= 50.0:
         raise CatalogError(f"--wind: {args.wind:g} m/s is outside 0-50 m/s")
     if not display_available():  # say so before any heavy import or preset read
-        raise CatalogError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
-                           + NO_DISPLAY_HINT)
+        raise NoDisplayError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
+                             + NO_DISPLAY_HINT)
     init_glfw()  # a named display that cannot be opened: the same one line, exit 2
     fabric, fabric_dir = args.fabric, args.fabric_dir
     if fabric is not None and fabric.endswith(".toml"):  # a preset file: browse its folder
@@ -143,5 +147,5 @@ def run(args: argparse.Namespace) -> int:
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
         ev100=ev, white_balance=white_balance, compare_fluorescence=args.compare_fluorescence,
         room_light=not args.no_room_light,
-        fabric_dir=fabric_dir if fabric_dir is not None else FABRIC_DIR)
+        fabric_dir=fabric_dir)
     return ViewerApp(options).run()

@@ -5,8 +5,24 @@ from __future__ import annotations
 from pathlib import Path
 
 
+#: Exit status of a refused input (a bad file, field or option).
+INPUT_EXIT = 2
+#: Exit status of an environment failure: the machine lacks something the command needs
+#: (no EGL device, no display, a shader file missing from the installation).
+ENVIRONMENT_EXIT = 3
+
+
 class CatalogError(Exception):
-    """A refusal with a one-line, user-facing message. The CLI prints it and exits 2."""
+    """A refusal with a one-line, user-facing message. The CLI prints it and exits with
+    :attr:`exit_code` (2: the input; :class:`EnvironmentFailure` is 3)."""
+
+    exit_code = INPUT_EXIT
+
+
+class EnvironmentFailure(CatalogError):
+    """Not the input's fault: no EGL device or display, a missing or uncompilable shader."""
+
+    exit_code = ENVIRONMENT_EXIT
 
 
 class InputError(CatalogError):

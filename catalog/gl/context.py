@@ -4,12 +4,12 @@
   a GPU's EGL where there is one);
 - :func:`wrap_window_context`: the context of a window the caller made current (glfw).
 
-Both require OpenGL 4.3 (compute shaders, std430). Failures are one-line CatalogErrors.
+Both require OpenGL 4.3 (compute shaders, std430). Failures are one-line EnvironmentFailures (exit 3).
 """
 
 from __future__ import annotations
 
-from catalog.core.errors import CatalogError
+from catalog.core.errors import EnvironmentFailure
 
 #: OpenGL version required (4.3: compute shaders for the cloth, std430 buffers).
 REQUIRED_GL = 430
@@ -28,7 +28,7 @@ def create_headless_context(device_index: int | None = None):
         return moderngl.create_standalone_context(backend="egl", require=REQUIRED_GL, **options)
     except Exception as exc:  # moderngl/glcontext raise plain Exceptions here
         reason = " ".join(str(exc).split()) or type(exc).__name__
-        raise CatalogError(f"no EGL device: cannot create a headless OpenGL {REQUIRED_GL // 100}."
+        raise EnvironmentFailure(f"no EGL device: cannot create a headless OpenGL {REQUIRED_GL // 100}."
                            f"{REQUIRED_GL // 10 % 10} context ({reason})") from None
 
 
@@ -63,7 +63,7 @@ def wrap_window_context():
         return moderngl.create_context(require=REQUIRED_GL)
     except Exception as exc:
         reason = " ".join(str(exc).split()) or type(exc).__name__
-        raise CatalogError(f"no usable OpenGL {REQUIRED_GL // 100}.{REQUIRED_GL // 10 % 10} "
+        raise EnvironmentFailure(f"no usable OpenGL {REQUIRED_GL // 100}.{REQUIRED_GL // 10 % 10} "
                            f"context in the current window ({reason})") from None
 
 

@@ -3,7 +3,9 @@
 After moderngl-window's program loader: sources are files (never strings in Python), an
 include is searched in the including file's folder and then in the registered folders, and
 nesting deeper than :data:`MAX_INCLUDE_DEPTH` is refused (which also catches cycles).
-Defines are written right after the ``#version`` line, so a variant is chosen at compile time.
+Defines are written right after the ``#version`` line, so a variant is chosen at compile time;
+the constants Python and GLSL share (:data:`catalog.core.constants.SHADER_DEFINES`) are
+defined in every program, so GLSL never repeats their values.
 
 Dialects: the files are written for desktop GLSL 4.30 (``core``); :data:`DIALECTS` ``"es300"``
 emits the GLSL ES 3.00 variant of the same files for WebGL2 (the web catalog): the version line
@@ -18,7 +20,8 @@ from pathlib import Path
 from typing import Mapping
 
 from catalog.core.resources import SHADER_DIR
-from catalog.core.errors import CatalogError
+from catalog.core.constants import SHADER_DEFINES
+from catalog.core.errors import CatalogError, EnvironmentFailure
 
 #: Deeper nesting than this is an error (an include cycle always reaches it).
 MAX_INCLUDE_DEPTH = 8
@@ -46,7 +49,7 @@ def find_shader(name: str, near: Path | None = None) -> Path:
         if candidate.is_file():
             return candidate
     searched = ", ".join(str(f) for f in folders)
-    raise CatalogError(f"shader file {name!r} not found (searched {searched})")
+    raise EnvironmentFailure(f"shader file {name!r} not found (searched {searched})")
 
 
 def _expand(path: Path, depth: int, chain: tuple[str, ...]) -> list[str]:
@@ -100,7 +103,7 @@ def load_source(name: str, defines: Mapping[str, object] | None = None,
     version, preamble = DIALECTS[dialect]
     path = find_shader(name)
     lines = _expand(path, 0, (path.name,))
-    extra = _define_lines(defines or {}) + list(preamble)
+    extra = _define_lines({**SHADER_DEFINES, **(defines or {})}) + list(preamble)
     for index, line in enumerate(lines):
         if _VERSION.match(line):
             head = [f"#version {version}"] if version is not None else lines[index:index + 1]
@@ -136,7 +139,8 @@ def glsl_literal(value) -> str:
 
 def create_program(ctx, vertex: str, fragment: str | None = None,
                    defines: Mapping[str, object] | None = None, fragment_outputs=None):
-    """A moderngl program from shader files; compile errors become one-line CatalogErrors."""
+    """A moderngl program from shader files; compile errors become one-line
+    EnvironmentFailures (the installed shaders or the driver are at fault, exit 3)."""
     import moderngl  # noqa: PLC0415
 
     recipe_sink = getattr(ctx, "program_recipe_sink", None)
@@ -149,7 +153,7 @@ def create_program(ctx, vertex: str, fragment: str | None = None,
         return ctx.program(**sources, fragment_outputs=fragment_outputs)
     except moderngl.Error as exc:
         first = next((ln for ln in str(exc).splitlines() if "error" in ln.lower()), str(exc))
-        raise CatalogError(f"shader {vertex}+{fragment} failed to compile: {first.strip()}") from None
+        raise EnvironmentFailure(f"shader {vertex}+{fragment} failed to compile: {first.strip()}") from None
 
 
 def create_compute(ctx, name: str, defines: Mapping[str, object] | None = None):
@@ -160,4 +164,4 @@ def create_compute(ctx, name: str, defines: Mapping[str, object] | None = None):
         return ctx.compute_shader(load_source(name, defines))
     except moderngl.Error as exc:
         first = next((ln for ln in str(exc).splitlines() if "error" in ln.lower()), str(exc))
-        raise CatalogError(f"compute shader {name} failed to compile: {first.strip()}") from None
+        raise EnvironmentFailure(f"compute shader {name} failed to compile: {first.strip()}") from None

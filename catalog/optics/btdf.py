@@ -63,6 +63,8 @@ import math
 
 import numpy as np
 
+from catalog.core.constants import HG_MIRROR_BELOW
+
 FOUR_PI = 4.0 * math.pi
 
 #: A straight-through point: theta below this (degrees) sees the lamp through the gaps
@@ -94,6 +96,20 @@ def hg_denominator(one_minus_cos, g):
     return one_minus_g * one_minus_g + 2 * g * one_minus_cos
 
 
+def hg_denominator_robust(one_minus_cos, one_plus_cos, g):
+    """Eq. 6's ``d`` in the form that keeps its digits: the forward form above for
+    ``g >= HG_MIRROR_BELOW``, the mirrored ``(1 + g)^2 - 2 g (1 + cos theta)`` below it
+    (the one threshold of catalog.core.constants, which the shaders' hg_d uses too)."""
+    one_plus_g = 1 + g
+    return np.where(np.asarray(g) >= HG_MIRROR_BELOW, hg_denominator(one_minus_cos, g),
+                    one_plus_g * one_plus_g - 2 * g * np.asarray(one_plus_cos))
+
+
+def hg_phase_of_d(d, g):
+    """Eq. 6 from its denominator's base ``d``: ``(1 - g)(1 + g) / (4 pi d sqrt(d))``."""
+    return (1 - g) * (1 + g) / (FOUR_PI * d * np.sqrt(d))
+
+
 def hg_phase_one_minus_cos(one_minus_cos, g):
     """Eq. 6 (per steradian) from ``1 - cos theta``, in the robust form above.
 
@@ -105,10 +121,7 @@ def hg_phase_one_minus_cos(one_minus_cos, g):
     # (NaN from the square root). For g < 0 use the mirrored form (1+g)^2 - 2g(1 + cos),
     # a sum of non-negative terms, as hg_phase_between does.
     one_minus_cos = np.clip(np.asarray(one_minus_cos), 0.0, 2.0)  # keeps float32 as float32
-    one_plus_g = 1 + g
-    d = np.where(np.asarray(g) >= 0, hg_denominator(one_minus_cos, g),
-                 one_plus_g * one_plus_g - 2 * g * (2.0 - one_minus_cos))
-    return (1 - g) * (1 + g) / (FOUR_PI * d * np.sqrt(d))  # eq. 6
+    return hg_phase_of_d(hg_denominator_robust(one_minus_cos, 2.0 - one_minus_cos, g), g)
 
 
 def hg_phase(cos_theta, g):
@@ -125,10 +138,7 @@ def hg_phase_between(travel: np.ndarray, view: np.ndarray, g):
     one_minus_cos = one_minus_cos_between(travel, view)
     total = travel + view
     one_plus_cos = 0.5 * np.einsum("...i,...i->...", total, total)
-    one_plus_g = 1 + g
-    d = np.where(np.asarray(g) >= 0, hg_denominator(one_minus_cos, g),
-                 one_plus_g * one_plus_g - 2 * g * one_plus_cos)
-    return (1 - g) * (1 + g) / (FOUR_PI * d * np.sqrt(d))  # eq. 6
+    return hg_phase_of_d(hg_denominator_robust(one_minus_cos, one_plus_cos, g), g)  # eq. 6
 
 
 def hg_phase_printed(cos_theta, g):
@@ -275,6 +285,7 @@ def cook_torrance_transmittance(to_light: np.ndarray, view: np.ndarray, direct, 
 
 
 __all__ = ["STRAIGHT_THROUGH_DEG", "one_minus_cos_between", "hg_denominator",
+           "hg_denominator_robust", "hg_phase_of_d",
            "hg_phase", "hg_phase_between", "hg_phase_one_minus_cos", "hg_phase_printed",
            "hg_phase_dg", "hg_phase_and_dg", "eq7_scattered", "eq7_transmittance", "is_straight_through",
            "woven_btdf", "woven_one_minus_cos", "cook_torrance_transmittance", "ct_geometry", "ct_lobes",

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from catalog.core.constants import LUMINOUS_EFFICACY_LM_W
 from catalog.optics.colorimetry import (M_PAPER_XYZ_TO_RGB, cmfs, delta_e_2000,
                                  linear_srgb_to_xyz, xyz_to_linear_srgb)
 from catalog.core.errors import CatalogError, InputError
@@ -40,8 +41,6 @@ from catalog.optics.spectra import GRID_NM, VISIBLE_NM, Spectrum
 PLANCK_J_S = 6.62607015e-34
 #: Speed of light in vacuum, m s^-1 (CODATA 2018, exact by definition of the metre).
 LIGHT_SPEED_M_S = 299792458.0
-#: Maximum luminous efficacy of radiation, lm W^-1 (the SI candela definition, 683 at 540 THz).
-LUMINOUS_EFFICACY_LM_W = 683.0
 
 #: Grid step of GRID_NM (1 nm): every sum over the grid is a Riemann sum with this dl.
 GRID_STEP_NM = 1.0

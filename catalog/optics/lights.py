@@ -35,12 +35,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from catalog.core.constants import LUMINOUS_EFFICACY_LM_W as K_M_LM_PER_W
 from catalog.optics import reference_tables
 from catalog.core.errors import CatalogError, InputError
 from catalog.optics.spectra import GRID_NM
 
-#: Maximum luminous efficacy of radiation (lm/W) in the photopic illuminance.
-K_M_LM_PER_W = 683.0
 #: Default level of the daylight illuminants (lx): an overcast-to-bright outdoor day.
 DAYLIGHT_LX = 10_000.0
 #: Default level of lamps (lx): a brightly lit shop or showroom.

@@ -26,11 +26,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from catalog.optics.btdf import hg_phase_one_minus_cos
+from catalog.core.constants import LUMINOUS_EFFICACY_LM_W
+from catalog.optics.btdf import hg_denominator_robust, hg_phase_of_d
 from catalog.optics.spectra import GRID_NM
 
-#: Luminous efficacy (lm/W) that puts Y in cd m^-2 for a radiance in W m^-2 sr^-1.
-LUMINOUS_EFFICACY_LM_W = 683.0
 #: Grid step of GRID_NM (nm).
 STEP_NM = 1.0
 #: Photons are carried in units of 1e18 m^-2 s^-1 in the shader (float32 range and precision).
@@ -74,16 +73,12 @@ class ShadingInputs:
 def hg_phase_chords(chord2, anti2, g):
     """Eq. 6 from the chords |view - travel|^2 and |view + travel|^2 (float64).
 
-    g >= 0: :func:`catalog.optics.btdf.hg_phase_one_minus_cos` with 1 - cos = chord2 / 2 (the same
-    robust form as shaders/common.glsl). g < 0: the mirrored form (1 + g)^2 - g anti2 that the
-    shader uses so that float32 keeps its digits near g = -1, theta = pi.
+    1 - cos = chord2 / 2 and 1 + cos = anti2 / 2 in :func:`catalog.optics.btdf.hg_denominator_robust`,
+    the same choice of form as shaders/common.glsl's hg_d (one threshold, HG_MIRROR_BELOW).
     """
     chord2 = np.asarray(chord2, dtype=np.float64)
     anti2 = np.asarray(anti2, dtype=np.float64)
-    if g >= 0:
-        return hg_phase_one_minus_cos(0.5 * chord2, g)
-    d = (1 + g) * (1 + g) - g * anti2
-    return (1 - g) * (1 + g) / (4 * math.pi * d * np.sqrt(d))  # eq. 6
+    return hg_phase_of_d(hg_denominator_robust(0.5 * chord2, 0.5 * anti2, g), g)  # eq. 6
 
 
 def woven_chord2(delta, t, b, n, anisotropy):

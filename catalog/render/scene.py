@@ -416,7 +416,9 @@ def decide_fluorescence(preset, irradiance: np.ndarray, requested: str) -> Fluor
     (:func:`catalog.optics.fluorescence.fluorescence_needed`; the same judgement for both modes)."""
     from catalog.optics.fluorescence import fluorescence_delta_e  # noqa: PLC0415
 
-    if requested not in ("off", "paper", "physical"):
+    from catalog.core.constants import FLUORESCENCE_MODES  # noqa: PLC0415
+
+    if requested not in FLUORESCENCE_MODES:
         raise CatalogError(f"fluorescence mode {requested!r}: choose off, paper or physical")
     material = fluorescent_material(preset, irradiance)
     if requested == "off" or material is None:

@@ -14,6 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
+from catalog.render.imagefile import (OCIO_LINEAR_SPACE, exr_colour_metadata,  # noqa: F401
+                                     read_metadata, write_image)
 
 IMAGE_SUFFIXES = (".exr", ".png")
 #: Frame step of the cloth simulation behind ``--frame N`` (s).
@@ -59,68 +61,6 @@ class SnapshotRequest:
     room_light: bool = True
     bloom: bool = True
     lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
-
-
-def encode_image(path: Path, pixels: np.ndarray, metadata: dict) -> None:
-    """Write (H, W, 3) pixels to ``path`` with OpenImageIO (float32 -> EXR, uint8 -> PNG, by
-    the suffix), not atomically: callers write a temporary file and rename it."""
-    import OpenImageIO as oiio  # noqa: PLC0415
-
-    height, width, channels = pixels.shape
-    kind = oiio.FLOAT if pixels.dtype == np.float32 else oiio.UINT8
-    spec = oiio.ImageSpec(width, height, channels, kind)
-    spec.channelnames = ("R", "G", "B")
-    for key, value in metadata.items():
-        if key == "chromaticities":
-            spec.attribute(key, oiio.TypeDesc("float[8]"), tuple(value))
-        else:
-            spec.attribute(key, str(value))
-    output = oiio.ImageOutput.create(str(path))
-    if output is None:
-        raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
-    ok = output.open(str(path), spec) and output.write_image(np.ascontiguousarray(pixels))
-    error = output.geterror()
-    output.close()
-    if not ok:
-        raise CatalogError(f"cannot write {path}: {error}")
-
-
-def write_image(path: Path, pixels: np.ndarray, metadata: dict) -> None:
-    """Write (H, W, 3) pixels with OpenImageIO, atomically: float32 -> EXR, uint8 -> PNG."""
-    from catalog.core.atomic import atomic_path  # noqa: PLC0415
-
-    with atomic_path(path) as tmp:
-        encode_image(tmp, pixels, metadata)
-
-
-def exr_colour_metadata() -> dict:
-    """What tools need to show our EXR with a standard view (OpenColorIO's built-in config
-    ``ocio://default``: the interop ID of its colour space "Linear Rec.709 (sRGB)"; the EXR chromaticities of
-    sRGB / Rec.709 with the D65 white, from colour-science's tables)."""
-    from catalog.render import display  # noqa: PLC0415
-
-    t = display.tables()
-    m = np.linalg.inv(t["srgb_xyz_to_rgb"])  # RGB -> XYZ: the columns are the primaries
-    xy = [(col[0] / col.sum(), col[1] / col.sum()) for col in m.T]
-    white = tuple(float(v) for v in t["srgb_whitepoint_xy"])
-    return {"oiio:ColorSpace": OCIO_LINEAR_SPACE,
-            "chromaticities": tuple(float(v) for pair in xy for v in pair) + white}
-
-
-#: The name of our EXR's colour space in OpenColorIO's built-in config (ocio://default).
-OCIO_LINEAR_SPACE = "lin_rec709_scene"   # the interop ID; "Linear Rec.709 (sRGB)" there
-
-
-def read_metadata(path: str | Path) -> dict[str, str]:
-    """The string attributes of an image (to check what a snapshot recorded)."""
-    import OpenImageIO as oiio  # noqa: PLC0415
-
-    image = oiio.ImageInput.open(str(path))
-    if image is None:
-        raise CatalogError(f"cannot read {path}: {oiio.geterror()}")
-    spec = image.spec()
-    image.close()
-    return {attr.name: str(attr.value) for attr in spec.extra_attribs}
 
 
 def simulated_curtain(preset, frames: int):

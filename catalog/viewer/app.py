@@ -19,7 +19,6 @@ from pathlib import Path
 
 import numpy as np
 
-from catalog.core.resources import FABRIC_DIR
 from catalog.core.errors import CatalogError
 from catalog.viewer.catalog_state import FabricCatalog
 from catalog.viewer.input import Action, MouseOrbit, OrbitCamera, action_for_key
@@ -63,7 +62,7 @@ class ViewerOptions:
     paused: bool = False
     render_scale: float | None = None  # scene resolution / window resolution; None: auto
     room_light: bool = True  # the room lit through the curtain, the clear sky, glare (issue 13)
-    fabric_dir: Path = FABRIC_DIR
+    fabric_dir: Path | None = None  # None: --fabrics / $CATALOG_FABRICS, then the built-in catalog
     ev100: float | None = None  # fixed exposure; None: automatic
     white_balance: str = "room"
     compare_fluorescence: str | None = None  # the right half's fluorescence (None: the left's)
@@ -83,7 +82,7 @@ class ViewerApp:
         self.options = options
         self.catalog = FabricCatalog(options.fabric_dir)
         if len(self.catalog) == 0:
-            raise CatalogError(f"no presets (*.toml) in {options.fabric_dir}")
+            raise CatalogError(f"no presets (*.toml) in {self.catalog.where}")
         self.settings = ViewerSettings(fluorescence=options.fluorescence, bands=options.bands,
                                        show_panel=options.panel, paused=options.paused,
                                        ev100=options.ev100, white_balance=options.white_balance,
@@ -100,6 +99,10 @@ class ViewerApp:
         self._quit = False
         self._screenshot_requested = False
         self.messages: dict[str, str] = {}  # topic -> one-line error shown in the panel
+        #: The first error that spoiled a frame (a fabric or light that could not be applied, a
+        #: render that failed). Interactive use shows it in the panel and goes on; a --frames
+        #: run ends with it (no screenshot, non-zero exit).
+        self.frame_error: CatalogError | None = None
         self.last_screenshot: str | None = None
 
     def _loadable_index(self, name: str) -> int:
@@ -227,6 +230,7 @@ class ViewerApp:
                         self.messages.pop(f"render{slot}", None)
                     except CatalogError as exc:  # e.g. no fabric loads: say so, keep running
                         self.messages[f"render{slot}"] = str(exc)
+                        self.frame_error = self.frame_error or exc
                 self.ctx.finish()
 
             with self.timer.part("ui"):
@@ -248,7 +252,7 @@ class ViewerApp:
             if self._screenshot_requested:
                 self._screenshot_requested = False
                 self._save_screenshot_pair()
-            if last_frame and self.options.screenshot is not None:
+            if last_frame and self.options.screenshot is not None and self.frame_error is None:
                 self._save_window_png(self.options.screenshot)
 
             self.ctx.copy_framebuffer(self.ctx.screen, self._fbo)
@@ -271,6 +275,8 @@ class ViewerApp:
             print(json.dumps(summary), flush=True)
         self.gui.shutdown()
         self.thumbnails.release()
+        if self.options.frames is not None and self.frame_error is not None:
+            raise self.frame_error  # one line on stderr, exit 2 (or 3 for the environment)
         return 0
 
     def _refresh_catalog(self) -> None:
@@ -453,7 +459,7 @@ class ViewerApp:
         """Pass the settings to each renderer, only what changed since the last frame."""
         settings = self.settings
         if len(self.catalog) == 0:
-            self.messages["catalog"] = f"no presets (*.toml) in {self.catalog.fabric_dir}"
+            self.messages["catalog"] = f"no presets (*.toml) in {self.catalog.where}"
             return
         self.messages.pop("catalog", None)
         fabrics = [settings.fabric_index]
@@ -470,6 +476,7 @@ class ViewerApp:
                     self.messages.pop(f"fabric{slot}", None)
                 except CatalogError as exc:
                     self.messages[f"fabric{slot}"] = str(exc)
+                    self.frame_error = self.frame_error or exc
                 applied["fabric"] = (entry.name, id(entry.preset))
             light_key = (settings.light, settings.sun_hour if settings.light == SUN else None)
             if applied.get("light") != light_key:
@@ -482,6 +489,7 @@ class ViewerApp:
                     self.messages.pop("light", None)
                 except CatalogError as exc:
                     self.messages["light"] = str(exc)
+                    self.frame_error = self.frame_error or exc
                 applied["light"] = light_key
             mode = settings.fluorescence if slot == 0 else settings.right_fluorescence
             if applied.get("fluorescence") != mode:

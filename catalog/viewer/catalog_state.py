@@ -17,7 +17,7 @@ from typing import Callable
 
 import numpy as np
 
-from catalog.core.resources import FABRIC_DIR
+from catalog.core.resources import fabric_dirs
 from catalog.core.errors import CatalogError
 from catalog.presets import Preset, list_presets, load_preset
 
@@ -168,14 +168,21 @@ class FabricCatalog:
     viewer can re-apply the preset it is showing.
     """
 
-    def __init__(self, fabric_dir: Path = FABRIC_DIR, rescan_interval_s: float = 0.5,
+    def __init__(self, fabric_dir: Path | None = None, rescan_interval_s: float = 0.5,
                  clock: Callable[[], float] = time.monotonic):
-        self.fabric_dir = Path(fabric_dir)
+        # None: the user's fabric folders, then the built-in catalog (catalog.core.resources)
+        self.fabric_dir = None if fabric_dir is None else Path(fabric_dir)
         self.rescan_interval_s = float(rescan_interval_s)
         self._clock = clock
         self._last_scan: float | None = None
         self.entries: list[FabricEntry] = []
         self.refresh(force=True)
+
+    @property
+    def where(self) -> str:
+        """The folder(s) searched, for messages."""
+        folders = [self.fabric_dir] if self.fabric_dir is not None else fabric_dirs()
+        return ", ".join(str(f) for f in folders)
 
     # -- the list ------------------------------------------------------------------
     @property
@@ -190,7 +197,7 @@ class FabricCatalog:
             if entry.name == name:
                 return i
         known = ", ".join(self.names) or "none"
-        raise CatalogError(f"--fabric: unknown fabric {name!r} in {self.fabric_dir} "
+        raise CatalogError(f"--fabric: unknown fabric {name!r} in {self.where} "
                            f"(known: {known})")
 
     def refresh(self, force: bool = False) -> list[str]:

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 
 from catalog.viewer.catalog_state import FabricFilter
 
-#: The renderer's fluorescence modes, in the order the F key cycles them.
-FLUORESCENCE_MODES = ("off", "paper", "physical")
+from catalog.core.constants import FLUORESCENCE_MODES
+
 #: Band counts the renderer compiles (3 = RGB).
 BAND_COUNTS = (3, 6, 9, 16)
 #: The lights the L key steps through: the sun (hour slider), CIE daylight and tungsten,

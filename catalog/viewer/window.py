@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 
-from catalog.core.errors import CatalogError
+from catalog.core.errors import EnvironmentFailure
 
 #: The renderer's shaders need OpenGL 4.3 (compute shaders, SSBOs).
 GL_VERSION = (4, 3)
@@ -19,7 +19,7 @@ NO_DISPLAY_HINT = ("render without a window with `catalog snapshot --fabric NAME
                    "--out FILE.png` or `catalog sheet --lights NAME,NAME --out DIR`")
 
 
-class NoDisplayError(CatalogError):
+class NoDisplayError(EnvironmentFailure):
     """No display to open a window on (the CLI prints the one line and exits 2)."""
 
 

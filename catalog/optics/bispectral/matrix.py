@@ -49,9 +49,10 @@ if TYPE_CHECKING:  # pragma: no cover
     from catalog.optics.fluorescence import FluorescentMaterial
 
 def bispectral_dir() -> Path:
-    """The shared data folder of measured matrices (read in place, never copied)."""
-    from catalog.core.resources import SHARED_DATA_DIR
-    return SHARED_DATA_DIR / "bispectral"
+    """The validation data's folder of measured matrices (read in place, never copied); a
+    one-line input error when it is absent (see :func:`catalog.core.resources.data_dir`)."""
+    from catalog.core.resources import data_dir
+    return data_dir("bispectral")
 
 
 #: Lines before the dimension line in a BFC-450 matrix file (the dimension line is line 11).
@@ -118,10 +119,10 @@ def _numbers(path: Path, line_no: int, fields: list[str], what: str) -> list[flo
         try:
             value = float(text)
         except ValueError:
-            raise InputError(f"{what}: field {i} is not a number: {text!r}", path=path,
+            raise InputError(f"{what}: field {i} is not a number", path=path,
                              line=line_no) from None
         if not math.isfinite(value):
-            raise InputError(f"{what}: field {i} is not finite: {text!r}", path=path,
+            raise InputError(f"{what}: field {i} is not finite", path=path,
                              line=line_no)
         out.append(value)
     return out
@@ -140,7 +141,7 @@ def _axis(path: Path, line_no: int, start: float, stop: float, step: float, coun
 
 
 def read_bfc(path: str | Path) -> DonaldsonMatrix:
-    """Read a BFC-450 matrix file (the layout of ../shared/data/README.md).
+    """Read a BFC-450 matrix file (the layout in docs/formats.md, "Where files are found").
 
     Ten header lines (the second says ``BFC-450 Matrix File``, lines starting with ';'
     carry the file name, the description, operator, instrument modes, date and time);
@@ -160,7 +161,7 @@ def read_bfc(path: str | Path) -> DonaldsonMatrix:
                          "(10 header lines, the dimension line, the r:c: line)", path=path,
                          line=len(lines))
     if "BFC" not in lines[1]:
-        raise InputError(f"not a BFC-450 matrix file (line 2 is {lines[1].strip()!r})",
+        raise InputError("not a BFC-450 matrix file (line 2 does not name the BFC instrument)",
                          path=path, line=2)
     comments = [ln.strip()[1:].strip() for ln in lines[2:HEADER_LINES] if ln.strip().startswith(";")]
     # the first comment repeats the file name (not always faithfully); the second describes it
@@ -233,6 +234,11 @@ def find_bfc(name_or_path: str | Path) -> Path:
     if path.is_file():
         return path
     stem = path.name.upper().removesuffix(".BFC")
+    from catalog.core.resources import data_missing_reason
+    reason = data_missing_reason("bispectral")
+    if reason is not None:
+        raise InputError(f"no such file, and no matrices to look the name up in ({reason})",
+                         path=name_or_path)
     folder = bispectral_dir()
     if folder.is_dir():
         for candidate in list_bfc(folder):

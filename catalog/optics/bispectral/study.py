@@ -60,6 +60,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from catalog.core.constants import LUMINOUS_EFFICACY_LM_W as LM_PER_W
 from catalog.optics.bispectral.matrix import (REFLECTANCE_BAND_NM, DonaldsonMatrix, SeparableFit,
                                 bin_irradiance, exact_exitance_on_grid, fit_separable)
 from catalog.optics.colorimetry import (M_PAPER_XYZ_TO_RGB, cmfs, delta_e_2000, linear_srgb_to_xyz,
@@ -85,8 +86,6 @@ STATE_OF_THE_ART = {"ignoring fluorescence": (11.6, 26.0), "naive 3x3": (10.7, 2
                     "separable (exact per light)": (0.48, 0.90)}
 #: The goal for ``physical`` over all matrices x GOAL_LIGHTS (issue 2).
 GOAL_MEAN, GOAL_MAX = 0.5, 1.0
-
-LM_PER_W = 683.0
 
 
 def _xyz(spectrum: np.ndarray) -> np.ndarray:

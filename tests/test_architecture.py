@@ -1,0 +1,152 @@
+"""The house: which room may import which (docs/architecture.md), checked statically.
+
+Every import statement of every module under catalog/ is read with ``ast`` (lazy imports
+inside functions included, since a lazy import still runs when that path runs), mapped to
+the room it comes from and the room it reaches, and checked against the design's rules.
+Nothing is imported to do this, so the test is fast and sees every branch.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parent.parent / "catalog"
+
+#: Rooms that may import only themselves and the rooms listed (the base of the house).
+ONLY = {
+    "core": {"core"},
+    "gl": {"gl", "core"},
+    "optics": {"optics", "core"},
+    "presets": {"presets", "core", "optics"},
+}
+
+#: (importing room, imported room or top-level module): arrows that must never exist.
+FORBIDDEN = [
+    ("optics", "render"), ("optics", "viewer"), ("optics", "gl"),   # the physics knows no GL
+    ("render", "fit"), ("viewer", "fit"),                           # drawing never fits ...
+    ("render", "scipy"), ("viewer", "scipy"),                       # ... nor imports scipy
+    ("render", "tools"), ("viewer", "tools"),
+    ("cloth", "viewer"), ("cloth", "render"),                       # cloth reaches GL via gl
+    ("presets", "render"), ("presets", "viewer"),
+    ("render", "pathtrace"), ("viewer", "pathtrace"),               # Mitsuba stays out of frames
+]
+#: Only these rooms may import the benchmarks (and bench itself).
+BENCH_IMPORTERS = {"bench", "commands"}
+
+
+def _module_name(path: Path, package: Path = PACKAGE) -> str:
+    parts = list(path.relative_to(package.parent).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _room(module: str) -> str:
+    """``catalog.optics.sun.model`` -> ``optics``; ``catalog`` itself -> ``catalog``;
+    anything outside the package -> its top-level name (``scipy``)."""
+    parts = module.split(".")
+    if parts[0] != "catalog":
+        return parts[0]
+    return parts[1] if len(parts) > 1 else "catalog"
+
+
+def _imports(path: Path, package_dir: Path = PACKAGE) -> list[tuple[int, str]]:
+    """(line, imported module) for every import in the file, relative ones resolved."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    here = _module_name(path, package_dir).split(".")
+    package = here if path.name == "__init__.py" else here[:-1]
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package[:len(package) - node.level + 1]
+                module = ".".join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module or ""
+            found.append((node.lineno, module))
+            # ``from catalog import optics`` reaches the optics room
+            found += [(node.lineno, f"{module}.{alias.name}") for alias in node.names
+                      if module == "catalog"]
+    return found
+
+
+def _edges(package: Path = PACKAGE) -> list[tuple[str, int, str, str]]:
+    """(file, line, from room, to room) for every import that crosses a room."""
+    edges = []
+    for path in sorted(package.rglob("*.py")):
+        source = _room(_module_name(path, package))
+        for line, module in _imports(path, package):
+            target = _room(module)
+            if target != source:
+                edges.append((path.relative_to(package.parent).as_posix(), line, source, target))
+    return edges
+
+
+EDGES = _edges()
+ROOMS = sorted({p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file()})
+
+
+def test_the_rooms_are_there():
+    for room in ("core", "optics", "presets", "fit", "gl", "cloth", "render", "viewer",
+                 "commands", "bench"):
+        assert room in ROOMS
+    # the top level holds only the package's own entry points, no module of a room
+    loose = sorted(p.name for p in PACKAGE.glob("*.py"))
+    assert loose == ["__init__.py", "__main__.py"]
+
+
+@pytest.mark.parametrize("room", sorted(ONLY))
+def test_base_rooms_import_only_what_is_below_them(room):
+    inside = {r for r in ROOMS} | {"catalog"}
+    bad = [f"{f}:{line} {src} -> {dst}" for f, line, src, dst in EDGES
+           if src == room and dst in inside and dst not in ONLY[room]]
+    assert bad == []
+
+
+def test_no_forbidden_arrow():
+    forbidden = set(FORBIDDEN)
+    bad = [f"{f}:{line} {src} -> {dst}" for f, line, src, dst in EDGES if (src, dst) in forbidden]
+    assert bad == []
+
+
+def test_only_commands_import_the_benchmarks():
+    bad = [f"{f}:{line} {src} -> bench" for f, line, src, dst in EDGES
+           if dst == "bench" and src not in BENCH_IMPORTERS]
+    assert bad == []
+
+
+def test_no_module_imports_one_that_imports_it():
+    """No two modules import each other (lazily or not): a cycle is a room boundary drawn
+    in the wrong place (cloth's backends and simulation, cloth and render, once)."""
+    graph: dict[str, set[str]] = {}
+    modules = {_module_name(p) for p in PACKAGE.rglob("*.py")}
+    for path in PACKAGE.rglob("*.py"):
+        name = _module_name(path)
+        targets = set()
+        for _, module in _imports(path):
+            # ``from catalog.cloth import mesh`` names the module catalog.cloth.mesh
+            targets |= {m for m in (module,) if m in modules}
+        graph[name] = targets - {name}
+    cycles = sorted({tuple(sorted((a, b))) for a in graph for b in graph[a]
+                     if a in graph.get(b, set()) and not (b.startswith(a + ".") or a.startswith(b + "."))})
+    assert cycles == []
+
+
+def test_the_checker_sees_a_forbidden_import(tmp_path):
+    """The rules can fail: a lazy import of the renderer in an optics module, and a relative
+    one of the benchmarks in the renderer, are both seen."""
+    package = tmp_path / "catalog"
+    (package / "optics").mkdir(parents=True)
+    (package / "render").mkdir()
+    for init in (package, package / "optics", package / "render"):
+        (init / "__init__.py").write_text("")
+    (package / "optics" / "probe.py").write_text("def f():\n    from catalog.render import frame\n")
+    (package / "render" / "probe.py").write_text("from ..bench import colour\n")
+    edges = _edges(package)
+    assert ("catalog/optics/probe.py", 2, "optics", "render") in edges
+    assert ("catalog/render/probe.py", 1, "render", "bench") in edges

@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+"""Fill the generated blocks of README.md, BENCHMARKS.md and docs/*.md from the benchmarks'
+committed JSON, so that no figure in the docs is typed by hand.
+
+    .venv/bin/python tools/docs_figures.py           # rewrite the blocks that changed
+    .venv/bin/python tools/docs_figures.py --check   # exit 1 naming the stale blocks
+
+A block is the text between ``<!-- generated:NAME -->`` and ``<!-- /generated:NAME -->``.
+Its content comes from a module of catalog.bench that has ``RESULT_JSON`` (the committed
+JSON, relative to the repository) and ``markdown_tables(result) -> {NAME: markdown}``. A
+marker whose NAME no module provides is an error (exit 2), as is a JSON file that is missing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import pkgutil
+import re
+import sys
+from pathlib import Path
+
+from catalog.core.atomic import write_text_atomic
+
+ROOT = Path(__file__).resolve().parent.parent
+BLOCK = re.compile(r"(<!-- generated:(?P<name>[\w.-]+) -->\n)(?P<body>.*?)(\n?<!-- /generated:(?P=name) -->)",
+                   re.S)
+
+
+def documents(root: Path = ROOT) -> list[Path]:
+    return [p for p in [root / "README.md", root / "BENCHMARKS.md",
+                        *sorted((root / "docs").glob("*.md"))] if p.is_file()]
+
+
+def tables(root: Path = ROOT) -> dict[str, str]:
+    """Every NAME -> markdown the bench modules make from their committed JSON."""
+    import catalog.bench as bench
+
+    out: dict[str, str] = {}
+    for info in pkgutil.iter_modules(bench.__path__):
+        module = importlib.import_module(f"catalog.bench.{info.name}")
+        source, make = getattr(module, "RESULT_JSON", None), getattr(module, "markdown_tables", None)
+        if source is None or make is None:
+            continue
+        path = root / source
+        if not path.is_file():
+            raise SystemExit(f"docs_figures: error: {source}: no such file (run the benchmark)")
+        for name, text in make(json.loads(path.read_text(encoding="utf-8"))).items():
+            if name in out:
+                raise SystemExit(f"docs_figures: error: block {name!r} made by two modules")
+            out[name] = text.rstrip("\n")
+    return out
+
+
+def fill(text: str, made: dict[str, str], where: str) -> str:
+    def replace(match: re.Match) -> str:
+        name = match.group("name")
+        if name not in made:
+            raise KeyError(f"{where}: <!-- generated:{name} --> has no source "
+                           f"(known: {', '.join(sorted(made)) or 'none'})")
+        return f"{match.group(1)}{made[name]}\n<!-- /generated:{name} -->"
+    return BLOCK.sub(replace, text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--check", action="store_true",
+                        help="change nothing; exit 1 if a block differs from its JSON")
+    args = parser.parse_args(argv)
+    made = tables()
+    stale = []
+    for path in documents():
+        text = path.read_text(encoding="utf-8")
+        try:
+            new = fill(text, made, str(path.relative_to(ROOT)))
+        except KeyError as exc:
+            print(f"docs_figures: error: {exc.args[0]}", file=sys.stderr)
+            return 2
+        if new != text:
+            stale.append(str(path.relative_to(ROOT)))
+            if not args.check:
+                write_text_atomic(path, new)
+    if args.check and stale:
+        print(f"docs_figures: stale generated blocks in {', '.join(stale)} "
+              "(run tools/docs_figures.py)", file=sys.stderr)
+        return 1
+    print(f"docs_figures: {'checked' if args.check else 'updated'} "
+          f"{len(stale) if not args.check else 0} file(s); {len(made)} block(s) known")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# CI: build the wheel, install it into a fresh virtual environment, and run the main
+# commands from a folder outside the checkout: what a user gets from `pip install`.
+# Usage: tools/wheel_check.sh [WORK_DIR]   (default: a temporary folder, removed after)
+set -euo pipefail
+ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+WORK="${1:-$(mktemp -d)}"
+[ -n "${1:-}" ] || trap 'rm -rf "$WORK"' EXIT
+mkdir -p "$WORK/wheel" "$WORK/run"
+PY=${PYTHON:-python3}
+
+echo "wheel_check: building the wheel"
+"$ROOT/.venv/bin/python" -m pip wheel -q --no-deps -w "$WORK/wheel" "$ROOT"
+"$PY" -m venv "$WORK/venv"
+WHEEL=$(ls "$WORK"/wheel/*.whl)
+"$WORK/venv/bin/python" -m pip install -q "$WHEEL[all]"
+CATALOG="$WORK/venv/bin/catalog"
+
+cd "$WORK/run"  # outside the checkout: only what the wheel carries is found
+unset CATALOG_FABRICS
+echo "wheel_check: snapshot"
+"$CATALOG" snapshot --fabric lace-fwa --light D65 --size 64x48 --out snap.png --json > snap.json
+echo "wheel_check: fit"
+# a measurement the user brings (here the checkout's own, copied out)
+cp "$ROOT/fabrics/measurements/voile-white/gonio.csv" gonio.csv
+"$CATALOG" fit --gonio gonio.csv --name my-voile --out my-voile.toml --json > fit.json
+echo "wheel_check: sheet (the built-in catalog and the user's folder)"
+mkdir -p mine && cp my-voile.toml mine/
+"$CATALOG" sheet --lights D65 --fabrics lace-fwa,my-voile,mine --size 48x36 --out sheet --json > sheet.json
+echo "wheel_check: view --frames under Xvfb"
+xvfb-run -a "$CATALOG" view --frames 2 --size 160x120 --grid 12x16 --cloth-backend numpy \
+  --fabric voile-white --screenshot view.png
+for f in snap.png sheet.json view.png my-voile.toml; do
+  [ -s "$f" ] || { echo "wheel_check: $f missing" >&2; exit 1; }
+done
+"$WORK/venv/bin/python" - <<'PY'
+import json
+snap = json.load(open("snap.json")); fit = json.load(open("fit.json")); sheet = json.load(open("sheet.json"))
+assert len(sheet["images"]) == 2, sheet
+print("wheel_check: ok:", snap.get("out", "snap.png"), "fit rmse", fit.get("rmse"), len(sheet["images"]), "sheet images")
+PY
