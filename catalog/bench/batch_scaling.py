@@ -43,6 +43,8 @@ LIGHTS = ("D65", "A")
 FRAMES = "0:5"
 YAWS = "0,30,60,90"
 CATALOG = [sys.executable, "-m", "catalog"]
+#: The committed result (tools/docs_figures.py fills the docs from it).
+RESULT_JSON = "benchmarks/bench_batch.json"
 
 
 def _timed(cmd: list[str]) -> tuple[float, float, subprocess.CompletedProcess]:
