@@ -26,5 +26,5 @@ fi
 PY=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PY" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e ".[all,test,pathtrace${EXTRAS:+,$EXTRAS}]"
+.venv/bin/python -m pip install -q -e ".[all,test,pathtrace,batch${EXTRAS:+,$EXTRAS}]"
 echo "setup: ready (.venv)"

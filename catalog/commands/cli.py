@@ -39,6 +39,7 @@ COMMANDS: dict[str, str] = {
     "fit": "catalog.commands.fit",
     "snapshot": "catalog.commands.snapshot",
     "sheet": "catalog.commands.sheet",
+    "render-catalog": "catalog.commands.render_catalog",
     "view": "catalog.commands.view",
     "simulate": "catalog.commands.simulate",
     "bench": "catalog.commands.bench",
