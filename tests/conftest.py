@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 from pathlib import Path
 
 # One BLAS thread for the tests and the commands they start: the suite runs on small shared
@@ -92,10 +93,15 @@ def make_preset(tmp_path):
         if extra_btdf:
             lines.append(extra_btdf)
         if fluorescent:
+            # the spectra beside the preset: a preset's files must lie in its own folder tree
             folder = FABRIC_DIR / "measurements" / "lace-fwa"
+            local = tmp_path / "measurements" / "lace-fwa"
+            local.mkdir(parents=True, exist_ok=True)
+            for spectrum in ("excitation.csv", "emission.csv"):
+                shutil.copyfile(folder / spectrum, local / spectrum)
             lines += ["[fluorescence]", "xyz = [33.0, 100.0, 1700.0]", "rgb = [39.0, -52.0, 1790.0]",
-                      f'excitation = "{folder / "excitation.csv"}"',
-                      f'emission = "{folder / "emission.csv"}"']
+                      'excitation = "measurements/lace-fwa/excitation.csv"',
+                      'emission = "measurements/lace-fwa/emission.csv"']
         if dye is not None:
             dye_path = tmp_path / f"{name}-dye.csv"
             dye_path.write_text("wavelength_nm,intensity\n"

@@ -1,7 +1,7 @@
 """Issue 15: UV and violet lights, the banded fluorescence model, its renderer path.
 
-Bounds are stated in each test. Tests that need the measured matrices skip when
-the validation data (--data DIR, CATALOG_DATA) is absent (it is never shipped).
+Bounds are stated in each test. Tests that need the measured matrices skip, with the
+reason, when the validation data's bispectral folder is absent (it is never shipped).
 """
 
 from __future__ import annotations
@@ -20,10 +20,9 @@ from catalog.optics.spectra import GRID_NM
 
 colour = pytest.importorskip("colour")
 
-HAS_MATRICES = (data_missing_reason("bispectral") is None
-                and (data_dir_candidate() / "bispectral" / "CIBA12.BFC").is_file())
-needs_matrices = pytest.mark.skipif(not HAS_MATRICES, reason=data_missing_reason("bispectral")
-                                    or "CIBA12.BFC missing from the validation data")
+HAS_MATRICES = data_missing_reason("bispectral") is None
+needs_matrices = pytest.mark.skipif(not HAS_MATRICES,
+                                    reason=str(data_missing_reason("bispectral")))
 
 
 # ----------------------------------------------------------------------------- lights
@@ -167,7 +166,8 @@ def test_banded_preset_renders_the_sum_of_its_bands(tmp_path):
     """The renderer's per-light pre-integration of a banded preset: the emission it hands
     the shader for the key light equals the bands' summed emission (relative 1e-5: the
     preset's CSV files and 6-digit quantum yields)."""
-    from catalog.optics.bispectral.bands import banded_preset, fit_banded
+    from catalog.bench.uv_fluorescence import banded_preset
+    from catalog.optics.bispectral.bands import fit_banded
     from catalog.optics.lights import get_light
     from catalog.presets import find_preset, load_preset
     from catalog.render import scene
@@ -186,7 +186,8 @@ def test_banded_preset_renders_the_sum_of_its_bands(tmp_path):
 
 
 def test_bad_band_entry_is_refused_naming_the_field(tmp_path):
-    from catalog.optics.bispectral.bands import banded_preset, fit_banded
+    from catalog.bench.uv_fluorescence import banded_preset
+    from catalog.optics.bispectral.bands import fit_banded
     from catalog.presets import find_preset, load_preset, preset_from_dict, preset_to_dict
     from catalog.render import scene
 

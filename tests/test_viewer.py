@@ -511,8 +511,10 @@ def test_a_failed_frame_fails_a_frames_run(xdisplay, tmp_path):
                        "--frames", "2", "--screenshot", str(tmp_path / "x.png")],
                       xdisplay, tmp_path, timeout=120)
     assert result.returncode == 2, result.stderr
-    errors = [line for line in result.stderr.splitlines() if "error:" in line]
-    assert len(errors) == 1 and "no-such-dye.csv" in errors[0], result.stderr  # one line
+    assert "no-such-dye.csv" in result.stderr
+    # one error line (the viewer's start-up note on llvmpipe's cheaper settings may precede it)
+    errors = [ln for ln in result.stderr.strip().splitlines() if "error:" in ln]
+    assert len(errors) == 1 and "Traceback" not in result.stderr, result.stderr
     assert not (tmp_path / "x.png").exists()
 
 

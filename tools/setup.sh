@@ -10,9 +10,10 @@ need_apt=()
 have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 # Mesa's EGL + llvmpipe (headless GL 4.5), GLX for windows, Xvfb and xdotool for window tests,
 # glslang-tools (glslangValidator) to check the display shader compiles as GLSL ES 3.00;
-# Chromium and its WebDriver for the web catalog's browser tests (WebGL2 through SwiftShader).
+# Chromium and its WebDriver for the web catalog's browser tests (WebGL2 through SwiftShader);
+# LLVM 19 for Mitsuba's JIT (the path-traced reference; Mesa's LLVM 14/15 cannot run it).
 for pkg in libegl1 libegl-mesa0 libgl1-mesa-dri libglx-mesa0 libgl1 xvfb xauth xdotool glslang-tools \
-           chromium chromium-driver; do
+           chromium chromium-driver libllvm19; do
   have_pkg "$pkg" || need_apt+=("$pkg")
 done
 if ((${#need_apt[@]})); then
@@ -25,5 +26,5 @@ fi
 PY=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PY" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e ".[all,test${EXTRAS:+,$EXTRAS}]"
+.venv/bin/python -m pip install -q -e ".[all,test,pathtrace,batch${EXTRAS:+,$EXTRAS}]"
 echo "setup: ready (.venv)"

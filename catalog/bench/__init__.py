@@ -21,7 +21,10 @@ optionally, ``plot(result, folder) -> list[Path]``:
 - ``startup``: import time and time to the first frame (:mod:`catalog.bench.startup`);
 - ``display``: each display transform's cost in the frame (:mod:`catalog.bench.display`);
 - ``room``: the frame with the room lit through the curtain, the clear sky and the glare
-  against the frame without, each pass's share (:mod:`catalog.bench.room`).
+  against the frame without, each pass's share (:mod:`catalog.bench.room`);
+- ``image``: the real-time frame against the path-traced reference of the same scene, FLIP
+  and Delta E per region, both run times (:mod:`catalog.bench.image`; needs the
+  ``pathtrace`` extra and LLVM 19, docs/pathtrace.md).
 
 docs/bench.md has the figures and how to reproduce them.
 """
@@ -47,4 +50,5 @@ SECTIONS: dict[str, str] = {
     "startup": "catalog.bench.startup",
     "display": "catalog.bench.display",
     "room": "catalog.bench.room",
+    "image": "catalog.bench.image",
 }

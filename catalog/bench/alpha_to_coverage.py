@@ -67,9 +67,8 @@ def run(ctx=None) -> dict:
                         "worst_two_layers": round(worst_two, 4)}}
 
 
-#: The committed result tools/docs_figures.py makes this module's tables from.
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
 RESULT_JSON = "benchmarks/bench_a2c.json"
-
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """``a2c_layers``: NAME -> markdown table."""

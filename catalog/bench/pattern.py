@@ -159,9 +159,8 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
                         "choice": choose_antialiasing(dict(ctx.info))}}
 
 
-#: The committed result tools/docs_figures.py makes this module's tables from.
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
 RESULT_JSON = "benchmarks/bench_pattern.json"
-
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """``pattern_cost`` and ``pattern_msaa``: NAME -> markdown table."""

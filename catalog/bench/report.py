@@ -138,6 +138,13 @@ def room_md(result: dict) -> str:
     return "\n\n".join(markdown_tables(result).values())
 
 
+def image_md(result: dict) -> str:
+    from catalog.bench.image import markdown_tables  # noqa: PLC0415
+
+    blocks = markdown_tables(result)
+    return blocks["image"] + "\n\nReal-time options (image-pareto.png):\n\n" + blocks["image-options"]
+
+
 def viewer_line(heavy: dict | None) -> str:
     if not heavy:
         return "The viewer's first frame was not measured."
@@ -166,8 +173,8 @@ SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "stability": ("Numerical stability at the parameters' edges", stability_md),
               "startup": ("Start-up", startup_md),
               "room": ("The room lit through the curtain: frame with and without", room_md),
-
-              "display": ("The display step's cost in the frame", display_md)}
+              "display": ("The display step's cost in the frame", display_md),
+              "image": ("The real-time frame against the path-traced reference", image_md)}
 
 
 def markdown(report: dict) -> str:
@@ -186,13 +193,14 @@ def write_report(report: dict, folder: Path, plotters: dict) -> list[Path]:
     from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
     from catalog.core.jsonout import _plain  # noqa: PLC0415
 
-    folder.mkdir(parents=True, exist_ok=True)
+    from catalog.core.atomic import staged_folder  # noqa: PLC0415
+
     written = []
-    for name, plot in plotters.items():
-        if name in report["sections"]:
-            written += [Path(p) for p in plot(report["sections"][name], folder)]
-    json_path = folder / "bench.json"
-    write_text_atomic(json_path, json.dumps(_plain(report), indent=1, allow_nan=False) + "\n")
-    md_path = folder / "bench.md"
-    write_text_atomic(md_path, markdown(report) + "\n")
-    return [md_path, json_path] + written
+    with staged_folder(folder) as stage:  # the report's files all appear, or none
+        for name, plot in plotters.items():
+            if name in report["sections"]:
+                written += [folder / Path(p).name for p in plot(report["sections"][name], stage)]
+        write_text_atomic(stage / "bench.json",
+                          json.dumps(_plain(report), indent=1, allow_nan=False) + "\n")
+        write_text_atomic(stage / "bench.md", markdown(report) + "\n")
+    return [folder / "bench.md", folder / "bench.json"] + written

@@ -137,9 +137,8 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int = 7) -> di
                         "bloom_ratio": by["room+sky+bloom, moving"]["ratio"]}}
 
 
-#: The committed result tools/docs_figures.py makes this module's tables from.
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
 RESULT_JSON = "benchmarks/bench_room.json"
-
 
 def markdown_tables(result: dict) -> dict[str, str]:
     w, h = result["size"]

@@ -3,7 +3,7 @@
     .venv/bin/python -m catalog.bench.uv_fluorescence [--quick] [--no-frame] [--out benchmarks/bench_uv.json]
 
 (also ``catalog bench --sections uv``). Needs the eight measured matrices
-(the validation data's bispectral/); docs/bispectral.md reads the tables it makes.
+(the validation data's bispectral/ folder, --data or $CATALOG_DATA); docs/bispectral.md reads the tables it makes.
 
 1. **Noise floor** (per matrix and TEST light): how far the exact colour itself moves
    under the data's own uncertainty: (a) the off-diagonal noise re-drawn at the matrix's
@@ -258,9 +258,8 @@ def _f(x: float) -> str:
     return f"{x:.2f}"
 
 
-#: The committed result tools/docs_figures.py makes this module's tables from.
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
 RESULT_JSON = "benchmarks/bench_uv.json"
-
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks: ``uv-noise-floor``, ``uv-models``, ``uv-cases``."""
@@ -343,7 +342,7 @@ def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> d
     import time  # noqa: PLC0415
 
     from catalog.optics.bispectral.matrix import bispectral_dir, find_bfc, read_bfc  # noqa: PLC0415
-    from catalog.optics.bispectral.bands import banded_preset, fit_banded  # noqa: PLC0415
+    from catalog.optics.bispectral.bands import fit_banded  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset, preset_from_dict, preset_to_dict  # noqa: PLC0415
     from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
@@ -445,6 +444,37 @@ def frame_table(frame: dict) -> str:
     lines.append(f"\nBanded fabric: {frame['what']}; {frame['repeats']} interleaved rounds of "
                  f"{frame['draws']} frames.")
     return "\n".join(lines)
+
+
+def banded_preset(base_preset, fit, folder, name: str | None = None):
+    """A preset like ``base_preset`` (its cloth, BTDF, paper-mode colour) whose physical-mode
+    fluorescence is ``fit``'s bands, written with its spectra into ``folder``; returns the
+    loaded :class:`catalog.presets.Preset`. For tests and benchmarks: the measured matrices
+    are not shipped, so no catalog fabric is made this way."""
+    from pathlib import Path  # noqa: PLC0415
+
+    from catalog.optics.bispectral.bands import band_materials_table  # noqa: PLC0415
+    from catalog.presets import preset_to_dict, save_preset_dict  # noqa: PLC0415
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    doc = preset_to_dict(base_preset)
+    name = name or f"{base_preset.name}-{fit.matrix_name.lower()}-banded"
+    doc["name"] = name
+    doc["display_name"] = f"{base_preset.display_name} ({fit.matrix_name}, {len(fit.components)} bands)"
+    doc.pop("fit", None)
+    source_folder = Path(base_preset.path).parent if base_preset.path is not None else None
+    pattern = dict(doc.get("pattern", {}))
+    for key in ("coverage", "height"):  # the base's pattern images, where they lie
+        if isinstance(pattern.get(key), str) and source_folder is not None:
+            pattern[key] = str((source_folder / pattern[key]).resolve())
+    if pattern:
+        doc["pattern"] = pattern
+    fluorescence = {k: v for k, v in doc["fluorescence"].items()
+                    if k in ("xyz", "rgb", "saturation_photon_irradiance")}
+    fluorescence.update(band_materials_table(fit, folder))
+    doc["fluorescence"] = fluorescence
+    return save_preset_dict(doc, folder / f"{name}.toml")
 
 
 def main(argv=None) -> int:

@@ -210,9 +210,8 @@ def main_before_after(args) -> int:
     return 0
 
 
-#: The committed --before run tools/docs_figures.py makes the viewer_before_after table from.
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
 RESULT_JSON = "benchmarks/viewer_pattern.json"
-
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """``viewer_before_after`` (a --before run's JSON): NAME -> markdown table."""

@@ -175,9 +175,8 @@ def run(quick: bool = False) -> dict:
     return result
 
 
-#: The committed result tools/docs_figures.py makes this module's tables from.
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
 RESULT_JSON = "benchmarks/bench_web.json"
-
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """Block ``web`` of BENCHMARKS.md."""

@@ -13,6 +13,8 @@ docs/bench.md has the latest figures.
 from __future__ import annotations
 
 RESOURCES = ("data",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+OUTPUT_FOLDERS = ("out",)
 HELP = "benchmarks: colour error against frame time, fluorescence, fit, cloth, stability, start-up"
 
 DEFAULT_OUT = "bench-out"
@@ -26,7 +28,7 @@ def add_arguments(parser) -> None:
                         help=f"folder for bench.md, bench.json and the plots (default {DEFAULT_OUT})")
     parser.add_argument("--sections", metavar="NAME,NAME",
                         help="run only these sections (default: all): colour, fluorescence, uv, "
-                             "fit, cloth, stability, startup, display")
+                             "fit, cloth, stability, startup, display, image")
 
 
 def parse_sections(text: str | None) -> list[str]:
@@ -75,7 +77,7 @@ def run(args) -> int:
     ctx = None
     machine = {"cpu_count": os.cpu_count(), "platform": platform.platform(),
                "python": platform.python_version()}
-    if any(n in ("colour", "stability", "display") for n in names):
+    if any(n in ("colour", "stability", "display", "image") for n in names):
         from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
 
         ctx = create_headless_context()

@@ -13,6 +13,9 @@ from __future__ import annotations
 import argparse
 
 RESOURCES = ("data",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("file",)
+OUTPUT_FOLDERS = ("export",)
 HELP = "fit a bispectral (Donaldson) matrix and show the colour error of each fluorescence model"
 
 
@@ -52,7 +55,13 @@ def run(args: argparse.Namespace) -> int:
     per_light = banded_colours(matrix, banded, lights)
     exported = {}
     if args.export:
-        exported = {k: str(v) for k, v in bispectral.to_fabric_measurements(matrix, args.export, fit).items()}
+        from pathlib import Path  # noqa: PLC0415
+
+        from catalog.core.atomic import staged_folder  # noqa: PLC0415
+
+        with staged_folder(args.export) as stage:  # all three files, or none
+            written = bispectral.to_fabric_measurements(matrix, stage, fit)
+        exported = {k: str(Path(args.export) / Path(v).name) for k, v in written.items()}
 
     fit_info = {"yield_absorptance": fit.yield_absorptance, "quantum_yield": fit.quantum_yield,
                 "peak_absorptance": fit.peak_absorptance,

@@ -39,10 +39,12 @@ COMMANDS: dict[str, str] = {
     "fit": "catalog.commands.fit",
     "snapshot": "catalog.commands.snapshot",
     "sheet": "catalog.commands.sheet",
+    "render-catalog": "catalog.commands.render_catalog",
     "view": "catalog.commands.view",
     "simulate": "catalog.commands.simulate",
     "bench": "catalog.commands.bench",
     "web": "catalog.commands.web",
+    "reference": "catalog.commands.reference",
 }
 
 
@@ -58,13 +60,30 @@ def _available_commands() -> dict[str, object]:
     return modules
 
 
+class CommandLineError(CatalogError):
+    """An option argparse refused (unknown, missing, or a value its type refused)."""
+
+    def __init__(self, prog: str, message: str):
+        self.prog = prog
+        super().__init__(message)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a refused option is one line (no usage block) and, with ``--json``,
+    one JSON object like every other refusal: :meth:`error` raises instead of exiting."""
+
+    def error(self, message: str):
+        raise CommandLineError(self.prog, message)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="catalog",
         description="Woven-cloth fabric catalog: fit measurements to presets, compute "
                     "fluorescence, simulate and render curtains under any light.")
     parser.add_argument("--version", action="version", version=f"catalog {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True,
+                                parser_class=_Parser)
     for name, module in _available_commands().items():
         command_parser = sub.add_parser(name, help=module.HELP, description=module.HELP)
         module.add_arguments(command_parser)
@@ -80,25 +99,92 @@ def build_parser() -> argparse.ArgumentParser:
                 help="the validation data folder (measured brightener spectra, bispectral "
                      f"matrices; not shipped). Default ${DATA_ENV}, else shared/data beside "
                      "a checkout")
-        command_parser.set_defaults(_run=module.run)
+        command_parser.set_defaults(_run=module.run, _module=module)
     return parser
 
 
+def check_outputs(module, args) -> None:
+    """Refuse, before any work, the outputs a command declares that cannot be written.
+
+    A command module may declare ``OUTPUT_FILES`` and ``OUTPUT_FOLDERS`` (option names whose
+    values are written) and ``INPUT_FILES`` (option names whose values are read): an output
+    that is a folder, sits under a file, is not writable, is on a read-only file system or
+    names one of the inputs is refused in one line naming the option
+    (:func:`catalog.core.atomic.check_target`).
+    """
+    from catalog.core.atomic import OutputError, check_target  # noqa: PLC0415
+
+    inputs = [value for name in getattr(module, "INPUT_FILES", ())
+              for value in _values(getattr(args, name, None))]
+    for names, folder in ((getattr(module, "OUTPUT_FILES", ()), False),
+                          (getattr(module, "OUTPUT_FOLDERS", ()), True)):
+        for name in names:
+            for value in _values(getattr(args, name, None)):
+                try:
+                    check_target(value, inputs=inputs, folder=folder)
+                except OutputError as exc:
+                    raise CatalogError(f"--{name.replace('_', '-')} {exc}") from None
+
+
+def _values(value) -> list:
+    if value is None or value is False:
+        return []
+    return list(value) if isinstance(value, (list, tuple)) else [value]
+
+
+def _report(args, exc: CatalogError) -> int:
+    from catalog.core.atomic import silence_stdout  # noqa: PLC0415
+
+    if getattr(exc, "path", None) == "stdout":
+        silence_stdout()  # the interpreter's last flush must not fail a second time
+    message = " ".join(str(exc).split())  # one line, whatever the message held
+    prog = "catalog" if args.command == "catalog" else f"catalog {args.command}"
+    print(f"{prog}: error: {message}", file=sys.stderr)
+    if getattr(args, "json", False):
+        from catalog.core.atomic import OutputError, write_stdout  # noqa: PLC0415
+
+        try:
+            write_stdout(json.dumps({"error": message, "exit_code": exc.exit_code}) + "\n")
+        except OutputError:
+            pass  # stdout itself is what failed: the line on stderr says so
+    return exc.exit_code
+
+
 def main(argv: list[str] | None = None) -> int:
+    from catalog.core.atomic import OutputError, install_signal_handlers, os_cause  # noqa: PLC0415
+
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except CommandLineError as exc:
+        words = sys.argv[1:] if argv is None else argv
+        command = exc.prog.split(" ", 1)[1] if " " in exc.prog else "catalog"
+        return _report(argparse.Namespace(command=command, json="--json" in words), exc)
+    install_signal_handlers()
     try:
         if getattr(args, "fabrics", None) and isinstance(args.fabrics, list):
             use_fabrics(args.fabrics)  # a command's own --fabrics (sheet's list) handles itself
         if getattr(args, "data", None) is not None:
             use_data(args.data)
-        return int(args._run(args) or 0)
+        check_outputs(args._module, args)
+        if sys.stdout is None and getattr(args, "json", False):
+            raise OutputError("stdout", "closed")
+        status = int(args._run(args) or 0)
+        try:
+            if sys.stdout is not None:
+                sys.stdout.flush()
+        except (BrokenPipeError, OSError) as exc:
+            raise OutputError("stdout", "closed" if isinstance(exc, BrokenPipeError)
+                              else os_cause(exc)) from None
+        return status
     except CatalogError as exc:
-        message = " ".join(str(exc).split())  # one line, whatever the message held
-        print(f"catalog {args.command}: error: {message}", file=sys.stderr)
-        if getattr(args, "json", False):
-            print(json.dumps({"error": message, "exit_code": exc.exit_code}), flush=True)
-        return exc.exit_code
+        return _report(args, exc)
+    except BrokenPipeError:
+        return _report(args, OutputError("stdout", "closed"))
+    except OSError as exc:
+        # an OS error no writer turned into a message (the output layer does for its own
+        # files): still one line, naming the path where the OS gave one
+        return _report(args, CatalogError(f"{exc.filename or 'a file'}: {os_cause(exc)}"))
     except KeyboardInterrupt:
         return 130
 

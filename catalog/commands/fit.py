@@ -12,6 +12,9 @@ from __future__ import annotations
 
 from catalog.fit.preset_build import DEFAULT_TAU_UNDYED
 
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("gonio", "excitation", "emission")
+OUTPUT_FILES = ("out", "plot")
 HELP = "fit the woven-cloth HG BTDF (eq. 7) to gonio data and write a fabric preset"
 
 

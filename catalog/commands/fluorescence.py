@@ -12,6 +12,9 @@ import argparse
 
 from catalog.core.constants import FLUORESCENT_MODES
 
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("excitation", "emission")
+OUTPUT_FILES = ("plot",)
 HELP = "fluorescence colour (eq. 1-3) and intensity (eq. 4 or physical) of a material under a light"
 
 

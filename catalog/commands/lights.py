@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+OUTPUT_FILES = ("plot",)
 HELP = "list the light library (illuminance, UV-A fraction, description) or plot spectra"
 
 

@@ -6,6 +6,8 @@ from catalog.commands.displayargs import add_display_arguments, display_choices
 from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+OUTPUT_FOLDERS = ("out",)
 HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
 
@@ -29,12 +31,16 @@ def add_arguments(parser) -> None:
 def run(args) -> int:
     from pathlib import Path  # noqa: PLC0415
 
+    from catalog.core.errors import InputError  # noqa: PLC0415
     from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.sheet import render_sheet  # noqa: PLC0415
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
     ev, white_balance = display_choices(args)
-    lights = [name.strip() for name in args.lights.split(",") if name.strip()]
+    names = [name.strip() for name in args.lights.split(",")]
+    if any(not name for name in names) and any(names):
+        raise InputError(f"{args.lights!r}: an empty light name between commas", field="--lights")
+    lights = [name for name in names if name]
     from catalog.core.cliargs import fabric_list  # noqa: PLC0415
 
     fabrics = fabric_list(args.fabrics)  # folders join the search path, names select

@@ -5,6 +5,9 @@ from __future__ import annotations
 import argparse
 
 RESOURCES = ("fabrics",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("fabric",)
+OUTPUT_FILES = ("out",)
 HELP = "simulate a curtain (mass-spring cloth) headless; report stretch, energy and speed"
 
 #: ClothParams field -> the option that sets it (for error messages)
@@ -14,16 +17,28 @@ _OPTION_OF_FIELD = {
 }
 
 
+#: Limits of the options (beyond them a run cannot finish or the physics is meaningless):
+#: frames in one run; wind, m/s (50 m/s is a hurricane, not a breeze at a window);
+#: particles along a side (1024^2 particles already take minutes a second on a CPU).
+MAX_STEPS = 10_000_000
+MAX_WIND_M_S = 50.0
+MAX_GRID_SIDE = 1024
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--grid", required=True, metavar="WxH",
                         help="particles across and down, e.g. 64x96")
-    parser.add_argument("--steps", required=True, type=int, metavar="N",
+    from catalog.core.cliargs import number_type  # noqa: PLC0415
+
+    parser.add_argument("--steps", required=True, type=number_type(1, MAX_STEPS, whole=True),
+                        metavar="N",
                         help="frames to simulate")
     parser.add_argument("--dt", type=float, default=1.0 / 60.0, metavar="S",
                         help="frame time in seconds (substeps are chosen inside; default 1/60)")
     parser.add_argument("--stiffness", type=float, default=None, metavar="K",
                         help="stretch stiffness, N/m (default: the fabric's or the weave's)")
-    parser.add_argument("--wind", type=float, default=0.0, metavar="SPEED",
+    parser.add_argument("--wind", type=number_type(0.0, MAX_WIND_M_S, unit="m/s"), default=0.0,
+                        metavar="SPEED",
                         help="mean wind speed from the window, m/s (gusty)")
     parser.add_argument("--opening", type=float, default=None, metavar="F",
                         help="fraction of the rest width the rings span (1 = closed)")
@@ -40,10 +55,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _parse_grid(text: str) -> tuple[int, int]:
     from catalog.core.cliargs import parse_wxh
 
-    return parse_wxh(text, "--grid", 2, unit="particles", example="64x96")
+    return parse_wxh(text, "--grid", 2, MAX_GRID_SIDE, unit="particles", example="64x96")
 
 
 def run(args: argparse.Namespace) -> int:
+    import contextlib
     import math
     import time
 
@@ -87,12 +103,28 @@ def run(args: argparse.Namespace) -> int:
 
     sequence = args.out is not None and "{frame" in args.out
     simulated = 0
-    start = time.perf_counter()
-    for frame in range(args.steps):
-        simulated += bool(sim.step(args.dt))
+    with contextlib.ExitStack() as stack:
         if sequence:
-            export_mesh(sim.mesh(), args.out.format(frame=frame))
-    seconds = time.perf_counter() - start
+            # every frame's file, or none: staged beside the folder, moved in at the end
+            from pathlib import Path
+
+            from catalog.core.atomic import staged_folder
+
+            try:
+                names = [Path(args.out.format(frame=f)) for f in (0, 1)]
+            except (ValueError, KeyError, IndexError) as exc:
+                raise CatalogError(f"--out: {args.out!r} is not a pattern with one "
+                                   f"{{frame}} field ({exc})") from None
+            if names[0].parent != names[1].parent or names[0] == names[1]:
+                raise CatalogError(f"--out: {args.out!r}: put {{frame}} in the file name, "
+                                   "not in a folder name")
+            stage = stack.enter_context(staged_folder(names[0].parent))
+        start = time.perf_counter()
+        for frame in range(args.steps):
+            simulated += bool(sim.step(args.dt))
+            if sequence:
+                export_mesh(sim.mesh(), stage / Path(args.out.format(frame=frame)).name)
+        seconds = time.perf_counter() - start
     if args.out is not None and not sequence:
         export_mesh(sim.mesh(), args.out)
 

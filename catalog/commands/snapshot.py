@@ -6,10 +6,15 @@ from catalog.commands.displayargs import add_display_arguments, display_choices
 from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("fabric",)
+OUTPUT_FILES = ("out",)
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
 
 
 def add_arguments(parser) -> None:
+    from catalog.core.cliargs import number_type  # noqa: PLC0415
+
     parser.add_argument("--fabric", required=True, help="preset name (fabrics/NAME.toml) or a .toml path")
     parser.add_argument("--light", default="D65",
                         help="light name (`catalog lights`: D65, A, FL2, LED-B4, sun:22, ...)")
@@ -24,10 +29,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model (default physical)")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3 (RGB), 6, 9, 16")
-    parser.add_argument("--yaw", type=float, default=0.0, help="camera yaw, deg")
-    parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
-    parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")
-    parser.add_argument("--exposure", type=float, default=1.0,
+    parser.add_argument("--yaw", type=number_type(-360.0, 360.0, unit="deg"), default=0.0, help="camera yaw, deg")
+    parser.add_argument("--pitch", type=number_type(-89.0, 89.0, unit="deg"), default=0.0, help="camera pitch, deg")
+    parser.add_argument("--distance", type=number_type(0.05, 50.0, unit="m", low_open=True), default=2.6, help="camera distance, m")
+    parser.add_argument("--exposure", type=number_type(0.0, 1e9, low_open=True), default=1.0,
                         help="exposure multiplier on top of --ev or the automatic exposure")
     add_display_arguments(parser)
     parser.add_argument("--environment", metavar="FILE.exr", default=None,

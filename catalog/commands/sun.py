@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+OUTPUT_FILES = ("plot",)
 HELP = ("sunlight through the atmosphere: spectra at path lengths (the paper's Fig. 10), "
         "date/place -> zenith -> path, SPECTRL2 comparison")
 

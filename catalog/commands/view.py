@@ -11,6 +11,9 @@ from catalog.core.cliargs import wxh_type
 from catalog.commands.displayargs import add_display_arguments
 
 RESOURCES = ("fabrics",)
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("fabric", "compare")
+OUTPUT_FILES = ("screenshot",)
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
 BAND_CHOICES = (3, 6, 9, 16)

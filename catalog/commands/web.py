@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+OUTPUT_FOLDERS = ("out",)
 HELP = "write a static web catalog (WebGL2, same shaders and light) that opens from file://"
 
 

@@ -37,6 +37,30 @@ def wxh_type(option: str, low: int, high: int | None = None, unit: str = "px",
     return parse
 
 
+def number_type(low: float, high: float, *, unit: str = "", low_open: bool = False,
+                high_open: bool = False, whole: bool = False):
+    """An argparse ``type=`` for a finite number in ``low..high`` (``low_open``/``high_open``
+    exclude the bound; ``whole`` asks for an integer). argparse names the option in its
+    message: ``argument --wind: must be a finite number in [0, 50] m/s, found 'nan'``."""
+    import math  # noqa: PLC0415
+
+    lo, hi = ("(" if low_open else "["), (")" if high_open else "]")
+    kind = "whole number" if whole else "finite number"
+    wanted = f"must be a {kind} in {lo}{low:g}, {high:g}{hi}" + (f" {unit}" if unit else "")
+
+    def parse(text: str):
+        try:
+            value = int(text) if whole else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{wanted}, found {text[:20]!r}") from None
+        ok = math.isfinite(value) and (value > low if low_open else value >= low) \
+            and (value < high if high_open else value <= high)
+        if not ok:
+            raise argparse.ArgumentTypeError(f"{wanted}, found {text[:20]!r}")
+        return value
+    return parse
+
+
 def fabric_list(text: str | None) -> list[str] | None:
     """``--fabrics A,B,DIR``: preset names or .toml paths, and folders of the user's own
     presets. The folders go first on the fabric search path (before the built-in catalog,

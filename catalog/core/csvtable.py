@@ -67,14 +67,15 @@ def read_numeric_csv(path: str | Path, required: tuple[str, ...],
             try:
                 value = float(field)
             except ValueError:
-                raise InputError(f"{name} is not a number: {field!r}", path=path,
+                # the header matched, so this is a measurement file: a short quote helps find the typo
+                raise InputError(f"{name} is not a number: {field[:20]!r}", path=path,
                                  line=line_no) from None
             if math.isnan(value):
                 raise InputError(f"{name} is NaN", path=path, line=line_no)
             if math.isinf(value):
                 raise InputError(f"{name} is infinite", path=path, line=line_no)
             if value < 0 and name not in allow_negative:
-                raise InputError(f"{name} is negative ({field})", path=path, line=line_no)
+                raise InputError(f"{name} is negative ({field[:20]})", path=path, line=line_no)
             values.append(value)
         rows.append(values)
         line_numbers.append(line_no)
@@ -114,7 +115,8 @@ def _check_header(path: Path, line_no: int, header: list[str], required: tuple[s
             [float(h) for h in header]
             problem = f"missing header: the first line must be '{expected}'"
         except ValueError:
-            problem = f"wrong header {','.join(header)!r}: expected '{expected}'"
+            # the file's own text is not echoed: it may not be a measurement at all
+            problem = f"wrong header: the first line must be '{expected}'"
         raise InputError(problem, path=path, line=line_no)
     extra = tuple(header[len(required):])
     if extra and extra != optional[:len(extra)]:

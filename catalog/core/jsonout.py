@@ -23,5 +23,6 @@ def _plain(value: Any) -> Any:
 
 def print_json(obj: dict[str, Any]) -> None:
     """Print ``obj`` as one line of strict JSON (NaN is not JSON: it becomes null)."""
-    sys.stdout.write(json.dumps(_plain(obj), allow_nan=False) + "\n")
-    sys.stdout.flush()
+    from catalog.core.atomic import write_stdout  # noqa: PLC0415
+
+    write_stdout(json.dumps(_plain(obj), allow_nan=False) + "\n")

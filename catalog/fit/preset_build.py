@@ -12,6 +12,8 @@ matplotlib) happen inside the functions.
 
 from __future__ import annotations
 
+import math
+
 #: tau of an undyed fibre: e^-tau only scales k_d and k_s (not identifiable from one
 #: band), so this only fixes how the product is split; a white fibre absorbs little.
 DEFAULT_TAU_UNDYED = 0.05
@@ -146,18 +148,24 @@ def preset_document(args, out, data, header, result, rho, tau, dye_path) -> dict
         btdf["rgb"] = {key: [_round(c["params"][key]) for c in channels]
                        for key in ("direct", "a_diff", "a_spec")}
         btdf["rgb"]["stderr"] = {key: [_round(c["stderr"][key]) for c in channels]
-                                 for key in ("direct", "a_diff", "a_spec")}
+                                 for key in ("direct", "a_diff", "a_spec")
+                                 if all(math.isfinite(c["stderr"][key]) for c in channels)}
     fit = {
         "rmse": _round(hg.rmse), "points": hg.points,
         "source": _relative(args.gonio, folder),
         "weighting": hg.weighting,
         "subset": args.points,
         "identifiable": {k: _round(p[k]) for k in IDENTIFIABLE},
-        "stderr": {k: _round(v) for k, v in hg.stderr.items()},
+        # a standard error the data cannot determine (singular Jacobian) is left out and
+        # named, never written as NaN (which no reader of the preset accepts)
+        "stderr": {k: _round(v) for k, v in hg.stderr.items() if math.isfinite(v)},
         "weighted_rms": _round(hg.weighted_rms),
         "cook_torrance": {"rmse": _round(ct.rmse), "weighted_rms": _round(ct.weighted_rms),
                           **{k: _round(v) for k, v in ct.params.items()}},
     }
+    undetermined = sorted(k for k, v in hg.stderr.items() if not math.isfinite(v))
+    if undetermined:
+        fit["stderr_undetermined"] = undetermined
     doc = {"schema": 1, "name": args.name,
            "display_name": args.display_name or header.get("display_name") or args.name,
            "btdf": btdf, "fit": fit}

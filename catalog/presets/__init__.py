@@ -75,7 +75,7 @@ class Preset:
     def resolve(self, relative: str | Path) -> Path:
         """A path written in the preset, resolved against the preset's folder."""
         base = self.path.parent if self.path is not None else FABRIC_DIR
-        return (base / relative).resolve()
+        return contained_path(self.path or "<preset>", str(relative), base, str(relative))
 
 
 # name -> (low, high, low_inclusive, high_inclusive)
@@ -88,6 +88,59 @@ _BTDF_RANGES: dict[str, tuple[float, float, bool, bool]] = {
     "g_diff": (-1.0, 1.0, False, False),
     "g_spec": (-1.0, 1.0, False, False),
 }
+
+
+#: ``[fluorescence]`` physical-mode keys: the same ranges the renderer's material enforces
+#: (catalog.optics.fluorescence.FluorescentMaterial), checked where the preset is read, so a
+#: preset that ``catalog fit`` writes is one that ``catalog snapshot`` accepts.
+_FLUORESCENCE_RANGES: dict[str, tuple[float, float, bool, bool]] = {
+    "peak_absorptance": (0.0, 1.0, False, True),
+    "quantum_yield": (0.0, 1.0, True, True),
+    "saturation_photon_irradiance": (0.0, math.inf, False, True),
+}
+#: Folders (os.pathsep-separated) besides a preset's own folder tree that the files a preset
+#: names may lie in.
+ALLOWED_PATHS_ENV = "CATALOG_PRESET_PATHS"
+
+
+def _non_finite_key(doc: Any, prefix: str = "") -> str | None:
+    """The dotted key of the first NaN or infinite number in a parsed TOML document."""
+    if isinstance(doc, float) and not math.isfinite(doc):
+        return prefix or "<value>"
+    if isinstance(doc, dict):
+        for key, value in doc.items():
+            found = _non_finite_key(value, f"{prefix}.{key}" if prefix else str(key))
+            if found:
+                return found
+    if isinstance(doc, list):
+        for i, value in enumerate(doc):
+            found = _non_finite_key(value, f"{prefix}[{i}]")
+            if found:
+                return found
+    return None
+
+
+def contained_path(where, key: str, base: Path, relative: Any) -> Path:
+    """``relative`` (a path written in a preset at ``key``) resolved against ``base``.
+
+    Refused unless it stays inside ``base``'s folder tree, a fabric folder (the built-in
+    catalog and the user's ``--fabrics`` folders, whose measurements a preset written
+    elsewhere may name) or a folder of ``$CATALOG_PRESET_PATHS``: a preset cannot make the
+    program read ``/etc/passwd`` or a key file, and the refusal never shows such a file.
+    """
+    import os  # noqa: PLC0415
+
+    if not isinstance(relative, str) or not relative or "\x00" in relative:
+        raise InputError("must be a non-empty path string", path=where, field=key)
+    resolved = (base / relative).resolve()
+    roots = [base.resolve()] + [Path(p).resolve() for p in fabric_dirs()]
+    roots += [Path(p).resolve() for p in
+              os.environ.get(ALLOWED_PATHS_ENV, "").split(os.pathsep) if p]
+    if not any(resolved.is_relative_to(root) for root in roots):
+        raise InputError(f"{relative!r} leaves the preset's folder ({base}); keep measurement "
+                         f"files beside the preset or list their folder in ${ALLOWED_PATHS_ENV}",
+                         path=where, field=key)
+    return resolved
 
 
 def _number(path, key, value) -> float:
@@ -140,6 +193,15 @@ def preset_from_dict(doc: dict[str, Any], path: Path | None = None) -> Preset:
     if not isinstance(display_name, str):
         raise InputError("must be a string", path=where, field="display_name")
 
+    bad = _non_finite_key(doc)
+    if bad is not None:
+        raise InputError("must be a finite number (NaN and inf are refused)", path=where, field=bad)
+    dye = doc.get("dye")
+    if dye is not None and not isinstance(dye, dict):
+        raise InputError("must be a table", path=where, field="dye")
+    if dye and "transmittance" in dye:
+        contained_path(where, "dye.transmittance",
+                       path.parent if path is not None else FABRIC_DIR, dye["transmittance"])
     btdf_doc = _require(where, doc, "btdf")
     if not isinstance(btdf_doc, dict):
         raise InputError("must be a table", path=where, field="btdf")
@@ -161,11 +223,12 @@ def preset_from_dict(doc: dict[str, Any], path: Path | None = None) -> Preset:
         paths = {}
         for key in ("excitation", "emission"):
             rel = _require(where, fl_doc, key, "fluorescence.")
-            if not isinstance(rel, str) or not rel:
-                raise InputError("must be a path string", path=where, field=f"fluorescence.{key}")
-            paths[key] = (base / rel).resolve()
+            paths[key] = contained_path(where, f"fluorescence.{key}", base, rel)
         extra = {k: v for k, v in fl_doc.items()
                  if k not in ("xyz", "rgb", "excitation", "emission")}
+        for key, bounds in _FLUORESCENCE_RANGES.items():
+            if key in extra:
+                extra[key] = _in_range(where, f"fluorescence.{key}", extra[key], *bounds)
         fluorescence = FluorescenceParams(
             xyz=_triple(where, "fluorescence.xyz", _require(where, fl_doc, "xyz", "fluorescence.")),
             rgb=_triple(where, "fluorescence.rgb", _require(where, fl_doc, "rgb", "fluorescence.")),
@@ -182,6 +245,10 @@ def load_preset(path: str | Path) -> Preset:
         data = path.read_bytes()
     except FileNotFoundError:
         raise InputError("no such preset file", path=path) from None
+    except IsADirectoryError:
+        raise InputError("is a folder, not a preset file", path=path) from None
+    except OSError as exc:
+        raise InputError(f"cannot read: {(exc.strerror or str(exc)).lower()}", path=path) from None
     try:
         doc = tomllib.loads(data.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
@@ -197,8 +264,10 @@ def find_preset(name_or_path: str | Path, fabric_dir: Path | None = None) -> Pat
     """A preset name (``lace-fwa``) or a path to a .toml -> the file's path. A name is looked
     up in ``fabric_dir``, or by default in the user's fabric folders (``--fabrics``,
     ``$CATALOG_FABRICS``) and then the built-in catalog (the first match wins)."""
+    if not str(name_or_path).strip():
+        raise InputError("empty fabric name", field="--fabric")
     candidate = Path(name_or_path)
-    if candidate.suffix == ".toml" or candidate.exists():
+    if candidate.suffix == ".toml" or candidate.is_file():
         if not candidate.exists():
             raise InputError("no such preset file", path=candidate)
         return candidate

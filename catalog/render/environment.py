@@ -90,7 +90,7 @@ def write_sky_environment(path: str | Path, to_sun, height: int = 256) -> None:
     latitude-longitude EXR: the project's own default view, under the project's licence.
     ``to_sun``: the sun's direction (the atmosphere's clear sky) or a ready SkyModel."""
     from catalog.optics.sun.sky import SkyModel, sky_model  # noqa: PLC0415
-    from catalog.render.snapshot import write_image  # noqa: PLC0415
+    from catalog.render.imagefile import write_image  # noqa: PLC0415
 
     dirs, _ = directions(int(height))
     model = to_sun if isinstance(to_sun, SkyModel) else sky_model(np.asarray(to_sun, dtype=np.float64))

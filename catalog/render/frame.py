@@ -85,6 +85,37 @@ def shared_division_safe(g_diff: float, g_spec: float) -> bool:
     return margin ** 6 > 1e-30
 
 
+#: Bytes one pixel of a frame costs: on the device the HDR target (RGBA32F, 16), its depth
+#: (4) and the display target (RGBA8, 4); on the host a linear read-back (RGB float32, 12).
+FRAME_BYTES_PER_PIXEL = 36
+
+
+def frame_memory_limit_bytes() -> int:
+    """The most memory one frame may take: a quarter of the machine's physical memory (a
+    software rasteriser's targets live there; a GPU's are smaller still, and GL has no
+    portable query of its memory)."""
+    import os  # noqa: PLC0415
+
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 4
+    except (ValueError, OSError, AttributeError):
+        return 4 << 30
+
+
+def gl_size_limit(ctx) -> int:
+    """The largest image side the context can render: the least of its texture,
+    renderbuffer and viewport limits (queried)."""
+    limit = MAX_SIDE_PX
+    for key in ("GL_MAX_TEXTURE_SIZE", "GL_MAX_RENDERBUFFER_SIZE"):
+        value = ctx.info.get(key)
+        if value:
+            limit = min(limit, int(value))
+    dims = ctx.info.get("GL_MAX_VIEWPORT_DIMS")
+    if dims:
+        limit = min(limit, *(int(d) for d in dims))
+    return limit
+
+
 def choose_antialiasing(info: dict) -> str:
     """``auto``'s choice for a context (``ctx.info`` plus ``GL_RENDERER``): ``msaa`` where
     the context multisamples float targets with at least MSAA_SAMPLES samples
@@ -98,17 +129,23 @@ def choose_antialiasing(info: dict) -> str:
 
 
 def check_size(size, ctx=None) -> tuple[int, int]:
-    """(width, height) in pixels, refused with a one-line error when impossible."""
+    """(width, height) in pixels, refused with a one-line error when impossible: a side
+    outside 1..the context's limit (:func:`gl_size_limit`), or a frame larger than
+    :func:`frame_memory_limit_bytes`."""
     try:
         width, height = (int(v) for v in size)
     except (TypeError, ValueError):
         raise CatalogError(f"image size {size!r} must be two whole numbers (width, height)") from None
-    limit = MAX_SIDE_PX
-    if ctx is not None:
-        limit = min(limit, int(ctx.info.get("GL_MAX_TEXTURE_SIZE", limit)))
+    limit = MAX_SIDE_PX if ctx is None else gl_size_limit(ctx)
     if not (1 <= width <= limit and 1 <= height <= limit):
         raise CatalogError(f"image size {width}x{height} is impossible: each side must lie in "
-                           f"1..{limit} px")
+                           f"1..{limit} px (this GL context's limit)")
+    need = width * height * FRAME_BYTES_PER_PIXEL
+    budget = frame_memory_limit_bytes()
+    if need > budget:
+        raise CatalogError(f"image size {width}x{height} needs about {need >> 20} MiB for one "
+                           f"frame, more than the {budget >> 20} MiB this machine allows; "
+                           "choose a smaller --size")
     return width, height
 
 
@@ -740,7 +777,11 @@ class FrameRenderer:
 
         ``fragment``: draw the same mesh (same vertex shader and uniforms of the mesh and
         camera) with this fragment shader file instead of the curtain's: how a benchmark
-        measures the rasteriser's floor with shaders of its own (catalog/bench/shaders/)."""
+        measures the rasteriser's floor with shaders of its own (catalog/bench/shaders/).
+        ``camera_position``: the eye for the view-dependent terms (default the camera's; the
+        room's passes draw the curtain as seen from the key light or the room);
+        ``overrides``: scene values replaced for this draw; ``coarse``: the coarser grid the
+        room's passes use."""
         eye = tuple(float(v) for v in (self.camera.position if camera_position is None
                                        else camera_position))
         if fragment is not None:

@@ -1,7 +1,9 @@
 """Contact sheets: every fabric under every light, one PNG per pair and a labelled grid.
 
-Rows are fabrics, columns lights. Everything is checked (fabrics, lights, size) before the
-first render, each image is written atomically, and the grid last.
+Rows are fabrics, columns lights. Everything is checked (fabrics, lights, size, the output
+folder and its free room) before the first render; the images and the grid are staged in a
+temporary folder beside ``out_dir`` and moved in only when all are written, so an
+interrupted or failed sheet leaves ``out_dir`` as it was.
 """
 
 from __future__ import annotations
@@ -72,9 +74,7 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.render import bands as band_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
-    from catalog.gl.context import create_headless_context  # noqa: PLC0415
-    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
-    from catalog.render.snapshot import write_image  # noqa: PLC0415
+    from catalog.core.atomic import staged_folder  # noqa: PLC0415
 
     if not lights:
         raise InputError("give at least one light", field="--lights")
@@ -89,6 +89,20 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     check_display_choices(ev, white_balance)
     if out_dir.exists() and not out_dir.is_dir():
         raise InputError(f"{str(out_dir)!r} exists and is not a folder", field="--out")
+    width, height = size
+    # an upper bound of what is written: every image and the grid, uncompressed
+    estimate_bytes = 2 * len(presets) * len(light_objects) * width * height * 3
+    with staged_folder(out_dir, estimate_bytes=estimate_bytes) as stage:
+        report = _render_into(stage, out_dir, presets, light_objects, size, fluorescence,
+                              bands, progress, ctx, ev, white_balance, labels)
+    return report
+
+
+def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluorescence,
+                 bands, progress, ctx, ev, white_balance, labels) -> dict:
+    from catalog.gl.context import create_headless_context  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.imagefile import write_image  # noqa: PLC0415
 
     ctx = ctx or create_headless_context()
     renderer = FrameRenderer(ctx, size)
@@ -97,7 +111,7 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     renderer.set_ev(ev)
     renderer.set_white_balance(white_balance)
     width, height = size
-    grid = np.zeros((height * len(presets), width * len(lights), 3), dtype=np.uint8)
+    grid = np.zeros((height * len(presets), width * len(light_objects), 3), dtype=np.uint8)
     images = []
     pairs = [(i, preset, j, light) for i, preset in enumerate(presets)
              for j, light in enumerate(light_objects)]
@@ -117,9 +131,10 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
             renderer.render()
             pixels = renderer.read_srgb8()
             safe_light = "".join(c if c.isalnum() or c in "-._" else "_" for c in light.name)
-            path = out_dir / f"{preset.name}__{safe_light}.png"
+            name = f"{preset.name}__{safe_light}.png"
+            path = out_dir / name
             info = renderer.info()
-            write_image(path, pixels, {"catalog:fabric": preset.name, "catalog:light": light.name,
+            write_image(stage / name, pixels, {"catalog:fabric": preset.name, "catalog:light": light.name,
                                        "catalog:mode": info["mode"],
                                        "catalog:fluorescence_variant": info["fluorescence_variant"],
                                        "catalog:ev100": f"{info['ev100']:.4f}",
@@ -145,7 +160,7 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     if labels:
         grid = labelled_grid(grid, [f"{p.display_name} ({p.name})" for p in presets],
                              [l.name for l in light_objects], (width, height))
-    write_image(grid_path, grid, {
+    write_image(stage / grid_path.name, grid, {
         "ImageDescription": "rows: " + ", ".join(p.name for p in presets)
                             + "; columns: " + ", ".join(l.name for l in light_objects),
         "catalog:fabrics": ",".join(p.name for p in presets),

@@ -14,6 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
+from catalog.render.imagefile import (OCIO_LINEAR_SPACE, exr_colour_metadata,  # noqa: F401
+                                     read_metadata, write_image)
 
 IMAGE_SUFFIXES = (".exr", ".png")
 #: Frame step of the cloth simulation behind ``--frame N`` (s).
@@ -61,75 +63,31 @@ class SnapshotRequest:
     lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
 
 
-def write_image(path: Path, pixels: np.ndarray, metadata: dict[str, str]) -> None:
-    """Write (H, W, 3) pixels with OpenImageIO, atomically: float32 -> EXR, uint8 -> PNG."""
-    import OpenImageIO as oiio  # noqa: PLC0415
-
-    from catalog.core.atomic import atomic_path  # noqa: PLC0415
-
-    height, width, channels = pixels.shape
-    kind = oiio.FLOAT if pixels.dtype == np.float32 else oiio.UINT8
-    spec = oiio.ImageSpec(width, height, channels, kind)
-    spec.channelnames = ("R", "G", "B")
-    for key, value in metadata.items():
-        if key == "chromaticities":
-            import OpenImageIO as oiio  # noqa: PLC0415
-
-            spec.attribute(key, oiio.TypeDesc("float[8]"), tuple(value))
-        else:
-            spec.attribute(key, str(value))
-    with atomic_path(path) as tmp:
-        output = oiio.ImageOutput.create(str(tmp))
-        if output is None:
-            raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
-        ok = output.open(str(tmp), spec) and output.write_image(np.ascontiguousarray(pixels))
-        error = output.geterror()
-        output.close()
-        if not ok:
-            raise CatalogError(f"cannot write {path}: {error}")
-
-
-def exr_colour_metadata() -> dict:
-    """What tools need to show our EXR with a standard view (OpenColorIO's built-in config
-    ``ocio://default``: the interop ID of its colour space "Linear Rec.709 (sRGB)"; the EXR chromaticities of
-    sRGB / Rec.709 with the D65 white, from colour-science's tables)."""
-    from catalog.render import display  # noqa: PLC0415
-
-    t = display.tables()
-    m = np.linalg.inv(t["srgb_xyz_to_rgb"])  # RGB -> XYZ: the columns are the primaries
-    xy = [(col[0] / col.sum(), col[1] / col.sum()) for col in m.T]
-    white = tuple(float(v) for v in t["srgb_whitepoint_xy"])
-    return {"oiio:ColorSpace": OCIO_LINEAR_SPACE,
-            "chromaticities": tuple(float(v) for pair in xy for v in pair) + white}
-
-
-#: The name of our EXR's colour space in OpenColorIO's built-in config (ocio://default).
-OCIO_LINEAR_SPACE = "lin_rec709_scene"   # the interop ID; "Linear Rec.709 (sRGB)" there
-
-
-def read_metadata(path: str | Path) -> dict[str, str]:
-    """The string attributes of an image (to check what a snapshot recorded)."""
-    import OpenImageIO as oiio  # noqa: PLC0415
-
-    image = oiio.ImageInput.open(str(path))
-    if image is None:
-        raise CatalogError(f"cannot read {path}: {oiio.geterror()}")
-    spec = image.spec()
-    image.close()
-    return {attr.name: str(attr.value) for attr in spec.extra_attribs}
-
-
 def simulated_curtain(preset, frames: int):
     """The curtain after ``frames`` frames of the cloth simulation started from the settled
     drape (frame 0: the settled drape itself; catalog.cloth.drape), moved onto the scene's
     rod. Returns (positions, normals, uv, tangents, indices, fabric size (w, h) m)."""
-    from catalog.cloth.drape import drape_params, rod_centre_x_m, settled_simulation  # noqa: PLC0415
+    simulation = curtain_simulation(preset)
+    simulation.run(frames, FRAME_DT_S)
+    return curtain_on_rod(simulation)
+
+
+def curtain_simulation(preset):
+    """The preset's cloth simulation at the settled drape (frame 0); step it by
+    ``FRAME_DT_S`` for the next frames (catalog render-catalog steps one through them all)."""
+    from catalog.cloth.drape import drape_params, settled_simulation  # noqa: PLC0415
+
+    return settled_simulation(drape_params(preset), backend="numpy")
+
+
+def curtain_on_rod(simulation):
+    """A running simulation's curtain moved onto the scene's rod: (positions, normals, uv,
+    tangents, indices, fabric size (w, h) m)."""
+    from catalog.cloth.drape import rod_centre_x_m  # noqa: PLC0415
     from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
-    params = drape_params(preset)
-    simulation = settled_simulation(params, backend="numpy")
-    simulation.run(frames, FRAME_DT_S)
+    params = simulation.params
     mesh = CurtainMesh.from_grid(simulation.positions(), params)
     offset = np.array([-rod_centre_x_m(params), scene_lib.CURTAIN_TOP_Y - params.rod_y_m,
                        scene_lib.CURTAIN_Z], dtype=np.float32)
@@ -212,24 +170,7 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
     ctx = ctx or create_headless_context()
     renderer = FrameRenderer(ctx, request.size)
     try:
-        renderer.set_fabric(preset)
-        sun = None
-        if request.hour is not None:
-            sun = renderer.set_sun_hour(request.hour)
-        else:
-            renderer.set_light(light)
-        renderer.set_fluorescence(request.fluorescence)
-        renderer.set_bands(request.bands)
-        renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
-        renderer.set_exposure(request.exposure)
-        renderer.set_ev(request.ev)
-        renderer.set_white_balance(request.white_balance)
-        renderer.set_curtain_open(request.curtain_open)
-        renderer.set_room_lighting(request.room_light)
-        renderer.set_bloom(request.bloom)
-        if request.environment is not None:
-            renderer.set_environment(request.environment)
-        renderer.set_room_lamps(request.lamps)
+        sun = configure_renderer(renderer, request, preset, light)
         *mesh, fabric_size = simulated_curtain(preset, request.frame)
         renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
         renderer.set_rings(ring_xs_m(preset))
@@ -245,26 +186,7 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
         renderer.release()
     if not np.all(np.isfinite(pixels)):
         raise CatalogError("the render has NaN or infinite pixels; nothing written")
-    metadata = {
-        "ImageDescription": f"catalog snapshot: {info['fabric']} under {info['light']}, "
-                            f"fluorescence {info['fluorescence_variant']}",
-        "catalog:fabric": info["fabric"],
-        "catalog:light": info["light"],
-        "catalog:mode": info["mode"],
-        "catalog:fluorescence_variant": info["fluorescence_variant"],
-        "catalog:bands": str(info["bands"]),
-        "catalog:frame": str(request.frame),
-        "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
-                             if request.out.suffix.lower() == ".exr"
-                             else "sRGB; CAT16 white balance, Michaelis-Menten tone curve, "
-                                  "OKLab gamut compression (docs/display.md)"),
-        "catalog:ev100": f"{info['ev100']:.4f}",
-        "catalog:exposure_scale": repr(info["exposure"]),
-        "catalog:auto_exposure": str(info["auto_exposure"]).lower(),
-        "catalog:white_balance": info["white_balance"],
-    }
-    if request.out.suffix.lower() == ".exr":
-        metadata.update(exr_colour_metadata())
+    metadata = image_metadata(info, request.frame, request.out.suffix.lower() == ".exr")
     write_image(request.out, pixels, metadata)
     report = dict(info)
     report.update({"out": str(request.out), "frame": request.frame, "mesh": mesh_source,
@@ -274,3 +196,52 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
     if sun is not None:
         report["sun"] = sun
     return report
+
+
+def configure_renderer(renderer, request: SnapshotRequest, preset, light):
+    """Every renderer setting a snapshot depends on but the mesh, from ``request`` (the
+    preset and light already loaded). Returns the sun's report with ``request.hour``."""
+    renderer.set_fabric(preset)
+    sun = None
+    if request.hour is not None:
+        sun = renderer.set_sun_hour(request.hour)
+    else:
+        renderer.set_light(light)
+    renderer.set_fluorescence(request.fluorescence)
+    renderer.set_bands(request.bands)
+    renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
+    renderer.set_exposure(request.exposure)
+    renderer.set_ev(request.ev)
+    renderer.set_white_balance(request.white_balance)
+    renderer.set_curtain_open(request.curtain_open)
+    renderer.set_room_lighting(request.room_light)
+    renderer.set_bloom(request.bloom)
+    if request.environment is not None:
+        renderer.set_environment(request.environment)
+    renderer.set_room_lamps(request.lamps)
+    return sun
+
+
+def image_metadata(info: dict, frame: int, linear: bool) -> dict:
+    """The metadata a snapshot writes, from the renderer's ``info()``."""
+    metadata = {
+        "ImageDescription": f"catalog snapshot: {info['fabric']} under {info['light']}, "
+                            f"fluorescence {info['fluorescence_variant']}",
+        "catalog:fabric": info["fabric"],
+        "catalog:light": info["light"],
+        "catalog:mode": info["mode"],
+        "catalog:fluorescence_variant": info["fluorescence_variant"],
+        "catalog:bands": str(info["bands"]),
+        "catalog:frame": str(frame),
+        "catalog:encoding": ("linear sRGB primaries, Y in cd/m2 (scene-referred)"
+                             if linear
+                             else "sRGB; CAT16 white balance, Michaelis-Menten tone curve, "
+                                  "OKLab gamut compression (docs/display.md)"),
+        "catalog:ev100": f"{info['ev100']:.4f}",
+        "catalog:exposure_scale": repr(info["exposure"]),
+        "catalog:auto_exposure": str(info["auto_exposure"]).lower(),
+        "catalog:white_balance": info["white_balance"],
+    }
+    if linear:
+        metadata.update(exr_colour_metadata())
+    return metadata

@@ -17,7 +17,7 @@ from catalog.core.errors import CatalogError
 def write_image(path: str | Path, pixels: np.ndarray, metadata: dict[str, str]) -> Path:
     """Write (H, W, 3) pixels, row 0 at the top: float32 -> 32-bit float EXR (the sun's disc
     is far above half-float range), uint8 -> 8-bit PNG. The renderer's writer does it."""
-    from catalog.render.snapshot import write_image as write  # noqa: PLC0415
+    from catalog.render.imagefile import write_image as write  # noqa: PLC0415
 
     path = Path(path)
     pixels = np.ascontiguousarray(pixels)

@@ -119,10 +119,10 @@ def _numbers(path: Path, line_no: int, fields: list[str], what: str) -> list[flo
         try:
             value = float(text)
         except ValueError:
-            raise InputError(f"{what}: field {i} is not a number: {text!r}", path=path,
+            raise InputError(f"{what}: field {i} is not a number", path=path,
                              line=line_no) from None
         if not math.isfinite(value):
-            raise InputError(f"{what}: field {i} is not finite: {text!r}", path=path,
+            raise InputError(f"{what}: field {i} is not finite", path=path,
                              line=line_no)
         out.append(value)
     return out
@@ -161,7 +161,7 @@ def read_bfc(path: str | Path) -> DonaldsonMatrix:
                          "(10 header lines, the dimension line, the r:c: line)", path=path,
                          line=len(lines))
     if "BFC" not in lines[1]:
-        raise InputError(f"not a BFC-450 matrix file (line 2 is {lines[1].strip()!r})",
+        raise InputError("not a BFC-450 matrix file (line 2 does not name the BFC instrument)",
                          path=path, line=2)
     comments = [ln.strip()[1:].strip() for ln in lines[2:HEADER_LINES] if ln.strip().startswith(";")]
     # the first comment repeats the file name (not always faithfully); the second describes it

@@ -1,0 +1,381 @@
+"""The real-time frame against the path-traced reference of the same scene (issue 11).
+
+For each scene of :data:`SCENES` (lace, voile and safety-yellow; the noon sun, D65 and the
+UV-A lamp; the room view and a close-up) the frame (:class:`catalog.render.frame.FrameRenderer`,
+the default options) and the reference (:mod:`catalog.pathtrace`: Mitsuba 3, volpath, two
+independent renders of spp / 2 averaged) are drawn at the same size from the same scene
+description and curtain mesh. Measured:
+
+- mean FLIP (LDR-FLIP of the two display images: the frame's own exposure and tone curve);
+- Delta E 2000 (mean, 95th percentile) on the curtain, the floor and the walls (masks from a
+  ray per pixel centre through the reference's geometry), the white a white diffuser under
+  the key light, raised to the cloth's 95th-percentile luminance where the cloth is brighter
+  (the UV-A glow; as the colour section does);
+- the reference's remaining noise: relative RMS of luminance from the two renders
+  (:func:`catalog.pathtrace.metrics.noise_between`);
+- both run times (frame: median of repeats with glFinish; reference: the two renders'
+  wall time, scene building excluded) and their ratio, at equal resolution.
+
+Real-time options (the Pareto plot): spectral bands 3/6/16, paper vs physical
+fluorescence, anti-aliasing (FXAA, the default; none; 2x2 supersampling), the room lit
+through the curtain (issue 13, the default) or the earlier constant room. The shadow map's size
+is a module constant, not a frame option: listed as absent.
+
+The goal of issue 11 (stated before measuring): on every scene mean FLIP <= 0.10, curtain
+Delta E 2000 mean <= 2, and the frame >= 1000x faster than the reference.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from catalog.bench.timing import median_wall_and_cpu
+
+#: The camera of each view: (yaw deg, pitch deg, distance m). The room view looks down
+#: across the room so that the floor by the window is in the picture.
+VIEWS = {"room": (20.0, 15.0, 2.6), "close-up": (0.0, 0.0, 0.8)}
+#: (label, fabric, light, view)
+SCENES = (
+    ("lace, noon sun, room", "lace-fwa", "noon", "room"),
+    ("voile, D65, room", "voile-white", "D65", "room"),
+    ("safety-yellow, UV-A, room", "safety-yellow", "UV-A", "room"),
+    ("lace, UV-A, close-up", "lace-fwa", "UV-A", "close-up"),
+    ("voile, noon sun, close-up", "voile-white", "noon", "close-up"),
+    ("safety-yellow, D65, close-up", "safety-yellow", "D65", "close-up"),
+)
+QUICK_SCENES = SCENES[1:2]
+SIZE = (192, 144)
+QUICK_SIZE = (64, 48)
+SPP = 256
+QUICK_SPP = 16
+#: (label, bands, fluorescence mode, supersample factor, anti-aliasing (None: the frame's
+#: default, FXAA)). The first is the frame's default.
+OPTIONS = (
+    ("default (physical, 3 bands, FXAA)", 3, "physical", 1, None),
+    ("room lighting off", 3, "physical", 1, None, False),
+    ("FXAA off", 3, "physical", 1, "off"),
+    ("6 bands", 6, "physical", 1, None),
+    ("16 bands", 16, "physical", 1, None),
+    ("paper fluorescence", 3, "paper", 1, None),
+    ("2x2 supersampled", 3, "physical", 2, "off"),
+)
+ABSENT_OPTIONS = ("shadow map size (catalog.render.room_light.SHADOW_TEXELS, not a frame option)",)
+#: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
+#: curtain (noise falls as 1 / sqrt(spp): the spp that reaches it is spp (noise / 1 %)^2).
+NOISE_TARGET = 0.01
+#: The committed figures (tools/docs_figures.py): {"runs": {"baseline": section, "after_12_16": section}}.
+RESULT_JSON = "benchmarks/bench_image.json"
+GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
+REGIONS = ("curtain", "floor", "walls")
+#: The hour of "noon sun" (local solar time, the scene's date and latitude).
+NOON_HOUR = 12.0
+
+
+def light_name(key: str) -> str:
+    if key == "noon":
+        from catalog.render.scene import sun_at_hour  # noqa: PLC0415
+
+        return sun_at_hour(NOON_HOUR).light_name
+    return key
+
+
+def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
+                 antialiasing: str | None = None, room_lighting: bool | None = None,
+                 repeats: int = 5) -> dict:
+    """The real-time frame at desc.size: ``linear`` radiance (H, W, 3), ``display`` (the
+    frame's own display image, sRGB in [0, 1]), the ``exposure`` and ``white_balance`` its
+    display step used, and ``seconds``, the median wall time of render + glFinish.
+    ``supersample`` renders s x s larger and box-averages the radiance (then displays it
+    with the same exposure and white balance); ``antialiasing`` None keeps the default."""
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    width, height = desc.size
+    renderer = FrameRenderer(ctx, (width * supersample, height * supersample))
+    try:
+        renderer.set_fabric(preset)
+        renderer.set_light(light)
+        renderer.set_fluorescence(mode)
+        renderer.set_bands(bands)
+        if antialiasing is not None:
+            renderer.set_antialiasing(antialiasing)
+        if room_lighting is not None:
+            renderer.set_room_lighting(room_lighting)
+        cam = desc.info["camera"]
+        renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
+        renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
+        renderer.set_rings(list(desc.ring_xs_m))
+        wall, _cpu = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)
+        linear = renderer.read_linear()
+        shown = renderer.read_srgb8().astype(np.float32) / 255.0
+        exposure = renderer.exposure_scale()
+        white_balance = renderer.white_balance_matrix()
+    finally:
+        renderer.release()
+    if supersample > 1:
+        s = supersample
+        linear = linear.reshape(height, s, width, s, 3).mean(axis=(1, 3))
+        shown = metrics.display(linear, exposure, white_balance)
+    return {"linear": linear.astype(np.float32), "display": shown, "exposure": exposure,
+            "white_balance": white_balance, "seconds": wall}
+
+
+def compare(frame: dict, reference: np.ndarray, masks: dict, inputs,
+            exposure: float, white_balance) -> dict:
+    """FLIP (display images) and Delta E (radiance) of one frame against the reference."""
+    from catalog.bench.colour import adapted_white  # noqa: PLC0415
+    from catalog.optics.colorimetry import linear_srgb_to_xyz  # noqa: PLC0415
+    from catalog.optics.shading_reference import white_xyz  # noqa: PLC0415
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+
+    flip = metrics.flip_map(frame["display"], metrics.display(reference, exposure, white_balance))
+    cloth_xyz = linear_srgb_to_xyz(reference[masks["curtain"]].astype(np.float64))
+    white = adapted_white(white_xyz(inputs), cloth_xyz)
+    delta_e = metrics.delta_e_map(frame["linear"], reference, white)
+    return {"mean_flip": float(flip.mean()), "flip_map": flip,
+            "delta_e": metrics.region_stats(delta_e, {r: masks[r] for r in REGIONS})}
+
+
+def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
+        out: Path | None = None) -> dict:
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+    from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
+    from catalog.pathtrace.render import MAX_DEPTH, region_masks, render_radiance  # noqa: PLC0415
+    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+
+    if ctx is None:
+        from catalog.gl.context import create_headless_context  # noqa: PLC0415
+
+        ctx = create_headless_context()
+    scenes = scenes or (QUICK_SCENES if quick else SCENES)
+    size = tuple(size or (QUICK_SIZE if quick else SIZE))
+    spp = int(spp or (QUICK_SPP if quick else SPP))
+    options = OPTIONS[:2] if quick else OPTIONS
+    mi = load_mitsuba()
+    rows, pareto, images = [], [], {}
+    for label, fabric, light_key, view in scenes:
+        preset = load_preset(find_preset(fabric))
+        light = get_light(light_name(light_key))
+        yaw, pitch, distance = VIEWS[view]
+        desc = describe_scene(preset, light, size=size, yaw_deg=yaw, pitch_deg=pitch,
+                              distance_m=distance)
+        scene = build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH)
+        start = time.perf_counter()
+        a = render_radiance(mi, scene, spp // 2, seed=0)
+        b = render_radiance(mi, scene, spp // 2, seed=1)
+        reference_s = time.perf_counter() - start
+        reference = 0.5 * (a + b)
+        masks = region_masks(mi, scene, desc)
+        noise = metrics.noise_between(a, b)
+        noise_curtain = metrics.noise_between(a, b, masks["curtain"])
+        option_rows = []
+        default = None
+        for opt_label, bands, mode, supersample, antialiasing, *room in options:
+            frame = frame_images(ctx, desc, preset, light, bands, mode, supersample,
+                                 antialiasing, room[0] if room else None,
+                                 repeats=3 if quick else 7)
+            if default is None:  # the default frame's exposure and white balance show both
+                exposure, white_balance = frame["exposure"], frame["white_balance"]
+            result = compare(frame, reference, masks, desc.inputs, exposure, white_balance)
+            option_rows.append({"option": opt_label, "mean_flip": result["mean_flip"],
+                                "curtain_mean_delta_e": (result["delta_e"]["curtain"] or {}).get("mean"),
+                                "frame_s": frame["seconds"]})
+            if default is None:
+                default = (frame, frame["seconds"], result)
+        frame, frame_s, result = default
+        # FLIP between the two half renders: what noise alone scores (each half has sqrt(2)
+        # the noise of their mean, so this bounds the noise's share of the frame's FLIP)
+        flip_noise = float(metrics.flip_map(metrics.display(a, exposure, white_balance),
+                                            metrics.display(b, exposure, white_balance)).mean())
+        de = result["delta_e"]
+        row = {"scene": label, "fabric": fabric, "light": light.name, "view": view,
+               "camera": {"yaw_deg": yaw, "pitch_deg": pitch, "distance_m": distance}, "size": list(size), "spp": spp,
+               "mean_flip": result["mean_flip"],
+               **{f"{r}_delta_e_mean": (de[r] or {}).get("mean") for r in REGIONS},
+               **{f"{r}_delta_e_p95": (de[r] or {}).get("p95") for r in REGIONS},
+               "frame_ms": 1e3 * frame_s, "reference_s": reference_s,
+               "speedup": reference_s / frame_s if frame_s > 0 else math.inf,
+               "reference_noise_rel": noise, "reference_noise_curtain_rel": noise_curtain,
+               "reference_flip_noise_bound": flip_noise,
+               "fluorescence": desc.info["fluorescence_variant"]}
+        row["meets_goal"] = bool(row["mean_flip"] <= GOAL["mean_flip_at_most"]
+                                 and (row["curtain_delta_e_mean"] or math.inf)
+                                 <= GOAL["curtain_mean_delta_e_at_most"]
+                                 and row["speedup"] >= GOAL["speedup_at_least"])
+        rows.append(row)
+        pareto.append({"scene": label, "options": option_rows})
+        images[label] = {"frame": frame["display"],
+                         "reference": metrics.display(reference, exposure, white_balance),
+                         "flip": result["flip_map"]}
+    summary = {
+        "goal": GOAL,
+        "scenes_meeting_goal": sum(r["meets_goal"] for r in rows),
+        "scenes": len(rows),
+        "worst_mean_flip": max(r["mean_flip"] for r in rows),
+        "worst_curtain_delta_e_mean": max((r["curtain_delta_e_mean"] or 0.0) for r in rows),
+        "median_speedup": float(np.median([r["speedup"] for r in rows])),
+        "max_reference_noise_rel": max(r["reference_noise_rel"] for r in rows),
+        "absent_options": list(ABSENT_OPTIONS),
+        "integrator": f"Mitsuba {mi.__version__} volpath, max_depth {MAX_DEPTH}, "
+                      f"{spp} spp (2 x {spp // 2}), llvm_ad_rgb",
+    }
+    result = {"rows": rows, "pareto": pareto, "summary": summary,
+              "settings": {"size": list(size), "spp": spp, "quick": bool(quick)}}
+    result["_images"] = images  # not JSON: plot() writes them and drops them
+    if out is not None:
+        plot(result, out)
+    return result
+
+
+def _u8(display):
+    return (np.clip(display, 0, 1) * 255 + 0.5).astype(np.uint8)
+
+
+def triptych(images: dict) -> np.ndarray:
+    """real-time | reference | FLIP map, uint8 (H, 3W + 8, 3)."""
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+
+    frame = _u8(images["frame"])
+    reference = _u8(images["reference"])
+    gap = np.full((frame.shape[0], 4, 3), 255, dtype=np.uint8)
+    return np.concatenate([frame, gap, reference, gap, metrics.error_map_image(images["flip"])], 1)
+
+
+def slug(label: str) -> str:
+    return "".join(c if c.isalnum() else "-" for c in label.lower()).strip("-").replace("--", "-")
+
+
+def plot(result: dict, folder) -> list[Path]:
+    """Per scene: real-time | reference | FLIP map (PNG); the Pareto plot of the options."""
+    from catalog.bench.plots import pyplot  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    plt = pyplot()
+    written = []
+    for label, images in result.pop("_images", {}).items():
+        path = folder / f"image-{slug(label)}.png"
+        with atomic_path(path) as tmp:
+            plt.imsave(tmp, triptych(images), format="png")
+        written.append(path)
+    written.append(plot_pareto(result, folder))
+    return written
+
+
+def option_summary(result: dict) -> list[dict]:
+    """Per real-time option over the scenes: mean of the mean FLIPs, mean curtain dE, and the
+    median frame time (ms); ``pareto`` marks the options no other beats on both error and time."""
+    labels = [o["option"] for o in result["pareto"][0]["options"]] if result["pareto"] else []
+    rows = []
+    for label in labels:
+        picks = [next(o for o in p["options"] if o["option"] == label) for p in result["pareto"]]
+        des = [o["curtain_mean_delta_e"] for o in picks if o["curtain_mean_delta_e"] is not None]
+        rows.append({"option": label, "mean_flip": float(np.mean([o["mean_flip"] for o in picks])),
+                     "curtain_mean_delta_e": float(np.mean(des)) if des else None,
+                     "frame_ms": float(np.median([1e3 * o["frame_s"] for o in picks]))})
+    for row in rows:
+        row["pareto"] = not any(o["mean_flip"] <= row["mean_flip"] and o["frame_ms"] <= row["frame_ms"]
+                                and (o["mean_flip"], o["frame_ms"]) != (row["mean_flip"], row["frame_ms"])
+                                for o in rows)
+    return rows
+
+
+def plot_pareto(result: dict, folder) -> Path:
+    """Mean FLIP over the scenes against the median frame time, one point per option."""
+    from catalog.bench.plots import pyplot, save_figure  # noqa: PLC0415
+
+    plt = pyplot()
+    rows = option_summary(result)
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for row in rows:
+        ax.scatter(row["frame_ms"], row["mean_flip"], s=40,
+                   marker="o" if row["pareto"] else "x", color="C0" if row["pareto"] else "C3")
+        ax.annotate(row["option"], (row["frame_ms"], row["mean_flip"]), fontsize=7,
+                    xytext=(4, 3), textcoords="offset points")
+    front = sorted((r for r in rows if r["pareto"]), key=lambda r: r["frame_ms"])
+    ax.plot([r["frame_ms"] for r in front], [r["mean_flip"] for r in front], color="C0", lw=0.8)
+    ax.axhline(GOAL["mean_flip_at_most"], color="grey", ls="--", lw=0.8)
+    ax.text(ax.get_xlim()[0], GOAL["mean_flip_at_most"], " goal: FLIP 0.10", fontsize=7,
+            va="bottom", color="grey")
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel("frame time, ms (llvmpipe, median over the scenes)")
+    ax.set_ylabel("mean FLIP against the path-traced reference")
+    ax.set_title(f"Real-time options against the reference ({len(result['rows'])} scenes)",
+                 fontsize=10)
+    fig.tight_layout()
+    return save_figure(fig, Path(folder) / "image-pareto.png")
+
+
+def spp_for_noise(spp: int, noise: float, target: float = NOISE_TARGET) -> float:
+    """Samples per pixel at which a render with relative noise ``noise`` at ``spp`` reaches
+    ``target`` (Monte Carlo: noise ~ 1 / sqrt(spp))."""
+    return spp * (noise / target) ** 2
+
+
+def _cell(value) -> str:
+    """3 significant digits, e-notation when small or large (catalog.bench.report's rule;
+    not imported: report imports this module for its section)."""
+    if isinstance(value, float) and math.isfinite(value) and value != 0:
+        return f"{value:.2e}" if (abs(value) < 1e-3 or abs(value) >= 1e5) else f"{value:.3g}"
+    return "0" if isinstance(value, float) and value == 0 else str(value)
+
+
+def table(rows: list[dict], columns: list[str], headers: list[str]) -> str:
+    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(_cell(row.get(c, "")) for c in columns) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run; of the
+    committed JSON (``{"runs": {...}}``) the baseline's, and ``image-after`` the run after
+    issues 12-16 (its table, its options and its error maps)."""
+    if "runs" in result:
+        blocks = markdown_tables(result["runs"]["baseline"])
+        after = markdown_tables(result["runs"]["after_12_16"])
+        blocks["image-after"] = (after["image"] + "\n\nReal-time options:\n\n" + after["image-options"]
+                                 + "\n\n![six scenes after issues 12-16: real-time | reference | FLIP]"
+                                 "(img/pathtrace_scenes_after_13.png)")
+        return blocks
+
+    s = result["summary"]
+    rows = [dict(r, spp_for_1pct=spp_for_noise(r["spp"], r["reference_noise_curtain_rel"]))
+            for r in result["rows"]]
+    per_scene = table(rows, [
+        "scene", "mean_flip", "curtain_delta_e_mean", "curtain_delta_e_p95", "floor_delta_e_mean",
+        "floor_delta_e_p95", "walls_delta_e_mean", "walls_delta_e_p95", "frame_ms", "reference_s",
+        "speedup", "reference_noise_rel", "reference_noise_curtain_rel", "spp_for_1pct",
+        "reference_flip_noise_bound",
+        "meets_goal"],
+        ["scene", "mean FLIP", "curtain dE mean", "curtain dE p95", "floor dE mean",
+         "floor dE p95", "walls dE mean", "walls dE p95", "frame ms", "reference s",
+         "x faster", "ref. noise (rel. RMS)", "ref. noise, curtain", "spp for 1 % on the curtain",
+         "FLIP of the two half renders (noise bound)",
+         "goal met"])
+    per_scene += (f"\n\n{result['settings']['size'][0]}x{result['settings']['size'][1]} px; "
+                  f"reference: {s['integrator']}. Goal (issue 11): mean FLIP <= "
+                  f"{GOAL['mean_flip_at_most']}, curtain dE mean <= "
+                  f"{GOAL['curtain_mean_delta_e_at_most']}, >= {GOAL['speedup_at_least']:g}x "
+                  f"faster: met on {s['scenes_meeting_goal']} of {s['scenes']} scenes.")
+    option_rows = []
+    for p in result["pareto"]:
+        for o in p["options"]:
+            option_rows.append({"scene": p["scene"], **o, "frame_ms": 1e3 * o["frame_s"]})
+    options = table(option_summary(result), ["option", "mean_flip", "curtain_mean_delta_e",
+                                             "frame_ms", "pareto"],
+                    ["real-time option", "mean FLIP (mean over scenes)",
+                     "curtain dE mean (mean over scenes)", "frame ms (median)", "on the Pareto front"])
+    options += "\n\n" + table(option_rows, ["scene", "option", "mean_flip", "curtain_mean_delta_e",
+                                            "frame_ms"],
+                               ["scene", "real-time option", "mean FLIP", "curtain dE mean", "frame ms"])
+    options += (f"\n\nNot yet in the frame (measured when they land): "
+                f"{', '.join(s['absent_options'])}.")
+    return {"image": per_scene, "image-options": options}
+

@@ -1,0 +1,46 @@
+"""``catalog reference``: a path-traced EXR of the snapshot scene (Mitsuba 3, CPU)."""
+
+from __future__ import annotations
+
+HELP = "path-trace the snapshot scene (Mitsuba 3 on the CPU) to a linear EXR: the reference"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--fabric", required=True, help="preset name (fabrics/NAME.toml) or a .toml path")
+    parser.add_argument("--light", default="D65", help="light name (`catalog lights`)")
+    parser.add_argument("--frame", type=int, default=0, help="cloth simulation frame (0: the static drape)")
+    parser.add_argument("--size", default="320x240", help="WIDTHxHEIGHT in pixels")
+    parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")
+    parser.add_argument("--yaw", type=float, default=0.0, help="camera yaw, deg")
+    parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
+    parser.add_argument("--spp", type=int, default=64, help="samples per pixel (>= 1)")
+    parser.add_argument("--seed", type=int, default=0, help="sampler seed (independent renders: differ)")
+    parser.add_argument("--max-depth", type=int, default=16, help="path length limit (bounces)")
+    parser.add_argument("--variant", default="llvm_ad_rgb",
+                        help="Mitsuba variant: llvm_ad_rgb (default) or llvm_ad_spectral")
+    parser.add_argument("--no-fluorescence", action="store_true", help="without fluorescence")
+    parser.add_argument("--mode", choices=("paper", "physical"), default="physical",
+                        help="fluorescence model (default physical)")
+    parser.add_argument("--out", required=True, help="FILE.exr (linear radiance)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def run(args) -> int:
+    from pathlib import Path  # noqa: PLC0415
+
+    from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.pathtrace.render import ReferenceRequest, render_reference  # noqa: PLC0415
+    from catalog.render.snapshot import parse_size  # noqa: PLC0415
+
+    request = ReferenceRequest(
+        fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
+        spp=args.spp, frame=args.frame, distance_m=args.distance, yaw_deg=args.yaw,
+        pitch_deg=args.pitch, fluorescence="off" if args.no_fluorescence else args.mode,
+        variant=args.variant, seed=args.seed, max_depth=args.max_depth)
+    _, report = render_reference(request)
+    if args.json:
+        print_json(report)
+    else:
+        print(f"wrote {report['out']} ({report['fabric']} under {report['light']}, "
+              f"{report['spp']} spp, {report['render_s']:.1f} s)")
+    return 0

@@ -1,0 +1,185 @@
+"""``catalog reference``: the path-traced radiance of the snapshot scene, as a linear EXR.
+
+Same arguments as ``catalog snapshot`` (fabric, light, cloth frame, size, camera distance)
+plus the sample count; the EXR holds linear sRGB radiance in the frame's units (Y in
+cd m^-2), exposure-free, written atomically (nothing is left behind on an error).
+
+Integrator: Mitsuba's ``volpath`` (a unidirectional path tracer with next-event estimation
+and MIS; unlike ``path`` it carries shadow rays through null surfaces, the cloth's gaps),
+MAX_DEPTH bounces with Russian roulette after RR_DEPTH. With grey walls of albedo 0.6 the
+light left after 16 bounces is 0.6^16 = 3e-4 of the first: the room's inter-reflections
+are converged in depth; the remaining error is noise (docs/pathtrace.md: the spp for a
+stated noise level, estimated from two independent renders).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from catalog.core.errors import CatalogError, InputError
+
+MAX_DEPTH = 16
+RR_DEPTH = 5
+#: The largest sample count accepted (a guard against typing an extra zero).
+MAX_SPP = 1 << 16
+
+
+@dataclass(frozen=True)
+class ReferenceRequest:
+    fabric: str
+    light: str
+    size: tuple[int, int]
+    out: Path | None
+    spp: int = 64
+    frame: int = 0
+    distance_m: float = 2.6
+    yaw_deg: float = 0.0
+    pitch_deg: float = 0.0
+    fluorescence: str = "physical"
+    variant: str = "llvm_ad_rgb"
+    seed: int = 0
+    max_depth: int = MAX_DEPTH
+
+
+def check_out(path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() != ".exr":
+        raise InputError(f"{str(path)!r}: the reference is linear radiance: the name must end "
+                         "in .exr", field="--out")
+    if path.is_dir():
+        raise InputError(f"{str(path)!r} is a folder", field="--out")
+    parent = path.parent if str(path.parent) else Path(".")
+    if parent.exists() and not parent.is_dir():
+        raise InputError(f"{str(parent)!r} is not a folder", field="--out")
+    import os  # noqa: PLC0415
+
+    probe = parent
+    while not probe.exists():
+        probe = probe.parent
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise InputError(f"{str(path)!r} cannot be written (no write permission in "
+                         f"{str(probe)!r})", field="--out")
+    return path
+
+
+def validate(request: ReferenceRequest):
+    """Refuse bad input before Mitsuba is loaded. Returns (preset, light)."""
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace.backend import check_variant  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.render.snapshot import parse_size  # noqa: PLC0415
+
+    if request.out is not None:
+        check_out(request.out)
+    check_variant(request.variant)
+    if not (isinstance(request.spp, int) and 1 <= request.spp <= MAX_SPP):
+        raise InputError(f"{request.spp!r} samples per pixel: give a whole number in 1..{MAX_SPP}",
+                         field="--spp")
+    width, height = request.size
+    parse_size(f"{width}x{height}")
+    if request.frame < 0:
+        raise InputError(f"{request.frame} must be >= 0", field="--frame")
+    if not (math.isfinite(request.distance_m) and request.distance_m > 0.05):
+        raise InputError(f"{request.distance_m!r} m: the camera distance must exceed 0.05 m",
+                         field="--distance")
+    if not 1 <= request.max_depth <= 256:
+        raise InputError(f"{request.max_depth} must lie in 1..256", field="--max-depth")
+    preset = load_preset(find_preset(request.fabric))
+    scene_lib.dye_transmittance(preset)
+    scene_lib.fluorescent_material(preset)
+    light = get_light(request.light)
+    return preset, light
+
+
+def describe(request: ReferenceRequest):
+    from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
+
+    preset, light = validate(request)
+    return describe_scene(preset, light, size=request.size, frame=request.frame,
+                          yaw_deg=request.yaw_deg, pitch_deg=request.pitch_deg,
+                          distance_m=request.distance_m, fluorescence=request.fluorescence)
+
+
+def render_radiance(mi, scene, spp: int, seed: int = 0) -> np.ndarray:
+    """(H, W, 3) float32 linear radiance of a loaded scene."""
+    image = mi.render(scene, spp=int(spp), seed=int(seed))
+    return np.asarray(image, dtype=np.float32)[..., :3]
+
+
+def render_reference(request: ReferenceRequest, desc=None) -> tuple[np.ndarray, dict]:
+    """Render the reference; write it when ``request.out`` is set. Returns (pixels, report)."""
+    from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
+    from catalog.pathtrace.scene import build_mitsuba_scene  # noqa: PLC0415
+
+    validate(request)  # bad input first, then the library (one line each), then the scene
+    mi = load_mitsuba(request.variant)
+    desc = desc if desc is not None else describe(request)
+    start = time.perf_counter()
+    scene = build_mitsuba_scene(mi, desc, max_depth=request.max_depth)
+    build_s = time.perf_counter() - start
+    start = time.perf_counter()
+    pixels = render_radiance(mi, scene, request.spp, request.seed)
+    render_s = time.perf_counter() - start
+    if not np.all(np.isfinite(pixels)):
+        raise CatalogError("the reference has NaN or infinite pixels; nothing written")
+    report = dict(desc.info)
+    report.update({"size": list(desc.size), "spp": request.spp, "variant": request.variant,
+                   "integrator": f"volpath, max_depth {request.max_depth}, rr_depth {RR_DEPTH}",
+                   "seed": request.seed, "build_s": round(build_s, 4),
+                   "render_s": round(render_s, 4),
+                   "mean_linear_rgb": [round(float(v), 4) for v in pixels.reshape(-1, 3).mean(0)]})
+    if request.out is not None:
+        from catalog.render.snapshot import write_image  # noqa: PLC0415
+
+        write_image(request.out, pixels, {
+            "ImageDescription": f"catalog reference: {report['fabric']} under {report['light']}, "
+                                f"path traced ({request.spp} spp)",
+            "catalog:fabric": report["fabric"], "catalog:light": report["light"],
+            "catalog:frame": str(request.frame), "catalog:spp": str(request.spp),
+            "catalog:variant": request.variant,
+            "catalog:fluorescence_variant": report["fluorescence_variant"],
+            "catalog:encoding": "linear sRGB primaries, Y in cd/m2 (scene-referred)"})
+        report["out"] = str(request.out)
+    return pixels, report
+
+
+def region_masks(mi, scene, desc) -> dict[str, np.ndarray]:
+    """Boolean (H, W) masks of what each pixel centre sees: curtain, floor, walls (the four
+    walls, the window wall and the ceiling), outside (through the window), other (the rod),
+    from a ray per pixel centre through the reference's own camera and geometry."""
+    import drjit as dr  # noqa: PLC0415
+
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    width, height = desc.size
+    sensor = scene.sensors()[0]
+    index = dr.arange(mi.UInt32, width * height)
+    film = mi.Point2f((mi.Float(index % width) + 0.5) / width,
+                      (mi.Float(index // width) + 0.5) / height)
+    ray, _ = sensor.sample_ray(0.0, 0.5, film, mi.Point2f(0.5, 0.5))
+    si = scene.ray_intersect(ray)
+    shapes = {s.id(): s for s in scene.shapes()}
+    valid = np.asarray(si.is_valid(), dtype=bool)
+    on_curtain = np.zeros(valid.shape, dtype=bool)
+    for name, shape in shapes.items():  # the cloth and its fluorescence shells
+        if name == "curtain" or name.startswith("fluorescence_"):
+            on_curtain |= np.asarray(si.shape == mi.ShapePtr(shape), dtype=bool)
+    on_curtain &= valid
+    on_room = valid & ~on_curtain
+    p = np.asarray(si.p, dtype=np.float64)
+    p = p.T if p.shape[0] == 3 else p
+    (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
+    tol = 2e-3
+    floor = on_room & (np.abs(p[:, 1] - y0) < tol)
+    walls = on_room & ~floor & ((np.abs(p[:, 1] - y1) < tol) | (np.abs(p[:, 0] - x0) < tol)
+                                | (np.abs(p[:, 0] - x1) < tol) | (np.abs(p[:, 2] - z1) < tol)
+                                | (np.abs(p[:, 2] - z0) < tol))
+    masks = {"curtain": on_curtain, "floor": floor, "walls": walls, "outside": ~valid,
+             "other": on_room & ~floor & ~walls}
+    return {k: v.reshape(height, width) for k, v in masks.items()}

@@ -1,0 +1,413 @@
+"""The scene of ``catalog snapshot`` exported for Mitsuba, from the same description.
+
+:func:`describe_scene` (numpy only) reads everything from :mod:`catalog.render.scene`
+(geometry, albedos, the key light's direction and disc, the sky and ground radiances of
+:func:`catalog.render.scene.build_shading_inputs`) and :mod:`catalog.render.snapshot` (the
+cloth simulation's curtain at a frame); :func:`build_mitsuba_scene` turns that into a
+Mitsuba scene dict. When the real-time scene changes (patterns, fullness, room lighting),
+the export follows because it holds no numbers of its own.
+
+What the reference keeps and what it replaces (the real-time frame's stand-ins for light
+it cannot trace are not light sources here; path tracing computes what they stand for):
+
+- kept: the room box with its window opening and the rod (grey Lambertian, ROOM_ALBEDO),
+  the curtain mesh, the camera (position, target, vertical field of view), the key light
+  as a distant source with the disc of SUN_RADIUS_RAD and the key's normal irradiance, the
+  sky above and the ground below the horizon with the real-time radiances (for a sun, the
+  frame's clear sky by direction, catalog.optics.sun.sky), all in one environment map (the disc resolved by supersampling, normalised to the exact irradiance);
+- replaced: the fill light (FILL_FRACTION of the key, a stand-in for the light bounced
+  into the room), the walls' constant ROOM_FRACTION radiance and the cloth's ambient term
+  (stand-ins for the inter-reflections): the path tracer follows the light's paths instead.
+  ``stand_ins=True`` adds the fill light back (the direct-light validation uses it).
+
+Colour: the RGB variant carries linear sRGB in the real-time frame's units (683 times the
+sRGB matching functions: Y in cd m^-2 for a radiance in W m^-2 sr^-1 nm^-1); the dye is the
+per-channel ratio RGB(key x dye) / RGB(key), exact for light of the key's spectrum, as the
+3-band real-time frame does.
+
+Fluorescence (physical mode), stated: a Lambertian emission on both sides of the cloth,
+per vertex, from the photons the cloth absorbs there: the key light's at its incidence
+|n . l| with its visibility from a shadow ray (folds shade each other), plus the outside
+half-space's sky and ground (the room's light, with almost no UV, is left out), through
+the same absorptance, quantum yield, saturation and emission spectrum as the real-time
+frame (catalog.render.scene.with_physical_emission), M / (2 pi) per side. It enters the
+scene as two emitting, null-scattering shells 0.5 mm either side of the cloth.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Environment map size (lat-long, width = 2 height). 2048 x 1024: 0.18 deg texels.
+ENV_WIDTH = 2048
+#: Sub-samples per texel side where the key light's disc may fall.
+DISC_SUPERSAMPLE = 8
+#: The fluorescence shells' distance from the cloth (m).
+SHELL_OFFSET_M = 5e-4
+
+
+@dataclass
+class SceneDescription:
+    """Everything the reference needs, as numpy arrays (no Mitsuba here)."""
+
+    size: tuple[int, int]
+    camera_position: np.ndarray
+    camera_target: np.ndarray
+    fov_y_deg: float
+    near_m: float
+    far_m: float
+    curtain: tuple                       # positions, normals, uvs, tangents, indices
+    room_positions: np.ndarray           # (3T, 3) non-indexed triangles
+    room_albedo: float
+    fabric: dict                         # woven BSDF parameters + dye_rgb
+    sky_rgb: np.ndarray
+    ground_rgb: np.ndarray
+    key_rgb: np.ndarray                  # normal irradiance, RGB
+    key_to_light: np.ndarray
+    key_radius_rad: float
+    fill_rgb: np.ndarray                 # the real-time stand-in (used with stand_ins only)
+    fill_to_light: np.ndarray
+    fluorescence: dict | None            # per-vertex emission recipe (see module doc)
+    inputs: object                       # catalog.optics.shading_reference.ShadingInputs of the frame
+    info: dict = field(default_factory=dict)
+    pattern: dict | None = None          # {"coverage": (H, W) array, "uv_scale": (su, sv)}
+    fabric_size_m: tuple | None = None   # the rest fabric's (width, length) that uv 0..1 spans
+    ring_xs_m: tuple = ()                # the curtain rings on the rod (x, m)
+    sky: object = None                   # the frame's clear-sky model (a sun above the horizon)
+
+
+def rgb_weights(key_irradiance: np.ndarray) -> np.ndarray:
+    """(3, L): spectrum -> linear sRGB in the frame's units (the 3-band weights)."""
+    from catalog.render.bands import band_weights  # noqa: PLC0415
+
+    weights, _ = band_weights(3, key_irradiance)
+    return weights
+
+
+def key_light_for(light) -> tuple[np.ndarray, bool]:
+    """The key light's direction (unit, to the light) and whether it is the sun, as the
+    real-time frame places it (:meth:`catalog.render.frame.FrameRenderer.set_light`)."""
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    is_sun = light.name.startswith(("sun:", "sun-clear:", "sun@"))
+    try:
+        elevation = scene_lib.key_elevation_for(light.name)
+    except (ValueError, CatalogError):
+        elevation = scene_lib.LAMP_ELEVATION_DEG
+    return scene_lib.key_direction(elevation), is_sun
+
+
+def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: float = 0.0,
+                   pitch_deg: float = 0.0, distance_m: float = 2.6,
+                   fluorescence: str = "physical", curtain=None) -> SceneDescription:
+    """The snapshot scene for ``preset`` under ``light`` (a catalog.optics.lights.Light)."""
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.render.camera import OrbitCamera  # noqa: PLC0415
+
+    camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
+                         distance_m=float(distance_m))
+    to_light, is_sun = key_light_for(light)
+    inside = bool(camera.position[2] > scene_lib.WINDOW_Z)
+    inputs, decision = scene_lib.build_shading_inputs(
+        preset, light.irradiance_w_m2_nm, to_light, is_sun=is_sun, fluorescence=fluorescence,
+        viewer_inside=inside)
+    fabric_size = None
+    rings: tuple = ()
+    if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth
+        from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
+
+        *curtain, fabric_size = simulated_curtain(preset, frame)
+        rings = tuple(ring_xs_m(preset))
+    elif len(curtain) == 6:
+        *curtain, fabric_size = curtain
+    room_positions, _ = scene_lib.room_props()
+    if rings:
+        ring_positions, _ = scene_lib.ring_mesh(list(rings))
+        room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
+                                         np.asarray(ring_positions).reshape(-1, 3)])
+    pattern = None
+    from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+
+    loaded = load_pattern(preset)
+    if loaded is not None:
+        cloth_m = fabric_size or (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
+        pattern = {"coverage": np.asarray(loaded.coverage, dtype=np.float32),
+                   "uv_scale": (float(cloth_m[0]) / loaded.repeat_m[0],
+                                float(cloth_m[1]) / loaded.repeat_m[1])}
+    w = rgb_weights(inputs.key_irradiance)
+    key_rgb = w @ inputs.key_irradiance
+    dyed = w @ (inputs.key_irradiance * inputs.dye_transmittance)
+    dye_rgb = np.where(key_rgb > 0, dyed / np.where(key_rgb > 0, key_rgb, 1.0), 0.0)
+    if not np.any(key_rgb > 0):  # a light with nothing visible (UV): the dye's own mean
+        dye_rgb = w @ inputs.dye_transmittance / np.maximum(w @ np.ones_like(inputs.key_irradiance), 1e-30)
+    fabric = {"direct": inputs.direct, "a_diff": inputs.a_diff, "g_diff": inputs.g_diff,
+              "a_spec": inputs.a_spec, "g_spec": inputs.g_spec, "anisotropy": inputs.anisotropy,
+              "dye_rgb": dye_rgb}
+    fl = None
+    if inputs.fluorescence_mode == "physical":
+        from catalog.optics.fluorescence import absorbed_photon_irradiance  # noqa: PLC0415
+
+        material = scene_lib.fluorescent_material(preset)
+        outside = math.pi * 0.5 * (inputs.sky_radiance + inputs.ground_radiance)
+        fl = {"mode": "physical", "key_photons": float(inputs.absorbed_photons[0]),
+              "outside_photons": absorbed_photon_irradiance(material, outside),
+              "saturation_photons": float(inputs.saturation_photons),
+              "emission_rgb_per_photon": w @ inputs.emission_per_photon}
+    elif inputs.fluorescence_mode == "paper":
+        fl = {"mode": "paper", "radiance_rgb": w @ inputs.paper_radiance}
+    return SceneDescription(
+        size=tuple(int(v) for v in size), camera_position=camera.position,
+        camera_target=np.asarray(camera.target, dtype=np.float64), fov_y_deg=camera.fov_y_deg,
+        near_m=camera.near_m, far_m=camera.far_m, curtain=tuple(np.asarray(a) for a in curtain),
+        room_positions=np.asarray(room_positions, dtype=np.float64),
+        room_albedo=scene_lib.ROOM_ALBEDO, fabric=fabric,
+        sky_rgb=w @ inputs.sky_radiance, ground_rgb=w @ inputs.ground_radiance,
+        key_rgb=key_rgb, key_to_light=np.asarray(inputs.key_to_light, dtype=np.float64),
+        key_radius_rad=scene_lib.SUN_RADIUS_RAD, fill_rgb=w @ inputs.fill_irradiance,
+        fill_to_light=np.asarray(inputs.fill_to_light, dtype=np.float64), fluorescence=fl,
+        inputs=inputs, pattern=pattern, fabric_size_m=fabric_size, ring_xs_m=rings,
+        sky=clear_sky_for(inputs, is_sun),
+        info={"fabric": preset.name, "light": light.name, "fluorescence_requested": decision.requested,
+              "fluorescence_variant": inputs.fluorescence_mode, "frame": int(frame),
+              "camera": {"yaw_deg": camera.yaw_deg, "pitch_deg": camera.pitch_deg,
+                         "distance_m": camera.distance_m}})
+
+
+# --------------------------------------------------------------------------- environment
+
+def clear_sky_for(inputs, is_sun: bool):
+    """The clear sky the frame draws behind the window for a sun above the horizon
+    (:meth:`catalog.render.frame.FrameRenderer.sky_model_for`: Preetham's distribution with
+    the irradiance of the scene's sky term and its ground), else None (the flat sky)."""
+    if not (is_sun and inputs.key_to_light[1] > 1e-3):
+        return None
+    from catalog.optics.sun.sky import sky_model  # noqa: PLC0415
+
+    return sky_model(inputs.key_to_light, diffuse_horizontal=math.pi * inputs.sky_radiance,
+                     ground_radiance=inputs.ground_radiance)
+
+
+def texel_directions(width: int, height: int, offsets=(0.5, 0.5)) -> np.ndarray:
+    """Unit directions (H, W, 3) of a lat-long map as Mitsuba's envmap reads it:
+    u = atan2(x, -z) / 2 pi, v = acos(y) / pi (y up, world = map frame)."""
+    theta = math.pi * (np.arange(height)[:, None] + offsets[1]) / height
+    phi = 2 * math.pi * (np.arange(width)[None, :] + offsets[0]) / width
+    s = np.sin(theta)
+    return np.stack(np.broadcast_arrays(s * np.sin(phi), np.cos(theta), -s * np.cos(phi)), -1)
+
+
+def environment_map(sky_rgb, ground_rgb, key_rgb, key_to_light, radius_rad,
+                    width: int = ENV_WIDTH, sky=None) -> np.ndarray:
+    """Lat-long RGB radiance (H, W, 3) float32: sky above the horizon, ground below, the key
+    light's disc of angular radius ``radius_rad`` whose integral over solid angle equals the
+    key's normal irradiance ``key_rgb`` exactly (texel coverage by DISC_SUPERSAMPLE^2 samples)."""
+    height = width // 2
+    d = texel_directions(width, height)
+    if sky is not None:  # the frame's clear sky (and hazy ground) by direction
+        env = np.asarray(sky.radiance(d), dtype=np.float64)
+    else:
+        env = np.where(d[..., 1:2] >= 0, np.asarray(sky_rgb)[None, None, :],
+                       np.asarray(ground_rgb)[None, None, :]).astype(np.float64)
+    to_light = np.asarray(key_to_light, dtype=np.float64)
+    to_light = to_light / np.linalg.norm(to_light)
+    cos_r = math.cos(radius_rad)
+    near = (d @ to_light) > math.cos(radius_rad + 4 * math.pi / height)
+    rows, cols = np.nonzero(near)
+    if rows.size == 0 or not np.any(np.asarray(key_rgb) > 0):
+        return env.astype(np.float32)
+    k = DISC_SUPERSAMPLE
+    sub = (np.arange(k) + 0.5) / k
+    cover = np.zeros(rows.size)
+    for sy in sub:
+        theta = math.pi * (rows + sy) / height
+        for sx in sub:
+            phi = 2 * math.pi * (cols + sx) / width
+            s = np.sin(theta)
+            dd = np.stack([s * np.sin(phi), np.cos(theta), -s * np.cos(phi)], -1)
+            cover += (dd @ to_light) >= cos_r
+    cover /= k * k
+    texel_sr = (2 * math.pi / width) * (math.pi / height) * np.sin(math.pi * (rows + 0.5) / height)
+    solid_angle = float(np.sum(cover * texel_sr))
+    if solid_angle <= 0:
+        return env.astype(np.float32)
+    disc = np.asarray(key_rgb, dtype=np.float64) / solid_angle  # radiance of the disc
+    env[rows, cols] = (1 - cover[:, None]) * env[rows, cols] + cover[:, None] * disc[None, :]
+    return env.astype(np.float32)
+
+
+# --------------------------------------------------------------------------- Mitsuba
+
+def _mesh(mi, name, positions, indices, normals=None, uvs=None, props=None):
+    import drjit as dr  # noqa: PLC0415
+
+    positions = np.ascontiguousarray(positions, dtype=np.float32).reshape(-1, 3)
+    indices = np.ascontiguousarray(indices, dtype=np.uint32).reshape(-1, 3)
+    mesh = mi.Mesh(name, positions.shape[0], indices.shape[0], props or mi.Properties(),
+                   has_vertex_normals=normals is not None, has_vertex_texcoords=uvs is not None)
+    params = mi.traverse(mesh)
+    params["vertex_positions"] = dr.ravel(mi.Point3f(positions.T))
+    params["faces"] = dr.ravel(mi.Vector3u(indices.T))
+    if normals is not None:
+        n = np.ascontiguousarray(normals, dtype=np.float32).reshape(-1, 3)
+        params["vertex_normals"] = dr.ravel(mi.Normal3f(n.T))
+    if uvs is not None:
+        params["vertex_texcoords"] = dr.ravel(mi.Point2f(np.ascontiguousarray(uvs, dtype=np.float32).T))
+    params.update()
+    return mesh
+
+
+def woven_bsdf_dict(fabric: dict, pattern: dict | None = None) -> dict:
+    out = {"type": "woven", **{k: float(fabric[k]) for k in
+                               ("direct", "a_diff", "g_diff", "a_spec", "g_spec", "anisotropy")},
+           **{f"dye_{c}": float(v) for c, v in zip("rgb", fabric["dye_rgb"])}}
+    if fabric.get("dye_spectrum") is not None:  # the spectral variant reads the dye per wavelength
+        wavelengths, values = fabric["dye_spectrum"]
+        out["dye"] = {"type": "regular", "wavelength_min": float(wavelengths[0]),
+                      "wavelength_max": float(wavelengths[-1]),
+                      "values": ", ".join(f"{v:.6g}" for v in values)}
+    if pattern is not None:  # the coverage hook (model.md section 9)
+        import mitsuba as mi  # noqa: PLC0415
+
+        coverage = np.asarray(pattern["coverage"], dtype=np.float32)
+        out["coverage"] = {"type": "bitmap", "raw": True,
+                           "bitmap": mi.Bitmap(coverage[..., None])}
+        out["coverage_mean"] = float(coverage.mean())
+        scale = pattern.get("uv_scale", 1.0)
+        su, sv = (scale, scale) if np.isscalar(scale) else scale
+        out["uv_scale_u"], out["uv_scale_v"] = float(su), float(sv)
+    return out
+
+
+def fluorescence_per_vertex(desc: SceneDescription, scene=None, mi=None) -> np.ndarray | None:
+    """Emitted radiance per side (V, 3) RGB at the curtain's vertices (module doc), or None.
+    ``scene``: a Mitsuba scene holding the curtain, for the key light's shadow rays."""
+    fl = desc.fluorescence
+    if fl is None:
+        return None
+    positions, normals = desc.curtain[0], desc.curtain[1]
+    count = np.asarray(positions).reshape(-1, 3).shape[0]
+    if fl["mode"] == "paper":
+        return np.repeat(np.asarray(fl["radiance_rgb"])[None, :], count, axis=0)
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    cos_key = np.abs(n @ desc.key_to_light)
+    visible = np.ones(count)
+    if scene is not None:
+        p = np.asarray(positions, dtype=np.float64).reshape(-1, 3) + 1e-3 * desc.key_to_light
+        d = np.repeat(desc.key_to_light[None, :], count, axis=0)
+        ray = mi.Ray3f(mi.Point3f(p.T.astype(np.float32)), mi.Vector3f(d.T.astype(np.float32)))
+        visible = 1.0 - np.asarray(scene.ray_test(ray), dtype=np.float64)
+        # the cloth lets LD through its gaps: a fold in front dims the key, not blacks it out
+        visible = visible + (1.0 - visible) * desc.fabric["direct"]
+    absorbed = cos_key * visible * fl["key_photons"] + fl["outside_photons"]
+    effective = absorbed / (1.0 + absorbed / fl["saturation_photons"])
+    return effective[:, None] * np.asarray(fl["emission_rgb_per_photon"])[None, :]
+
+
+#: The least share of next-event samples an emitter gets (none is starved).
+MIN_SAMPLING_SHARE = 0.15
+
+
+def emitter_sampling_weights(desc: SceneDescription, emission: np.ndarray) -> dict[str, float]:
+    """Next-event estimation's choice between the environment (sky, ground, the key's disc)
+    and each fluorescence shell, in proportion to the luminous power each sends into the
+    room (the environment's through the window, a shell's pi L A), at least
+    MIN_SAMPLING_SHARE each. Mitsuba's default, uniform over emitters, spends two thirds of
+    the shadow rays on a faint glow under daylight and on a black sky under a UV lamp."""
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    luma = np.array([0.2126, 0.7152, 0.0722])
+    x0, x1, y0, y1 = scene_lib.WINDOW_RECT
+    window_m2 = (x1 - x0) * (y1 - y0)
+    env = max(float(desc.key_rgb @ luma), 0.0) + math.pi * 0.5 * max(
+        float((desc.sky_rgb + desc.ground_rgb) @ luma), 0.0)
+    env *= window_m2
+    positions = np.asarray(desc.curtain[0], dtype=np.float64).reshape(-1, 3)
+    tri = np.asarray(desc.curtain[4]).reshape(-1, 3)
+    area = 0.5 * np.linalg.norm(np.cross(positions[tri[:, 1]] - positions[tri[:, 0]],
+                                         positions[tri[:, 2]] - positions[tri[:, 0]]), axis=1).sum()
+    shell = math.pi * max(float(np.mean(np.abs(emission @ luma))), 0.0) * area
+    total = env + 2 * shell
+    if not total > 0:
+        return {"environment": 1.0, "shell": 1.0}
+    env_w, shell_w = env / total, shell / total
+    env_w, shell_w = max(env_w, MIN_SAMPLING_SHARE), max(shell_w, MIN_SAMPLING_SHARE)
+    return {"environment": env_w, "shell": shell_w}
+
+
+def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
+                        integrator: dict | None = None, room: bool = True,
+                        environment: bool = True, stand_ins: bool = False,
+                        key_as_directional: bool = False):
+    """The Mitsuba scene of ``desc`` (loaded). ``room``/``environment``/``stand_ins`` and
+    ``key_as_directional`` switch parts for the validation scenes (the direct-light check
+    uses the curtain alone under the two directional lights of the real-time frame)."""
+    width, height = desc.size
+    sensor = {
+        "type": "perspective", "fov": float(desc.fov_y_deg), "fov_axis": "y",
+        "near_clip": float(desc.near_m), "far_clip": float(desc.far_m),
+        "to_world": mi.ScalarTransform4f().look_at(origin=[float(v) for v in desc.camera_position],
+                                                   target=[float(v) for v in desc.camera_target],
+                                                   up=[0.0, 1.0, 0.0]),
+        "film": {"type": "hdrfilm", "width": width, "height": height, "pixel_format": "rgb",
+                 "rfilter": {"type": "box"}},
+        "sampler": {"type": "independent"},
+    }
+    scene = {"type": "scene", "sensor": sensor,
+             "integrator": integrator or {"type": "volpath", "max_depth": int(max_depth),
+                                          "rr_depth": 5}}
+    positions, normals, uvs, _tangents, indices = desc.curtain
+    props = mi.Properties()
+    fabric = dict(desc.fabric)
+    if mi.is_spectral:  # the dye per wavelength (visible range of the grid), not per channel
+        from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
+
+        visible = (GRID_NM >= 360) & (GRID_NM <= 830)
+        fabric["dye_spectrum"] = (GRID_NM[visible], desc.inputs.dye_transmittance[visible])
+    props["bsdf"] = mi.load_dict(woven_bsdf_dict(fabric, desc.pattern))
+    scene["curtain"] = _mesh(mi, "curtain", positions, indices, normals, uvs, props)
+    if room:
+        tris = desc.room_positions.reshape(-1, 3)
+        room_props = mi.Properties()
+        room_props["bsdf"] = mi.load_dict({"type": "diffuse", "reflectance": {
+            "type": "rgb", "value": [desc.room_albedo] * 3}})
+        scene["room"] = _mesh(mi, "room", tris, np.arange(tris.shape[0]).reshape(-1, 3),
+                              props=room_props)
+    if environment:
+        env = environment_map(desc.sky_rgb, desc.ground_rgb,
+                              np.zeros(3) if key_as_directional else desc.key_rgb,
+                              desc.key_to_light, desc.key_radius_rad, sky=desc.sky)
+        scene["environment"] = {"type": "envmap", "bitmap": mi.Bitmap(env)}
+    if key_as_directional:
+        scene["key"] = {"type": "directional", "direction": [float(-v) for v in desc.key_to_light],
+                        "irradiance": {"type": "rgb", "value": [float(v) for v in desc.key_rgb]}}
+    if stand_ins:
+        scene["fill"] = {"type": "directional",
+                         "direction": [float(-v) for v in desc.fill_to_light],
+                         "irradiance": {"type": "rgb", "value": [float(v) for v in desc.fill_rgb]}}
+    loaded = mi.load_dict(scene)
+    if desc.fluorescence is None:
+        return loaded
+    emission = fluorescence_per_vertex(desc, loaded, mi)
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    tri = np.asarray(indices).reshape(-1, 3)
+    weights = emitter_sampling_weights(desc, emission)
+    if environment:
+        scene["environment"]["sampling_weight"] = weights["environment"]
+    for side, sign in (("front", 1.0), ("back", -1.0)):
+        shell_props = mi.Properties()
+        shell_props["bsdf"] = mi.load_dict({"type": "null"})
+        shell_props["emitter"] = mi.load_dict({"type": "area", "sampling_weight": weights["shell"],
+                                               "radiance": {"type": "mesh_attribute",
+                                                            "name": "vertex_fluorescence"}})
+        faces = tri if sign > 0 else tri[:, ::-1]
+        shell = _mesh(mi, f"fluorescence_{side}", p + sign * SHELL_OFFSET_M * n, faces,
+                      sign * n, None, shell_props)
+        shell.add_attribute("vertex_fluorescence", 3,
+                            np.ascontiguousarray(emission, dtype=np.float32).ravel())
+        scene[f"fluorescence_{side}"] = shell
+    return mi.load_dict(scene)
