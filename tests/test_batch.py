@@ -299,7 +299,9 @@ def test_resume_after_kill(tmp_path):
     for name in before:  # every file under a final name is a whole image
         buf = oiio.ImageBuf(str(out / name))
         assert buf.get_pixels(oiio.UINT8).shape == (32, 48, 3), name
-    (out / "lace-fwa" / ".lace-fwa__A__f0002__yaw0.part-x1y2.png").write_bytes(b"\x89PNG torn")
+    from catalog.core.atomic import TEMP_MARK
+    torn = f".lace-fwa__A__f0002__yaw0.png{TEMP_MARK}-{proc.pid}-x1y2.png"  # the killed run's
+    (out / "lace-fwa" / torn).write_bytes(b"\x89PNG torn")
     with open(out / "manifest.journal.jsonl", "a") as journal:
         journal.write('{"path": "lace-fwa/torn')  # a line cut by the kill
 
@@ -313,7 +315,7 @@ def test_resume_after_kill(tmp_path):
         assert (stat.st_ino, stat.st_mtime_ns, _sha(after[name])) == (inode, mtime, digest), name
     assert summary["rendered"] == total - len(before)
     assert summary["rendered"] + summary["kept"] + summary["skipped"] == total
-    assert not list(out.rglob("*.part-*")), "temporary files left behind"
+    assert not [p for p in out.rglob("*") if TEMP_MARK in p.name], "temporary files left behind"
     manifest = json.loads((out / "manifest.json").read_text())
     assert {r["path"]: r["sha256"] for r in manifest["images"]} == {
         name: _sha(p) for name, p in after.items()}

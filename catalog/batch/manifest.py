@@ -89,13 +89,12 @@ class Manifest:
                         continue  # a line torn by a crash: its image is checked again
 
     def _remove_parts(self) -> None:
-        """Temporary images a killed run left (``.<name>.part-XXXX.<ext>``)."""
-        from catalog.batch.worker import PART_MARK  # noqa: PLC0415
+        """Temporary images a killed run left (the output layer's ``.NAME.catalog-tmp-PID-*``
+        of a process that is gone), in the folder and each fabric's sub-folder."""
+        from catalog.core.atomic import remove_stale_temporaries  # noqa: PLC0415
 
-        for suffix in (".png", ".exr"):
-            for path in self.out_dir.glob(f"*/.*{PART_MARK}*{suffix}"):
-                with contextlib.suppress(FileNotFoundError):
-                    path.unlink()
+        for folder in [self.out_dir, *(p for p in self.out_dir.iterdir() if p.is_dir())]:
+            remove_stale_temporaries(folder)
 
     # ------------------------------------------------------------------ queries
     def is_done(self, image) -> bool:

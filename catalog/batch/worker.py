@@ -20,7 +20,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
-import tempfile
 import threading
 import time
 from pathlib import Path
@@ -32,7 +31,6 @@ from catalog.core.errors import CatalogError
 #: Metadata attribute holding the image's input key.
 KEY_ATTRIBUTE = "catalog:inputs"
 #: Temporary image files are called ``.<name>.part-XXXX.<ext>`` (removed on the next run).
-PART_MARK = ".part-"
 
 
 class RendererPool:
@@ -133,56 +131,14 @@ def file_sha256(path: Path) -> str:
 
 
 def write_durable(target: Path, pixels: np.ndarray, metadata: dict[str, str]) -> tuple[str, int]:
-    """Encode ``pixels`` into a temporary file beside ``target``, fsync it, rename it onto
-    ``target``, fsync the folder. Returns (sha256 of the file, its size in bytes)."""
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, name = tempfile.mkstemp(prefix=f".{target.stem}{PART_MARK}", suffix=target.suffix,
-                                dir=target.parent)
-    os.close(fd)
-    tmp = Path(name)
-    try:
-        encode_image(tmp, pixels, metadata)
-        with open(tmp, "rb") as handle:
-            os.fsync(handle.fileno())
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        digest, size = file_sha256(tmp), tmp.stat().st_size
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            tmp.unlink()
-        raise
-    folder = os.open(target.parent, os.O_RDONLY)
-    try:
-        os.fsync(folder)
-    finally:
-        os.close(folder)
-    return digest, size
+    """Write an image through the project's output layer (catalog.render.imagefile: a
+    temporary file beside ``target``, read back, ``fsync``, rename, the folder ``fsync``ed),
+    so a crash leaves the whole image or none under its name. Returns (sha256 of the file,
+    its size in bytes)."""
+    from catalog.render.imagefile import write_image  # noqa: PLC0415
 
-
-def encode_image(path: Path, pixels: np.ndarray, metadata: dict) -> None:
-    """(H, W, 3) pixels into ``path`` with OpenImageIO (float32 -> EXR, uint8 -> PNG, by the
-    suffix), in place: :func:`write_durable` gives it a temporary path."""
-    import OpenImageIO as oiio  # noqa: PLC0415
-
-    height, width, channels = pixels.shape
-    kind = oiio.FLOAT if pixels.dtype == np.float32 else oiio.UINT8
-    spec = oiio.ImageSpec(width, height, channels, kind)
-    spec.channelnames = ("R", "G", "B")
-    for key, value in metadata.items():
-        if key == "chromaticities":
-            spec.attribute(key, oiio.TypeDesc("float[8]"), tuple(value))
-        else:
-            spec.attribute(key, str(value))
-    output = oiio.ImageOutput.create(str(path))
-    if output is None:
-        raise CatalogError(f"cannot write {path}: {oiio.geterror()}")
-    ok = output.open(str(path), spec) and output.write_image(np.ascontiguousarray(pixels))
-    error = output.geterror()
-    output.close()
-    if not ok:
-        raise CatalogError(f"cannot write {path}: {error}")
+    write_image(target, pixels, metadata)
+    return file_sha256(target), target.stat().st_size
 
 
 def existing_key(path: Path) -> str | None:

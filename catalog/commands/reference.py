@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+INPUT_FILES = ("fabric",)
+OUTPUT_FILES = ("out",)
 HELP = "path-trace the snapshot scene (Mitsuba 3 on the CPU) to a linear EXR: the reference"
 
 

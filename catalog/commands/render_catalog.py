@@ -8,6 +8,8 @@ finished; a re-run renders only what is missing.
 
 from __future__ import annotations
 
+#: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
+OUTPUT_FOLDERS = ("out",)
 HELP = "render a whole catalog (fabrics x lights x frames x yaws) with a resumable manifest"
 #: Exit status when some fabrics failed and the rest finished.
 EXIT_PARTIAL = 3
