@@ -77,6 +77,7 @@ def test_exr_opens_in_ocio_with_a_standard_view(gl, tmp_path):
     assert 0.1 < pixels.mean() < 0.9
 
 
+@pytest.mark.slow
 def test_sheet_grid_is_labelled(tmp_path):
     out = tmp_path / "sheet"
     result = _run("sheet", "--lights", "D65,UV-A", "--fabrics", "lace-fwa,net-grey",

@@ -211,6 +211,7 @@ def test_far_limit_equals_the_unpatterned_cloth(gl, name):
 
 # --- the white fabrics told apart ---------------------------------------------------------
 
+@pytest.mark.slow
 def test_white_fabrics_differ_pairwise_at_the_default_view(gl):
     """``catalog snapshot`` of each white fabric (its settled drape, D65, the default view,
     256x144): every pair differs by a mean per-pixel Delta E 2000 >= 3 over the pixels that

@@ -209,6 +209,7 @@ def test_viewer_imports_no_scipy_by_its_first_frame(stats_run):
     assert heavy["scipy"] is False, f"the viewer imported scipy by its first frame ({loaded})"
 
 
+@pytest.mark.slow
 def test_split_screen_shows_two_fabrics(xdisplay, tmp_path):
     """--compare: left and right halves show the two fabrics under the same light."""
     _need_presets(LACE, DYED)

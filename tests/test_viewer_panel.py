@@ -42,6 +42,7 @@ def panel_runs(xdisplay, tmp_path_factory):
     return runs
 
 
+@pytest.mark.slow
 def test_thumbnails_differ_between_fabrics_and_change_with_the_light(panel_runs):
     d65, _ = panel_runs["D65"]
     uva, _ = panel_runs["UV-A"]
