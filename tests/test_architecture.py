@@ -19,9 +19,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "catalog"
 ONLY = {
     "core": {"core"},
     "gl": {"gl", "core"},
-    # optics.bispectral.bands writes a preset from fitted bands (lazily, for tests and the
-    # bench): presets is a leaf that imports only core, so this makes no cycle of rooms
-    "optics": {"optics", "core", "presets"},
+    "optics": {"optics", "core"},
     "presets": {"presets", "core", "optics"},
 }
 
@@ -35,9 +33,9 @@ FORBIDDEN = [
     ("presets", "render"), ("presets", "viewer"),
     ("render", "pathtrace"), ("viewer", "pathtrace"),               # Mitsuba stays out of frames
 ]
-#: Module pairs that still import each other (lazily, inside one room), to be untied: the
-#: environment map loader writes images with snapshot's writer, which snapshot's scene uses.
-KNOWN_CYCLES = {("catalog.render.environment", "catalog.render.snapshot")}
+#: Module pairs allowed to import each other (none: image writing lives in render.imagefile,
+#: which both the snapshot and the environment tool use).
+KNOWN_CYCLES: set[tuple[str, str]] = set()
 #: Only these rooms may import the benchmarks (and bench itself).
 BENCH_IMPORTERS = {"bench", "commands"}
 
