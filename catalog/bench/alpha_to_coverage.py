@@ -92,7 +92,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     result = run()
     print(markdown_tables(result)["a2c_layers"])
-    args.json_out.write_text(json.dumps(result, indent=1) + "\n")
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    write_text_atomic(args.json_out, json.dumps(result, indent=1) + "\n")
     print(f"wrote {args.json_out}")
     return 0
 

@@ -248,7 +248,9 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default=str(PROJECT_ROOT / "benchmarks" / "bench_batch.json"))
     args = parser.parse_args(argv)
     result = run(args.quick, args.size, args.repeats, args.per_image_all)
-    Path(args.out).write_text(json.dumps(result, indent=1) + "\n")
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    write_text_atomic(args.out, json.dumps(result, indent=1) + "\n")
     for table in markdown_tables(result).values():
         print(table + "\n")
     return 0

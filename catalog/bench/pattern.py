@@ -200,7 +200,9 @@ def main(argv=None) -> int:
     result = run(quick=args.quick, repeats=args.repeats)
     for table in markdown_tables(result).values():
         print(table + "\n")
-    args.json_out.write_text(json.dumps(result, indent=1) + "\n")
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    write_text_atomic(args.json_out, json.dumps(result, indent=1) + "\n")
     print(f"wrote {args.json_out}")
     return 0
 

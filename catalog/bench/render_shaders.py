@@ -229,7 +229,9 @@ def main(argv=None) -> int:
         print(f"\n{'light|fluorescence|bands':<28} {'mean dE00':>10} {'max dE00':>10}")
         for key, (mean, worst) in errors.items():
             print(f"{key:<28} {mean:10.4f} {worst:10.4f}")
-    Path(args.json).write_text(json.dumps(result, indent=1))
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    write_text_atomic(args.json, json.dumps(result, indent=1))
     print(f"wrote {args.json}")
     renderer.release()
     return 0

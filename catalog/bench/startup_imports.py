@@ -79,7 +79,9 @@ def main(argv: list[str] | None = None) -> int:
     result = {"benchmark": "startup", "repeats": repeats, "rows": rows, "imports": imports}
     if args.json_out:
         args.json_out.parent.mkdir(parents=True, exist_ok=True)
-        args.json_out.write_text(json.dumps(result, indent=2) + "\n")
+        from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+        write_text_atomic(args.json_out, json.dumps(result, indent=2) + "\n")
     return 0
 
 

@@ -155,7 +155,9 @@ def main(argv: list[str] | None = None) -> int:
               "frames": args.frames, "warmup": args.warmup, "fabric": args.fabric,
               "light": args.light, "rows": rows}
     args.json_out.parent.mkdir(parents=True, exist_ok=True)
-    args.json_out.write_text(json.dumps(report, indent=2) + "\n")
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    write_text_atomic(args.json_out, json.dumps(report, indent=2) + "\n")
     print(f"wrote {args.json_out}")
     return 0
 
@@ -205,7 +207,9 @@ def main_before_after(args) -> int:
               "before": args.before, "rounds": args.rounds, "frames": args.frames,
               "warmup": args.warmup, "fabric": args.fabric, "light": args.light, "rows": rows}
     args.json_out.parent.mkdir(parents=True, exist_ok=True)
-    args.json_out.write_text(json.dumps(report, indent=2) + "\n")
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    write_text_atomic(args.json_out, json.dumps(report, indent=2) + "\n")
     print(f"wrote {args.json_out}")
     return 0
 
