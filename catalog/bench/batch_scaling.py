@@ -214,7 +214,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
              "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for row in result["rows"]:
         name = row["engine"]
-        if name == "process-per-image":
+        if name == "process-per-image" and row["sampled_images"] < row["images"]:
             name += f" ({row['sampled_images']} run, scaled)"
         lines.append(f"| {name} | {row['wall_s']:.1f} | {row['images_per_s']:.2f} | "
                      f"{row['speedup_vs_dask_1']:.2f} | {row['cpu_s_per_image']:.3f} | "
