@@ -833,7 +833,7 @@ class FrameRenderer:
         """The clear-sky model for a sun above the horizon (catalog/optics/sun/sky.py), else None."""
         if not (self.sky_model and self._is_sun and inputs.key_to_light[1] > 1e-3):
             return None
-        key = self._inputs_key
+        key = (self._inputs_key, self.n_bands)
         if getattr(self, "_sky_key", None) != key:
             from catalog.optics.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
             from catalog.optics.sun.sky import HAZE_RAD  # noqa: PLC0415
@@ -848,8 +848,25 @@ class FrameRenderer:
                 "u_haze_rad": HAZE_RAD,
                 "u_ground_rgb": tuple(float(v) for v in model.ground_rgb),
             }
+            if self.n_bands != 3:
+                self._sky_value.update(self._sky_band_values(inputs))
             self._sky_key = key
         return self._sky_value
+
+    def spectral_sky_for(self, inputs):
+        """The sky of :meth:`sky_model_for` per wavelength (catalog/optics/sun/sky.py SpectralSky)."""
+        from catalog.optics.sun.sky import spectral_sky  # noqa: PLC0415
+
+        return spectral_sky(inputs.key_to_light, math.pi * inputs.sky_radiance, inputs.ground_radiance)
+
+    def _sky_band_values(self, inputs) -> dict:
+        """SKY_BANDS' uniforms: the sky and the ground integrated over the renderer's bands (the
+        key light's band weights and display matrix, as the curtain's own terms)."""
+        weights, to_rgb = band_lib.band_weights(self.n_bands, inputs.key_irradiance)
+        colours = self.spectral_sky_for(inputs).band_colours(weights, to_rgb)
+        return {"u_sky_basis_rgb": np.asarray(colours["basis_rgb"], dtype="f4"),
+                "u_sky_basis_luminance": tuple(float(v) for v in colours["basis_luminance"]),
+                "u_ground_rgb": tuple(float(v) for v in colours["ground_rgb"])}
 
     def environment_scale(self, inputs) -> float:
         """The environment image's factor: its upper hemisphere's horizontal illuminance made
@@ -863,6 +880,7 @@ class FrameRenderer:
         sky = None if self.environment is not None else self._sky(inputs)
         program = self._program("fullscreen.vert", "background.frag",
                                 {"SKY_MODEL": sky is not None,
+                                 "SKY_BANDS": sky is not None and self.n_bands != 3,
                                  "ENVIRONMENT": self.environment is not None})
         self._scene_uniforms(program, view_proj, inputs, camera_position)
         if self.environment is not None:
