@@ -332,7 +332,8 @@ ES_VARIANTS = [
     ("room.frag", {"ROOM_LIGHTING": True}), ("room.frag", {}),
     ("room_shadow.vert", {"HAS_UV": True}), ("room_shadow.frag", {}),
     ("room_lightmap.frag", {}), ("room_bounce.frag", {}),
-    ("background.frag", {"SKY_MODEL": True}), ("background.frag", {"ENVIRONMENT": True}),
+    ("background.frag", {"SKY_MODEL": True}),
+    ("background.frag", {"SKY_MODEL": True, "SKY_BANDS": True}), ("background.frag", {"ENVIRONMENT": True}),
     ("background.frag", {}),
     ("bloom_down.frag", {}), ("bloom_glow.frag", {"BLOOM_LEVELS": 6}), ("bloom.frag", {}),
 ]
