@@ -24,7 +24,7 @@ uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to th
 #ifdef OIT
 uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
-#ifdef GBUFFER
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
 INTERPOLATION in vec3 v_position;
 #endif
 
@@ -80,8 +80,21 @@ layout(location = 3) out vec4 out_tangent;
 // sky above / ground below the horizon and the sun's disc outside, the room inside:
 // LD (room + outside (ground - room + above (sky - ground + disc sun_disc))), disc = 1 - the
 // rim's smoothstep (exactly 0 off the disc: the disc's huge radiance must not be cancelled).
+#ifdef N_ROOM_LAMPS
+// Lamps in the room (issue 13; isotropic points, eq. 8's lobes with the lamp as the light):
+// position (m) and intensity x dye per band (irradiance at 1 m), chunk k of lamp j at j NV4 + k.
+uniform vec3 u_room_lamp_position[N_ROOM_LAMPS];
+uniform vec4 u_room_lamp_dyed[N_ROOM_LAMPS * NV4];
+float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set in main)
+#endif
+
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
     vec4 band = g_key * u_key_dyed[k] + g_fill * u_fill_dyed[k];
+#ifdef N_ROOM_LAMPS
+    for (int j = 0; j < N_ROOM_LAMPS; ++j) {
+        band += g_room_lamp[j] * u_room_lamp_dyed[j * NV4 + k];
+    }
+#endif
     vec4 constant = u_ambient[k];
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
@@ -145,6 +158,21 @@ void main() {
     float g_key = key.x / key.y;
     float g_fill = fill.x / fill.y;
     float effective = fluorescence_effective_photons(absorbed, u_inv_saturation);
+#endif
+#ifdef N_ROOM_LAMPS
+    for (int j = 0; j < N_ROOM_LAMPS; ++j) {
+        vec3 d = u_room_lamp_position[j] - v_position;
+        float r2 = dot(d, d);
+        vec3 to_lamp = d * inversesqrt(r2);
+#ifdef ANISOTROPIC
+        float tan_lamp = dot(v_tangent, to_lamp);
+#else
+        float tan_lamp = 0.0;
+#endif
+        vec2 g = woven_transmission_ratio(to_lamp, dot(n, to_lamp), tan_lamp, view,
+                                          u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
+        g_room_lamp[j] = g.x / (g.y * r2);
+    }
 #endif
     vec3 bg = vec3(0.0);   // outside, above, sun disc
 #ifdef SEE_THROUGH

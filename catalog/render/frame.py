@@ -601,6 +601,8 @@ class FrameRenderer:
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
                    "GBUFFER": gbuffer, "SPECIALISED": self.specialise,
                    "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
+        if self.room_lamps:
+            defines["N_ROOM_LAMPS"] = len(self.room_lamps)   # the lamps light the cloth too
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -623,6 +625,24 @@ class FrameRenderer:
         for name, value in self._band_uniforms().items():
             values[name] = tuple(float(v) for v in value) if isinstance(value, tuple) else value
         return values
+
+    def room_lamp_values(self) -> dict:
+        """ROOM_LAMPS' uniforms: each lamp's position (m) and its intensity (irradiance at 1 m,
+        isotropic) times the dye, in the renderer's bands (the key light's band weights)."""
+        key = (self._inputs_key, self.n_bands,
+               tuple((light.name, position) for light, position in self.room_lamps))
+        if getattr(self, "_lamp_values_key", None) != key:
+            inputs = self.shading_inputs()
+            weights, _ = band_lib.band_weights(self.n_bands, inputs.key_irradiance)
+            nv4 = band_lib.chunks(self.n_bands)
+            dyed = np.zeros((len(self.room_lamps), 4 * nv4), dtype="f4")
+            for j, (light, _position) in enumerate(self.room_lamps):
+                dyed[j, :self.n_bands] = weights @ (light.irradiance_w_m2_nm * inputs.dye_transmittance)
+            self._lamp_values = {
+                "u_room_lamp_position": np.asarray([p for _l, p in self.room_lamps], dtype="f4"),
+                "u_room_lamp_dyed": dyed.reshape(-1, 4)}
+            self._lamp_values_key = key
+        return self._lamp_values
 
     def _curtain_program(self, gbuffer: bool, overrides: dict | None = None):
         defines = self.variant_defines(gbuffer)
@@ -803,6 +823,9 @@ class FrameRenderer:
                 self._set(program, "u_oit_depth_ref", self.oit_depth_reference_m())
             if not self.specialise:
                 for name, value in self._scene_values_with(overrides).items():
+                    self._set(program, name, value)
+            if self.room_lamps:
+                for name, value in self.room_lamp_values().items():
                     self._set(program, name, value)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
