@@ -59,9 +59,7 @@ uniform sampler2D u_environment;  // latitude-longitude, v = 0 at the nadir, u =
 uniform float u_environment_scale;
 
 vec3 environment_radiance(vec3 dir) {
-    float u = atan(dir.x, -dir.z) / (2.0 * PI) + 0.5;
-    float v = acos(clamp(-dir.y, -1.0, 1.0)) / PI;
-    return u_environment_scale * textureLod(u_environment, vec2(u, v), 0.0).rgb;
+    return environment_lookup(u_environment, u_environment_scale, dir);
 }
 #endif
 

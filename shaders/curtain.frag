@@ -80,6 +80,14 @@ layout(location = 3) out vec4 out_tangent;
 // sky above / ground below the horizon and the sun's disc outside, the room inside:
 // LD (room + outside (ground - room + above (sky - ground + disc sun_disc))), disc = 1 - the
 // rim's smoothstep (exactly 0 off the disc: the disc's huge radiance must not be cancelled).
+#ifdef CURTAIN_ENVIRONMENT
+// --environment with the flat cloth's see-through (issue 13): LD times the image where the ray
+// leaves through the window (the sky and ground band terms dropped; the image is RGB, a sum,
+// so it is added after the bands' display conversion, exact in any basis).
+uniform sampler2D u_environment;
+uniform float u_environment_scale;
+#endif
+
 #ifdef N_ROOM_LAMPS
 // Lamps in the room (issue 13; isotropic points, eq. 8's lobes with the lamp as the light):
 // position (m) and intensity x dye per band (irradiance at 1 m), chunk k of lamp j at j NV4 + k.
@@ -99,7 +107,11 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
 #endif
-#ifdef SEE_THROUGH
+#if defined(SEE_THROUGH) && defined(CURTAIN_ENVIRONMENT)
+    vec4 outside = bg.y * bg.z * (u_direct * u_sun_disc[k]) - u_direct * u_room[k];
+    band += bg.x * outside;
+    constant += u_direct * u_room[k];
+#elif defined(SEE_THROUGH)
     vec4 outside = bg.y * (u_direct * (u_sky[k] - u_ground[k]) + bg.z * (u_direct * u_sun_disc[k]))
                  + u_direct * (u_ground[k] - u_room[k]);
     band += bg.x * outside;
@@ -188,6 +200,9 @@ void main() {
 #endif
 #if NV4 > 3
     rgb += shade_chunk(3, g_key, g_fill, bg, effective);
+#endif
+#if defined(SEE_THROUGH) && defined(CURTAIN_ENVIRONMENT)
+    rgb += (bg.x * u_direct) * environment_lookup(u_environment, u_environment_scale, ray);
 #endif
 #ifdef PATTERN
     // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole

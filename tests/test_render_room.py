@@ -339,6 +339,8 @@ ES_VARIANTS = [
     ("curtain.vert", {"N_ROOM_LAMPS": 2}),
     ("curtain.frag", {"N_BANDS": 16, "NV4": 4, "FLUORESCENCE_PHYSICAL": True, "SEE_THROUGH": True,
                       "ANISOTROPIC": True, "N_ROOM_LAMPS": 2}),
+    ("curtain.frag", {"N_BANDS": 3, "NV4": 1, "FLUORESCENCE_PAPER": True, "SEE_THROUGH": True,
+                      "CURTAIN_ENVIRONMENT": True}),
 ]
 
 

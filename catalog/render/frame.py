@@ -72,6 +72,8 @@ SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "swrast", "lavapipe", "swiftshad
 MAX_SPECIALISED = 8
 #: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
 PATTERN_UNIT = 3
+#: Texture unit of the environment image (background and the curtain's see-through).
+ENVIRONMENT_UNIT = 5
 PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
@@ -601,6 +603,8 @@ class FrameRenderer:
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
                    "GBUFFER": gbuffer, "SPECIALISED": self.specialise,
                    "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
+        if self.environment is not None and defines["SEE_THROUGH"]:
+            defines["CURTAIN_ENVIRONMENT"] = True  # the see-through shows the image
         if self.room_lamps:
             defines["N_ROOM_LAMPS"] = len(self.room_lamps)   # the lamps light the cloth too
         if self.antialiasing == "msaa" and not gbuffer:
@@ -827,6 +831,10 @@ class FrameRenderer:
             if self.room_lamps:
                 for name, value in self.room_lamp_values().items():
                     self._set(program, name, value)
+            if "u_environment" in program:
+                self.environment[1].use(location=ENVIRONMENT_UNIT)
+                self._set(program, "u_environment", ENVIRONMENT_UNIT)
+                self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
 
@@ -907,8 +915,8 @@ class FrameRenderer:
                                  "ENVIRONMENT": self.environment is not None})
         self._scene_uniforms(program, view_proj, inputs, camera_position)
         if self.environment is not None:
-            self.environment[1].use(location=5)
-            self._set(program, "u_environment", 5)
+            self.environment[1].use(location=ENVIRONMENT_UNIT)
+            self._set(program, "u_environment", ENVIRONMENT_UNIT)
             self._set(program, "u_environment_scale", self.environment_scale(inputs))
         self._set(program, "u_inverse_view_proj", gl_bytes(np.linalg.inv(view_proj)))
         colours = self._display_colours(inputs)
