@@ -240,6 +240,14 @@ float room_window_beam(vec3 p, vec3 to_light, vec4 opening, vec2 wall_z, float t
 }
 
 
+// ---- An environment image (issue 13): latitude-longitude, v = 0 at the nadir, u = 0 towards
+// -z (catalog/render/environment.py); the radiance towards dir, times its scale to the sky.
+vec3 environment_lookup(sampler2D image, float scale, vec3 dir) {
+    float u = atan(dir.x, -dir.z) / (2.0 * PI) + 0.5;
+    float v = acos(clamp(-dir.y, -1.0, 1.0)) / PI;
+    return scale * textureLod(image, vec2(u, v), 0.0).rgb;
+}
+
 // ---- The clear sky (issue 13; catalog/sky.py is the float64 twin). Preetham, Shirley & Smits
 // 1999, the Perez et al. 1993 function F(theta, gamma) = (1 + A e^(B / cos theta))
 // (1 + C e^(D gamma) + E cos^2 gamma) for x, y and Y at once (columns of the coefficients).

@@ -24,7 +24,7 @@ uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to th
 #ifdef OIT
 uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
-#ifdef GBUFFER
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
 INTERPOLATION in vec3 v_position;
 #endif
 
@@ -80,13 +80,38 @@ layout(location = 3) out vec4 out_tangent;
 // sky above / ground below the horizon and the sun's disc outside, the room inside:
 // LD (room + outside (ground - room + above (sky - ground + disc sun_disc))), disc = 1 - the
 // rim's smoothstep (exactly 0 off the disc: the disc's huge radiance must not be cancelled).
+#ifdef CURTAIN_ENVIRONMENT
+// --environment with the flat cloth's see-through (issue 13): LD times the image where the ray
+// leaves through the window (the sky and ground band terms dropped; the image is RGB, a sum,
+// so it is added after the bands' display conversion, exact in any basis).
+uniform sampler2D u_environment;
+uniform float u_environment_scale;
+#endif
+
+#ifdef N_ROOM_LAMPS
+// Lamps in the room (issue 13; isotropic points, eq. 8's lobes with the lamp as the light):
+// position (m) and intensity x dye per band (irradiance at 1 m), chunk k of lamp j at j NV4 + k.
+uniform vec3 u_room_lamp_position[N_ROOM_LAMPS];
+uniform vec4 u_room_lamp_dyed[N_ROOM_LAMPS * NV4];
+float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set in main)
+#endif
+
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
     vec4 band = g_key * u_key_dyed[k] + g_fill * u_fill_dyed[k];
+#ifdef N_ROOM_LAMPS
+    for (int j = 0; j < N_ROOM_LAMPS; ++j) {
+        band += g_room_lamp[j] * u_room_lamp_dyed[j * NV4 + k];
+    }
+#endif
     vec4 constant = u_ambient[k];
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
 #endif
-#ifdef SEE_THROUGH
+#if defined(SEE_THROUGH) && defined(CURTAIN_ENVIRONMENT)
+    vec4 outside = bg.y * bg.z * (u_direct * u_sun_disc[k]) - u_direct * u_room[k];
+    band += bg.x * outside;
+    constant += u_direct * u_room[k];
+#elif defined(SEE_THROUGH)
     vec4 outside = bg.y * (u_direct * (u_sky[k] - u_ground[k]) + bg.z * (u_direct * u_sun_disc[k]))
                  + u_direct * (u_ground[k] - u_room[k]);
     band += bg.x * outside;
@@ -146,6 +171,21 @@ void main() {
     float g_fill = fill.x / fill.y;
     float effective = fluorescence_effective_photons(absorbed, u_inv_saturation);
 #endif
+#ifdef N_ROOM_LAMPS
+    for (int j = 0; j < N_ROOM_LAMPS; ++j) {
+        vec3 d = u_room_lamp_position[j] - v_position;
+        float r2 = dot(d, d);
+        vec3 to_lamp = d * inversesqrt(r2);
+#ifdef ANISOTROPIC
+        float tan_lamp = dot(v_tangent, to_lamp);
+#else
+        float tan_lamp = 0.0;
+#endif
+        vec2 g = woven_transmission_ratio(to_lamp, dot(n, to_lamp), tan_lamp, view,
+                                          u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
+        g_room_lamp[j] = g.x / (g.y * r2);
+    }
+#endif
     vec3 bg = vec3(0.0);   // outside, above, sun disc
 #ifdef SEE_THROUGH
     bg = background_terms(ray, u_sun_direction, u_sun_chord2.x, u_sun_chord2.y);
@@ -160,6 +200,9 @@ void main() {
 #endif
 #if NV4 > 3
     rgb += shade_chunk(3, g_key, g_fill, bg, effective);
+#endif
+#if defined(SEE_THROUGH) && defined(CURTAIN_ENVIRONMENT)
+    rgb += (bg.x * u_direct) * environment_lookup(u_environment, u_environment_scale, ray);
 #endif
 #ifdef PATTERN
     // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole

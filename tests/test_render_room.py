@@ -332,9 +332,15 @@ ES_VARIANTS = [
     ("room.frag", {"ROOM_LIGHTING": True}), ("room.frag", {}),
     ("room_shadow.vert", {"HAS_UV": True}), ("room_shadow.frag", {}),
     ("room_lightmap.frag", {}), ("room_bounce.frag", {}),
-    ("background.frag", {"SKY_MODEL": True}), ("background.frag", {"ENVIRONMENT": True}),
+    ("background.frag", {"SKY_MODEL": True}),
+    ("background.frag", {"SKY_MODEL": True, "SKY_BANDS": True}), ("background.frag", {"ENVIRONMENT": True}),
     ("background.frag", {}),
     ("bloom_down.frag", {}), ("bloom_glow.frag", {"BLOOM_LEVELS": 6}), ("bloom.frag", {}),
+    ("curtain.vert", {"N_ROOM_LAMPS": 2}),
+    ("curtain.frag", {"N_BANDS": 16, "NV4": 4, "FLUORESCENCE_PHYSICAL": True, "SEE_THROUGH": True,
+                      "ANISOTROPIC": True, "N_ROOM_LAMPS": 2}),
+    ("curtain.frag", {"N_BANDS": 3, "NV4": 1, "FLUORESCENCE_PAPER": True, "SEE_THROUGH": True,
+                      "CURTAIN_ENVIRONMENT": True}),
 ]
 
 
@@ -357,3 +363,49 @@ def test_room_shaders_compile_as_glsl_es_300(tmp_path, name, defines):
                                *lines[1:]]) + "\n")
     result = subprocess.run([validator, str(path)], capture_output=True, text=True)
     assert result.returncode == 0, f"{name} {defines}: {result.stdout}"
+
+
+@pytest.mark.parametrize("n_bands", [3, 16])
+def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
+    """A lamp in the room (A, isotropic, 1.5 m above the floor's centre) adds to every curtain
+    pixel seen from the room eq. 8 with the lamp as the light: the band values of
+    I(l) x dye(l) times G(to_lamp, view) / r^2 (catalog.optics.shading_reference.
+    woven_transmission, float64, at the G-buffer's own positions and normals), shown through
+    the bands' display matrix; read back within 1 % (float32) where the added radiance is
+    above 1 % of its largest value. Without the lamp term the added radiance would be 0."""
+    from catalog.optics.shading_reference import woven_transmission
+    from catalog.render import bands as band_lib
+
+    r = _renderer(gl)
+    r.set_bands(n_bands)
+    r.set_curtain_open(False)
+    before = r.render_gbuffer()
+    faces = room_light.room_faces()
+    floor = faces[0]
+    centre = floor.origin + 0.5 * floor.axis_s + 0.5 * floor.axis_t
+    lamp = np.array([centre[0], centre[1] + 1.5, centre[2]])
+    r.set_room_lamps([("A", tuple(float(v) for v in lamp))])
+    after = r.render_gbuffer()
+    mask = before["mask"] & after["mask"]
+    assert mask.sum() > 500
+    inputs = r.shading_inputs()
+    p = after["position"][mask].astype(np.float64)
+    n = after["normal"][mask].astype(np.float64)
+    t = after["tangent"][mask].astype(np.float64)
+    b = np.cross(n, t)
+    d = lamp - p
+    r2 = np.einsum("ij,ij->i", d, d)
+    to_lamp = d / np.sqrt(r2)[:, None]
+    eye = np.asarray(r.camera.position, dtype=np.float64)
+    to_viewer = (eye - p) / np.linalg.norm(eye - p, axis=-1, keepdims=True)
+    g = np.array([woven_transmission(to_lamp[i], to_viewer[i], t[i], b[i], n[i], inputs)
+                  for i in range(len(p))]) / r2
+    weights, to_rgb = band_lib.band_weights(n_bands, inputs.key_irradiance)
+    lamp_rgb = to_rgb @ (weights @ (r.room_lamps[0][0].irradiance_w_m2_nm * inputs.dye_transmittance))
+    expected = g[:, None] * lamp_rgb
+    added = (after["radiance"][mask] - before["radiance"][mask]).astype(np.float64)
+    big = expected.sum(-1) > 0.01 * expected.sum(-1).max()
+    assert big.sum() > 0.5 * mask.sum()
+    assert np.all(added.sum(-1) > 0.0)
+    assert np.allclose(added[big], expected[big], rtol=1e-2, atol=1e-3 * expected.max())
+    r.release()

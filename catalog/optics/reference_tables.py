@@ -3,7 +3,7 @@
 ``import colour`` takes seconds and pulls in scipy; ``import pvlib`` pulls in pandas. The
 renderer and the viewer need only a few of their tables (the CIE 1931 2 deg CMFs, the CIE
 illuminants, the sRGB matrix, ASTM G173's extraterrestrial spectrum, Bird & Riordan's ozone
-coefficients), so ``tools/make_reference_tables.py`` copies them once, by program, from the
+coefficients, the CIE daylight basis S0 S1 S2), so ``tools/make_reference_tables.py`` copies them once, by program, from the
 installed packages into ``catalog/optics/data/reference_tables.npz``. Nothing is typed in by hand,
 and ``tests/test_reference_tables.py`` regenerates the file from the packages and checks it
 is identical, so the cache cannot drift from its sources.
@@ -36,6 +36,7 @@ def build_tables() -> dict[str, np.ndarray]:
         value_parts.append(np.asarray(sd.values, dtype=np.float64))
         offsets.append(offsets[-1] + len(wl_parts[-1]))
     space = colour.RGB_COLOURSPACES["sRGB"]
+    daylight = colour.colorimetry.SDS_BASIS_FUNCTIONS_CIE_ILLUMINANT_D_SERIES
     g173 = get_reference_spectra(standard="ASTM G173-03")
     spectrl2 = importlib.import_module("pvlib.spectrum.spectrl2")
     coeffs = spectrl2._SPECTRL2_COEFFS  # noqa: SLF001  (pvlib keeps the table module-private)
@@ -52,6 +53,9 @@ def build_tables() -> dict[str, np.ndarray]:
         "g173_extraterrestrial": np.asarray(g173["extraterrestrial"], dtype=np.float64),
         "ozone_wavelength_nm": np.asarray(coeffs["wavelength"], dtype=np.float64),
         "ozone_absorption_per_atm_cm": np.asarray(coeffs["ozone_absorption"], dtype=np.float64),
+        "daylight_wavelength_nm": np.asarray(daylight["S0"].wavelengths, dtype=np.float64),
+        "daylight_basis": np.stack([np.asarray(daylight[k].values, dtype=np.float64)
+                                    for k in ("S0", "S1", "S2")]),
     }
 
 
@@ -73,6 +77,12 @@ def cmfs_table() -> tuple[np.ndarray, np.ndarray]:
     """CIE 1931 2 deg colour-matching functions: wavelengths (nm) and (N, 3) xbar ybar zbar."""
     t = tables()
     return t["cmfs_wavelength_nm"], t["cmfs_values"]
+
+
+def daylight_basis_table() -> tuple[np.ndarray, np.ndarray]:
+    """The CIE D-series basis S0, S1, S2: wavelengths (nm) and (3, N) values."""
+    t = tables()
+    return t["daylight_wavelength_nm"], t["daylight_basis"]
 
 
 def illuminant_names() -> tuple[str, ...]:

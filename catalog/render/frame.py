@@ -72,6 +72,8 @@ SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "swrast", "lavapipe", "swiftshad
 MAX_SPECIALISED = 8
 #: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
 PATTERN_UNIT = 3
+#: Texture unit of the environment image (background and the curtain's see-through).
+ENVIRONMENT_UNIT = 5
 PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
@@ -601,6 +603,10 @@ class FrameRenderer:
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
                    "GBUFFER": gbuffer, "SPECIALISED": self.specialise,
                    "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
+        if self.environment is not None and defines["SEE_THROUGH"]:
+            defines["CURTAIN_ENVIRONMENT"] = True  # the see-through shows the image
+        if self.room_lamps:
+            defines["N_ROOM_LAMPS"] = len(self.room_lamps)   # the lamps light the cloth too
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -623,6 +629,24 @@ class FrameRenderer:
         for name, value in self._band_uniforms().items():
             values[name] = tuple(float(v) for v in value) if isinstance(value, tuple) else value
         return values
+
+    def room_lamp_values(self) -> dict:
+        """ROOM_LAMPS' uniforms: each lamp's position (m) and its intensity (irradiance at 1 m,
+        isotropic) times the dye, in the renderer's bands (the key light's band weights)."""
+        key = (self._inputs_key, self.n_bands,
+               tuple((light.name, position) for light, position in self.room_lamps))
+        if getattr(self, "_lamp_values_key", None) != key:
+            inputs = self.shading_inputs()
+            weights, _ = band_lib.band_weights(self.n_bands, inputs.key_irradiance)
+            nv4 = band_lib.chunks(self.n_bands)
+            dyed = np.zeros((len(self.room_lamps), 4 * nv4), dtype="f4")
+            for j, (light, _position) in enumerate(self.room_lamps):
+                dyed[j, :self.n_bands] = weights @ (light.irradiance_w_m2_nm * inputs.dye_transmittance)
+            self._lamp_values = {
+                "u_room_lamp_position": np.asarray([p for _l, p in self.room_lamps], dtype="f4"),
+                "u_room_lamp_dyed": dyed.reshape(-1, 4)}
+            self._lamp_values_key = key
+        return self._lamp_values
 
     def _curtain_program(self, gbuffer: bool, overrides: dict | None = None):
         defines = self.variant_defines(gbuffer)
@@ -804,6 +828,13 @@ class FrameRenderer:
             if not self.specialise:
                 for name, value in self._scene_values_with(overrides).items():
                     self._set(program, name, value)
+            if self.room_lamps:
+                for name, value in self.room_lamp_values().items():
+                    self._set(program, name, value)
+            if "u_environment" in program:
+                self.environment[1].use(location=ENVIRONMENT_UNIT)
+                self._set(program, "u_environment", ENVIRONMENT_UNIT)
+                self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
 
@@ -833,7 +864,7 @@ class FrameRenderer:
         """The clear-sky model for a sun above the horizon (catalog/optics/sun/sky.py), else None."""
         if not (self.sky_model and self._is_sun and inputs.key_to_light[1] > 1e-3):
             return None
-        key = self._inputs_key
+        key = (self._inputs_key, self.n_bands)
         if getattr(self, "_sky_key", None) != key:
             from catalog.optics.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
             from catalog.optics.sun.sky import HAZE_RAD  # noqa: PLC0415
@@ -848,8 +879,25 @@ class FrameRenderer:
                 "u_haze_rad": HAZE_RAD,
                 "u_ground_rgb": tuple(float(v) for v in model.ground_rgb),
             }
+            if self.n_bands != 3:
+                self._sky_value.update(self._sky_band_values(inputs))
             self._sky_key = key
         return self._sky_value
+
+    def spectral_sky_for(self, inputs):
+        """The sky of :meth:`sky_model_for` per wavelength (catalog/optics/sun/sky.py SpectralSky)."""
+        from catalog.optics.sun.sky import spectral_sky  # noqa: PLC0415
+
+        return spectral_sky(inputs.key_to_light, math.pi * inputs.sky_radiance, inputs.ground_radiance)
+
+    def _sky_band_values(self, inputs) -> dict:
+        """SKY_BANDS' uniforms: the sky and the ground integrated over the renderer's bands (the
+        key light's band weights and display matrix, as the curtain's own terms)."""
+        weights, to_rgb = band_lib.band_weights(self.n_bands, inputs.key_irradiance)
+        colours = self.spectral_sky_for(inputs).band_colours(weights, to_rgb)
+        return {"u_sky_basis_rgb": np.asarray(colours["basis_rgb"], dtype="f4"),
+                "u_sky_basis_luminance": tuple(float(v) for v in colours["basis_luminance"]),
+                "u_ground_rgb": tuple(float(v) for v in colours["ground_rgb"])}
 
     def environment_scale(self, inputs) -> float:
         """The environment image's factor: its upper hemisphere's horizontal illuminance made
@@ -863,11 +911,12 @@ class FrameRenderer:
         sky = None if self.environment is not None else self._sky(inputs)
         program = self._program("fullscreen.vert", "background.frag",
                                 {"SKY_MODEL": sky is not None,
+                                 "SKY_BANDS": sky is not None and self.n_bands != 3,
                                  "ENVIRONMENT": self.environment is not None})
         self._scene_uniforms(program, view_proj, inputs, camera_position)
         if self.environment is not None:
-            self.environment[1].use(location=5)
-            self._set(program, "u_environment", 5)
+            self.environment[1].use(location=ENVIRONMENT_UNIT)
+            self._set(program, "u_environment", ENVIRONMENT_UNIT)
             self._set(program, "u_environment_scale", self.environment_scale(inputs))
         self._set(program, "u_inverse_view_proj", gl_bytes(np.linalg.inv(view_proj)))
         colours = self._display_colours(inputs)

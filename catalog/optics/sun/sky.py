@@ -164,3 +164,103 @@ def sky_model(to_sun: np.ndarray, atmosphere=None, diffuse_horizontal=None,
     perez_sun = _perez(perez, math.cos(sun_zenith), sun_zenith)
     return SkyModel(turbidity, to_sun, perez, zenith_xyY(turbidity, sun_zenith), perez_sun,
                     scale, ground)
+
+
+# ---- The sky per band (issue 13): Preetham's spectral reconstruction -----------------------
+# The chromaticity x, y of a direction selects a CIE daylight spectrum S0 + M1 S1 + M2 S2
+# (Preetham et al. 1999, section 4 and appendix: the CIE D-series method for any x, y), scaled
+# to the luminance Y. A spectral factor s(l) then makes the sky's horizontal irradiance equal
+# the atmosphere's diffuse spectrum wavelength by wavelength (not only per display channel).
+# Because S is linear in (1, M1, M2), its integral against any band weight w_b(l) is the same
+# linear combination of three band vectors: the shader needs three colours, whatever N is.
+
+
+def daylight_m1_m2(x, y) -> tuple[np.ndarray, np.ndarray]:
+    """The CIE D-series weights M1, M2 of chromaticity x, y (CIE 15, eq. for S(l))."""
+    x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+    m = 0.0241 + 0.2562 * x - 0.7341 * y
+    return (-1.3515 - 1.7703 * x + 5.9114 * y) / m, (0.0300 - 31.4424 * x + 30.0717 * y) / m
+
+
+@functools.lru_cache(maxsize=1)
+def daylight_basis_on_grid() -> np.ndarray:
+    """(3, len(GRID_NM)): S0, S1, S2 interpolated (linearly) onto the project's grid."""
+    from catalog.optics.reference_tables import daylight_basis_table  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
+
+    wl, basis = daylight_basis_table()
+    out = np.stack([np.interp(GRID_NM, wl, b, left=0.0, right=0.0) for b in basis])
+    out.setflags(write=False)
+    return out
+
+
+def preetham_xyY(directions: np.ndarray, to_sun: np.ndarray, turbidity: float) -> np.ndarray:
+    """Preetham's x, y, Y (cd m^-2) for unit directions (..., 3), y up (clamped at the horizon)."""
+    to_sun = np.asarray(to_sun, dtype=np.float64) / np.linalg.norm(to_sun)
+    sun_zenith = math.acos(max(min(to_sun[1], 1.0), -1.0))
+    coefficients = perez_coefficients(turbidity)
+    d = np.asarray(directions, dtype=np.float64)
+    gamma = np.arccos(np.clip(d @ to_sun, -1.0, 1.0))
+    ratio = _perez(coefficients, d[..., 1], gamma) / _perez(coefficients, math.cos(sun_zenith), sun_zenith)
+    return zenith_xyY(turbidity, min(sun_zenith, math.pi / 2)) * ratio
+
+
+def preetham_spectral(directions: np.ndarray, to_sun: np.ndarray, turbidity: float) -> np.ndarray:
+    """Preetham's sky as spectral radiance (..., len(GRID_NM)) on the grid, luminance Y
+    (cd m^-2 scale: 683 sum ybar L dl = Y), unscaled (s(l) = 1)."""
+    from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
+    from catalog.optics.shading_reference import LUMINOUS_EFFICACY_LM_W, STEP_NM  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
+
+    xyy = preetham_xyY(directions, to_sun, turbidity)
+    m1, m2 = daylight_m1_m2(xyy[..., 0], xyy[..., 1])
+    s0, s1, s2 = daylight_basis_on_grid()
+    spectrum = s0 + m1[..., None] * s1 + m2[..., None] * s2
+    lum = LUMINOUS_EFFICACY_LM_W * STEP_NM * (spectrum @ cmfs(GRID_NM)[:, 1])
+    return spectrum * (xyy[..., 2] / lum)[..., None]
+
+
+@dataclass(frozen=True)
+class SpectralSky:
+    """The clear sky per wavelength: L(l, d) = s(l) Y(d) S(l; x(d), y(d)) / Y_S(x(d), y(d))."""
+
+    model: SkyModel
+    spectral_scale: np.ndarray     # s(l) on the grid
+    ground: np.ndarray             # the ground's spectral radiance
+
+    def radiance(self, directions: np.ndarray) -> np.ndarray:
+        """Spectral radiance (..., len(GRID_NM)), the hazy ground below the horizon (no seam)."""
+        d = np.asarray(directions, dtype=np.float64)
+        horizon = d.copy()
+        horizon[..., 1] = np.maximum(horizon[..., 1], 0.0)
+        horizon /= np.maximum(np.linalg.norm(horizon, axis=-1, keepdims=True), 1e-12)
+        sky = self.spectral_scale * preetham_spectral(horizon, self.model.to_sun, self.model.turbidity)
+        depression = np.arcsin(np.clip(-d[..., 1], 0.0, 1.0))
+        fade = np.exp(-depression / HAZE_RAD)[..., None]
+        return np.where(d[..., 1:2] >= 0.0, sky, fade * sky + (1.0 - fade) * self.ground)
+
+    def band_colours(self, weights: np.ndarray, band_to_rgb: np.ndarray) -> dict[str, np.ndarray]:
+        """What background.frag's SKY_BANDS needs for band weights (N, L) and a display matrix
+        (3, N): the display colours C_i = band_to_rgb (weights (s S_i)) of the three basis
+        spectra, the basis's luminances Y_i (so Y_S = Y0 + M1 Y1 + M2 Y2) and the ground's."""
+        from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
+        from catalog.optics.shading_reference import LUMINOUS_EFFICACY_LM_W, STEP_NM  # noqa: PLC0415
+        from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
+
+        basis = daylight_basis_on_grid()
+        colours = band_to_rgb @ (weights @ (self.spectral_scale * basis).T)   # (3, 3): columns C_i
+        lum = LUMINOUS_EFFICACY_LM_W * STEP_NM * (basis @ cmfs(GRID_NM)[:, 1])
+        return {"basis_rgb": colours.T, "basis_luminance": lum,
+                "ground_rgb": band_to_rgb @ (weights @ self.ground)}
+
+
+def spectral_sky(to_sun: np.ndarray, diffuse_horizontal: np.ndarray, ground_radiance: np.ndarray,
+                 atmosphere=None, n_theta: int = 48) -> SpectralSky:
+    """The sky of :func:`sky_model` per wavelength: s(l) makes its horizontal irradiance
+    ``diffuse_horizontal`` (W m^-2 nm^-1 on the grid) at every wavelength."""
+    model = sky_model(to_sun, atmosphere, diffuse_horizontal, ground_radiance)
+    target = np.asarray(diffuse_horizontal, dtype=np.float64)
+    unscaled = horizontal_irradiance_rgb(lambda d: preetham_spectral(d, model.to_sun, model.turbidity),
+                                         n_theta=n_theta)
+    scale = np.where(unscaled > 0, target / np.where(unscaled > 0, unscaled, 1.0), 0.0)
+    return SpectralSky(model, scale, np.asarray(ground_radiance, dtype=np.float64))
