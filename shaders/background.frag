@@ -1,8 +1,8 @@
 #version 430
 // The background: what a camera ray sees behind everything else (the outside through the
 // window: sky, ground, the sun's disc; or the room), in linear sRGB radiance.
-// SKY_MODEL (issue 13, catalog/sky.py): the clear sky of Preetham et al. 1999 scaled to the
-// project's atmosphere (catalog/sun.py clear_sky), the ground below fading in from the
+// SKY_MODEL (issue 13, catalog/optics/sun/sky.py): the clear sky of Preetham et al. 1999 scaled to the
+// project's atmosphere (catalog/optics/sun/model.py clear_sky), the ground below fading in from the
 // horizon's haze over u_haze_rad of depression (no seam). ENVIRONMENT: an HDR image in
 // latitude-longitude layout instead (scaled to the same sky's illuminance).
 // SKY_BANDS (with SKY_MODEL; 6, 9 or 16 bands): the sky per band, Preetham's spectral

@@ -248,7 +248,7 @@ vec3 environment_lookup(sampler2D image, float scale, vec3 dir) {
     return scale * textureLod(image, vec2(u, v), 0.0).rgb;
 }
 
-// ---- The clear sky (issue 13; catalog/sky.py is the float64 twin). Preetham, Shirley & Smits
+// ---- The clear sky (issue 13; catalog/optics/sun/sky.py is the float64 twin). Preetham, Shirley & Smits
 // 1999, the Perez et al. 1993 function F(theta, gamma) = (1 + A e^(B / cos theta))
 // (1 + C e^(D gamma) + E cos^2 gamma) for x, y and Y at once (columns of the coefficients).
 vec3 perez_xyY(float cos_theta, float gamma, vec3 a, vec3 b, vec3 c, vec3 d, vec3 e) {

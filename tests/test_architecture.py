@@ -123,6 +123,7 @@ def test_only_commands_import_the_benchmarks():
     assert bad == []
 
 
+@pytest.mark.slow
 def test_no_module_imports_one_that_imports_it():
     """No two modules import each other (lazily or not): a cycle is a room boundary drawn
     in the wrong place (cloth's backends and simulation, cloth and render, once)."""

@@ -160,6 +160,7 @@ def test_retry_then_report_in_process(monkeypatch, tmp_path):
 # ---------------------------------------------------------------------- rendering (GL)
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_batch_images_equal_snapshot_images(gl, tmp_path):
     """The kept renderer, reused across lights, frames and yaws, gives exactly the pixels of
     a fresh `catalog snapshot` of the same fabric, light, frame and yaw (0 px differ)."""
@@ -188,6 +189,7 @@ def test_batch_images_equal_snapshot_images(gl, tmp_path):
 
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_failing_fabric_reported_rest_finish(tmp_path, make_preset):
     broken = make_preset("broken", rho=1.5)  # out of range: refused when the worker loads it
     out = tmp_path / "out"
@@ -209,6 +211,7 @@ def test_failing_fabric_reported_rest_finish(tmp_path, make_preset):
 
 @pytest.mark.gl
 @needs_dask
+@pytest.mark.slow
 def test_failing_fabric_on_dask_workers(tmp_path, make_preset):
     broken = make_preset("broken", g_spec=3.0)
     out = tmp_path / "out"

@@ -107,6 +107,7 @@ def test_every_section_module_has_run():
 # --------------------------------------------------------------------------- sections, tiny
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_colour_section_on_one_fabric_and_light(gl, tmp_path):
     from catalog.bench import colour
 
@@ -184,6 +185,7 @@ def test_fit_errors_are_zero_for_the_true_parameters():
     assert fit.errors(data, t, t)["weighted_rms_4800"] == pytest.approx(0.02, rel=0.15)
 
 
+@pytest.mark.slow
 def test_cloth_runs_are_deterministic_and_deviation_is_a_distance():
     from catalog.bench import cloth
 

@@ -6,10 +6,13 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from catalog.bench import alpha_to_coverage, pattern, viewer_frames
 from catalog.render.frame import choose_antialiasing
 
 
+@pytest.mark.slow
 def test_pattern_benchmark_quick_run(gl):
     result = pattern.run(quick=True, ctx=gl, repeats=2)
     cases = [row["case"] for row in result["rows"]]

@@ -237,6 +237,7 @@ def test_colour_refinement_never_sees_a_goal_light():
         bispectral.refine_for_colour(noisy, lights=())
 
 
+@pytest.mark.slow
 def test_colour_refinement_keeps_the_model_and_stays_near_the_data(matrices, fits):
     """Same supports (one absorption band, one emission band), phi <= 1, the reflectance
     within 0.01 of the least-squares one, the strength within 5%, the entries still within
@@ -373,6 +374,7 @@ def test_chain_is_exact_for_an_exactly_separable_matrix():
         assert error < (0.3 if light_name == "UV-A" else 0.05), light_name
 
 
+@pytest.mark.slow
 def test_goal_lights_mean_and_max(study_rows):
     """Issue 2's goal for the separable fit in physical mode, 8 matrices x 5 lights:
     mean <= 0.5, max <= 1.0, and below the paper mode (both scales) in every case but the
@@ -481,6 +483,7 @@ def test_table_tool_prints_markdown_and_json(tmp_path):
 
 
 @pytest.mark.data
+@pytest.mark.slow
 def test_command_json_and_export(tmp_path, capsys):
     import json
 

@@ -85,6 +85,7 @@ def sphere_integral(g: float, mu0: float = -1.0, nodes: int = 24, panels: int = 
 
 @settings(max_examples=300, deadline=None)
 @given(unit_vectors(), unit_vectors(), G)
+@pytest.mark.slow
 def test_hg_finite_positive_and_matches_decimal_reference(a, b, g):
     a, b = _normalise(a), _normalise(b)
     value = btdf.hg_phase_between(a, b, g)
@@ -164,6 +165,7 @@ def test_printed_form_fails_in_float32_and_robust_form_holds():
 @settings(max_examples=400, deadline=None)
 @given(unit_vectors(), unit_vectors(), G, st.floats(min_value=-8, max_value=0),
        st.sampled_from([-1.0, 0.0, 1.0]))
+@pytest.mark.slow
 def test_robust_form_in_float32_within_1e6_at_all_angles(a, b, g, log_scale, near):
     """Vectors in float32 (forward, backward and random pairs) against float64 on the
     same float32 inputs."""

@@ -6,6 +6,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 from catalog.commands.cli import COMMANDS
 
 HEAVY = ("numpy", "scipy", "colour", "matplotlib", "moderngl", "OpenImageIO", "numba",
@@ -72,6 +74,7 @@ def test_wxh_values_are_parsed_and_refused_by_one_rule():
 
 # ---- exit codes: 2 the input, 3 the environment; with --json the error is one object ---
 
+@pytest.mark.slow
 def test_missing_shader_is_an_environment_failure_with_a_json_error(gl, tmp_path, monkeypatch,
                                                                     capsys, fabric_dir):
     """A shader file missing from the installation: exit 3, one line on stderr, and with
@@ -133,6 +136,7 @@ def test_user_fabric_folder_is_searched_before_the_built_in_catalog(tmp_path, mo
     resources.use_fabrics(None)
 
 
+@pytest.mark.slow
 def test_missing_validation_data_is_one_line_exit_2(tmp_path):
     """Without the validation data, commands that need it say so in one line (exit 2)."""
     import os

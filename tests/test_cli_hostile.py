@@ -86,6 +86,7 @@ def _is_valid_spectrum(text: str) -> bool:
 
 @SETTINGS
 @given(text=bad_spectrum_text(), which=st.sampled_from(["--excitation", "--emission"]))
+@pytest.mark.slow
 def test_fluorescence_refuses_bad_spectra(tmp_path, capsys, project_root, text, which):
     if _is_valid_spectrum(text):
         return  # hypothesis drew a valid file: not this test's subject
@@ -104,6 +105,7 @@ def test_fluorescence_refuses_bad_spectra(tmp_path, capsys, project_root, text, 
 @given(text=st.one_of(st.text(max_size=200), st.binary(max_size=200).map(lambda b: b.decode("latin-1")),
                       st.lists(st.text(alphabet="0123456789.,- e\n", max_size=40), max_size=15)
                       .map(lambda ls: "\n".join(["; header"] * 10 + ls))))
+@pytest.mark.slow
 def test_bispectral_refuses_bad_matrix_files(tmp_path, capsys, text):
     bad = tmp_path / "BAD.BFC"
     bad.write_bytes(text.encode("utf-8", "surrogatepass"))
@@ -145,6 +147,7 @@ _BTDF_KEYS = ["direct", "rho", "g_diff", "g_spec", "k_d", "tau"]
 @SETTINGS
 @given(key=st.sampled_from(_BTDF_KEYS + ["quantum_yield", "peak_absorptance", "schema",
                                          "name", "<drop>", "<garbage>"]), data=st.data())
+@pytest.mark.slow
 def test_snapshot_refuses_bad_presets(tmp_path, capsys, make_preset, key, data):
     value = data.draw(st.one_of(_NOT_NUMBERS, st.sampled_from(_OUT_OF_RANGE.get(key, [-1.0]))))
     path = make_preset("hostile")

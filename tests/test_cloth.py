@@ -141,6 +141,7 @@ def _params(**changes):
     return ClothParams(**base)
 
 
+@pytest.mark.slow
 def test_numba_follows_the_numpy_reference_for_one_second():
     params = _params()
     ref = ClothSimulation(params, "numpy")
@@ -155,6 +156,7 @@ def test_numba_follows_the_numpy_reference_for_one_second():
     assert fast.max_stretch == pytest.approx(ref.max_stretch, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_rings_slide_to_a_new_opening_and_both_backends_agree():
     params = _params(wind_speed_m_s=0.0, opening=1.0, ring_speed_m_s=2.0)
     sims = [ClothSimulation(params, b) for b in ("numpy", "cpu")]
@@ -208,6 +210,7 @@ def test_hundred_thousand_steps_stay_finite():
 
 
 @pytest.mark.parametrize("w, h, frames", [(4, 4, 60), (64, 64, 4), (256, 256, 1)])
+@pytest.mark.slow
 def test_grid_sizes(w, h, frames):
     p = ClothParams(grid_w=w, grid_h=h, opening=0.7, stretch_stiffness_n_m=1e6,
                     wind_speed_m_s=1.0)

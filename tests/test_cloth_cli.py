@@ -14,6 +14,7 @@ KEYS = {"steps", "dt", "substeps", "finite", "max_stretch", "kinetic_energy",
         "steps_per_second"}
 
 
+@pytest.mark.slow
 def test_simulate_json_contract(tmp_path):
     out = tmp_path / "curtain.ply"
     proc = subprocess.run(

@@ -17,6 +17,7 @@ def _pair(gl, **changes):
     return ClothSimulation(params, "cpu"), ClothSimulation(params, "gpu", ctx=gl)
 
 
+@pytest.mark.slow
 def test_gpu_follows_the_reference_for_one_second(gl):
     # flat curtain, no wind: a smooth motion (the top row sags between its rings)
     cpu, gpu = _pair(gl, opening=1.0)
@@ -97,6 +98,7 @@ def test_springs12_on_the_gpu_matches_the_reference(gl):
     np.testing.assert_allclose(gpu.positions(), reference, atol=2e-5)
 
 
+@pytest.mark.slow
 def test_gpu_parameters_change_while_running(gl):
     params = ClothParams(grid_w=12, grid_h=12, opening=0.8)
     gpu = ClothSimulation(params, "gpu", ctx=gl)

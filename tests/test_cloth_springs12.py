@@ -17,6 +17,7 @@ from catalog.bench.springs12 import Springs12Numba, Springs12Problem, reference_
 
 @pytest.mark.parametrize("n", [2, 3, 7, 33])
 @pytest.mark.parametrize("threads", [1, 2, 3])
+@pytest.mark.slow
 def test_numba_kernel_matches_the_float64_reference(n, threads):
     problem = Springs12Problem(n=n)
     steps = 150
@@ -36,6 +37,7 @@ def test_reference_float32_close_to_float64():
     np.testing.assert_allclose(x32, x64, atol=2e-5)
 
 
+@pytest.mark.slow
 def test_cloth_at_rest_without_gravity_stays_put():
     problem = Springs12Problem(n=9, gravity_m_s2=0.0)
     x, v = reference_steps(problem, 50)

@@ -79,6 +79,7 @@ def test_delta_e_2000_matches_colour_science_on_random_and_edge_pairs():
     np.testing.assert_allclose(cm.delta_e_2000_lab(lab_a, lab_b), ref, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_colorimetry_does_not_import_colour_or_scipy():
     import subprocess
     import sys

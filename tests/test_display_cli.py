@@ -30,6 +30,7 @@ def test_bad_display_options_are_refused_in_one_line(tmp_path, option, value):
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_fixed_ev_sets_the_exposure_and_one_stop_doubles_it(gl, tmp_path):
     reports = [render_snapshot(SnapshotRequest(fabric="voile-white", light="D65", size=(32, 24),
                                                out=tmp_path / f"ev{ev}.png", ev=ev), ctx=gl)
@@ -41,6 +42,7 @@ def test_fixed_ev_sets_the_exposure_and_one_stop_doubles_it(gl, tmp_path):
     assert meta["catalog:ev100"] == "11.0000" and meta["catalog:auto_exposure"] == "false"
 
 
+@pytest.mark.slow
 def test_camera_white_balance_leaves_a_lamp_warm(gl, tmp_path):
     room = render_snapshot(SnapshotRequest(fabric="voile-white", light="A", size=(32, 24),
                                            out=tmp_path / "room.png"), ctx=gl)
@@ -52,6 +54,7 @@ def test_camera_white_balance_leaves_a_lamp_warm(gl, tmp_path):
     assert abs(r_room - b_room) < 10 < r_cam - b_cam  # adapted: neutral; camera: orange
 
 
+@pytest.mark.slow
 def test_exr_opens_in_ocio_with_a_standard_view(gl, tmp_path):
     import OpenImageIO as oiio
 

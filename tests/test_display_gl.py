@@ -94,6 +94,7 @@ def _exact_mean_linear(renderer, mask, like):
     ("lace-fwa", "UV-A", None, "room"), ("safety-yellow", "sun:500", None, "room"),
     ("lace-fwa", "A", None, "room"), ("fluoro-pink", "D65", 15.0, "camera"),
     ("sheer-teal", "sun:22", 10.0, "room")])
+@pytest.mark.slow
 def test_shader_equals_numpy_twin_per_pixel(gl, fabric, light, ev, wb):
     renderer, _ = _frame(gl, fabric, light, ev=ev, white_balance=wb)
     hdr = renderer.read_linear().astype(np.float64)
@@ -131,6 +132,7 @@ def test_at_most_one_percent_of_curtain_pixels_clip_under_every_light(gl, capsys
 @pytest.mark.parametrize("fabric, light", [("lace-fwa", "UV-A"), ("fluoro-pink", "D65"),
                                            ("fluoro-pink", "UV-A"), ("safety-yellow", "D65"),
                                            ("safety-yellow", "UV-A")])
+@pytest.mark.slow
 def test_displayed_hue_is_the_exact_spectral_hue(gl, fabric, light, capsys):
     renderer, mask = _frame(gl, fabric, light)
     shown = _displayed_mean_linear(renderer, mask)
@@ -170,6 +172,7 @@ def test_lace_under_a_displays_as_an_adapted_white(gl, capsys):
     assert chroma <= 10.0
 
 
+@pytest.mark.slow
 def test_table_2_direction_in_the_display_image(gl, capsys):
     off, mask = _frame(gl, "lace-fwa", None, mode="off", hour=12.0)
     ev = off.current_ev100()
@@ -187,6 +190,7 @@ def test_table_2_direction_in_the_display_image(gl, capsys):
     assert abs(change[0]) <= abs(change[1])
 
 
+@pytest.mark.slow
 def test_display_benchmark_section_reports_every_step(gl):
     """The benchmark's shape (not its speed): four pass variants, meter and frame per scene."""
     from catalog.bench.display import SCENES, STAGES, markdown_tables, run

@@ -37,6 +37,7 @@ def test_fullness_from_the_preset_and_its_refusal():
             fullness_of({"fullness": bad})
 
 
+@pytest.mark.slow
 def test_the_settled_drape_is_pleated_and_is_where_every_simulation_starts():
     """At rest the fabric folds towards the room and the window between the rings (pleat
     depth > 3 cm at the heading and still > 1 cm at the hem); a simulation starts exactly at

@@ -248,6 +248,7 @@ def test_catalog_fit_writes_the_preset_and_json(tmp_path, capsys):
     assert preset.table("cloth")["weave"] == "lace"
 
 
+@pytest.mark.slow
 def test_catalog_fit_79_points_dye_and_plot(tmp_path, capsys):
     from catalog.presets import load_preset
 

@@ -398,7 +398,10 @@ def _bump(center, width, grid=GRID_NM):
 @settings(max_examples=60, deadline=None)
 @given(ex_center=st.floats(300, 700), ex_width=st.floats(3, 80),
        em_center=st.floats(380, 780), em_width=st.floats(3, 80),
-       peak_absorptance=st.floats(0.01, 1.0), quantum_yield=st.floats(0.0, 1.0),
+       # no subnormal yields (below 2.2e-308): their products lose relative precision (a
+       # subnormal has fewer significant bits), so no relative bound holds for them
+       peak_absorptance=st.floats(0.01, 1.0),
+       quantum_yield=st.floats(0.0, 1.0, allow_subnormal=False),
        log_n_sat=st.floats(14, 30), light_center=st.floats(300, 780),
        light_width=st.floats(2, 300), log_level=st.floats(-6, 6))
 def test_emitted_photons_never_exceed_absorbed_for_any_material_and_light(

@@ -83,6 +83,7 @@ def test_led_b4_does_not_need_the_lace_brightener(capsys):
     assert _json(capsys, "--light", "LED-B4")["fluorescence_needed"] is False
 
 
+@pytest.mark.slow
 def test_plot_is_written(tmp_path, capsys):
     target = tmp_path / "figs" / "fig5_6.png"
     result = _json(capsys, "--light", "D65", "--plot", str(target))

@@ -16,6 +16,7 @@ MEASUREMENTS = FABRIC_DIR / "measurements"
 FABRICS = ("lace-fwa", "safety-yellow", "fluoro-pink")
 
 
+@pytest.mark.slow
 def test_the_script_reproduces_the_committed_files_byte_for_byte(tmp_path):
     subprocess.run([sys.executable, str(PROJECT_ROOT / "tools" / "make_fluorescent_spectra.py"),
                     "--out", str(tmp_path)], check=True, capture_output=True, timeout=120)

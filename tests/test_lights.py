@@ -197,6 +197,7 @@ def test_cli_lights_lists_everything_as_json(capsys):
     assert [r["name"] for r in out["lights"]] == light_names()
 
 
+@pytest.mark.slow
 def test_cli_lights_plot_is_written_atomically(tmp_path, capsys):
     from catalog.commands.cli import main
 

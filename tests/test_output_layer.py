@@ -190,6 +190,7 @@ def _fill(disk: Path) -> None:
 
 
 @pytest.mark.parametrize("name", sorted(WRITERS))
+@pytest.mark.slow
 def test_full_disk_is_one_line_and_the_old_file_stays(tmp_path, name, project_root):
     disk = tmp_path / "disk"
     with _tmpfs(disk, size="64k") as mounted:
@@ -233,6 +234,7 @@ JSON_COMMANDS = {
 
 @pytest.mark.parametrize("how", ["closed", "full"])
 @pytest.mark.parametrize("name", sorted(JSON_COMMANDS))
+@pytest.mark.slow
 def test_closed_or_full_stdout_is_one_line(tmp_path, project_root, how, name):
     if how == "full" and not Path("/dev/full").exists():
         pytest.skip("no /dev/full on this machine")

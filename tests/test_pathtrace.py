@@ -61,6 +61,7 @@ def _samples(mi, bsdf, wi, n, seed=0):
 # --------------------------------------------------------------------------- the BSDF
 
 @pytest.mark.parametrize("wi", [(0.0, 0.0, 1.0), (0.6, 0.0, 0.8), (0.0, -0.8, -0.6)])
+@pytest.mark.slow
 def test_sampling_matches_the_density_chi_square(mi, wi):
     """Mitsuba's chi-square test; bins fine enough for g = 0.82's peak (half-width ~0.02 in
     cos theta: on a 41-bin grid the density's own quadrature is 2 % off and fails it)."""
@@ -162,6 +163,7 @@ def _lace_d65(size=(48, 36), **kw):
     return describe_scene(load_preset(find_preset("lace-fwa")), get_light("D65"), size=size, **kw)
 
 
+@pytest.mark.slow
 def test_export_reads_the_real_time_scene():
     from catalog.render import bands, scene as scene_lib
     from catalog.render.snapshot import simulated_curtain
@@ -231,6 +233,7 @@ def test_direct_light_matches_the_float64_reference_per_pixel(mi):
         assert rel.max() < 0.01, (light, np.median(rel), rel.max())
 
 
+@pytest.mark.slow
 def test_noise_falls_as_one_over_root_spp_and_the_estimates_agree(mi):
     """The stated convergence check (one small room scene): relative RMS noise from two
     independent renders at 8 and 32 spp; quadrupling spp halves it (0.5 +- 0.15), and the
@@ -283,6 +286,7 @@ def _main(capsys, *args):
     return code, captured.out, captured.err.strip().splitlines()
 
 
+@pytest.mark.slow
 def test_reference_command_writes_an_exr_with_json(mi, tmp_path, capsys):
     out = tmp_path / "ref.exr"
     code, stdout, err = _main(capsys, "--fabric", "lace-fwa", "--light", "D65", "--size",
@@ -325,6 +329,7 @@ def test_unwritable_output_is_one_line(tmp_path, capsys):
     assert blocker.read_text() == "not a folder"
 
 
+@pytest.mark.slow
 def test_missing_llvm_is_an_environment_failure(tmp_path):
     env = dict(os.environ, DRJIT_LIBLLVM_PATH=str(tmp_path / "libLLVM-missing.so"))
     result = _catalog("--fabric", "voile-white", "--size", "8x6", "--spp", "1",

@@ -53,6 +53,7 @@ def test_jacquard_has_no_holes_and_lace_has_many():
     assert lace.repeat_m[0] == pytest.approx(0.1)
 
 
+@pytest.mark.slow
 def test_the_generator_reproduces_the_committed_patterns():
     make_patterns = _make_patterns()
     for name in sorted(make_patterns.PATTERNS):

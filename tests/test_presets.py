@@ -123,6 +123,7 @@ def _assert_same_document(new, old, where=""):
         assert new == old, where
 
 
+@pytest.mark.slow
 def test_regenerating_reproduces_the_committed_presets(tmp_path):
     """tools/make_presets.py (catalog fit on every measurement) into a scratch folder
     beside a link to the same measurements gives the committed files."""

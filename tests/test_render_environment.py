@@ -49,6 +49,7 @@ def test_upper_illuminance_of_a_uniform_sky_is_pi_l():
 
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_the_procedural_sky_as_an_image_renders_as_the_sky(gl, tmp_path):
     """The default sky written as an EXR (the project's own environment) and read back through
     --environment draws the same background as the analytic sky: median relative difference
@@ -75,6 +76,7 @@ def test_the_procedural_sky_as_an_image_renders_as_the_sky(gl, tmp_path):
     r.release()
 
 
+@pytest.mark.slow
 def test_cli_refuses_a_bad_environment_in_one_line(tmp_path):
     bad = _write(tmp_path / "square.exr", np.ones((16, 16, 3)))
     out = tmp_path / "x.png"

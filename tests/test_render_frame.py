@@ -269,6 +269,7 @@ def test_band_shader_arithmetic_matches_float64_bands(gl, make_preset, n_bands):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_specialised_and_uniform_programs_agree(gl, make_preset):
     """Scene values compiled in as constants (the default) or passed as uniforms: the same
     frame up to float32 constant folding; and old specialised programs are released."""

@@ -294,6 +294,7 @@ def dolly_change(renderer, mask_frames, filtered: bool, frames: int = 40) -> flo
     return float(np.mean(changes))
 
 
+@pytest.mark.slow
 def test_a_slow_dolly_does_not_shimmer(gl):
     """Static lace, 40 frames from 3 m to 0.2 m (7 % closer each frame), 128x96, one fixed
     exposure. The change
@@ -330,6 +331,7 @@ def test_a_slow_dolly_does_not_shimmer(gl):
 # --- anti-aliasing ----------------------------------------------------------------------------
 
 @pytest.mark.parametrize("mode", ["fxaa", "msaa"])
+@pytest.mark.slow
 def test_antialiasing_brings_edges_closer_to_a_supersampled_frame(gl, mode):
     """The lace's frame at 96x72 with FXAA (or MSAA 4x: HDR and OIT targets multisampled)
     and without, against the same frame rendered at 4x4 the pixels and box-filtered down in
@@ -409,6 +411,7 @@ def test_msaa_keeps_the_curtain_interior_and_the_layers(gl):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl):
     """The settled lace at 320x180, MSAA against one sample, over the curtain's interior
     (pixels whose 5x5 neighbourhood is curtain in the G-buffer mask: the folds' silhouettes

@@ -96,6 +96,7 @@ def _patch_ratio_cv(gl, azimuth_deg, patterned):
     return ratio.std() / ratio.mean()
 
 
+@pytest.mark.slow
 def test_folds_pattern_the_patch(gl):
     """The flat cloth (the fabric's pattern off): with the key 50 deg to the side its beam
     crosses the deepest folds twice (the fold's slope, up to 55 deg, is steeper than the ray's
@@ -106,6 +107,7 @@ def test_folds_pattern_the_patch(gl):
     assert _patch_ratio_cv(gl, 15.0, patterned=False) < 0.01
 
 
+@pytest.mark.slow
 def test_the_lace_pattern_patterns_the_patch(gl):
     """lace-fwa's [pattern] (holes and threads, 10 cm repeat) projected through the shadow map:
     with the key 15 deg to the side, where the flat cloth leaves the patch flat within 1 %,
@@ -113,6 +115,7 @@ def test_the_lace_pattern_patterns_the_patch(gl):
     assert _patch_ratio_cv(gl, 15.0, patterned=True) > 0.03
 
 
+@pytest.mark.slow
 def test_safety_yellow_tints_the_patch(gl):
     """Yellowness (R + G) / 2B of the patch: the yellow dye scatters yellow light into the beam,
     so closing safety-yellow raises it by more than 30 %; undyed lace-fwa changes it by less
@@ -138,6 +141,7 @@ def _wall_strips(img):
     return np.concatenate([img[:, : w // 5].reshape(-1, 3), img[:, -(w // 5):].reshape(-1, 3)])
 
 
+@pytest.mark.slow
 def test_uv_fluorescence_raises_the_rooms_blue(gl):
     """Under UV-A, lace-fwa's brightener emits blue from the curtain into the room: the wall's
     blue rises by more than 20 % against the same scene without fluorescence, and more than
@@ -156,6 +160,7 @@ def test_uv_fluorescence_raises_the_rooms_blue(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_walls_differ_between_fabrics(gl):
     """Default view, D65: with the room lit through the curtain, the window wall's mean colour
     differs between every two of the ten fabrics (by more than 0.3 % in some channel of linear
@@ -187,6 +192,7 @@ def test_walls_differ_between_fabrics(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_layers_multiply_in_the_shadow_map(gl):
     """Two parallel sheets across the window, facing the key: the shadow map passes T^2 where
     one sheet passes T (half-float storage: 2e-3); the flat cloth, so that T is uniform."""
@@ -242,6 +248,7 @@ def test_room_lamp_outside_the_room_is_refused(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_room_light_is_stable_as_the_cloth_moves(gl):
     """The drape slid sideways 2 cm at a time (folds 31 cm apart): no texel of the room's light
     map changes by more than 5 % a step. Each window patch is the mean of 4 x 4 capture samples;
@@ -266,6 +273,7 @@ def test_room_light_is_stable_as_the_cloth_moves(gl):
 @pytest.mark.parametrize("lamp, needle", [("A@0,9,2.5", "inside the room"),
                                           ("A0,1,2", "LIGHT@X,Y,Z"),
                                           ("NOPE@0,1,2", "NOPE")])
+@pytest.mark.slow
 def test_cli_refuses_a_bad_lamp_in_one_line(tmp_path, lamp, needle):
     import subprocess
     import sys
@@ -291,6 +299,7 @@ def test_stored_ambient_occlusion_is_the_computed_one():
     assert floor[0, 0] < 0.7 and floor[k // 2, k // 2] == 1.0
 
 
+@pytest.mark.slow
 def test_room_benchmark_quick_runs_and_tabulates(gl):
     """The benchmark's quick run: every configuration timed, finite ratios, each pass's
     share summing to 1, and both generated tables."""

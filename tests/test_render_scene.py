@@ -161,6 +161,7 @@ def test_room_solids_match_trimesh_and_face_outwards():
         assert mesh.area == pytest.approx(reference.area, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_frame_setup_imports_no_scipy():
     """Drawing a frame must not import scipy (the viewer's rule): checked in a fresh process."""
     import subprocess

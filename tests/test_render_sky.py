@@ -69,6 +69,7 @@ def test_no_seam_at_the_horizon():
         assert np.all(np.abs(hi - lo) <= 0.02 * np.abs(hi))
 
 
+@pytest.mark.slow
 def test_background_pixels_match_the_sky_model(gl):
     """Curtain open, looking out of the window under the sun: every pixel whose ray leaves
     through the opening (10 cm inside its edge, off the sun's disc) equals the float64 sky
@@ -175,6 +176,7 @@ def test_band_frame_sky_is_the_band_integral_of_the_spectral_sky(gl, n_bands):
     r.release()
 
 
+@pytest.mark.slow
 def test_bloom_keeps_the_frames_energy_and_glows_around_the_sun(gl):
     """The bloomed frame's total radiance equals the unbloomed frame's within 1 % (box blurs
     keep the integral; the edges lose a little), and pixels a few degrees from the sun's disc

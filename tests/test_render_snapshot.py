@@ -20,6 +20,7 @@ def _request(preset, out, **changes):
     return SnapshotRequest(**values)
 
 
+@pytest.mark.slow
 def test_exr_and_png_with_metadata(gl, make_preset, tmp_path):
     import OpenImageIO as oiio
 
@@ -94,6 +95,7 @@ def test_no_egl_device_is_one_line(monkeypatch):
     assert str(err.value).startswith("no EGL device") and "\n" not in str(err.value)
 
 
+@pytest.mark.slow
 def test_cli_json_and_one_line_error(make_preset, tmp_path):
     out = tmp_path / "c.png"
     ok = subprocess.run([sys.executable, "-m", "catalog", "snapshot", "--fabric",
@@ -114,6 +116,7 @@ def test_cli_json_and_one_line_error(make_preset, tmp_path):
     assert not (tmp_path / "d.png").exists()
 
 
+@pytest.mark.slow
 def test_sheet_every_fabric_and_light(gl, make_preset, tmp_path):
     from catalog.render.sheet import render_sheet
 
@@ -131,6 +134,7 @@ def test_sheet_every_fabric_and_light(gl, make_preset, tmp_path):
         assert oiio.ImageBuf(image["path"]).spec().width == 24
 
 
+@pytest.mark.slow
 def test_frame_n_renders_the_simulated_cloth(gl, make_preset, tmp_path):
     """--frame 0 is the settled drape, --frame N > 0 the simulation started from it."""
     preset = make_preset()

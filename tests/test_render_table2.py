@@ -50,6 +50,7 @@ def _lit_cloth_mean(gl, preset, mode, *, hour=None, light=None, paper_mode=False
 
 
 @pytest.mark.parametrize("mode", ["physical", "paper"])
+@pytest.mark.slow
 def test_brightened_lace_under_noon_sun_turns_blue(gl, make_preset, mode, capsys):
     lace = _lace(make_preset)
     off, off8, off_info, _ = _lit_cloth_mean(gl, lace, "off", hour=12.0)
@@ -74,6 +75,7 @@ def test_fabric_without_brightener_renders_identically(gl, make_preset):
     assert np.array_equal(off, on) and np.array_equal(off8, on8)
 
 
+@pytest.mark.slow
 def test_led_b4_change_is_below_threshold_and_not_compiled(gl, make_preset):
     lace = _lace(make_preset)
     off, _, _, _ = _lit_cloth_mean(gl, lace, "off", light="LED-B4")

@@ -162,6 +162,7 @@ def test_per_column_bands_reproduce_the_short_columns():
     assert np.abs(rank1 - matrix.values)[short].max() > 100 * error.max()
 
 
+@pytest.mark.slow
 def test_banded_preset_renders_the_sum_of_its_bands(tmp_path):
     """The renderer's per-light pre-integration of a banded preset: the emission it hands
     the shader for the key light equals the bands' summed emission (relative 1e-5: the

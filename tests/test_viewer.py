@@ -185,6 +185,7 @@ def stats_run(xdisplay, tmp_path_factory):
     return _stats_records(result.stdout)
 
 
+@pytest.mark.slow
 def test_stats_log_frame_time_and_its_parts(stats_run):
     """--stats: one JSON line per frame with its parts, then a summary."""
     frames = [r for r in stats_run if "frame" in r]
@@ -201,6 +202,7 @@ def test_stats_log_frame_time_and_its_parts(stats_run):
     assert summary[0]["median_total_ms"] >= summary[0]["median_shading_ms"] > 0
 
 
+@pytest.mark.slow
 def test_viewer_imports_no_scipy_by_its_first_frame(stats_run):
     """The viewer (window, renderer, cloth, panel) must not pull in scipy or matplotlib."""
     heavy = stats_run[0]["heavy_modules"]
@@ -461,6 +463,7 @@ def _copy_fabrics(target: Path, names: list[str]) -> None:
     (target / "patterns").symlink_to(FABRIC_DIR / "patterns")   # and their [pattern] images
 
 
+@pytest.mark.slow
 def test_broken_preset_shows_an_error_and_the_others_render(xdisplay, tmp_path):
     _need_presets(LACE, VOILE)
     fabrics = tmp_path / "fabrics"
@@ -485,6 +488,7 @@ def test_broken_preset_shows_an_error_and_the_others_render(xdisplay, tmp_path):
     assert float(image[:, 330:].std()) > 0.02  # the curtain still renders
 
 
+@pytest.mark.slow
 def test_broken_preset_on_the_command_line_is_refused(xdisplay, tmp_path):
     _need_presets(VOILE)
     fabrics = tmp_path / "fabrics"
@@ -498,6 +502,7 @@ def test_broken_preset_on_the_command_line_is_refused(xdisplay, tmp_path):
     assert not (tmp_path / "x.png").exists()
 
 
+@pytest.mark.slow
 def test_a_failed_frame_fails_a_frames_run(xdisplay, tmp_path):
     """--frames N --screenshot: a frame that could not be drawn as asked (here the shown
     fabric's dye file is missing) ends the run with its one-line error, exit 2, and no

@@ -54,6 +54,7 @@ def test_thumbnails_differ_between_fabrics_and_change_with_the_light(panel_runs)
     assert lace_uva[2] > lace_uva[0] + 20  # the brightener's blue glow under the UV lamp
 
 
+@pytest.mark.slow
 def test_panel_states_full_names_and_facts(panel_runs):
     summary, window = panel_runs["D65"]
     assert summary["labels"][LACE] == "White lace, brightened (lace-fwa)"
@@ -66,6 +67,7 @@ def test_panel_states_full_names_and_facts(panel_runs):
     assert np.abs(window[60:, panel] - uva_window[60:, panel]).mean() > 0.02
 
 
+@pytest.mark.slow
 def test_compare_fluorescence_on_and_off_at_one_exposure(xdisplay, tmp_path):
     out = tmp_path / "onoff.png"
     summary = _summary(_catalog(["view", *QUICK, "--fabric", LACE, "--compare", LACE,

@@ -89,6 +89,7 @@ def test_baked_loop_is_seamless_and_small():
 
 # ---------------------------------------------------------------- the recorded frame
 @pytest.mark.gl
+@pytest.mark.slow
 def test_recording_context_changes_nothing_of_the_desktop_frame(gl):
     """The frame rendered through the recording proxy is bit-identical to the plain one, and
     the recorded programs are the frame's files with their defines."""

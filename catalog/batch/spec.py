@@ -20,10 +20,10 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from catalog.core.constants import FLUORESCENCE_MODES as FLUORESCENCE
 from catalog.core.errors import CatalogError, InputError
 
 FORMATS = ("png", "exr")
-FLUORESCENCE = ("off", "paper", "physical")
 #: The most images one job may ask for (a guard against a typo such as 0:4800000).
 MAX_IMAGES = 50_000_000
 _SLICE = re.compile(r"\s*(-?\d+)\s*:\s*(-?\d+)\s*(?::\s*(-?\d+)\s*)?")

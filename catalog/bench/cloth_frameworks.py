@@ -45,9 +45,50 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 from catalog.bench.springs12 import Springs12Numba, Springs12Problem, reference_steps  # noqa: E402
 from catalog.cloth.topology import GATHER_OFFSETS  # noqa: E402
 
+RESULT_JSON = "benchmarks/bench_cloth.json"
 AGREE_STEPS = 200
 AGREE_TOLERANCE_M = 1e-4
 PEERS = ("taichi", "warp")
+
+
+# ---- the docs' tables (tools/docs_figures.py) --------------------------------------------
+
+_COLUMNS = (("numpy-f32", "numpy f32"), ("cpu", "**cpu (numba, 1 thread)**"),
+            ("cpu-2t", "cpu, 2 threads"), ("gpu", "gpu (compute, llvmpipe)"),
+            ("taichi", "Taichi 1.7.4 (2 threads)"), ("warp", "Warp 1.19"))
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``cloth_frameworks``: steps per second by n and implementation, with the ratio to the
+    fastest peer for ours and the peers (the numpy reference and llvmpipe have none);
+    ``cloth_stiffness``: the cost of a 1/30 s frame at 1e3 and 1e6 N/m."""
+    rows = result["springs12"]
+    lines = ["| n | " + " | ".join(label for _, label in _COLUMNS) + " |",
+             "|---|" + "---|" * len(_COLUMNS)]
+    for n in sorted({r["n"] for r in rows}):
+        cells = []
+        for impl, _ in _COLUMNS:
+            r = next((r for r in rows if r["n"] == n and r["impl"] == impl), None)
+            if r is None or "steps_per_second" not in r:
+                cells.append("unavailable")
+                continue
+            cell = f"{r['steps_per_second']:.0f}"
+            if impl not in ("numpy-f32", "gpu"):
+                cell += f" ({r['ratio_to_fastest_peer']:.2f}x)"
+            cells.append(f"**{cell}**" if impl == "cpu" else cell)
+        lines.append(f"| {n} | " + " | ".join(cells) + " |")
+    stiff = result["stiffness_cost"]
+    slines = ["| stiffness | no wind ms/frame | wind 1 m/s ms/frame | max stretch |",
+              "|---|---|---|---|"]
+    for k in sorted({r["stiffness_n_m"] for r in stiff["rows"]}):
+        calm, windy = (next(r for r in stiff["rows"]
+                            if r["stiffness_n_m"] == k and r["wind_m_s"] == w) for w in (0.0, 1.0))
+        slines.append(f"| {k:.0e}".replace("e+0", "e") + f" N/m | {calm['ms_per_frame']:.1f} | "
+                      f"{windy['ms_per_frame']:.1f} | {calm['max_stretch']:.3f} / "
+                      f"{windy['max_stretch']:.3f} |")
+    ratio = stiff["ratio_1e6_to_1e3"]
+    slines.append(f"| cost(1e6) / cost(1e3) | **{ratio['0.0']:.2f}** | **{ratio['1.0']:.2f}** | |")
+    return {"cloth_frameworks": "\n".join(lines), "cloth_stiffness": "\n".join(slines)}
 
 
 # ---- peers ------------------------------------------------------------------------------

@@ -17,6 +17,22 @@ import sys
 import time
 from pathlib import Path
 
+RESULT_JSON = "benchmarks/bench_lights.json"
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``lights_cost``: every case of one committed run (medians), seconds for whole
+    processes, milliseconds or microseconds in process."""
+    lines = [f"| case | kind | median (of {result['repeats']} processes, or of at least 20 calls) |",
+             "|---|---|---|"]
+    for r in result["rows"]:
+        value = r["seconds"]
+        shown = (f"{value:.2f} s" if value >= 0.1 else f"{value * 1e3:.1f} ms" if value >= 1e-3
+                 else f"{value * 1e6:.3g} us")
+        lines.append(f"| {r['case']} | {r['kind']} | {shown} |")
+    return {"lights_cost": "\n".join(lines)}
+
+
 PROCESS_CASES = {
     "python -c pass (floor)": "pass",
     "import colour (the bound for a CIE light)": "import colour",

@@ -34,11 +34,11 @@ from typing import Callable
 
 import numpy as np
 
+# UV_BAND_NM: the UV band added to the colour-matching functions (nm), the light's UV below
+# the visible carried as a fourth channel; the same band as the bispectral study's
+from catalog.optics.bispectral.study import UV_BAND_NM
 from catalog.optics.spectra import GRID_NM
 
-#: The UV band added to the colour-matching functions (nm): the light's UV below the
-#: visible, carried as a fourth channel.
-UV_BAND_NM = (300.0, 379.0)
 #: Box edges (nm) of the per-light basis: UV + blue, green, red.
 LIGHT_BOX_EDGES_NM = (300.0, 490.0, 580.0, 781.0)
 LIGHT_BOX_EDGES_UV_NM = (300.0, 380.0, 490.0, 580.0, 781.0)

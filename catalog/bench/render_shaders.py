@@ -30,6 +30,66 @@ from catalog.core.resources import PROJECT_ROOT as ROOT  # noqa: E402
 
 from catalog.core.resources import FABRIC_DIR  # noqa: E402
 
+RESULT_JSON = "benchmarks/bench_render.json"
+
+# the docs' names of the variants (tools/docs_figures.py); a variant not named here keeps
+# its benchmark label
+_DOC_LABELS = {
+    "trivial": "trivial (constant colour, same mesh/vertex shader/target/depth)",
+    "floor + normal as colour (one varying)": "*context:* floor + normal as colour (one varying)",
+    "floor + least eq. 5-7 work (2 lights x 2 HG lobes, isotropic)":
+        "*context:* floor + least eq. 5-7 work (2 lights x 2 HG lobes)",
+    "rgb off": "RGB, fluorescence off, see-through",
+    "rgb paper": "RGB, paper",
+    "rgb physical": "**RGB, physical (the full shader)**",
+    "rgb off, no see-through": "RGB, off, no see-through (direct = 0)",
+    "rgb physical, scene values as uniforms (not specialised)":
+        "RGB, physical, scene values as uniforms (not specialised)",
+    "6 bands physical": "6 bands, physical",
+    "9 bands physical": "9 bands, physical",
+    "16 bands physical": "16 bands, physical",
+    "whole frame (rgb physical: background, room, curtain, tone map)":
+        "whole frame (room, curtain, background, tone map)",
+}
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``render_shaders``: every variant, wall and CPU medians and the best round, each over
+    the trivial shader (docs/render.md); ``render_shaders_brief``: the rows BENCHMARKS.md
+    shows, the band counts on one row."""
+    rows = {r["variant"]: r for r in result["rows"]}
+    w, h = result["size"]
+    full = [f"| variant (curtain pass, {w}x{h}) | wall ms | x trivial | CPU ms | x trivial "
+            "| best x trivial |", "|---|---|---|---|---|---|"]
+    for r in result["rows"]:
+        bold = r["variant"] == "rgb physical"
+        ratio, cpu_ratio = f"{r['ratio']:.2f}", f"{r['cpu_ratio']:.2f}"
+        if bold:
+            ratio, cpu_ratio = f"**{ratio}**", f"**{cpu_ratio}**"
+        full.append(f"| {_DOC_LABELS.get(r['variant'], r['variant'])} | {r['ms']:.1f} | {ratio} | "
+                    f"{r['cpu_ms']:.1f} | {cpu_ratio} | {r['best_ratio']:.2f} |")
+
+    def one(label: str, key: str) -> str:
+        return f"| {label} | {rows[key]['ms']:.1f} | {rows[key]['ratio']:.2f} |"
+    bands = [rows[f"{n} bands physical"] for n in (6, 9, 16) if f"{n} bands physical" in rows]
+    brief = ["| variant | ms | x trivial |", "|---|---|---|",
+             one("trivial (constant colour)", "trivial"),
+             one("context: the least eq. 5-7 arithmetic (2 lights x 2 HG lobes)",
+                 "floor + least eq. 5-7 work (2 lights x 2 HG lobes, isotropic)"),
+             f"| **RGB, physical (the full shader)** | {rows['rgb physical']['ms']:.1f} | "
+             f"**{rows['rgb physical']['ratio']:.2f}** |",
+             one("RGB, fluorescence off", "rgb off"),
+             one("RGB, physical, values as uniforms instead of compiled in",
+                 "rgb physical, scene values as uniforms (not specialised)")]
+    if bands:
+        brief.append("| 6 / 9 / 16 bands, physical | "
+                     + " / ".join(f"{b['ms']:.1f}" for b in bands) + " | "
+                     + " / ".join(f"{b['ratio']:.2f}" for b in bands) + " |")
+    brief.append(one("whole frame (room, curtain, background, tone map)",
+                     "whole frame (rgb physical: background, room, curtain, tone map)"))
+    return {"render_shaders": "\n".join(full), "render_shaders_brief": "\n".join(brief)}
+
+
 FALLBACK_PRESET = """schema = 1
 name = "bench-lace"
 display_name = "bench lace (hand-written)"

@@ -20,13 +20,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from catalog.cloth.params import ClothParams
+from catalog.cloth.params import STRAIN_TOLERANCE, ClothParams
 from catalog.cloth.state import ClothState, SolverConstants
 from catalog.cloth.topology import SELECTORS
 from catalog.cloth.wind import wind_velocity
-
-#: Strain above the limit that the last substep's sweeps accept before stopping.
-STRAIN_TOLERANCE = 5e-4
 
 
 def grid_normals(x: np.ndarray) -> np.ndarray:

@@ -14,12 +14,12 @@ import math
 import numpy as np
 from numba import njit
 
+from catalog.cloth.params import STRAIN_TOLERANCE
+
 # fp indices
 DAMPING, GRAVITY, AERO, WIND_SPEED, WIND_X, WIND_Y, WIND_Z, GUST, GUST_LENGTH, GUST_PERIOD, \
     MAX_STRETCH, FLOOR, WALL, CONTACT_DAMPING, RING_SPEED, STRAIN_PASSES = range(16)
 FP_SIZE = 16
-#: Strain above the limit that the last substep's sweeps accept before stopping.
-STRAIN_TOLERANCE = 5e-4
 
 
 @njit(cache=True, inline="always")

@@ -24,6 +24,9 @@ from catalog.core.errors import InputError
 GRAVITY_M_S2 = 9.80665
 #: Air density at 20 C, sea level, kg m^-3.
 AIR_DENSITY_KG_M3 = 1.204
+#: Strain above the limit that the last substep's sweeps accept before stopping (both cpu
+#: backends; the gpu backend runs a fixed number of sweeps instead).
+STRAIN_TOLERANCE = 5e-4
 
 #: Defaults by weave: (areal density kg/m^2, stretch stiffness N/m, bend stiffness N/m).
 #: Orders of magnitude for curtain fabrics: a voile or lace is light and open, a plain

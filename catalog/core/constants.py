@@ -6,6 +6,9 @@ by catalog.gl.shaderlib into every program), never as a second literal in GLSL."
 #: 540 THz). XYZ = 683 sum cmf(l) S(l) dl puts Y in lux for an irradiance, cd m^-2 for a radiance.
 LUMINOUS_EFFICACY_LM_W = 683.0
 
+#: Relative luminance of linear sRGB / Rec. 709 primaries (Y = 0.2126 R + 0.7152 G + 0.0722 B).
+LUMA_REC709 = (0.2126, 0.7152, 0.0722)
+
 #: The fluorescence modes of eq. 8 (docs/model.md section 6): none, the paper's, physical.
 FLUORESCENCE_MODES = ("off", "paper", "physical")
 #: The modes that draw fluorescence (the command lines' --mode choices).

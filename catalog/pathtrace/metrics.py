@@ -17,9 +17,11 @@ import math
 
 import numpy as np
 
+from catalog.core.constants import LUMA_REC709
+
 #: FLIP's observer: pixels per degree of visual angle (FLIP's default viewing condition).
 PIXELS_PER_DEGREE = 67.0
-LUMA = np.array([0.2126, 0.7152, 0.0722])
+LUMA = np.array(LUMA_REC709)
 
 
 def display(linear: np.ndarray, exposure: float, white_balance=None) -> np.ndarray:

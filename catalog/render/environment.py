@@ -19,9 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
+from catalog.core.constants import LUMA_REC709
 from catalog.core.errors import InputError
 
-LUMA = np.array([0.2126, 0.7152, 0.0722])
+LUMA = np.array(LUMA_REC709)
 #: The smallest image accepted (width x height).
 MIN_SIZE = (8, 4)
 

@@ -45,7 +45,7 @@ CANDIDATE_EDGES = {
 }
 
 #: The model the renderer carries: the candidate chosen on the selection lights by
-#: catalog/benchsuite/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
+#: catalog/bench/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
 CHOSEN = "14 bands: every 10 nm below 430"
 DEFAULT_EDGES_NM = CANDIDATE_EDGES[CHOSEN]
 
