@@ -272,3 +272,52 @@ def test_site_is_whole(web_site):
     # no reference to the network or to fetch in the page's code
     page = (out / "app.js").read_text() + (out / "index.html").read_text()
     assert "http://" not in page and "https://" not in page and "fetch(" not in page
+
+
+def test_float_texels_quantised_within_half_a_step():
+    """encode_texels -> the page's decoding (decode_texels does the page's arithmetic): every
+    float32 texel within half a quantum of its channel's range (+ float32 rounding), 8-bit
+    textures unchanged, a constant channel exact; 16 bits take half the bytes of float32."""
+    from catalog.web.export import decode_texels, encode_texels
+
+    rng = np.random.default_rng(3)
+    texels = np.stack([rng.uniform(-0.7, 0.7, 500), rng.uniform(-1, 1, 500),
+                       np.full(500, 0.25), rng.uniform(0, 1, 500)], axis=1).astype("f4")
+    for bits in (8, 16):
+        desc = {"dtype": "f4", "components": 4}
+        enc = encode_texels(texels.tobytes(), desc, bits=bits)
+        back = decode_texels({**desc, **enc}).reshape(-1, 4)
+        step = (texels.max(axis=0) - texels.min(axis=0)) / ((1 << bits) - 1)
+        err = np.abs(back.astype(np.float64) - texels)
+        assert np.all(err <= step / 2 + 1e-6), (bits, err.max(axis=0), step)
+        assert np.all(back[:, 2] == np.float32(0.25))
+        float_b64 = len(encode_texels(texels.tobytes(), {"dtype": "f1"})["data"])
+        assert len(enc["data"]) <= float_b64 * bits / 32 + 4
+    raw = bytes(range(256))
+    assert decode_texels({"dtype": "f1", "components": 4, **encode_texels(raw, {"dtype": "f1", "components": 4})}).tobytes() == raw
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_site_carries_each_fabrics_pattern(web_site):
+    """The page shows the desktop's patterned cloth (issue 12): the curtain program is built
+    with PATTERN and OIT, and each fabric's pattern texture reaches data.js quantised to
+    16 bits, decoding to the desktop's texels within half a quantum."""
+    from catalog.presets import load_preset
+    from catalog.core.resources import FABRIC_DIR
+    from catalog.presets.patterns import load_pattern
+    from catalog.web.export import DESKTOP_MODES, decode_texels
+
+    assert DESKTOP_MODES["patterned"] is True
+    out, report = web_site
+    text = (out / "data.js").read_text()
+    data = json.loads(text[len("window.CATALOG_DATA = "):].rstrip().rstrip(";"))
+    assert any(s["defines"].get("PATTERN") and s["defines"].get("OIT") for s in data["shaders"])
+    quantised = [t for t in data["textures"].values() if t.get("quantised")]
+    for name in report["fabrics"]:
+        texels = load_pattern(load_preset(FABRIC_DIR / f"{name}.toml")).normal_map()
+        h, w = texels.shape[:2]
+        match = [t for t in quantised if t["size"] == [w, h] and t.get("mipmaps")]
+        assert match, f"no {w}x{h} pattern texture for {name}"
+        best = min(np.abs(decode_texels(t).reshape(h, w, 4) - texels).max() for t in match)
+        assert best <= 2.0 / 65535 + 1e-6

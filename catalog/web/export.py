@@ -39,7 +39,9 @@ SUN_TOKEN = "sun-by-hour"
 SUN_HOURS = tuple(range(6, 19))
 #: Uniforms that depend on the camera: the page computes them (name -> what).
 CAMERA_UNIFORMS = {"u_view_proj": "view_proj", "u_inverse_view_proj": "inverse_view_proj",
-                   "u_camera_position": "camera_position"}
+                   "u_camera_position": "camera_position",
+                   # the patterned cloth's OIT depth weight: FrameRenderer.oit_depth_reference_m
+                   "u_oit_depth_ref": "oit_depth_ref"}
 #: The size of the recorded frame: the page replaces it by its canvas size wherever it
 #: appears (targets, viewports). Odd numbers nothing else in the frame is equal to.
 RECORD_SIZE = (67, 43)
@@ -55,7 +57,7 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: browser test compares against the same modes.
 #: ``antialiasing``: FXAA, a pass the page replays (the renderer's ``auto`` would take MSAA
 #: on a GPU: multisampled renderbuffers and resolves the recording refuses).
-DESKTOP_MODES = {"patterned": False, "room_lighting": False, "bloom": False,
+DESKTOP_MODES = {"patterned": True, "room_lighting": False, "bloom": False,
                  "antialiasing": "fxaa"}
 
 
@@ -176,6 +178,47 @@ def split_commands(commands: list[dict]) -> tuple[list[dict], list]:
 
 def _b64(data: bytes) -> str:
     return base64.b64encode(data).decode("ascii")
+
+
+#: Bits per channel of a float texture the frame filled (the fabrics' pattern textures:
+#: thread normal, coverage) on the page: each channel quantised between its own least and
+#: greatest value, so the error is at most (hi - lo) / (2 (2^bits - 1)) per texel (about
+#: 8e-6 of the range at 16 bits: below what float32 shading shows at 8-bit output). The
+#: page decodes them to float32 and builds the mipmaps itself, as the desktop frame does.
+TEXEL_BITS = 16
+
+
+def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
+    """The page's form of recorded texels: 8-bit textures as they are; float32 ones
+    quantised to ``bits`` (8 or 16) per channel with a per-channel range (``lo``, ``hi``),
+    little-endian, base64."""
+    if texture["dtype"] != "f4":
+        return {"data": _b64(data)}
+    if bits not in (8, 16):
+        raise CatalogError(f"texel bits must be 8 or 16, not {bits}")
+    texels = np.frombuffer(data, dtype="<f4").reshape(-1, texture["components"]).astype(np.float64)
+    if not np.all(np.isfinite(texels)):
+        raise CatalogError("a recorded float texture has non-finite texels")
+    lo, hi = texels.min(axis=0), texels.max(axis=0)
+    top = (1 << bits) - 1
+    span = np.where(hi > lo, hi - lo, 1.0)
+    q = np.rint((texels - lo) / span * top)
+    encoded = q.astype("<u2" if bits == 16 else "u1").tobytes()
+    return {"data": _b64(encoded),
+            "quantised": {"bits": bits, "lo": [float(v) for v in lo],
+                          "hi": [float(v) for v in lo + span]}}
+
+
+def decode_texels(texture: dict) -> np.ndarray:
+    """The page's decoding of :func:`encode_texels` (float32, flat), for the tests."""
+    raw = base64.b64decode(texture["data"])
+    quantised = texture.get("quantised")
+    if quantised is None:
+        return np.frombuffer(raw, dtype="u1")
+    q = np.frombuffer(raw, dtype="<u2" if quantised["bits"] == 16 else "u1")
+    q = q.reshape(-1, texture["components"]).astype(np.float64)
+    lo, hi = np.array(quantised["lo"]), np.array(quantised["hi"])
+    return (lo + q * (hi - lo) / ((1 << quantised["bits"]) - 1)).astype(np.float32).ravel()
 
 
 def fabric_facts(preset) -> dict:
@@ -334,7 +377,8 @@ class SiteExporter:
             "shaders": list(sources.values()),
             "programs": programs,
             "buffers": buffers,
-            "textures": {rid: dict(rec.textures[rid], **({"data": _b64(rec.texture_data[rid])}
+            "textures": {rid: dict(rec.textures[rid], **(encode_texels(rec.texture_data[rid],
+                                                                       rec.textures[rid])
                                                           if rid in rec.texture_data else {}))
                          for rid in sorted(used_textures)},
             "renderbuffers": {rid: rec.renderbuffers[rid] for rid in

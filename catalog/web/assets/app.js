@@ -67,7 +67,9 @@
   function columnMajor(m) { const o = new Array(16); for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) o[c * 4 + r] = m[r * 4 + c]; return o; }
   function cameraUniforms(c, aspect) {
     const vp = Camera.viewProjection(c, aspect);
-    return { view_proj: columnMajor(vp), inverse_view_proj: columnMajor(invert(vp)), camera_position: Camera.position(c) };
+    return { view_proj: columnMajor(vp), inverse_view_proj: columnMajor(invert(vp)), camera_position: Camera.position(c),
+             // FrameRenderer.oit_depth_reference_m: the OIT depth weight's 1 (m)
+             oit_depth_ref: Math.max(0, c.distance_m - 1) };
   }
 
   // ---------------------------------------------------------------- baked cloth
@@ -236,7 +238,12 @@
         let texels = null;
         if (t.data) {  // a texture the frame filled (e.g. a pattern): its texels as recorded
           const bytes = b64bytes(t.data);
-          texels = float ? new Float32Array(bytes.buffer) : bytes;
+          const q = t.quantised;  // float texels quantised per channel (export.encode_texels)
+          if (q) {
+            const ints = q.bits === 16 ? new Uint16Array(bytes.buffer) : bytes, top = (1 << q.bits) - 1;
+            texels = new Float32Array(ints.length);
+            for (let i = 0; i < ints.length; i++) { const ch = i % t.components; texels[i] = q.lo[ch] + ints[i] * (q.hi[ch] - q.lo[ch]) / top; }
+          } else texels = float ? new Float32Array(bytes.buffer) : bytes;
         }
         gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
         gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
