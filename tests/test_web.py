@@ -147,15 +147,19 @@ def test_split_commands_keeps_every_uniform_value_in_order(gl):
     finally:
         renderer.release()
     structure, values = split_commands(commands)
-    uniforms = [c for c in commands if c["op"] == "uniform"]
-    assert len(values) == len(uniforms) > 20
-    assert [c["slot"] for c in structure if c["op"] == "uniform"] == list(range(len(values)))
-    # float32-exact: 9 significant digits give the same float32
-    for command, value in zip(uniforms, values):
-        assert np.array_equal(np.float32(command["value"]), np.float32(value))
+    moved = ("uniform", "buffer_write")  # values of the scene: uniforms, bytes written
+    scene = [c for c in commands if c["op"] in moved]
+    assert len(values) == len(scene) > 20
+    assert [c["slot"] for c in structure if c["op"] in moved] == list(range(len(values)))
+    for command, value in zip(scene, values):
+        if command["op"] == "uniform":  # float32-exact: 9 significant digits give it back
+            assert np.array_equal(np.float32(command["value"]), np.float32(value))
+        else:
+            import base64
+            assert base64.b64decode(value) == command["data"]
     # every other command kept as it was, in order (room, curtain, background, display ...)
-    assert [c for c in structure if c["op"] != "uniform"] == \
-        [c for c in commands if c["op"] != "uniform"]
+    assert [c for c in structure if c["op"] not in moved] == \
+        [c for c in commands if c["op"] not in moved]
     assert sum(c["op"] == "draw" for c in structure) >= 4
 
 
@@ -308,11 +312,15 @@ def test_site_carries_each_fabrics_pattern(web_site):
     from catalog.presets.patterns import load_pattern
     from catalog.web.export import DESKTOP_MODES, decode_texels
 
-    assert DESKTOP_MODES["patterned"] is True
+    assert DESKTOP_MODES["patterned"] is True and DESKTOP_MODES["room_lighting"] is True
     out, report = web_site
     text = (out / "data.js").read_text()
     data = json.loads(text[len("window.CATALOG_DATA = "):].rstrip().rstrip(";"))
     assert any(s["defines"].get("PATTERN") and s["defines"].get("OIT") for s in data["shaders"])
+    # and the room's light passes (issue 13): shadow map, light map, bounce, the lit room
+    files = {f for s in data["shaders"] for f in s["files"]}
+    assert {"room_shadow.frag", "room_lightmap.frag", "room_bounce.frag"} <= files
+    assert any(s["defines"].get("ROOM_LIGHTING") for s in data["shaders"])
     quantised = [t for t in data["textures"].values() if t.get("quantised")]
     for name in report["fabrics"]:
         texels = load_pattern(load_preset(FABRIC_DIR / f"{name}.toml")).normal_map()
