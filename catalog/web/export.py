@@ -277,6 +277,8 @@ class SiteExporter:
         self.structures: list[list[dict]] = []
         self._structure_index: dict[str, int] = {}
         self.curtain_tags: dict[int, str] = {}
+        self.blobs: list[str] = []   # base64 bytes the frames write into buffers (shared)
+        self._blob_index: dict[str, int] = {}
 
     # -- the curtain's buffers: found by their bytes after set_mesh
     def use_mesh(self, positions, normals, uvs, tangents, indices) -> None:
@@ -315,6 +317,9 @@ class SiteExporter:
         rec.start()
         r.render()
         structure, values = split_commands(rec.stop(), self.camera_values())
+        for command in structure:  # bytes written in a frame: shared by the scenes alike
+            if command["op"] == "buffer_write":
+                values[command["slot"]] = {"blob": self._blob(values[command["slot"]])}
         key = hashlib.sha256(json.dumps(structure, sort_keys=True).encode()).hexdigest()
         if key not in self._structure_index:
             self._structure_index[key] = len(self.structures)
@@ -324,6 +329,13 @@ class SiteExporter:
                 "ev100": round(float(ev100), 6),
                 "fluorescence_variant": info["fluorescence_variant"],
                 "illuminance_lx": info["illuminance_lx"]}
+
+    def _blob(self, text: str) -> int:
+        """Index of ``text`` in :attr:`blobs` (added once)."""
+        if text not in self._blob_index:
+            self._blob_index[text] = len(self.blobs)
+            self.blobs.append(text)
+        return self._blob_index[text]
 
     def camera_values(self) -> dict:
         """The recorded frame's camera uniforms (CAMERA_UNIFORMS) as the frame sets them."""

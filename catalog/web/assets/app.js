@@ -328,7 +328,7 @@
           case 'buffer_write': {  // bytes the frame wrote this frame (record.py)
             const b = this.buffer(c.buffer);
             gl.bindVertexArray(null); gl.bindBuffer(b.target, b);
-            gl.bufferSubData(b.target, c.offset, b64bytes(scene.values[c.slot]));
+            gl.bufferSubData(b.target, c.offset, b64bytes(D.blobs[scene.values[c.slot].blob]));
             break;
           }
           case 'mipmaps': {  // a render target's mip chain built again (record.py), on a spare
