@@ -148,15 +148,19 @@ def test_split_commands_keeps_every_uniform_value_in_order(gl):
     finally:
         renderer.release()
     structure, values = split_commands(commands)
-    uniforms = [c for c in commands if c["op"] == "uniform"]
-    assert len(values) == len(uniforms) > 20
-    assert [c["slot"] for c in structure if c["op"] == "uniform"] == list(range(len(values)))
-    # float32-exact: 9 significant digits give the same float32
-    for command, value in zip(uniforms, values):
-        assert np.array_equal(np.float32(command["value"]), np.float32(value))
+    moved = ("uniform", "buffer_write")  # values of the scene: uniforms, bytes written
+    scene = [c for c in commands if c["op"] in moved]
+    assert len(values) == len(scene) > 20
+    assert [c["slot"] for c in structure if c["op"] in moved] == list(range(len(values)))
+    for command, value in zip(scene, values):
+        if command["op"] == "uniform":  # float32-exact: 9 significant digits give it back
+            assert np.array_equal(np.float32(command["value"]), np.float32(value))
+        else:
+            import base64
+            assert base64.b64decode(value) == command["data"]
     # every other command kept as it was, in order (room, curtain, background, display ...)
-    assert [c for c in structure if c["op"] != "uniform"] == \
-        [c for c in commands if c["op"] != "uniform"]
+    assert [c for c in structure if c["op"] not in moved] == \
+        [c for c in commands if c["op"] not in moved]
     assert sum(c["op"] == "draw" for c in structure) >= 4
 
 
@@ -273,3 +277,58 @@ def test_site_is_whole(web_site):
     # no reference to the network or to fetch in the page's code
     page = (out / "app.js").read_text() + (out / "index.html").read_text()
     assert "http://" not in page and "https://" not in page and "fetch(" not in page
+
+
+def test_float_texels_quantised_within_half_a_step():
+    """encode_texels -> the page's decoding (decode_texels does the page's arithmetic): every
+    float32 texel within half a quantum of its channel's range (+ float32 rounding), 8-bit
+    textures unchanged, a constant channel exact; 16 bits take half the bytes of float32."""
+    from catalog.web.export import decode_texels, encode_texels
+
+    rng = np.random.default_rng(3)
+    texels = np.stack([rng.uniform(-0.7, 0.7, 500), rng.uniform(-1, 1, 500),
+                       np.full(500, 0.25), rng.uniform(0, 1, 500)], axis=1).astype("f4")
+    for bits in (8, 16):
+        desc = {"dtype": "f4", "components": 4}
+        enc = encode_texels(texels.tobytes(), desc, bits=bits)
+        back = decode_texels({**desc, **enc}).reshape(-1, 4)
+        step = (texels.max(axis=0) - texels.min(axis=0)) / ((1 << bits) - 1)
+        err = np.abs(back.astype(np.float64) - texels)
+        assert np.all(err <= step / 2 + 1e-6), (bits, err.max(axis=0), step)
+        assert np.all(back[:, 2] == np.float32(0.25))
+        float_b64 = len(encode_texels(texels.tobytes(), {"dtype": "f1"})["data"])
+        assert len(enc["data"]) <= float_b64 * bits / 32 + 4
+    raw = bytes(range(256))
+    assert decode_texels({"dtype": "f1", "components": 4, **encode_texels(raw, {"dtype": "f1", "components": 4})}).tobytes() == raw
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_site_carries_each_fabrics_pattern(web_site):
+    """The page shows the desktop's patterned cloth (issue 12): the curtain program is built
+    with PATTERN and OIT, and each fabric's pattern texture reaches data.js quantised
+    (TEXEL_BITS), decoding to the desktop's texels within half a quantum per channel."""
+    from catalog.presets import load_preset
+    from catalog.core.resources import FABRIC_DIR
+    from catalog.presets.patterns import load_pattern
+    from catalog.web.export import DESKTOP_MODES, decode_texels
+
+    assert DESKTOP_MODES["patterned"] is True and DESKTOP_MODES["room_lighting"] is True
+    out, report = web_site
+    text = (out / "data.js").read_text()
+    data = json.loads(text[len("window.CATALOG_DATA = "):].rstrip().rstrip(";"))
+    assert any(s["defines"].get("PATTERN") and s["defines"].get("OIT") for s in data["shaders"])
+    # and the room's light passes (issue 13): shadow map, light map, bounce, the lit room
+    files = {f for s in data["shaders"] for f in s["files"]}
+    assert {"room_shadow.frag", "room_lightmap.frag", "room_bounce.frag"} <= files
+    assert any(s["defines"].get("ROOM_LIGHTING") for s in data["shaders"])
+    quantised = [t for t in data["textures"].values() if t.get("quantised")]
+    for name in report["fabrics"]:
+        texels = load_pattern(load_preset(FABRIC_DIR / f"{name}.toml")).normal_map()
+        h, w = texels.shape[:2]
+        match = [t for t in quantised if t["size"] == [w, h] and t.get("mipmaps")]
+        assert match, f"no {w}x{h} pattern texture for {name}"
+        q = match[0]["quantised"]
+        half_step = (np.array(q["hi"]) - np.array(q["lo"])) / (2 * ((1 << q["bits"]) - 1))
+        assert min(np.max(np.abs(decode_texels(t).reshape(h, w, 4) - texels) - half_step)
+                   for t in match) <= 1e-6

@@ -1233,6 +1233,7 @@ class FrameRenderer:
     def invalidate_room_light(self) -> None:
         """Redraw the room's light at the next frame (e.g. after the cloth moved on the GPU)."""
         self._room_key = None
+        self._room_order_key = None  # and sort the room's triangles toward the light again
 
     def _timed(self, profile, name, work) -> None:
         """Run ``work()``; with a ``profile`` dict, finish the GL queue and add its wall time (s)."""

@@ -39,7 +39,9 @@ SUN_TOKEN = "sun-by-hour"
 SUN_HOURS = tuple(range(6, 19))
 #: Uniforms that depend on the camera: the page computes them (name -> what).
 CAMERA_UNIFORMS = {"u_view_proj": "view_proj", "u_inverse_view_proj": "inverse_view_proj",
-                   "u_camera_position": "camera_position"}
+                   "u_camera_position": "camera_position",
+                   # the patterned cloth's OIT depth weight: FrameRenderer.oit_depth_reference_m
+                   "u_oit_depth_ref": "oit_depth_ref"}
 #: The size of the recorded frame: the page replaces it by its canvas size wherever it
 #: appears (targets, viewports). Odd numbers nothing else in the frame is equal to.
 RECORD_SIZE = (67, 43)
@@ -47,15 +49,15 @@ RECORD_SIZE = (67, 43)
 FLUORESCENCE = {"on": "physical", "off": "off"}
 #: The orbit limits of the page: the camera stays in the room (in front of the window).
 ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_m": [1.2, 4.0]}
-#: The desktop frame's modes the page shows. Not on the page yet (docs/web.md): the thread
-#: patterns (issue 12: per-fabric normal/coverage maps up to 1024^2 float texels, the
-#: layers' order-independent transparency), the room lit through the curtain (issue 13:
-#: shadow map, luminaire, bounce, recomputed when the scene changes) and the glare. The page
-#: shows the desktop frame with these off (its flat-cloth, constant-room modes), and the
-#: browser test compares against the same modes.
+#: The desktop frame's modes the page shows: the thread patterns (issue 12: each fabric's
+#: normal/coverage texture, quantised to TEXEL_BITS on the page; the layers' order-independent
+#: transparency) and the room lit through the curtain (issue 13: transmittance shadow map,
+#: window capture, light map with bounce, recorded with every scene and replayed by the page
+#: each frame, so that they follow its moving cloth). Not on the page: the glare (off, as on
+#: llvmpipe); the browser test compares against the same modes.
 #: ``antialiasing``: FXAA, a pass the page replays (the renderer's ``auto`` would take MSAA
 #: on a GPU: multisampled renderbuffers and resolves the recording refuses).
-DESKTOP_MODES = {"patterned": False, "room_lighting": False, "bloom": False,
+DESKTOP_MODES = {"patterned": True, "room_lighting": True, "bloom": False,
                  "antialiasing": "fxaa"}
 
 
@@ -153,15 +155,28 @@ def _clean(value):
     return value
 
 
-def split_commands(commands: list[dict]) -> tuple[list[dict], list]:
-    """(structure, values): every uniform command's value moved into ``values`` (in order)."""
+def _same(a, b) -> bool:
+    return (isinstance(a, list) == isinstance(b, list)
+            and np.allclose(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64),
+                            rtol=1e-5, atol=1e-6) if np.size(a) == np.size(b) else False)
+
+
+def split_commands(commands: list[dict], camera_values: dict | None = None
+                   ) -> tuple[list[dict], list]:
+    """(structure, values): every uniform command's value moved into ``values`` (in order).
+    ``camera_values``: the frame camera's value of each of CAMERA_UNIFORMS; a uniform of that
+    name set to it is marked ``camera`` (the page computes it from its own camera); set to
+    another (e.g. the room's window capture or the light's view) it is an ordinary value."""
     structure, values = [], []
+    camera_values = camera_values or {}
     inverse = [_f32(1.0 / RECORD_SIZE[0]), _f32(1.0 / RECORD_SIZE[1])]
     for command in commands:
         if command["op"] == "uniform":
             entry = {"op": "uniform", "program": command["program"], "name": command["name"],
                      "slot": len(values)}
             value = _clean(command["value"])
+            if command["name"] in camera_values and _same(value, camera_values[command["name"]]):
+                entry["camera"] = True
             # a value that is the recorded frame's size or texel size: the page puts its own
             if value == inverse:
                 entry["canvas"] = "texel"
@@ -169,6 +184,10 @@ def split_commands(commands: list[dict]) -> tuple[list[dict], list]:
                 entry["canvas"] = "size"
             structure.append(entry)
             values.append(value)
+        elif command["op"] == "buffer_write":  # the bytes are the scene's, the place is not
+            structure.append({k: v for k, v in command.items() if k != "data"}
+                             | {"slot": len(values)})
+            values.append(_b64(command["data"]))
         else:
             structure.append(command)
     return structure, values
@@ -176,6 +195,49 @@ def split_commands(commands: list[dict]) -> tuple[list[dict], list]:
 
 def _b64(data: bytes) -> str:
     return base64.b64encode(data).decode("ascii")
+
+
+#: Bits per channel of a float texture the frame filled (the fabrics' pattern textures:
+#: thread normal, coverage) on the page: each channel quantised between its own least and
+#: greatest value, so the error is at most (hi - lo) / (2 (2^bits - 1)) per texel. 8 bits:
+#: a quarter of the float32 bytes; the browser test's frames still match the EGL frame
+#: (fluoro-pink under D65: mean 0.046/255 against 0.025/255 at 16 bits, no pixel off but
+#: one-pixel edge shifts). The page decodes them to float32 and builds the mipmaps itself,
+#: as the desktop frame does.
+TEXEL_BITS = 8
+
+
+def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
+    """The page's form of recorded texels: 8-bit textures as they are; float32 ones
+    quantised to ``bits`` (8 or 16) per channel with a per-channel range (``lo``, ``hi``),
+    little-endian, base64."""
+    if texture["dtype"] != "f4":
+        return {"data": _b64(data)}
+    if bits not in (8, 16):
+        raise CatalogError(f"texel bits must be 8 or 16, not {bits}")
+    texels = np.frombuffer(data, dtype="<f4").reshape(-1, texture["components"]).astype(np.float64)
+    if not np.all(np.isfinite(texels)):
+        raise CatalogError("a recorded float texture has non-finite texels")
+    lo, hi = texels.min(axis=0), texels.max(axis=0)
+    top = (1 << bits) - 1
+    span = np.where(hi > lo, hi - lo, 1.0)
+    q = np.rint((texels - lo) / span * top)
+    encoded = q.astype("<u2" if bits == 16 else "u1").tobytes()
+    return {"data": _b64(encoded),
+            "quantised": {"bits": bits, "lo": [float(v) for v in lo],
+                          "hi": [float(v) for v in lo + span]}}
+
+
+def decode_texels(texture: dict) -> np.ndarray:
+    """The page's decoding of :func:`encode_texels` (float32, flat), for the tests."""
+    raw = base64.b64decode(texture["data"])
+    quantised = texture.get("quantised")
+    if quantised is None:
+        return np.frombuffer(raw, dtype="u1")
+    q = np.frombuffer(raw, dtype="<u2" if quantised["bits"] == 16 else "u1")
+    q = q.reshape(-1, texture["components"]).astype(np.float64)
+    lo, hi = np.array(quantised["lo"]), np.array(quantised["hi"])
+    return (lo + q * (hi - lo) / ((1 << quantised["bits"]) - 1)).astype(np.float32).ravel()
 
 
 def fabric_facts(preset) -> dict:
@@ -217,6 +279,8 @@ class SiteExporter:
         self.structures: list[list[dict]] = []
         self._structure_index: dict[str, int] = {}
         self.curtain_tags: dict[int, str] = {}
+        self.blobs: list[str] = []   # base64 bytes the frames write into buffers (shared)
+        self._blob_index: dict[str, int] = {}
 
     # -- the curtain's buffers: found by their bytes after set_mesh
     def use_mesh(self, positions, normals, uvs, tangents, indices) -> None:
@@ -251,9 +315,13 @@ class SiteExporter:
         r = self.renderer
         r.set_ev(ev100)
         rec = self.ctx.recording
+        r.invalidate_room_light()  # the room's light passes are part of every recorded frame
         rec.start()
         r.render()
-        structure, values = split_commands(rec.stop())
+        structure, values = split_commands(rec.stop(), self.camera_values())
+        for command in structure:  # bytes written in a frame: shared by the scenes alike
+            if command["op"] == "buffer_write":
+                values[command["slot"]] = {"blob": self._blob(values[command["slot"]])}
         key = hashlib.sha256(json.dumps(structure, sort_keys=True).encode()).hexdigest()
         if key not in self._structure_index:
             self._structure_index[key] = len(self.structures)
@@ -263,6 +331,25 @@ class SiteExporter:
                 "ev100": round(float(ev100), 6),
                 "fluorescence_variant": info["fluorescence_variant"],
                 "illuminance_lx": info["illuminance_lx"]}
+
+    def _blob(self, text: str) -> int:
+        """Index of ``text`` in :attr:`blobs` (added once)."""
+        if text not in self._blob_index:
+            self._blob_index[text] = len(self.blobs)
+            self.blobs.append(text)
+        return self._blob_index[text]
+
+    def camera_values(self) -> dict:
+        """The recorded frame's camera uniforms (CAMERA_UNIFORMS) as the frame sets them."""
+        from catalog.render.camera import gl_bytes  # noqa: PLC0415
+
+        r = self.renderer
+        view_proj = r.camera.view_projection(RECORD_SIZE[0] / RECORD_SIZE[1])
+        matrix = lambda m: [float(v) for v in np.frombuffer(gl_bytes(m), dtype=np.float32)]  # noqa: E731
+        return {"u_view_proj": matrix(view_proj),
+                "u_inverse_view_proj": matrix(np.linalg.inv(view_proj)),
+                "u_camera_position": [float(v) for v in r.camera.position],
+                "u_oit_depth_ref": float(r.oit_depth_reference_m())}
 
     def check_camera_uniforms(self, preset, light: LightChoice) -> None:
         """Refuse a desktop frame whose other uniforms depend on the camera: the page would
@@ -278,7 +365,7 @@ class SiteExporter:
             raise CatalogError("the desktop frame's passes change with the camera; the web "
                                "page cannot replay that")
         for command in structure:
-            if command["op"] == "uniform" and command["name"] not in CAMERA_UNIFORMS:
+            if command["op"] == "uniform" and not command.get("camera"):
                 if first["values"][command["slot"]] != second["values"][command["slot"]]:
                     raise CatalogError(f"uniform {command['name']} depends on the camera; the "
                                        "web page computes only "
@@ -330,11 +417,14 @@ class SiteExporter:
         for rid in sorted(used_buffers):
             tag = self.curtain_tags.get(rid)
             buffers[rid] = {"curtain": tag} if tag else {"data": _b64(rec.buffers[rid])}
+            if any(v["index_buffer"] == rid for v in vaos.values()):
+                buffers[rid]["index"] = True  # WebGL binds a buffer to one target for life
         return {
             "shaders": list(sources.values()),
             "programs": programs,
             "buffers": buffers,
-            "textures": {rid: dict(rec.textures[rid], **({"data": _b64(rec.texture_data[rid])}
+            "textures": {rid: dict(rec.textures[rid], **(encode_texels(rec.texture_data[rid],
+                                                                       rec.textures[rid])
                                                           if rid in rec.texture_data else {}))
                          for rid in sorted(used_textures)},
             "renderbuffers": {rid: rec.renderbuffers[rid] for rid in

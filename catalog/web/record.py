@@ -79,6 +79,10 @@ class _Buffer(_Proxy):
         data = bytes(data)
         old = self._rec.buffers[self.rid]
         self._rec.buffers[self.rid] = old[:offset] + data + old[offset + len(data):]
+        # written within a frame (e.g. the room's triangles sorted toward the key light):
+        # a command the page replays with the scene's bytes
+        self._rec.note({"op": "buffer_write", "buffer": self.rid, "offset": int(offset),
+                        "data": data})
         return self._real.write(data, offset=offset)
 
 
@@ -101,7 +105,14 @@ class _Texture(_Proxy):
     def build_mipmaps(self, base: int = 0, max_level: int = 1000):
         if base != 0:
             raise CatalogError("the web page replays only full mipmap chains")
-        self._rec.textures[self.rid]["mipmaps"] = True  # the page calls generateMipmap
+        if max_level < 1000 and self._rec.commands is not None:
+            raise CatalogError("the web page replays only full mipmap chains")
+        # made with mipmaps: the page calls generateMipmap after filling it; built again
+        # within a frame (a render target, e.g. the room's shadow map): a command the page
+        # replays at the same place
+        self._rec.textures[self.rid]["mipmaps"] = True
+        if self.rid not in self._rec.texture_data:  # texels drawn by the frame, not given
+            self._rec.note({"op": "mipmaps", "texture": self.rid})
         return self._real.build_mipmaps(base, max_level)
 
     @property
@@ -131,7 +142,10 @@ class _Framebuffer(_Proxy):
     def use(self):
         self._rec.bound_framebuffer = self
         self._rec.note({"op": "framebuffer", "framebuffer": self.rid})
-        return self._real.use()
+        result = self._real.use()
+        # moderngl's use() also sets the viewport to the framebuffer's (GL's bind does not)
+        self._rec.note({"op": "viewport", "viewport": [int(v) for v in self._real.viewport]})
+        return result
 
     def clear(self, red=0.0, green=0.0, blue=0.0, alpha=0.0, depth=1.0, viewport=None, **kw):
         self._rec.note({"op": "clear", "framebuffer": self.rid,
@@ -179,12 +193,15 @@ class _Program(_Proxy):
 
 
 class _VertexArray(_Proxy):
-    def render(self, mode=None, vertices: int = -1, **kw):
+    def render(self, mode=None, vertices: int = -1, first: int = 0, **kw):
+        if kw:
+            raise CatalogError(f"the web page replays draws without {', '.join(kw)}")
         self._rec.note({"op": "draw", "vertex_array": self.rid, "mode": int(mode)
-                        if mode is not None else 4, "vertices": int(vertices)})
+                        if mode is not None else 4, "vertices": int(vertices),
+                        "first": int(first)})
         if mode is None:
-            return self._real.render(vertices=vertices, **kw)
-        return self._real.render(mode, vertices=vertices, **kw)
+            return self._real.render(vertices=vertices, first=first)
+        return self._real.render(mode, vertices=vertices, first=first)
 
 
 #: Context attributes passed through unrecorded: they read, wait or release, and change

@@ -171,6 +171,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             "camera_uniforms": export.CAMERA_UNIFORMS,
             **objects,
             "structures": exporter.structures,
+            "blobs": exporter.blobs,
             "scenes": scenes,
             "fabrics": [{"name": p.name, "display_name": p.display_name,
                          "facts": export.fabric_facts(p), "swatch": swatches[p.name],

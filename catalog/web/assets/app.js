@@ -67,7 +67,9 @@
   function columnMajor(m) { const o = new Array(16); for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) o[c * 4 + r] = m[r * 4 + c]; return o; }
   function cameraUniforms(c, aspect) {
     const vp = Camera.viewProjection(c, aspect);
-    return { view_proj: columnMajor(vp), inverse_view_proj: columnMajor(invert(vp)), camera_position: Camera.position(c) };
+    return { view_proj: columnMajor(vp), inverse_view_proj: columnMajor(invert(vp)), camera_position: Camera.position(c),
+             // FrameRenderer.oit_depth_reference_m: the OIT depth weight's 1 (m)
+             oit_depth_ref: Math.max(0, c.distance_m - 1) };
   }
 
   // ---------------------------------------------------------------- baked cloth
@@ -163,7 +165,7 @@
     buffer(rid) {
       if (this.buffers[rid]) return this.buffers[rid];
       const gl = this.gl, desc = D.buffers[rid], b = gl.createBuffer();
-      const target = desc.curtain === 'index' ? gl.ELEMENT_ARRAY_BUFFER : gl.ARRAY_BUFFER;
+      const target = desc.curtain === 'index' || desc.index ? gl.ELEMENT_ARRAY_BUFFER : gl.ARRAY_BUFFER;
       gl.bindBuffer(target, b);
       if (desc.data) { const bytes = b64bytes(desc.data); gl.bufferData(target, bytes, gl.STATIC_DRAW); b.bytes = bytes.length; }
       b.curtain = desc.curtain; b.target = target;
@@ -230,18 +232,25 @@
       for (const [rid, t] of Object.entries(D.textures)) {
         const tex = gl.createTexture(), s = sized(t.size);
         gl.bindTexture(gl.TEXTURE_2D, tex);
-        const float = t.dtype === 'f4', c = t.components - 1;
+        const half = t.dtype === 'f2', float = t.dtype === 'f4' || half, c = t.components - 1;
+        if (t.data && half) throw new Error('half-float texels given by the frame: not replayed');
         const formats = [gl.RED, gl.RG, gl.RGB, gl.RGBA];
-        const internal = float ? [gl.R32F, gl.RG32F, gl.RGB32F, gl.RGBA32F] : [gl.R8, gl.RG8, gl.RGB8, gl.RGBA8];
+        const internal = half ? [gl.R16F, gl.RG16F, gl.RGB16F, gl.RGBA16F]
+          : float ? [gl.R32F, gl.RG32F, gl.RGB32F, gl.RGBA32F] : [gl.R8, gl.RG8, gl.RGB8, gl.RGBA8];
         let texels = null;
         if (t.data) {  // a texture the frame filled (e.g. a pattern): its texels as recorded
           const bytes = b64bytes(t.data);
-          texels = float ? new Float32Array(bytes.buffer) : bytes;
+          const q = t.quantised;  // float texels quantised per channel (export.encode_texels)
+          if (q) {
+            const ints = q.bits === 16 ? new Uint16Array(bytes.buffer) : bytes, top = (1 << q.bits) - 1;
+            texels = new Float32Array(ints.length);
+            for (let i = 0; i < ints.length; i++) { const ch = i % t.components; texels[i] = q.lo[ch] + ints[i] * (q.hi[ch] - q.lo[ch]) / top; }
+          } else texels = float ? new Float32Array(bytes.buffer) : bytes;
         }
         gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
-        gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
+        gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], half ? gl.HALF_FLOAT : float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
         // float textures filter linearly only with OES_texture_float_linear
-        const linearOk = !float || this.floatLinear;
+        const linearOk = !float || half || this.floatLinear;  // half floats always filter
         const pick = (f) => (linearOk ? f : (f === gl.LINEAR || f === gl.LINEAR_MIPMAP_LINEAR || f === gl.LINEAR_MIPMAP_NEAREST || f === gl.NEAREST_MIPMAP_LINEAR ? gl.NEAREST : f));
         const filter = t.filter || [gl.LINEAR, gl.LINEAR];
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, t.mipmaps ? pick(filter[0]) : pick(filter[0] === gl.LINEAR_MIPMAP_LINEAR ? gl.LINEAR : filter[0]));
@@ -316,12 +325,24 @@
           case 'blend_func': c.factors.length === 4 ? gl.blendFuncSeparate(...c.factors) : gl.blendFunc(...c.factors); break;
           case 'texture':
             gl.activeTexture(gl.TEXTURE0 + c.unit); gl.bindTexture(gl.TEXTURE_2D, this.targets[c.texture].tex); break;
+          case 'buffer_write': {  // bytes the frame wrote this frame (record.py)
+            const b = this.buffer(c.buffer);
+            gl.bindVertexArray(null); gl.bindBuffer(b.target, b);
+            gl.bufferSubData(b.target, c.offset, b64bytes(D.blobs[scene.values[c.slot].blob]));
+            break;
+          }
+          case 'mipmaps': {  // a render target's mip chain built again (record.py), on a spare
+            // unit (as moderngl does) so that no unit a later draw samples changes
+            const units = gl.getParameter(gl.MAX_COMBINED_TEXTURE_IMAGE_UNITS);
+            gl.activeTexture(gl.TEXTURE0 + units - 1);
+            gl.bindTexture(gl.TEXTURE_2D, this.targets[c.texture].tex); gl.generateMipmap(gl.TEXTURE_2D); break;
+          }
           case 'uniform': {
             const p = this.program(c.program);
             if (current !== p.program) { gl.useProgram(p.program); current = p.program; }
             const u = p.uniforms[c.name];
             if (!u) break;
-            const which = D.camera_uniforms[c.name];
+            const which = c.camera ? D.camera_uniforms[c.name] : null;  // the frame's camera
             const canvas = c.canvas === 'texel' ? [1 / w, 1 / h] : c.canvas === 'size' ? [w, h] : null;
             this.setUniform(u, which ? cam[which] : canvas || scene.values[c.slot]);
             break;
@@ -333,10 +354,10 @@
             gl.bindVertexArray(vao);
             if (vao.indexed) {
               const count = c.vertices >= 0 ? c.vertices : (vao.indexBuffer.curtain ? this.curtainCount : vao.indexBuffer.bytes / 4);
-              gl.drawElements(c.mode, count, gl.UNSIGNED_INT, 0);
+              gl.drawElements(c.mode, count, gl.UNSIGNED_INT, 4 * (c.first || 0));
             } else {
-              const count = c.vertices >= 0 ? c.vertices : vao.content[0].buffer.bytes / vao.content[0].stride;
-              gl.drawArrays(c.mode, 0, count);
+              const count = c.vertices >= 0 ? c.vertices : vao.content[0].buffer.bytes / vao.content[0].stride - (c.first || 0);
+              gl.drawArrays(c.mode, c.first || 0, count);
             }
             gl.bindVertexArray(null);
             break;
