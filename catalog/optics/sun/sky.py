@@ -85,13 +85,7 @@ def preetham_rgb(directions: np.ndarray, to_sun: np.ndarray, turbidity: float) -
     below the horizon get the horizon's value."""
     from catalog.optics.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
 
-    to_sun = np.asarray(to_sun, dtype=np.float64) / np.linalg.norm(to_sun)
-    sun_zenith = math.acos(max(min(to_sun[1], 1.0), -1.0))
-    coefficients = perez_coefficients(turbidity)
-    d = np.asarray(directions, dtype=np.float64)
-    gamma = np.arccos(np.clip(d @ to_sun, -1.0, 1.0))
-    ratio = _perez(coefficients, d[..., 1], gamma) / _perez(coefficients, math.cos(sun_zenith), sun_zenith)
-    xyy = zenith_xyY(turbidity, min(sun_zenith, math.pi / 2)) * ratio
+    xyy = preetham_xyY(directions, to_sun, turbidity)
     x, y, lum = xyy[..., 0], xyy[..., 1], xyy[..., 2]
     xyz = np.stack([x * lum / y, lum, (1.0 - x - y) * lum / y], axis=-1)
     return xyz_to_linear_srgb(xyz)
