@@ -69,17 +69,23 @@ def test_no_seam_at_the_horizon():
         assert np.all(np.abs(hi - lo) <= 0.02 * np.abs(hi))
 
 
-@pytest.mark.slow
-def test_background_pixels_match_the_sky_model(gl):
-    """Curtain open, looking out of the window under the sun: every pixel whose ray leaves
-    through the opening (10 cm inside its edge, off the sun's disc) equals the float64 sky
-    within 0.3 % (float32 exp and acos)."""
+def _looking_out_under_the_sun(gl):
+    """A renderer with the curtain open, looking out of the window under sun:60 (no glare)."""
     r = FrameRenderer(gl, SIZE)
     r.set_fabric("lace-fwa")
     r.set_light("sun:60")
     r.set_curtain_open(True)
     r.set_bloom(False)
     r.set_camera(0.0, 5.0, 1.0)
+    return r
+
+
+@pytest.mark.slow
+def test_background_pixels_match_the_sky_model(gl):
+    """Curtain open, looking out of the window under the sun: every pixel whose ray leaves
+    through the opening (10 cm inside its edge, off the sun's disc) equals the float64 sky
+    within 0.3 % (float32 exp and acos)."""
+    r = _looking_out_under_the_sun(gl)
     r.render()
     img = r.read_linear()
     d, ok = _window_rays(r)
@@ -154,12 +160,7 @@ def test_band_frame_sky_is_the_band_integral_of_the_spectral_sky(gl, n_bands):
     some pixel), so the test can fail."""
     from catalog.render import bands as band_lib
 
-    r = FrameRenderer(gl, SIZE)
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:60")
-    r.set_curtain_open(True)
-    r.set_bloom(False)
-    r.set_camera(0.0, 5.0, 1.0)
+    r = _looking_out_under_the_sun(gl)
     r.set_bands(n_bands)
     r.render()
     img = r.read_linear()

@@ -101,6 +101,16 @@ def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backe
     return row
 
 
+def _write_report(args, fields: dict) -> None:
+    """The run's JSON (the machine, then ``fields``) into ``args.json_out``, atomically."""
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    report = {"machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(),
+                          "python": platform.python_version(), "display": "Xvfb + Mesa llvmpipe"
+                          if args.display is None else args.display}, **fields}
+    write_text_atomic(args.json_out, json.dumps(report, indent=2) + "\n")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=60)
@@ -149,15 +159,8 @@ def main(argv: list[str] | None = None) -> int:
         if xvfb is not None:
             xvfb.terminate()
             xvfb.wait()
-    report = {"machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(),
-                          "python": platform.python_version(), "display": "Xvfb + Mesa llvmpipe"
-                          if args.display is None else args.display},
-              "frames": args.frames, "warmup": args.warmup, "fabric": args.fabric,
-              "light": args.light, "rows": rows}
-    args.json_out.parent.mkdir(parents=True, exist_ok=True)
-    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
-
-    write_text_atomic(args.json_out, json.dumps(report, indent=2) + "\n")
+    _write_report(args, {"frames": args.frames, "warmup": args.warmup, "fabric": args.fabric,
+                         "light": args.light, "rows": rows})
     print(f"wrote {args.json_out}")
     return 0
 
@@ -201,15 +204,9 @@ def main_before_after(args) -> int:
         if xvfb is not None:
             xvfb.terminate()
             xvfb.wait()
-    report = {"machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(),
-                          "python": platform.python_version(), "display": "Xvfb + Mesa llvmpipe"
-                          if args.display is None else args.display},
-              "before": args.before, "rounds": args.rounds, "frames": args.frames,
-              "warmup": args.warmup, "fabric": args.fabric, "light": args.light, "rows": rows}
-    args.json_out.parent.mkdir(parents=True, exist_ok=True)
-    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
-
-    write_text_atomic(args.json_out, json.dumps(report, indent=2) + "\n")
+    _write_report(args, {"before": args.before, "rounds": args.rounds, "frames": args.frames,
+                         "warmup": args.warmup, "fabric": args.fabric, "light": args.light,
+                         "rows": rows})
     print(f"wrote {args.json_out}")
     return 0
 
