@@ -51,7 +51,9 @@ def run(args: argparse.Namespace) -> int:
     reference = [m for m in study.reference_models() if m.matrix.name != matrix.name]
     models = study.with_global_paper_scale(reference + [models])[-1]
     rows = study.study_material(models, lights)
-    banded = bispectral_bands.fit_banded(matrix, base=fit)
+    banded = bispectral_bands.fit_banded(matrix, base=fit,
+                                         residual=bispectral_bands.DEFAULT_RESIDUAL,
+                                         residual_rank=bispectral_bands.DEFAULT_RESIDUAL_RANK)
     per_light = banded_colours(matrix, banded, lights)
     exported = {}
     if args.export:
@@ -80,6 +82,10 @@ def run(args: argparse.Namespace) -> int:
                     "lights": per_light, "model": {
                         "name": bispectral_bands.CHOSEN,
                         "excitation_band_edges_nm": list(banded.edges_nm),
+                        "measured_residual": (None if banded.residual is None else
+                                              "whole" if banded.residual_rank is None
+                                              else f"rank {banded.residual_rank}"),
+                        "stored_numbers": banded.stored_numbers(),
                         "white": WHITE_POINT},
                     "diagnostics": list(study.DIAGNOSTICS), "exported": exported})
         return 0
@@ -116,20 +122,18 @@ WHITE_POINT = ("the light's own XYZ (a perfect white diffuser under it); when th
 
 
 def banded_colours(matrix, banded, lights) -> dict:
-    """Per light: exact XYZ (the whole matrix), the banded model's XYZ as the renderer
-    pre-integrates it (one effective fluorophore per light), Delta E 2000 between them."""
+    """Per light: exact XYZ (the whole matrix), the model's XYZ as the renderer
+    pre-integrates it (the bands as one effective fluorophore per light, plus the measured
+    residual's spectrum under that light), Delta E 2000 between them."""
     from catalog.optics.bispectral import study as study  # noqa: PLC0415
     from catalog.optics.bispectral.matrix import exact_exitance_on_grid, training_light  # noqa: PLC0415
     from catalog.optics.colorimetry import delta_e_2000  # noqa: PLC0415
-    from catalog.optics.fluorescence import emitted_exitance_w_m2_nm  # noqa: PLC0415
 
     out = {}
     for name in lights:
         light = training_light(name)
         exact = study._xyz(exact_exitance_on_grid(matrix, light))
-        effective = banded.effective_material(light)
-        emitted = emitted_exitance_w_m2_nm(effective, light) if effective is not None else 0.0
-        model = study._xyz(banded.reflectance_on_grid() * light + emitted)
+        model = study._xyz(banded.exitance_w_m2_nm(light))
         white = study.white_xyz(light, exact)
         out[name] = {"xyz_exact": exact.tolist(), "xyz_model": model.tolist(),
                      "delta_e_2000": float(delta_e_2000(model, exact, white)),

@@ -229,6 +229,14 @@ def preset_from_dict(doc: dict[str, Any], path: Path | None = None) -> Preset:
         for key, bounds in _FLUORESCENCE_RANGES.items():
             if key in extra:
                 extra[key] = _in_range(where, f"fluorescence.{key}", extra[key], *bounds)
+        if "residual" in extra:  # a measured residual (docs/formats.md): a file, checked here
+            rel = extra["residual"]
+            if not isinstance(rel, str) or not rel:
+                raise InputError(f"must be a path string, not {rel!r}", path=where,
+                                 field="fluorescence.residual")
+            from catalog.optics.measured_residual import read_residual  # noqa: PLC0415
+
+            read_residual(contained_path(where, "fluorescence.residual", base, rel))
         fluorescence = FluorescenceParams(
             xyz=_triple(where, "fluorescence.xyz", _require(where, fl_doc, "xyz", "fluorescence.")),
             rgb=_triple(where, "fluorescence.rgb", _require(where, fl_doc, "rgb", "fluorescence.")),

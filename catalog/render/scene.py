@@ -385,6 +385,34 @@ def fluorescent_material(preset, irradiance: np.ndarray | None = None):
     return fl.combine_under_light(materials, np.asarray(irradiance, dtype=np.float64))
 
 
+@functools.lru_cache(maxsize=32)
+def _residual_cached(path: str):
+    from catalog.optics.measured_residual import read_residual  # noqa: PLC0415
+
+    return read_residual(path)
+
+
+def fluorescence_residual(preset):
+    """The preset's measured residual (``[fluorescence] residual``, a file beside the preset;
+    catalog.optics.measured_residual), or None. Bad fields: one-line InputError."""
+    if preset.fluorescence is None:
+        return None
+    rel = preset.fluorescence.extra.get("residual")
+    if rel is None:
+        return None
+    if not isinstance(rel, str) or not rel:
+        raise InputError(f"must be a path string, not {rel!r}", path=preset.path,
+                         field="fluorescence.residual")
+    if not preset.fluorescence.extra.get("bands") and "quantum_yield" not in preset.fluorescence.extra:
+        raise InputError("a residual needs the fitted bands it belongs to (quantum_yield, "
+                         "peak_absorptance, bands)", path=preset.path, field="fluorescence.residual")
+    base = preset.path.parent if preset.path is not None else preset.fluorescence.excitation.parent
+    path = (base / rel).resolve()
+    if not path.is_file():
+        raise InputError("residual file not found", path=path, field="fluorescence.residual")
+    return _residual_cached(str(path))
+
+
 def paper_emission_shape(preset) -> np.ndarray:
     """The emission Le on GRID_NM, 380-780 nm only (eq. 1), scaled so that sum ybar s dl = 1
     (eq. 3's K / 100): F = 100 sum cmf s is the paper's fluorescence colour."""
@@ -424,7 +452,8 @@ def decide_fluorescence(preset, irradiance: np.ndarray, requested: str) -> Fluor
     if requested == "off" or material is None:
         return FluorescenceDecision(requested, "off", None, None)
     delta_e = fluorescence_delta_e(material, irradiance)
-    needed = delta_e > 0.1
+    # a measured residual is carried with the physical emission whenever a band is excited
+    needed = delta_e > 0.1 or (requested == "physical" and fluorescence_residual(preset) is not None)
     return FluorescenceDecision(requested, requested if needed else "off", needed, delta_e)
 
 
@@ -513,16 +542,27 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         absorbed_photons=absorbed, saturation_photons=saturation,
         emission_per_photon=emission_per_photon)
     if decision.used == "physical":
-        inputs = with_physical_emission(inputs, fluorescent_material(preset, key))
+        residual = fluorescence_residual(preset)
+        inputs = with_physical_emission(
+            inputs, fluorescent_material(preset, key),
+            None if residual is None else residual.exitance_w_m2_nm(key))
     return inputs, decision
 
 
-def with_physical_emission(inputs: ShadingInputs, material) -> ShadingInputs:
+def with_physical_emission(inputs: ShadingInputs, material,
+                           residual_exitance: np.ndarray | None = None) -> ShadingInputs:
     """``inputs`` with physical-mode fluorescence of ``material`` switched on (the one place
     these terms are made): absorbed photons at normal incidence for the key and fill lights
     and, from both sides of the cloth, the outside half-space and the room; the emission
     ``quantum_yield p(l) h c / l`` per effective photon as a radiance, M / pi shared by the
-    two sides of a thin cloth (M / (2 pi) on each)."""
+    two sides of a thin cloth (M / (2 pi) on each).
+
+    ``residual_exitance`` (W m^-2 nm^-1 on GRID_NM, signed: a measured residual under the
+    key light at normal incidence, catalog.optics.measured_residual) is folded into the
+    emission per photon, M_res / (2 pi N_key): under the key (any incidence) and the fill
+    (the key's spectrum) the shader then adds exactly M_res's share, at no extra cost; under
+    the ambient light, whose spectrum differs, and above saturation, approximately. Dropped
+    when the key excites no band (N_key = 0)."""
     from dataclasses import replace  # noqa: PLC0415
 
     from catalog.optics.fluorescence import absorbed_photon_irradiance, photon_energy_j  # noqa: PLC0415
@@ -534,6 +574,9 @@ def with_physical_emission(inputs: ShadingInputs, material) -> ShadingInputs:
                 absorbed_photon_irradiance(material, ambient_irradiance))
     emission = (material.quantum_yield * material.emission_pdf_per_nm
                 * photon_energy_j(GRID_NM) / (2 * math.pi))
+    if residual_exitance is not None and absorbed[0] > 0:
+        effective_key = absorbed[0] / (1.0 + absorbed[0] / material.saturation_photon_irradiance)
+        emission = emission + np.asarray(residual_exitance, dtype=np.float64) / (2 * math.pi * effective_key)
     return replace(inputs, fluorescence_mode="physical", absorbed_photons=absorbed,
                    saturation_photons=material.saturation_photon_irradiance,
                    emission_per_photon=emission)

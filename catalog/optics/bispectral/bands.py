@@ -20,6 +20,18 @@ the separable fit; with one band per column it is the matrix (off the reflectanc
 A renderer that pre-integrates per (material, light) pays nothing per frame for the
 bands: under one light the components collapse into ONE effective fluorophore
 (:meth:`BandedFit.effective_material`), the same numbers the shader already takes.
+
+**The measured residual** (issue 15, second part). What the bands cannot hold is kept
+apart as a signed matrix ``residual`` on the matrix's grid: every off-diagonal entry minus
+the bands' fluorescence there (the near-diagonal neighbours, the anti-Stokes stray light,
+the negative entries of the noisy UV columns), optionally truncated to its leading
+``residual_rank`` singular pairs. With a residual, the reflectance is the measured diagonal
+less the bands' fluorescence on it (a line; the neighbours are in the residual), so the
+model with the full residual is the whole matrix: physical part (non-negative bands,
+quantum yield <= 1) + the data's rest, which is not fluorescence and not physical
+(docs/bispectral.md, "The measured residual"). Under one light the residual is one signed
+spectrum, ``L_res(lo) = sum_li residual(lo, li) E_bin(li)`` (the light's 10 nm bin means, as
+the exact result uses them), pre-integrated with the bands.
 """
 
 from __future__ import annotations
@@ -46,8 +58,38 @@ CANDIDATE_EDGES = {
 
 #: The model the renderer carries: the candidate chosen on the selection lights by
 #: catalog/bench/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
-CHOSEN = "14 bands: every 10 nm below 430"
-DEFAULT_EDGES_NM = CANDIDATE_EDGES[CHOSEN]
+BANDS_CHOSEN = "14 bands: every 10 nm below 430"
+DEFAULT_EDGES_NM = CANDIDATE_EDGES[BANDS_CHOSEN]
+
+#: Candidates with a measured residual (on top of BANDS_CHOSEN): rank of the kept residual
+#: (None: the whole residual, every off-diagonal entry). Compared on the selection lights
+#: with the band candidates, ordered by the numbers each stores.
+RESIDUAL_CANDIDATES = {
+    f"{BANDS_CHOSEN} + residual rank 1": 1,
+    f"{BANDS_CHOSEN} + residual rank 2": 2,
+    f"{BANDS_CHOSEN} + residual rank 4": 4,
+    f"{BANDS_CHOSEN} + residual rank 8": 8,
+    f"{BANDS_CHOSEN} + residual rank 16": 16,
+    f"{BANDS_CHOSEN} + whole residual": None,
+}
+
+#: The model the renderer carries: the candidate chosen on the selection lights by
+#: catalog/bench/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
+CHOSEN = f"{BANDS_CHOSEN} + whole residual"
+#: The chosen model's residual rank (None: whole) and whether it has one at all.
+DEFAULT_RESIDUAL = True
+DEFAULT_RESIDUAL_RANK = RESIDUAL_CANDIDATES[CHOSEN]
+
+
+def candidate_settings(label: str) -> tuple[tuple[float, ...], bool, int | None]:
+    """(band edges, with residual, residual rank) of a candidate label."""
+    if label in CANDIDATE_EDGES:
+        return CANDIDATE_EDGES[label], False, None
+    return DEFAULT_EDGES_NM, True, RESIDUAL_CANDIDATES[label]
+
+
+def all_candidates() -> list[str]:
+    return list(CANDIDATE_EDGES) + list(RESIDUAL_CANDIDATES)
 
 
 @dataclass(frozen=True)
@@ -69,6 +111,32 @@ class BandedFit:
     edges_nm: tuple[float, ...]
     reflectance: np.ndarray            # R(lo) on emission_nm
     components: tuple[Component, ...]  # one per band, shortest band first
+    residual: np.ndarray | None = None  # signed (emission x excitation), per 10 nm bin; 0 on the diagonal
+    residual_rank: int | None = None    # None: the whole residual
+
+    def residual_exitance_w_m2_nm(self, irradiance_w_m2_nm: np.ndarray) -> np.ndarray:
+        """The residual under a light, W m^-2 nm^-1 on GRID_NM (signed; 0 without one):
+        applied to the light's bin means and interpolated from the 10 nm emission grid,
+        exactly as the exact result treats off-diagonal entries."""
+        if self.residual is None:
+            return np.zeros(GRID_NM.size)
+        from catalog.optics.bispectral.matrix import bin_irradiance  # noqa: PLC0415
+
+        bins = bin_irradiance(self.excitation_nm, np.asarray(irradiance_w_m2_nm, dtype=np.float64),
+                              width_nm=self.excitation_step_nm)
+        return np.interp(GRID_NM, self.emission_nm, self.residual @ bins, left=0.0, right=0.0)
+
+    def stored_numbers(self) -> int:
+        """Numbers a material stores: each absorbing band's two spectra, + 2, + the residual
+        (rank r: r (emission + excitation) samples; whole: its off-diagonal entries)."""
+        n = sum(1 for c in self.components if np.any(c.absorption > 0))
+        count = n * (self.excitation_nm.size + self.emission_nm.size) + 2
+        if self.residual is not None:
+            whole = int(np.count_nonzero(self.excitation_nm[None, :] != self.emission_nm[:, None]))
+            rank = self.residual_rank
+            count += whole if rank is None else min(whole, rank * (self.excitation_nm.size
+                                                                   + self.emission_nm.size))
+        return int(count)
 
     def fluorescence_matrix(self) -> np.ndarray:
         energy = (self.excitation_nm[None, :] / self.emission_nm[:, None]) * self.excitation_step_nm
@@ -90,8 +158,15 @@ class BandedFit:
                    np.zeros(GRID_NM.size))
 
     def exitance_w_m2_nm(self, irradiance_w_m2_nm: np.ndarray) -> np.ndarray:
+        """Reflected + emitted + residual (W m^-2 nm^-1 on GRID_NM): the model's exitance,
+        with the bands collapsed under the light as the renderer does."""
         light = np.asarray(irradiance_w_m2_nm, dtype=np.float64)
-        return self.reflectance_on_grid() * light + self.emitted_w_m2_nm(light)
+        from catalog.optics.fluorescence import emitted_exitance_w_m2_nm  # noqa: PLC0415
+
+        effective = self.effective_material(light)
+        emitted = (emitted_exitance_w_m2_nm(effective, light) if effective is not None
+                   else np.zeros(GRID_NM.size))
+        return self.reflectance_on_grid() * light + emitted + self.residual_exitance_w_m2_nm(light)
 
     def effective_material(self, irradiance_w_m2_nm: np.ndarray):
         """The bands collapsed into ONE fluorophore for this light (what the renderer
@@ -124,7 +199,8 @@ def _pdf_scale(emission_nm: np.ndarray, u: np.ndarray) -> float:
 
 
 def fit_banded(matrix: DonaldsonMatrix, edges_nm: tuple[float, ...] = DEFAULT_EDGES_NM,
-               base: SeparableFit | None = None, band_nm: float = REFLECTANCE_BAND_NM) -> BandedFit:
+               base: SeparableFit | None = None, band_nm: float = REFLECTANCE_BAND_NM, *,
+               residual: bool = False, residual_rank: int | None = None) -> BandedFit:
     """The banded model of ``matrix`` with excitation band edges ``edges_nm`` (ascending).
 
     ``base`` (default: :func:`fit_separable`, colour-refined) supplies the last band's pair
@@ -165,7 +241,27 @@ def fit_banded(matrix: DonaldsonMatrix, edges_nm: tuple[float, ...] = DEFAULT_ED
     old = np.sum(np.where(band, base.fluorescence_matrix(), 0.0), axis=1)
     new = np.sum(np.where(band, banded.fluorescence_matrix(), 0.0), axis=1)
     reflectance = np.maximum(np.array(base.reflectance) + old - new, 0.0)
-    return BandedFit(matrix.name, lo, li, step, edges, reflectance, tuple(components))
+    banded = BandedFit(matrix.name, lo, li, step, edges, reflectance, tuple(components))
+    return with_residual(matrix, banded, residual_rank) if residual else banded
+
+
+def with_residual(matrix: DonaldsonMatrix, fit: BandedFit, rank: int | None = None) -> BandedFit:
+    """``fit`` with the matrix's measured residual kept (module docstring): the reflectance
+    becomes the diagonal less the bands' fluorescence there (clipped at 0; what the clip
+    removes is lost; the tests bound it), and ``residual`` every off-diagonal entry less the bands'
+    fluorescence, truncated to ``rank`` singular pairs (None: all)."""
+    fluorescence = fit.fluorescence_matrix()
+    on_diagonal = matrix.stokes_shift_nm() == 0
+    rest = np.where(on_diagonal, 0.0, matrix.values - fluorescence)
+    if rank is not None:
+        if rank < 0:
+            raise ValueError(f"residual rank must be >= 0, not {rank}")
+        u, s, vt = np.linalg.svd(rest, full_matrices=False)
+        rest = (u[:, :rank] * s[:rank]) @ vt[:rank]
+    diagonal = np.sum(np.where(on_diagonal, matrix.values - fluorescence, 0.0), axis=1)
+    rest.setflags(write=False)
+    return BandedFit(fit.matrix_name, fit.emission_nm, fit.excitation_nm, fit.excitation_step_nm,
+                     fit.edges_nm, np.maximum(diagonal, 0.0), fit.components, rest, rank)
 
 
 def band_materials_table(fit: BandedFit, out_dir) -> dict:
@@ -203,5 +299,15 @@ def band_materials_table(fit: BandedFit, out_dir) -> dict:
                         "quantum_yield": round(material.quantum_yield, 6),
                         "peak_absorptance": round(material.peak_absorptance, 6)})
     main = entries[-1]
-    return {**main, "bands": entries[:-1]}
+    table = {**main, "bands": entries[:-1]}
+    if fit.residual is not None:
+        from catalog.optics.measured_residual import write_residual  # noqa: PLC0415
+
+        rank = "whole" if fit.residual_rank is None else f"rank {fit.residual_rank}"
+        write_residual(out_dir / "residual.csv", fit.emission_nm, fit.excitation_nm, fit.residual,
+                       fit.excitation_step_nm,
+                       [f"measured residual ({rank}) of {fit.matrix_name}: the matrix less its "
+                        "banded fit, off the diagonal; signed, not fluorescence", source])
+        table["residual"] = "residual.csv"
+    return table
 
