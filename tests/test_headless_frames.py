@@ -37,9 +37,7 @@ def test_tables_hold_every_committed_row():
     result = json.loads((PROJECT_ROOT / bench.RESULT_JSON).read_text())
     tables = bench.markdown_tables(result)
     frames = tables["viewer-headless-frames"].splitlines()[2:]
-    keys = ("h200_gpu_cloth_fxaa", "h200_gpu_cloth", "h200_numba_cloth", "h200_numpy_cloth",
-            "llvmpipe_numpy_cloth")
-    assert len(frames) == sum(len(result["runs"][k]["rows"]) for k in keys)
+    assert len(frames) == sum(len(result["runs"][k]["rows"]) for k in bench.FRAME_RUNS)
     summary = tables["gpu-frame-summary"].splitlines()[2:]
     assert summary and all("|" in line for line in summary)
     accuracy = tables["viewer-gpu-accuracy"].splitlines()[2:]

@@ -67,7 +67,7 @@ MSAA_SAMPLES = 4
 #: Renderer strings of CPU rasterisers: there MSAA multiplies the HDR passes' cost (each
 #: sample shaded and blended in float: 3.5x the flat frame's HDR passes on llvmpipe, where
 #: FXAA costs a fifth of the frame; benchmarks/bench_pattern.json), so ``auto`` takes FXAA.
-SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "swrast", "lavapipe", "swiftshader")
+SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "swrast", "swr", "lavapipe", "swiftshader")
 #: Specialised curtain programs kept compiled (one per light/fabric/mode/bands seen lately).
 MAX_SPECIALISED = 8
 #: Texture unit of the fabric's pattern, and its anisotropic filtering (samples, at most).
@@ -118,14 +118,31 @@ def gl_size_limit(ctx) -> int:
     return limit
 
 
+def software_rasteriser(info: dict) -> bool:
+    """True for a CPU rasteriser (llvmpipe, SwiftShader, ...), from ``ctx.info``'s GL_RENDERER."""
+    renderer = str(info.get("GL_RENDERER", "")).lower()
+    return any(name in renderer for name in SOFTWARE_RASTERISERS)
+
+
+def choose_specialise(info: dict) -> bool:
+    """Whether a renderer compiles the scene's values into the curtain shader as constants.
+
+    On a CPU rasteriser yes: it runs every operation per fragment, so folded constants and no
+    uniform loads are measured savings (docs/render.md). On a GPU no: uniforms cost it
+    nothing, a light change then compiles nothing, and NVIDIA's compiler was measured to fold
+    the see-through constants (model.md eq. 8's LD terms) with a relative error up to 1.1e-3
+    against the float64 reference, where the uniform program stays within 1.2e-6
+    (docs/gpu.md)."""
+    return software_rasteriser(info)
+
+
 def choose_antialiasing(info: dict) -> str:
     """``auto``'s choice for a context (``ctx.info`` plus ``GL_RENDERER``): ``msaa`` where
     the context multisamples float targets with at least MSAA_SAMPLES samples
     (GL_MAX_SAMPLES) on a GPU, where multisampling is paid in bandwidth, not shading;
     ``fxaa`` on CPU rasterisers (the measured cost rule) and where samples are lacking."""
-    renderer = str(info.get("GL_RENDERER", "")).lower()
     samples = int(info.get("GL_MAX_SAMPLES", 0) or 0)
-    if samples < MSAA_SAMPLES or any(name in renderer for name in SOFTWARE_RASTERISERS):
+    if samples < MSAA_SAMPLES or software_rasteriser(info):
         return "fxaa"
     return "msaa"
 
@@ -174,10 +191,11 @@ def fabric_size_from_mesh(positions, uvs, indices) -> tuple[float, float]:
 class FrameRenderer:
     """Renders the curtain scene with a given moderngl context at a given size (w, h)."""
 
-    def __init__(self, ctx, size: tuple[int, int], specialise: bool = True):
+    def __init__(self, ctx, size: tuple[int, int], specialise: bool | None = None):
         """``specialise``: compile the scene's values into the curtain shader as constants
         (recompiled when the light, fabric, mode or band count changes; a CPU rasteriser then
-        loads no uniforms per fragment) rather than passing them as uniforms."""
+        loads no uniforms per fragment) rather than passing them as uniforms; None (default):
+        :func:`choose_specialise` for this context (constants on a CPU rasteriser only)."""
         import moderngl  # noqa: PLC0415
 
         self._moderngl = moderngl
@@ -214,7 +232,8 @@ class FrameRenderer:
         self._pattern = None
         self._fabric_size_m = (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
         self._programs: dict[tuple, object] = {}
-        self.specialise = bool(specialise)
+        self.specialise = (choose_specialise(dict(ctx.info)) if specialise is None
+                           else bool(specialise))
         self._vaos: dict[tuple, object] = {}
 
         self.preset = None

@@ -29,7 +29,6 @@ from catalog.viewer.timing import FrameTimer
 FIXED_FRAME_DT_S = 1.0 / 60.0
 #: Scene resolution on a software rasteriser (llvmpipe): a quarter of the pixels, upscaled.
 SOFTWARE_RENDER_SCALE = 0.5
-SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "SWR")
 #: On a software rasteriser the room's light (issue 13) follows a moving cloth every this many
 #: frames, and the glare (bloom) is off: docs/room.md has their cost.
 SOFTWARE_ROOM_UPDATE_EVERY = 4
@@ -430,8 +429,9 @@ class ViewerApp:
         return {"room_light": True, "bloom": True, "room_update_every": 1}
 
     def _software_gl(self) -> bool:
-        renderer = self.ctx.info.get("GL_RENDERER", "")
-        return any(name in renderer for name in SOFTWARE_RENDERERS)
+        from catalog.render.frame import software_rasteriser  # noqa: PLC0415
+
+        return software_rasteriser(self.ctx.info)
 
     def _choose_cloth_backend(self) -> str:
         """The option's backend, or: the GLSL compute cloth on a GPU (it writes the vertex
