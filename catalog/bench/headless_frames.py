@@ -150,17 +150,27 @@ def run(cases: list[str], backend: str = "auto", frames: int = 60, warmup: int =
             "rows": rows}
 
 
+FRAME_HEADER = ("window", "cloth", "anti-aliasing", "scene values", "total ms", "fps",
+                "simulation ms", "shading ms")
+
+
+def _frame_cells(row: dict) -> list[str]:
+    """One row's cells under FRAME_HEADER."""
+    w, h = row["size"]
+    gx, gy = row["grid"]
+    return [f"{w}x{h}", f"{row['backend']} {gx}x{gy}", row["antialiasing"], row["scene_values"],
+            f"{row['total_ms']:.1f}", f"{row['fps']:g}", f"{row['simulation_ms']:.1f}",
+            f"{row['shading_ms']:.1f}"]
+
+
+def _table(header: list[str] | tuple[str, ...], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    return "\n".join(lines + ["| " + " | ".join(cells) + " |" for cells in rows])
+
+
 def markdown_table(result: dict) -> str:
     """The rows of one run as a markdown table (ms, medians)."""
-    lines = ["| window | cloth | total ms | fps | simulation ms | shading ms | first frame |",
-             "|---|---|---|---|---|---|---|"]
-    for row in result["rows"]:
-        w, h = row["size"]
-        gx, gy = row["grid"]
-        lines.append(f"| {w}x{h} | {row['backend']} {gx}x{gy} | {row['total_ms']:.2f} | "
-                     f"{row['fps']:g} | {row['simulation_ms']:.2f} | {row['shading_ms']:.2f} | "
-                     f"{row['first_frame_s']:.1f} s |")
-    return "\n".join(lines)
+    return _table(FRAME_HEADER, [_frame_cells(row) for row in result["rows"]])
 
 
 def _run_label(run: dict) -> str:
@@ -180,16 +190,9 @@ def markdown_tables(result: dict) -> dict[str, str]:
     """RESULT_JSON's runs as docs/gpu.md's tables: frames per machine, cloth backend,
     anti-aliasing and scene values (constants or uniforms); the render passes; a summary at
     1920x1080 with the 128x128 cloth; the curtain's accuracy against the float64 reference."""
-    lines = ["| machine | window | cloth | anti-aliasing | scene values | total ms | fps | "
-             "simulation ms | shading ms |", "|---|---|---|---|---|---|---|---|---|"]
-    for key in FRAME_RUNS:
-        run = result["runs"][key]
-        for row in run["rows"]:
-            w, h = row["size"]
-            gx, gy = row["grid"]
-            lines.append(f"| {_run_label(run)} | {w}x{h} | {row['backend']} {gx}x{gy} | "
-                         f"{row['antialiasing']} | {row['scene_values']} | {row['total_ms']:.1f} | "
-                         f"{row['fps']:g} | {row['simulation_ms']:.1f} | {row['shading_ms']:.1f} |")
+    frames = _table(("machine", *FRAME_HEADER),
+                    [[_run_label(result["runs"][key]), *_frame_cells(row)]
+                     for key in FRAME_RUNS for row in result["runs"][key]["rows"]])
     rows = []
     for key in PASS_RUNS:
         run = result["runs"][key]
@@ -219,7 +222,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
         cpu = result["accuracy_llvmpipe"][case]
         accuracy.append(f"| {case} | {gpu['max']:.2e} | {gpu['median']:.2e} | {uniform['max']:.2e} | "
                         f"{uniform['median']:.2e} | {cpu['max']:.2e} | {cpu['median']:.2e} |")
-    return {"viewer-headless-frames": "\n".join(lines),
+    return {"viewer-headless-frames": frames,
             "gpu-frame-summary": "\n".join(summary),
             "viewer-headless-passes": "\n".join(passes),
             "viewer-gpu-accuracy": "\n".join(accuracy)}
