@@ -78,13 +78,41 @@ def test_baked_loop_is_seamless_and_small():
     from catalog.presets import find_preset, load_preset
     from catalog.web import bake
 
-    animation = bake.bake(load_preset(find_preset("voile-white")))
+    from catalog.render import snapshot
+
+    preset = load_preset(find_preset("voile-white"))
+    animation = bake.bake(preset)
     positions, _, _ = bake.decode_frames(animation)
+    # hung where the snapshot hangs its settled drape: the same rod offset (the loop's grid
+    # plus the offset = the snapshot's mesh, both from the settled drape's grid), fabric size
+    # (the pattern's scale) and rings
+    still = snapshot.curtain_simulation(preset)
+    on_rod, *_, size = snapshot.curtain_on_rod(still)
+    assert np.allclose(still.positions().reshape(-1, 3) + np.array(animation.offset_m), on_rod,
+                       atol=1e-6)
+    assert animation.fabric_size_m == size
+    assert animation.rings_x_m == tuple(snapshot.ring_xs_m(preset))
     steps = np.abs(np.diff(positions, axis=0)).max(axis=(1, 2))
     wrap = np.abs(positions[0] - positions[-1]).max()
     assert wrap <= steps.max()
     manifest = animation.manifest()
     assert manifest["encoded_bytes"] <= 0.6 * manifest["raw_bytes"]
+
+
+def test_bake_hangs_the_desktops_settled_drape():
+    """The baked loop's cloth is the curtain `catalog snapshot` shows: the drape's parameters
+    (grid, fullness, rings) in the page's wind (test_baked_loop_... checks where it hangs)."""
+    from catalog.cloth.drape import GRID, drape_params
+    from catalog.presets import find_preset, load_preset
+    from catalog.web import bake
+
+    preset = load_preset(find_preset("voile-white"))
+    params = bake.bake_params(preset)
+    drape = drape_params(preset)
+    assert (params.grid_w, params.grid_h) == GRID
+    assert params == drape.with_changes(wind_speed_m_s=bake.WIND_M_S,
+                                        gust_strength=bake.GUST_STRENGTH)
+    assert bake.cloth_key(params) != bake.cloth_key(drape)
 
 
 # ---------------------------------------------------------------- the recorded frame
@@ -128,6 +156,16 @@ def test_recording_context_refuses_what_the_page_cannot_replay(gl):
     texels = bytes(range(16))
     texture = ctx.texture((2, 2), 4, texels)
     assert ctx.recording.texture_data[texture.rid] == texels
+    # a framebuffer's depth mask is noted (moderngl applies it at use and clear: the OIT
+    # layers write no depth and their clear keeps the room's); other framebuffer state refused
+    fbo = ctx.framebuffer([texture], ctx.depth_renderbuffer((2, 2)))
+    assert "depth_mask" not in ctx.recording.framebuffers[fbo.rid]
+    fbo.depth_mask = False
+    assert ctx.recording.framebuffers[fbo.rid]["depth_mask"] is False
+    assert fbo.depth_mask is False
+    with pytest.raises(CatalogError, match="color_mask"):
+        fbo.color_mask = (True, False, True, True)
+    fbo.release()
     texture.release()
 
 

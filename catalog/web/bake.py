@@ -1,6 +1,8 @@
 """Baked cloth animation for the web page (WebGL2 has no compute shaders for the simulation).
 
-The project's cloth simulation (:mod:`catalog.cloth`, the numba backend) runs a curtain in a
+The project's cloth simulation (:mod:`catalog.cloth`, the numba backend) runs the desktop's
+curtain -- the preset's *settled drape* (:mod:`catalog.cloth.drape`: fullness, pleats between
+the rings, the drape ``catalog snapshot`` shows at frame 0), hung on the scene's rod -- in a
 gentle gusty wind; after it settles, :data:`LOOP_S` seconds are sampled at :data:`BAKE_FPS`
 and made to loop by cross-fading the last :data:`CROSSFADE_FRAMES` frames into the frames
 just before the loop's start (so the last frame leads into the first). Normals and weft
@@ -53,11 +55,15 @@ class BakedAnimation:
     offset_m: tuple[float, float, float]  # cloth frame -> scene
     lo_m: np.ndarray         # float64 (3,) bounding box low corner
     payload: bytes           # zlib of the shuffled, delta-coded frames
+    fabric_size_m: tuple[float, float] = (0.0, 0.0)  # rest width, length (uv 0..1 spans them)
+    rings_x_m: tuple[float, ...] = ()   # the rings on the rod, scene x (m)
 
     def manifest(self) -> dict:
         return {"key": self.key, "frames": self.frames, "fps": self.fps,
                 "vertex_count": self.vertex_count,
                 "offset_m": list(self.offset_m),
+                "fabric_size_m": [float(v) for v in self.fabric_size_m],
+                "rings_x_m": [float(v) for v in self.rings_x_m],
                 "lo_m": [float(v) for v in self.lo_m], "step_m": POSITION_STEP_M,
                 "index_count": int(self.indices.size),
                 "encoded_bytes": len(self.payload),
@@ -89,7 +95,8 @@ def read_script(path) -> BakedAnimation:
         indices=np.frombuffer(base64.b64decode(data["indices"]), dtype="<u4"),
         uv=np.frombuffer(base64.b64decode(data["uv"]), dtype="<f4").reshape(-1, 2),
         offset_m=tuple(m["offset_m"]), lo_m=np.array(m["lo_m"], dtype=np.float64),
-        payload=base64.b64decode(data["payload"]))
+        payload=base64.b64decode(data["payload"]),
+        fabric_size_m=tuple(m["fabric_size_m"]), rings_x_m=tuple(m["rings_x_m"]))
 
 
 def cloth_key(params) -> str:
@@ -97,13 +104,22 @@ def cloth_key(params) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
+def bake_params(preset):
+    """The cloth parameters of a preset's baked loop: the desktop's drape
+    (:func:`catalog.cloth.drape.drape_params`) in the page's wind."""
+    from catalog.cloth.drape import drape_params  # noqa: PLC0415
+
+    return drape_params(preset).with_changes(wind_speed_m_s=WIND_M_S, gust_strength=GUST_STRENGTH)
+
+
 def simulate_loop(params, fps: float = BAKE_FPS, loop_s: float = LOOP_S,
                   crossfade: int = CROSSFADE_FRAMES, settle_s: float = SETTLE_S):
-    """(frames, H, W, 3) float64 grid positions of a seamless loop, cloth frame, metres."""
-    from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
+    """(frames, H, W, 3) float64 grid positions of a seamless loop, cloth frame, metres:
+    ``params`` (:func:`bake_params`) started from their settled drape, as every desktop
+    simulation starts (:func:`catalog.cloth.drape.settled_simulation`)."""
+    from catalog.cloth.drape import settled_simulation  # noqa: PLC0415
 
-    params = params.with_changes(wind_speed_m_s=WIND_M_S, gust_strength=GUST_STRENGTH)
-    simulation = ClothSimulation(params, backend="cpu")
+    simulation = settled_simulation(params, backend="cpu")
     dt = 1.0 / fps
     settle = int(round(settle_s * fps))
     loop = int(round(loop_s * fps))
@@ -148,23 +164,26 @@ def encode(frames_p, frames_n, frames_t):
 
 def bake(preset, fps: float = BAKE_FPS, loop_s: float = LOOP_S) -> BakedAnimation:
     """Simulate and encode the looping curtain of a preset (its ``[cloth]`` table)."""
+    from catalog.cloth.drape import rod_centre_x_m  # noqa: PLC0415
     from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
-    from catalog.cloth.params import ClothParams  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.render.snapshot import ring_xs_m  # noqa: PLC0415
 
-    params = ClothParams.from_preset(preset)
-    grids, params = simulate_loop(params, fps, loop_s)
+    grids, params = simulate_loop(bake_params(preset), fps, loop_s)
     meshes = [CurtainMesh.from_grid(g, params) for g in grids]
     frames_p = np.stack([m.positions.astype(np.float64) for m in meshes])
     frames_n = np.stack([m.normals for m in meshes])
     frames_t = np.stack([m.tangents[:, :3] for m in meshes])
     lo, payload = encode(frames_p, frames_n, frames_t)
-    offset = (0.0, scene_lib.CURTAIN_TOP_Y - params.rod_y_m, scene_lib.CURTAIN_Z)
+    # the desktop's rod offset (catalog.render.snapshot.curtain_on_rod): rings centred on the window
+    offset = (-rod_centre_x_m(params), scene_lib.CURTAIN_TOP_Y - params.rod_y_m,
+              scene_lib.CURTAIN_Z)
     return BakedAnimation(key=cloth_key(params), frames=len(meshes), fps=float(fps),
                           vertex_count=meshes[0].positions.shape[0],
                           indices=meshes[0].indices.astype(np.uint32).ravel(),
                           uv=meshes[0].uv, offset_m=offset, lo_m=lo,
-                          payload=payload)
+                          payload=payload, fabric_size_m=(params.width_m, params.height_m),
+                          rings_x_m=tuple(ring_xs_m(preset)))
 
 
 def decode_frames(animation: BakedAnimation):

@@ -136,8 +136,10 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
         if ev100 is not None:
             renderer.set_ev(ev100)
         renderer.set_mesh(positions, normals, animation.uv, tangents,
-                          animation.indices.astype(np.int32))
+                          animation.indices.astype(np.int32),
+                          fabric_size_m=animation.fabric_size_m)
         renderer.set_mesh_offset((0.0, 0.0, 0.0))
+        renderer.set_rings(animation.rings_x_m)
         renderer.render()
         return renderer.read_srgb8()
     finally:

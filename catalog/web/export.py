@@ -281,6 +281,7 @@ class SiteExporter:
         self.curtain_tags: dict[int, str] = {}
         self.blobs: list[str] = []   # base64 bytes the frames write into buffers (shared)
         self._blob_index: dict[str, int] = {}
+        self._rings: tuple | None = None
 
     # -- the curtain's buffers: found by their bytes after set_mesh
     def use_mesh(self, positions, normals, uvs, tangents, indices) -> None:
@@ -296,6 +297,16 @@ class SiteExporter:
             tag = wanted.get(buffers[rid])
             if tag is not None and tag not in self.curtain_tags.values():
                 self.curtain_tags[rid] = tag
+
+    def use_drape(self, animation) -> None:
+        """The fabric's drape (the desktop's settled drape, baked): the rest size its uv spans
+        (the pattern's scale) and the rings on the rod, as ``catalog snapshot`` sets them."""
+        rings = tuple(animation.rings_x_m)
+        for renderer in (self.renderer, self.meter):
+            renderer.set_fabric_size(animation.fabric_size_m)
+            if rings != self._rings:  # a new ring buffer only when they move (fullness)
+                renderer.set_rings(rings)
+        self._rings = rings
 
     def record(self, preset, light: LightChoice, fluorescence: str,
                ev100: float | None = None) -> dict:

@@ -27,6 +27,8 @@ import time
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
+
 from catalog.core.errors import CatalogError, InputError
 
 #: The page's own files (catalog/web/assets), copied as they are.
@@ -130,23 +132,28 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         animations = {}
         fabric_animation = {}
         for preset in presets:
-            from catalog.cloth.params import ClothParams  # noqa: PLC0415
-            key = bake_lib.cloth_key(ClothParams.from_preset(preset).with_changes(
-                wind_speed_m_s=bake_lib.WIND_M_S, gust_strength=bake_lib.GUST_STRENGTH))
+            key = bake_lib.cloth_key(bake_lib.bake_params(preset))
             if key not in animations:
                 animations[key] = bake_lib.bake(preset)
-            fabric_animation[preset.name] = animations[key].key
+            fabric_animation[preset.name] = animations[key]
+        first = next(iter(animations.values()))
+        for animation in animations.values():  # the page swaps the curtain's buffers only
+            if not (np.array_equal(animation.indices, first.indices)
+                    and np.array_equal(animation.uv, first.uv)):
+                raise CatalogError("the baked curtains differ in their grids; the page's "
+                                   "recorded frame has one")
         timings["bake_s"] = time.perf_counter() - t
 
         t = time.perf_counter()
         exporter = export.SiteExporter(ctx)
         try:
-            first = next(iter(animations.values()))
             positions, normals, tangents = bake_lib.decode_frame(first, 0)
             exporter.use_mesh(positions, normals, first.uv, tangents, first.indices)
+            exporter.use_drape(fabric_animation[presets[0].name])
             exporter.check_camera_uniforms(presets[0], choices[0])
             scenes = {}
             for preset in presets:
+                exporter.use_drape(fabric_animation[preset.name])
                 for choice in choices:
                     on = exporter.record(preset, choice, "on")
                     scenes[f"{preset.name}|{choice.id}|on"] = on
@@ -175,7 +182,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             "scenes": scenes,
             "fabrics": [{"name": p.name, "display_name": p.display_name,
                          "facts": export.fabric_facts(p), "swatch": swatches[p.name],
-                         "animation": fabric_animation[p.name]} for p in presets],
+                         "animation": fabric_animation[p.name].key} for p in presets],
             "lights": [{"id": c.id, "label": c.label, "kind": c.kind, "hour": c.hour}
                        for c in choices],
             "fluorescence": list(export.FLUORESCENCE),

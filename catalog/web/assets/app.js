@@ -138,6 +138,7 @@
       this.gl = gl;
       this.floatLinear = !!gl.getExtension('OES_texture_float_linear');
       gl.getExtension('EXT_float_blend');  // blending into float targets (layered cloth)
+      this.aniso = gl.getExtension('EXT_texture_filter_anisotropic');
       this.shaders = {}; this.programs = {}; this.buffers = {}; this.vaos = {}; this.targets = null;
       this.size = [0, 0]; this.curtainCount = 0; this.curtainAnim = null;
     }
@@ -259,6 +260,10 @@
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, t.repeat_x === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, t.repeat_y === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
         if (t.mipmaps) gl.generateMipmap(gl.TEXTURE_2D);
+        if (t.anisotropy > 1 && this.aniso) {  // the desktop's anisotropic filter (record.py)
+          gl.texParameterf(gl.TEXTURE_2D, this.aniso.TEXTURE_MAX_ANISOTROPY_EXT,
+            Math.min(t.anisotropy, gl.getParameter(this.aniso.MAX_TEXTURE_MAX_ANISOTROPY_EXT)));
+        }
         textures[rid] = { tex };
       }
       for (const [rid, r] of Object.entries(D.renderbuffers)) {
@@ -308,14 +313,16 @@
       const full = (v) => v && v[0] === 0 && v[1] === 0 && v[2] === RW && v[3] === RH;
       for (const c of structure) {
         switch (c.op) {
-          case 'framebuffer':
+          case 'framebuffer':  // moderngl's use(): the framebuffer's depth mask with it
             gl.bindFramebuffer(gl.FRAMEBUFFER, c.framebuffer === screen ? null : this.targets['fbo' + c.framebuffer].fbo);
+            gl.depthMask(D.framebuffers[c.framebuffer].depth_mask !== false);
             break;
           case 'viewport':
             gl.viewport(...(full(c.viewport) ? [0, 0, w, h] : c.viewport)); break;
           case 'clear':
             gl.bindFramebuffer(gl.FRAMEBUFFER, c.framebuffer === screen ? null : this.targets['fbo' + c.framebuffer].fbo);
-            gl.clearColor(...c.colour); gl.clearDepth(c.depth); gl.depthMask(true);
+            gl.clearColor(...c.colour); gl.clearDepth(c.depth);
+            gl.depthMask(D.framebuffers[c.framebuffer].depth_mask !== false);  // as moderngl's clear
             gl.clear(gl.COLOR_BUFFER_BIT | (D.framebuffers[c.framebuffer].depth != null ? gl.DEPTH_BUFFER_BIT : 0));
             break;
           case 'enable': for (const f of c.flags) gl.enable(gl[f]); break;
