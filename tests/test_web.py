@@ -303,9 +303,11 @@ def test_site_is_whole(web_site):
     out, report = web_site
     names = {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()}
     assert {"index.html", "app.js", "style.css", "data.js", "catalog-web-site.json"} <= names
+    from catalog.web.browser import site_data
+
     text = (out / "data.js").read_text()
-    assert text.startswith("window.CATALOG_DATA = ")
-    data = json.loads(text[len("window.CATALOG_DATA = "):].rstrip().rstrip(";"))
+    assert text.startswith("window.CATALOG_PACKED = ")
+    data = site_data(out)
     assert len(data["scenes"]) == len(report["fabrics"]) * len(report["lights"]) * 2
     for shader in data["shaders"]:
         assert shader["vertex"].startswith("#version 300 es")
@@ -353,8 +355,9 @@ def test_site_carries_each_fabrics_pattern(web_site):
 
     assert DESKTOP_MODES["patterned"] is True and DESKTOP_MODES["room_lighting"] is True
     out, report = web_site
-    text = (out / "data.js").read_text()
-    data = json.loads(text[len("window.CATALOG_DATA = "):].rstrip().rstrip(";"))
+    from catalog.web.browser import site_data
+
+    data = site_data(out)
     assert any(s["defines"].get("PATTERN") and s["defines"].get("OIT") for s in data["shaders"])
     # and the room's light passes (issue 13): shadow map, light map, bounce, the lit room
     files = {f for s in data["shaders"] for f in s["files"]}
@@ -370,3 +373,22 @@ def test_site_carries_each_fabrics_pattern(web_site):
         half_step = (np.array(q["hi"]) - np.array(q["lo"])) / (2 * ((1 << q["bits"]) - 1))
         assert min(np.max(np.abs(decode_texels(t).reshape(h, w, 4) - texels) - half_step)
                    for t in match) <= 1e-6
+
+
+def test_packed_data_round_trips_and_is_smaller():
+    """pack_data -> unpack_data gives back the page's data exactly (bytes as base64, as the
+    recorder writes them); repetitive bytes and JSON shrink under deflate."""
+    import base64
+
+    from catalog.web.site import pack_data, unpack_data
+
+    b64 = lambda raw: base64.b64encode(raw).decode("ascii")  # noqa: E731
+    data = {"format": 2, "scenes": {f"s{i}": {"values": [0.125 * i, [1.0, 2.0, 3.0]]} for i in range(200)},
+            "textures": {"1": {"size": [64, 64], "data": b64(bytes(range(256)) * 64)},
+                         "2": {"size": [1, 1]}},
+            "buffers": {"3": {"data": b64(np.arange(300, dtype="<f4").tobytes())}, "4": {"curtain": "uv"}},
+            "blobs": [b64(b"\x00" * 1000), b64(b"xy")]}
+    text, plain = pack_data(data)
+    assert text.startswith("window.CATALOG_PACKED = ")
+    assert unpack_data(text) == data
+    assert len(text) < 0.5 * plain

@@ -91,6 +91,36 @@ def test_page_frame_matches_the_egl_frame(page, web_site, animations, gl, fabric
     assert page.console_errors() == []
 
 
+def test_page_decodes_the_packed_data_as_the_reference(page, web_site, animations):
+    """data.js and anim/*.js hold deflated, quantised bytes (site.pack_data, bake.encode,
+    export.encode_texels); what the page decodes from them is bit for bit what the reference
+    decoders give, whose distance to the desktop's values the codec tests bound (texels within
+    half a step of their channel's range, positions within 0.05 mm, normals within 1/254)."""
+    import base64
+
+    from catalog.web.bake import decode_frames
+    from catalog.web.export import decode_texels
+
+    out, _ = web_site
+    page.open(out)
+    data = web_browser.site_data(out)
+    run = "const done = arguments[arguments.length - 1];" \
+          "window.catalogApp.decoded(arguments[0], arguments[1], arguments[2]).then(done);"
+    as_f32 = lambda text: np.frombuffer(base64.b64decode(text), dtype="<f4")  # noqa: E731
+    quantised = [rid for rid, t in data["textures"].items() if t.get("quantised")]
+    assert len(quantised) >= 2  # the two fabrics' patterns
+    for rid in quantised:
+        page_texels = as_f32(page.driver.execute_async_script(run, "texels", rid, 0))
+        assert np.array_equal(page_texels, decode_texels(data["textures"][rid])), rid
+    for key, animation in animations.items():
+        reference = decode_frames(animation)
+        for frame in (0, 1, 2, animation.frames - 1):
+            arrays = page.driver.execute_async_script(run, "animation", key, frame)
+            for got, want in zip(arrays, reference):
+                assert np.array_equal(as_f32(got), want[frame].ravel()), (key, frame)
+    assert page.console_errors() == []
+
+
 def test_fluorescence_switch_changes_the_uv_picture(page, web_site):
     """Under UV-A, switching the brightener's fluorescence off (key F) changes the curtain (at
     least a tenth of the picture) and only darkens: fluorescence adds light to every pixel

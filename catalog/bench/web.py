@@ -100,8 +100,7 @@ def run(quick: bool = False) -> dict:
             "vertices": next(iter(report["animations"].values()))["vertex_count"],
             "build_s": round(time.perf_counter() - start, 2),
             "bake_s": report["bake_s"], "record_s": report["record_s"]}
-        key = json.loads((out / "data.js").read_text()[len("window.CATALOG_DATA = "):]
-                         .rstrip().rstrip(";"))
+        key = web_browser.site_data(out)
         anim_key = next(f["animation"] for f in key["fabrics"] if f["name"] == FABRIC)
         animation = bake_lib.read_script(out / "anim" / f"{anim_key}.js")
 

@@ -72,9 +72,11 @@ class Browser:
         return None if first is None else first / 1000.0
 
     def settle(self) -> None:
+        # the page starts once its data is inflated: wait for its hooks first
         self.driver.execute_async_script(
             "const done = arguments[arguments.length - 1];"
-            "window.catalogApp.settle().then(() => done(true));")
+            "const poll = () => window.catalogApp ? window.catalogApp.settle().then(() => done(true))"
+            " : window.catalogStartError ? done(false) : setTimeout(poll, 20); poll();")
 
     def set(self, **state) -> None:
         self.driver.execute_script("window.catalogApp.set(arguments[0])", state)
@@ -161,11 +163,10 @@ EDGE_SHARE_MAX = 0.01
 
 
 def site_data(site: Path) -> dict:
-    """window.CATALOG_DATA of a built site."""
-    import json  # noqa: PLC0415
+    """The page's data of a built site (data.js unpacked; bytes as base64)."""
+    from catalog.web.site import unpack_data  # noqa: PLC0415
 
-    text = (Path(site) / "data.js").read_text(encoding="utf-8")
-    return json.loads(text[text.index("= ") + 2:].rstrip().rstrip(";"))
+    return unpack_data((Path(site) / "data.js").read_text(encoding="utf-8"))
 
 
 def _neighbourhood(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -210,7 +210,7 @@ TEXEL_BITS = 8
 def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
     """The page's form of recorded texels: 8-bit textures as they are; float32 ones
     quantised to ``bits`` (8 or 16) per channel with a per-channel range (``lo``, ``hi``),
-    little-endian, base64."""
+    little-endian, in channel planes, base64."""
     if texture["dtype"] != "f4":
         return {"data": _b64(data)}
     if bits not in (8, 16):
@@ -222,10 +222,13 @@ def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
     top = (1 << bits) - 1
     span = np.where(hi > lo, hi - lo, 1.0)
     q = np.rint((texels - lo) / span * top)
-    encoded = q.astype("<u2" if bits == 16 else "u1").tobytes()
+    # in planes (every texel's channel 0, then channel 1, ..): deflate (site.pack_data) then
+    # finds each channel's own repetitions (a third of the interleaved bytes' deflated size
+    # on the lace's pattern)
+    encoded = np.ascontiguousarray(q.T).astype("<u2" if bits == 16 else "u1").tobytes()
     return {"data": _b64(encoded),
             "quantised": {"bits": bits, "lo": [float(v) for v in lo],
-                          "hi": [float(v) for v in lo + span]}}
+                          "hi": [float(v) for v in lo + span], "planar": True}}
 
 
 def decode_texels(texture: dict) -> np.ndarray:
@@ -235,7 +238,7 @@ def decode_texels(texture: dict) -> np.ndarray:
     if quantised is None:
         return np.frombuffer(raw, dtype="u1")
     q = np.frombuffer(raw, dtype="<u2" if quantised["bits"] == 16 else "u1")
-    q = q.reshape(-1, texture["components"]).astype(np.float64)
+    q = q.reshape(texture["components"], -1).T.astype(np.float64)
     lo, hi = np.array(quantised["lo"]), np.array(quantised["hi"])
     return (lo + q * (hi - lo) / ((1 << quantised["bits"]) - 1)).astype(np.float32).ravel()
 

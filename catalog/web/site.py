@@ -5,8 +5,9 @@ The site (docs/web.md)::
     DIR/index.html     the page (assets/index.html)
     DIR/app.js         the WebGL2 replayer, camera, animation decoder and controls
     DIR/style.css
-    DIR/data.js        window.CATALOG_DATA: shaders (GLSL ES variant), recorded frame
-                       structures and per-scene uniform values, fabrics, lights, swatches
+    DIR/data.js        window.CATALOG_PACKED: the page's data (shaders (GLSL ES variant),
+                       recorded frame structures and per-scene uniform values, fabrics,
+                       lights, swatches, pattern texels, buffers), deflated (pack_data)
     DIR/anim/KEY.js    one baked cloth animation per distinct cloth parameter set, loaded
                        by a <script> tag when a fabric is first shown
 
@@ -35,7 +36,69 @@ from catalog.core.errors import CatalogError, InputError
 ASSET_FILES = ("index.html", "app.js", "style.css")
 #: A file every site has: marks a folder as ours (safe to replace).
 MARKER = "catalog-web-site.json"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: data.js packed (pack_data)
+
+
+#: The places in data.js that hold bytes (base64 in the recorded data): packed apart from the
+#: JSON (see :func:`pack_data`). (section, field); ``None``: every item of the list.
+BINARY_FIELDS = (("textures", "data"), ("buffers", "data"), ("blobs", None))
+
+
+def pack_data(data: dict) -> tuple[str, int]:
+    """data.js's text, and the bytes a plain ``window.CATALOG_DATA = JSON`` would take.
+
+    data.js sets ``window.CATALOG_PACKED = {"json": Z, "binary": [Z, ..]}``: Z is base64 of zlib
+    (the page inflates it with the browser's DecompressionStream; a script, not a fetch, so
+    that file:// works). The bulky bytes (:data:`BINARY_FIELDS`: the fabrics' pattern texels,
+    vertex buffers, bytes a frame writes) leave the JSON: each becomes ``{"binary": i}``, its
+    bytes deflated on their own (deflate does much better on bytes than on their base64), and
+    the rest of the JSON (uniform values, frame structures, shaders) is deflated as text."""
+    import base64  # noqa: PLC0415
+    import copy  # noqa: PLC0415
+    import zlib  # noqa: PLC0415
+
+    plain = len("window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n")
+    data = copy.deepcopy(data)
+    binary: list[str] = []
+
+    def move(text: str) -> dict:
+        binary.append(base64.b64encode(zlib.compress(base64.b64decode(text), 9)).decode("ascii"))
+        return {"binary": len(binary) - 1}
+
+    for section, field in BINARY_FIELDS:
+        if field is None:
+            data[section] = [move(v) for v in data[section]]
+            continue
+        for entry in data[section].values():
+            if isinstance(entry.get(field), str):
+                entry[field] = move(entry[field])
+    text = json.dumps(data, separators=(",", ":")).encode("utf-8")
+    packed = {"format": FORMAT_VERSION,
+              "json": base64.b64encode(zlib.compress(text, 9)).decode("ascii"),
+              "binary": binary}
+    return "window.CATALOG_PACKED = " + json.dumps(packed, separators=(",", ":")) + ";\n", plain
+
+
+def unpack_data(text: str) -> dict:
+    """The data of a data.js written by :func:`pack_data`, bytes back as base64 (as recorded)."""
+    import base64  # noqa: PLC0415
+    import zlib  # noqa: PLC0415
+
+    packed = json.loads(text[text.index("= ") + 2:].rstrip().rstrip(";"))
+    data = json.loads(zlib.decompress(base64.b64decode(packed["json"])))
+
+    def back(ref):
+        raw = zlib.decompress(base64.b64decode(packed["binary"][ref["binary"]]))
+        return base64.b64encode(raw).decode("ascii")
+
+    for section, field in BINARY_FIELDS:
+        if field is None:
+            data[section] = [back(v) for v in data[section]]
+            continue
+        for entry in data[section].values():
+            if isinstance(entry.get(field), dict):
+                entry[field] = back(entry[field])
+    return data
 
 
 def _check_out(out: Path) -> Path:
@@ -188,8 +251,8 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             "fluorescence": list(export.FLUORESCENCE),
             "animations": {k: a.manifest() for k, a in animations.items()},
         }
-        text = "window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n"
-        (stage / "data.js").write_text(text, encoding="utf-8")
+        packed, plain_bytes = pack_data(data)
+        (stage / "data.js").write_text(packed, encoding="utf-8")
         (stage / "anim").mkdir()
         for animation in animations.values():
             (stage / "anim" / f"{animation.key}.js").write_text(animation.script(), encoding="utf-8")
@@ -204,6 +267,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                   "bytes": sizes, "total_bytes": sum(sizes.values()),
                   "first_view_bytes": sum(v for k, v in sizes.items() if not k.startswith("anim/"))
                   + max(a.stat().st_size for a in (stage / "anim").iterdir()),
+                  "data_js_plain_bytes": plain_bytes,
                   **{k: round(v, 3) for k, v in timings.items()}}
         (stage / MARKER).write_text(json.dumps({"format": FORMAT_VERSION, "fabrics": names,
                                                 "lights": report["lights"]}, indent=1) + "\n",

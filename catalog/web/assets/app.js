@@ -3,15 +3,35 @@
 // No network: data.js and anim/*.js are loaded by <script> tags (works from file://).
 'use strict';
 (function () {
-  const D = window.CATALOG_DATA;
-  const RW = D.record_size[0], RH = D.record_size[1];
-
   function b64bytes(text) {
     const s = atob(text);
     const out = new Uint8Array(s.length);
     for (let i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
     return out;
   }
+  async function inflate(bytes) {
+    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+  // data.js (catalog/web/site.py pack_data): the JSON and the bulky bytes, each deflated;
+  // {"binary": i} in the JSON names the i-th bytes (bin() below)
+  const unpackStart = performance.now();
+  async function unpack(packed) {
+    const [text, ...binary] = await Promise.all([packed.json, ...packed.binary].map((z) => inflate(b64bytes(z))));
+    const data = JSON.parse(new TextDecoder().decode(text));
+    data.binary = binary;
+    return data;
+  }
+  unpack(window.CATALOG_PACKED).then(start, (e) => {
+    window.catalogStartError = String(e);
+    document.getElementById('status').textContent = 'cannot read the catalog data: ' + (e.message || e);
+    console.error(e);
+  });
+
+  function start(D) {
+  const unpackMs = performance.now() - unpackStart;
+  const RW = D.record_size[0], RH = D.record_size[1];
+  const bin = (ref) => D.binary[ref.binary];  // the bytes of a {"binary": i}
 
   // ---------------------------------------------------------------- camera
   // The orbit camera of catalog/render/camera.py (float64 here, float32 on upload).
@@ -74,10 +94,6 @@
 
   // ---------------------------------------------------------------- baked cloth
   const animations = {};  // key -> Promise of {frames, positions[], normals[], tangents[], indices, ...}
-  async function inflate(bytes) {
-    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
-    return new Uint8Array(await new Response(stream).arrayBuffer());
-  }
   function loadScript(src) {
     return new Promise((resolve, reject) => {
       const s = document.createElement('script');
@@ -85,29 +101,36 @@
       document.head.appendChild(s);
     });
   }
-  // The decoder of catalog/web/bake.py (decode_frames): deltas summed mod 2^16 / 2^8,
-  // positions (lo + q step) + offset in float64 then float32, normals and tangents int8 / 127.
+  // The decoder of catalog/web/bake.py (decode_frames): planes (x, y, z of every vertex) of
+  // zigzag residuals; positions are second differences mod 2^16 (q[k] = 2 q[k-1] - q[k-2] + d),
+  // normals and tangents first differences mod 2^8; positions (lo + q step) + offset in
+  // float64 then float32, normals and tangents int8 / 127.
+  const unzigzag = (z) => (z >>> 1) ^ -(z & 1);
   async function decodeAnimation(entry) {
     const m = entry.manifest, V = m.vertex_count, n = 3 * V;
     const planes = await inflate(b64bytes(entry.payload));
-    const q = new Int32Array(n), qn = new Int32Array(n), qt = new Int32Array(n);
+    const q1 = new Int32Array(n), q2 = new Int32Array(n), qn = new Int32Array(n), qt = new Int32Array(n);
     const positions = [], normals = [], tangents = [];
     for (let f = 0; f < m.frames; f++) {
       const base = f * 12 * V;
       const p = new Float32Array(n), nn = new Float32Array(n), tt = new Float32Array(n);
-      for (let i = 0; i < n; i++) {
-        const c = i % 3;
-        q[i] = (q[i] + (planes[base + i] | (planes[base + n + i] << 8))) & 0xFFFF;
-        p[i] = (m.lo_m[c] + q[i] * m.step_m) + m.offset_m[c];
-        qn[i] = (qn[i] + planes[base + 2 * n + i]) & 0xFF;
-        qt[i] = (qt[i] + planes[base + 3 * n + i]) & 0xFF;
-        nn[i] = (qn[i] > 127 ? qn[i] - 256 : qn[i]) / 127;
-        tt[i] = (qt[i] > 127 ? qt[i] - 256 : qt[i]) / 127;
+      for (let c = 0; c < 3; c++) {
+        for (let v = 0; v < V; v++) {
+          const j = c * V + v, i = 3 * v + c;  // plane index, vertex-major index
+          const d = unzigzag(planes[base + j] | (planes[base + n + j] << 8));
+          const q = (f === 0 ? d : f === 1 ? q1[i] + d : 2 * q1[i] - q2[i] + d) & 0xFFFF;
+          q2[i] = q1[i]; q1[i] = q;
+          p[i] = (m.lo_m[c] + q * m.step_m) + m.offset_m[c];
+          qn[i] = (qn[i] + unzigzag(planes[base + 2 * n + j])) & 0xFF;
+          qt[i] = (qt[i] + unzigzag(planes[base + 3 * n + j])) & 0xFF;
+          nn[i] = (qn[i] > 127 ? qn[i] - 256 : qn[i]) / 127;
+          tt[i] = (qt[i] > 127 ? qt[i] - 256 : qt[i]) / 127;
+        }
       }
       positions.push(p); normals.push(nn); tangents.push(tt);
     }
-    const indices = new Uint32Array(b64bytes(entry.indices).buffer);
-    const uv = new Float32Array(b64bytes(entry.uv).buffer);
+    const indices = new Uint32Array((await inflate(b64bytes(entry.indices))).buffer);
+    const uv = new Float32Array((await inflate(b64bytes(entry.uv))).buffer);
     return { manifest: m, frames: m.frames, fps: m.fps, positions, normals, tangents, indices, uv };
   }
   function animation(key) {
@@ -124,6 +147,23 @@
     const mix = (a, b) => { const o = new Float32Array(a.length); for (let i = 0; i < a.length; i++) o[i] = a[i] + w * (b[i] - a[i]); return o; };
     return { position: mix(anim.positions[k0], anim.positions[k1]), normal: mix(anim.normals[k0], anim.normals[k1]),
              tangent: mix(anim.tangents[k0], anim.tangents[k1]) };
+  }
+
+  // A texture's texels as the desktop gave them, float32 for float textures: quantised ones
+  // (export.encode_texels: channel planes of 8 or 16 bits, each between its lo and hi)
+  // rebuilt as export.decode_texels does; decoded once per texture (both panes share them).
+  const texelCache = {};
+  function decodeTexels(t) {
+    const bytes = bin(t.data), q = t.quantised;
+    if (!q) return t.dtype === 'f4' ? new Float32Array(bytes.buffer, bytes.byteOffset, bytes.byteLength / 4) : bytes;
+    if (texelCache[t.data.binary]) return texelCache[t.data.binary];
+    const ints = q.bits === 16 ? new Uint16Array(bytes.buffer, bytes.byteOffset, bytes.byteLength / 2) : bytes;
+    const top = (1 << q.bits) - 1, C = t.components, N = ints.length / C, texels = new Float32Array(ints.length);
+    for (let ch = 0; ch < C; ch++) {
+      const lo = q.lo[ch], span = q.hi[ch] - q.lo[ch];  // the reference's order of operations
+      for (let i = 0; i < N; i++) texels[i * C + ch] = lo + ints[ch * N + i] * span / top;
+    }
+    return (texelCache[t.data.binary] = texels);
   }
 
   // ---------------------------------------------------------------- the replayer
@@ -168,7 +208,7 @@
       const gl = this.gl, desc = D.buffers[rid], b = gl.createBuffer();
       const target = desc.curtain === 'index' || desc.index ? gl.ELEMENT_ARRAY_BUFFER : gl.ARRAY_BUFFER;
       gl.bindBuffer(target, b);
-      if (desc.data) { const bytes = b64bytes(desc.data); gl.bufferData(target, bytes, gl.STATIC_DRAW); b.bytes = bytes.length; }
+      if (desc.data) { const bytes = bin(desc.data); gl.bufferData(target, bytes, gl.STATIC_DRAW); b.bytes = bytes.length; }
       b.curtain = desc.curtain; b.target = target;
       return (this.buffers[rid] = b);
     }
@@ -240,13 +280,7 @@
           : float ? [gl.R32F, gl.RG32F, gl.RGB32F, gl.RGBA32F] : [gl.R8, gl.RG8, gl.RGB8, gl.RGBA8];
         let texels = null;
         if (t.data) {  // a texture the frame filled (e.g. a pattern): its texels as recorded
-          const bytes = b64bytes(t.data);
-          const q = t.quantised;  // float texels quantised per channel (export.encode_texels)
-          if (q) {
-            const ints = q.bits === 16 ? new Uint16Array(bytes.buffer) : bytes, top = (1 << q.bits) - 1;
-            texels = new Float32Array(ints.length);
-            for (let i = 0; i < ints.length; i++) { const ch = i % t.components; texels[i] = q.lo[ch] + ints[i] * (q.hi[ch] - q.lo[ch]) / top; }
-          } else texels = float ? new Float32Array(bytes.buffer) : bytes;
+          texels = decodeTexels(t);
         }
         gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
         gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], half ? gl.HALF_FLOAT : float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
@@ -335,7 +369,7 @@
           case 'buffer_write': {  // bytes the frame wrote this frame (record.py)
             const b = this.buffer(c.buffer);
             gl.bindVertexArray(null); gl.bindBuffer(b.target, b);
-            gl.bufferSubData(b.target, c.offset, b64bytes(D.blobs[scene.values[c.slot].blob]));
+            gl.bufferSubData(b.target, c.offset, bin(D.blobs[scene.values[c.slot].blob]));
             break;
           }
           case 'mipmaps': {  // a render target's mip chain built again (record.py), on a spare
@@ -603,6 +637,19 @@
   // window.catalogApp: the browser tests and the benchmark drive the page through these.
   window.catalogApp = {
     state, stats, set,
+    // the page's decoded data as float32 bytes in base64: a texture's texels, or a baked
+    // frame's [positions, normals, tangents] (the tests compare them with the reference decoders)
+    async decoded(kind, id, frame) {
+      const b64 = (a) => {
+        const u = new Uint8Array(a.buffer, a.byteOffset, a.byteLength);
+        let s = '';
+        for (let i = 0; i < u.length; i += 8192) s += String.fromCharCode.apply(null, u.subarray(i, i + 8192));
+        return btoa(s);
+      };
+      if (kind === 'texels') return b64(decodeTexels(D.textures[id]));
+      const a = await animation(id);
+      return [a.positions[frame], a.normals[frame], a.tangents[frame]].map(b64);
+    },
     // resolves when the current state has been drawn (animations loaded)
     settle() {
       return new Promise((resolve) => {
@@ -636,6 +683,8 @@
     document.addEventListener('keydown', onKey);
     window.addEventListener('resize', () => (dirty = true));
     set(readHash());
+    stats.unpackMs = unpackMs; stats.gridReadyMs = performance.now();
     requestAnimationFrame(frame);
   } catch (e) { fail(e); }
+  }
 })();
