@@ -308,7 +308,10 @@ def test_site_is_whole(web_site):
     text = (out / "data.js").read_text()
     assert text.startswith("window.CATALOG_PACKED = ")
     data = site_data(out)
-    assert len(data["scenes"]) == len(report["fabrics"]) * len(report["lights"]) * 2
+    from catalog.web.export import FLUORESCENCE, GLARE, ROOM_LAMPS
+
+    switches = len(FLUORESCENCE) * len(GLARE) * len(ROOM_LAMPS)
+    assert len(data["scenes"]) == len(report["fabrics"]) * len(report["lights"]) * switches
     for shader in data["shaders"]:
         assert shader["vertex"].startswith("#version 300 es")
         assert shader["fragment"].startswith("#version 300 es")

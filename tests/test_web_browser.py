@@ -67,25 +67,27 @@ def test_page_loads_without_errors_and_renders(page, web_site):
     assert page.console_errors() == []
 
 
-@pytest.mark.parametrize("fabric, light, fluorescence, frame, camera", [
-    ("fluoro-pink", "D65", "on", 0, None),
-    ("linen-dense", "sun@8", "on", 17, None),
-    ("fluoro-pink", "UV-A", "off", 30, None),
-    ("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8)),   # the page's own camera matrices
+@pytest.mark.parametrize("fabric, light, fluorescence, frame, camera, glare, lamp", [
+    ("fluoro-pink", "D65", "on", 0, None, "off", "none"),
+    ("linen-dense", "sun@8", "on", 17, None, "off", "none"),
+    ("fluoro-pink", "UV-A", "off", 30, None, "off", "none"),
+    ("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8), "off", "none"),  # the page's camera
+    ("fluoro-pink", "D65", "on", 0, None, "on", "none"),     # the glare's half/quarter targets
+    ("linen-dense", "sun@18", "on", 3, None, "on", "A"),     # a room lamp: room and cloth lit
 ])
 def test_page_frame_matches_the_egl_frame(page, web_site, animations, gl, fabric, light,
-                                          fluorescence, frame, camera):
-    """The page's canvas and the desktop frame (EGL, same baked cloth frame, same camera):
-    off edges every channel within 3/255, mean within 0.5/255, at most 1 % of the pixels
-    over 3/255 on edges (browser.py states the rule)."""
+                                          fluorescence, frame, camera, glare, lamp):
+    """The page's canvas and the desktop frame (EGL, same baked cloth frame, same camera, same
+    glare and room lamp): off edges every channel within 3/255, mean within 0.5/255, at most
+    1 % of the pixels over 3/255 on edges (browser.py states the rule)."""
     out, _ = web_site
     orbit = {} if camera is None else dict(zip(("yaw_deg", "pitch_deg", "distance_m"), camera))
     shown = _viewer(page, out, fabric=fabric, light=light, fluorescence=fluorescence, frame=frame,
-                    **orbit)
-    scene = web_browser.site_data(out)["scenes"][f"{fabric}|{light}|{fluorescence}"]
+                    glare=glare, lamp=lamp, **orbit)
+    scene = web_browser.site_data(out)["scenes"][f"{fabric}|{light}|{fluorescence}|{glare}|{lamp}"]
     desktop = web_browser.egl_frame(fabric, light, fluorescence, frame, SIZE,
                                     _animation_of(out, fabric, animations), ctx=gl, camera=camera,
-                                    ev100=scene["ev100"])
+                                    ev100=scene["ev100"], glare=glare, lamp=lamp)
     figures = web_browser.compare_frames(shown, desktop)
     assert web_browser.frames_match(figures), json.dumps(figures)
     assert page.console_errors() == []
@@ -140,6 +142,55 @@ def test_fluorescence_switch_changes_the_uv_picture(page, web_site):
     brightness_off = off.astype(int).sum(axis=-1)[changed]
     assert np.all(brightness_off <= brightness_on)
     assert np.array_equal(again, on)
+
+
+def test_glare_switch_spreads_light_from_bright_to_dark(page, web_site):
+    """The glare (key G, then the checkbox) is the desktop's energy-preserving bloom: it
+    brightens the darkest tenth of the picture (mean +1/255 at least; measured +2..3/255 at the
+    bounds' setting) and does not brighten the brightest tenth (mean change <= +0.1/255;
+    measured -0.2..-0.4/255); off again gives the frame back exactly."""
+    out, _ = web_site
+    on = _viewer(page, out, fabric="linen-dense", light="D65", frame=0)
+    assert page.state()["glare"] == "on"  # the snapshot's default
+    page.driver.find_element("id", "canvas-a").send_keys("g")
+    page.settle()
+    assert page.state()["glare"] == "off"
+    off = page.canvas()
+    page.driver.find_element("id", "glare").click()
+    page.settle()
+    assert page.state()["glare"] == "on" and np.array_equal(page.canvas(), on)
+    lum = off.astype(float).mean(axis=-1)
+    change = (on.astype(float) - off).mean(axis=-1)
+    dark, bright = lum <= np.percentile(lum, 10), lum >= np.percentile(lum, 90)
+    assert change[dark].mean() >= 1.0
+    assert change[bright].mean() <= 0.1
+
+
+def test_room_lamp_switch_lights_the_room_beside_it(page, web_site):
+    """A room lamp (the select, then key M) stands right of the window: it only adds light
+    (at most 0.5 % of the pixels darker by over 2/255: edge pixels; the exposure is the
+    scene's), more on the right third of the picture than on the left (measured 32 vs 9/255),
+    and the incandescent lamp's light is redder than the white LED's (red over blue)."""
+    from selenium.webdriver.support.ui import Select
+
+    out, _ = web_site
+    none = _viewer(page, out, fabric="linen-dense", light="D65", frame=0, glare="off").astype(int)
+    Select(page.driver.find_element("id", "lamp")).select_by_value("A")
+    page.settle()
+    assert page.state()["lamp"] == "A"
+    lamp_a = page.canvas().astype(int)
+    page.driver.find_element("id", "canvas-a").send_keys("m")
+    page.settle()
+    assert page.state()["lamp"] == "LED-B4"
+    lamp_led = page.canvas().astype(int)
+    w = none.shape[1]
+    ratios = []
+    for lit in (lamp_a, lamp_led):
+        change = lit - none
+        assert (change.min(axis=-1) < -2).mean() <= 0.005
+        assert change[:, 2 * w // 3:].mean() > 2.0 * change[:, :w // 3].mean() > 0
+        ratios.append(change[..., 0].mean() / change[..., 2].mean())
+    assert ratios[0] > 1.5 * ratios[1]
 
 
 def test_light_switch_and_sun_hour(page, web_site):

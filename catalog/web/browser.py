@@ -114,14 +114,15 @@ class Browser:
 
 def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tuple[int, int],
               animation, ctx=None, camera: tuple[float, float, float] | None = None,
-              ev100: float | None = None) -> np.ndarray:
-    """The desktop frame (EGL) of the same fabric, light, fluorescence switch, baked cloth frame
-    and camera (yaw deg, pitch deg, distance m; default the renderer's): uint8 (H, W, 3), row
+              ev100: float | None = None, glare: str = "off", lamp: str = "none") -> np.ndarray:
+    """The desktop frame (EGL) of the same fabric, light, fluorescence, glare and room-lamp
+    switches, baked cloth frame and camera (yaw deg, pitch deg, distance m; default the renderer's): uint8 (H, W, 3), row
     0 = top. ``ev100``: the page's fixed exposure of the scene (None: the desktop meters)."""
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.web import bake as bake_lib  # noqa: PLC0415
-    from catalog.web.export import FLUORESCENCE, configure_desktop_frame  # noqa: PLC0415
+    from catalog.web.export import (FLUORESCENCE, GLARE, configure_desktop_frame,  # noqa: PLC0415
+                                    room_lamps)
 
     positions, normals, tangents = bake_lib.decode_frame(animation, frame)
     renderer = FrameRenderer(ctx or create_headless_context(), size)
@@ -133,6 +134,8 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
             renderer.set_light(light)
         renderer.set_fluorescence(FLUORESCENCE[fluorescence])
         configure_desktop_frame(renderer)
+        renderer.set_bloom(GLARE[glare])
+        renderer.set_room_lamps(room_lamps(lamp))
         if camera is not None:
             renderer.set_camera(*camera)
         if ev100 is not None:

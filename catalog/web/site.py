@@ -20,6 +20,7 @@ existing ``DIR`` is replaced only if it is an earlier catalog site or empty.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import os
 import shutil
@@ -52,7 +53,8 @@ def pack_data(data: dict) -> tuple[str, int]:
     that file:// works). The bulky bytes (:data:`BINARY_FIELDS`: the fabrics' pattern texels,
     vertex buffers, bytes a frame writes) leave the JSON: each becomes ``{"binary": i}``, its
     bytes deflated on their own (deflate does much better on bytes than on their base64), and
-    the rest of the JSON (uniform values, frame structures, shaders) is deflated as text."""
+    the rest of the JSON (uniform values, frame structures, shaders) is deflated as text, each
+    distinct uniform value once (``value_pool``; a scene's ``values`` index it)."""
     import base64  # noqa: PLC0415
     import copy  # noqa: PLC0415
     import zlib  # noqa: PLC0415
@@ -60,6 +62,14 @@ def pack_data(data: dict) -> tuple[str, int]:
     plain = len("window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n")
     data = copy.deepcopy(data)
     binary: list[str] = []
+    # every distinct uniform value once ("values": [0.5, ..] -> "values": [i, ..] into
+    # "value_pool"): scenes of one fabric or light share most of theirs
+    pool: dict[str, int] = {}
+    for scene in data.get("scenes", {}).values():
+        scene["values"] = [pool.setdefault(json.dumps(v, separators=(",", ":")), len(pool))
+                           for v in scene["values"]]
+    if "scenes" in data:
+        data["value_pool"] = [json.loads(text) for text in pool]
 
     def move(text: str) -> dict:
         binary.append(base64.b64encode(zlib.compress(base64.b64decode(text), 9)).decode("ascii"))
@@ -86,6 +96,10 @@ def unpack_data(text: str) -> dict:
 
     packed = json.loads(text[text.index("= ") + 2:].rstrip().rstrip(";"))
     data = json.loads(zlib.decompress(base64.b64decode(packed["json"])))
+    pool = data.pop("value_pool", None)
+    if pool is not None:
+        for scene in data["scenes"].values():
+            scene["values"] = [pool[i] for i in scene["values"]]
 
     def back(ref):
         raw = zlib.decompress(base64.b64decode(packed["binary"][ref["binary"]]))
@@ -218,11 +232,16 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             for preset in presets:
                 exporter.use_drape(fabric_animation[preset.name])
                 for choice in choices:
-                    on = exporter.record(preset, choice, "on")
-                    scenes[f"{preset.name}|{choice.id}|on"] = on
-                    # the switch keeps the exposure: it shows the brightener's light
-                    scenes[f"{preset.name}|{choice.id}|off"] = exporter.record(
-                        preset, choice, "off", ev100=on["ev100"])
+                    metered = exporter.record(preset, choice, "on")
+                    # the switches keep the exposure metered with fluorescence on, no glare,
+                    # no lamp: they show the brightener's, the glare's and the lamp's light
+                    for fluorescence, glare, lamp in itertools.product(
+                            export.FLUORESCENCE, export.GLARE, export.ROOM_LAMPS):
+                        key = export.scene_key(preset.name, choice.id, fluorescence, glare, lamp)
+                        scenes[key] = (metered if (fluorescence, glare, lamp) == ("on", "off", "none")
+                                       else exporter.record(preset, choice, fluorescence,
+                                                            ev100=metered["ev100"], glare=glare,
+                                                            lamp=lamp))
             objects = exporter.objects()
             swatches = {p.name: base64.b64encode(export.swatch_png(exporter.ctx._ctx, p))
                         .decode("ascii") for p in presets}
@@ -249,6 +268,8 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             "lights": [{"id": c.id, "label": c.label, "kind": c.kind, "hour": c.hour}
                        for c in choices],
             "fluorescence": list(export.FLUORESCENCE),
+            "glare": list(export.GLARE),
+            "room_lamps": [{"id": k, "label": v} for k, v in export.ROOM_LAMPS.items()],
             "animations": {k: a.manifest() for k, a in animations.items()},
         }
         packed, plain_bytes = pack_data(data)

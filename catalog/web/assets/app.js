@@ -30,8 +30,8 @@
 
   function start(D) {
   const unpackMs = performance.now() - unpackStart;
-  const RW = D.record_size[0], RH = D.record_size[1];
   const bin = (ref) => D.binary[ref.binary];  // the bytes of a {"binary": i}
+  const value = (scene, slot) => D.value_pool[scene.values[slot]];  // site.pack_data's pool
 
   // ---------------------------------------------------------------- camera
   // The orbit camera of catalog/render/camera.py (float64 here, float32 on upload).
@@ -263,15 +263,22 @@
       gl.bindVertexArray(null);
       return (this.vaos[rid] = vao);
     }
+    // export.canvas_level: the canvas size halved k times, rounded up (the glare's targets)
+    canvasAt(k) {
+      let [w, h] = this.size;
+      for (let i = 0; i < k; i++) { w = Math.max(1, Math.ceil(w / 2)); h = Math.max(1, Math.ceil(h / 2)); }
+      return [w, h];
+    }
     resize() {
       const gl = this.gl, w = this.canvas.width, h = this.canvas.height;
+      const canvasAt = (k) => this.canvasAt(k);
       if (this.targets && this.size[0] === w && this.size[1] === h) return;
       for (const t of Object.values(this.targets || {})) (t.tex ? gl.deleteTexture(t.tex) : null, t.rb ? gl.deleteRenderbuffer(t.rb) : null, t.fbo ? gl.deleteFramebuffer(t.fbo) : null);
       this.size = [w, h];
-      const sized = (s) => (s[0] === RW && s[1] === RH ? [w, h] : s);
+      const sized = (t) => (t.canvas_level != null ? canvasAt(t.canvas_level) : t.size);
       const textures = {}, renderbuffers = {};
       for (const [rid, t] of Object.entries(D.textures)) {
-        const tex = gl.createTexture(), s = sized(t.size);
+        const tex = gl.createTexture(), s = sized(t);
         gl.bindTexture(gl.TEXTURE_2D, tex);
         const half = t.dtype === 'f2', float = t.dtype === 'f4' || half, c = t.components - 1;
         if (t.data && half) throw new Error('half-float texels given by the frame: not replayed');
@@ -301,7 +308,7 @@
         textures[rid] = { tex };
       }
       for (const [rid, r] of Object.entries(D.renderbuffers)) {
-        const rb = gl.createRenderbuffer(), s = sized(r.size);
+        const rb = gl.createRenderbuffer(), s = sized(r);
         gl.bindRenderbuffer(gl.RENDERBUFFER, rb);
         gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, s[0], s[1]);
         renderbuffers[rid] = { rb };
@@ -344,7 +351,6 @@
       let screen = null;
       for (const c of structure) if (c.op === 'framebuffer') screen = c.framebuffer;
       let current = null;
-      const full = (v) => v && v[0] === 0 && v[1] === 0 && v[2] === RW && v[3] === RH;
       for (const c of structure) {
         switch (c.op) {
           case 'framebuffer':  // moderngl's use(): the framebuffer's depth mask with it
@@ -352,7 +358,7 @@
             gl.depthMask(D.framebuffers[c.framebuffer].depth_mask !== false);
             break;
           case 'viewport':
-            gl.viewport(...(full(c.viewport) ? [0, 0, w, h] : c.viewport)); break;
+            gl.viewport(...(c.canvas_level != null ? [0, 0, ...this.canvasAt(c.canvas_level)] : c.viewport)); break;
           case 'clear':
             gl.bindFramebuffer(gl.FRAMEBUFFER, c.framebuffer === screen ? null : this.targets['fbo' + c.framebuffer].fbo);
             gl.clearColor(...c.colour); gl.clearDepth(c.depth);
@@ -369,7 +375,7 @@
           case 'buffer_write': {  // bytes the frame wrote this frame (record.py)
             const b = this.buffer(c.buffer);
             gl.bindVertexArray(null); gl.bindBuffer(b.target, b);
-            gl.bufferSubData(b.target, c.offset, bin(D.blobs[scene.values[c.slot].blob]));
+            gl.bufferSubData(b.target, c.offset, bin(D.blobs[value(scene, c.slot).blob]));
             break;
           }
           case 'mipmaps': {  // a render target's mip chain built again (record.py), on a spare
@@ -385,7 +391,7 @@
             if (!u) break;
             const which = c.camera ? D.camera_uniforms[c.name] : null;  // the frame's camera
             const canvas = c.canvas === 'texel' ? [1 / w, 1 / h] : c.canvas === 'size' ? [w, h] : null;
-            this.setUniform(u, which ? cam[which] : canvas || scene.values[c.slot]);
+            this.setUniform(u, which ? cam[which] : canvas || value(scene, c.slot));
             break;
           }
           case 'draw': {
@@ -418,13 +424,15 @@
   const clamp = (x, r) => Math.min(r[1], Math.max(r[0], x));
   const state = {
     view: 'grid', fabric: D.fabrics[0].name, light: D.lights[0].id, fluorescence: 'on', compare: '',
+    glare: 'on', lamp: 'none',  // `catalog snapshot`'s defaults: glare, no lamp
     yaw_deg: D.camera.yaw_deg, pitch_deg: D.camera.pitch_deg, distance_m: D.camera.distance_m,
     t: 0, playing: true, size: null,
   };
   const stats = { loadStartMs: performance.timeOrigin ? 0 : 0, firstFrameMs: null, frames: 0, errors: [] };
   let panes = null, dirty = true, lastTime = null, readyResolve, ready = new Promise((r) => (readyResolve = r));
 
-  function sceneKey(fabric) { return fabric + '|' + state.light + '|' + state.fluorescence; }
+  // export.scene_key: fabric, light and the three switches
+  function sceneKey(fabric) { return [fabric, state.light, state.fluorescence, state.glare, state.lamp].join('|'); }
   function lightOf(id) { return D.lights.find((l) => l.id === id); }
 
   function buildGrid() {
@@ -458,6 +466,9 @@
     light.onchange = () => set({ light: light.value === 'sun' ? sunNearest(12).id : light.value });
     $('hour').oninput = () => set({ light: sunNearest(+$('hour').value).id });
     $('fluorescence').onchange = () => set({ fluorescence: $('fluorescence').checked ? 'on' : 'off' });
+    $('glare').onchange = () => set({ glare: $('glare').checked ? 'on' : 'off' });
+    for (const l of D.room_lamps) $('lamp').add(new Option(l.label || 'none', l.id));
+    $('lamp').onchange = () => set({ lamp: $('lamp').value });
     $('play').onclick = () => set({ playing: !state.playing });
     $('back').onclick = () => set({ view: 'grid' });
     $('home').onclick = (e) => { e.preventDefault(); set({ view: 'grid' }); };
@@ -498,6 +509,8 @@
     $('hour-label').hidden = l.kind !== 'sun';
     if (l.kind === 'sun') { $('hour').value = l.hour; $('hour-out').textContent = String(l.hour).padStart(2, '0') + ':00'; }
     $('fluorescence').checked = state.fluorescence === 'on';
+    $('glare').checked = state.glare === 'on';
+    $('lamp').value = state.lamp;
     $('play').textContent = state.playing ? 'Pause' : 'Play';
     $('pane-b').hidden = !state.compare;
     $('caption-a').textContent = fabricByName[state.fabric].display_name;
@@ -505,7 +518,8 @@
     showFacts();
   }
   function writeHash() {
-    const h = new URLSearchParams({ view: state.view, fabric: state.fabric, light: state.light, fluorescence: state.fluorescence });
+    const h = new URLSearchParams({ view: state.view, fabric: state.fabric, light: state.light, fluorescence: state.fluorescence,
+                                    glare: state.glare, lamp: state.lamp });
     if (state.compare) h.set('compare', state.compare);
     history.replaceState(null, '', '#' + h.toString());
   }
@@ -514,6 +528,8 @@
     if (h.get('fabric') && fabricByName[h.get('fabric')]) p.fabric = h.get('fabric');
     if (h.get('light') && lightOf(h.get('light'))) p.light = h.get('light');
     if (h.get('fluorescence') === 'off') p.fluorescence = 'off';
+    if (h.get('glare') === 'off') p.glare = 'off';
+    if (h.get('lamp') && D.room_lamps.some((l) => l.id === h.get('lamp'))) p.lamp = h.get('lamp');
     if (h.get('compare') && fabricByName[h.get('compare')]) p.compare = h.get('compare');
     if (h.get('view') === 'viewer') p.view = 'viewer';
     if (h.get('frame') !== null) { p.t = +h.get('frame'); p.playing = false; }
@@ -626,6 +642,8 @@
       l: () => cycleLight(1), L: () => cycleLight(-1),
       '[': () => suns.length && set({ light: sunNearest((hour ?? 13) - 1).id }), ']': () => suns.length && set({ light: sunNearest((hour ?? 11) + 1).id }),
       f: () => set({ fluorescence: state.fluorescence === 'on' ? 'off' : 'on' }),
+      g: () => set({ glare: state.glare === 'on' ? 'off' : 'on' }),
+      m: () => { const ids = D.room_lamps.map((l) => l.id); set({ lamp: ids[(ids.indexOf(state.lamp) + 1) % ids.length] }); },
       c: () => { const names = ['', ...D.fabrics.map((f) => f.name).filter((n) => n !== state.fabric)]; set({ compare: names[(names.indexOf(state.compare) + 1) % names.length] }); },
       n: () => cycleFabric(1), p: () => cycleFabric(-1), ' ': () => set({ playing: !state.playing }),
       r: resetView, Escape: () => set({ view: 'grid' }),
