@@ -20,10 +20,18 @@ import tempfile
 import time
 from pathlib import Path
 
-from catalog.web.export import configure_desktop_frame  # noqa: E402  (the page's modes)
+from catalog.web.export import configure_desktop_frame, scene_key  # noqa: E402  (the page's modes)
 
-#: The scene every timing uses.
-FABRIC, LIGHT = "fluoro-pink", "D65"
+#: The scene every timing uses (the page's default switches: glare on, no room lamp).
+FABRIC, LIGHT, GLARE, LAMP = "fluoro-pink", "D65", "on", "none"
+#: The page-vs-EGL comparisons (the browser test's scenes): fabric, light, fluorescence,
+#: baked frame, camera (yaw, pitch, distance) or None, glare, room lamp.
+COMPARED = (("fluoro-pink", "D65", "on", 0, None, "off", "none"),
+            ("fluoro-pink", "UV-A", "off", 30, None, "off", "none"),
+            ("linen-dense", "sun@8", "on", 17, None, "off", "none"),
+            ("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8), "off", "none"),
+            ("fluoro-pink", "D65", "on", 0, None, "on", "none"),
+            ("linen-dense", "sun@18", "on", 3, None, "on", "A"))
 
 
 class DesktopFrames:
@@ -39,12 +47,19 @@ class DesktopFrames:
         self.ctx = create_headless_context()
         positions, normals, tangents = bake_lib.decode_frame(animation, 0)
         self.renderer = FrameRenderer(self.ctx, size, specialise=specialise)
+        from catalog.web.export import GLARE as GLARE_SWITCH  # noqa: PLC0415
+        from catalog.web.export import room_lamps  # noqa: PLC0415
+
         self.renderer.set_fabric(FABRIC)
         configure_desktop_frame(self.renderer)
+        self.renderer.set_bloom(GLARE_SWITCH[GLARE])
+        self.renderer.set_room_lamps(room_lamps(LAMP))
         self.renderer.set_light(LIGHT)
         self.renderer.set_mesh(positions, normals, animation.uv, tangents,
-                               animation.indices.astype(np.int32))
+                               animation.indices.astype(np.int32),
+                               fabric_size_m=animation.fabric_size_m)
         self.renderer.set_mesh_offset((0.0, 0.0, 0.0))
+        self.renderer.set_rings(animation.rings_x_m)
         self.times(1)  # compile, and meter the exposure once
         # like the page: a fixed exposure (no per-frame read-back and histogram)
         self.renderer.set_ev(self.renderer.current_ev100())
@@ -90,6 +105,8 @@ def run(quick: bool = False) -> dict:
             "animations": len(report["animations"]),
             "total_bytes": report["total_bytes"], "first_view_bytes": report["first_view_bytes"],
             "data_js_bytes": report["bytes"]["data.js"], "app_js_bytes": report["bytes"]["app.js"],
+            # data.js as plain JSON with the bytes in base64 (the form before pack_data)
+            "data_js_plain_bytes": report["data_js_plain_bytes"],
             "animation_encoded_bytes": statistics.median(
                 a["encoded_bytes"] for a in report["animations"].values()),
             "animation_raw_bytes": next(iter(report["animations"].values()))["raw_bytes"],
@@ -106,22 +123,29 @@ def run(quick: bool = False) -> dict:
 
         b = web_browser.Browser(1000, 900)
         try:
-            first_frame, grid_ready = [], []
+            first_frame, grid_ready, unpack, scripts = [], [], [], []
             for _ in range(loads):
                 b.open(out, view="viewer", fabric=FABRIC, light=LIGHT, size="320x240")
-                first_frame.append(b.driver.execute_script(
-                    "return window.catalogApp.stats.firstFrameMs"))
-                grid_ready.append(b.driver.execute_script(
+                stats = b.driver.execute_script("return window.catalogApp.stats")
+                first_frame.append(stats["firstFrameMs"])
+                grid_ready.append(stats["gridReadyMs"])
+                unpack.append(stats["unpackMs"])
+                scripts.append(b.driver.execute_script(
                     "const t = performance.getEntriesByType('navigation')[0];"
                     "return t.domContentLoadedEventEnd"))
+            # ms from navigation: the scripts read (data.js parsed), data.js inflated and the
+            # grid built (page ready), the first curtain frame drawn (its loop inflated)
             result["load"] = {"first_frame_ms": round(statistics.median(first_frame), 1),
                               "page_ready_ms": round(statistics.median(grid_ready), 1),
+                              "unpack_ms": round(statistics.median(unpack), 1),
+                              "scripts_read_ms": round(statistics.median(scripts), 1),
                               "loads": loads}
             rows = []
             for w, h in sizes:
                 # side by side: rounds alternate the page and the two desktop variants, so a
                 # load spike on the shared machine hits all three alike; medians of all frames
-                b.open(out, view="viewer", fabric=FABRIC, light=LIGHT, size=f"{w}x{h}")
+                b.open(out, view="viewer", fabric=FABRIC, light=LIGHT, size=f"{w}x{h}",
+                       glare=GLARE, lamp=LAMP)
                 b.benchmark(3)  # warm-up
                 desktops = {"desktop": DesktopFrames((w, h), animation, True),
                             "unspecialised": DesktopFrames((w, h), animation, False)}
@@ -147,26 +171,25 @@ def run(quick: bool = False) -> dict:
             result["frames_per_case"] = frames * rounds
             # the page frame against the EGL frame (the browser test's rule)
             comparisons = []
-            for fabric, light, switch, frame, camera in (
-                    ("fluoro-pink", "D65", "on", 0, None),
-                    ("fluoro-pink", "UV-A", "off", 30, None),
-                    ("linen-dense", "sun@8", "on", 17, None),
-                    ("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8))):
+            for fabric, light, switch, frame, camera, glare, lamp in COMPARED:
                 size = (160, 120)
                 orbit = {} if camera is None else dict(
                     zip(("yaw_deg", "pitch_deg", "distance_m"), camera))
                 b.open(out, view="viewer", fabric=fabric, light=light, fluorescence=switch,
-                       frame=frame, size=f"{size[0]}x{size[1]}", **orbit)
+                       frame=frame, size=f"{size[0]}x{size[1]}", glare=glare, lamp=lamp, **orbit)
                 fabric_anim = next(f["animation"] for f in key["fabrics"] if f["name"] == fabric)
+                scene = key["scenes"][scene_key(fabric, light, switch, glare, lamp)]
                 figures = web_browser.compare_frames(
                     b.canvas(), web_browser.egl_frame(fabric, light, switch, frame, size,
                                                       bake_lib.read_script(
                                                           out / "anim" / f"{fabric_anim}.js"),
-                                                      camera=camera,
-                                                      ev100=key["scenes"][f"{fabric}|{light}|{switch}"]["ev100"]))
+                                                      camera=camera, ev100=scene["ev100"],
+                                                      glare=glare, lamp=lamp))
                 view = "" if camera is None else " / camera yaw {:g} pitch {:g} d {:g} m".format(*camera)
+                extra = "".join([" / glare" if glare == "on" else "",
+                                 f" / lamp {lamp}" if lamp != "none" else ""])
                 comparisons.append({"scene": f"{fabric} / {light} / fluorescence {switch} / "
-                                             f"frame {frame}{view}", **figures,
+                                             f"frame {frame}{view}{extra}", **figures,
                                     "match": web_browser.frames_match(figures)})
             result["pixels"] = comparisons
         finally:
@@ -181,20 +204,25 @@ def markdown_tables(result: dict) -> dict[str, str]:
     """Block ``web`` of BENCHMARKS.md."""
     s, load = result["site"], result["load"]
     lines = [
-        f"Catalog of {s['fabrics']} fabrics x {s['lights']} lights x fluorescence on/off "
-        f"({s['scenes']} scenes, {s['shader_programs']} GLSL ES programs, "
-        f"{s['animations']} baked cloth loops).",
+        f"Catalog of {s['fabrics']} fabrics x {s['lights']} lights x fluorescence on/off x glare "
+        f"on/off x room lamp (none and two) ({s['scenes']} scenes, {s['shader_programs']} GLSL ES "
+        f"programs, {s['animations']} baked cloth loops of the settled drape).",
         "",
         "| site | value |",
         "|---|---|",
         f"| whole site | {s['total_bytes'] / 1e6:.2f} MB |",
         f"| first view (page, data, one cloth loop) | {s['first_view_bytes'] / 1e6:.2f} MB |",
-        f"| data.js (shaders, recorded frames, uniforms, swatches) | {s['data_js_bytes'] / 1e3:.0f} kB |",
+        f"| data.js (shaders, recorded frames, uniforms, swatches, pattern texels; deflated) | "
+        f"{s['data_js_bytes'] / 1e3:.0f} kB |",
+        f"| the same as plain JSON with base64 bytes (the form before packing) | "
+        f"{s['data_js_plain_bytes'] / 1e6:.2f} MB |",
         f"| one cloth loop: {s['animation_frames']} frames at {s['animation_fps']:g} fps, "
         f"{s['vertices']} vertices | {s['animation_encoded_bytes'] / 1e3:.0f} kB encoded "
         f"(raw {s['animation_raw_bytes'] / 1e3:.0f} kB; file {s['animation_file_bytes'] / 1e3:.0f} kB in base64) |",
         f"| build (`catalog web`) | {s['build_s']:.1f} s (bake {s['bake_s']:.1f} s, record {s['record_s']:.1f} s) |",
-        f"| load to page ready (file://) | {load['page_ready_ms']:.0f} ms |",
+        f"| load to scripts read (file://) | {load['scripts_read_ms']:.0f} ms |",
+        f"| load to page ready (file://; data.js inflated and parsed: {load['unpack_ms']:.0f} ms) "
+        f"| {load['page_ready_ms']:.0f} ms |",
         f"| load to first curtain frame (file://, 320x240) | {load['first_frame_ms']:.0f} ms |",
         "",
         f"Frame times: medians of {result['frames_per_case']} frames per case, the page and the "

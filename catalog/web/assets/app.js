@@ -102,17 +102,40 @@
     });
   }
   // The decoder of catalog/web/bake.py (decode_frames): planes (x, y, z of every vertex) of
-  // zigzag residuals; positions are second differences mod 2^16 (q[k] = 2 q[k-1] - q[k-2] + d),
-  // normals and tangents first differences mod 2^8; positions (lo + q step) + offset in
-  // float64 then float32, normals and tangents int8 / 127.
+  // zigzag residuals, positions second differences mod 2^16 (q[k] = 2 q[k-1] - q[k-2] + d);
+  // positions (lo + q step) + offset in float64 then float32; normals and weft tangents
+  // computed from the float64 grid (lo + q step) as bake.frames_of_grid does, sums in its order.
   const unzigzag = (z) => (z >>> 1) ^ -(z & 1);
+  function gridFrames(x, cols, rows, normals, tangents) {
+    const at = (r, c, k) => x[3 * (r * cols + c) + k];
+    for (let r = 0; r < rows; r++) {
+      const r0 = r === 0 ? 0 : r === rows - 1 ? rows - 2 : r - 1, r1 = r === 0 ? 1 : r === rows - 1 ? rows - 1 : r + 1;
+      for (let c = 0; c < cols; c++) {
+        const c0 = c === 0 ? 0 : c === cols - 1 ? cols - 2 : c - 1, c1 = c === 0 ? 1 : c === cols - 1 ? cols - 1 : c + 1;
+        const d0 = at(r1, c, 0) - at(r0, c, 0), d1 = at(r1, c, 1) - at(r0, c, 1), d2 = at(r1, c, 2) - at(r0, c, 2);
+        const a0 = at(r, c1, 0) - at(r, c0, 0), a1 = at(r, c1, 1) - at(r, c0, 1), a2 = at(r, c1, 2) - at(r, c0, 2);
+        let n0 = d1 * a2 - d2 * a1, n1 = d2 * a0 - d0 * a2, n2 = d0 * a1 - d1 * a0;
+        let len = Math.sqrt(n0 * n0 + n1 * n1 + n2 * n2);
+        if (!(len > 0)) len = 1;
+        n0 /= len; n1 /= len; n2 /= len;
+        const dot = a0 * n0 + a1 * n1 + a2 * n2;
+        const t0 = a0 - dot * n0, t1 = a1 - dot * n1, t2 = a2 - dot * n2;
+        let tl = Math.sqrt(t0 * t0 + t1 * t1 + t2 * t2);
+        if (!(tl > 0)) tl = 1;
+        const i = 3 * (r * cols + c);
+        normals[i] = n0; normals[i + 1] = n1; normals[i + 2] = n2;
+        tangents[i] = t0 / tl; tangents[i + 1] = t1 / tl; tangents[i + 2] = t2 / tl;
+      }
+    }
+  }
   async function decodeAnimation(entry) {
-    const m = entry.manifest, V = m.vertex_count, n = 3 * V;
+    const m = entry.manifest, V = m.vertex_count, n = 3 * V, [cols, rows] = m.grid;
+    if (cols * rows !== V) throw new Error('baked loop ' + m.key + ': grid is not ' + V + ' vertices');
     const planes = await inflate(b64bytes(entry.payload));
-    const q1 = new Int32Array(n), q2 = new Int32Array(n), qn = new Int32Array(n), qt = new Int32Array(n);
+    const q1 = new Int32Array(n), q2 = new Int32Array(n), cloth = new Float64Array(n);
     const positions = [], normals = [], tangents = [];
     for (let f = 0; f < m.frames; f++) {
-      const base = f * 12 * V;
+      const base = f * 6 * V;
       const p = new Float32Array(n), nn = new Float32Array(n), tt = new Float32Array(n);
       for (let c = 0; c < 3; c++) {
         for (let v = 0; v < V; v++) {
@@ -120,13 +143,11 @@
           const d = unzigzag(planes[base + j] | (planes[base + n + j] << 8));
           const q = (f === 0 ? d : f === 1 ? q1[i] + d : 2 * q1[i] - q2[i] + d) & 0xFFFF;
           q2[i] = q1[i]; q1[i] = q;
-          p[i] = (m.lo_m[c] + q * m.step_m) + m.offset_m[c];
-          qn[i] = (qn[i] + unzigzag(planes[base + 2 * n + j])) & 0xFF;
-          qt[i] = (qt[i] + unzigzag(planes[base + 3 * n + j])) & 0xFF;
-          nn[i] = (qn[i] > 127 ? qn[i] - 256 : qn[i]) / 127;
-          tt[i] = (qt[i] > 127 ? qt[i] - 256 : qt[i]) / 127;
+          cloth[i] = m.lo_m[c] + q * m.step_m;
+          p[i] = cloth[i] + m.offset_m[c];
         }
       }
+      gridFrames(cloth, cols, rows, nn, tt);
       positions.push(p); normals.push(nn); tangents.push(tt);
     }
     const indices = new Uint32Array((await inflate(b64bytes(entry.indices))).buffer);
