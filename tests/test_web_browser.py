@@ -350,6 +350,24 @@ def test_static_host_and_no_network(page, web_site):
         assert ref.startswith(("data:", "#")) or "://" not in ref and not ref.startswith("//"), ref
 
 
+def test_plain_json_data_renders_the_same(page, web_site, tmp_path):
+    """The page also reads data.js as plain JSON (site.plain_data_js, the form before packing,
+    which the benchmark loads for its before/after): the same canvas, pixel for pixel."""
+    import shutil
+
+    from catalog.web.site import plain_data_js
+
+    out, _ = web_site
+    plain = tmp_path / "plain"
+    shutil.copytree(out, plain)
+    (plain / "data.js").write_text(plain_data_js(web_browser.site_data(out)), encoding="utf-8")
+    state = {"fabric": "fluoro-pink", "light": "sun@15", "frame": 5, "lamp": "A"}
+    packed_image = _viewer(page, out, **state)
+    plain_image = _viewer(page, plain, **state)
+    assert np.array_equal(packed_image, plain_image)
+    assert page.console_errors() == [] and page.page_errors() == []
+
+
 def test_frame_time_under_swiftshader_is_reported(page, web_site, record_property):
     """Reported, not asserted as a speed (BENCHMARKS.md has the benchmark's figures): the hook
     gives finite frame times, the CPU part no larger than the whole frame."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import json
 import platform
+import shutil
 import statistics
 import sys
 import tempfile
@@ -82,7 +83,7 @@ class DesktopFrames:
 def run(quick: bool = False) -> dict:
     from catalog.web import bake as bake_lib  # noqa: PLC0415
     from catalog.web import browser as web_browser  # noqa: PLC0415
-    from catalog.web.site import build_site  # noqa: PLC0415
+    from catalog.web.site import build_site, plain_data_js  # noqa: PLC0415
 
     reason = web_browser.missing_reason()
     if reason:
@@ -123,23 +124,31 @@ def run(quick: bool = False) -> dict:
 
         b = web_browser.Browser(1000, 900)
         try:
-            first_frame, grid_ready, unpack, scripts = [], [], [], []
+            # the same site with data.js as plain JSON (bytes in base64; the form before
+            # site.pack_data), loaded in alternation with the packed one
+            plain = Path(tmp) / "plain"
+            shutil.copytree(out, plain)
+            (plain / "data.js").write_text(plain_data_js(key), encoding="utf-8")
+            result["site"]["data_js_plain_file_bytes"] = (plain / "data.js").stat().st_size
+            samples = {form: {"first_frame_ms": [], "page_ready_ms": [], "unpack_ms": [],
+                              "scripts_read_ms": []} for form in ("packed", "plain")}
             for _ in range(loads):
-                b.open(out, view="viewer", fabric=FABRIC, light=LIGHT, size="320x240")
-                stats = b.driver.execute_script("return window.catalogApp.stats")
-                first_frame.append(stats["firstFrameMs"])
-                grid_ready.append(stats["gridReadyMs"])
-                unpack.append(stats["unpackMs"])
-                scripts.append(b.driver.execute_script(
-                    "const t = performance.getEntriesByType('navigation')[0];"
-                    "return t.domContentLoadedEventEnd"))
-            # ms from navigation: the scripts read (data.js parsed), data.js inflated and the
-            # grid built (page ready), the first curtain frame drawn (its loop inflated)
-            result["load"] = {"first_frame_ms": round(statistics.median(first_frame), 1),
-                              "page_ready_ms": round(statistics.median(grid_ready), 1),
-                              "unpack_ms": round(statistics.median(unpack), 1),
-                              "scripts_read_ms": round(statistics.median(scripts), 1),
-                              "loads": loads}
+                for form, site in (("packed", out), ("plain", plain)):
+                    b.open(site, view="viewer", fabric=FABRIC, light=LIGHT, size="320x240")
+                    stats = b.driver.execute_script("return window.catalogApp.stats")
+                    got = samples[form]
+                    got["first_frame_ms"].append(stats["firstFrameMs"])
+                    got["page_ready_ms"].append(stats["gridReadyMs"])
+                    got["unpack_ms"].append(stats["unpackMs"])
+                    got["scripts_read_ms"].append(b.driver.execute_script(
+                        "const t = performance.getEntriesByType('navigation')[0];"
+                        "return t.domContentLoadedEventEnd"))
+            # ms from navigation (medians): the scripts read (data.js parsed), data.js
+            # inflated and the grid built (page ready), the first curtain frame drawn
+            result["load"] = {k: round(statistics.median(v), 1) for k, v in samples["packed"].items()}
+            result["load"]["loads"] = loads
+            result["load_plain"] = {k: round(statistics.median(v), 1)
+                                    for k, v in samples["plain"].items()}
             rows = []
             for w, h in sizes:
                 # side by side: rounds alternate the page and the two desktop variants, so a
@@ -220,10 +229,30 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"{s['vertices']} vertices | {s['animation_encoded_bytes'] / 1e3:.0f} kB encoded "
         f"(raw {s['animation_raw_bytes'] / 1e3:.0f} kB; file {s['animation_file_bytes'] / 1e3:.0f} kB in base64) |",
         f"| build (`catalog web`) | {s['build_s']:.1f} s (bake {s['bake_s']:.1f} s, record {s['record_s']:.1f} s) |",
-        f"| load to scripts read (file://) | {load['scripts_read_ms']:.0f} ms |",
-        f"| load to page ready (file://; data.js inflated and parsed: {load['unpack_ms']:.0f} ms) "
-        f"| {load['page_ready_ms']:.0f} ms |",
-        f"| load to first curtain frame (file://, 320x240) | {load['first_frame_ms']:.0f} ms |",
+    ]
+    plain = result.get("load_plain")
+    if plain:
+        lines += [
+            "",
+            f"Loading from file:// (medians of {load['loads']} loads each, alternating), the "
+            "packed data.js against the same site with data.js as plain JSON "
+            f"({s['data_js_plain_file_bytes'] / 1e6:.2f} MB, the form before packing; the same "
+            "page reads both):",
+            "",
+            "| ms from navigation | packed data.js | plain JSON data.js |",
+            "|---|---|---|",
+            f"| DOMContentLoaded (the scripts read and run) | {load['scripts_read_ms']:.0f} | {plain['scripts_read_ms']:.0f} |",
+            f"| app.js unpacking, its own time (packed: inflate and parse the JSON; plain: decode "
+            f"the base64, the JSON was parsed with the script) | {load['unpack_ms']:.0f} | "
+            f"{plain['unpack_ms']:.0f} |",
+            f"| page ready (grid built) | {load['page_ready_ms']:.0f} | {plain['page_ready_ms']:.0f} |",
+            f"| first curtain frame (320x240) | {load['first_frame_ms']:.0f} | "
+            f"{plain['first_frame_ms']:.0f} |",
+        ]
+    else:
+        lines += [f"| load to page ready (file://) | {load['page_ready_ms']:.0f} ms |",
+                  f"| load to first curtain frame (file://, 320x240) | {load['first_frame_ms']:.0f} ms |"]
+    lines += [
         "",
         f"Frame times: medians of {result['frames_per_case']} frames per case, the page and the "
         "desktop variants measured in alternating rounds in one run; the page's frame ends "

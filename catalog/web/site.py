@@ -59,7 +59,7 @@ def pack_data(data: dict) -> tuple[str, int]:
     import copy  # noqa: PLC0415
     import zlib  # noqa: PLC0415
 
-    plain = len("window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n")
+    plain = len(plain_data_js(data))
     data = copy.deepcopy(data)
     binary: list[str] = []
     # every distinct uniform value once ("values": [0.5, ..] -> "values": [i, ..] into
@@ -87,6 +87,12 @@ def pack_data(data: dict) -> tuple[str, int]:
               "json": base64.b64encode(zlib.compress(text, 9)).decode("ascii"),
               "binary": binary}
     return "window.CATALOG_PACKED = " + json.dumps(packed, separators=(",", ":")) + ";\n", plain
+
+
+def plain_data_js(data: dict) -> str:
+    """data.js as plain JSON (``window.CATALOG_DATA``, bytes as base64): the form before
+    :func:`pack_data`, which the page still reads (the benchmark loads both)."""
+    return "window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n"
 
 
 def unpack_data(text: str) -> dict:

@@ -22,7 +22,20 @@
     data.binary = binary;
     return data;
   }
-  unpack(window.CATALOG_PACKED).then(start, (e) => {
+  // a data.js of plain JSON (window.CATALOG_DATA, bytes as base64: site.plain_data_js, the
+  // form before packing; the benchmark loads both) is brought to the same shape
+  function plain(data) {
+    data.binary = [];
+    const move = (text) => { data.binary.push(b64bytes(text)); return { binary: data.binary.length - 1 }; };
+    for (const section of ['textures', 'buffers']) {
+      for (const entry of Object.values(data[section])) if (typeof entry.data === 'string') entry.data = move(entry.data);
+    }
+    data.blobs = data.blobs.map(move);
+    data.value_pool = [];
+    for (const scene of Object.values(data.scenes)) scene.values = scene.values.map((v) => data.value_pool.push(v) - 1);
+    return data;
+  }
+  (window.CATALOG_PACKED ? unpack(window.CATALOG_PACKED) : Promise.resolve().then(() => plain(window.CATALOG_DATA))).then(start, (e) => {
     window.catalogStartError = String(e);
     document.getElementById('status').textContent = 'cannot read the catalog data: ' + (e.message || e);
     console.error(e);
