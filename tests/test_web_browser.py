@@ -67,27 +67,59 @@ def test_page_loads_without_errors_and_renders(page, web_site):
     assert page.console_errors() == []
 
 
-@pytest.mark.parametrize("fabric, light, fluorescence, frame, camera", [
-    ("fluoro-pink", "D65", "on", 0, None),
-    ("linen-dense", "sun@8", "on", 17, None),
-    ("fluoro-pink", "UV-A", "off", 30, None),
-    ("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8)),   # the page's own camera matrices
+@pytest.mark.parametrize("fabric, light, fluorescence, frame, camera, glare, lamp", [
+    ("fluoro-pink", "D65", "on", 0, None, "off", "none"),
+    ("linen-dense", "sun@8", "on", 17, None, "off", "none"),
+    ("fluoro-pink", "UV-A", "off", 30, None, "off", "none"),
+    ("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8), "off", "none"),  # the page's camera
+    ("fluoro-pink", "D65", "on", 0, None, "on", "none"),     # the glare's half/quarter targets
+    ("linen-dense", "sun@18", "on", 3, None, "on", "A"),     # a room lamp: room and cloth lit
 ])
 def test_page_frame_matches_the_egl_frame(page, web_site, animations, gl, fabric, light,
-                                          fluorescence, frame, camera):
-    """The page's canvas and the desktop frame (EGL, same baked cloth frame, same camera):
-    off edges every channel within 3/255, mean within 0.5/255, at most 1 % of the pixels
-    over 3/255 on edges (browser.py states the rule)."""
+                                          fluorescence, frame, camera, glare, lamp):
+    """The page's canvas and the desktop frame (EGL, same baked cloth frame, same camera, same
+    glare and room lamp): off edges every channel within 3/255, mean within 0.5/255, at most
+    1 % of the pixels over 3/255 on edges (browser.py states the rule)."""
     out, _ = web_site
     orbit = {} if camera is None else dict(zip(("yaw_deg", "pitch_deg", "distance_m"), camera))
     shown = _viewer(page, out, fabric=fabric, light=light, fluorescence=fluorescence, frame=frame,
-                    **orbit)
-    scene = web_browser.site_data(out)["scenes"][f"{fabric}|{light}|{fluorescence}"]
+                    glare=glare, lamp=lamp, **orbit)
+    scene = web_browser.site_data(out)["scenes"][f"{fabric}|{light}|{fluorescence}|{glare}|{lamp}"]
     desktop = web_browser.egl_frame(fabric, light, fluorescence, frame, SIZE,
                                     _animation_of(out, fabric, animations), ctx=gl, camera=camera,
-                                    ev100=scene["ev100"])
+                                    ev100=scene["ev100"], glare=glare, lamp=lamp)
     figures = web_browser.compare_frames(shown, desktop)
     assert web_browser.frames_match(figures), json.dumps(figures)
+    assert page.console_errors() == []
+
+
+def test_page_decodes_the_packed_data_as_the_reference(page, web_site, animations):
+    """data.js and anim/*.js hold deflated, quantised bytes (site.pack_data, bake.encode,
+    export.encode_texels); what the page decodes from them is bit for bit what the reference
+    decoders give, whose distance to the desktop's values the codec tests bound (texels within
+    half a step of their channel's range, positions within 0.05 mm, normals within 1/254)."""
+    import base64
+
+    from catalog.web.bake import decode_frames
+    from catalog.web.export import decode_texels
+
+    out, _ = web_site
+    page.open(out)
+    data = web_browser.site_data(out)
+    run = "const done = arguments[arguments.length - 1];" \
+          "window.catalogApp.decoded(arguments[0], arguments[1], arguments[2]).then(done);"
+    as_f32 = lambda text: np.frombuffer(base64.b64decode(text), dtype="<f4")  # noqa: E731
+    quantised = [rid for rid, t in data["textures"].items() if t.get("quantised")]
+    assert len(quantised) >= 2  # the two fabrics' patterns
+    for rid in quantised:
+        page_texels = as_f32(page.driver.execute_async_script(run, "texels", rid, 0))
+        assert np.array_equal(page_texels, decode_texels(data["textures"][rid])), rid
+    for key, animation in animations.items():
+        reference = decode_frames(animation)
+        for frame in (0, 1, 2, animation.frames - 1):
+            arrays = page.driver.execute_async_script(run, "animation", key, frame)
+            for got, want in zip(arrays, reference):
+                assert np.array_equal(as_f32(got), want[frame].ravel()), (key, frame)
     assert page.console_errors() == []
 
 
@@ -110,6 +142,55 @@ def test_fluorescence_switch_changes_the_uv_picture(page, web_site):
     brightness_off = off.astype(int).sum(axis=-1)[changed]
     assert np.all(brightness_off <= brightness_on)
     assert np.array_equal(again, on)
+
+
+def test_glare_switch_spreads_light_from_bright_to_dark(page, web_site):
+    """The glare (key G, then the checkbox) is the desktop's energy-preserving bloom: it
+    brightens the darkest tenth of the picture (mean +1/255 at least; measured +2..3/255 at the
+    bounds' setting) and does not brighten the brightest tenth (mean change <= +0.1/255;
+    measured -0.2..-0.4/255); off again gives the frame back exactly."""
+    out, _ = web_site
+    on = _viewer(page, out, fabric="linen-dense", light="D65", frame=0)
+    assert page.state()["glare"] == "on"  # the snapshot's default
+    page.driver.find_element("id", "canvas-a").send_keys("g")
+    page.settle()
+    assert page.state()["glare"] == "off"
+    off = page.canvas()
+    page.driver.find_element("id", "glare").click()
+    page.settle()
+    assert page.state()["glare"] == "on" and np.array_equal(page.canvas(), on)
+    lum = off.astype(float).mean(axis=-1)
+    change = (on.astype(float) - off).mean(axis=-1)
+    dark, bright = lum <= np.percentile(lum, 10), lum >= np.percentile(lum, 90)
+    assert change[dark].mean() >= 1.0
+    assert change[bright].mean() <= 0.1
+
+
+def test_room_lamp_switch_lights_the_room_beside_it(page, web_site):
+    """A room lamp (the select, then key M) stands right of the window: it only adds light
+    (at most 0.5 % of the pixels darker by over 2/255: edge pixels; the exposure is the
+    scene's), more on the right third of the picture than on the left (measured 32 vs 9/255),
+    and the incandescent lamp's light is redder than the white LED's (red over blue)."""
+    from selenium.webdriver.support.ui import Select
+
+    out, _ = web_site
+    none = _viewer(page, out, fabric="linen-dense", light="D65", frame=0, glare="off").astype(int)
+    Select(page.driver.find_element("id", "lamp")).select_by_value("A")
+    page.settle()
+    assert page.state()["lamp"] == "A"
+    lamp_a = page.canvas().astype(int)
+    page.driver.find_element("id", "canvas-a").send_keys("m")
+    page.settle()
+    assert page.state()["lamp"] == "LED-B4"
+    lamp_led = page.canvas().astype(int)
+    w = none.shape[1]
+    ratios = []
+    for lit in (lamp_a, lamp_led):
+        change = lit - none
+        assert (change.min(axis=-1) < -2).mean() <= 0.005
+        assert change[:, 2 * w // 3:].mean() > 2.0 * change[:, :w // 3].mean() > 0
+        ratios.append(change[..., 0].mean() / change[..., 2].mean())
+    assert ratios[0] > 1.5 * ratios[1]
 
 
 def test_light_switch_and_sun_hour(page, web_site):
@@ -267,6 +348,24 @@ def test_static_host_and_no_network(page, web_site):
     assert any(r.startswith("anim/") for r in refs)
     for ref in refs:
         assert ref.startswith(("data:", "#")) or "://" not in ref and not ref.startswith("//"), ref
+
+
+def test_plain_json_data_renders_the_same(page, web_site, tmp_path):
+    """The page also reads data.js as plain JSON (site.plain_data_js, the form before packing,
+    which the benchmark loads for its before/after): the same canvas, pixel for pixel."""
+    import shutil
+
+    from catalog.web.site import plain_data_js
+
+    out, _ = web_site
+    plain = tmp_path / "plain"
+    shutil.copytree(out, plain)
+    (plain / "data.js").write_text(plain_data_js(web_browser.site_data(out)), encoding="utf-8")
+    state = {"fabric": "fluoro-pink", "light": "sun@15", "frame": 5, "lamp": "A"}
+    packed_image = _viewer(page, out, **state)
+    plain_image = _viewer(page, plain, **state)
+    assert np.array_equal(packed_image, plain_image)
+    assert page.console_errors() == [] and page.page_errors() == []
 
 
 def test_frame_time_under_swiftshader_is_reported(page, web_site, record_property):

@@ -515,6 +515,14 @@ class FrameRenderer:
         self.mesh_arrays = (positions, normals, tangents)
         self._mesh_version = getattr(self, "_mesh_version", 0) + 1
 
+    def set_fabric_size(self, fabric_size_m) -> None:
+        """The rest fabric's width and length (m) that uv 0..1 spans (the pattern's scale) for
+        the current mesh, e.g. when another fabric hangs in the same grid."""
+        size = tuple(float(v) for v in fabric_size_m)
+        if len(size) != 2 or not all(math.isfinite(v) and v > 0 for v in size):
+            raise CatalogError(f"fabric size {fabric_size_m!r} must be two positive lengths (m)")
+        self._fabric_size_m = size
+
     def update_positions(self, positions, normals) -> None:
         """New positions and normals for the same vertices (a simulation frame)."""
         positions = np.ascontiguousarray(positions, dtype="f4").reshape(-1, 3)

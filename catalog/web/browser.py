@@ -72,9 +72,11 @@ class Browser:
         return None if first is None else first / 1000.0
 
     def settle(self) -> None:
+        # the page starts once its data is inflated: wait for its hooks first
         self.driver.execute_async_script(
             "const done = arguments[arguments.length - 1];"
-            "window.catalogApp.settle().then(() => done(true));")
+            "const poll = () => window.catalogApp ? window.catalogApp.settle().then(() => done(true))"
+            " : window.catalogStartError ? done(false) : setTimeout(poll, 20); poll();")
 
     def set(self, **state) -> None:
         self.driver.execute_script("window.catalogApp.set(arguments[0])", state)
@@ -112,14 +114,15 @@ class Browser:
 
 def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tuple[int, int],
               animation, ctx=None, camera: tuple[float, float, float] | None = None,
-              ev100: float | None = None) -> np.ndarray:
-    """The desktop frame (EGL) of the same fabric, light, fluorescence switch, baked cloth frame
-    and camera (yaw deg, pitch deg, distance m; default the renderer's): uint8 (H, W, 3), row
+              ev100: float | None = None, glare: str = "off", lamp: str = "none") -> np.ndarray:
+    """The desktop frame (EGL) of the same fabric, light, fluorescence, glare and room-lamp
+    switches, baked cloth frame and camera (yaw deg, pitch deg, distance m; default the renderer's): uint8 (H, W, 3), row
     0 = top. ``ev100``: the page's fixed exposure of the scene (None: the desktop meters)."""
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.web import bake as bake_lib  # noqa: PLC0415
-    from catalog.web.export import FLUORESCENCE, configure_desktop_frame  # noqa: PLC0415
+    from catalog.web.export import (FLUORESCENCE, GLARE, configure_desktop_frame,  # noqa: PLC0415
+                                    room_lamps)
 
     positions, normals, tangents = bake_lib.decode_frame(animation, frame)
     renderer = FrameRenderer(ctx or create_headless_context(), size)
@@ -131,13 +134,17 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
             renderer.set_light(light)
         renderer.set_fluorescence(FLUORESCENCE[fluorescence])
         configure_desktop_frame(renderer)
+        renderer.set_bloom(GLARE[glare])
+        renderer.set_room_lamps(room_lamps(lamp))
         if camera is not None:
             renderer.set_camera(*camera)
         if ev100 is not None:
             renderer.set_ev(ev100)
         renderer.set_mesh(positions, normals, animation.uv, tangents,
-                          animation.indices.astype(np.int32))
+                          animation.indices.astype(np.int32),
+                          fabric_size_m=animation.fabric_size_m)
         renderer.set_mesh_offset((0.0, 0.0, 0.0))
+        renderer.set_rings(animation.rings_x_m)
         renderer.render()
         return renderer.read_srgb8()
     finally:
@@ -159,11 +166,10 @@ EDGE_SHARE_MAX = 0.01
 
 
 def site_data(site: Path) -> dict:
-    """window.CATALOG_DATA of a built site."""
-    import json  # noqa: PLC0415
+    """The page's data of a built site (data.js unpacked; bytes as base64)."""
+    from catalog.web.site import unpack_data  # noqa: PLC0415
 
-    text = (Path(site) / "data.js").read_text(encoding="utf-8")
-    return json.loads(text[text.index("= ") + 2:].rstrip().rstrip(";"))
+    return unpack_data((Path(site) / "data.js").read_text(encoding="utf-8"))
 
 
 def _neighbourhood(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -47,18 +47,41 @@ CAMERA_UNIFORMS = {"u_view_proj": "view_proj", "u_inverse_view_proj": "inverse_v
 RECORD_SIZE = (67, 43)
 #: Fluorescence switch: on = the desktop's default mode.
 FLUORESCENCE = {"on": "physical", "off": "off"}
+#: Glare switch (the desktop's bloom before the tone map, docs/room.md): on = `catalog
+#: snapshot`'s default.
+GLARE = {"on": True, "off": False}
+#: Where the page's room lamp stands (m, scene frame: right of the window, a metre into the
+#: room, 1.5 m above the floor; a floor lamp beside the curtain).
+ROOM_LAMP_POSITION_M = (1.3, 0.2, 1.0)
+#: The room-lamp switch: none, or one lamp of the light library at ROOM_LAMP_POSITION_M
+#: (FrameRenderer.set_room_lamps, `catalog snapshot --lamp`): it lights the room and the cloth.
+ROOM_LAMPS = {"none": None, "A": "Incandescent lamp (A)", "LED-B4": "White LED lamp (LED-B4)"}
+#: Sizes that follow the canvas: the recorded frame's (level 0) and its halvings rounded up
+#: (level k: ceil(size / 2^k); the glare's half- and quarter-size targets). The page puts its
+#: canvas's at the same level.
+CANVAS_LEVELS = 3
+
+
+def canvas_level(size) -> int | None:
+    """k when ``size`` (w, h) is the recorded frame's size halved k times (rounded up)."""
+    w, h = RECORD_SIZE
+    for k in range(CANVAS_LEVELS):
+        if [int(v) for v in size] == [w, h]:
+            return k
+        w, h = max(1, (w + 1) // 2), max(1, (h + 1) // 2)
+    return None
 #: The orbit limits of the page: the camera stays in the room (in front of the window).
 ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_m": [1.2, 4.0]}
 #: The desktop frame's modes the page shows: the thread patterns (issue 12: each fabric's
 #: normal/coverage texture, quantised to TEXEL_BITS on the page; the layers' order-independent
 #: transparency) and the room lit through the curtain (issue 13: transmittance shadow map,
 #: window capture, light map with bounce, recorded with every scene and replayed by the page
-#: each frame, so that they follow its moving cloth). Not on the page: the glare (off, as on
-#: llvmpipe); the browser test compares against the same modes.
+#: each frame, so that they follow its moving cloth). The glare and the room lamp are the
+#: page's switches (GLARE, ROOM_LAMPS: recorded per scene); the browser test compares against
+#: the same modes.
 #: ``antialiasing``: FXAA, a pass the page replays (the renderer's ``auto`` would take MSAA
 #: on a GPU: multisampled renderbuffers and resolves the recording refuses).
-DESKTOP_MODES = {"patterned": True, "room_lighting": True, "bloom": False,
-                 "antialiasing": "fxaa"}
+DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa"}
 
 
 def configure_desktop_frame(renderer) -> None:
@@ -87,6 +110,18 @@ class LightChoice:
     label: str
     kind: str        # "lamp" | "sun"
     hour: float | None = None
+
+
+def scene_key(fabric: str, light: str, fluorescence: str, glare: str, lamp: str) -> str:
+    """The page's name of a recorded scene (fabric, light id, and its three switches)."""
+    return "|".join((fabric, light, fluorescence, glare, lamp))
+
+
+def room_lamps(lamp: str) -> list:
+    """FrameRenderer.set_room_lamps' argument for a ROOM_LAMPS choice."""
+    if lamp not in ROOM_LAMPS:
+        raise CatalogError(f"room lamp {lamp!r}: choose one of {', '.join(ROOM_LAMPS)}")
+    return [] if lamp == "none" else [(lamp, ROOM_LAMP_POSITION_M)]
 
 
 def parse_fabrics(text: str | None) -> list[str]:
@@ -184,6 +219,9 @@ def split_commands(commands: list[dict], camera_values: dict | None = None
                 entry["canvas"] = "size"
             structure.append(entry)
             values.append(value)
+        elif command["op"] == "viewport" and command["viewport"][:2] == [0, 0] \
+                and canvas_level(command["viewport"][2:]) is not None:
+            structure.append(dict(command, canvas_level=canvas_level(command["viewport"][2:])))
         elif command["op"] == "buffer_write":  # the bytes are the scene's, the place is not
             structure.append({k: v for k, v in command.items() if k != "data"}
                              | {"slot": len(values)})
@@ -210,7 +248,7 @@ TEXEL_BITS = 8
 def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
     """The page's form of recorded texels: 8-bit textures as they are; float32 ones
     quantised to ``bits`` (8 or 16) per channel with a per-channel range (``lo``, ``hi``),
-    little-endian, base64."""
+    little-endian, in channel planes, base64."""
     if texture["dtype"] != "f4":
         return {"data": _b64(data)}
     if bits not in (8, 16):
@@ -222,10 +260,13 @@ def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
     top = (1 << bits) - 1
     span = np.where(hi > lo, hi - lo, 1.0)
     q = np.rint((texels - lo) / span * top)
-    encoded = q.astype("<u2" if bits == 16 else "u1").tobytes()
+    # in planes (every texel's channel 0, then channel 1, ..): deflate (site.pack_data) then
+    # finds each channel's own repetitions (a third of the interleaved bytes' deflated size
+    # on the lace's pattern)
+    encoded = np.ascontiguousarray(q.T).astype("<u2" if bits == 16 else "u1").tobytes()
     return {"data": _b64(encoded),
             "quantised": {"bits": bits, "lo": [float(v) for v in lo],
-                          "hi": [float(v) for v in lo + span]}}
+                          "hi": [float(v) for v in lo + span], "planar": True}}
 
 
 def decode_texels(texture: dict) -> np.ndarray:
@@ -235,7 +276,7 @@ def decode_texels(texture: dict) -> np.ndarray:
     if quantised is None:
         return np.frombuffer(raw, dtype="u1")
     q = np.frombuffer(raw, dtype="<u2" if quantised["bits"] == 16 else "u1")
-    q = q.reshape(-1, texture["components"]).astype(np.float64)
+    q = q.reshape(texture["components"], -1).T.astype(np.float64)
     lo, hi = np.array(quantised["lo"]), np.array(quantised["hi"])
     return (lo + q * (hi - lo) / ((1 << quantised["bits"]) - 1)).astype(np.float32).ravel()
 
@@ -281,6 +322,7 @@ class SiteExporter:
         self.curtain_tags: dict[int, str] = {}
         self.blobs: list[str] = []   # base64 bytes the frames write into buffers (shared)
         self._blob_index: dict[str, int] = {}
+        self._rings: tuple | None = None
 
     # -- the curtain's buffers: found by their bytes after set_mesh
     def use_mesh(self, positions, normals, uvs, tangents, indices) -> None:
@@ -297,10 +339,20 @@ class SiteExporter:
             if tag is not None and tag not in self.curtain_tags.values():
                 self.curtain_tags[rid] = tag
 
+    def use_drape(self, animation) -> None:
+        """The fabric's drape (the desktop's settled drape, baked): the rest size its uv spans
+        (the pattern's scale) and the rings on the rod, as ``catalog snapshot`` sets them."""
+        rings = tuple(animation.rings_x_m)
+        for renderer in (self.renderer, self.meter):
+            renderer.set_fabric_size(animation.fabric_size_m)
+            if rings != self._rings:  # a new ring buffer only when they move (fullness)
+                renderer.set_rings(rings)
+        self._rings = rings
+
     def record(self, preset, light: LightChoice, fluorescence: str,
-               ev100: float | None = None) -> dict:
+               ev100: float | None = None, glare: str = "off", lamp: str = "none") -> dict:
         """One scene's structure index and values; ``ev100``: its exposure (None: metered by
-        a METER_SIZE desktop frame at the default camera)."""
+        a METER_SIZE desktop frame at the default camera, with the glare and lamp asked)."""
         for r in (self.meter, self.renderer):
             r.set_fabric(preset)
             if light.kind == "sun":
@@ -308,6 +360,8 @@ class SiteExporter:
             else:
                 r.set_light(light.id)
             r.set_fluorescence(FLUORESCENCE[fluorescence])
+            r.set_bloom(GLARE[glare])
+            r.set_room_lamps(room_lamps(lamp))
         if ev100 is None:
             self.meter.set_ev(None)
             self.meter.render()
@@ -356,9 +410,11 @@ class SiteExporter:
         not follow them (it computes only CAMERA_UNIFORMS)."""
         r = self.renderer
         saved = r.camera
-        first = self.record(preset, light, "on")
+        richest = {"glare": "on", "lamp": list(ROOM_LAMPS)[-1]}  # every pass the page has
+        ev100 = self.record(preset, light, "on", **richest)["ev100"]  # one exposure for both
+        first = self.record(preset, light, "on", ev100=ev100, **richest)
         r.set_camera(saved.yaw_deg + 30.0, saved.pitch_deg + 20.0, saved.distance_m * 0.8)
-        second = self.record(preset, light, "on")
+        second = self.record(preset, light, "on", ev100=ev100, **richest)
         r.camera = saved
         structure = self.structures[first["structure"]]
         if first["structure"] != second["structure"]:
@@ -423,11 +479,11 @@ class SiteExporter:
             "shaders": list(sources.values()),
             "programs": programs,
             "buffers": buffers,
-            "textures": {rid: dict(rec.textures[rid], **(encode_texels(rec.texture_data[rid],
-                                                                       rec.textures[rid])
-                                                          if rid in rec.texture_data else {}))
+            "textures": {rid: _sized(dict(rec.textures[rid], **(encode_texels(rec.texture_data[rid],
+                                                                              rec.textures[rid])
+                                                                 if rid in rec.texture_data else {})))
                          for rid in sorted(used_textures)},
-            "renderbuffers": {rid: rec.renderbuffers[rid] for rid in
+            "renderbuffers": {rid: _sized(dict(rec.renderbuffers[rid])) for rid in
                               sorted({rec.framebuffers[f]["depth"] for f in used_fbos} - {None})},
             "framebuffers": {rid: rec.framebuffers[rid] for rid in sorted(used_fbos)},
             "vertex_arrays": vaos,
@@ -436,6 +492,14 @@ class SiteExporter:
     def release(self) -> None:
         self.renderer.release()
         self.meter.release()
+
+
+def _sized(entry: dict) -> dict:
+    """A render target whose size follows the frame's: marked with its canvas level."""
+    level = canvas_level(entry["size"])
+    if level is not None and "data" not in entry:
+        entry["canvas_level"] = level
+    return entry
 
 
 def swatch_png(ctx, preset, size=SWATCH_SIZE) -> bytes:

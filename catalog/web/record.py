@@ -96,6 +96,17 @@ class _Texture(_Proxy):
         self._rec.textures[self.rid]["filter"] = [int(v) for v in value]
         self._real.filter = value
 
+    @property
+    def anisotropy(self):
+        return self._real.anisotropy
+
+    @anisotropy.setter
+    def anisotropy(self, value) -> None:
+        # the page asks EXT_texture_filter_anisotropic for the same (the pattern's, at oblique
+        # pleats the filter decides what a texel looks like)
+        self._rec.textures[self.rid]["anisotropy"] = float(value)
+        self._real.anisotropy = value
+
     def write(self, data, **kw):
         if kw:
             raise CatalogError("the web page replays only whole-texture writes")
@@ -139,6 +150,24 @@ class _Texture(_Proxy):
 
 
 class _Framebuffer(_Proxy):
+    @property
+    def depth_mask(self):
+        return self._real.depth_mask
+
+    @depth_mask.setter
+    def depth_mask(self, value) -> None:
+        # moderngl applies it whenever the framebuffer is used or cleared (the OIT layers are
+        # depth-tested against the room but write no depth, and their clear keeps the room's)
+        self._rec.framebuffers[self.rid]["depth_mask"] = bool(value)
+        self._real.depth_mask = value
+
+    def __setattr__(self, name, value):
+        # any other framebuffer state (colour mask, scissor, viewport) the page would not know
+        if not isinstance(getattr(type(self), name, None), property):
+            raise CatalogError(f"the desktop frame sets a framebuffer's {name}; the web page "
+                               "replays only its depth mask")
+        object.__setattr__(self, name, value)
+
     def use(self):
         self._rec.bound_framebuffer = self
         self._rec.note({"op": "framebuffer", "framebuffer": self.rid})

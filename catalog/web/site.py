@@ -5,8 +5,9 @@ The site (docs/web.md)::
     DIR/index.html     the page (assets/index.html)
     DIR/app.js         the WebGL2 replayer, camera, animation decoder and controls
     DIR/style.css
-    DIR/data.js        window.CATALOG_DATA: shaders (GLSL ES variant), recorded frame
-                       structures and per-scene uniform values, fabrics, lights, swatches
+    DIR/data.js        window.CATALOG_PACKED: the page's data (shaders (GLSL ES variant),
+                       recorded frame structures and per-scene uniform values, fabrics,
+                       lights, swatches, pattern texels, buffers), deflated (pack_data)
     DIR/anim/KEY.js    one baked cloth animation per distinct cloth parameter set, loaded
                        by a <script> tag when a fabric is first shown
 
@@ -19,6 +20,7 @@ existing ``DIR`` is replaced only if it is an earlier catalog site or empty.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import os
 import shutil
@@ -27,13 +29,96 @@ import time
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
+
 from catalog.core.errors import CatalogError, InputError
 
 #: The page's own files (catalog/web/assets), copied as they are.
 ASSET_FILES = ("index.html", "app.js", "style.css")
 #: A file every site has: marks a folder as ours (safe to replace).
 MARKER = "catalog-web-site.json"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: data.js packed (pack_data)
+
+
+#: The places in data.js that hold bytes (base64 in the recorded data): packed apart from the
+#: JSON (see :func:`pack_data`). (section, field); ``None``: every item of the list.
+BINARY_FIELDS = (("textures", "data"), ("buffers", "data"), ("blobs", None))
+
+
+def pack_data(data: dict) -> tuple[str, int]:
+    """data.js's text, and the bytes a plain ``window.CATALOG_DATA = JSON`` would take.
+
+    data.js sets ``window.CATALOG_PACKED = {"json": Z, "binary": [Z, ..]}``: Z is base64 of zlib
+    (the page inflates it with the browser's DecompressionStream; a script, not a fetch, so
+    that file:// works). The bulky bytes (:data:`BINARY_FIELDS`: the fabrics' pattern texels,
+    vertex buffers, bytes a frame writes) leave the JSON: each becomes ``{"binary": i}``, its
+    bytes deflated on their own (deflate does much better on bytes than on their base64), and
+    the rest of the JSON (uniform values, frame structures, shaders) is deflated as text, each
+    distinct uniform value once (``value_pool``; a scene's ``values`` index it)."""
+    import base64  # noqa: PLC0415
+    import copy  # noqa: PLC0415
+    import zlib  # noqa: PLC0415
+
+    plain = len(plain_data_js(data))
+    data = copy.deepcopy(data)
+    binary: list[str] = []
+    # every distinct uniform value once ("values": [0.5, ..] -> "values": [i, ..] into
+    # "value_pool"): scenes of one fabric or light share most of theirs
+    pool: dict[str, int] = {}
+    for scene in data.get("scenes", {}).values():
+        scene["values"] = [pool.setdefault(json.dumps(v, separators=(",", ":")), len(pool))
+                           for v in scene["values"]]
+    if "scenes" in data:
+        data["value_pool"] = [json.loads(text) for text in pool]
+
+    def move(text: str) -> dict:
+        binary.append(base64.b64encode(zlib.compress(base64.b64decode(text), 9)).decode("ascii"))
+        return {"binary": len(binary) - 1}
+
+    for section, field in BINARY_FIELDS:
+        if field is None:
+            data[section] = [move(v) for v in data[section]]
+            continue
+        for entry in data[section].values():
+            if isinstance(entry.get(field), str):
+                entry[field] = move(entry[field])
+    text = json.dumps(data, separators=(",", ":")).encode("utf-8")
+    packed = {"format": FORMAT_VERSION,
+              "json": base64.b64encode(zlib.compress(text, 9)).decode("ascii"),
+              "binary": binary}
+    return "window.CATALOG_PACKED = " + json.dumps(packed, separators=(",", ":")) + ";\n", plain
+
+
+def plain_data_js(data: dict) -> str:
+    """data.js as plain JSON (``window.CATALOG_DATA``, bytes as base64): the form before
+    :func:`pack_data`, which the page still reads (the benchmark loads both)."""
+    return "window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n"
+
+
+def unpack_data(text: str) -> dict:
+    """The data of a data.js written by :func:`pack_data`, bytes back as base64 (as recorded)."""
+    import base64  # noqa: PLC0415
+    import zlib  # noqa: PLC0415
+
+    packed = json.loads(text[text.index("= ") + 2:].rstrip().rstrip(";"))
+    data = json.loads(zlib.decompress(base64.b64decode(packed["json"])))
+    pool = data.pop("value_pool", None)
+    if pool is not None:
+        for scene in data["scenes"].values():
+            scene["values"] = [pool[i] for i in scene["values"]]
+
+    def back(ref):
+        raw = zlib.decompress(base64.b64decode(packed["binary"][ref["binary"]]))
+        return base64.b64encode(raw).decode("ascii")
+
+    for section, field in BINARY_FIELDS:
+        if field is None:
+            data[section] = [back(v) for v in data[section]]
+            continue
+        for entry in data[section].values():
+            if isinstance(entry.get(field), dict):
+                entry[field] = back(entry[field])
+    return data
 
 
 def _check_out(out: Path) -> Path:
@@ -130,29 +215,39 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         animations = {}
         fabric_animation = {}
         for preset in presets:
-            from catalog.cloth.params import ClothParams  # noqa: PLC0415
-            key = bake_lib.cloth_key(ClothParams.from_preset(preset).with_changes(
-                wind_speed_m_s=bake_lib.WIND_M_S, gust_strength=bake_lib.GUST_STRENGTH))
+            key = bake_lib.cloth_key(bake_lib.bake_params(preset))
             if key not in animations:
                 animations[key] = bake_lib.bake(preset)
-            fabric_animation[preset.name] = animations[key].key
+            fabric_animation[preset.name] = animations[key]
+        first = next(iter(animations.values()))
+        for animation in animations.values():  # the page swaps the curtain's buffers only
+            if not (np.array_equal(animation.indices, first.indices)
+                    and np.array_equal(animation.uv, first.uv)):
+                raise CatalogError("the baked curtains differ in their grids; the page's "
+                                   "recorded frame has one")
         timings["bake_s"] = time.perf_counter() - t
 
         t = time.perf_counter()
         exporter = export.SiteExporter(ctx)
         try:
-            first = next(iter(animations.values()))
             positions, normals, tangents = bake_lib.decode_frame(first, 0)
             exporter.use_mesh(positions, normals, first.uv, tangents, first.indices)
+            exporter.use_drape(fabric_animation[presets[0].name])
             exporter.check_camera_uniforms(presets[0], choices[0])
             scenes = {}
             for preset in presets:
+                exporter.use_drape(fabric_animation[preset.name])
                 for choice in choices:
-                    on = exporter.record(preset, choice, "on")
-                    scenes[f"{preset.name}|{choice.id}|on"] = on
-                    # the switch keeps the exposure: it shows the brightener's light
-                    scenes[f"{preset.name}|{choice.id}|off"] = exporter.record(
-                        preset, choice, "off", ev100=on["ev100"])
+                    metered = exporter.record(preset, choice, "on")
+                    # the switches keep the exposure metered with fluorescence on, no glare,
+                    # no lamp: they show the brightener's, the glare's and the lamp's light
+                    for fluorescence, glare, lamp in itertools.product(
+                            export.FLUORESCENCE, export.GLARE, export.ROOM_LAMPS):
+                        key = export.scene_key(preset.name, choice.id, fluorescence, glare, lamp)
+                        scenes[key] = (metered if (fluorescence, glare, lamp) == ("on", "off", "none")
+                                       else exporter.record(preset, choice, fluorescence,
+                                                            ev100=metered["ev100"], glare=glare,
+                                                            lamp=lamp))
             objects = exporter.objects()
             swatches = {p.name: base64.b64encode(export.swatch_png(exporter.ctx._ctx, p))
                         .decode("ascii") for p in presets}
@@ -175,14 +270,16 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             "scenes": scenes,
             "fabrics": [{"name": p.name, "display_name": p.display_name,
                          "facts": export.fabric_facts(p), "swatch": swatches[p.name],
-                         "animation": fabric_animation[p.name]} for p in presets],
+                         "animation": fabric_animation[p.name].key} for p in presets],
             "lights": [{"id": c.id, "label": c.label, "kind": c.kind, "hour": c.hour}
                        for c in choices],
             "fluorescence": list(export.FLUORESCENCE),
+            "glare": list(export.GLARE),
+            "room_lamps": [{"id": k, "label": v} for k, v in export.ROOM_LAMPS.items()],
             "animations": {k: a.manifest() for k, a in animations.items()},
         }
-        text = "window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n"
-        (stage / "data.js").write_text(text, encoding="utf-8")
+        packed, plain_bytes = pack_data(data)
+        (stage / "data.js").write_text(packed, encoding="utf-8")
         (stage / "anim").mkdir()
         for animation in animations.values():
             (stage / "anim" / f"{animation.key}.js").write_text(animation.script(), encoding="utf-8")
@@ -197,6 +294,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                   "bytes": sizes, "total_bytes": sum(sizes.values()),
                   "first_view_bytes": sum(v for k, v in sizes.items() if not k.startswith("anim/"))
                   + max(a.stat().st_size for a in (stage / "anim").iterdir()),
+                  "data_js_plain_bytes": plain_bytes,
                   **{k: round(v, 3) for k, v in timings.items()}}
         (stage / MARKER).write_text(json.dumps({"format": FORMAT_VERSION, "fabrics": names,
                                                 "lights": report["lights"]}, indent=1) + "\n",

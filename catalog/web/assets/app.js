@@ -3,15 +3,48 @@
 // No network: data.js and anim/*.js are loaded by <script> tags (works from file://).
 'use strict';
 (function () {
-  const D = window.CATALOG_DATA;
-  const RW = D.record_size[0], RH = D.record_size[1];
-
   function b64bytes(text) {
     const s = atob(text);
     const out = new Uint8Array(s.length);
     for (let i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
     return out;
   }
+  async function inflate(bytes) {
+    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+  // data.js (catalog/web/site.py pack_data): the JSON and the bulky bytes, each deflated;
+  // {"binary": i} in the JSON names the i-th bytes (bin() below)
+  const unpackStart = performance.now();
+  async function unpack(packed) {
+    const [text, ...binary] = await Promise.all([packed.json, ...packed.binary].map((z) => inflate(b64bytes(z))));
+    const data = JSON.parse(new TextDecoder().decode(text));
+    data.binary = binary;
+    return data;
+  }
+  // a data.js of plain JSON (window.CATALOG_DATA, bytes as base64: site.plain_data_js, the
+  // form before packing; the benchmark loads both) is brought to the same shape
+  function plain(data) {
+    data.binary = [];
+    const move = (text) => { data.binary.push(b64bytes(text)); return { binary: data.binary.length - 1 }; };
+    for (const section of ['textures', 'buffers']) {
+      for (const entry of Object.values(data[section])) if (typeof entry.data === 'string') entry.data = move(entry.data);
+    }
+    data.blobs = data.blobs.map(move);
+    data.value_pool = [];
+    for (const scene of Object.values(data.scenes)) scene.values = scene.values.map((v) => data.value_pool.push(v) - 1);
+    return data;
+  }
+  (window.CATALOG_PACKED ? unpack(window.CATALOG_PACKED) : Promise.resolve().then(() => plain(window.CATALOG_DATA))).then(start, (e) => {
+    window.catalogStartError = String(e);
+    document.getElementById('status').textContent = 'cannot read the catalog data: ' + (e.message || e);
+    console.error(e);
+  });
+
+  function start(D) {
+  const unpackMs = performance.now() - unpackStart;
+  const bin = (ref) => D.binary[ref.binary];  // the bytes of a {"binary": i}
+  const value = (scene, slot) => D.value_pool[scene.values[slot]];  // site.pack_data's pool
 
   // ---------------------------------------------------------------- camera
   // The orbit camera of catalog/render/camera.py (float64 here, float32 on upload).
@@ -74,10 +107,6 @@
 
   // ---------------------------------------------------------------- baked cloth
   const animations = {};  // key -> Promise of {frames, positions[], normals[], tangents[], indices, ...}
-  async function inflate(bytes) {
-    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
-    return new Uint8Array(await new Response(stream).arrayBuffer());
-  }
   function loadScript(src) {
     return new Promise((resolve, reject) => {
       const s = document.createElement('script');
@@ -85,29 +114,57 @@
       document.head.appendChild(s);
     });
   }
-  // The decoder of catalog/web/bake.py (decode_frames): deltas summed mod 2^16 / 2^8,
-  // positions (lo + q step) + offset in float64 then float32, normals and tangents int8 / 127.
+  // The decoder of catalog/web/bake.py (decode_frames): planes (x, y, z of every vertex) of
+  // zigzag residuals, positions second differences mod 2^16 (q[k] = 2 q[k-1] - q[k-2] + d);
+  // positions (lo + q step) + offset in float64 then float32; normals and weft tangents
+  // computed from the float64 grid (lo + q step) as bake.frames_of_grid does, sums in its order.
+  const unzigzag = (z) => (z >>> 1) ^ -(z & 1);
+  function gridFrames(x, cols, rows, normals, tangents) {
+    const at = (r, c, k) => x[3 * (r * cols + c) + k];
+    for (let r = 0; r < rows; r++) {
+      const r0 = r === 0 ? 0 : r === rows - 1 ? rows - 2 : r - 1, r1 = r === 0 ? 1 : r === rows - 1 ? rows - 1 : r + 1;
+      for (let c = 0; c < cols; c++) {
+        const c0 = c === 0 ? 0 : c === cols - 1 ? cols - 2 : c - 1, c1 = c === 0 ? 1 : c === cols - 1 ? cols - 1 : c + 1;
+        const d0 = at(r1, c, 0) - at(r0, c, 0), d1 = at(r1, c, 1) - at(r0, c, 1), d2 = at(r1, c, 2) - at(r0, c, 2);
+        const a0 = at(r, c1, 0) - at(r, c0, 0), a1 = at(r, c1, 1) - at(r, c0, 1), a2 = at(r, c1, 2) - at(r, c0, 2);
+        let n0 = d1 * a2 - d2 * a1, n1 = d2 * a0 - d0 * a2, n2 = d0 * a1 - d1 * a0;
+        let len = Math.sqrt(n0 * n0 + n1 * n1 + n2 * n2);
+        if (!(len > 0)) len = 1;
+        n0 /= len; n1 /= len; n2 /= len;
+        const dot = a0 * n0 + a1 * n1 + a2 * n2;
+        const t0 = a0 - dot * n0, t1 = a1 - dot * n1, t2 = a2 - dot * n2;
+        let tl = Math.sqrt(t0 * t0 + t1 * t1 + t2 * t2);
+        if (!(tl > 0)) tl = 1;
+        const i = 3 * (r * cols + c);
+        normals[i] = n0; normals[i + 1] = n1; normals[i + 2] = n2;
+        tangents[i] = t0 / tl; tangents[i + 1] = t1 / tl; tangents[i + 2] = t2 / tl;
+      }
+    }
+  }
   async function decodeAnimation(entry) {
-    const m = entry.manifest, V = m.vertex_count, n = 3 * V;
+    const m = entry.manifest, V = m.vertex_count, n = 3 * V, [cols, rows] = m.grid;
+    if (cols * rows !== V) throw new Error('baked loop ' + m.key + ': grid is not ' + V + ' vertices');
     const planes = await inflate(b64bytes(entry.payload));
-    const q = new Int32Array(n), qn = new Int32Array(n), qt = new Int32Array(n);
+    const q1 = new Int32Array(n), q2 = new Int32Array(n), cloth = new Float64Array(n);
     const positions = [], normals = [], tangents = [];
     for (let f = 0; f < m.frames; f++) {
-      const base = f * 12 * V;
+      const base = f * 6 * V;
       const p = new Float32Array(n), nn = new Float32Array(n), tt = new Float32Array(n);
-      for (let i = 0; i < n; i++) {
-        const c = i % 3;
-        q[i] = (q[i] + (planes[base + i] | (planes[base + n + i] << 8))) & 0xFFFF;
-        p[i] = (m.lo_m[c] + q[i] * m.step_m) + m.offset_m[c];
-        qn[i] = (qn[i] + planes[base + 2 * n + i]) & 0xFF;
-        qt[i] = (qt[i] + planes[base + 3 * n + i]) & 0xFF;
-        nn[i] = (qn[i] > 127 ? qn[i] - 256 : qn[i]) / 127;
-        tt[i] = (qt[i] > 127 ? qt[i] - 256 : qt[i]) / 127;
+      for (let c = 0; c < 3; c++) {
+        for (let v = 0; v < V; v++) {
+          const j = c * V + v, i = 3 * v + c;  // plane index, vertex-major index
+          const d = unzigzag(planes[base + j] | (planes[base + n + j] << 8));
+          const q = (f === 0 ? d : f === 1 ? q1[i] + d : 2 * q1[i] - q2[i] + d) & 0xFFFF;
+          q2[i] = q1[i]; q1[i] = q;
+          cloth[i] = m.lo_m[c] + q * m.step_m;
+          p[i] = cloth[i] + m.offset_m[c];
+        }
       }
+      gridFrames(cloth, cols, rows, nn, tt);
       positions.push(p); normals.push(nn); tangents.push(tt);
     }
-    const indices = new Uint32Array(b64bytes(entry.indices).buffer);
-    const uv = new Float32Array(b64bytes(entry.uv).buffer);
+    const indices = new Uint32Array((await inflate(b64bytes(entry.indices))).buffer);
+    const uv = new Float32Array((await inflate(b64bytes(entry.uv))).buffer);
     return { manifest: m, frames: m.frames, fps: m.fps, positions, normals, tangents, indices, uv };
   }
   function animation(key) {
@@ -126,6 +183,23 @@
              tangent: mix(anim.tangents[k0], anim.tangents[k1]) };
   }
 
+  // A texture's texels as the desktop gave them, float32 for float textures: quantised ones
+  // (export.encode_texels: channel planes of 8 or 16 bits, each between its lo and hi)
+  // rebuilt as export.decode_texels does; decoded once per texture (both panes share them).
+  const texelCache = {};
+  function decodeTexels(t) {
+    const bytes = bin(t.data), q = t.quantised;
+    if (!q) return t.dtype === 'f4' ? new Float32Array(bytes.buffer, bytes.byteOffset, bytes.byteLength / 4) : bytes;
+    if (texelCache[t.data.binary]) return texelCache[t.data.binary];
+    const ints = q.bits === 16 ? new Uint16Array(bytes.buffer, bytes.byteOffset, bytes.byteLength / 2) : bytes;
+    const top = (1 << q.bits) - 1, C = t.components, N = ints.length / C, texels = new Float32Array(ints.length);
+    for (let ch = 0; ch < C; ch++) {
+      const lo = q.lo[ch], span = q.hi[ch] - q.lo[ch];  // the reference's order of operations
+      for (let i = 0; i < N; i++) texels[i * C + ch] = lo + ints[ch * N + i] * span / top;
+    }
+    return (texelCache[t.data.binary] = texels);
+  }
+
   // ---------------------------------------------------------------- the replayer
   const DEPTH_FUNCS = { '<': 'LESS', '<=': 'LEQUAL', '>': 'GREATER', '>=': 'GEQUAL', '==': 'EQUAL', '!=': 'NOTEQUAL' };
 
@@ -138,6 +212,7 @@
       this.gl = gl;
       this.floatLinear = !!gl.getExtension('OES_texture_float_linear');
       gl.getExtension('EXT_float_blend');  // blending into float targets (layered cloth)
+      this.aniso = gl.getExtension('EXT_texture_filter_anisotropic');
       this.shaders = {}; this.programs = {}; this.buffers = {}; this.vaos = {}; this.targets = null;
       this.size = [0, 0]; this.curtainCount = 0; this.curtainAnim = null;
     }
@@ -167,7 +242,7 @@
       const gl = this.gl, desc = D.buffers[rid], b = gl.createBuffer();
       const target = desc.curtain === 'index' || desc.index ? gl.ELEMENT_ARRAY_BUFFER : gl.ARRAY_BUFFER;
       gl.bindBuffer(target, b);
-      if (desc.data) { const bytes = b64bytes(desc.data); gl.bufferData(target, bytes, gl.STATIC_DRAW); b.bytes = bytes.length; }
+      if (desc.data) { const bytes = bin(desc.data); gl.bufferData(target, bytes, gl.STATIC_DRAW); b.bytes = bytes.length; }
       b.curtain = desc.curtain; b.target = target;
       return (this.buffers[rid] = b);
     }
@@ -222,15 +297,22 @@
       gl.bindVertexArray(null);
       return (this.vaos[rid] = vao);
     }
+    // export.canvas_level: the canvas size halved k times, rounded up (the glare's targets)
+    canvasAt(k) {
+      let [w, h] = this.size;
+      for (let i = 0; i < k; i++) { w = Math.max(1, Math.ceil(w / 2)); h = Math.max(1, Math.ceil(h / 2)); }
+      return [w, h];
+    }
     resize() {
       const gl = this.gl, w = this.canvas.width, h = this.canvas.height;
+      const canvasAt = (k) => this.canvasAt(k);
       if (this.targets && this.size[0] === w && this.size[1] === h) return;
       for (const t of Object.values(this.targets || {})) (t.tex ? gl.deleteTexture(t.tex) : null, t.rb ? gl.deleteRenderbuffer(t.rb) : null, t.fbo ? gl.deleteFramebuffer(t.fbo) : null);
       this.size = [w, h];
-      const sized = (s) => (s[0] === RW && s[1] === RH ? [w, h] : s);
+      const sized = (t) => (t.canvas_level != null ? canvasAt(t.canvas_level) : t.size);
       const textures = {}, renderbuffers = {};
       for (const [rid, t] of Object.entries(D.textures)) {
-        const tex = gl.createTexture(), s = sized(t.size);
+        const tex = gl.createTexture(), s = sized(t);
         gl.bindTexture(gl.TEXTURE_2D, tex);
         const half = t.dtype === 'f2', float = t.dtype === 'f4' || half, c = t.components - 1;
         if (t.data && half) throw new Error('half-float texels given by the frame: not replayed');
@@ -239,13 +321,7 @@
           : float ? [gl.R32F, gl.RG32F, gl.RGB32F, gl.RGBA32F] : [gl.R8, gl.RG8, gl.RGB8, gl.RGBA8];
         let texels = null;
         if (t.data) {  // a texture the frame filled (e.g. a pattern): its texels as recorded
-          const bytes = b64bytes(t.data);
-          const q = t.quantised;  // float texels quantised per channel (export.encode_texels)
-          if (q) {
-            const ints = q.bits === 16 ? new Uint16Array(bytes.buffer) : bytes, top = (1 << q.bits) - 1;
-            texels = new Float32Array(ints.length);
-            for (let i = 0; i < ints.length; i++) { const ch = i % t.components; texels[i] = q.lo[ch] + ints[i] * (q.hi[ch] - q.lo[ch]) / top; }
-          } else texels = float ? new Float32Array(bytes.buffer) : bytes;
+          texels = decodeTexels(t);
         }
         gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
         gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], half ? gl.HALF_FLOAT : float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
@@ -259,10 +335,14 @@
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, t.repeat_x === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, t.repeat_y === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
         if (t.mipmaps) gl.generateMipmap(gl.TEXTURE_2D);
+        if (t.anisotropy > 1 && this.aniso) {  // the desktop's anisotropic filter (record.py)
+          gl.texParameterf(gl.TEXTURE_2D, this.aniso.TEXTURE_MAX_ANISOTROPY_EXT,
+            Math.min(t.anisotropy, gl.getParameter(this.aniso.MAX_TEXTURE_MAX_ANISOTROPY_EXT)));
+        }
         textures[rid] = { tex };
       }
       for (const [rid, r] of Object.entries(D.renderbuffers)) {
-        const rb = gl.createRenderbuffer(), s = sized(r.size);
+        const rb = gl.createRenderbuffer(), s = sized(r);
         gl.bindRenderbuffer(gl.RENDERBUFFER, rb);
         gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, s[0], s[1]);
         renderbuffers[rid] = { rb };
@@ -305,17 +385,18 @@
       let screen = null;
       for (const c of structure) if (c.op === 'framebuffer') screen = c.framebuffer;
       let current = null;
-      const full = (v) => v && v[0] === 0 && v[1] === 0 && v[2] === RW && v[3] === RH;
       for (const c of structure) {
         switch (c.op) {
-          case 'framebuffer':
+          case 'framebuffer':  // moderngl's use(): the framebuffer's depth mask with it
             gl.bindFramebuffer(gl.FRAMEBUFFER, c.framebuffer === screen ? null : this.targets['fbo' + c.framebuffer].fbo);
+            gl.depthMask(D.framebuffers[c.framebuffer].depth_mask !== false);
             break;
           case 'viewport':
-            gl.viewport(...(full(c.viewport) ? [0, 0, w, h] : c.viewport)); break;
+            gl.viewport(...(c.canvas_level != null ? [0, 0, ...this.canvasAt(c.canvas_level)] : c.viewport)); break;
           case 'clear':
             gl.bindFramebuffer(gl.FRAMEBUFFER, c.framebuffer === screen ? null : this.targets['fbo' + c.framebuffer].fbo);
-            gl.clearColor(...c.colour); gl.clearDepth(c.depth); gl.depthMask(true);
+            gl.clearColor(...c.colour); gl.clearDepth(c.depth);
+            gl.depthMask(D.framebuffers[c.framebuffer].depth_mask !== false);  // as moderngl's clear
             gl.clear(gl.COLOR_BUFFER_BIT | (D.framebuffers[c.framebuffer].depth != null ? gl.DEPTH_BUFFER_BIT : 0));
             break;
           case 'enable': for (const f of c.flags) gl.enable(gl[f]); break;
@@ -328,7 +409,7 @@
           case 'buffer_write': {  // bytes the frame wrote this frame (record.py)
             const b = this.buffer(c.buffer);
             gl.bindVertexArray(null); gl.bindBuffer(b.target, b);
-            gl.bufferSubData(b.target, c.offset, b64bytes(D.blobs[scene.values[c.slot].blob]));
+            gl.bufferSubData(b.target, c.offset, bin(D.blobs[value(scene, c.slot).blob]));
             break;
           }
           case 'mipmaps': {  // a render target's mip chain built again (record.py), on a spare
@@ -344,7 +425,7 @@
             if (!u) break;
             const which = c.camera ? D.camera_uniforms[c.name] : null;  // the frame's camera
             const canvas = c.canvas === 'texel' ? [1 / w, 1 / h] : c.canvas === 'size' ? [w, h] : null;
-            this.setUniform(u, which ? cam[which] : canvas || scene.values[c.slot]);
+            this.setUniform(u, which ? cam[which] : canvas || value(scene, c.slot));
             break;
           }
           case 'draw': {
@@ -377,13 +458,15 @@
   const clamp = (x, r) => Math.min(r[1], Math.max(r[0], x));
   const state = {
     view: 'grid', fabric: D.fabrics[0].name, light: D.lights[0].id, fluorescence: 'on', compare: '',
+    glare: 'on', lamp: 'none',  // `catalog snapshot`'s defaults: glare, no lamp
     yaw_deg: D.camera.yaw_deg, pitch_deg: D.camera.pitch_deg, distance_m: D.camera.distance_m,
     t: 0, playing: true, size: null,
   };
   const stats = { loadStartMs: performance.timeOrigin ? 0 : 0, firstFrameMs: null, frames: 0, errors: [] };
   let panes = null, dirty = true, lastTime = null, readyResolve, ready = new Promise((r) => (readyResolve = r));
 
-  function sceneKey(fabric) { return fabric + '|' + state.light + '|' + state.fluorescence; }
+  // export.scene_key: fabric, light and the three switches
+  function sceneKey(fabric) { return [fabric, state.light, state.fluorescence, state.glare, state.lamp].join('|'); }
   function lightOf(id) { return D.lights.find((l) => l.id === id); }
 
   function buildGrid() {
@@ -417,6 +500,9 @@
     light.onchange = () => set({ light: light.value === 'sun' ? sunNearest(12).id : light.value });
     $('hour').oninput = () => set({ light: sunNearest(+$('hour').value).id });
     $('fluorescence').onchange = () => set({ fluorescence: $('fluorescence').checked ? 'on' : 'off' });
+    $('glare').onchange = () => set({ glare: $('glare').checked ? 'on' : 'off' });
+    for (const l of D.room_lamps) $('lamp').add(new Option(l.label || 'none', l.id));
+    $('lamp').onchange = () => set({ lamp: $('lamp').value });
     $('play').onclick = () => set({ playing: !state.playing });
     $('back').onclick = () => set({ view: 'grid' });
     $('home').onclick = (e) => { e.preventDefault(); set({ view: 'grid' }); };
@@ -457,6 +543,8 @@
     $('hour-label').hidden = l.kind !== 'sun';
     if (l.kind === 'sun') { $('hour').value = l.hour; $('hour-out').textContent = String(l.hour).padStart(2, '0') + ':00'; }
     $('fluorescence').checked = state.fluorescence === 'on';
+    $('glare').checked = state.glare === 'on';
+    $('lamp').value = state.lamp;
     $('play').textContent = state.playing ? 'Pause' : 'Play';
     $('pane-b').hidden = !state.compare;
     $('caption-a').textContent = fabricByName[state.fabric].display_name;
@@ -464,7 +552,8 @@
     showFacts();
   }
   function writeHash() {
-    const h = new URLSearchParams({ view: state.view, fabric: state.fabric, light: state.light, fluorescence: state.fluorescence });
+    const h = new URLSearchParams({ view: state.view, fabric: state.fabric, light: state.light, fluorescence: state.fluorescence,
+                                    glare: state.glare, lamp: state.lamp });
     if (state.compare) h.set('compare', state.compare);
     history.replaceState(null, '', '#' + h.toString());
   }
@@ -473,6 +562,8 @@
     if (h.get('fabric') && fabricByName[h.get('fabric')]) p.fabric = h.get('fabric');
     if (h.get('light') && lightOf(h.get('light'))) p.light = h.get('light');
     if (h.get('fluorescence') === 'off') p.fluorescence = 'off';
+    if (h.get('glare') === 'off') p.glare = 'off';
+    if (h.get('lamp') && D.room_lamps.some((l) => l.id === h.get('lamp'))) p.lamp = h.get('lamp');
     if (h.get('compare') && fabricByName[h.get('compare')]) p.compare = h.get('compare');
     if (h.get('view') === 'viewer') p.view = 'viewer';
     if (h.get('frame') !== null) { p.t = +h.get('frame'); p.playing = false; }
@@ -585,6 +676,8 @@
       l: () => cycleLight(1), L: () => cycleLight(-1),
       '[': () => suns.length && set({ light: sunNearest((hour ?? 13) - 1).id }), ']': () => suns.length && set({ light: sunNearest((hour ?? 11) + 1).id }),
       f: () => set({ fluorescence: state.fluorescence === 'on' ? 'off' : 'on' }),
+      g: () => set({ glare: state.glare === 'on' ? 'off' : 'on' }),
+      m: () => { const ids = D.room_lamps.map((l) => l.id); set({ lamp: ids[(ids.indexOf(state.lamp) + 1) % ids.length] }); },
       c: () => { const names = ['', ...D.fabrics.map((f) => f.name).filter((n) => n !== state.fabric)]; set({ compare: names[(names.indexOf(state.compare) + 1) % names.length] }); },
       n: () => cycleFabric(1), p: () => cycleFabric(-1), ' ': () => set({ playing: !state.playing }),
       r: resetView, Escape: () => set({ view: 'grid' }),
@@ -596,6 +689,19 @@
   // window.catalogApp: the browser tests and the benchmark drive the page through these.
   window.catalogApp = {
     state, stats, set,
+    // the page's decoded data as float32 bytes in base64: a texture's texels, or a baked
+    // frame's [positions, normals, tangents] (the tests compare them with the reference decoders)
+    async decoded(kind, id, frame) {
+      const b64 = (a) => {
+        const u = new Uint8Array(a.buffer, a.byteOffset, a.byteLength);
+        let s = '';
+        for (let i = 0; i < u.length; i += 8192) s += String.fromCharCode.apply(null, u.subarray(i, i + 8192));
+        return btoa(s);
+      };
+      if (kind === 'texels') return b64(decodeTexels(D.textures[id]));
+      const a = await animation(id);
+      return [a.positions[frame], a.normals[frame], a.tangents[frame]].map(b64);
+    },
     // resolves when the current state has been drawn (animations loaded)
     settle() {
       return new Promise((resolve) => {
@@ -629,6 +735,8 @@
     document.addEventListener('keydown', onKey);
     window.addEventListener('resize', () => (dirty = true));
     set(readHash());
+    stats.unpackMs = unpackMs; stats.gridReadyMs = performance.now();
     requestAnimationFrame(frame);
   } catch (e) { fail(e); }
+  }
 })();
