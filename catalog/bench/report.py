@@ -63,23 +63,10 @@ def colour_md(result: dict) -> str:
 
 
 def fluorescence_md(result: dict) -> str:
-    s = result["summary"]
-    rows = [{"method": k, **v} for k, v in s["per_method"].items()]
-    st = result["settings"]
-    return "\n".join([
-        f"{len(st['materials'])} measured matrices x {len(st['lights'])} lights ({s['cases']} cases); "
-        f"Delta E 2000 against the exact matrix result.", "",
-        table(rows, ["label", "mean_goal_lights", "max_goal_lights", "mean_all_lights",
-                     "p95_all_lights", "max_all_lights", "shader_numbers", "recomputed_per_light",
-                     "cpu_ms_per_light"],
-              ["representation", "mean, D65 A FL2 FL11 LED-B4", "max, same", "mean, all lights",
-               "p95, all", "max, all", "numbers in the shader", "per light", "CPU ms per light"]),
-        "",
-        f"Shader should carry: **{s['per_method'][s['choice']]['label']}** (lowest mean over all "
-        f"lights among representations of <= 16 numbers built from the fabric's spectra); best "
-        f"light-independent one: {s['per_method'][s['best_light_independent']]['label']}. "
-        f"Our reduction against the bispectral study's implementation: max relative difference "
-        f"{fmt(st['reduction_vs_bispectral_study_max_rel_diff'])}."])
+    from catalog.bench.fluorescence_rgb import markdown_tables  # noqa: PLC0415
+
+    blocks = markdown_tables(result)
+    return blocks["fluorescence_representations"] + "\n\n" + blocks["fluorescence_findings"]
 
 
 def fit_md(result: dict) -> str:
@@ -204,3 +191,62 @@ def write_report(report: dict, folder: Path, plotters: dict) -> list[Path]:
                           json.dumps(_plain(report), indent=1, allow_nan=False) + "\n")
         write_text_atomic(stage / "bench.md", markdown(report) + "\n")
     return [folder / "bench.md", folder / "bench.json"] + written
+
+
+#: Sections that draw, and so need an OpenGL context (catalog bench makes one for them).
+GL_SECTIONS = ("colour", "stability", "display", "image")
+
+
+def machine_info(ctx=None) -> dict:
+    """The machine a result was measured on: cores, platform, Python, the GL renderer."""
+    import os  # noqa: PLC0415
+    import platform  # noqa: PLC0415
+
+    machine = {"cpu_count": os.cpu_count(), "platform": platform.platform(),
+               "python": platform.python_version()}
+    if ctx is not None:
+        from catalog.gl.context import describe  # noqa: PLC0415
+
+        machine["gl_renderer"] = describe(ctx)["renderer"]
+    return machine
+
+
+def section_main(name: str, argv: list[str] | None = None) -> int:
+    """``python -m catalog.bench.<module>`` for a section of ``catalog bench``: run it at full
+    size (``--quick``: the CI size), write its result with the machine to the module's
+    committed JSON (``RESULT_JSON`` under the checkout; ``--json-out FILE`` elsewhere) and
+    print the tables the docs are generated from (tools/docs_figures.py)."""
+    import argparse  # noqa: PLC0415
+    import importlib  # noqa: PLC0415
+    import time  # noqa: PLC0415
+
+    from catalog.bench import SECTIONS  # noqa: PLC0415
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+    from catalog.core.jsonout import _plain  # noqa: PLC0415
+    from catalog.core.resources import PROJECT_ROOT  # noqa: PLC0415
+
+    module = importlib.import_module(SECTIONS[name])
+    parser = argparse.ArgumentParser(description=(module.__doc__ or name).splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="the CI size (fewer cases, repeats)")
+    parser.add_argument("--json-out", type=Path, default=PROJECT_ROOT / module.RESULT_JSON,
+                        metavar="FILE", help=f"write the result here (default {module.RESULT_JSON})")
+    args = parser.parse_args(argv)
+    ctx = None
+    if name in GL_SECTIONS:
+        from catalog.gl.context import create_headless_context  # noqa: PLC0415
+
+        ctx = create_headless_context()
+    try:
+        start = time.perf_counter()
+        result = module.run(quick=args.quick, ctx=ctx)
+        result["seconds"] = time.perf_counter() - start
+        result["quick"] = bool(args.quick)
+        result["machine"] = machine_info(ctx)
+    finally:
+        if ctx is not None:
+            ctx.release()
+    write_text_atomic(args.json_out, json.dumps(_plain(result), indent=1, allow_nan=False) + "\n")
+    for table_name, text in module.markdown_tables(result).items():
+        print(f"<!-- generated:{table_name} -->\n{text}\n<!-- /generated:{table_name} -->\n")
+    print(f"wrote {args.json_out}")
+    return 0
