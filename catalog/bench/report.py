@@ -109,14 +109,9 @@ def stability_md(result: dict) -> str:
 
 
 def startup_md(result: dict) -> str:
-    s = result["summary"]
-    return "\n".join([
-        table(result["rows"], ["case", "median_s", "ratio_to_python"],
-              ["case", "median s", "x python -c pass"]), "",
-        "Heavy modules loaded by importing: " + "; ".join(
-            f"{k}: {', '.join(v) if v else 'none'}" for k, v in s["heavy_imports"].items()
-            if v is not None) + ".",
-        viewer_line(s["viewer_heavy_at_first_frame"]) + f" scipy loaded: {s['viewer_imports_scipy']}."])
+    from catalog.bench.startup import markdown_tables  # noqa: PLC0415
+
+    return markdown_tables(result)["startup"]
 
 
 def room_md(result: dict) -> str:
@@ -130,14 +125,6 @@ def image_md(result: dict) -> str:
 
     blocks = markdown_tables(result)
     return blocks["image"] + "\n\nReal-time options (image-pareto.png):\n\n" + blocks["image-options"]
-
-
-def viewer_line(heavy: dict | None) -> str:
-    if not heavy:
-        return "The viewer's first frame was not measured."
-    loaded = ", ".join(heavy["loaded"]) or "none"
-    return (f"The viewer process at its first frame had loaded, of {', '.join(heavy['checked'])}: "
-            f"{loaded}.")
 
 
 def uv_md(section: dict) -> str:
@@ -203,7 +190,8 @@ def machine_info(ctx=None) -> dict:
     import platform  # noqa: PLC0415
 
     machine = {"cpu_count": os.cpu_count(), "platform": platform.platform(),
-               "python": platform.python_version()}
+               "python": platform.python_version(),
+               "load_average_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
     if ctx is not None:
         from catalog.gl.context import describe  # noqa: PLC0415
 
