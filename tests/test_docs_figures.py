@@ -46,3 +46,40 @@ def test_a_changed_figure_changes_the_block_and_unknown_names_are_refused(docs_f
     with pytest.raises(KeyError, match="no-such-table"):
         docs_figures.fill("<!-- generated:no-such-table -->\n<!-- /generated:no-such-table -->",
                           made, "x.md")
+
+
+def test_a_module_may_make_its_tables_from_several_runs(docs_figures, tmp_path):
+    """RESULT_JSONS: markdown_tables receives every run by its key; a missing run, or a
+    module giving both RESULT_JSON and RESULT_JSONS, is refused naming it."""
+    import types
+
+    (tmp_path / "a.json").write_text(json.dumps({"ms": 2.5}))
+    (tmp_path / "b.json").write_text(json.dumps({"ms": 7.0}))
+    module = types.SimpleNamespace(
+        __name__="fake", RESULT_JSONS={"cpu": "a.json", "gpu": "b.json"},
+        markdown_tables=lambda runs: {"t": " / ".join(f"{k} {v['ms']}" for k, v in runs.items()) + "\n"})
+    assert docs_figures.module_tables(module, tmp_path) == {"t": "cpu 2.5 / gpu 7.0"}
+    module.RESULT_JSONS["h200"] = "c.json"
+    with pytest.raises(SystemExit, match="c.json: no such file"):
+        docs_figures.module_tables(module, tmp_path)
+    del module.RESULT_JSONS["h200"]
+    module.RESULT_JSON = "a.json"
+    with pytest.raises(SystemExit, match="both RESULT_JSON and RESULT_JSONS"):
+        docs_figures.module_tables(module, tmp_path)
+    assert docs_figures.module_tables(types.SimpleNamespace(__name__="plain"), tmp_path) is None
+
+
+def test_the_viewer_tables_take_one_more_run_as_one_more_row_set():
+    """The viewer's frame table spans its runs: a run added (e.g. on a GPU) adds its rows."""
+    from catalog.bench import viewer_frames
+
+    runs = {key: json.loads((PROJECT_ROOT / path).read_text())
+            for key, path in viewer_frames.RESULT_JSONS.items()}
+    before = viewer_frames.markdown_tables(runs)["viewer_frames"].splitlines()
+    extra = json.loads(json.dumps(runs["defaults"]))
+    extra["machine"]["gl_renderer"] = "NVIDIA H200/PCIe/SSE2"
+    for row in extra["rows"]:
+        row["gl_renderer"] = "NVIDIA H200/PCIe/SSE2"
+    after = viewer_frames.markdown_tables({**runs, "h200": extra})["viewer_frames"].splitlines()
+    assert after[:len(before)] == before and len(after) == len(before) + len(extra["rows"])
+    assert all(line.startswith("| NVIDIA H200/PCIe/SSE2 |") for line in after[len(before):])

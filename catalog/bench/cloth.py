@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-FRAME_DT_S = 1.0 / 60.0
+from catalog.core.constants import FRAME_DT_S
 REFERENCE_SUBSTEPS = 100
 SUBSTEPS = (1, 2, 5, 10, 20, 40)
 QUICK_SUBSTEPS = (2, 10, 20)

@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from catalog.core.constants import FRAME_DT_S  # noqa: E402
 from catalog.core.resources import PROJECT_ROOT as ROOT  # noqa: E402
 # numba's OpenMP threads spin while waiting by default; on a 2-core machine shared with
 # other work that spinning starves the other thread (measured: 2 threads at 1/5 the speed
@@ -354,8 +355,8 @@ def bench_gpu_frame(ctx, repeats: int) -> list[dict]:
     for n in (4, 64, 128):
         p = ClothParams(grid_w=n, grid_h=n, opening=0.8, wind_speed_m_s=1.0)
         sim = ClothSimulation(p, "gpu", ctx=ctx, monitor_every=10 ** 9)
-        sim.step(1 / 60)
-        ms = _frame_ms(sim, 5, 1 / 60, repeats)
+        sim.step(FRAME_DT_S)
+        ms = _frame_ms(sim, 5, FRAME_DT_S, repeats)
         rows.append({"n": n, "ms_per_frame_llvmpipe": ms, "substeps": sim.last_substeps})
     return rows
 

@@ -29,6 +29,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from catalog.core.constants import FRAME_DT_S
+
 G_EDGES = (-0.99999, -0.9999, -0.999, -0.9, -0.3, 0.0, 0.3, 0.9, 0.999, 0.9999, 0.99999)
 THETAS = np.concatenate([[0.0], np.geomspace(1e-7, 1e-2, 24), np.linspace(0.02, math.pi, 60)])
 SCALES = tuple(10.0 ** k for k in range(-6, 7, 2))  # 12 orders of magnitude
@@ -223,12 +225,12 @@ def cloth_sweep(quick: bool) -> list[dict]:
 
     cases = []
     for k in (10.0, 1e3, 1e5, 1e7):
-        cases.append((f"stretch={k:g} N/m", {"stretch_stiffness_n_m": k}, 1 / 60))
+        cases.append((f"stretch={k:g} N/m", {"stretch_stiffness_n_m": k}, FRAME_DT_S))
     for b in (0.0, 100.0):
-        cases.append((f"bend={b:g} N/m", {"bend_stiffness_n_m": b}, 1 / 60))
+        cases.append((f"bend={b:g} N/m", {"bend_stiffness_n_m": b}, FRAME_DT_S))
     for dt in (1 / 1000, 1 / 10):
         cases.append((f"dt={dt:g} s", {}, dt))
-    cases.append(("wind=30 m/s", {"wind_speed_m_s": 30.0}, 1 / 60))
+    cases.append(("wind=30 m/s", {"wind_speed_m_s": 30.0}, FRAME_DT_S))
     cases.append(("stretch=1e7, wind=30, dt=0.1", {"stretch_stiffness_n_m": 1e7,
                                                    "wind_speed_m_s": 30.0}, 1 / 10))
     if quick:
