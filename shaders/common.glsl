@@ -1,8 +1,9 @@
 // common.glsl: the physical terms of model.md, one small function per term.
 // Included by every pass (catalog/gl/shaderlib.py resolves #include and injects
-// #defines: N_BANDS, NV4 = ceil(N_BANDS / 4), FLUORESCENCE_OFF | FLUORESCENCE_PAPER |
-// FLUORESCENCE_PHYSICAL, SEE_THROUGH, ANISOTROPIC, GBUFFER, SHARED_DIVISION). Band quantities travel
-// as vec4 chunks.
+// #defines: the constants of catalog/core/constants.py, HG_MIRROR_BELOW, into every program;
+// per program e.g. N_BANDS, NV4 = ceil(N_BANDS / 4), FLUORESCENCE_OFF | FLUORESCENCE_PAPER |
+// FLUORESCENCE_PHYSICAL, SEE_THROUGH, ANISOTROPIC, GBUFFER, SHARED_DIVISION, PATTERN, OIT,
+// ROOM_LIGHTING). Band quantities travel as vec4 chunks.
 // The float64 twin of every function is in catalog/optics/shading_reference.py.
 
 #ifndef CATALOG_COMMON_GLSL
