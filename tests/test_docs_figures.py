@@ -83,3 +83,20 @@ def test_the_viewer_tables_take_one_more_run_as_one_more_row_set():
     after = viewer_frames.markdown_tables({**runs, "h200": extra})["viewer_frames"].splitlines()
     assert after[:len(before)] == before and len(after) == len(before) + len(extra["rows"])
     assert all(line.startswith("| NVIDIA H200/PCIe/SSE2 |") for line in after[len(before):])
+
+
+def test_no_two_bench_modules_claim_the_same_json(docs_figures):
+    """One module's run must not overwrite another's committed result (docs_figures refuses
+    it too)."""
+    import importlib
+    import pkgutil
+
+    import catalog.bench as bench
+
+    owners: dict[str, list[str]] = {}
+    for info in pkgutil.iter_modules(bench.__path__):
+        module = importlib.import_module(f"catalog.bench.{info.name}")
+        for source in docs_figures.result_sources(module):
+            owners.setdefault(source, []).append(info.name)
+    shared = {k: v for k, v in owners.items() if len(v) > 1}
+    assert owners and not shared, f"JSON files claimed by several modules: {shared}"

@@ -11,7 +11,8 @@ Its content comes from a module of catalog.bench that has ``markdown_tables`` an
 -> {NAME: markdown}``) or ``RESULT_JSONS`` (several: ``{KEY: path}``; ``markdown_tables``
 then receives ``{KEY: result}``, so a table may span runs, and one more run is one more
 entry). A marker whose NAME no module provides is an error (exit 2), as is a JSON file that
-is missing, a module with both attributes, or a NAME made by two modules.
+is missing, a module with both attributes, a NAME made by two modules, or a JSON file
+claimed by two modules (one would overwrite the other's result).
 """
 
 from __future__ import annotations
@@ -34,6 +35,12 @@ BLOCK = re.compile(r"(<!-- generated:(?P<name>[\w.-]+) -->\n)(?P<body>.*?)(\n?<!
 def documents(root: Path = ROOT) -> list[Path]:
     return [p for p in [root / "README.md", root / "BENCHMARKS.md",
                         *sorted((root / "docs").glob("*.md"))] if p.is_file()]
+
+
+def result_sources(module) -> list[str]:
+    """The committed JSON files a bench module's tables are made from."""
+    one, several = getattr(module, "RESULT_JSON", None), getattr(module, "RESULT_JSONS", None)
+    return ([one] if one is not None else []) + list((several or {}).values())
 
 
 def module_tables(module, root: Path = ROOT) -> dict[str, str] | None:
@@ -62,8 +69,14 @@ def tables(root: Path = ROOT) -> dict[str, str]:
     import catalog.bench as bench
 
     out: dict[str, str] = {}
+    owner: dict[str, str] = {}  # JSON path -> the module that writes it
     for info in pkgutil.iter_modules(bench.__path__):
-        made = module_tables(importlib.import_module(f"catalog.bench.{info.name}"), root)
+        module = importlib.import_module(f"catalog.bench.{info.name}")
+        for source in result_sources(module):
+            if owner.setdefault(source, module.__name__) != module.__name__:
+                raise SystemExit(f"docs_figures: error: {source} is the result of both "
+                                 f"{owner[source]} and {module.__name__}")
+        made = module_tables(module, root)
         for name, text in (made or {}).items():
             if name in out:
                 raise SystemExit(f"docs_figures: error: block {name!r} made by two modules")
