@@ -209,6 +209,9 @@ def test_startup_section_without_first_frames():
     heavy = result["summary"]["heavy_imports"]
     assert heavy["catalog.commands.cli"] == [] and "scipy" not in heavy["catalog.viewer"]
     assert result["summary"]["help_s"] > 0
+    tables = startup.markdown_tables(result)  # the docs' tables also say when a part is missing
+    assert set(tables) == {"startup", "startup_brief"}
+    assert "The viewer was not timed (first frames not timed" in tables["startup"]
 
 
 # --------------------------------------------------------------------------- reductions

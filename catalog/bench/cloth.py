@@ -165,7 +165,7 @@ RESULT_JSON = "benchmarks/bench_cloth_substeps.json"
 def markdown_tables(result: dict) -> dict[str, str]:
     """``bench_cloth`` (every backend and substep count, docs/bench.md) and
     ``bench_cloth_brief`` (the default's figures, BENCHMARKS.md)."""
-    from catalog.bench.report import fmt  # noqa: PLC0415
+    from catalog.bench.results import fmt  # noqa: PLC0415
 
     st, summary = result["settings"], result["summary"]
     default = st["default_substeps"]
@@ -208,6 +208,6 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 if __name__ == "__main__":
-    from catalog.bench.report import section_main  # noqa: PLC0415
+    from catalog.bench.results import section_main  # noqa: PLC0415
 
     raise SystemExit(section_main("cloth"))

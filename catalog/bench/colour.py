@@ -268,7 +268,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
     """``bench_colour`` (every variant and the per-light means, docs/bench.md),
     ``bench_colour_findings`` (the figures docs/bench.md's prose rests on) and
     ``bench_colour_brief`` (BENCHMARKS.md)."""
-    from catalog.bench.report import fmt  # noqa: PLC0415
+    from catalog.bench.results import fmt  # noqa: PLC0415
 
     s, st, rows = result["summary"], result["settings"], result["rows"]
     per, default = s["per_variant"], s["default"]
@@ -340,6 +340,6 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 if __name__ == "__main__":
-    from catalog.bench.report import section_main  # noqa: PLC0415
+    from catalog.bench.results import section_main  # noqa: PLC0415
 
     raise SystemExit(section_main("colour"))

@@ -171,7 +171,7 @@ RESULT_JSON = "benchmarks/bench_fit.json"
 def markdown_tables(result: dict) -> dict[str, str]:
     """``bench_fit`` (the three methods, docs/bench.md) and ``bench_fit_brief`` (what they
     show, BENCHMARKS.md)."""
-    from catalog.bench.report import fmt  # noqa: PLC0415
+    from catalog.bench.results import fmt  # noqa: PLC0415
 
     per = result["summary"]["per_method"]
     lines = ["| method | median time s | weighted RMS / best, median | worst "
@@ -206,6 +206,6 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 if __name__ == "__main__":
-    from catalog.bench.report import section_main  # noqa: PLC0415
+    from catalog.bench.results import section_main  # noqa: PLC0415
 
     raise SystemExit(section_main("fit"))

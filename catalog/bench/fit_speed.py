@@ -168,7 +168,7 @@ def main(argv=None) -> int:
     full, plain = rows[0], rows[2]
     print(f"full fit / one plain start: {full['median_s'] / plain['median_s']:.2f}x (medians); "
           f"target: full fit < 100 ms -> {'met' if full['median_s'] < TARGET_S else 'NOT met'}")
-    from catalog.bench.report import machine_info
+    from catalog.bench.results import machine_info
     from catalog.core.atomic import write_text_atomic
 
     write_text_atomic(args.json_out, json.dumps({"benchmark": "fit", "fabric": args.fabric,

@@ -192,7 +192,7 @@ BRIEF_METHODS = ("ignore", "paper", "fichet_3x3", "fichet_3x3_uv", "bands_16", "
 def markdown_tables(result: dict) -> dict[str, str]:
     """``fluorescence_representations`` (every method, docs/bench.md), ``fluorescence_brief``
     (BENCHMARKS.md) and ``fluorescence_findings`` (the figures the prose rests on)."""
-    from catalog.bench.report import fmt  # noqa: PLC0415
+    from catalog.bench.results import fmt  # noqa: PLC0415
 
     s, st = result["summary"], result["settings"]
     per = s["per_method"]
@@ -246,6 +246,6 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 if __name__ == "__main__":
-    from catalog.bench.report import section_main  # noqa: PLC0415
+    from catalog.bench.results import section_main  # noqa: PLC0415
 
     raise SystemExit(section_main("fluorescence"))

@@ -320,11 +320,10 @@ def spp_for_noise(spp: int, noise: float, target: float = NOISE_TARGET) -> float
 
 
 def _cell(value) -> str:
-    """3 significant digits, e-notation when small or large (catalog.bench.report's rule;
-    not imported: report imports this module for its section)."""
-    if isinstance(value, float) and math.isfinite(value) and value != 0:
-        return f"{value:.2e}" if (abs(value) < 1e-3 or abs(value) >= 1e5) else f"{value:.3g}"
-    return "0" if isinstance(value, float) and value == 0 else str(value)
+    """A table cell in the benchmarks' number format (catalog.bench.results.fmt)."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    return fmt(value)
 
 
 def table(rows: list[dict], columns: list[str], headers: list[str]) -> str:

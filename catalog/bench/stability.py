@@ -295,7 +295,7 @@ PROBE_LABELS = {
 def markdown_tables(result: dict) -> dict[str, str]:
     """``bench_stability`` (every probe, docs/bench.md) and ``bench_stability_brief``
     (BENCHMARKS.md)."""
-    from catalog.bench.report import fmt  # noqa: PLC0415
+    from catalog.bench.results import fmt  # noqa: PLC0415
 
     summary, rows = result["summary"], result["rows"]
 
@@ -335,6 +335,6 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 if __name__ == "__main__":
-    from catalog.bench.report import section_main  # noqa: PLC0415
+    from catalog.bench.results import section_main  # noqa: PLC0415
 
     raise SystemExit(section_main("stability"))

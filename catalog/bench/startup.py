@@ -132,7 +132,7 @@ BRIEF_CASES = ("catalog --help", "import colour (colour-science)", "import numba
 def markdown_tables(result: dict) -> dict[str, str]:
     """``startup`` (every case and what each import loads, docs/bench.md) and
     ``startup_brief`` (BENCHMARKS.md)."""
-    from catalog.bench.report import fmt  # noqa: PLC0415
+    from catalog.bench.results import fmt  # noqa: PLC0415
 
     s, st = result["summary"], result["settings"]
 
@@ -169,6 +169,6 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 if __name__ == "__main__":
-    from catalog.bench.report import section_main  # noqa: PLC0415
+    from catalog.bench.results import section_main  # noqa: PLC0415
 
     raise SystemExit(section_main("startup"))

@@ -83,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
     print("\nheavy modules imported by importing:")
     for name, heavy in imports.items():
         print(f"  {name:24s} {'(absent)' if heavy is None else ', '.join(heavy) or 'none'}")
-    from catalog.bench.report import machine_info  # noqa: PLC0415
+    from catalog.bench.results import machine_info  # noqa: PLC0415
     from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
 
     result = {"benchmark": "startup", "repeats": repeats, "rows": rows, "imports": imports,

@@ -105,7 +105,7 @@ def _write_report(args, fields: dict) -> None:
     """The run's JSON (the machine, then ``fields``) into ``args.json_out``, atomically."""
     from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
 
-    from catalog.bench.report import machine_info  # noqa: PLC0415
+    from catalog.bench.results import machine_info  # noqa: PLC0415
 
     renderers = sorted({row["gl_renderer"] for row in fields.get("rows", []) if row.get("gl_renderer")})
     report = {"machine": {**machine_info(), "display": "Xvfb" if args.display is None
