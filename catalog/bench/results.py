@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 
 
@@ -52,11 +53,8 @@ def section_main(name: str, argv: list[str] | None = None) -> int:
     print the tables the docs are generated from (tools/docs_figures.py)."""
     import argparse  # noqa: PLC0415
     import importlib  # noqa: PLC0415
-    import time  # noqa: PLC0415
 
     from catalog.bench import SECTIONS  # noqa: PLC0415
-    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
-    from catalog.core.jsonout import _plain  # noqa: PLC0415
     from catalog.core.resources import PROJECT_ROOT  # noqa: PLC0415
 
     module = importlib.import_module(SECTIONS[name])
@@ -65,6 +63,21 @@ def section_main(name: str, argv: list[str] | None = None) -> int:
     parser.add_argument("--json-out", type=Path, default=PROJECT_ROOT / module.RESULT_JSON,
                         metavar="FILE", help=f"write the result here (default {module.RESULT_JSON})")
     args = parser.parse_args(argv)
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+
+    try:
+        return _run_section(name, module, args)
+    except CatalogError as exc:  # missing data, no EGL: one line, the documented exit code
+        print(f"{module.__name__}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+
+
+def _run_section(name: str, module, args) -> int:
+    import time  # noqa: PLC0415
+
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+    from catalog.core.jsonout import _plain  # noqa: PLC0415
+
     ctx = None
     if name in GL_SECTIONS:
         from catalog.gl.context import create_headless_context  # noqa: PLC0415
