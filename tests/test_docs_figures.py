@@ -100,3 +100,22 @@ def test_no_two_bench_modules_claim_the_same_json(docs_figures):
             owners.setdefault(source, []).append(info.name)
     shared = {k: v for k, v in owners.items() if len(v) > 1}
     assert owners and not shared, f"JSON files claimed by several modules: {shared}"
+
+
+def test_fit_table_margins_count_the_combinations_hg_loses():
+    """The generated sentence counts, it does not assume: a combination where CT is better
+    is reported as such."""
+    from catalog.bench import fit_table
+
+    def row(fabric, points, weighting, hg, ct):
+        return {"fabric": fabric, "points": points, "weighting": weighting, "hg_rmse": hg,
+                "ct_rmse": ct, "hg_relative_rms": 0.1, "ct_relative_rms": 0.2,
+                "hg_anisotropy_rmse": None if points == 79 else hg}
+
+    rows = [row(f, p, w, 1.0, 2.0) for f in ("a", "b") for p in (4800, 79)
+            for w in ("relative", "none")]
+    rows[1]["ct_rmse"] = 0.5
+    tables = fit_table.markdown_tables({"rows": rows})
+    assert "lower rmse in 7 of 8 combinations" in tables["fit_table_margins"]
+    assert "from 0.5x (a, 4800 points, none weighting)" in tables["fit_table_margins"]
+    assert len(tables["fit_table_readme"].splitlines()) == 2 + 2
