@@ -332,6 +332,26 @@ def table(rows: list[dict], columns: list[str], headers: list[str]) -> str:
     return "\n".join(lines)
 
 
+def ranges_sentence(before: dict, after: dict) -> str:
+    """README's summary of the after-run over its scenes, with the floor and walls before."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    def span(run: dict, *keys: str) -> str:
+        values = [r[k] for r in run["rows"] for k in keys if r.get(k) is not None]
+        return f"{fmt(min(values))}-{fmt(max(values))}"
+
+    s = after["summary"]
+    speed = [r["speedup"] for r in after["rows"]]
+    return (f"Over {s['scenes']} scenes mean FLIP is {span(after, 'mean_flip')} and the curtain's "
+            f"mean Delta E 2000 {span(after, 'curtain_delta_e_mean')} (goal: <= "
+            f"{GOAL['mean_flip_at_most']} and <= {GOAL['curtain_mean_delta_e_at_most']} on every "
+            f"scene: met on {s['scenes_meeting_goal']}); the floor's and walls' mean error went from "
+            f"{span(before, 'floor_delta_e_mean', 'walls_delta_e_mean')} before the room lighting of "
+            f"issue 13 to {span(after, 'floor_delta_e_mean', 'walls_delta_e_mean')}. The frame is "
+            f"{min(speed):,.0f}-{max(speed):,.0f}x faster than the reference (goal >= "
+            f"{GOAL['speedup_at_least']:g}x: {'met' if min(speed) >= GOAL['speedup_at_least'] else 'NOT met'}).")
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run; of the
     committed JSON (``{"runs": {...}}``) the baseline's, and ``image-after`` the run after
@@ -342,6 +362,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
         blocks["image-after"] = (after["image"] + "\n\nReal-time options:\n\n" + after["image-options"]
                                  + "\n\n![six scenes after issues 12-16: real-time | reference | FLIP]"
                                  "(img/pathtrace_scenes_after_13.png)")
+        blocks["image-ranges"] = ranges_sentence(result["runs"]["baseline"], result["runs"]["after_12_16"])
         return blocks
 
     s = result["summary"]
