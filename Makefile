@@ -13,4 +13,4 @@ measurements:
 
 # The per-fabric HG vs Cook-Torrance error table of docs/fit.md.
 fit-table:
-	$(PYTHON) tools/make_presets.py --table docs/fit-table.md
+	$(PYTHON) -m catalog.bench.fit_table && $(PYTHON) tools/docs_figures.py

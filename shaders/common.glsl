@@ -1,8 +1,9 @@
 // common.glsl: the physical terms of model.md, one small function per term.
 // Included by every pass (catalog/gl/shaderlib.py resolves #include and injects
-// #defines: N_BANDS, NV4 = ceil(N_BANDS / 4), FLUORESCENCE_OFF | FLUORESCENCE_PAPER |
-// FLUORESCENCE_PHYSICAL, SEE_THROUGH, ANISOTROPIC, GBUFFER, SHARED_DIVISION). Band quantities travel
-// as vec4 chunks.
+// #defines: the constants of catalog/core/constants.py, HG_MIRROR_BELOW, into every program;
+// per program e.g. N_BANDS, NV4 = ceil(N_BANDS / 4), FLUORESCENCE_OFF | FLUORESCENCE_PAPER |
+// FLUORESCENCE_PHYSICAL, SEE_THROUGH, ANISOTROPIC, GBUFFER, SHARED_DIVISION, PATTERN, OIT,
+// ROOM_LIGHTING). Band quantities travel as vec4 chunks.
 // The float64 twin of every function is in catalog/optics/shading_reference.py.
 
 #ifndef CATALOG_COMMON_GLSL
@@ -13,8 +14,8 @@ const float PI = 3.14159265358979;
 // Henyey & Greenstein 1941, "Diffuse radiation in the galaxy"; model.md eq. 6 in the robust form of
 // catalog/optics/btdf.py (unchanged for g >= 0):
 // 1 + g^2 - 2 g cos(theta) = (1 - g)^2 + 2 g (1 - cos theta) with 1 - cos theta = chord2 / 2, and
-// = (1 + g)^2 - 2 g (1 + cos theta) with 1 + cos theta = anti2 / 2 for g < 0 (no cancellation
-// near g = -1); the power 1.5 as d * sqrt(d). chord2 = |w_view - w_travel|^2, anti2 = |w_view + w_travel|^2.
+// = (1 + g)^2 - 2 g (1 + cos theta) with 1 + cos theta = anti2 / 2 for g < HG_MIRROR_BELOW (no
+// cancellation near g = -1; hg_d below); the power 1.5 as d * sqrt(d). chord2 = |w_view - w_travel|^2, anti2 = |w_view + w_travel|^2.
 float hg_d(float chord2, float anti2, float g);  // below: the one choice of form
 float hg_phase_robust(float chord2, float anti2, float g) {
     float d = hg_d(chord2, anti2, g);

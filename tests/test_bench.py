@@ -209,6 +209,9 @@ def test_startup_section_without_first_frames():
     heavy = result["summary"]["heavy_imports"]
     assert heavy["catalog.commands.cli"] == [] and "scipy" not in heavy["catalog.viewer"]
     assert result["summary"]["help_s"] > 0
+    tables = startup.markdown_tables(result)  # the docs' tables also say when a part is missing
+    assert set(tables) == {"startup", "startup_brief"}
+    assert "The viewer was not timed (first frames not timed" in tables["startup"]
 
 
 # --------------------------------------------------------------------------- reductions
@@ -298,3 +301,18 @@ def test_n_bands_are_exact_for_a_grey_non_fluorescent_material(n_bands):
         light = _light(light_name)
         expected = LM_PER_W * 0.45 * (light @ red.cmf_sensors(False))
         np.testing.assert_allclose(bands_xyz(models, light, n_bands), expected, rtol=2e-6)
+
+
+def test_a_section_run_alone_without_its_data_says_so_in_one_line(tmp_path, monkeypatch, capsys):
+    """python -m catalog.bench.fluorescence_rgb without the measured matrices: exit 2, one line
+    naming --data, no JSON written (the committed one is never half-replaced)."""
+    from catalog.bench.results import section_main
+    from catalog.core import resources
+
+    monkeypatch.setattr(resources, "_user_data", None)
+    monkeypatch.setenv(resources.DATA_ENV, str(tmp_path / "nowhere"))
+    out = tmp_path / "result.json"
+    assert section_main("fluorescence", ["--quick", "--json-out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--data" in err[0] and "nowhere" in err[0]
+    assert not out.exists()

@@ -36,7 +36,7 @@ def test_viewer_before_after_table():
         rows.append({"version": version, "case": "1280x720:default", "size": "1280x720",
                      "render_scale": 0.5, "grid": "96x56 (default)", "total_ms": total,
                      "simulation_ms": 5.0, "shading_ms": 20.0, "ui_ms": 5.0, "other_ms": 10.0})
-    table = viewer_frames.markdown_tables({"rows": rows})["viewer_before_after"]
+    table = viewer_frames.before_after_table({"rows": rows})
     lines = table.splitlines()
     assert len(lines) == 4 and lines[2].endswith("| 1.00 |") and lines[3].endswith("| 1.50 |")
 

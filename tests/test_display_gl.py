@@ -148,6 +148,7 @@ def test_displayed_hue_is_the_exact_spectral_hue(gl, fabric, light, capsys):
     assert abs(difference) <= 10.0
 
 
+@pytest.mark.slow  # 1-3 s: measured with --durations (issue 10)
 def test_lace_and_safety_yellow_differ_at_sunset(gl, capsys):
     labs = []
     for fabric in ("lace-fwa", "safety-yellow"):

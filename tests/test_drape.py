@@ -54,7 +54,7 @@ def test_the_settled_drape_is_pleated_and_is_where_every_simulation_starts():
 @pytest.mark.slow
 def test_the_default_breeze_sways_the_lightest_curtain_and_a_gale_throws_it():
     """Voile (0.05 kg/m2, the lightest catalog cloth), 2 s from the settled drape. At the
-    default breeze the hem rises less than 10 cm (it sways about its rest line; docs/drape.md
+    default breeze the hem rises less than 10 cm (it sways about its rest line; docs/pattern.md
     has the displacement and why 0.5 m/s is plausible); at 2 m/s it rises more than 30 cm
     (the wind lifts it into the room: stronger wind stays available)."""
     rises = {}

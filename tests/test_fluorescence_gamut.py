@@ -3,20 +3,14 @@
 
 from __future__ import annotations
 
-import importlib.util
-
 import pytest
-
-from catalog.core.resources import PROJECT_ROOT
 
 
 @pytest.fixture(scope="module")
 def tables(shared_data):  # the measured brightener is one of the emissions studied
-    spec = importlib.util.spec_from_file_location(
-        "fluorescence_tables", PROJECT_ROOT / "tools" / "fluorescence_tables.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    from catalog.bench import fluorescence_tables
+
+    return fluorescence_tables
 
 
 @pytest.fixture(scope="module")

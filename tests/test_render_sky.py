@@ -126,6 +126,7 @@ def _spectral_sky(zenith_deg=30.0):
                                0.2 * c.global_horizontal / math.pi)
 
 
+@pytest.mark.slow  # 1-3 s: measured with --durations (issue 10)
 def test_spectral_sky_irradiance_is_the_atmospheres_diffuse_per_wavelength():
     """The per-band sky (Preetham's spectral reconstruction scaled by s(l)): its horizontal
     irradiance, integrated on a finer grid (192 x 384) than the one s(l) was fitted on

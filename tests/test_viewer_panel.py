@@ -102,6 +102,7 @@ def test_filter_by_facts():
 
 
 @pytest.mark.gl
+@pytest.mark.slow  # 1-3 s: measured with --durations (issue 10)
 def test_thumbnail_cache_renders_once_per_scene_and_again_on_change(gl):
     from catalog.viewer.catalog_state import FabricCatalog
     from catalog.viewer.thumbnails import ThumbnailCache

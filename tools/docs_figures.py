@@ -6,9 +6,13 @@ committed JSON, so that no figure in the docs is typed by hand.
     .venv/bin/python tools/docs_figures.py --check   # exit 1 naming the stale blocks
 
 A block is the text between ``<!-- generated:NAME -->`` and ``<!-- /generated:NAME -->``.
-Its content comes from a module of catalog.bench that has ``RESULT_JSON`` (the committed
-JSON, relative to the repository) and ``markdown_tables(result) -> {NAME: markdown}``. A
-marker whose NAME no module provides is an error (exit 2), as is a JSON file that is missing.
+Its content comes from a module of catalog.bench that has ``markdown_tables`` and either
+``RESULT_JSON`` (one committed JSON, relative to the repository; ``markdown_tables(result)
+-> {NAME: markdown}``) or ``RESULT_JSONS`` (several: ``{KEY: path}``; ``markdown_tables``
+then receives ``{KEY: result}``, so a table may span runs, and one more run is one more
+entry). A marker whose NAME no module provides is an error (exit 2), as is a JSON file that
+is missing, a module with both attributes, a NAME made by two modules, or a JSON file
+claimed by two modules (one would overwrite the other's result).
 """
 
 from __future__ import annotations
@@ -33,23 +37,50 @@ def documents(root: Path = ROOT) -> list[Path]:
                         *sorted((root / "docs").glob("*.md"))] if p.is_file()]
 
 
+def result_sources(module) -> list[str]:
+    """The committed JSON files a bench module's tables are made from."""
+    one, several = getattr(module, "RESULT_JSON", None), getattr(module, "RESULT_JSONS", None)
+    return ([one] if one is not None else []) + list((several or {}).values())
+
+
+def module_tables(module, root: Path = ROOT) -> dict[str, str] | None:
+    """NAME -> markdown of one bench module from its committed JSON (None: it has none)."""
+    one, several = getattr(module, "RESULT_JSON", None), getattr(module, "RESULT_JSONS", None)
+    make = getattr(module, "markdown_tables", None)
+    if make is None or (one is None and several is None):
+        return None
+    if one is not None and several is not None:
+        raise SystemExit(f"docs_figures: error: {module.__name__} has both RESULT_JSON and "
+                         "RESULT_JSONS")
+
+    def load(source: str) -> dict:
+        path = root / source
+        if not path.is_file():
+            raise SystemExit(f"docs_figures: error: {source}: no such file (run the benchmark)")
+        return json.loads(path.read_text(encoding="utf-8"))
+
+    made = make(load(one)) if one is not None else make({key: load(source)
+                                                         for key, source in several.items()})
+    return {name: text.rstrip("\n") for name, text in made.items()}
+
+
 def tables(root: Path = ROOT) -> dict[str, str]:
     """Every NAME -> markdown the bench modules make from their committed JSON."""
     import catalog.bench as bench
 
     out: dict[str, str] = {}
+    owner: dict[str, str] = {}  # JSON path -> the module that writes it
     for info in pkgutil.iter_modules(bench.__path__):
         module = importlib.import_module(f"catalog.bench.{info.name}")
-        source, make = getattr(module, "RESULT_JSON", None), getattr(module, "markdown_tables", None)
-        if source is None or make is None:
-            continue
-        path = root / source
-        if not path.is_file():
-            raise SystemExit(f"docs_figures: error: {source}: no such file (run the benchmark)")
-        for name, text in make(json.loads(path.read_text(encoding="utf-8"))).items():
+        for source in result_sources(module):
+            if owner.setdefault(source, module.__name__) != module.__name__:
+                raise SystemExit(f"docs_figures: error: {source} is the result of both "
+                                 f"{owner[source]} and {module.__name__}")
+        made = module_tables(module, root)
+        for name, text in (made or {}).items():
             if name in out:
                 raise SystemExit(f"docs_figures: error: block {name!r} made by two modules")
-            out[name] = text.rstrip("\n")
+            out[name] = text
     return out
 
 

@@ -257,3 +257,89 @@ def plot(result: dict, folder) -> list:
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
     return [save_figure(fig, Path(folder) / "bench_colour_pareto.png")]
+
+
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py);
+#: `python -m catalog.bench.colour` writes it (the same section as `catalog bench --sections colour`).
+RESULT_JSON = "benchmarks/bench_colour.json"
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``bench_colour`` (every variant and the per-light means, docs/bench.md),
+    ``bench_colour_findings`` (the figures docs/bench.md's prose rests on) and
+    ``bench_colour_brief`` (BENCHMARKS.md)."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    s, st, rows = result["summary"], result["settings"], result["rows"]
+    per, default = s["per_variant"], s["default"]
+    n_cases = next(iter(per.values()))["cases"]
+
+    def bold(label: str, text: str) -> str:
+        return f"**{text}**" if label == default else text
+
+    full = ["| variant | mean dE | worst case mean dE | mean p95 dE | worst p95 dE | frame ms (median) "
+            "| x RGB frame, wall | x RGB frame, CPU | cases mean < 0.5 |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for label, v in per.items():
+        full.append("| " + " | ".join([
+            bold(label, label), bold(label, fmt(v["mean_delta_e"])),
+            bold(label, fmt(v["worst_case_mean_delta_e"])), fmt(v["mean_p95_delta_e"]),
+            fmt(v["worst_p95_delta_e"]), fmt(v["median_frame_ms"]), fmt(v["median_time_ratio"]),
+            fmt(v["median_cpu_time_ratio"]),
+            bold(label, f"{v['cases_mean_below_goal']} / {v['cases']}")]) + " |")
+    lights = ["| light | " + " | ".join(per) + " |", "|---|" + "---|" * len(per)]
+    for light, values in s["per_light_mean_delta_e"].items():
+        lights.append(f"| {light} | " + " | ".join(fmt(values[k]) for k in per) + " |")
+    head = (f"{len(st['fabrics'])} fabrics x {len(st['lights'])} lights ({', '.join(st['lights'])}): "
+            f"{n_cases} cases. Delta E 2000 over the lit cloth at {st['error_size'][0]}x"
+            f"{st['error_size'][1]} px; whole frame at {st['time_size'][0]}x{st['time_size'][1]} px, "
+            f"median of {st['repeats']} ({st['device']['renderer']}).")
+    goal = s["goal"]
+    verdict = (f"Default chosen (the fastest variant with a mean Delta E under "
+               f"{fmt(goal['mean_delta_e_below'])} in every case at <= {fmt(goal['time_ratio_at_most'])}x "
+               f"the RGB frame time): **{default or 'none'}**, goal "
+               f"{'met' if s['goal_met'] else 'NOT met'}. Pareto front: {', '.join(s['pareto_front'])}.")
+    # what the prose rests on: the default's worst cases, the bands' misses, paper mode
+    findings = [verdict]
+    if default:
+        mine = sorted((r for r in rows if r["variant"] == default),
+                      key=lambda r: r["mean_delta_e"], reverse=True)
+        above = [r for r in mine if r["mean_delta_e"] > 1e-3]
+        findings.append(f"The default's cases above 0.001: " + (", ".join(
+            f"{r['fabric']} under {r['light']} ({fmt(r['mean_delta_e'])})" for r in above) or "none")
+            + ".")
+    bands = [k for k in per if "bands" in k]
+    if bands:
+        most = bands[-1]
+        worst = max((r for r in rows if r["variant"] == most), key=lambda r: r["mean_delta_e"])
+        findings.append(f"{most}: {per[most]['cases'] - per[most]['cases_mean_below_goal']} of "
+                        f"{per[most]['cases']} cases above 0.5, the worst {worst['fabric']} under "
+                        f"{worst['light']} ({fmt(worst['mean_delta_e'])}), at "
+                        f"{fmt(per[most]['median_time_ratio'])}x the frame time.")
+    fluorescent = sorted({r["fabric"] for r in rows if r.get("shader_fluorescence")
+                          and r["variant"] == default and r["shader_fluorescence"] != "off"})
+    paper = [k for k in per if k.startswith("paper")]
+    none = [k for k in per if "no fluorescence" in k]
+    if fluorescent and paper and none:
+        def mean_of(label):
+            return float(np.mean([r["mean_delta_e"] for r in rows
+                                  if r["variant"] == label and r["fabric"] in fluorescent]))
+        findings.append(f"On the fluorescent fabrics ({', '.join(fluorescent)}): {paper[0]} "
+                        f"{fmt(mean_of(paper[0]))} mean against {fmt(mean_of(none[0]))} for "
+                        f"{none[0]}.")
+    brief = ["| variant | mean Delta E 2000 | worst case mean | x RGB frame time |",
+             "|---|---|---|---|"]
+    for label, v in per.items():
+        brief.append("| " + " | ".join([bold(label, label), bold(label, fmt(v["mean_delta_e"])),
+                                        bold(label, fmt(v["worst_case_mean_delta_e"])),
+                                        fmt(v["median_time_ratio"])]) + " |")
+    return {"bench_colour": head + "\n\n" + "\n".join(full) + "\n\nMean Delta E per light:\n\n"
+            + "\n".join(lights),
+            "bench_colour_findings": " ".join(findings),
+            "bench_colour_brief": "\n".join(brief) + "\n\n" + verdict}
+
+
+if __name__ == "__main__":
+    from catalog.bench.results import section_main  # noqa: PLC0415
+
+    raise SystemExit(section_main("colour"))

@@ -161,3 +161,51 @@ def plot(result: dict, folder) -> list:
     ax.legend(fontsize=7)
     fig.tight_layout()
     return [save_figure(fig, Path(folder) / "bench_fit.png")]
+
+
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py);
+#: `python -m catalog.bench.fit` writes it (the same section as `catalog bench --sections fit`).
+RESULT_JSON = "benchmarks/bench_fit.json"
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``bench_fit`` (the three methods, docs/bench.md) and ``bench_fit_brief`` (what they
+    show, BENCHMARKS.md)."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    per = result["summary"]["per_method"]
+    lines = ["| method | median time s | weighted RMS / best, median | worst "
+             "| synthetic set: worst relative parameter error |", "|---|---|---|---|---|"]
+    for method, v in per.items():
+        lines.append(f"| {method} | {fmt(v['median_seconds'])} | "
+                     f"{fmt(v['median_weighted_rms_over_best'])} | "
+                     f"{fmt(v['worst_weighted_rms_over_best'])} | "
+                     f"{fmt(v['synthetic_max_rel_param_error'])} |")
+    rows = result["rows"]
+    by = {(r["case"], r["method"]): r for r in rows}
+    cases = sorted({r["case"] for r in rows}, key=[r["case"] for r in rows].index)
+    paper, lm, de = list(per)  # run order: LM 79 points, LM 4800 points, differential evolution
+    gap = max(abs(by[(c, lm)]["weighted_rms_4800"] - by[(c, de)]["weighted_rms_4800"])
+              / by[(c, de)]["weighted_rms_4800"] for c in cases)
+    lm_not_worse = all(by[(c, lm)]["weighted_rms_4800"] <= by[(c, de)]["weighted_rms_4800"] * (1 + 1e-9)
+                       for c in cases)
+    paper_ratio = {c: by[(c, paper)]["weighted_rms_4800"] / by[(c, lm)]["weighted_rms_4800"]
+                   for c in cases}
+    worst = max(paper_ratio, key=paper_ratio.get)
+    speed = per[de]["median_seconds"] / per[lm]["median_seconds"]
+    text = (f"{len(cases)} cases. LM on the whole grid "
+            f"{'reaches' if lm_not_worse else 'does NOT always reach'} the global optimiser's "
+            f"minimum (largest relative difference in weighted RMS {fmt(gap)}) in "
+            f"{fmt(per[lm]['median_seconds'] * 1e3)} ms against {fmt(per[de]['median_seconds'])} s "
+            f"({speed:.0f}x, medians). The paper's 79 points cost "
+            f"{100 * (per[paper]['median_weighted_rms_over_best'] - 1):.0f} % more weighted error on "
+            f"the full grid (median; {100 * (paper_ratio[worst] - 1):.0f} % for {worst}), and "
+            f"{fmt(per[paper]['synthetic_max_rel_param_error'])} worst relative parameter error on "
+            f"the synthetic set against {fmt(per[lm]['synthetic_max_rel_param_error'])}.")
+    return {"bench_fit": "\n".join(lines) + "\n\n" + text, "bench_fit_brief": text}
+
+
+if __name__ == "__main__":
+    from catalog.bench.results import section_main  # noqa: PLC0415
+
+    raise SystemExit(section_main("fit"))

@@ -16,6 +16,12 @@ physical-mode and the plain-RGB methods). Added here:
 Cost columns: the numbers the shader carries for the material under one light, whether
 they depend on the light (then they are recomputed on the CPU when the light changes),
 and the median CPU time of that computation.
+
+    .venv/bin/python -m catalog.bench.fluorescence_rgb [--quick] [--json-out FILE]
+
+writes benchmarks/bench_fluorescence.json (needs the validation data, ``--data``/CATALOG_DATA:
+the matrices are not shipped), from which tools/docs_figures.py makes the tables of
+docs/bench.md and BENCHMARKS.md.
 """
 
 from __future__ import annotations
@@ -40,7 +46,7 @@ METHODS = {
     "bands_16": ("physical mode, 16 bands", 32, True),
     "fichet_3x3": ("reduced 3x3 (Fichet et al. 2024)", 9, False),
     "fichet_3x3_uv": ("reduced 3x3 + UV band (Fichet et al. 2024)", 12, False),
-    "per_light_3x3": ("reduced 3x3, per-light basis", 9, True),
+    "per_light_3x3": ("reduced 3x3, per-light basis (needs the measured matrix)", 9, True),
 }
 STUDY_METHODS = ("ignore", "paper", "paper_global", "physical", "physical_rgb", "rgb_product")
 BAND_COUNTS = (6, 9, 16)
@@ -159,7 +165,7 @@ def plot(result: dict, folder) -> list:
     plt = pyplot()
     per = result["summary"]["per_method"]
     names = list(per)
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = plt.subplots(figsize=(9, 5))
     y = np.arange(len(names))
     ax.barh(y - 0.2, [max(per[m]["mean_all_lights"], 1e-3) for m in names], 0.4,
             label=f"mean, all {len(result['settings']['lights'])} lights")
@@ -167,10 +173,79 @@ def plot(result: dict, folder) -> list:
             label="mean, D65 A FL2 FL11 LED-B4")
     ax.set_yticks(y, [f"{per[m]['label']} [{per[m]['shader_numbers']}]" for m in names], fontsize=7)
     ax.set_xscale("log")
-    ax.set_xlabel("Delta E 2000 against the exact matrix result, 8 measured matrices "
-                  "(below 1e-3 drawn at 1e-3)")
+    ax.set_xlabel(f"Delta E 2000 against the exact matrix result, "
+                  f"{len(result['settings']['materials'])} measured matrices\n"
+                  "(below 1e-3 drawn at 1e-3)", fontsize=8)
     choice = per[result["summary"]["choice"]]["label"]
-    ax.set_title(f"Fluorescence in an RGB engine [numbers carried]; choice: {choice}", fontsize=9)
+    ax.set_title(f"Fluorescence in an RGB engine [numbers carried]\nchoice: {choice}", fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
     return [save_figure(fig, Path(folder) / "bench_fluorescence_rgb.png")]
+
+
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
+RESULT_JSON = "benchmarks/bench_fluorescence.json"
+#: Rows of the short table in BENCHMARKS.md, the renderer's last.
+BRIEF_METHODS = ("ignore", "paper", "fichet_3x3", "fichet_3x3_uv", "bands_16", "physical_rgb")
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``fluorescence_representations`` (every method, docs/bench.md), ``fluorescence_brief``
+    (BENCHMARKS.md) and ``fluorescence_findings`` (the figures the prose rests on)."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    s, st = result["summary"], result["settings"]
+    per = s["per_method"]
+    n_lights, goal = len(st["lights"]), " ".join(s["goal_lights"])
+    choice = s["choice"]
+
+    def bold(method: str, text: str) -> str:
+        return f"**{text}**" if method == choice else text
+
+    full = [f"| representation | mean, {goal} | max, same | mean, all {n_lights} lights | p95, all "
+            "| max, all | numbers in the shader | recomputed per light | CPU ms per light |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for method, v in per.items():
+        full.append("| " + " | ".join([
+            bold(method, v["label"]), bold(method, fmt(v["mean_goal_lights"])),
+            bold(method, fmt(v["max_goal_lights"])), bold(method, fmt(v["mean_all_lights"])),
+            fmt(v["p95_all_lights"]), fmt(v["max_all_lights"]), str(v["shader_numbers"]),
+            "yes" if v["recomputed_per_light"] else "no", fmt(v["cpu_ms_per_light"])]) + " |")
+    full += ["", f"{len(st['materials'])} measured matrices x {n_lights} lights: {s['cases']} cases "
+             "(a light whose exact result is black is left out); Delta E 2000 against the exact "
+             "matrix result; CPU time: median for one (material, light) pair under D65."]
+    brief = ["| representation | mean | max | mean, all lights |", "|---|---|---|---|"]
+    for method in BRIEF_METHODS:
+        v = per[method]
+        brief.append("| " + " | ".join(bold(method, x) for x in (
+            v["label"], fmt(v["mean_goal_lights"]), fmt(v["max_goal_lights"]),
+            fmt(v["mean_all_lights"]))) + " |")
+    brief += ["", f"Mean / max over {goal}; the last column over all {n_lights} library lights "
+              f"({len(st['materials'])} Donaldson matrices, {s['cases']} cases)."]
+    c, best = per[choice], per[s["best_light_independent"]]
+    plain, uv, b16 = per["fichet_3x3"], per["fichet_3x3_uv"], per["bands_16"]
+    findings = (
+        f"Chosen (lowest mean over every light among the representations of at most 16 numbers "
+        f"built from the fabric's spectra): **{c['label']}**, {fmt(c['mean_goal_lights'])} mean / "
+        f"{fmt(c['max_goal_lights'])} max on {goal}, {fmt(c['mean_all_lights'])} mean over all "
+        f"{n_lights} lights, {c['shader_numbers']} numbers recomputed in "
+        f"{fmt(c['cpu_ms_per_light'])} ms when the light or fabric changes. The best "
+        f"light-independent representation, {best['label']}: {fmt(best['mean_goal_lights'])} / "
+        f"{fmt(best['max_goal_lights'])}, {fmt(best['mean_all_lights'])} over all lights. "
+        f"Over all lights the 3x3 without the UV band: {fmt(plain['mean_all_lights'])} mean, "
+        f"{fmt(plain['max_all_lights'])} worst, against {fmt(uv['mean_all_lights'])} and "
+        f"{fmt(uv['max_all_lights'])} with it. 16 bands ({b16['shader_numbers']} numbers): "
+        f"{fmt(b16['mean_all_lights'])} mean over all lights, "
+        f"{b16['mean_all_lights'] / c['mean_all_lights']:.1f}x the chosen one's. Our reduction "
+        f"on {goal}: {fmt(plain['mean_goal_lights'])} / {fmt(plain['max_goal_lights'])} (3x3), "
+        f"{fmt(uv['mean_goal_lights'])} / {fmt(uv['max_goal_lights'])} (with the UV band); "
+        f"against the bispectral study's implementation: "
+        f"{fmt(st['reduction_vs_bispectral_study_max_rel_diff'])} relative.")
+    return {"fluorescence_representations": "\n".join(full),
+            "fluorescence_brief": "\n".join(brief), "fluorescence_findings": findings}
+
+
+if __name__ == "__main__":
+    from catalog.bench.results import section_main  # noqa: PLC0415
+
+    raise SystemExit(section_main("fluorescence"))

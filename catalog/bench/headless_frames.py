@@ -28,7 +28,7 @@ import sys
 import time
 from pathlib import Path
 
-from catalog.render.snapshot import FRAME_DT_S  # one 1/60 s frame, as snapshot steps
+from catalog.core.constants import FRAME_DT_S
 
 #: the committed runs (on an NVIDIA H200 and on this project's 2-core llvmpipe machine)
 RESULT_JSON = "benchmarks/headless_frames.json"

@@ -320,17 +320,36 @@ def spp_for_noise(spp: int, noise: float, target: float = NOISE_TARGET) -> float
 
 
 def _cell(value) -> str:
-    """3 significant digits, e-notation when small or large (catalog.bench.report's rule;
-    not imported: report imports this module for its section)."""
-    if isinstance(value, float) and math.isfinite(value) and value != 0:
-        return f"{value:.2e}" if (abs(value) < 1e-3 or abs(value) >= 1e5) else f"{value:.3g}"
-    return "0" if isinstance(value, float) and value == 0 else str(value)
+    """A table cell in the benchmarks' number format (catalog.bench.results.fmt)."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    return fmt(value)
 
 
 def table(rows: list[dict], columns: list[str], headers: list[str]) -> str:
     lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(columns)]
     lines += ["| " + " | ".join(_cell(row.get(c, "")) for c in columns) + " |" for row in rows]
     return "\n".join(lines)
+
+
+def ranges_sentence(before: dict, after: dict) -> str:
+    """README's summary of the after-run over its scenes, with the floor and walls before."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    def span(run: dict, *keys: str) -> str:
+        values = [r[k] for r in run["rows"] for k in keys if r.get(k) is not None]
+        return f"{fmt(min(values))}-{fmt(max(values))}"
+
+    s = after["summary"]
+    speed = [r["speedup"] for r in after["rows"]]
+    return (f"Over {s['scenes']} scenes mean FLIP is {span(after, 'mean_flip')} and the curtain's "
+            f"mean Delta E 2000 {span(after, 'curtain_delta_e_mean')} (goal: <= "
+            f"{GOAL['mean_flip_at_most']} and <= {GOAL['curtain_mean_delta_e_at_most']} on every "
+            f"scene: met on {s['scenes_meeting_goal']}); the floor's and walls' mean error went from "
+            f"{span(before, 'floor_delta_e_mean', 'walls_delta_e_mean')} before the room lighting of "
+            f"issue 13 to {span(after, 'floor_delta_e_mean', 'walls_delta_e_mean')}. The frame is "
+            f"{min(speed):,.0f}-{max(speed):,.0f}x faster than the reference (goal >= "
+            f"{GOAL['speedup_at_least']:g}x: {'met' if min(speed) >= GOAL['speedup_at_least'] else 'NOT met'}).")
 
 
 def markdown_tables(result: dict) -> dict[str, str]:
@@ -343,6 +362,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
         blocks["image-after"] = (after["image"] + "\n\nReal-time options:\n\n" + after["image-options"]
                                  + "\n\n![six scenes after issues 12-16: real-time | reference | FLIP]"
                                  "(img/pathtrace_scenes_after_13.png)")
+        blocks["image-ranges"] = ranges_sentence(result["runs"]["baseline"], result["runs"]["after_12_16"])
         return blocks
 
     s = result["summary"]

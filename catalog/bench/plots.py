@@ -20,6 +20,6 @@ def save_figure(fig, path: Path) -> Path:
     from catalog.core.atomic import atomic_path  # noqa: PLC0415
 
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+        fig.savefig(tmp, dpi=110, format="png", bbox_inches="tight")  # no label cut off
     pyplot().close(fig)
     return Path(path)

@@ -7,25 +7,9 @@
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
-
-def fmt(value, digits: int = 3) -> str:
-    """A number for a table: 3 significant digits, small and large values in e-notation."""
-    if isinstance(value, bool) or value is None:
-        return str(value)
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        if not math.isfinite(value):
-            return str(value)
-        if value == 0:
-            return "0"
-        if abs(value) < 1e-3 or abs(value) >= 1e5:
-            return f"{value:.{digits - 1}e}"
-        return f"{value:.{digits}g}"
-    return str(value)
+from catalog.bench.results import fmt  # noqa: F401  (the tables' number format, re-exported)
 
 
 def table(rows: list[dict], columns: list[str], headers: list[str] | None = None) -> str:
@@ -37,99 +21,46 @@ def table(rows: list[dict], columns: list[str], headers: list[str] | None = None
 
 
 def colour_md(result: dict) -> str:
-    s = result["summary"]
-    st = result["settings"]
-    rows = [{"variant": k, **v} for k, v in s["per_variant"].items()]
-    text = [f"Fabrics: {', '.join(st['fabrics'])}; lights: {', '.join(st['lights'])}. "
-            f"Delta E 2000 over the lit cloth at {st['error_size'][0]}x{st['error_size'][1]} px "
-            f"against the float64 spectral reference of the physical model; whole frame at "
-            f"{st['time_size'][0]}x{st['time_size'][1]} px, median of {st['repeats']} "
-            f"({st['device']['renderer']}).", "",
-            table(rows, ["variant", "mean_delta_e", "worst_case_mean_delta_e", "mean_p95_delta_e",
-                         "worst_p95_delta_e", "median_frame_ms", "median_time_ratio",
-                         "median_cpu_time_ratio", "cases_mean_below_goal", "cases"],
-                  ["variant", "mean dE", "worst case mean dE", "mean p95 dE", "worst p95 dE",
-                   "frame ms (median)", "x RGB frame, wall (median)", "x RGB frame, CPU (median)",
-                   "cases mean < 0.5", "cases"]),
-            "", "Mean Delta E per light (over the fabrics):", "",
-            table([{"light": light, **values} for light, values in s["per_light_mean_delta_e"].items()],
-                  ["light"] + list(s["per_variant"])),
-            "",
-            f"Pareto front: {', '.join(s['pareto_front'])}. Default chosen: "
-            f"**{s['default'] or 'none'}** (goal: mean Delta E < {s['goal']['mean_delta_e_below']} "
-            f"in every case at <= {s['goal']['time_ratio_at_most']}x the RGB frame time: "
-            f"{'met' if s['goal_met'] else 'NOT met'})."]
-    return "\n".join(text)
+    from catalog.bench.colour import markdown_tables  # noqa: PLC0415
+
+    blocks = markdown_tables(result)
+    return blocks["bench_colour"] + "\n\n" + blocks["bench_colour_findings"]
 
 
 def fluorescence_md(result: dict) -> str:
-    s = result["summary"]
-    rows = [{"method": k, **v} for k, v in s["per_method"].items()]
-    st = result["settings"]
-    return "\n".join([
-        f"{len(st['materials'])} measured matrices x {len(st['lights'])} lights ({s['cases']} cases); "
-        f"Delta E 2000 against the exact matrix result.", "",
-        table(rows, ["label", "mean_goal_lights", "max_goal_lights", "mean_all_lights",
-                     "p95_all_lights", "max_all_lights", "shader_numbers", "recomputed_per_light",
-                     "cpu_ms_per_light"],
-              ["representation", "mean, D65 A FL2 FL11 LED-B4", "max, same", "mean, all lights",
-               "p95, all", "max, all", "numbers in the shader", "per light", "CPU ms per light"]),
-        "",
-        f"Shader should carry: **{s['per_method'][s['choice']]['label']}** (lowest mean over all "
-        f"lights among representations of <= 16 numbers built from the fabric's spectra); best "
-        f"light-independent one: {s['per_method'][s['best_light_independent']]['label']}. "
-        f"Our reduction against the bispectral study's implementation: max relative difference "
-        f"{fmt(st['reduction_vs_bispectral_study_max_rel_diff'])}."])
+    from catalog.bench.fluorescence_rgb import markdown_tables  # noqa: PLC0415
+
+    blocks = markdown_tables(result)
+    return blocks["fluorescence_representations"] + "\n\n" + blocks["fluorescence_findings"]
 
 
 def fit_md(result: dict) -> str:
-    rows = [{"method": k, **v} for k, v in result["summary"]["per_method"].items()]
+    from catalog.bench.fit import markdown_tables  # noqa: PLC0415
+
     return "\n".join([
-        table(rows, ["method", "median_seconds", "median_weighted_rms_over_best",
-                     "worst_weighted_rms_over_best", "synthetic_max_rel_param_error"],
-              ["method", "median time s", "weighted RMS / best (median)", "worst",
-               "synthetic: max rel. parameter error"]),
-        "", "Per case:", "",
+        markdown_tables(result)["bench_fit"], "", "Per case:", "",
         table(result["rows"], ["case", "method", "seconds", "rmse_4800", "weighted_rms_4800",
                                "direct", "a_diff", "a_spec", "g_diff", "g_spec"])])
 
 
 def cloth_md(result: dict) -> str:
-    st = result["settings"]
-    return "\n".join([
-        f"Grid {st['grid'][0]}x{st['grid'][1]}, {st['frames']} frames of {fmt(st['frame_dt_s'])} s, "
-        f"wind {st['wind_m_s']} m/s; reference: {st['reference_substeps']} substeps on "
-        f"{st['reference_backend']}; the simulator's default: {st['default_substeps']} substeps. "
-        f"Backends available: {', '.join(k for k, v in st['backends_available'].items() if v)}.", "",
-        table(result["rows"], ["backend", "substeps", "rms_deviation_m", "max_deviation_m",
-                               "frames_per_second", "finite"],
-              ["backend", "substeps", "RMS deviation m", "max deviation m", "frames/s", "finite"])])
+    from catalog.bench.cloth import markdown_tables  # noqa: PLC0415
+
+    return markdown_tables(result)["bench_cloth"]
 
 
 def stability_md(result: dict) -> str:
-    s = result["summary"]
-    rows = [{"probe": k, **v} for k, v in s["per_probe"].items()]
-    bad = [r for r in result["rows"] if r["non_finite"]]
-    lines = [table(rows, ["probe", "checked", "worst_rel_error", "non_finite"],
-                   ["probe", "values checked", "worst relative error", "non-finite"]), "",
-             f"Non-finite values: {s['non_finite']} (bar: zero, {'met' if s['bar_met'] else 'NOT met'})."]
-    if bad:
-        lines += ["", "Where:", ""] + [f"- {r['probe']}: {r['parameter']}: {r['non_finite']}"
-                                       for r in bad]
-    lines += ["", "All probes:", "", table(result["rows"], ["probe", "parameter", "checked",
-                                                            "worst_rel_error", "non_finite"])]
-    return "\n".join(lines)
+    from catalog.bench.stability import markdown_tables  # noqa: PLC0415
+
+    return "\n".join([markdown_tables(result)["bench_stability"], "", "All probes:", "",
+                      table(result["rows"], ["probe", "parameter", "checked", "worst_rel_error",
+                                             "non_finite"])])
 
 
 def startup_md(result: dict) -> str:
-    s = result["summary"]
-    return "\n".join([
-        table(result["rows"], ["case", "median_s", "ratio_to_python"],
-              ["case", "median s", "x python -c pass"]), "",
-        "Heavy modules loaded by importing: " + "; ".join(
-            f"{k}: {', '.join(v) if v else 'none'}" for k, v in s["heavy_imports"].items()
-            if v is not None) + ".",
-        viewer_line(s["viewer_heavy_at_first_frame"]) + f" scipy loaded: {s['viewer_imports_scipy']}."])
+    from catalog.bench.startup import markdown_tables  # noqa: PLC0415
+
+    return markdown_tables(result)["startup"]
 
 
 def room_md(result: dict) -> str:
@@ -143,14 +74,6 @@ def image_md(result: dict) -> str:
 
     blocks = markdown_tables(result)
     return blocks["image"] + "\n\nReal-time options (image-pareto.png):\n\n" + blocks["image-options"]
-
-
-def viewer_line(heavy: dict | None) -> str:
-    if not heavy:
-        return "The viewer's first frame was not measured."
-    loaded = ", ".join(heavy["loaded"]) or "none"
-    return (f"The viewer process at its first frame had loaded, of {', '.join(heavy['checked'])}: "
-            f"{loaded}.")
 
 
 def uv_md(section: dict) -> str:

@@ -29,6 +29,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from catalog.core.constants import FRAME_DT_S
+
 G_EDGES = (-0.99999, -0.9999, -0.999, -0.9, -0.3, 0.0, 0.3, 0.9, 0.999, 0.9999, 0.99999)
 THETAS = np.concatenate([[0.0], np.geomspace(1e-7, 1e-2, 24), np.linspace(0.02, math.pi, 60)])
 SCALES = tuple(10.0 ** k for k in range(-6, 7, 2))  # 12 orders of magnitude
@@ -223,12 +225,12 @@ def cloth_sweep(quick: bool) -> list[dict]:
 
     cases = []
     for k in (10.0, 1e3, 1e5, 1e7):
-        cases.append((f"stretch={k:g} N/m", {"stretch_stiffness_n_m": k}, 1 / 60))
+        cases.append((f"stretch={k:g} N/m", {"stretch_stiffness_n_m": k}, FRAME_DT_S))
     for b in (0.0, 100.0):
-        cases.append((f"bend={b:g} N/m", {"bend_stiffness_n_m": b}, 1 / 60))
+        cases.append((f"bend={b:g} N/m", {"bend_stiffness_n_m": b}, FRAME_DT_S))
     for dt in (1 / 1000, 1 / 10):
         cases.append((f"dt={dt:g} s", {}, dt))
-    cases.append(("wind=30 m/s", {"wind_speed_m_s": 30.0}, 1 / 60))
+    cases.append(("wind=30 m/s", {"wind_speed_m_s": 30.0}, FRAME_DT_S))
     cases.append(("stretch=1e7, wind=30, dt=0.1", {"stretch_stiffness_n_m": 1e7,
                                                    "wind_speed_m_s": 30.0}, 1 / 10))
     if quick:
@@ -270,3 +272,69 @@ def run(quick: bool = False, ctx=None) -> dict:
     return {"rows": rows, "summary": {"per_probe": per_probe, "non_finite": total_bad,
                                       "bar_met": total_bad == 0},
             "settings": {"scales": list(scales), "g": list(G_EDGES)}}
+
+
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py);
+#: `python -m catalog.bench.stability` writes it (the same section as `catalog bench --sections stability`).
+RESULT_JSON = "benchmarks/bench_stability.json"
+
+
+#: What each probe sweeps, for the tables.
+PROBE_LABELS = {
+    "hg_glsl": "HG in float32 GLSL (`probe_hg.comp`) vs float64, g = -0.99999 .. 0.99999, theta 0 .. pi",
+    "hg_float64": "HG in float64, abs(g) up to 1 - 1e-15, both catalog.optics.btdf forms; sphere integral",
+    "fluorescence": "physical fluorescence vs closed form, irradiance 1e-6 .. 1e6 x D65 (saturation)",
+    "render_irradiance": "renderer float32 RGB vs float64 reference, light x1e-6 .. x1e6, tau 0 and 20, "
+                         "g +-0.999, sun:22 and UV-A",
+    "render_band_scaling": "16-band frame scales with the light over 12 decades",
+    "cloth": "cloth: stretch 10 .. 1e7 N/m, bend 0 .. 100, dt 1/1000 .. 1/10 s, wind up to 30 m/s "
+             "(largest spring strain / the limit)",
+}
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``bench_stability`` (every probe, docs/bench.md) and ``bench_stability_brief``
+    (BENCHMARKS.md)."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    summary, rows = result["summary"], result["rows"]
+
+    def worst_row(probe: str, keep=lambda r: True) -> dict:
+        mine = [r for r in rows if r["probe"] == probe and keep(r)
+                and math.isfinite(r["worst_rel_error"])]
+        return max(mine, key=lambda r: r["worst_rel_error"])
+
+    def g_of(row) -> float:
+        return abs(float(row["parameter"].split("=")[1].split(",")[0]))
+
+    lines = ["| probe | values | worst relative error | where | non-finite |", "|---|---|---|---|---|"]
+    for probe, v in summary["per_probe"].items():
+        worst = worst_row(probe)
+        where = worst["parameter"]
+        error = fmt(v["worst_rel_error"])
+        if probe == "hg_glsl":
+            inner = worst_row(probe, lambda r: g_of(r) <= 0.9999)
+            error = f"{fmt(inner['worst_rel_error'])} for abs(g) <= 0.9999, {error}"
+        lines.append(f"| {PROBE_LABELS.get(probe, probe)} | {v['checked']} | {error} | {where} | "
+                     f"{v['non_finite']} |")
+    bad = [r for r in rows if r["non_finite"]]
+    verdict = (f"**Bar {'met' if summary['bar_met'] else 'NOT met'}: {summary['non_finite']} "
+               "non-finite values**" + ("" if not bad else " (" + "; ".join(
+                   f"{r['probe']}: {r['parameter']}: {r['non_finite']}" for r in bad) + ")") + ".")
+    cloth = worst_row("cloth")
+    photons = max((r.get("photons_created", 0) for r in rows if r["probe"] == "fluorescence"),
+                  default=0)
+    per = summary["per_probe"]
+    brief = (f"{verdict} HG in float32 GLSL: "
+             f"{fmt(worst_row('hg_glsl', lambda r: g_of(r) <= 0.9999)['worst_rel_error'])} for "
+             f"abs(g) <= 0.9999; renderer float32 vs float64: "
+             f"{fmt(per['render_irradiance']['worst_rel_error'])}; fluorescence over 12 decades of "
+             f"irradiance: {fmt(per['fluorescence']['worst_rel_error'])}, photons created: {photons}; "
+             f"the cloth's largest spring strain: {fmt(cloth['max_strain'])} ({cloth['parameter']}).")
+    return {"bench_stability": "\n".join(lines) + "\n\n" + verdict, "bench_stability_brief": brief}
+
+
+if __name__ == "__main__":
+    from catalog.bench.results import section_main  # noqa: PLC0415
+
+    raise SystemExit(section_main("stability"))

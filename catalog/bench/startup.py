@@ -119,3 +119,56 @@ def first_frame_rows(rows: list[dict], floor: float, frame_repeats: int):
             xvfb.terminate()
             xvfb.wait()
     return viewer_heavy, rows_note
+
+
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
+RESULT_JSON = "benchmarks/bench_startup.json"
+#: Rows of the short table in BENCHMARKS.md.
+BRIEF_CASES = ("catalog --help", "import colour (colour-science)", "import numba (cpu cloth backend)",
+               "catalog snapshot 640x360 (start to written frame)",
+               "catalog view 640x360, Xvfb (start to first frame, exit)")
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``startup`` (every case and what each import loads, docs/bench.md) and
+    ``startup_brief`` (BENCHMARKS.md)."""
+    from catalog.bench.results import fmt  # noqa: PLC0415
+
+    s, st = result["summary"], result["settings"]
+
+    def rows_md(rows) -> str:
+        return "\n".join(["| case | median s | x `python -c pass` |", "|---|---|---|"]
+                          + [f"| {r['case']} | {fmt(r['median_s'])} | {fmt(r['ratio_to_python'])} |"
+                             for r in rows])
+
+    from catalog.bench.startup_imports import HEAVY  # noqa: PLC0415
+
+    found = {k: v for k, v in s["heavy_imports"].items() if v is not None}
+    light = [k for k, v in found.items() if not v]
+    imports = (f"Importing {', '.join(f'`{k}`' for k in light) or 'no probed module'} loads none of "
+               f"{', '.join(HEAVY)}; " if light else "")
+    imports += "; ".join(f"`import {k}` loads {', '.join(v)}" for k, v in found.items() if v) + "."
+    heavy = s["viewer_heavy_at_first_frame"]
+    if heavy:
+        viewer = (f"The viewer process at its first frame had loaded, of "
+                  f"{', '.join(heavy['checked'])}: {', '.join(heavy['loaded']) or 'none'}")
+        view_row = next((r for r in result["rows"] if r["case"].startswith("catalog view")), None)
+        if view_row and view_row.get("first_frame_ms"):
+            viewer += (f"; of its {fmt(view_row['median_s'])} s, the first frame itself took "
+                       f"{fmt(view_row['first_frame_ms'] / 1e3)} s (`--stats`), the rest is imports, "
+                       "the window and the GL context")
+        viewer += "."
+    else:
+        viewer = f"The viewer was not timed ({st.get('note', 'no display')})."
+    repeats = (f"Fresh processes, median of {st['repeats']} (first frames: of "
+               f"{st['frame_repeats']}).")
+    text = f"{imports} {viewer}"
+    brief = [r for r in result["rows"] if r["case"] in BRIEF_CASES]
+    return {"startup": f"{repeats}\n\n{rows_md(result['rows'])}\n\n{text}",
+            "startup_brief": f"{rows_md(brief)}\n\n{repeats} {text}"}
+
+
+if __name__ == "__main__":
+    from catalog.bench.results import section_main  # noqa: PLC0415
+
+    raise SystemExit(section_main("startup"))

@@ -1,6 +1,7 @@
 """Start-up cost: package import time, `catalog --help`, and what a command imports.
 
-Prints a table and writes JSON. Each figure is the median of --repeats fresh processes
+Prints a table and writes JSON (default benchmarks/bench_startup_imports.json; the docs'
+start-up tables come from catalog/bench/startup.py, which reuses these cases). Each figure is the median of --repeats fresh processes
 (the machine is shared and noisy; medians, not means).
 
     .venv/bin/python -m catalog.bench.startup_imports [--repeats 7] [--json-out FILE]
@@ -38,6 +39,9 @@ IMPORT_PROBES = {
 
 
 def time_command(cmd: list[str], repeats: int) -> float:
+    """Median wall time of ``repeats`` fresh processes, after one untimed run (so that the
+    first case, the floor, does not pay alone for a cold file cache)."""
+    subprocess.run(cmd, check=True, capture_output=True)
     samples = []
     for _ in range(repeats):
         start = time.perf_counter()
@@ -59,7 +63,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--quick", action="store_true", help="3 repeats")
-    parser.add_argument("--json-out", type=Path)
+    from catalog.core.resources import PROJECT_ROOT  # noqa: PLC0415
+
+    parser.add_argument("--json-out", type=Path,
+                        default=PROJECT_ROOT / "benchmarks" / "bench_startup_imports.json")
     args = parser.parse_args(argv)
     repeats = 3 if args.quick else args.repeats
 
@@ -76,12 +83,14 @@ def main(argv: list[str] | None = None) -> int:
     print("\nheavy modules imported by importing:")
     for name, heavy in imports.items():
         print(f"  {name:24s} {'(absent)' if heavy is None else ', '.join(heavy) or 'none'}")
-    result = {"benchmark": "startup", "repeats": repeats, "rows": rows, "imports": imports}
-    if args.json_out:
-        args.json_out.parent.mkdir(parents=True, exist_ok=True)
-        from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+    from catalog.bench.results import machine_info  # noqa: PLC0415
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
 
-        write_text_atomic(args.json_out, json.dumps(result, indent=2) + "\n")
+    result = {"benchmark": "startup", "repeats": repeats, "rows": rows, "imports": imports,
+              "machine": machine_info()}
+    args.json_out.parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(args.json_out, json.dumps(result, indent=2) + "\n")
+    print(f"wrote {args.json_out}")
     return 0
 
 

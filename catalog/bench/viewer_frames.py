@@ -21,7 +21,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import shutil
 import statistics
 import subprocess
@@ -93,7 +92,8 @@ def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backe
            "backend": summary["cloth_backend"], "frames": len(steady),
            "render_scale": summary["render_scale"],
            "first_frame_ms": round(first["total_ms"], 1), "wall_s": round(wall, 1),
-           "scipy_imported": first["heavy_modules"]["scipy"]}
+           "scipy_imported": first["heavy_modules"]["scipy"],
+           "gl_renderer": summary.get("renderer")}
     for part in PARTS:
         values = [r[f"{part}_ms"] for r in steady]
         row[f"{part}_ms"] = round(statistics.median(values), 2)
@@ -105,9 +105,12 @@ def _write_report(args, fields: dict) -> None:
     """The run's JSON (the machine, then ``fields``) into ``args.json_out``, atomically."""
     from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
 
-    report = {"machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(),
-                          "python": platform.python_version(), "display": "Xvfb + Mesa llvmpipe"
-                          if args.display is None else args.display}, **fields}
+    from catalog.bench.results import machine_info  # noqa: PLC0415
+
+    renderers = sorted({row["gl_renderer"] for row in fields.get("rows", []) if row.get("gl_renderer")})
+    report = {"machine": {**machine_info(), "display": "Xvfb" if args.display is None
+                          else args.display, "gl_renderer": ", ".join(renderers) or None},
+              **fields}
     write_text_atomic(args.json_out, json.dumps(report, indent=2) + "\n")
 
 
@@ -211,11 +214,25 @@ def main_before_after(args) -> int:
     return 0
 
 
-#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
-RESULT_JSON = "benchmarks/viewer_pattern.json"
+#: The committed runs the docs' generated blocks are made from (tools/docs_figures.py), in
+#: table order. ``pattern``: a ``--before`` run; ``room``: a ``--room-light both`` run; every
+#: other entry is a plain run whose rows go into the frame-time table, so a run on another
+#: machine (a GPU with ``--display``) is one more line here.
+RESULT_JSONS = {
+    "defaults": "benchmarks/viewer.json",
+    "scale1": "benchmarks/viewer_scale1.json",
+    "numpy_cloth": "benchmarks/viewer_numpy_cloth.json",
+    "gpu_cloth": "benchmarks/viewer_gpu_cloth.json",
+    "pattern": "benchmarks/viewer_pattern.json",
+    "room": "benchmarks/viewer_room.json",
+}
+#: Keys of RESULT_JSONS that are not plain frame-time runs.
+SPECIAL_RUNS = ("pattern", "room")
+BACKEND_NAMES = {"cpu": "cpu (numba)", "numpy": "numpy", "gpu": "gpu (compute)"}
 
-def markdown_tables(result: dict) -> dict[str, str]:
-    """``viewer_before_after`` (a --before run's JSON): NAME -> markdown table."""
+
+def before_after_table(result: dict) -> str:
+    """A ``--before`` run's JSON as a markdown table, each row's frame over its case's before."""
     lines = ["| viewer | window | grid | frame ms (median) | simulation | shading | UI | other "
              "| / before |", "|---|---|---|---|---|---|---|---|---|"]
     base = {}
@@ -227,7 +244,92 @@ def markdown_tables(result: dict) -> dict[str, str]:
                      f"| {row['total_ms']:.1f} | {row['simulation_ms']:.1f} | "
                      f"{row['shading_ms']:.1f} | {row['ui_ms']:.1f} | {row['other_ms']:.1f} | "
                      f"{ratio:.2f} |")
-    return {"viewer_before_after": "\n".join(lines)}
+    return "\n".join(lines)
+
+
+def _renderer(run: dict, row: dict) -> str:
+    name = row.get("gl_renderer") or run["machine"].get("gl_renderer") or run["machine"].get("display", "?")
+    return name.split(" (")[0]  # "llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe"
+
+
+def frame_table(runs: dict[str, dict]) -> str:
+    """The plain runs' rows: the frame's parts in ms, the machine's load while it ran."""
+    lines = ["| GL | window | scene scale | cloth | load | total | fps | simulation | shading | UI "
+             "| other | first frame |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for run in runs.values():
+        load = run["machine"].get("load_average_1min")
+        for row in run["rows"]:
+            lines.append(
+                f"| {_renderer(run, row)} | {row['size']} | {row['render_scale']:g} | "
+                f"{BACKEND_NAMES.get(row['backend'], row['backend'])} {row['grid']} | "
+                f"{'-' if load is None else f'{load:.1f}'} | {row['total_ms']:.0f} | {row['fps']} | "
+                f"{row['simulation_ms']:.0f} | {row['shading_ms']:.0f} | {row['ui_ms']:.0f} | "
+                f"{row['other_ms']:.0f} | {row['first_frame_ms'] / 1e3:.1f} s |")
+    return "\n".join(lines)
+
+
+def _row(run: dict, size: str, grid: str) -> dict | None:
+    return next((r for r in run["rows"] if r["size"] == size and r["grid"] == grid), None)
+
+
+def findings(runs: dict[str, dict]) -> str:
+    """The comparisons docs/viewer.md's prose rests on, from the same runs."""
+    out = []
+    default, numpy_run = runs.get("defaults"), runs.get("numpy_cloth")
+    if default and numpy_run:
+        for size, grid in (("1280x720", "48x64"), ("1920x1080", "128x128")):
+            a, b = _row(default, size, grid), _row(numpy_run, size, grid)
+            if a and b and a["backend"] != b["backend"]:
+                out.append(f"At {size} with a {grid} cloth the default {BACKEND_NAMES.get(a['backend'], a['backend'])} "
+                           f"cloth costs {a['simulation_ms']:.0f} ms a frame against numpy's "
+                           f"{b['simulation_ms']:.0f} ms ({b['simulation_ms'] / a['simulation_ms']:.1f}x), "
+                           f"its first frame {a['first_frame_ms'] / 1e3:.1f} s against "
+                           f"{b['first_frame_ms'] / 1e3:.1f} s.")
+    scale1 = runs.get("scale1")
+    if default and scale1:
+        a, b = _row(default, "1920x1080", "48x64"), _row(scale1, "1920x1080", "48x64")
+        if a and b and a["render_scale"] != b["render_scale"]:
+            out.append(f"Rendering the scene at scale {a['render_scale']:g} instead of "
+                       f"{b['render_scale']:g} (1920x1080) cuts shading from {b['shading_ms']:.0f} "
+                       f"to {a['shading_ms']:.0f} ms ({b['shading_ms'] / a['shading_ms']:.1f}x; the "
+                       f"pixels: {(b['render_scale'] / a['render_scale']) ** 2:.0f}x).")
+    gpu = runs.get("gpu_cloth")
+    if default and gpu:
+        a, b = _row(default, "1920x1080", "128x128"), _row(gpu, "1920x1080", "128x128")
+        if a and b and a["backend"] != b["backend"]:
+            out.append(f"The compute-shader cloth at 128x128 on {_renderer(gpu, b)}: "
+                       f"{b['simulation_ms']:.0f} ms a frame against {a['simulation_ms']:.0f} ms "
+                       f"for the {BACKEND_NAMES.get(a['backend'], a['backend'])} cloth.")
+    return " ".join(out)
+
+
+def room_light_table(result: dict) -> str:
+    """A ``--room-light both`` run: each case without and with the room lit through the curtain."""
+    lines = ["| window | cloth | room light | frame ms (median) | simulation | shading | UI | other "
+             "| with / without |", "|---|---|---|---|---|---|---|---|---|"]
+    without = {}
+    for row in result["rows"]:
+        key = (row["size"], row["grid"])
+        if not row.get("room_light"):
+            without[key] = row["total_ms"]
+        ratio = f"{row['total_ms'] / without[key]:.2f}" if row.get("room_light") and key in without else ""
+        lines.append(f"| {row['size']} x{row['render_scale']:g} | {BACKEND_NAMES.get(row['backend'], row['backend'])} "
+                     f"{row['grid']} | {'on' if row.get('room_light') else 'off'} | "
+                     f"{row['total_ms']:.1f} | {row['simulation_ms']:.1f} | {row['shading_ms']:.1f} "
+                     f"| {row['ui_ms']:.1f} | {row['other_ms']:.1f} | {ratio} |")
+    load = result["machine"].get("load_average_1min")
+    return "\n".join(lines) + ("" if load is None else f"\n\nLoad average while it ran: {load:.1f}.")
+
+
+def markdown_tables(results: dict[str, dict]) -> dict[str, str]:
+    """``viewer_before_after`` (the ``pattern`` run), ``viewer_room_light`` (the ``room`` run),
+    ``viewer_frames`` and ``viewer_findings`` (every other run, docs/viewer.md) and
+    ``viewer_brief`` (the default run, BENCHMARKS.md)."""
+    runs = {k: v for k, v in results.items() if k not in SPECIAL_RUNS}
+    return {"viewer_before_after": before_after_table(results["pattern"]),
+            "viewer_room_light": room_light_table(results["room"]),
+            "viewer_frames": frame_table(runs), "viewer_findings": findings(runs),
+            "viewer_brief": frame_table({"defaults": results["defaults"]})}
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from catalog.cloth.params import DEFAULT_WEAVE, ClothParams
+from catalog.core.constants import FRAME_DT_S
 from catalog.core.errors import InputError
 
 #: Fabric width / rod span by weave: sheers are hung full, a heavy damask flatter.
@@ -32,9 +33,8 @@ LENGTH_M = 2.2
 RING_SPACING_M = 0.24
 #: The drape's grid: columns across the (full) fabric, rows down it.
 GRID = (96, 56)
-#: Frames (1/60 s) the cloth hangs without wind before it counts as settled.
+#: Frames (FRAME_DT_S each) the cloth hangs without wind before it counts as settled.
 SETTLE_FRAMES = 24
-FRAME_DT_S = 1.0 / 60.0
 
 
 def fullness_of(preset) -> float:

@@ -21,6 +21,7 @@ from catalog.cloth.backend import ClothBackend, DeviceBackend
 from catalog.cloth.params import ClothParams
 from catalog.cloth.state import ClothState, inverse_mass, ring_positions
 from catalog.cloth.topology import FAMILIES, rest_lengths_m
+from catalog.core.constants import FRAME_DT_S
 from catalog.core.errors import CatalogError, InputError
 
 BACKENDS = ("numpy", "cpu", "gpu")
@@ -190,5 +191,5 @@ def warm_up_numba() -> float:
     import time
 
     start = time.perf_counter()
-    ClothSimulation(ClothParams(grid_w=4, grid_h=4, wind_speed_m_s=1.0), "cpu").step(1 / 60)
+    ClothSimulation(ClothParams(grid_w=4, grid_h=4, wind_speed_m_s=1.0), "cpu").step(FRAME_DT_S)
     return time.perf_counter() - start

@@ -47,8 +47,6 @@ def parse_sections(text: str | None) -> list[str]:
 
 def run(args) -> int:
     import importlib  # noqa: PLC0415
-    import os  # noqa: PLC0415
-    import platform  # noqa: PLC0415
     import sys  # noqa: PLC0415
     import time  # noqa: PLC0415
     import traceback  # noqa: PLC0415
@@ -56,6 +54,7 @@ def run(args) -> int:
 
     from catalog.bench import SECTIONS  # noqa: PLC0415
     from catalog.bench.report import write_report  # noqa: PLC0415
+    from catalog.bench.results import GL_SECTIONS, machine_info  # noqa: PLC0415
     from catalog.core.errors import InputError  # noqa: PLC0415
     from catalog.core.jsonout import print_json  # noqa: PLC0415
 
@@ -75,13 +74,11 @@ def run(args) -> int:
         print(f"catalog bench: {text}", file=sys.stderr, flush=True)
 
     ctx = None
-    machine = {"cpu_count": os.cpu_count(), "platform": platform.platform(),
-               "python": platform.python_version()}
-    if any(n in ("colour", "stability", "display", "image") for n in names):
-        from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
+    if any(n in GL_SECTIONS for n in names):
+        from catalog.gl.context import create_headless_context  # noqa: PLC0415
 
         ctx = create_headless_context()
-        machine["gl_renderer"] = describe(ctx)["renderer"]
+    machine = machine_info(ctx)
     report = {"benchmark": "catalog bench", "quick": bool(args.quick), "machine": machine,
               "sections": {}, "failed": {}}
     start_all = time.perf_counter()

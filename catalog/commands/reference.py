@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from catalog.core.constants import FLUORESCENT_MODES
+
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 INPUT_FILES = ("fabric",)
 OUTPUT_FILES = ("out",)
@@ -22,7 +24,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--variant", default="llvm_ad_rgb",
                         help="Mitsuba variant: llvm_ad_rgb (default) or llvm_ad_spectral")
     parser.add_argument("--no-fluorescence", action="store_true", help="without fluorescence")
-    parser.add_argument("--mode", choices=("paper", "physical"), default="physical",
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model (default physical)")
     parser.add_argument("--out", required=True, help="FILE.exr (linear radiance)")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")

@@ -8,6 +8,8 @@ finished; a re-run renders only what is missing.
 
 from __future__ import annotations
 
+from catalog.core.constants import FLUORESCENT_MODES
+
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
 HELP = "render a whole catalog (fabrics x lights x frames x yaws) with a resumable manifest"
@@ -34,7 +36,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--lp-threads", type=int, default=None,
                         help="llvmpipe threads per Dask worker (default: cores / workers per host)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
-    parser.add_argument("--mode", choices=("paper", "physical"), default="physical")
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3, 6, 9, 16")
     parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
     parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")

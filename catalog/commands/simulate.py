@@ -29,11 +29,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--grid", required=True, metavar="WxH",
                         help="particles across and down, e.g. 64x96")
     from catalog.core.cliargs import number_type  # noqa: PLC0415
+    from catalog.core.constants import FRAME_DT_S  # noqa: PLC0415
 
     parser.add_argument("--steps", required=True, type=number_type(1, MAX_STEPS, whole=True),
                         metavar="N",
                         help="frames to simulate")
-    parser.add_argument("--dt", type=float, default=1.0 / 60.0, metavar="S",
+    parser.add_argument("--dt", type=float, default=FRAME_DT_S, metavar="S",
                         help="frame time in seconds (substeps are chosen inside; default 1/60)")
     parser.add_argument("--stiffness", type=float, default=None, metavar="K",
                         help="stretch stiffness, N/m (default: the fabric's or the weave's)")

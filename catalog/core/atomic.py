@@ -287,7 +287,7 @@ def staged_folder(destination: str | Path, *, inputs: Iterable[str | Path] = (),
     folder; only when the block ends without error are the files moved into
     ``destination`` (created if needed), each by an atomic rename, sub-folders included.
     On failure or a signal the staging folder is removed and ``destination`` is left as
-    it was. Returns through :func:`published` which files were moved.
+    it was. It returns nothing: the caller knows the names it wrote into the stage.
     """
     destination = check_target(destination, inputs=inputs, estimate_bytes=estimate_bytes,
                                folder=True)

@@ -6,6 +6,11 @@ by catalog.gl.shaderlib into every program), never as a second literal in GLSL."
 #: 540 THz). XYZ = 683 sum cmf(l) S(l) dl puts Y in lux for an irradiance, cd m^-2 for a radiance.
 LUMINOUS_EFFICACY_LM_W = 683.0
 
+#: The cloth's frame step (s): what one rendered frame advances the simulation by wherever the
+#: frame count, not the wall clock, sets the time (``--frame N``, ``view --frames``, the drape's
+#: settling, the batch renderer, the cloth benchmark). Substeps are chosen inside a step.
+FRAME_DT_S = 1.0 / 60.0
+
 #: Relative luminance of linear sRGB / Rec. 709 primaries (Y = 0.2126 R + 0.7152 G + 0.0722 B).
 LUMA_REC709 = (0.2126, 0.7152, 0.0722)
 

@@ -27,8 +27,9 @@ sum of non-negative terms keeps full relative precision::
 
 For g >= 0 both terms of ``d`` are >= 0, so there is no cancellation at all. For
 g < 0 the mirror case (a backward peak, theta -> pi, g -> -1) cancels the same way, and
-the mirrored form keeps it exact (used by :func:`hg_phase_between`, which has the
-vectors; shaders/common.glsl does the same)::
+the mirrored form keeps it exact; it is taken below ``HG_MIRROR_BELOW`` (-0.2,
+catalog.core.constants: :func:`hg_denominator_robust`, which shaders/common.glsl's hg_d and
+the path tracer's plugin share)::
 
     one_plus_cos = 0.5 * dot(travel + view, travel + view)    # = 1 + cos theta, exact
     d = (1 + g) * (1 + g) - 2 * g * one_plus_cos               # g < 0
@@ -118,8 +119,8 @@ def hg_phase_one_minus_cos(one_minus_cos, g):
     _check_g(g)
     # 1 - cos theta lies in [0, 2]; rounding can step just outside, and for g -> -1 at
     # theta = pi the forward form (1-g)^2 + 2g(1 - cos) cancels to a tiny negative number
-    # (NaN from the square root). For g < 0 use the mirrored form (1+g)^2 - 2g(1 + cos),
-    # a sum of non-negative terms, as hg_phase_between does.
+    # (NaN from the square root). Below HG_MIRROR_BELOW the mirrored form (1+g)^2 - 2g(1 + cos),
+    # a sum of non-negative terms, is taken (hg_denominator_robust, as hg_phase_between does).
     one_minus_cos = np.clip(np.asarray(one_minus_cos), 0.0, 2.0)  # keeps float32 as float32
     return hg_phase_of_d(hg_denominator_robust(one_minus_cos, 2.0 - one_minus_cos, g), g)
 
@@ -132,7 +133,7 @@ def hg_phase(cos_theta, g):
 
 def hg_phase_between(travel: np.ndarray, view: np.ndarray, g):
     """Eq. 6 for the light's direction of travel and the view direction (unit vectors,
-    last axis 3): the forward robust form for g >= 0, the mirrored one for g < 0."""
+    last axis 3): the forward robust form for g >= HG_MIRROR_BELOW, the mirrored one below."""
     _check_g(g)
     travel, view = np.asarray(travel), np.asarray(view)
     one_minus_cos = one_minus_cos_between(travel, view)

@@ -45,8 +45,8 @@ MAX_SIDE_PX = 8192
 @dataclass(frozen=True)
 class Pattern:
     """One repeat: coverage (H, W) float32 in [0, 1], row 0 = the top of the image (v = 0
-    at the image's bottom row is *not* assumed: texture v runs with image rows, see
-    :meth:`texture_rows`); height (H, W) float32 in [0, 1] or None; repeat (u, v) in metres."""
+    at the image's bottom row is *not* assumed: texture v runs with image rows, as the
+    renderer uploads :meth:`normal_map` row by row); height (H, W) float32 in [0, 1] or None; repeat (u, v) in metres."""
 
     coverage: np.ndarray
     height: np.ndarray | None

@@ -13,13 +13,12 @@ from pathlib import Path
 
 import numpy as np
 
+from catalog.core.constants import FRAME_DT_S  # noqa: F401  (the frame step behind --frame N)
 from catalog.core.errors import CatalogError, InputError
 from catalog.render.imagefile import (OCIO_LINEAR_SPACE, exr_colour_metadata,  # noqa: F401
                                      read_metadata, write_image)
 
 IMAGE_SUFFIXES = (".exr", ".png")
-#: Frame step of the cloth simulation behind ``--frame N`` (s).
-FRAME_DT_S = 1.0 / 60.0
 
 
 def parse_size(text: str) -> tuple[int, int]:

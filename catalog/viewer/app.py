@@ -19,14 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
+from catalog.core.constants import FRAME_DT_S
 from catalog.core.errors import CatalogError
 from catalog.viewer.catalog_state import FabricCatalog
 from catalog.viewer.input import Action, MouseOrbit, OrbitCamera, action_for_key
 from catalog.viewer.settings import (SUN, ViewerSettings, next_fluorescence, next_light)
 from catalog.viewer.timing import FrameTimer
 
-#: Simulated time per frame when a frame count is given (reproducible runs), s.
-FIXED_FRAME_DT_S = 1.0 / 60.0
 #: Scene resolution on a software rasteriser (llvmpipe): a quarter of the pixels, upscaled.
 SOFTWARE_RENDER_SCALE = 0.5
 #: On a software rasteriser the room's light (issue 13) follows a moving cloth every this many
@@ -193,7 +192,7 @@ class ViewerApp:
 
             now = time.perf_counter()
             if self.options.frames is not None:
-                frame_dt = FIXED_FRAME_DT_S
+                frame_dt = FRAME_DT_S  # a frame count: reproducible simulated time
             else:
                 frame_dt = min(MAX_FRAME_DT_S, max(MIN_FRAME_DT_S, now - last_time))
             last_time = now

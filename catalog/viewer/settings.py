@@ -37,7 +37,8 @@ EV_SLIDER_RANGE = (-2.0, 18.0)
 WIND_RANGE_M_S = (0.0, 8.0)
 #: A light breeze through the open window: it sways a sheer, it does not throw it (at 1.5 m/s
 #: the drag on a 0.05 kg/m2 voile, 1/2 rho C_d v^2 = 1.6 N/m2, is three times its weight and
-#: lifts it into the room; docs/drape.md has the hem's displacement). Stronger wind: the slider.
+#: lifts it into the room; docs/pattern.md, "The breeze", has the hem's displacement).
+#: Stronger wind: the slider.
 DEFAULT_WIND_M_S = 0.5
 
 

@@ -1,12 +1,15 @@
-#!/usr/bin/env python3
-"""Print the tables of docs/fluorescence.md (markdown) and optionally write them as JSON.
+"""The tables of docs/fluorescence.md (and README's "which lights need a fluorescence term").
 
-    .venv/bin/python tools/fluorescence_tables.py [--json FILE]
+    .venv/bin/python -m catalog.bench.fluorescence_tables [--json-out FILE]
+
+writes benchmarks/fluorescence_tables.json (needs the validation data's measured brightener,
+``--data``/CATALOG_DATA), from which tools/docs_figures.py makes the tables:
 
 1. Which lights need a fluorescence term: the brightened lace under D65, A, FL2, FL11,
    LED-B4, LED-warm, UV-A and the sun at 22 and 500 km, in paper mode (eq. 4) and
    physical mode (absorbed photons, emitted luminance, Delta E 2000 of the lit cloth).
-2. The colour error of carrying an out-of-gamut emission to the shader as signed linear
+2. The Delta E 2000 of each fluorescent fabric's emission on a white-lit cloth, per light.
+3. The colour error of carrying an out-of-gamut emission to the shader as signed linear
    sRGB, clipped, or desaturated, against the exact spectral result (Delta E 2000).
 """
 
@@ -19,14 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from catalog.core.resources import data_dir  # noqa: E402
-from catalog.optics import fluorescence as fl  # noqa: E402
-from catalog.optics.colorimetry import delta_e_2000, xyz_to_linear_srgb  # noqa: E402
-from catalog.optics.lights import get_light  # noqa: E402
-from catalog.optics.spectra import GRID_NM, read_spectrum  # noqa: E402
+from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT, data_dir
+from catalog.optics import fluorescence as fl
+from catalog.optics.colorimetry import delta_e_2000, xyz_to_linear_srgb
+from catalog.optics.lights import get_light
+from catalog.optics.spectra import GRID_NM, read_spectrum
 
 INTENSITY_LIGHTS = ("D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "UV-A", "sun:22", "sun:500")
 GAMUT_LIGHTS = ("D65", "A", "FL2", "FL11", "LED-B4", "LED-warm", "UV-A", "sun:22", "sun:500")
@@ -41,7 +41,7 @@ WHITE_CLOTH = 0.85
 
 
 def fabric_material(name: str) -> tuple[fl.FluorescentMaterial, object, object]:
-    folder = ROOT / "fabrics" / "measurements" / name
+    folder = FABRIC_DIR / "measurements" / name
     excitation = read_spectrum(folder / "excitation.csv", normalise=True)
     emission = read_spectrum(folder / "emission.csv", normalise=True)
     return fl.material_from_spectra(excitation, emission, **FABRIC_PARAMETERS[name]), excitation, emission
@@ -160,38 +160,69 @@ def _markdown(rows: list[dict], columns: list[tuple[str, str, str]]) -> str:
     return "\n".join(lines)
 
 
+INTENSITY_COLUMNS = [
+    ("light", "light", ""), ("illuminance_lx", "lx", ".4g"), ("uva_fraction", "UV-A share", ".3f"),
+    ("paper_intensity", "paper I (eq. 4)", ".4g"),
+    ("absorbed_photons_m2_s", "absorbed photons m^-2 s^-1", ".3g"),
+    ("emitted_exitance_w_m2", "emitted W m^-2", ".3g"),
+    ("luminance_ratio", "emission / white (Y)", ".3g"),
+    ("delta_e_2000", "Delta E 2000", ".3g"), ("needed", "needed", "")]
+#: The README's rows (the full set is in docs/fluorescence.md).
+BRIEF_LIGHTS = ("D65", "A", "FL2", "LED-B4", "UV-A", "sun:22", "sun:500")
+BRIEF_COLUMNS = [
+    ("light", "light", ""), ("paper_intensity", "paper I (eq. 4)", ".4f"),
+    ("absorbed_photons_m2_s", "absorbed photons m⁻² s⁻¹", ".3g"),
+    ("emitted_exitance_w_m2", "emitted W m⁻²", ".3g"), ("delta_e_2000", "Delta E 2000", ".3g"),
+    ("needed", "needed", "")]
+MATERIAL_COLUMNS = [
+    ("fabric", "fabric", ""), ("quantum_yield", "QY", "g"),
+    ("peak_absorptance", "peak absorptance", "g"), ("paper_rgb", "F (eq. 2)", ""),
+    *[(name, name, ".3g") for name in INTENSITY_LIGHTS]]
+GAMUT_COLUMNS = [
+    ("material", "material", ""), ("background", "background", ""), ("light", "light", ""),
+    ("signed", "signed", ".1g"), ("clip", "clip", ".3g"), ("desaturate", "desaturate", ".3g"),
+    ("sum_in_gamut", "sum in gamut", ""), ("display_floor", "display floor", ".3g"),
+    ("signed_display", "signed, display", ".3g"), ("clip_display", "clip, display", ".3g"),
+    ("desaturate_display", "desat., display", ".3g"),
+    ("signed_display_desaturate", "signed, display desat.", ".3g")]
+#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
+RESULT_JSON = "benchmarks/fluorescence_tables.json"
+
+
+def run() -> dict:
+    return {"intensity": intensity_rows(), "materials": material_rows(), "gamut": gamut_rows(),
+            "settings": {"white_cloth": WHITE_CLOTH, "fabrics": FABRIC_PARAMETERS,
+                         "needed_above_delta_e": 0.1}}
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``fluorescence_needed`` (docs/fluorescence.md) and its short form for README
+    (``fluorescence_needed_brief``), ``fluorescence_dyes`` and ``fluorescence_carry``."""
+    brief = [dict(row, needed="yes" if row["needed"] else "no") for row in result["intensity"]
+             if row["light"] in BRIEF_LIGHTS]
+    return {"fluorescence_needed": _markdown(result["intensity"], INTENSITY_COLUMNS),
+            "fluorescence_needed_brief": _markdown(brief, BRIEF_COLUMNS),
+            "fluorescence_dyes": _markdown(result["materials"], MATERIAL_COLUMNS),
+            "fluorescence_carry": _markdown(result["gamut"], GAMUT_COLUMNS)}
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", type=Path, help="also write the rows as JSON here")
+    parser.add_argument("--json-out", type=Path, default=PROJECT_ROOT / RESULT_JSON,
+                        help=f"write the result here (default {RESULT_JSON})")
     args = parser.parse_args(argv)
-    intensity = intensity_rows()
-    gamut = gamut_rows()
-    print("## Which lights need a fluorescence term (lace-fwa, QY 0.6, peak absorptance 0.5)\n")
-    print(_markdown(intensity, [
-        ("light", "light", ""), ("illuminance_lx", "lx", ".4g"),
-        ("uva_fraction", "UV-A share", ".3f"),
-        ("paper_intensity", "paper I (eq. 4)", ".4g"),
-        ("absorbed_photons_m2_s", "absorbed photons m^-2 s^-1", ".3g"),
-        ("emitted_exitance_w_m2", "emitted W m^-2", ".3g"),
-        ("luminance_ratio", "emission / white (Y)", ".3g"),
-        ("delta_e_2000", "Delta E 2000", ".3g"), ("needed", "needed", "")]))
-    print("\n## Delta E 2000 of the emission on a white-lit cloth, per fabric and light\n")
-    print(_markdown(material_rows(), [
-        ("fabric", "fabric", ""), ("quantum_yield", "QY", "g"),
-        ("peak_absorptance", "peak absorptance", "g"), ("paper_rgb", "F (eq. 2)", ""),
-        *[(name, name, ".3g") for name in INTENSITY_LIGHTS]]))
-    print("\n## Carrying the emission colour: Delta E 2000 against the exact spectral colour\n")
-    print(_markdown(gamut, [
-        ("material", "material", ""), ("background", "background", ""), ("light", "light", ""),
-        ("signed", "signed", ".1g"), ("clip", "clip", ".3g"), ("desaturate", "desaturate", ".3g"),
-        ("sum_in_gamut", "sum in gamut", ""), ("display_floor", "display floor", ".3g"),
-        ("signed_display", "signed, display", ".3g"), ("clip_display", "clip, display", ".3g"),
-        ("desaturate_display", "desat., display", ".3g"),
-        ("signed_display_desaturate", "signed, display desat.", ".3g")]))
-    if args.json:
-        from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
-        write_text_atomic(args.json, json.dumps({"intensity": intensity, "gamut": gamut},
-                                                indent=1, default=float))
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+
+    try:
+        result = run()
+    except CatalogError as exc:  # the measured brightener is absent: one line, exit 2
+        print(f"fluorescence_tables: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    write_text_atomic(args.json_out, json.dumps(result, indent=1, default=float) + "\n")
+    for name, text in markdown_tables(result).items():
+        print(f"<!-- generated:{name} -->\n{text}\n<!-- /generated:{name} -->\n")
+    print(f"wrote {args.json_out}")
     return 0
 
 
