@@ -6,7 +6,8 @@ output, the tests record them (the ``record_figure`` fixture of tests/conftest.p
 run with ``CATALOG_RECORD_FIGURES`` set merges them into benchmarks/tested_figures.json:
 
     CATALOG_RECORD_FIGURES=$PWD/benchmarks/tested_figures.json .venv/bin/python -m pytest \\
-        tests/test_display_gl.py tests/test_render_frame.py tests/test_render_pattern.py
+        tests/test_display_gl.py tests/test_render_frame.py tests/test_render_pattern.py \\
+        tests/test_uv_fluorescence.py
 
 :func:`markdown_tables` makes the docs' tables from that JSON (tools/docs_figures.py).
 """
@@ -133,12 +134,19 @@ def _pattern_checks(f: dict) -> tuple[str, str]:
 def markdown_tables(result: dict) -> dict[str, str]:
     """``display_checks`` (docs/display.md), ``display_checks_brief`` (README),
     ``render_reference_error`` (docs/render.md), ``render_reference_brief`` (README),
-    ``pattern_checks`` (docs/pattern.md) and ``pattern_pairwise_brief`` (README)."""
+    ``pattern_checks`` (docs/pattern.md), ``pattern_pairwise_brief`` (README) and
+    ``render_led405_brief`` (docs/render.md)."""
     f = result["figures"]
     display, display_brief = _display_checks(f)
     reference, reference_brief = _render_reference(f)
     out = {"display_checks": display, "display_checks_brief": display_brief,
            "render_reference_error": reference, "render_reference_brief": reference_brief}
+    blue = f.get("render.led405_blue")
+    if blue:
+        out["render_led405_brief"] = (
+            f"its mean blue channel is {blue['lace'] / blue['voile']:.1f}x the plain voile's "
+            f"({blue['lace']:.0f} against {blue['voile']:.0f} of 255; the test holds >= 1.2x and the "
+            "voile unclipped)")
     if "pattern.spectrum_peak" in f:
         out["pattern_checks"], out["pattern_pairwise_brief"] = _pattern_checks(f)
     return out
