@@ -125,3 +125,34 @@ def web_site(tmp_path_factory):
     out = tmp_path_factory.mktemp("web") / "site"
     report = build_site(out, fabrics="fluoro-pink,linen-dense", lights="D65,UV-A,sun-by-hour")
     return out, report
+
+
+# ---- figures the docs quote from test runs ------------------------------------------------
+#: NAME -> value measured by a test in this session (catalog/bench/tested_figures.py).
+_FIGURES: dict[str, object] = {}
+
+
+@pytest.fixture
+def record_figure():
+    """``record_figure(NAME, value)``: keep a figure a test measured (a number, list or dict of
+    them). With CATALOG_RECORD_FIGURES=FILE.json set, the session merges every recorded figure
+    into that file at its end (benchmarks/tested_figures.json is where the docs' tables come
+    from: catalog/bench/tested_figures.py); otherwise nothing is written."""
+    def record(name: str, value) -> None:
+        _FIGURES[name] = value
+    return record
+
+
+def pytest_sessionfinish(session, exitstatus):
+    target = os.environ.get("CATALOG_RECORD_FIGURES")
+    if not target or not _FIGURES:
+        return
+    import json
+
+    from catalog.core.atomic import write_text_atomic
+
+    path = Path(target)
+    merged = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    merged.setdefault("figures", {}).update(_FIGURES)
+    merged["figures"] = dict(sorted(merged["figures"].items()))
+    write_text_atomic(path, json.dumps(merged, indent=1, default=float) + "\n")

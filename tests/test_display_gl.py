@@ -95,7 +95,7 @@ def _exact_mean_linear(renderer, mask, like):
     ("lace-fwa", "A", None, "room"), ("fluoro-pink", "D65", 15.0, "camera"),
     ("sheer-teal", "sun:22", 10.0, "room")])
 @pytest.mark.slow
-def test_shader_equals_numpy_twin_per_pixel(gl, fabric, light, ev, wb):
+def test_shader_equals_numpy_twin_per_pixel(gl, fabric, light, ev, wb, record_figure):
     renderer, _ = _frame(gl, fabric, light, ev=ev, white_balance=wb)
     hdr = renderer.read_linear().astype(np.float64)
     expected = np.round(255 * display.display_transform(hdr, renderer.exposure_scale(),
@@ -103,12 +103,15 @@ def test_shader_equals_numpy_twin_per_pixel(gl, fabric, light, ev, wb):
     got = renderer.read_srgb8().astype(float)
     diff = np.abs(got - expected)
     renderer.release()
+    record_figure(f"display.twin|{fabric}|{light}", {"within_1_level": float(np.mean(diff <= 1)),
+                                                     "equal": float(np.mean(diff == 0)),
+                                                     "max_levels": float(diff.max())})
     assert np.mean(diff <= 1) >= 0.999, np.mean(diff <= 1)
     assert diff.max() <= 4
 
 
 @pytest.mark.slow
-def test_at_most_one_percent_of_curtain_pixels_clip_under_every_light(gl, capsys):
+def test_at_most_one_percent_of_curtain_pixels_clip_under_every_light(gl, capsys, record_figure):
     worst = []
     for fabric in _presets():
         renderer = FrameRenderer(gl, SIZE)
@@ -123,6 +126,8 @@ def test_at_most_one_percent_of_curtain_pixels_clip_under_every_light(gl, capsys
             worst.append((clipped.mean(), fabric, light))
         renderer.release()
     worst.sort(reverse=True)
+    record_figure("display.clipped", {"cases": len(worst), "worst_fraction": float(worst[0][0]),
+                                      "worst_case": f"{worst[0][1]} {worst[0][2]}"})
     with capsys.disabled():
         print("\nclipped curtain pixels, worst five: "
               + "; ".join(f"{f} {l} {100 * c:.2f} %" for c, f, l in worst[:5]))
@@ -133,13 +138,15 @@ def test_at_most_one_percent_of_curtain_pixels_clip_under_every_light(gl, capsys
                                            ("fluoro-pink", "UV-A"), ("safety-yellow", "D65"),
                                            ("safety-yellow", "UV-A")])
 @pytest.mark.slow
-def test_displayed_hue_is_the_exact_spectral_hue(gl, fabric, light, capsys):
+def test_displayed_hue_is_the_exact_spectral_hue(gl, fabric, light, capsys, record_figure):
     renderer, mask = _frame(gl, fabric, light)
     shown = _displayed_mean_linear(renderer, mask)
     exact = _exact_mean_linear(renderer, mask, shown)
     renderer.release()
     lab_shown, lab_exact = _lab(shown), _lab(exact)
     difference = (_hue_deg(lab_shown) - _hue_deg(lab_exact) + 180) % 360 - 180
+    record_figure(f"display.hue|{fabric}|{light}", {"shown_deg": float(_hue_deg(lab_shown)),
+                                                    "exact_deg": float(_hue_deg(lab_exact))})
     with capsys.disabled():
         print(f"\n{fabric} under {light}: hue shown {_hue_deg(lab_shown):.1f}, exact "
               f"{_hue_deg(lab_exact):.1f} deg (C* {np.hypot(*lab_shown[1:]):.1f} / "
@@ -149,24 +156,26 @@ def test_displayed_hue_is_the_exact_spectral_hue(gl, fabric, light, capsys):
 
 
 @pytest.mark.slow  # 1-3 s: measured with --durations (issue 10)
-def test_lace_and_safety_yellow_differ_at_sunset(gl, capsys):
+def test_lace_and_safety_yellow_differ_at_sunset(gl, capsys, record_figure):
     labs = []
     for fabric in ("lace-fwa", "safety-yellow"):
         renderer, mask = _frame(gl, fabric, "sun:500")
         labs.append(_lab(_displayed_mean_linear(renderer, mask)))
         renderer.release()
     delta = float(delta_e_2000_lab(labs[0], labs[1]))
+    record_figure("display.sunset_lace_vs_yellow_delta_e", delta)
     with capsys.disabled():
         print(f"\nsun:500 lace vs safety yellow: Delta E 2000 {delta:.1f}")
     assert delta >= 10.0
 
 
-def test_lace_under_a_displays_as_an_adapted_white(gl, capsys):
+def test_lace_under_a_displays_as_an_adapted_white(gl, capsys, record_figure):
     renderer, mask = _frame(gl, "lace-fwa", "A")
     lab = _lab(_displayed_mean_linear(renderer, mask))
     info = renderer.info()
     renderer.release()
     chroma = float(np.hypot(lab[1], lab[2]))
+    record_figure("display.lace_a_chroma", chroma)
     with capsys.disabled():
         print(f"\nlace under A: L* {lab[0]:.1f}, C*ab {chroma:.1f}, hue {_hue_deg(lab):.0f} deg")
     assert info["white_balance_adapted"]
@@ -174,7 +183,7 @@ def test_lace_under_a_displays_as_an_adapted_white(gl, capsys):
 
 
 @pytest.mark.slow
-def test_table_2_direction_in_the_display_image(gl, capsys):
+def test_table_2_direction_in_the_display_image(gl, capsys, record_figure):
     off, mask = _frame(gl, "lace-fwa", None, mode="off", hour=12.0)
     ev = off.current_ev100()
     off8 = off.read_srgb8()[mask].astype(float).mean(axis=0)
@@ -183,6 +192,7 @@ def test_table_2_direction_in_the_display_image(gl, capsys):
     on8 = on.read_srgb8()[mask].astype(float).mean(axis=0)
     on.release()
     change = on8 - off8
+    record_figure("display.table2_change_levels", [float(c) for c in change])
     with capsys.disabled():
         print(f"\nTable 2 on the display (EV {ev:.2f}): off {np.round(off8, 1)}, on "
               f"{np.round(on8, 1)}, change R {change[0]:+.1f} G {change[1]:+.1f} B {change[2]:+.1f}")

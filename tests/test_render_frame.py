@@ -59,13 +59,16 @@ CASES = [
 
 
 @pytest.mark.parametrize("light,mode,options", CASES)
-def test_rgb_radiance_matches_float64_reference_per_pixel(gl, make_preset, light, mode, options):
+def test_rgb_radiance_matches_float64_reference_per_pixel(gl, make_preset, light, mode, options,
+                                                          record_figure):
     extra = f"anisotropy = {options['anisotropy']}" if "anisotropy" in options else ""
     path = make_preset(dye=YELLOW_DYE if options.get("dye") else None, extra_btdf=extra)
     renderer = _renderer(gl, path, light, mode)
     renderer.set_camera(yaw_deg=20.0, pitch_deg=-10.0, distance_m=2.2)
     gl_rgb, reference = _compare(renderer)
     error = _relative_error(gl_rgb, reference)
+    record_figure(f"render.rgb_vs_reference|{light}|{mode}|{','.join(options) or '-'}",
+                  float(error.max()))
     assert error.max() < 1e-3, (light, mode, float(error.max()))
     renderer.release()
 
@@ -228,7 +231,8 @@ def test_cloth_interleaved_vertex_buffer_draws_like_set_mesh(gl, make_preset):
 
 
 @pytest.mark.parametrize("illuminance_lx", [0.0, 1e9])
-def test_zero_and_huge_light_stay_finite_and_match_the_reference(gl, make_preset, illuminance_lx):
+def test_zero_and_huge_light_stay_finite_and_match_the_reference(gl, make_preset, illuminance_lx,
+                                                                 record_figure):
     from catalog.optics.lights import Light, get_light
     from catalog.optics.spectra import GRID_NM
 
@@ -244,7 +248,9 @@ def test_zero_and_huge_light_stay_finite_and_match_the_reference(gl, make_preset
         assert np.all(gl_rgb == 0.0) and np.all(reference == 0.0)
         assert renderer.shading_inputs().fluorescence_mode == "off"
     else:
-        assert _relative_error(gl_rgb, reference).max() < 1e-3
+        error = float(_relative_error(gl_rgb, reference).max())
+        record_figure(f"render.rgb_vs_reference|D65 at {illuminance_lx:g} lx|physical|-", error)
+        assert error < 1e-3
     renderer.release()
 
 

@@ -86,7 +86,7 @@ def test_mip_far_limit_is_the_fitted_open_area(gl, path):
 # --- layers: weighted blended OIT against sorted compositing --------------------------------
 
 @pytest.mark.parametrize("antialiasing", ["auto", "msaa"])
-def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, antialiasing):
+def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, antialiasing, record_figure):
     """Two overlapping layers of a flat cloth (coverage a = 1 - LD = 0.6 each), the back one
     tilted 35 deg so the layers' radiances C1, C2 differ. Sorted compositing gives
     I = a C1 + (1 - a)(a C2 + (1 - a) B). Weighted blended OIT gives the layers' weighted
@@ -135,6 +135,7 @@ def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, ant
     error = np.abs(both - sorted_ref)[overlap]
     bound = max(a * a / 2, a * (1 - a)) * np.abs(c1 - c2)[overlap] + 1e-3 * sorted_ref[overlap]
     print(f"OIT vs sorted: worst error / bound {float((error / bound).max()):.3f}")
+    record_figure(f"pattern.oit_over_bound|{antialiasing}", float((error / bound).max()))
     assert np.all(error <= bound), float((error - bound).max())
     assert np.allclose(revealage[overlap], (1 - a) ** 2, atol=1e-5)
     # two layers are visibly denser: the scene behind shows at (1 - a)^2 = 0.16, not 0.4
@@ -189,7 +190,7 @@ def test_a_known_pattern_appears_where_the_texture_coordinates_put_it(gl, make_p
 # --- far away the patterned cloth is the fitted cloth -------------------------------------
 
 @pytest.mark.parametrize("name", WHITES + ["net-grey", "linen-dense"])
-def test_far_limit_equals_the_unpatterned_cloth(gl, name):
+def test_far_limit_equals_the_unpatterned_cloth(gl, name, record_figure):
     """At 4.3 m on a 48x36 image a pixel spans 0.11 m of cloth, more than the largest repeat
     (the lace's 0.1 m): the curtain's mean displayed colour equals the flat cloth's (eq. 8
     with LD times the background) within Delta E 2000 0.5 (issue 12)."""
@@ -205,6 +206,7 @@ def test_far_limit_equals_the_unpatterned_cloth(gl, name):
         means.append(_display_xyz(renderer)[mask].mean(axis=0))
     delta = float(delta_e_2000(means[0], means[1], WHITE_XYZ))
     print(f"{name}: far limit Delta E 2000 {delta:.3f}")
+    record_figure(f"pattern.far_limit|{name}", float(delta))
     assert delta <= 0.5
     renderer.release()
 
@@ -212,7 +214,7 @@ def test_far_limit_equals_the_unpatterned_cloth(gl, name):
 # --- the white fabrics told apart ---------------------------------------------------------
 
 @pytest.mark.slow
-def test_white_fabrics_differ_pairwise_at_the_default_view(gl):
+def test_white_fabrics_differ_pairwise_at_the_default_view(gl, record_figure):
     """``catalog snapshot`` of each white fabric (its settled drape, D65, the default view,
     256x144): every pair differs by a mean per-pixel Delta E 2000 >= 3 over the pixels that
     are curtain in both images (issue 12)."""
@@ -234,6 +236,7 @@ def test_white_fabrics_differ_pairwise_at_the_default_view(gl):
         both = masks[a] & masks[b]
         delta = float(delta_e_2000(images[a][both], images[b][both], WHITE_XYZ).mean())
         print(f"{a} vs {b}: mean Delta E 2000 {delta:.2f}")
+        record_figure(f"pattern.pairwise|{a}|{b}", delta)
         worst = min(worst, delta)
     assert worst >= 3.0
     renderer.release()
@@ -241,7 +244,7 @@ def test_white_fabrics_differ_pairwise_at_the_default_view(gl):
 
 # --- a close-up resolves the lace's repeat ---------------------------------------------------
 
-def test_close_up_luminance_spectrum_peaks_at_the_lace_repeat(gl):
+def test_close_up_luminance_spectrum_peaks_at_the_lace_repeat(gl, record_figure):
     """The lace hung flat (fullness 1, so no pleat shading) seen from 0.3 m, 256x256 px,
     D65: the strongest frequency of the curtain's luminance off the axes is a fundamental
     of the motif's (centred) lattice, (+-1 / repeat_u, +-1 / repeat_v) in cycles per metre of
@@ -270,6 +273,8 @@ def test_close_up_luminance_spectrum_peaks_at_the_lace_repeat(gl):
     iy, ix = np.unravel_index(np.argmax(spectrum), spectrum.shape)
     peak = (abs(ky[iy, ix]), abs(kx[iy, ix]))
     print(f"peak at {peak} cycles/image (vertical, horizontal), expected {expected}")
+    record_figure("pattern.spectrum_peak", {"peak": [float(v) for v in peak],
+                                            "expected": [float(v) for v in expected]})
     assert abs(peak[0] - expected[0]) <= 1.0 and abs(peak[1] - expected[1]) <= 1.0
     renderer.release()
 
@@ -295,7 +300,7 @@ def dolly_change(renderer, mask_frames, filtered: bool, frames: int = 40) -> flo
 
 
 @pytest.mark.slow
-def test_a_slow_dolly_does_not_shimmer(gl):
+def test_a_slow_dolly_does_not_shimmer(gl, record_figure):
     """Static lace, 40 frames from 3 m to 0.2 m (7 % closer each frame), 128x96, one fixed
     exposure. The change
     between frames has a part every image of a zoom has (edges and motifs move by their
@@ -323,6 +328,7 @@ def test_a_slow_dolly_does_not_shimmer(gl):
     unfiltered = dolly_change(renderer, masks, False)
     print(f"dolly: mean frame-to-frame change {filtered:.2f} levels filtered, "
           f"{unfiltered:.2f} unfiltered")
+    record_figure("pattern.dolly_levels", {"filtered": float(filtered), "unfiltered": float(unfiltered)})
     assert filtered <= 0.6 * unfiltered
     assert filtered < 8.0
     renderer.release()
@@ -332,7 +338,7 @@ def test_a_slow_dolly_does_not_shimmer(gl):
 
 @pytest.mark.parametrize("mode", ["fxaa", "msaa"])
 @pytest.mark.slow
-def test_antialiasing_brings_edges_closer_to_a_supersampled_frame(gl, mode):
+def test_antialiasing_brings_edges_closer_to_a_supersampled_frame(gl, mode, record_figure):
     """The lace's frame at 96x72 with FXAA (or MSAA 4x: HDR and OIT targets multisampled)
     and without, against the same frame rendered at 4x4 the pixels and box-filtered down in
     linear light (the supersampled reference). On the pixels where aliasing shows (the
@@ -364,6 +370,7 @@ def test_antialiasing_brings_edges_closer_to_a_supersampled_frame(gl, mode):
     error_fxaa = float(np.abs(fxaa - reference)[edges].mean())
     print(f"edge pixels {int(edges.sum())}: mean error {error_plain:.2f} levels without, "
           f"{error_fxaa:.2f} with {mode}")
+    record_figure(f"pattern.edges_levels|{mode}", {"without": error_plain, "with": error_fxaa})
     assert error_fxaa <= 0.8 * error_plain
 
 
@@ -381,7 +388,7 @@ def test_auto_antialiasing_takes_msaa_on_a_gpu_and_fxaa_on_a_cpu_rasteriser(gl):
     renderer.release()
 
 
-def test_msaa_keeps_the_curtain_interior_and_the_layers(gl):
+def test_msaa_keeps_the_curtain_interior_and_the_layers(gl, record_figure):
     """MSAA changes edges only: over the curtain's interior (pixels whose 3x3 neighbourhood
     is curtain in the G-buffer mask) the resolved HDR radiance equals the one-sample frame's
     within 2 % (mean relative difference; the composite after the resolve is the same
@@ -407,12 +414,13 @@ def test_msaa_keeps_the_curtain_interior_and_the_layers(gl):
     rel = np.abs(y["msaa"] - y["off"])[interior] / np.maximum(y["off"][interior], 1e-9)
     print(f"MSAA vs 1 sample over {int(interior.sum())} interior pixels: mean relative "
           f"difference {rel.mean():.4f}")
+    record_figure("pattern.msaa_interior_relative", float(rel.mean()))
     assert rel.mean() < 0.02
     renderer.release()
 
 
 @pytest.mark.slow
-def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl):
+def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl, record_figure):
     """The settled lace at 320x180, MSAA against one sample, over the curtain's interior
     (pixels whose 5x5 neighbourhood is curtain in the G-buffer mask: the folds' silhouettes
     inside it, not its outline against the room, where coverage alone may differ by a
@@ -455,6 +463,7 @@ def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl):
     excess = (luma["msaa"] - ceiling)[inner]
     print(f"MSAA above the one-sample 3x3 maximum over {int(inner.sum())} interior pixels: "
           f"at most {excess.max():.1f} levels")
+    record_figure("pattern.msaa_silhouette_excess_levels", float(excess.max()))
     assert excess.max() < 10.0
 
 

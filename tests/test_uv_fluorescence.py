@@ -270,7 +270,7 @@ def test_committed_benchmark_choice_is_the_model_the_renderer_carries():
 # ---------------------------------------------------------------------------- picture
 
 @pytest.mark.gl
-def test_violet_lamp_shows_the_brightened_lace_glow(gl):
+def test_violet_lamp_shows_the_brightened_lace_glow(gl, record_figure):
     """Under LED-405 the brightened lace is bluer than a plain white voile (mean B of the
     cloth at least 1.2x) and the plain voile is not clipped (mean B below 250 of 255)."""
     from catalog.render.frame import FrameRenderer
@@ -285,5 +285,7 @@ def test_violet_lamp_shows_the_brightened_lace_glow(gl):
         image = renderer.read_srgb8().astype(np.float64)[..., :3]
         means[fabric] = image[16:36, 24:40].reshape(-1, 3).mean(axis=0)
     renderer.release()
+    record_figure("render.led405_blue", {"lace": float(means["lace-fwa"][2]),
+                                         "voile": float(means["voile-white"][2])})
     assert means["lace-fwa"][2] >= 1.2 * means["voile-white"][2]
     assert means["voile-white"][2] < 250

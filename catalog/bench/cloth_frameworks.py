@@ -64,8 +64,8 @@ _COLUMNS = (("numpy-f32", "numpy f32"), ("cpu", "**cpu (numba, 1 thread)**"),
 def markdown_tables(result: dict) -> dict[str, str]:
     """``cloth_frameworks``: steps per second by n and implementation, with the ratio to the
     fastest peer for ours and the peers (the numpy reference and llvmpipe have none);
-    ``cloth_stiffness``: the cost of a 1/30 s frame at 1e3 and 1e6 N/m; ``cloth_frameworks_goal``
-    and ``cloth_gpu_frame``: the sentences docs/cloth.md's prose rests on."""
+    ``cloth_stiffness``: the cost of a 1/30 s frame at 1e3 and 1e6 N/m; ``cloth_frameworks_goal``,
+    ``cloth_gpu_frame`` and ``cloth_frameworks_agreement``: the sentences docs/cloth.md's prose rests on."""
     rows = result["springs12"]
     lines = ["| n | " + " | ".join(label for _, label in _COLUMNS) + " |",
              "|---|" + "---|" * len(_COLUMNS)]
@@ -102,8 +102,13 @@ def markdown_tables(result: dict) -> dict[str, str]:
                 "2 CPU cores, one run): " + ", ".join(
                     f"{r['ms_per_frame_llvmpipe']:.0f} ms at {r['n']}x{r['n']}" for r in gpu)
                 + f" ({gpu[0]['substeps']} substeps)." if gpu else "The GPU frame was not measured.")
+    checked = [r["max_error_m"] for r in rows if "max_error_m" in r]
+    agreement = (f"Every implementation within {max(checked):.1g} m of the float64 numpy reference "
+                 f"(tolerance {AGREE_TOLERANCE_M:g} m)." if checked
+                 else "No implementation was checked against the reference.")
     return {"cloth_frameworks": "\n".join(lines), "cloth_stiffness": "\n".join(slines),
-            "cloth_frameworks_goal": goal, "cloth_gpu_frame": gpu_text}
+            "cloth_frameworks_goal": goal, "cloth_gpu_frame": gpu_text,
+            "cloth_frameworks_agreement": agreement}
 
 
 # ---- peers ------------------------------------------------------------------------------

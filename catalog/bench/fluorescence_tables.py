@@ -11,6 +11,10 @@ writes benchmarks/fluorescence_tables.json (needs the validation data's measured
 2. The Delta E 2000 of each fluorescent fabric's emission on a white-lit cloth, per light.
 3. The colour error of carrying an out-of-gamut emission to the shader as signed linear
    sRGB, clipped, or desaturated, against the exact spectral result (Delta E 2000).
+4. The measured Calcofluor White (eq. 2's F, eq. 4 and the physical mode under D65), and the
+   real bispectral matrices (CIPLAW10, CIBA12, TEXTYELL) judged as the lace is: Delta E 2000
+   of the lit sample with and without its off-diagonal (fluorescent) entries, and its
+   emission's luminance over a white diffuser's, under D65 and LED-B4.
 """
 
 from __future__ import annotations
@@ -146,6 +150,51 @@ def gamut_rows() -> list[dict]:
     return rows
 
 
+#: The measured matrices compared with the lace (in the validation data's bispectral/).
+REAL_MATRICES = ("CIPLAW10", "CIBA12", "TEXTYELL")
+REAL_LIGHTS = ("D65", "LED-B4")
+
+
+def calcofluor_figures() -> dict:
+    """The measured Calcofluor White emission and excitation at the lace's parameters."""
+    folder = data_dir("brightener")
+    excitation = read_spectrum(folder / "calcofluor_white_excitation.csv", normalise=True)
+    emission = read_spectrum(folder / "calcofluor_white_emission.csv", normalise=True)
+    material = calcofluor_material()
+    e = get_light("D65").irradiance_w_m2_nm
+    _, rgb = fl.paper_colour(emission)
+    return {"paper_rgb": [float(v) for v in rgb],
+            "paper_intensity_d65": fl.paper_intensity(e, excitation.resample(GRID_NM)),
+            "absorbed_photons_m2_s_d65": fl.absorbed_photon_irradiance(material, e),
+            "emitted_exitance_w_m2_d65": float(np.sum(fl.emitted_exitance_w_m2_nm(material, e))),
+            "delta_e_2000_d65": fl.fluorescence_delta_e(material, e, WHITE_CLOTH),
+            "needed_led_b4": fl.fluorescence_needed(material, get_light("LED-B4").irradiance_w_m2_nm,
+                                                    WHITE_CLOTH)}
+
+
+def real_matrix_rows() -> list[dict]:
+    """Each real matrix under REAL_LIGHTS: Delta E 2000 between the full matrix's response
+    and its diagonal alone (white = a perfect diffuser under the light, as for the lace), and
+    the re-radiated luminance over the white's."""
+    from catalog.optics.bispectral.matrix import exact_exitance_on_grid, find_bfc, read_bfc
+    from catalog.optics.bispectral.study import _xyz, light_irradiance
+
+    rows = []
+    for name in REAL_MATRICES:
+        matrix = read_bfc(find_bfc(name))
+        diagonal = np.interp(GRID_NM, matrix.emission_nm, matrix.diagonal())
+        row = {"matrix": name}
+        for light_name in REAL_LIGHTS:
+            light = light_irradiance(light_name)
+            exact = _xyz(exact_exitance_on_grid(matrix, light))
+            reflected = _xyz(diagonal * light)
+            white = _xyz(light)
+            row[f"delta_e_2000|{light_name}"] = float(delta_e_2000(exact, reflected, white))
+            row[f"emission_over_white|{light_name}"] = float((exact[1] - reflected[1]) / white[1])
+        rows.append(row)
+    return rows
+
+
 def _cell(value: object, fmt: str) -> str:
     if isinstance(value, float) and fmt and abs(value) < 1e-9:
         return "0"  # exact to rounding (the sums differ in the last bits only)
@@ -191,19 +240,37 @@ RESULT_JSON = "benchmarks/fluorescence_tables.json"
 
 def run() -> dict:
     return {"intensity": intensity_rows(), "materials": material_rows(), "gamut": gamut_rows(),
+            "calcofluor": calcofluor_figures(), "real_matrices": real_matrix_rows(),
             "settings": {"white_cloth": WHITE_CLOTH, "fabrics": FABRIC_PARAMETERS,
                          "needed_above_delta_e": 0.1}}
 
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """``fluorescence_needed`` (docs/fluorescence.md) and its short form for README
-    (``fluorescence_needed_brief``), ``fluorescence_dyes`` and ``fluorescence_carry``."""
+    (``fluorescence_needed_brief``), ``fluorescence_dyes``, ``fluorescence_carry``,
+    ``fluorescence_real`` (the real matrices beside the lace) and ``fluorescence_calcofluor``."""
+    lace = {r["light"]: r for r in result["intensity"]}
+    real = ["| sample | Delta E 2000, D65 | Delta E 2000, LED-B4 | emission / white (Y), D65 |",
+            "|---|---|---|---|",
+            f"| lace-fwa (the catalog's model, table above) | {lace['D65']['delta_e_2000']:.3g} | "
+            f"{lace['LED-B4']['delta_e_2000']:.3g} | {100 * lace['D65']['luminance_ratio']:.1f} % |"]
+    for r in result.get("real_matrices", []):
+        real.append(f"| {r['matrix']} (measured matrix) | {r['delta_e_2000|D65']:.3g} | "
+                    f"{r['delta_e_2000|LED-B4']:.3g} | {100 * r['emission_over_white|D65']:.1f} % |")
+    c = result["calcofluor"]
+    calcofluor = ("| eq. 2 F (paper's matrix) | eq. 4 I under D65 | absorbed photons m^-2 s^-1, D65 | "
+                  "emitted W m^-2, D65 | Delta E 2000 on white cloth, D65 | needed under LED-B4 |\n"
+                  "|---|---|---|---|---|---|\n"
+                  f"| ({', '.join(f'{v:.2f}' for v in c['paper_rgb'])}) | {c['paper_intensity_d65']:.4g} | "
+                  f"{c['absorbed_photons_m2_s_d65']:.3g} | {c['emitted_exitance_w_m2_d65']:.3g} | "
+                  f"{c['delta_e_2000_d65']:.2f} | {'yes' if c['needed_led_b4'] else 'no'} |")
     brief = [dict(row, needed="yes" if row["needed"] else "no") for row in result["intensity"]
              if row["light"] in BRIEF_LIGHTS]
     return {"fluorescence_needed": _markdown(result["intensity"], INTENSITY_COLUMNS),
             "fluorescence_needed_brief": _markdown(brief, BRIEF_COLUMNS),
             "fluorescence_dyes": _markdown(result["materials"], MATERIAL_COLUMNS),
-            "fluorescence_carry": _markdown(result["gamut"], GAMUT_COLUMNS)}
+            "fluorescence_carry": _markdown(result["gamut"], GAMUT_COLUMNS),
+            "fluorescence_real": "\n".join(real), "fluorescence_calcofluor": calcofluor}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -186,6 +186,45 @@ SUMMARY_RUNS = ("h200_gpu_cloth_fxaa_uniforms", "h200_gpu_cloth_msaa_uniforms",
                 "h200_gpu_cloth_fxaa", "h200_numba_cloth", "llvmpipe_numpy_cloth")
 
 
+def _findings(runs: dict) -> str:
+    """The figures docs/gpu.md's "What the figures say" rests on, from the same runs."""
+    def row(key: str, size, grid) -> dict:
+        return next(r for r in runs[key]["rows"] if r["size"] == list(size) and r["grid"] == list(grid))
+    hd, big = (1920, 1080), (128, 128)
+    gpu_sim = [r["simulation_ms"] for k, run in runs.items() if k.startswith("h200_")
+               for r in run["rows"] if r["backend"] == "gpu"]
+    grids = sorted({tuple(r["grid"]) for k, run in runs.items() if k.startswith("h200_gpu")
+                    for r in run["rows"]}, key=lambda g: g[0] * g[1])
+    numba = [row("h200_numba_cloth", hd, g)["simulation_ms"] for g in ((48, 64), big)]
+    numpy_ = [row("h200_numpy_cloth", hd, g)["simulation_ms"] for g in ((48, 64), big)]
+    constants = row("h200_gpu_cloth_fxaa", hd, big)["total_ms"]
+    uniforms = row("h200_gpu_cloth_fxaa_uniforms", hd, big)["total_ms"]
+    msaa = row("h200_gpu_cloth_msaa_uniforms", hd, big)["total_ms"]
+    fxaa_passes = row("h200_passes_fxaa", hd, big)["passes_ms"]
+    msaa_passes = row("h200_passes_msaa", hd, big)["passes_ms"]
+    display = [r["passes_ms"]["display"] for k, run in runs.items() if k.startswith("h200_passes")
+               for r in run["rows"] if r["size"] == list(hd) and "passes_ms" in r]
+    llvmpipe = row("llvmpipe_numpy_cloth", hd, big)["total_ms"]
+    budget = 1000.0 / 60.0
+    lines = ["| figure (H200 unless named; medians of the runs above) | value |", "|---|---|",
+             f"| compute cloth, 10 substeps, grids {grids[0][0]}x{grids[0][1]} to "
+             f"{grids[-1][0]}x{grids[-1][1]} | {min(gpu_sim):.1f}-{max(gpu_sim):.1f} ms |",
+             f"| numba cloth (16 cores), 48x64 / 128x128 | {numba[0]:.0f} / {numba[1]:.0f} ms |",
+             f"| numpy cloth, 48x64 / 128x128 | {numpy_[0]:.0f} / {numpy_[1]:.0f} ms |",
+             f"| frame, 1920x1080, 128x128, FXAA: scene values as constants -> uniforms | "
+             f"{constants:.1f} -> {uniforms:.1f} ms |",
+             f"| left of the {budget:.1f} ms budget for the panel and the swap (uniforms, FXAA) | "
+             f"{budget - uniforms:.1f} ms |",
+             f"| the same frame with MSAA 4x (uniforms) | {msaa:.1f} ms |",
+             f"| curtain pass of the passes' sum, 1920x1080, constants: FXAA / MSAA | "
+             f"{fxaa_passes['curtain']:.1f} of {sum(fxaa_passes.values()):.1f} / "
+             f"{msaa_passes['curtain']:.1f} of {sum(msaa_passes.values()):.1f} ms |",
+             f"| display pass at 1920x1080 | {min(display):.1f}-{max(display):.1f} ms |",
+             f"| llvmpipe (2 shared cores), 1920x1080, 128x128 (numpy cloth); x the H200's FXAA + "
+             f"uniforms frame | {llvmpipe:.0f} ms; {llvmpipe / uniforms:.0f}x |"]
+    return "\n".join(lines)
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """RESULT_JSON's runs as docs/gpu.md's tables: frames per machine, cloth backend,
     anti-aliasing and scene values (constants or uniforms); the render passes; a summary at
@@ -223,6 +262,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
         accuracy.append(f"| {case} | {gpu['max']:.2e} | {gpu['median']:.2e} | {uniform['max']:.2e} | "
                         f"{uniform['median']:.2e} | {cpu['max']:.2e} | {cpu['median']:.2e} |")
     return {"viewer-headless-frames": frames,
+            "viewer-gpu-findings": _findings(result["runs"]),
             "gpu-frame-summary": "\n".join(summary),
             "viewer-headless-passes": "\n".join(passes),
             "viewer-gpu-accuracy": "\n".join(accuracy)}

@@ -87,7 +87,29 @@ def markdown_tables(result: dict) -> dict[str, str]:
                      + " / ".join(f"{b['ratio']:.2f}" for b in bands) + " |")
     brief.append(one("whole frame (room, curtain, background, tone map)",
                      "whole frame (rgb physical: background, room, curtain, tone map)"))
-    return {"render_shaders": "\n".join(full), "render_shaders_brief": "\n".join(brief)}
+    out = {"render_shaders": "\n".join(full), "render_shaders_brief": "\n".join(brief)}
+    if bands:
+        rgb = rows["rgb physical"]["ms"]
+        out["render_bands_cost"] = ("| bands | 6 | 9 | 16 |\n|---|---|---|---|\n"
+                                    "| time / RGB physical (wall medians) | "
+                                    + " | ".join(f"{b['ms'] / rgb:.2f}" for b in bands) + " |")
+    errors = result.get("delta_e_2000_vs_spectral")
+    if errors:
+        cases = list(dict.fromkeys(key.rsplit("|", 1)[0] for key in errors))
+        counts = sorted({int(key.rsplit("|", 1)[1]) for key in errors})
+        table = ["| light, fluorescence | " + " | ".join(
+                     f"{n} (RGB)" if n == 3 else str(n) for n in counts) + " |",
+                 "|" + "---|" * (len(counts) + 1)]
+
+        def cell(e: dict) -> str:
+            return " / ".join("0" if v < 5e-5 else f"{v:.2g}" if v < 0.01 else f"{v:.2f}"
+                              for v in (e["mean"], e["max"]))
+        for case in cases:
+            light, mode = case.split("|")
+            table.append(f"| {light}, {mode} | " + " | ".join(
+                cell(errors[f"{case}|{n}"]) for n in counts) + " |")
+        out["render_bands_delta_e"] = "\n".join(table)
+    return out
 
 
 FALLBACK_PRESET = """schema = 1

@@ -1,0 +1,75 @@
+"""Figures the docs quote from records, studies and test runs (issue 10): each has a source
+that says where it came from, and the quick studies reproduce their committed JSON."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+
+import pytest
+
+from catalog.bench import records, sun_spectrl2, tested_figures
+from catalog.core.resources import PROJECT_ROOT
+
+
+def _load(path: str) -> dict:
+    return json.loads((PROJECT_ROOT / path).read_text(encoding="utf-8"))
+
+
+def test_every_record_names_its_provenance_and_a_commit():
+    """A record is history: it must say where it came from (a commit of this repository and
+    how it was measured), and its rows must fit its columns."""
+    result = _load(records.RESULT_JSON)
+    assert result["records"]
+    for name, record in result["records"].items():
+        assert re.search(r"\b[0-9a-f]{7,40}\b", record["provenance"]), name
+        assert (PROJECT_ROOT / record["doc"]).is_file(), name
+        assert f"<!-- generated:{name} -->" in (PROJECT_ROOT / record["doc"]).read_text(), name
+        text = records.render_record(record)
+        assert "Historical record, not re-runnable" in text and record["provenance"] in text
+
+
+def test_a_record_row_that_does_not_fit_its_columns_is_refused():
+    with pytest.raises(ValueError, match="2 cells under 3 columns"):
+        records.render_record({"columns": ["a", "b", "c"], "rows": [[1, 2]], "provenance": "x"})
+
+
+def test_the_sun_study_reproduces_its_committed_json():
+    committed = _load(sun_spectrl2.RESULT_JSON)["rows"]
+    fresh = sun_spectrl2.run()["rows"]
+    assert len(fresh) == len(committed)
+    for a, b in zip(fresh, committed):
+        for key, value in b.items():
+            assert a[key] == pytest.approx(value, rel=1e-9, abs=1e-12), key
+
+
+def test_tested_figures_make_every_block_the_docs_use():
+    made = tested_figures.markdown_tables(_load(tested_figures.RESULT_JSON))
+    assert {"display_checks", "display_checks_brief", "render_reference_error",
+            "render_reference_brief", "pattern_checks", "pattern_pairwise_brief",
+            "render_led405_brief"} <= set(made)
+
+
+def test_record_figure_merges_into_the_named_json_only_when_asked(tmp_path):
+    """The conftest hook: with CATALOG_RECORD_FIGURES set, a session's figures are merged
+    into the file (earlier figures kept); without it nothing is written."""
+    test = tmp_path / "test_probe.py"
+    test.write_text("def test_one(record_figure):\n    record_figure('probe.value', 1.5)\n")
+    target = tmp_path / "figures.json"
+    target.write_text(json.dumps({"figures": {"earlier": 2}}))
+    conftest = PROJECT_ROOT / "tests" / "conftest.py"
+    (tmp_path / "conftest.py").write_text(conftest.read_text())
+
+    def run(env_value):
+        env = {"PATH": "/usr/bin:/bin", "CATALOG_RECORD_FIGURES": env_value} if env_value else \
+            {"PATH": "/usr/bin:/bin"}
+        proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                               str(test)], cwd=tmp_path, env=env, capture_output=True, text=True)
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+
+    run(None)
+    assert json.loads(target.read_text()) == {"figures": {"earlier": 2}}
+    run(str(target))
+    assert json.loads(target.read_text()) == {"figures": {"earlier": 2, "probe.value": 1.5}}
