@@ -25,7 +25,8 @@ def test_gpu_follows_the_reference_for_one_second(gl):
     gpu.run(60, 1 / 60)
     assert np.abs(cpu.positions() - gpu.positions()).max() < 1e-3
     # gusts and pleats: buckling amplifies float32 rounding (a 1e-7 m nudge of the float64
-    # run moves it by about a millimetre here too), so RMS is held to a centimetre
+    # run grows over the second: docs/cloth.md's generated table, catalog.bench.cloth_studies),
+    # so RMS is held to a centimetre, a bound with room for a longer or gustier run
     cpu, gpu = _pair(gl, opening=0.7, wind_speed_m_s=1.5)
     cpu.run(60, 1 / 60)
     gpu.run(60, 1 / 60)
