@@ -24,7 +24,7 @@ uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to th
 #ifdef OIT
 uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
 INTERPOLATION in vec3 v_position;
 #endif
 
@@ -96,8 +96,26 @@ uniform vec4 u_room_lamp_dyed[N_ROOM_LAMPS * NV4];
 float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set in main)
 #endif
 
+#ifdef KEY_SHADOW
+// The key light's visibility on the cloth (issue 11, model.md section 9): the window wall's
+// shadow (the opening's soft mask, room_window_beam) times the folds' shadow: the key's
+// front-layer map (room_shadow.frag, FRONT_LAYER: per texel the transmittance of the layer
+// of cloth nearest the light and its depth) dims a fragment lying behind that layer.
+uniform sampler2D u_key_front;     // rgb: the nearest layer's transmittance, a: its depth (0..1)
+uniform mat4 u_light_view_proj;
+uniform float u_key_depth_bias;    // depth (0..1 units) a fragment must lie behind to be shaded
+uniform vec4 u_window_rect;
+uniform vec2 u_wall_z;
+uniform float u_tan_sun_radius;
+vec4 g_key_visibility[NV4];        // per band chunk (set in main)
+#endif
+
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
+#ifdef KEY_SHADOW
+    vec4 band = g_key * (u_key_dyed[k] * g_key_visibility[k]) + g_fill * u_fill_dyed[k];
+#else
     vec4 band = g_key * u_key_dyed[k] + g_fill * u_fill_dyed[k];
+#endif
 #ifdef N_ROOM_LAMPS
     for (int j = 0; j < N_ROOM_LAMPS; ++j) {
         band += g_room_lamp[j] * u_room_lamp_dyed[j * NV4 + k];
@@ -154,10 +172,30 @@ void main() {
                                          u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
     // eq. 8 fluorescence, physical: fluorescence_effective_photons, N / (1 + N / N_sat), with its
     // denominator kept apart so that SHARED_DIVISION can fold it into the one division
+    float key_uv = 1.0;   // the key's excitation reaching the fragment (KEY_SHADOW)
+#ifdef KEY_SHADOW
+    {
+        float beam = room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z,
+                                      u_tan_sun_radius);
+        vec4 clip = u_light_view_proj * vec4(v_position, 1.0);
+        vec4 front = texture(u_key_front, clip.xy * 0.5 + 0.5);
+        float behind = step(front.a + u_key_depth_bias, clip.z * 0.5 + 0.5);
+        vec3 t = beam * mix(vec3(1.0), front.rgb, behind);
+#if N_BANDS == 3
+        g_key_visibility[0] = vec4(t, 0.0);
+#else
+        for (int k = 0; k < NV4; ++k) {
+            g_key_visibility[k] = vec4(dot(t, vec3(LUMA_R, LUMA_G, LUMA_B)));
+        }
+#endif
+        // UV excitation through a fold: the gaps only (LD), as the reference's shadow ray
+        key_uv = beam * mix(1.0, u_direct, behind);
+    }
+#endif
     float absorbed = 0.0;
     float saturation = 1.0;
 #ifdef FLUORESCENCE_PHYSICAL
-    absorbed = abs(cos_key) * u_absorbed_photons.x + abs(cos_fill) * u_absorbed_photons.y
+    absorbed = abs(cos_key) * key_uv * u_absorbed_photons.x + abs(cos_fill) * u_absorbed_photons.y
              + u_absorbed_photons.z;
     saturation = 1.0 + absorbed * u_inv_saturation;
 #endif

@@ -29,7 +29,7 @@ INTERPOLATION out vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 INTERPOLATION out vec3 v_tangent;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
 INTERPOLATION out vec3 v_position;
 #endif
 
@@ -43,7 +43,7 @@ void main() {
 #ifdef PATTERN
     v_pattern_uv = in_uv * u_uv_to_repeats;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
     v_position = position;
 #endif
     gl_Position = u_view_proj * vec4(position, 1.0);

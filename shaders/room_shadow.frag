@@ -34,5 +34,11 @@ float curtain_coverage(vec2 uv) {
 
 void main() {
     float c = curtain_coverage(v_uv);
+#ifdef FRONT_LAYER
+    // the key's front-layer map (curtain.frag, KEY_SHADOW): the nearest layer's transmittance
+    // and its depth, kept by the depth test (no blending)
+    out_transmittance = vec4(vec3(1.0 - c) + c * u_thread_beam_rgb, gl_FragCoord.z);
+#else
     out_transmittance = vec4(vec3(1.0 - c) + c * u_thread_beam_rgb, 1.0);
+#endif
 }

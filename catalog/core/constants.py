@@ -22,4 +22,5 @@ FLUORESCENT_MODES = FLUORESCENCE_MODES[1:]
 HG_MIRROR_BELOW = -0.2
 
 #: What every shader program gets as #define (name -> value), from the constants above.
-SHADER_DEFINES = {"HG_MIRROR_BELOW": HG_MIRROR_BELOW}
+SHADER_DEFINES = {"HG_MIRROR_BELOW": HG_MIRROR_BELOW, "LUMA_R": LUMA_REC709[0],
+                  "LUMA_G": LUMA_REC709[1], "LUMA_B": LUMA_REC709[2]}

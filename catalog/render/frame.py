@@ -74,6 +74,12 @@ MAX_SPECIALISED = 8
 PATTERN_UNIT = 3
 #: Texture unit of the environment image (background and the curtain's see-through).
 ENVIRONMENT_UNIT = 5
+#: Texture unit of the key light's front-layer map (the curtain's KEY_SHADOW).
+KEY_FRONT_UNIT = 6
+#: How far (m, along the key's travel) a fragment must lie behind the cloth layer nearest the
+#: key light to be in that layer's shadow: a little over one texel of the front-layer map on a
+#: fold's flank (room_light.SHADOW_TEXELS over ~2.4 m: 1 cm), so a layer does not shade itself.
+KEY_SHADOW_BIAS_M = 0.02
 PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
@@ -238,6 +244,9 @@ class FrameRenderer:
         self._last = None  # (vw, vh, fbo, viewport)
         #: issue 13: the room lit through the curtain (False: the earlier constant room)
         self.room_lighting = True
+        #: issue 11: the key light on the cloth shaded by the window wall and by the folds
+        #: nearer the light (curtain.frag KEY_SHADOW; False: the key reaches every fragment)
+        self.key_shadow = True
         self.curtain_open = False
         self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
         self._room_gl = None
@@ -389,6 +398,11 @@ class FrameRenderer:
         """Light the room through the curtain (shadow map, area light, bounce: issue 13) or
         keep the earlier constant room (a fraction of the key light plus the fill light)."""
         self.room_lighting = bool(on)
+
+    def set_key_shadow(self, on: bool) -> None:
+        """Shade the key light on the cloth by the window wall and the folds nearer the light
+        (issue 11; curtain.frag KEY_SHADOW), or let it reach every fragment (the earlier frame)."""
+        self.key_shadow = bool(on)
 
     def set_curtain_open(self, open_: bool) -> None:
         """Open: the curtain is drawn aside (not drawn, casts nothing, lights nothing)."""
@@ -607,6 +621,8 @@ class FrameRenderer:
             defines["CURTAIN_ENVIRONMENT"] = True  # the see-through shows the image
         if self.room_lamps:
             defines["N_ROOM_LAMPS"] = len(self.room_lamps)   # the lamps light the cloth too
+        if self.key_shadow and not self.curtain_open:
+            defines["KEY_SHADOW"] = True   # the wall's and the folds' shadow on the cloth
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -835,6 +851,8 @@ class FrameRenderer:
                 self.environment[1].use(location=ENVIRONMENT_UNIT)
                 self._set(program, "u_environment", ENVIRONMENT_UNIT)
                 self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
+            if "u_key_front" in program:
+                self._key_shadow_uniforms(program, self.shading_inputs())
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
 
@@ -1016,7 +1034,13 @@ class FrameRenderer:
             ao = ctx.texture((aw, ah), 4, data=room_light.ao_and_mask_texture().tobytes(), dtype="f4")
             ao.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             ao.build_mipmaps()
+            key_front = ctx.texture((n, n), 4, dtype="f4")
+            key_front.filter = (mgl.NEAREST, mgl.NEAREST)
+            key_front.repeat_x = key_front.repeat_y = False
+            key_front_depth = ctx.depth_renderbuffer((n, n))
             self._room_gl = {
+                "key_front": key_front, "key_front_depth": key_front_depth,
+                "key_front_fbo": ctx.framebuffer([key_front], key_front_depth),
                 "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
                 "luminaire": luminaire, "luminaire_depth": luminaire_depth,
                 "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
@@ -1041,6 +1065,23 @@ class FrameRenderer:
         return {"u_key_rgb": tuple(float(v) for v in key), "u_mean_coverage": 1.0 - float(inputs.direct),
                 "u_thread_beam_rgb": tuple(float(v) for v in thread)}
 
+    def _key_shadow_uniforms(self, program, inputs) -> None:
+        """curtain.frag's KEY_SHADOW: the front-layer map, its frame and depth bias, the opening."""
+        gl = self._room_resources()
+        gl["key_front"].use(location=KEY_FRONT_UNIT)
+        s = self._set
+        s(program, "u_key_front", KEY_FRONT_UNIT)
+        matrix = room_light.light_view_projection(inputs.key_to_light)
+        s(program, "u_light_view_proj", gl_bytes(matrix))
+        # orthographic: window depth (0..1) = 0.5 ndc z + 0.5, ndc z = m[2, 2] z_view + ..:
+        # one metre along the travel is -m[2, 2] / 2 of depth
+        s(program, "u_key_depth_bias", KEY_SHADOW_BIAS_M * abs(float(matrix[2, 2])) / 2)
+        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+        z0 = scene_lib.ROOM_BOX[2][0]
+        s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
+        s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
+        s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
+
     def _room_common_uniforms(self, program, inputs) -> None:
         s = self._set
         for name, value in room_light.face_uniforms().items():
@@ -1048,15 +1089,17 @@ class FrameRenderer:
         wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
         z0 = scene_lib.ROOM_BOX[2][0]
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
-        s(program, "u_wall_z", (z0, z0 - 0.1))
+        s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
         s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
         s(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_key_rgb", self._room_colours(inputs)["u_key_rgb"])
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
         s(program, "u_albedo", scene_lib.ROOM_ALBEDO)
 
-    def _shadow_vao(self, program):
-        key = ("shadow", id(program))
+    def _shadow_vao(self, program, fine: bool = False):
+        """The curtain from the key light (coarse grid; ``fine``: the drawn mesh itself, for
+        the cloth's own shadow, whose depth must match the shaded surface's)."""
+        key = ("shadow", id(program), fine)
         if key not in self._vaos:
             b = self._curtain_buffers
             if self._curtain_format == "interleaved":
@@ -1066,7 +1109,7 @@ class FrameRenderer:
             if "in_uv" in program and "uv" in b and self._curtain_format != "interleaved":
                 content.append((b["uv"], "2f", "in_uv"))
             self._vaos[key] = self.ctx.vertex_array(
-                program, content, index_buffer=b.get("coarse_index", b["index"]),
+                program, content, index_buffer=b["index"] if fine else b.get("coarse_index", b["index"]),
                 index_element_size=4)
         return self._vaos[key]
 
@@ -1103,7 +1146,35 @@ class FrameRenderer:
             self._shadow_vao(program).render(mgl.TRIANGLES)
             self.ctx.blend_func = mgl.DEFAULT_BLENDING
             self.ctx.disable(mgl.BLEND)
+            if self.key_shadow:
+                self._draw_key_front(inputs, patterned, colours)
         gl["shadow"].build_mipmaps()
+
+    def _draw_key_front(self, inputs, patterned: bool, colours: dict) -> None:
+        """The key light's front-layer map (curtain.frag KEY_SHADOW): per texel the layer of
+        cloth nearest the light, its transmittance (as the room's map, one layer) and depth."""
+        mgl, gl = self._moderngl, self._room_resources()
+        n = room_light.SHADOW_TEXELS
+        gl["key_front_fbo"].use()
+        self.ctx.viewport = (0, 0, n, n)
+        gl["key_front_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
+        program = self._program("room_shadow.vert", "room_shadow.frag",
+                                {"HAS_UV": True, "PATTERN": patterned, "FRONT_LAYER": True})
+        if patterned:
+            self._pattern_texture.use(location=3)
+            self._set(program, "u_pattern", 3)
+            self._set(program, "u_uv_to_repeats", tuple(
+                f / r for f, r in zip(self._fabric_size_m, self._pattern_repeat_m)))
+        self._set(program, "u_light_view_proj",
+                  gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+        self._set(program, "u_mesh_offset", self._mesh_offset)
+        self._set(program, "u_mean_coverage", colours["u_mean_coverage"])
+        self._set(program, "u_thread_beam_rgb", colours["u_thread_beam_rgb"])
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<"
+        self.ctx.disable(mgl.CULL_FACE)
+        self._shadow_vao(program, fine=True).render(mgl.TRIANGLES)
+        self.ctx.disable(mgl.DEPTH_TEST)
 
     def draw_room_luminaire(self, inputs) -> None:
         """Pass R2: what the room sees in the window (the curtain's room-side radiance, or the
@@ -1216,7 +1287,7 @@ class FrameRenderer:
 
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
-        key = (self._inputs_key, self.curtain_open, getattr(self, "patterned", None),
+        key = (self._inputs_key, self.curtain_open, self.key_shadow, getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
@@ -1256,10 +1327,11 @@ class FrameRenderer:
         inputs = self.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
-        if self.room_lighting and self._room_light_stale():
+        if (self.room_lighting or self.key_shadow) and self._room_light_stale():
             self._timed(profile, "room_shadow", lambda: self.draw_room_shadow(inputs))
-            self._timed(profile, "room_luminaire", lambda: self.draw_room_luminaire(inputs))
-            self._timed(profile, "room_lightmap", lambda: self.draw_room_lightmap(inputs))
+            if self.room_lighting:
+                self._timed(profile, "room_luminaire", lambda: self.draw_room_luminaire(inputs))
+                self._timed(profile, "room_lightmap", lambda: self.draw_room_lightmap(inputs))
         msaa = self._msaa_targets() if self.antialiasing == "msaa" else None
         hdr_fbo = msaa["hdr_fbo"] if msaa else self._hdr_fbo
         hdr_fbo.use()
@@ -1555,7 +1627,8 @@ class FrameRenderer:
             "white_balance": self.white_balance,
             "white_balance_adapted": not np.allclose(self.white_balance_matrix(), np.eye(3)),
             "size": list(self.size),
-            "room_lighting": self.room_lighting, "curtain_open": self.curtain_open,
+            "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
+            "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
             "environment": None if self.environment is None else self.environment[0],
             "room_lamps": [[light.name, list(position)] for light, position in self.room_lamps],

@@ -39,6 +39,8 @@ WINDOW_RECT = (-0.95, 0.95, -0.9, 1.35)
 #: The room box (x, y, z extents), metres.
 ROOM_BOX = ((-2.2, 2.2), (-1.3, 1.7), (WINDOW_Z, 4.5))
 CURTAIN_TOP_Y = 1.25
+#: The walls' thickness (m): the window's reveals are this deep.
+WALL_THICKNESS_M = 0.1
 CURTAIN_Z = -0.08
 CURTAIN_WIDTH_M = 1.7
 CURTAIN_HEIGHT_M = 2.2
@@ -171,7 +173,7 @@ def ring_mesh(xs_m) -> tuple[np.ndarray, np.ndarray]:
 def _room_parts() -> list[np.ndarray]:
     (x0, x1), (y0, y1), (z0, z1) = ROOM_BOX
     wx0, wx1, wy0, wy1 = WINDOW_RECT
-    t = 0.1  # wall thickness
+    t = WALL_THICKNESS_M
     return [
         box_triangles(x0 - t, x1 + t, y0 - t, y0, z0 - t, z1 + t),       # floor
         box_triangles(x0 - t, x1 + t, y1, y1 + t, z0 - t, z1 + t),       # ceiling
