@@ -72,6 +72,7 @@ layout(location = 1) out vec4 out_oit_weight;
 layout(location = 1) out vec4 out_position;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_tangent;
+layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, outside occlusion
 #endif
 
 // One chunk of 4 bands: eq. 8's terms summed, then projected to display colour. Called with a
@@ -99,20 +100,41 @@ float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set
 #ifdef KEY_SHADOW
 // The key light's visibility on the cloth (issue 11, model.md section 9): the window wall's
 // shadow (the opening's soft mask, room_window_beam) times the folds' shadow: the key's
-// front-layer map (room_shadow.frag, FRONT_LAYER: per texel the transmittance of the layer
-// of cloth nearest the light and its depth) dims a fragment lying behind that layer.
-uniform sampler2D u_key_front;     // rgb: the nearest layer's transmittance, a: its depth (0..1)
+// front-layer map (room_shadow.frag, FRONT_LAYER: per texel the thread coverage c of the
+// layer of cloth nearest the light and its depth); a fragment behind that layer receives the
+// beam through it, (1 - c) key dye + c key dye thread (u_key_thread: c = 1), the float64
+// twin's layer_beam_transmittance, and the excitation through its holes, 1 - c.
+SCENE_VALUE(vec4, u_key_thread[NV4], S_KEY_THREAD);
+uniform sampler2D u_key_front;     // r: the nearest layer's coverage, a: its depth (0..1)
 uniform mat4 u_light_view_proj;
 uniform float u_key_depth_bias;    // depth (0..1 units) a fragment must lie behind to be shaded
 uniform vec4 u_window_rect;
 uniform vec2 u_wall_z;
 uniform float u_tan_sun_radius;
-vec4 g_key_visibility[NV4];        // per band chunk (set in main)
+float g_key_beam = 1.0;            // the window's mask (set in main)
+float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
+#endif
+#ifdef SKY_OCCLUSION
+// The outside hidden by the cloth's own folds (issue 11, model.md section 9): the fraction
+// of N_OCCLUSION directions (cosine-weighted about the window's normal) in which a layer of
+// cloth lies between the fragment and the outside, from one front-layer depth map per
+// direction (tiles of u_occlusion_maps); the ambient term loses that fraction of what a
+// layer does not pass (u_ambient_occluded: the float64 twin's outside_occluded_radiance).
+SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
+uniform sampler2D u_occlusion_maps; // a: the nearest layer's depth, tile j of a square grid
+uniform mat4 u_occlusion_view_proj[N_OCCLUSION];
+uniform float u_occlusion_depth_bias[N_OCCLUSION];
+uniform vec3 u_occlusion_direction[N_OCCLUSION];   // towards the outside
+uniform float u_occlusion_grid;     // tiles per side
+uniform float u_occlusion_offset_m; // the lookup moved off the surface towards the direction
+float g_occlusion = 0.0;            // set in main
 #endif
 
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
 #ifdef KEY_SHADOW
-    vec4 band = g_key * (u_key_dyed[k] * g_key_visibility[k]) + g_fill * u_fill_dyed[k];
+    vec4 key_seen = g_key_beam * ((1.0 - g_front_coverage) * u_key_dyed[k]
+                                  + g_front_coverage * u_key_thread[k]);
+    vec4 band = g_key * key_seen + g_fill * u_fill_dyed[k];
 #else
     vec4 band = g_key * u_key_dyed[k] + g_fill * u_fill_dyed[k];
 #endif
@@ -122,6 +144,9 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
     }
 #endif
     vec4 constant = u_ambient[k];
+#ifdef SKY_OCCLUSION
+    constant -= g_occlusion * u_ambient_occluded[k];
+#endif
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
 #endif
@@ -175,21 +200,29 @@ void main() {
     float key_uv = 1.0;   // the key's excitation reaching the fragment (KEY_SHADOW)
 #ifdef KEY_SHADOW
     {
-        float beam = room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z,
+        g_key_beam = room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z,
                                       u_tan_sun_radius);
         vec4 clip = u_light_view_proj * vec4(v_position, 1.0);
         vec4 front = texture(u_key_front, clip.xy * 0.5 + 0.5);
-        float behind = step(front.a + u_key_depth_bias, clip.z * 0.5 + 0.5);
-        vec3 t = beam * mix(vec3(1.0), front.rgb, behind);
-#if N_BANDS == 3
-        g_key_visibility[0] = vec4(t, 0.0);
-#else
-        for (int k = 0; k < NV4; ++k) {
-            g_key_visibility[k] = vec4(dot(t, vec3(LUMA_R, LUMA_G, LUMA_B)));
-        }
+        g_front_coverage = front.r * step(front.a + u_key_depth_bias, clip.z * 0.5 + 0.5);
+        key_uv = g_key_beam * (1.0 - g_front_coverage);   // UV passes the holes only
+    }
 #endif
-        // UV excitation through a fold: the gaps only (LD), as the reference's shadow ray
-        key_uv = beam * mix(1.0, u_direct, behind);
+#ifdef SKY_OCCLUSION
+    {
+        vec3 ng = normalize(v_normal);
+        float hidden = 0.0;
+        for (int j = 0; j < N_OCCLUSION; ++j) {
+            vec3 d = u_occlusion_direction[j];
+            // off the surface on the direction's side (normal offset: no self-shadowing)
+            vec3 q = v_position + (u_occlusion_offset_m * sign(dot(ng, d))) * ng;
+            vec4 clip = u_occlusion_view_proj[j] * vec4(q, 1.0);
+            vec2 tile = vec2(mod(float(j), u_occlusion_grid), floor(float(j) / u_occlusion_grid));
+            vec2 uv = (tile + clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0)) / u_occlusion_grid;
+            float depth = texture(u_occlusion_maps, uv).a;
+            hidden += step(depth + u_occlusion_depth_bias[j], clip.z * 0.5 + 0.5);
+        }
+        g_occlusion = hidden / float(N_OCCLUSION);
     }
 #endif
     float absorbed = 0.0;
@@ -262,5 +295,13 @@ void main() {
     out_position = vec4(v_position, 1.0);
     out_normal = vec4(n, 1.0);
     out_tangent = vec4(normalize(v_tangent - dot(v_tangent, n) * n), 1.0);
+    vec3 shadows = vec3(1.0, 0.0, 0.0);
+#ifdef KEY_SHADOW
+    shadows.xy = vec2(g_key_beam, g_front_coverage);
+#endif
+#ifdef SKY_OCCLUSION
+    shadows.z = g_occlusion;
+#endif
+    out_shadows = vec4(shadows, 1.0);
 #endif
 }

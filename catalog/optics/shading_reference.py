@@ -66,6 +66,7 @@ class ShadingInputs:
     absorbed_photons: tuple[float, float, float] = (0.0, 0.0, 0.0)  # key, fill (normal incidence), ambient; m^-2 s^-1
     saturation_photons: float = math.inf  # N_sat, m^-2 s^-1
     emission_per_photon: np.ndarray | None = None     # radiance per effective absorbed photon m^-2 s^-1, per side
+    ambient_outside_radiance: np.ndarray | None = None  # the outside's share of ambient_radiance (None: 0)
 
 
 # --------------------------------------------------------------------------- terms
@@ -145,11 +146,45 @@ def hg_hemisphere_factors(g: float) -> tuple[float, float]:
     return (1.0 + g) / 2.0 - shared, (1.0 - g) / 2.0 - shared
 
 
+# --------------------------------------------------------------------------- the cloth's own shadow (issue 11)
+
+def layer_beam_transmittance(inputs: ShadingInputs, coverage) -> np.ndarray:
+    """(P, L): the key light's beam after one layer of cloth of thread coverage ``coverage``
+    (P,) (model.md section 9): the holes pass it, a thread passes the directional lobe's
+    forward-scattered part in the dye's colour per unit of mean coverage,
+    T = (1 - c) + c a_spec forward(g_spec) dye / (1 - LD). c = 0: no layer (T = 1)."""
+    c = np.asarray(coverage, dtype=np.float64).reshape(-1, 1)
+    forward = hg_hemisphere_factors(inputs.g_spec)[0]
+    thread = inputs.a_spec * forward * inputs.dye_transmittance / max(1.0 - inputs.direct, 1e-6)
+    return (1.0 - c) + c * thread[None, :]
+
+
+def outside_occluded_radiance(inputs: ShadingInputs) -> np.ndarray:
+    """(L,): the ambient radiance a fully occluded outside takes away (model.md section 9):
+    the outside's share of the ambient term times what a layer of cloth in the way does not
+    pass of diffuse light, 1 - (LD + dye (a_diff forward(g_diff) + a_spec forward(g_spec)))."""
+    if inputs.ambient_outside_radiance is None:
+        return np.zeros_like(inputs.ambient_radiance)
+    forward_d = hg_hemisphere_factors(inputs.g_diff)[0]
+    forward_s = hg_hemisphere_factors(inputs.g_spec)[0]
+    passed = inputs.direct + inputs.dye_transmittance * (inputs.a_diff * forward_d
+                                                         + inputs.a_spec * forward_s)
+    return (1.0 - passed) * inputs.ambient_outside_radiance
+
+
 # --------------------------------------------------------------------------- shading
 
 def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
-                   camera_position) -> np.ndarray:
-    """Spectral radiance (P, len(GRID_NM)) W m^-2 sr^-1 nm^-1 at world positions (P, 3)."""
+                   camera_position, key_beam=None, front_coverage=None,
+                   outside_occlusion=None) -> np.ndarray:
+    """Spectral radiance (P, len(GRID_NM)) W m^-2 sr^-1 nm^-1 at world positions (P, 3).
+
+    The cloth's shadows (issue 11, model.md section 9), per position (P,), default none:
+    ``key_beam`` the window's mask on the key light (0..1), ``front_coverage`` the thread
+    coverage of the layer of cloth between the position and the key light (0: none; the beam
+    is multiplied by :func:`layer_beam_transmittance`, the excitation by 1 - c),
+    ``outside_occlusion`` the fraction of the outside hidden by the cloth itself (the ambient
+    term loses that fraction of :func:`outside_occluded_radiance`)."""
     p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     n = n / np.linalg.norm(n, axis=1, keepdims=True)
@@ -165,8 +200,15 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
     g_fill = woven_transmission(inputs.fill_to_light, to_viewer, t, b, n, inputs)
     dyed_key = inputs.key_irradiance * inputs.dye_transmittance
     dyed_fill = inputs.fill_irradiance * inputs.dye_transmittance
-    radiance = (g_key[:, None] * dyed_key + g_fill[:, None] * dyed_fill
+    count = p.shape[0]
+    beam = np.ones(count) if key_beam is None else np.asarray(key_beam, dtype=np.float64).reshape(-1)
+    cover = np.zeros(count) if front_coverage is None else np.asarray(front_coverage, dtype=np.float64).reshape(-1)
+    key_seen = beam[:, None] * layer_beam_transmittance(inputs, cover) * dyed_key[None, :]
+    radiance = (g_key[:, None] * key_seen + g_fill[:, None] * dyed_fill
                 + inputs.ambient_radiance[None, :])
+    if outside_occlusion is not None:
+        radiance -= (np.asarray(outside_occlusion, dtype=np.float64).reshape(-1, 1)
+                     * outside_occluded_radiance(inputs)[None, :])
     if inputs.direct > 0:
         w = inputs.direct * background_weights(ray, inputs.key_to_light, *inputs.sun_chord2)
         radiance += (w[:, 0:1] * inputs.sky_radiance + w[:, 1:2] * inputs.ground_radiance
@@ -175,11 +217,18 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
         radiance += inputs.paper_radiance[None, :]  # eq. 8: a constant per light
     elif inputs.fluorescence_mode == "physical":
         n_key, n_fill, n_ambient = inputs.absorbed_photons
-        absorbed = (np.abs(n @ np.asarray(inputs.key_to_light)) * n_key
+        absorbed = (np.abs(n @ np.asarray(inputs.key_to_light)) * (beam * (1.0 - cover)) * n_key
                     + np.abs(n @ np.asarray(inputs.fill_to_light)) * n_fill + n_ambient)
         effective = absorbed / (1.0 + absorbed / inputs.saturation_photons)
         radiance += effective[:, None] * inputs.emission_per_photon[None, :]
     return radiance
+
+
+def shadow_terms(shadows) -> dict:
+    """:func:`shade_spectral`'s shadow arguments from the frame's G-buffer ``shadows`` (P, 3):
+    the key's window mask, the coverage of the layer in front of the key, the occlusion."""
+    s = np.asarray(shadows, dtype=np.float64).reshape(-1, 3)
+    return {"key_beam": s[:, 0], "front_coverage": s[:, 1], "outside_occlusion": s[:, 2]}
 
 
 def spectral_to_linear_srgb(radiance: np.ndarray) -> np.ndarray:
@@ -197,10 +246,11 @@ def spectral_to_xyz(radiance: np.ndarray) -> np.ndarray:
 
 
 def reference_linear_srgb(inputs: ShadingInputs, positions, normals, tangents,
-                          camera_position) -> np.ndarray:
-    """The full-spectral (1 nm) float64 reference colour of the given pixels, (P, 3)."""
+                          camera_position, **shadows) -> np.ndarray:
+    """The full-spectral (1 nm) float64 reference colour of the given pixels, (P, 3);
+    ``shadows``: :func:`shade_spectral`'s key_beam, front_coverage, outside_occlusion."""
     return spectral_to_linear_srgb(shade_spectral(inputs, positions, normals, tangents,
-                                                  camera_position))
+                                                  camera_position, **shadows))
 
 
 def white_xyz(inputs: ShadingInputs) -> np.ndarray:

@@ -22,7 +22,8 @@ import math
 import numpy as np
 
 from catalog.core.errors import CatalogError
-from catalog.optics.shading_reference import LUMINOUS_EFFICACY_LM_W, PHOTON_UNIT, STEP_NM, ShadingInputs
+from catalog.optics.shading_reference import (LUMINOUS_EFFICACY_LM_W, PHOTON_UNIT, STEP_NM, ShadingInputs,
+                                              layer_beam_transmittance, outside_occluded_radiance)
 from catalog.optics.spectra import GRID_NM
 
 #: Band counts the shaders are built for.
@@ -95,6 +96,10 @@ def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray |
         "u_key_dyed": band(inputs.key_irradiance * inputs.dye_transmittance),
         "u_fill_dyed": band(inputs.fill_irradiance * inputs.dye_transmittance),
         "u_ambient": band(inputs.ambient_radiance),
+        # issue 11's shadows on the cloth (KEY_SHADOW, SKY_OCCLUSION in curtain.frag)
+        "u_key_thread": band(inputs.key_irradiance * inputs.dye_transmittance
+                             * layer_beam_transmittance(inputs, [1.0])[0]),
+        "u_ambient_occluded": band(outside_occluded_radiance(inputs)),
         "u_sky": band(inputs.sky_radiance),
         "u_ground": band(inputs.ground_radiance),
         "u_sun_disc": band(inputs.sun_disc_radiance),

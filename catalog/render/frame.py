@@ -80,6 +80,12 @@ KEY_FRONT_UNIT = 6
 #: key light to be in that layer's shadow: a little over one texel of the front-layer map on a
 #: fold's flank (room_light.SHADOW_TEXELS over ~2.4 m: 1 cm), so a layer does not shade itself.
 KEY_SHADOW_BIAS_M = 0.02
+#: Texture unit of the occlusion maps (the curtain's SKY_OCCLUSION).
+OCCLUSION_UNIT = 7
+#: SKY_OCCLUSION's depth bias (m) and its lookup's offset off the surface (m): a texel and a
+#: half of an occlusion map (room_light.OCCLUSION_TEXELS over ~2.4 m: 2 cm each).
+OCCLUSION_BIAS_M = 0.01
+OCCLUSION_OFFSET_M = 0.03
 PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
@@ -247,6 +253,9 @@ class FrameRenderer:
         #: issue 11: the key light on the cloth shaded by the window wall and by the folds
         #: nearer the light (curtain.frag KEY_SHADOW; False: the key reaches every fragment)
         self.key_shadow = True
+        #: issue 11: the cloth's own folds hide part of the outside from its ambient term
+        #: (curtain.frag SKY_OCCLUSION; False: every fragment sees the whole outside)
+        self.sky_occlusion = True
         self.curtain_open = False
         self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
         self._room_gl = None
@@ -403,6 +412,11 @@ class FrameRenderer:
         """Shade the key light on the cloth by the window wall and the folds nearer the light
         (issue 11; curtain.frag KEY_SHADOW), or let it reach every fragment (the earlier frame)."""
         self.key_shadow = bool(on)
+
+    def set_sky_occlusion(self, on: bool) -> None:
+        """Let the cloth's own folds hide part of the outside from its ambient term (issue 11;
+        curtain.frag SKY_OCCLUSION), or let every fragment see the whole outside."""
+        self.sky_occlusion = bool(on)
 
     def set_curtain_open(self, open_: bool) -> None:
         """Open: the curtain is drawn aside (not drawn, casts nothing, lights nothing)."""
@@ -623,6 +637,9 @@ class FrameRenderer:
             defines["N_ROOM_LAMPS"] = len(self.room_lamps)   # the lamps light the cloth too
         if self.key_shadow and not self.curtain_open:
             defines["KEY_SHADOW"] = True   # the wall's and the folds' shadow on the cloth
+        if self.sky_occlusion and not self.curtain_open:
+            defines["SKY_OCCLUSION"] = True   # the folds hide part of the outside
+            defines["N_OCCLUSION"] = room_light.OCCLUSION_DIRECTIONS
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -853,6 +870,8 @@ class FrameRenderer:
                 self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
             if "u_key_front" in program:
                 self._key_shadow_uniforms(program, self.shading_inputs())
+            if "u_occlusion_maps" in program:
+                self._occlusion_uniforms(program)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
 
@@ -1038,9 +1057,15 @@ class FrameRenderer:
             key_front.filter = (mgl.NEAREST, mgl.NEAREST)
             key_front.repeat_x = key_front.repeat_y = False
             key_front_depth = ctx.depth_renderbuffer((n, n))
+            side = self._occlusion_grid() * room_light.OCCLUSION_TEXELS
+            occlusion = ctx.texture((side, side), 4, dtype="f4")
+            occlusion.filter = (mgl.NEAREST, mgl.NEAREST)
+            occlusion_depth = ctx.depth_renderbuffer((side, side))
             self._room_gl = {
                 "key_front": key_front, "key_front_depth": key_front_depth,
                 "key_front_fbo": ctx.framebuffer([key_front], key_front_depth),
+                "occlusion": occlusion, "occlusion_depth": occlusion_depth,
+                "occlusion_fbo": ctx.framebuffer([occlusion], occlusion_depth),
                 "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
                 "luminaire": luminaire, "luminaire_depth": luminaire_depth,
                 "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
@@ -1081,6 +1106,25 @@ class FrameRenderer:
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
         s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
+
+    def _occlusion_uniforms(self, program) -> None:
+        """curtain.frag's SKY_OCCLUSION: the occlusion maps and each direction's frame."""
+        gl = self._room_resources()
+        gl["occlusion"].use(location=OCCLUSION_UNIT)
+        s = self._set
+        s(program, "u_occlusion_maps", OCCLUSION_UNIT)
+        directions = room_light.occlusion_directions()
+        matrices = [room_light.light_view_projection(d) for d in directions]
+        s(program, "u_occlusion_view_proj", b"".join(gl_bytes(m) for m in matrices))
+        s(program, "u_occlusion_depth_bias",
+          tuple(OCCLUSION_BIAS_M * abs(float(m[2, 2])) / 2 for m in matrices))
+        s(program, "u_occlusion_direction", np.asarray(directions, dtype="f4"))
+        s(program, "u_occlusion_grid", float(self._occlusion_grid()))
+        s(program, "u_occlusion_offset_m", OCCLUSION_OFFSET_M)
+
+    @staticmethod
+    def _occlusion_grid() -> int:
+        return math.ceil(math.sqrt(room_light.OCCLUSION_DIRECTIONS))
 
     def _room_common_uniforms(self, program, inputs) -> None:
         s = self._set
@@ -1146,9 +1190,44 @@ class FrameRenderer:
             self._shadow_vao(program).render(mgl.TRIANGLES)
             self.ctx.blend_func = mgl.DEFAULT_BLENDING
             self.ctx.disable(mgl.BLEND)
-            if self.key_shadow:
-                self._draw_key_front(inputs, patterned, colours)
         gl["shadow"].build_mipmaps()
+        self.draw_cloth_shadow_maps(inputs)
+
+    def draw_cloth_shadow_maps(self, inputs) -> None:
+        """The maps of the cloth's own shadows (issue 11): the key's front layer (KEY_SHADOW)
+        and the occlusion maps (SKY_OCCLUSION), when they are on and the curtain is drawn."""
+        if self.curtain_open:
+            return
+        pattern = getattr(self, "_pattern_texture", None)
+        patterned = (pattern is not None and getattr(self, "patterned", False)
+                     and self._curtain_format != "interleaved")
+        if self.key_shadow:
+            self._draw_key_front(inputs, patterned, self._room_colours(inputs))
+        if self.sky_occlusion:
+            self._draw_occlusion_maps()
+
+    def _draw_occlusion_maps(self) -> None:
+        """SKY_OCCLUSION's maps: per direction of room_light.occlusion_directions, the depth
+        of the layer of cloth nearest the outside along it (one tile each)."""
+        mgl, gl = self._moderngl, self._room_resources()
+        n = room_light.OCCLUSION_TEXELS
+        grid = self._occlusion_grid()
+        gl["occlusion_fbo"].use()
+        gl["occlusion_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
+        program = self._program("room_shadow.vert", "room_shadow.frag",
+                                {"HAS_UV": True, "PATTERN": False, "FRONT_LAYER": True})
+        self._set(program, "u_mesh_offset", self._mesh_offset)
+        self._set(program, "u_mean_coverage", 1.0)
+        self._set(program, "u_thread_beam_rgb", (0.0, 0.0, 0.0))
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<"
+        self.ctx.disable(mgl.CULL_FACE)
+        vao = self._shadow_vao(program, fine=True)
+        for j, direction in enumerate(room_light.occlusion_directions()):
+            self.ctx.viewport = ((j % grid) * n, (j // grid) * n, n, n)
+            self._set(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(direction)))
+            vao.render(mgl.TRIANGLES)
+        self.ctx.disable(mgl.DEPTH_TEST)
 
     def _draw_key_front(self, inputs, patterned: bool, colours: dict) -> None:
         """The key light's front-layer map (curtain.frag KEY_SHADOW): per texel the layer of
@@ -1287,7 +1366,8 @@ class FrameRenderer:
 
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
-        key = (self._inputs_key, self.curtain_open, self.key_shadow, getattr(self, "patterned", None),
+        key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
+               getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
@@ -1327,11 +1407,13 @@ class FrameRenderer:
         inputs = self.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
-        if (self.room_lighting or self.key_shadow) and self._room_light_stale():
-            self._timed(profile, "room_shadow", lambda: self.draw_room_shadow(inputs))
-            if self.room_lighting:
+        if (self.room_lighting or self.key_shadow or self.sky_occlusion) and self._room_light_stale():
+            if self.room_lighting:   # the room's passes (the cloth's own shadow maps with them)
+                self._timed(profile, "room_shadow", lambda: self.draw_room_shadow(inputs))
                 self._timed(profile, "room_luminaire", lambda: self.draw_room_luminaire(inputs))
                 self._timed(profile, "room_lightmap", lambda: self.draw_room_lightmap(inputs))
+            else:
+                self._timed(profile, "cloth_shadow", lambda: self.draw_cloth_shadow_maps(inputs))
         msaa = self._msaa_targets() if self.antialiasing == "msaa" else None
         hdr_fbo = msaa["hdr_fbo"] if msaa else self._hdr_fbo
         hdr_fbo.use()
@@ -1578,12 +1660,16 @@ class FrameRenderer:
 
     def render_gbuffer(self) -> dict[str, np.ndarray]:
         """The curtain alone with the G-buffer variant: radiance and the per-pixel geometry the
-        shader used (world position, unit normal, weft tangent), float32 (H, W, 3) each, and a
-        boolean mask of curtain pixels. The reference shades these positions in float64."""
+        shader used (world position, unit normal, weft tangent), float32 (H, W, 3) each, a
+        boolean mask of curtain pixels, and ``shadows`` (H, W, 3): the key's window mask, the
+        coverage of the layer in front of the key and the outside's occlusion (issue 11; 1, 0,
+        0 where those are off). The reference shades these positions in float64."""
         mgl = self._moderngl
         w, h = self.size
+        if self.key_shadow or self.sky_occlusion:   # the cloth's shadow maps of this mesh
+            self.draw_cloth_shadow_maps(self.shading_inputs())
         if self._gbuffer is None:
-            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(4)]
+            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(5)]
             depth = self.ctx.depth_renderbuffer((w, h))
             self._gbuffer = (textures, self.ctx.framebuffer(textures, depth))
         textures, fbo = self._gbuffer
@@ -1595,11 +1681,11 @@ class FrameRenderer:
         self.draw_curtain(self.camera.view_projection(w / h), gbuffer=True)
         self.ctx.disable(mgl.DEPTH_TEST)
         out = {}
-        for name, attachment in zip(("radiance", "position", "normal", "tangent"), range(4)):
+        for name, attachment in zip(("radiance", "position", "normal", "tangent", "shadows"), range(5)):
             data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
             out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
         out["mask"] = out["position"][..., 3] > 0.5
-        for name in ("radiance", "position", "normal", "tangent"):
+        for name in ("radiance", "position", "normal", "tangent", "shadows"):
             out[name] = out[name][..., :3]
         return out
 
@@ -1628,6 +1714,7 @@ class FrameRenderer:
             "white_balance_adapted": not np.allclose(self.white_balance_matrix(), np.eye(3)),
             "size": list(self.size),
             "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
+            "sky_occlusion": self.sky_occlusion,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
             "environment": None if self.environment is None else self.environment[0],

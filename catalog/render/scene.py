@@ -492,6 +492,12 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
     fwd_s, back_s = hg_hemisphere_factors(btdf.g_spec)
     ambient = dye * (btdf.a_diff * (fwd_d * behind + back_d * front)
                      + btdf.a_spec * (fwd_s * behind + back_s * front))
+    # the outside's share of it (the cloth's own folds hide part of the outside: issue 11)
+    outside = 0.5 * (sky + ground)
+    if viewer_inside:
+        ambient_outside = dye * (btdf.a_diff * fwd_d + btdf.a_spec * fwd_s) * outside
+    else:
+        ambient_outside = dye * (btdf.a_diff * back_d + btdf.a_spec * back_s) * outside
 
     decision = decide_fluorescence(preset, key, fluorescence)
     paper = None
@@ -513,7 +519,7 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         g_spec=btdf.g_spec, anisotropy=anisotropy, dye_transmittance=dye,
         ambient_radiance=ambient, fluorescence_mode=decision.used, paper_radiance=paper,
         absorbed_photons=absorbed, saturation_photons=saturation,
-        emission_per_photon=emission_per_photon)
+        emission_per_photon=emission_per_photon, ambient_outside_radiance=ambient_outside)
     if decision.used == "physical":
         inputs = with_physical_emission(inputs, fluorescent_material(preset, key))
     return inputs, decision
