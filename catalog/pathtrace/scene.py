@@ -398,15 +398,20 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     weights = emitter_sampling_weights(desc, emission)
     if environment:
         scene["environment"]["sampling_weight"] = weights["environment"]
+    radiance = {"type": "mesh_attribute", "name": "vertex_fluorescence"}
+    if desc.pattern is not None:  # the glow leaves through the threads (c / mean(c)), not the holes
+        glow = woven_bsdf_dict(desc.fabric, desc.pattern)
+        radiance = {"type": "patterned_glow", "base": radiance, "coverage": glow["coverage"],
+                    "coverage_mean": glow["coverage_mean"], "uv_scale_u": glow["uv_scale_u"],
+                    "uv_scale_v": glow["uv_scale_v"]}
     for side, sign in (("front", 1.0), ("back", -1.0)):
         shell_props = mi.Properties()
         shell_props["bsdf"] = mi.load_dict({"type": "null"})
         shell_props["emitter"] = mi.load_dict({"type": "area", "sampling_weight": weights["shell"],
-                                               "radiance": {"type": "mesh_attribute",
-                                                            "name": "vertex_fluorescence"}})
+                                               "radiance": radiance})
         faces = tri if sign > 0 else tri[:, ::-1]
         shell = _mesh(mi, f"fluorescence_{side}", p + sign * SHELL_OFFSET_M * n, faces,
-                      sign * n, None, shell_props)
+                      sign * n, uvs if desc.pattern is not None else None, shell_props)
         shell.add_attribute("vertex_fluorescence", 3,
                             np.ascontiguousarray(emission, dtype=np.float32).ravel())
         scene[f"fluorescence_{side}"] = shell

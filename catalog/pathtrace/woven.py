@@ -216,3 +216,47 @@ def register(mi) -> None:
                     f"a_spec={self.a_spec}, g_spec={self.g_spec}, anisotropy={self.anisotropy}]")
 
     mi.register_bsdf("woven", lambda props: WovenBSDF(props))
+
+    class PatternedGlow(mi.Texture):
+        """The fluorescence shells' radiance (plugin ``patterned_glow``, issue 11): a ``base``
+        texture (the per-vertex emission) times c(uv) / mean(c), the pattern's coverage, so
+        that the glow leaves through the threads, not the holes, and its mean over a repeat is
+        the base (as the frame's patterned curtain draws it; model.md section 9)."""
+
+        def __init__(self, props):
+            mi.Texture.__init__(self, props)
+            self.base = props.get_texture("base", 1.0)
+            self.coverage = props.get_texture("coverage", 1.0)
+            self.coverage_mean = max(float(props.get("coverage_mean", 1.0)), 1e-6)
+            self.uv_scale = (float(props.get("uv_scale_u", 1.0)), float(props.get("uv_scale_v", 1.0)))
+
+        def _scale(self, si, active):
+            si2 = mi.SurfaceInteraction3f(si)
+            si2.uv = mi.Point2f(si.uv.x * self.uv_scale[0], si.uv.y * self.uv_scale[1])
+            return dr.clip(self.coverage.eval_1(si2, active), 0.0, 1.0) / self.coverage_mean
+
+        def eval(self, si, active=True):
+            return self.base.eval(si, active) * self._scale(si, active)
+
+        def eval_3(self, si, active=True):
+            return self.base.eval_3(si, active) * self._scale(si, active)
+
+        def eval_1(self, si, active=True):
+            return self.base.eval_1(si, active) * self._scale(si, active)
+
+        def mean(self):
+            return self.base.mean()
+
+        def is_spatially_varying(self):
+            return True
+
+        def traverse(self, callback):
+            pass
+
+        def parameters_changed(self, keys):
+            pass
+
+        def to_string(self):
+            return f"PatternedGlow[coverage_mean={self.coverage_mean}]"
+
+    mi.register_texture("patterned_glow", lambda props: PatternedGlow(props))
