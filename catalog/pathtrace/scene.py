@@ -112,9 +112,11 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
                          distance_m=float(distance_m))
     to_light, is_sun = key_light_for(light)
     inside = bool(camera.position[2] > scene_lib.WINDOW_Z)
+    # as the frame builds them (FrameRenderer.shading_inputs): a ``sun:PATH_KM`` light is the
+    # paper's beam, whose sky and ground are that beam Rayleigh-scattered (paper_beam)
     inputs, decision = scene_lib.build_shading_inputs(
         preset, light.irradiance_w_m2_nm, to_light, is_sun=is_sun, fluorescence=fluorescence,
-        viewer_inside=inside)
+        paper_beam=light.name.startswith("sun:"), viewer_inside=inside)
     fabric_size = None
     rings: tuple = ()
     if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth
