@@ -72,7 +72,7 @@ layout(location = 1) out vec4 out_oit_weight;
 layout(location = 1) out vec4 out_position;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_tangent;
-layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, outside occlusion
+layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, the outside's occlusion: cloth, wall
 #endif
 
 // One chunk of 4 bands: eq. 8's terms summed, then projected to display colour. Called with a
@@ -121,13 +121,17 @@ float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; s
 // direction (tiles of u_occlusion_maps); the ambient term loses that fraction of what a
 // layer does not pass (u_ambient_occluded: the float64 twin's outside_occluded_radiance).
 SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
+SCENE_VALUE(vec4, u_ambient_outside[NV4], S_AMBIENT_OUTSIDE);
 uniform sampler2D u_occlusion_maps; // a: the nearest layer's depth, tile j of a square grid
 uniform mat4 u_occlusion_view_proj[N_OCCLUSION];
 uniform float u_occlusion_depth_bias[N_OCCLUSION];
 uniform vec3 u_occlusion_direction[N_OCCLUSION];   // towards the outside
 uniform float u_occlusion_grid;     // tiles per side
 uniform float u_occlusion_offset_m; // the lookup moved off the surface towards the direction
-float g_occlusion = 0.0;            // set in main
+uniform vec4 u_occlusion_window;    // the opening (x0, x1, y0, y1), m
+uniform vec2 u_occlusion_wall_z;    // the window wall's inner and outer planes, m
+float g_occlusion = 0.0;            // the cloth's share (set in main)
+float g_wall_occlusion = 0.0;       // the window wall's share: no outside that way at all
 #endif
 
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
@@ -145,7 +149,7 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
 #endif
     vec4 constant = u_ambient[k];
 #ifdef SKY_OCCLUSION
-    constant -= g_occlusion * u_ambient_occluded[k];
+    constant -= g_occlusion * u_ambient_occluded[k] + g_wall_occlusion * u_ambient_outside[k];
 #endif
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
@@ -212,17 +216,26 @@ void main() {
     {
         vec3 ng = normalize(v_normal);
         float hidden = 0.0;
+        float walled = 0.0;
         for (int j = 0; j < N_OCCLUSION; ++j) {
             vec3 d = u_occlusion_direction[j];
+            // through the opening? (the ray must cross it in both of the wall's planes)
+            vec2 q_in = v_position.xy + ((u_occlusion_wall_z.x - v_position.z) / d.z) * d.xy;
+            vec2 q_out = v_position.xy + ((u_occlusion_wall_z.y - v_position.z) / d.z) * d.xy;
+            vec4 inside = step(u_occlusion_window.xzxz, vec4(q_in, q_out))
+                        * step(vec4(q_in, q_out), u_occlusion_window.ywyw);
+            float open = inside.x * inside.y * inside.z * inside.w;
             // off the surface on the direction's side (normal offset: no self-shadowing)
             vec3 q = v_position + (u_occlusion_offset_m * sign(dot(ng, d))) * ng;
             vec4 clip = u_occlusion_view_proj[j] * vec4(q, 1.0);
             vec2 tile = vec2(mod(float(j), u_occlusion_grid), floor(float(j) / u_occlusion_grid));
             vec2 uv = (tile + clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0)) / u_occlusion_grid;
             float depth = texture(u_occlusion_maps, uv).a;
-            hidden += step(depth + u_occlusion_depth_bias[j], clip.z * 0.5 + 0.5);
+            hidden += open * step(depth + u_occlusion_depth_bias[j], clip.z * 0.5 + 0.5);
+            walled += 1.0 - open;
         }
         g_occlusion = hidden / float(N_OCCLUSION);
+        g_wall_occlusion = walled / float(N_OCCLUSION);
     }
 #endif
     float absorbed = 0.0;
@@ -295,13 +308,13 @@ void main() {
     out_position = vec4(v_position, 1.0);
     out_normal = vec4(n, 1.0);
     out_tangent = vec4(normalize(v_tangent - dot(v_tangent, n) * n), 1.0);
-    vec3 shadows = vec3(1.0, 0.0, 0.0);
+    vec4 shadows = vec4(1.0, 0.0, 0.0, 0.0);
 #ifdef KEY_SHADOW
     shadows.xy = vec2(g_key_beam, g_front_coverage);
 #endif
 #ifdef SKY_OCCLUSION
-    shadows.z = g_occlusion;
+    shadows.zw = vec2(g_occlusion, g_wall_occlusion);
 #endif
-    out_shadows = vec4(shadows, 1.0);
+    out_shadows = shadows;
 #endif
 }

@@ -176,7 +176,7 @@ def outside_occluded_radiance(inputs: ShadingInputs) -> np.ndarray:
 
 def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
                    camera_position, key_beam=None, front_coverage=None,
-                   outside_occlusion=None) -> np.ndarray:
+                   outside_occlusion=None, wall_occlusion=None) -> np.ndarray:
     """Spectral radiance (P, len(GRID_NM)) W m^-2 sr^-1 nm^-1 at world positions (P, 3).
 
     The cloth's shadows (issue 11, model.md section 9), per position (P,), default none:
@@ -184,7 +184,9 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
     coverage of the layer of cloth between the position and the key light (0: none; the beam
     is multiplied by :func:`layer_beam_transmittance`, the excitation by 1 - c),
     ``outside_occlusion`` the fraction of the outside hidden by the cloth itself (the ambient
-    term loses that fraction of :func:`outside_occluded_radiance`)."""
+    term loses that fraction of :func:`outside_occluded_radiance`), ``wall_occlusion`` the
+    fraction hidden by the window wall (the ambient loses that fraction of the outside's
+    share, ``inputs.ambient_outside_radiance``)."""
     p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     n = n / np.linalg.norm(n, axis=1, keepdims=True)
@@ -209,6 +211,9 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
     if outside_occlusion is not None:
         radiance -= (np.asarray(outside_occlusion, dtype=np.float64).reshape(-1, 1)
                      * outside_occluded_radiance(inputs)[None, :])
+    if wall_occlusion is not None and inputs.ambient_outside_radiance is not None:
+        radiance -= (np.asarray(wall_occlusion, dtype=np.float64).reshape(-1, 1)
+                     * inputs.ambient_outside_radiance[None, :])
     if inputs.direct > 0:
         w = inputs.direct * background_weights(ray, inputs.key_to_light, *inputs.sun_chord2)
         radiance += (w[:, 0:1] * inputs.sky_radiance + w[:, 1:2] * inputs.ground_radiance
@@ -225,10 +230,12 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
 
 
 def shadow_terms(shadows) -> dict:
-    """:func:`shade_spectral`'s shadow arguments from the frame's G-buffer ``shadows`` (P, 3):
-    the key's window mask, the coverage of the layer in front of the key, the occlusion."""
-    s = np.asarray(shadows, dtype=np.float64).reshape(-1, 3)
-    return {"key_beam": s[:, 0], "front_coverage": s[:, 1], "outside_occlusion": s[:, 2]}
+    """:func:`shade_spectral`'s shadow arguments from the frame's G-buffer ``shadows`` (P, 4):
+    the key's window mask, the coverage of the layer in front of the key, the outside's
+    occlusion by the cloth and by the window wall."""
+    s = np.asarray(shadows, dtype=np.float64).reshape(-1, 4)
+    return {"key_beam": s[:, 0], "front_coverage": s[:, 1], "outside_occlusion": s[:, 2],
+            "wall_occlusion": s[:, 3]}
 
 
 def spectral_to_linear_srgb(radiance: np.ndarray) -> np.ndarray:

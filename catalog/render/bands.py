@@ -100,6 +100,8 @@ def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray |
         "u_key_thread": band(inputs.key_irradiance * inputs.dye_transmittance
                              * layer_beam_transmittance(inputs, [1.0])[0]),
         "u_ambient_occluded": band(outside_occluded_radiance(inputs)),
+        "u_ambient_outside": band(inputs.ambient_outside_radiance
+                                  if inputs.ambient_outside_radiance is not None else zeros),
         "u_sky": band(inputs.sky_radiance),
         "u_ground": band(inputs.ground_radiance),
         "u_sun_disc": band(inputs.sun_disc_radiance),

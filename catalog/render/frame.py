@@ -1121,6 +1121,10 @@ class FrameRenderer:
         s(program, "u_occlusion_direction", np.asarray(directions, dtype="f4"))
         s(program, "u_occlusion_grid", float(self._occlusion_grid()))
         s(program, "u_occlusion_offset_m", OCCLUSION_OFFSET_M)
+        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+        z0 = scene_lib.ROOM_BOX[2][0]
+        s(program, "u_occlusion_window", (wx0, wx1, wy0, wy1))
+        s(program, "u_occlusion_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
 
     @staticmethod
     def _occlusion_grid() -> int:
@@ -1661,9 +1665,9 @@ class FrameRenderer:
     def render_gbuffer(self) -> dict[str, np.ndarray]:
         """The curtain alone with the G-buffer variant: radiance and the per-pixel geometry the
         shader used (world position, unit normal, weft tangent), float32 (H, W, 3) each, a
-        boolean mask of curtain pixels, and ``shadows`` (H, W, 3): the key's window mask, the
-        coverage of the layer in front of the key and the outside's occlusion (issue 11; 1, 0,
-        0 where those are off). The reference shades these positions in float64."""
+        boolean mask of curtain pixels, and ``shadows`` (H, W, 4): the key's window mask, the
+        coverage of the layer in front of the key and the outside's occlusion by the cloth and
+        by the window wall (issue 11; 1, 0, 0, 0 where those are off). The reference shades these positions in float64."""
         mgl = self._moderngl
         w, h = self.size
         if self.key_shadow or self.sky_occlusion:   # the cloth's shadow maps of this mesh
@@ -1685,7 +1689,7 @@ class FrameRenderer:
             data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
             out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
         out["mask"] = out["position"][..., 3] > 0.5
-        for name in ("radiance", "position", "normal", "tangent", "shadows"):
+        for name in ("radiance", "position", "normal", "tangent"):
             out[name] = out[name][..., :3]
         return out
 
