@@ -227,16 +227,17 @@ float soft_rect(vec2 q, vec4 box, float half_width) {
 
 // The key light's beam through the window opening at room point p (to_light.z < 0: the light
 // is outside): the ray p + s to_light must cross the opening (x0, x1, y0, y1) = rect in both
-// the wall's inner plane z = wall_z.x and outer plane z = wall_z.y (the reveals shade). The
-// edge is soft by the penumbra of a source of angular radius atan(tan_radius) at the distance
-// travelled (PCSS's estimate for a distant disc).
+// the wall's inner plane z = wall_z.x and outer plane z = wall_z.y (the reveals shade); a
+// point within the wall's depth (the reveals themselves, the sill) only in the planes still
+// ahead of it. The edge is soft by the penumbra of a source of angular radius
+// atan(tan_radius) at the distance travelled (PCSS's estimate for a distant disc).
 float room_window_beam(vec3 p, vec3 to_light, vec4 opening, vec2 wall_z, float tan_radius) {
     float s_in = (wall_z.x - p.z) / to_light.z;
     float s_out = (wall_z.y - p.z) / to_light.z;
     vec2 q_in = p.xy + s_in * to_light.xy;
     vec2 q_out = p.xy + s_out * to_light.xy;
-    return step(0.0, s_in) * soft_rect(q_in, opening, s_in * tan_radius + 1e-3)
-         * soft_rect(q_out, opening, s_out * tan_radius + 1e-3);
+    float inner = s_in > 0.0 ? soft_rect(q_in, opening, s_in * tan_radius + 1e-3) : 1.0;
+    return step(0.0, s_out) * inner * soft_rect(q_out, opening, s_out * tan_radius + 1e-3);
 }
 
 
