@@ -53,6 +53,13 @@ SCENE_VALUE(float, u_anisotropy, S_ANISOTROPY);
 SCENE_VALUE(vec4, u_key_dyed[NV4], S_KEY_DYED);             // key light normal irradiance x dye
 SCENE_VALUE(vec4, u_fill_dyed[NV4], S_FILL_DYED);           // fill light (viewer side) x dye
 SCENE_VALUE(vec4, u_ambient[NV4], S_AMBIENT);               // cloth radiance from the diffuse surroundings
+SCENE_VALUE(vec4, u_ambient_outside[NV4], S_AMBIENT_OUTSIDE); // the outside's share of it
+// the ambient by view (issue 11, model.md section 9): its ratio to the normal view's at
+// mu = |n . v| = i / (AMBIENT_VIEW_NODES - 1), the outside's share and the room's
+SCENE_VALUE(vec4, u_ambient_view_outside[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_OUTSIDE);
+SCENE_VALUE(vec4, u_ambient_view_room[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_ROOM);
+float g_view_outside = 1.0;   // set in main
+float g_view_room = 1.0;
 SCENE_VALUE(vec4, u_sky[NV4], S_SKY);
 SCENE_VALUE(vec4, u_ground[NV4], S_GROUND);
 SCENE_VALUE(vec4, u_sun_disc[NV4], S_SUN_DISC);
@@ -121,7 +128,6 @@ float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; s
 // direction (tiles of u_occlusion_maps); the ambient term loses that fraction of what a
 // layer does not pass (u_ambient_occluded: the float64 twin's outside_occluded_radiance).
 SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
-SCENE_VALUE(vec4, u_ambient_outside[NV4], S_AMBIENT_OUTSIDE);
 uniform sampler2D u_occlusion_maps; // a: the nearest layer's depth, tile j of a square grid
 uniform mat4 u_occlusion_view_proj[N_OCCLUSION];
 uniform float u_occlusion_depth_bias[N_OCCLUSION];
@@ -133,6 +139,15 @@ uniform vec2 u_occlusion_wall_z;    // the window wall's inner and outer planes,
 float g_occlusion = 0.0;            // the cloth's share (set in main)
 float g_wall_occlusion = 0.0;       // the window wall's share: no outside that way at all
 #endif
+
+// A table of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes.
+float ambient_view(vec4 table[AMBIENT_VIEW_VEC4], float mu) {
+    float x = clamp(mu, 0.0, 1.0) * float(AMBIENT_VIEW_NODES - 1);
+    int i = min(int(x), AMBIENT_VIEW_NODES - 2);
+    float a = table[i / 4][i % 4];
+    float b = table[(i + 1) / 4][(i + 1) % 4];
+    return a + (x - float(i)) * (b - a);
+}
 
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
 #ifdef KEY_SHADOW
@@ -147,9 +162,10 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
         band += g_room_lamp[j] * u_room_lamp_dyed[j * NV4 + k];
     }
 #endif
-    vec4 constant = u_ambient[k];
+    vec4 constant = g_view_room * u_ambient[k] + (g_view_outside - g_view_room) * u_ambient_outside[k];
 #ifdef SKY_OCCLUSION
-    constant -= g_occlusion * u_ambient_occluded[k] + g_wall_occlusion * u_ambient_outside[k];
+    constant -= g_view_outside * (g_occlusion * u_ambient_occluded[k]
+                                  + g_wall_occlusion * u_ambient_outside[k]);
 #endif
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
@@ -195,6 +211,9 @@ void main() {
 #endif
     float cos_key = dot(n, u_key_to_light);
     float cos_fill = dot(n, u_fill_to_light);
+    float mu_view = abs(dot(n, ray));
+    g_view_outside = ambient_view(u_ambient_view_outside, mu_view);
+    g_view_room = ambient_view(u_ambient_view_room, mu_view);
     vec2 key = woven_transmission_ratio(u_key_to_light, cos_key, tan_key, view,
                                         u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
     vec2 fill = woven_transmission_ratio(u_fill_to_light, cos_fill, tan_fill, view,
@@ -204,8 +223,10 @@ void main() {
     float key_uv = 1.0;   // the key's excitation reaching the fragment (KEY_SHADOW)
 #ifdef KEY_SHADOW
     {
-        g_key_beam = room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z,
-                                      u_tan_sun_radius);
+        // the window's mask where the key shines through it (a light in the room: none)
+        g_key_beam = u_key_to_light.z < 0.0
+                   ? room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius)
+                   : 1.0;
         vec4 clip = u_light_view_proj * vec4(v_position, 1.0);
         vec4 front = texture(u_key_front, clip.xy * 0.5 + 0.5);
         g_front_coverage = front.r * step(front.a + u_key_depth_bias, clip.z * 0.5 + 0.5);

@@ -21,12 +21,13 @@ Colour: ``linear_srgb = 683 * M_sRGB . sum_l cmf(l) L(l) dl`` (cd m^-2 scale for
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from catalog.core.constants import LUMINOUS_EFFICACY_LM_W
+from catalog.core.constants import AMBIENT_VIEW_NODE_COUNT, LUMINOUS_EFFICACY_LM_W
 from catalog.optics.btdf import hg_denominator_robust, hg_phase_of_d
 from catalog.optics.spectra import GRID_NM
 
@@ -67,6 +68,10 @@ class ShadingInputs:
     saturation_photons: float = math.inf  # N_sat, m^-2 s^-1
     emission_per_photon: np.ndarray | None = None     # radiance per effective absorbed photon m^-2 s^-1, per side
     ambient_outside_radiance: np.ndarray | None = None  # the outside's share of ambient_radiance (None: 0)
+    # the ambient term's dependence on the view (issue 11): ratio to the normal view's at
+    # mu = |n . v| = AMBIENT_VIEW_NODES, for the outside's share and the room's (None: 1)
+    ambient_view_outside: np.ndarray | None = None
+    ambient_view_room: np.ndarray | None = None
 
 
 # --------------------------------------------------------------------------- terms
@@ -146,6 +151,69 @@ def hg_hemisphere_factors(g: float) -> tuple[float, float]:
     return (1.0 + g) / 2.0 - shared, (1.0 - g) / 2.0 - shared
 
 
+# --------------------------------------------------------------------------- the ambient by view (issue 11)
+
+#: mu = |n . v| at which the ambient term's view dependence is tabulated (linear between).
+AMBIENT_VIEW_NODES = np.linspace(0.0, 1.0, AMBIENT_VIEW_NODE_COUNT)
+
+
+@functools.lru_cache(maxsize=64)
+def hg_hemisphere_factors_by_view(g: float, nodes: tuple = tuple(AMBIENT_VIEW_NODES)) -> tuple[np.ndarray, np.ndarray]:
+    """(forward, backward) at each node mu: cloth radiance per unit radiance of a uniform
+    hemisphere for a view at cos = mu from the normal (model.md section 9). forward: the light
+    comes from the hemisphere behind the cloth, F(mu) = integral over t.n > 0 of
+    ph(t . v) (t . n) d omega; backward: from the viewer's side, the same over t.n < 0 with
+    |t . n|. In coordinates about the view (t . v = cos gamma), the azimuthal integral of the
+    clamped cosine max(a + b cos psi, 0), a = mu cos gamma, b = sqrt(1 - mu^2) sin gamma, is
+    closed (2 (a psi0 + b sin psi0), cos psi0 = -a / b), leaving a 1-D integral over cos gamma
+    (midpoint rule, nodes finer towards the peak at cos gamma = 1 for g > 0). At mu = 1 these
+    are :func:`hg_hemisphere_factors` (a test checks 1e-4)."""
+    # nodes in u = cos gamma: uniform plus a geometric cluster at the peak
+    edges = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 40001),
+                                      1.0 - np.geomspace(1e-7, 2.0, 4001),
+                                      -1.0 + np.geomspace(1e-7, 2.0, 4001)]))
+    edges = np.clip(edges, -1.0, 1.0)
+    u = 0.5 * (edges[1:] + edges[:-1])
+    du = np.diff(edges)
+    sin_g = np.sqrt(np.maximum(1.0 - u * u, 0.0))
+    phase = hg_phase_chords(2.0 * (1.0 - u), 2.0 * (1.0 + u), g)
+    out = []
+    for sign in (1.0, -1.0):
+        values = []
+        for mu in nodes:
+            a = sign * mu * u
+            b = np.abs(math.sqrt(max(1.0 - mu * mu, 0.0)) * sin_g)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                psi0 = np.arccos(np.clip(np.where(b > 0, -a / np.where(b > 0, b, 1.0), 0.0), -1.0, 1.0))
+            clamped = np.where(a >= b, 2 * math.pi * a,
+                               np.where(a <= -b, 0.0, 2.0 * (a * psi0 + b * np.sin(psi0))))
+            values.append(float(np.sum(phase * clamped * du)))
+        out.append(np.asarray(values))
+    return out[0], out[1]
+
+
+def ambient_view_ratios(a_diff: float, g_diff: float, a_spec: float, g_spec: float,
+                        backward: bool) -> np.ndarray:
+    """The ambient term's ratio to the normal view's at AMBIENT_VIEW_NODES, for light from the
+    hemisphere behind the cloth (``backward`` False) or from the viewer's side (True): the
+    lobes' (a_diff F_diff(mu) + a_spec F_spec(mu)) over the same at mu = 1 in closed form."""
+    k = 1 if backward else 0
+    by_view = (a_diff * hg_hemisphere_factors_by_view(g_diff)[k]
+               + a_spec * hg_hemisphere_factors_by_view(g_spec)[k])
+    normal = (a_diff * hg_hemisphere_factors(g_diff)[k] + a_spec * hg_hemisphere_factors(g_spec)[k])
+    if not normal > 0:
+        return np.ones_like(AMBIENT_VIEW_NODES)
+    return by_view / normal
+
+
+def ambient_view_ratio(table, mu) -> np.ndarray:
+    """A table of :func:`ambient_view_ratios` at mu (linear between nodes; None: 1)."""
+    mu = np.asarray(mu, dtype=np.float64)
+    if table is None:
+        return np.ones_like(mu)
+    return np.interp(np.clip(mu, 0.0, 1.0), AMBIENT_VIEW_NODES, np.asarray(table, dtype=np.float64))
+
+
 # --------------------------------------------------------------------------- the cloth's own shadow (issue 11)
 
 def layer_beam_transmittance(inputs: ShadingInputs, coverage) -> np.ndarray:
@@ -206,14 +274,21 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
     beam = np.ones(count) if key_beam is None else np.asarray(key_beam, dtype=np.float64).reshape(-1)
     cover = np.zeros(count) if front_coverage is None else np.asarray(front_coverage, dtype=np.float64).reshape(-1)
     key_seen = beam[:, None] * layer_beam_transmittance(inputs, cover) * dyed_key[None, :]
+    # the ambient term by view (ratios to the normal view's): the room's share r_room, the
+    # outside's r_out, the occlusions' losses with the outside's
+    mu = np.abs(np.einsum("pi,pi->p", to_viewer, n))
+    r_out = ambient_view_ratio(inputs.ambient_view_outside, mu)[:, None]
+    r_room = ambient_view_ratio(inputs.ambient_view_room, mu)[:, None]
+    outside_share = (inputs.ambient_outside_radiance if inputs.ambient_outside_radiance is not None
+                     else np.zeros_like(inputs.ambient_radiance))
     radiance = (g_key[:, None] * key_seen + g_fill[:, None] * dyed_fill
-                + inputs.ambient_radiance[None, :])
+                + r_room * inputs.ambient_radiance[None, :] + (r_out - r_room) * outside_share[None, :])
     if outside_occlusion is not None:
-        radiance -= (np.asarray(outside_occlusion, dtype=np.float64).reshape(-1, 1)
+        radiance -= (r_out * np.asarray(outside_occlusion, dtype=np.float64).reshape(-1, 1)
                      * outside_occluded_radiance(inputs)[None, :])
-    if wall_occlusion is not None and inputs.ambient_outside_radiance is not None:
-        radiance -= (np.asarray(wall_occlusion, dtype=np.float64).reshape(-1, 1)
-                     * inputs.ambient_outside_radiance[None, :])
+    if wall_occlusion is not None:
+        radiance -= (r_out * np.asarray(wall_occlusion, dtype=np.float64).reshape(-1, 1)
+                     * outside_share[None, :])
     if inputs.direct > 0:
         w = inputs.direct * background_weights(ray, inputs.key_to_light, *inputs.sun_chord2)
         radiance += (w[:, 0:1] * inputs.sky_radiance + w[:, 1:2] * inputs.ground_radiance

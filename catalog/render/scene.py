@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
-from catalog.optics.shading_reference import ShadingInputs, hg_hemisphere_factors
+from catalog.optics.shading_reference import ShadingInputs, ambient_view_ratios, hg_hemisphere_factors
 from catalog.optics.spectra import GRID_NM
 
 WINDOW_Z = -0.2
@@ -519,7 +519,12 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         g_spec=btdf.g_spec, anisotropy=anisotropy, dye_transmittance=dye,
         ambient_radiance=ambient, fluorescence_mode=decision.used, paper_radiance=paper,
         absorbed_photons=absorbed, saturation_photons=saturation,
-        emission_per_photon=emission_per_photon, ambient_outside_radiance=ambient_outside)
+        emission_per_photon=emission_per_photon, ambient_outside_radiance=ambient_outside,
+        # the ambient by view (issue 11): the outside lies behind the cloth for a viewer inside
+        ambient_view_outside=ambient_view_ratios(btdf.a_diff, btdf.g_diff, btdf.a_spec,
+                                                 btdf.g_spec, backward=not viewer_inside),
+        ambient_view_room=ambient_view_ratios(btdf.a_diff, btdf.g_diff, btdf.a_spec,
+                                              btdf.g_spec, backward=viewer_inside))
     if decision.used == "physical":
         inputs = with_physical_emission(inputs, fluorescent_material(preset, key))
     return inputs, decision
