@@ -122,22 +122,14 @@ float g_key_beam = 1.0;            // the window's mask (set in main)
 float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
 #endif
 #ifdef SKY_OCCLUSION
-// The outside hidden by the cloth's own folds (issue 11, model.md section 9): the fraction
-// of N_OCCLUSION directions (cosine-weighted about the window's normal) in which a layer of
-// cloth lies between the fragment and the outside, from one front-layer depth map per
-// direction (tiles of u_occlusion_maps); the ambient term loses that fraction of what a
-// layer does not pass (u_ambient_occluded: the float64 twin's outside_occluded_radiance).
+// The outside hidden by the cloth's own folds and by the window wall (issue 11, model.md
+// section 9), per vertex (curtain.vert) and interpolated: the ambient term loses that
+// fraction of what a layer of cloth does not pass (u_ambient_occluded: the float64 twin's
+// outside_occluded_radiance), and all of the outside where the wall hides it.
 SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
-uniform sampler2D u_occlusion_maps; // a: the nearest layer's depth, tile j of a square grid
-uniform mat4 u_occlusion_view_proj[N_OCCLUSION];
-uniform float u_occlusion_depth_bias[N_OCCLUSION];
-uniform vec3 u_occlusion_direction[N_OCCLUSION];   // towards the outside
-uniform float u_occlusion_grid;     // tiles per side
-uniform float u_occlusion_offset_m; // the lookup moved off the surface towards the direction
-uniform vec4 u_occlusion_window;    // the opening (x0, x1, y0, y1), m
-uniform vec2 u_occlusion_wall_z;    // the window wall's inner and outer planes, m
-float g_occlusion = 0.0;            // the cloth's share (set in main)
-float g_wall_occlusion = 0.0;       // the window wall's share: no outside that way at all
+INTERPOLATION in vec2 v_occlusion;  // the cloth's share, the window wall's
+float g_occlusion = 0.0;            // set in main
+float g_wall_occlusion = 0.0;
 #endif
 
 // A table of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes.
@@ -234,30 +226,8 @@ void main() {
     }
 #endif
 #ifdef SKY_OCCLUSION
-    {
-        vec3 ng = normalize(v_normal);
-        float hidden = 0.0;
-        float walled = 0.0;
-        for (int j = 0; j < N_OCCLUSION; ++j) {
-            vec3 d = u_occlusion_direction[j];
-            // through the opening? (the ray must cross it in both of the wall's planes)
-            vec2 q_in = v_position.xy + ((u_occlusion_wall_z.x - v_position.z) / d.z) * d.xy;
-            vec2 q_out = v_position.xy + ((u_occlusion_wall_z.y - v_position.z) / d.z) * d.xy;
-            vec4 inside = step(u_occlusion_window.xzxz, vec4(q_in, q_out))
-                        * step(vec4(q_in, q_out), u_occlusion_window.ywyw);
-            float open = inside.x * inside.y * inside.z * inside.w;
-            // off the surface on the direction's side (normal offset: no self-shadowing)
-            vec3 q = v_position + (u_occlusion_offset_m * sign(dot(ng, d))) * ng;
-            vec4 clip = u_occlusion_view_proj[j] * vec4(q, 1.0);
-            vec2 tile = vec2(mod(float(j), u_occlusion_grid), floor(float(j) / u_occlusion_grid));
-            vec2 uv = (tile + clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0)) / u_occlusion_grid;
-            float depth = texture(u_occlusion_maps, uv).a;
-            hidden += open * step(depth + u_occlusion_depth_bias[j], clip.z * 0.5 + 0.5);
-            walled += 1.0 - open;
-        }
-        g_occlusion = hidden / float(N_OCCLUSION);
-        g_wall_occlusion = walled / float(N_OCCLUSION);
-    }
+    g_occlusion = v_occlusion.x;
+    g_wall_occlusion = v_occlusion.y;
 #endif
     float absorbed = 0.0;
     float saturation = 1.0;
