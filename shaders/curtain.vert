@@ -1,4 +1,5 @@
 #version 430
+#include "common.glsl"
 // The curtain mesh: positions (moved into the scene by u_mesh_offset: the cloth simulation's
 // own frame has the rod elsewhere), normals and the weft tangent; shared by the shading pass,
 // the G-buffer variant and the trivial floor shader. The view ray (position - camera) is
@@ -21,45 +22,13 @@ INTERPOLATION out vec2 v_pattern_uv;
 #endif
 
 #ifdef SKY_OCCLUSION
-// The outside hidden from this vertex (issue 11, model.md section 9): of N_OCCLUSION
-// directions (cosine-weighted about the window's normal, catalog/render/room_light.py), the
-// fraction in which a layer of cloth lies between the vertex and the outside (one front-layer
-// depth map per direction, tiles of u_occlusion_maps), and the fraction that does not leave
-// through the window opening (the wall). Per vertex: the occlusion varies over a fold, not a
-// pixel, and a CPU rasteriser pays it once a vertex instead of once a fragment.
-uniform sampler2D u_occlusion_maps; // a: the nearest layer's depth, tile j of a square grid
-uniform mat4 u_occlusion_view_proj[N_OCCLUSION];
-uniform float u_occlusion_depth_bias[N_OCCLUSION];
-uniform vec3 u_occlusion_direction[N_OCCLUSION];   // towards the outside
-uniform float u_occlusion_grid;     // tiles per side
-uniform float u_occlusion_offset_m; // the lookup moved off the surface towards the direction
-uniform vec4 u_occlusion_window;    // the opening (x0, x1, y0, y1), m
-uniform vec2 u_occlusion_wall_z;    // the window wall's inner and outer planes, m
+// The outside hidden from this vertex by the cloth and by the window wall (issue 11,
+// common.glsl outside_occlusion), computed once per update of the room's light by
+// occlusion_points.vert into one texel per vertex (u_vertex_occlusion, u_vertex_occlusion_width
+// texels a row) and read here by the vertex's index.
+uniform sampler2D u_vertex_occlusion;
+uniform int u_vertex_occlusion_width;
 INTERPOLATION out vec2 v_occlusion; // the cloth's share, the wall's
-
-vec2 outside_occlusion(vec3 p, vec3 normal) {
-    vec3 ng = normalize(normal);
-    float hidden = 0.0;
-    float walled = 0.0;
-    for (int j = 0; j < N_OCCLUSION; ++j) {
-        vec3 d = u_occlusion_direction[j];
-        // through the opening? (the ray must cross it in both of the wall's planes)
-        vec2 q_in = p.xy + ((u_occlusion_wall_z.x - p.z) / d.z) * d.xy;
-        vec2 q_out = p.xy + ((u_occlusion_wall_z.y - p.z) / d.z) * d.xy;
-        vec4 inside = step(u_occlusion_window.xzxz, vec4(q_in, q_out))
-                    * step(vec4(q_in, q_out), u_occlusion_window.ywyw);
-        float open = inside.x * inside.y * inside.z * inside.w;
-        // off the surface on the direction's side (normal offset: no self-shadowing)
-        vec3 q = p + (u_occlusion_offset_m * sign(dot(ng, d))) * ng;
-        vec4 clip = u_occlusion_view_proj[j] * vec4(q, 1.0);
-        vec2 tile = vec2(mod(float(j), u_occlusion_grid), floor(float(j) / u_occlusion_grid));
-        vec2 uv = (tile + clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0)) / u_occlusion_grid;
-        float depth = textureLod(u_occlusion_maps, uv, 0.0).a;
-        hidden += open * step(depth + u_occlusion_depth_bias[j], clip.z * 0.5 + 0.5);
-        walled += 1.0 - open;
-    }
-    return vec2(hidden, walled) / float(N_OCCLUSION);
-}
 #endif
 
 uniform mat4 u_view_proj;
@@ -89,7 +58,8 @@ void main() {
     v_position = position;
 #endif
 #ifdef SKY_OCCLUSION
-    v_occlusion = outside_occlusion(position, in_normal);
+    v_occlusion = texelFetch(u_vertex_occlusion, ivec2(gl_VertexID % u_vertex_occlusion_width,
+                                                       gl_VertexID / u_vertex_occlusion_width), 0).xy;
 #endif
     gl_Position = u_view_proj * vec4(position, 1.0);
 }

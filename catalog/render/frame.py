@@ -86,6 +86,8 @@ OCCLUSION_UNIT = 7
 #: half of an occlusion map (room_light.OCCLUSION_TEXELS over ~2.4 m: 2 cm each).
 OCCLUSION_BIAS_M = 0.01
 OCCLUSION_OFFSET_M = 0.03
+#: Texels a row of the per-vertex occlusion texture (curtain.vert reads texel index % width).
+VERTEX_OCCLUSION_WIDTH = 256
 PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
@@ -870,8 +872,8 @@ class FrameRenderer:
                 self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
             if "u_key_front" in program:
                 self._key_shadow_uniforms(program, self.shading_inputs())
-            if "u_occlusion_maps" in program:
-                self._occlusion_uniforms(program)
+            if "u_vertex_occlusion" in program:
+                self._vertex_occlusion_uniforms(program)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
 
@@ -1107,8 +1109,52 @@ class FrameRenderer:
         s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
 
+    def _vertex_occlusion_uniforms(self, program) -> None:
+        """curtain.vert's SKY_OCCLUSION: the per-vertex occlusion texture."""
+        texture = self._room_resources().get("vertex_occlusion")
+        if texture is None:   # not drawn yet (a mesh bound after the last update): none
+            texture = self._vertex_occlusion_target(1)
+        texture.use(location=OCCLUSION_UNIT)
+        self._set(program, "u_vertex_occlusion", OCCLUSION_UNIT)
+        self._set(program, "u_vertex_occlusion_width", VERTEX_OCCLUSION_WIDTH)
+
+    def _vertex_occlusion_target(self, vertices: int):
+        """The per-vertex occlusion texture for ``vertices`` (VERTEX_OCCLUSION_WIDTH a row),
+        made or remade when the count needs more rows; cleared to no occlusion."""
+        mgl, gl = self._moderngl, self._room_resources()
+        rows = max(1, -(-int(vertices) // VERTEX_OCCLUSION_WIDTH))
+        texture = gl.get("vertex_occlusion")
+        if texture is None or texture.size[1] < rows:
+            if texture is not None:
+                gl["vertex_occlusion_fbo"].release()
+                texture.release()
+            texture = self.ctx.texture((VERTEX_OCCLUSION_WIDTH, rows), 4, dtype="f4")
+            texture.filter = (mgl.NEAREST, mgl.NEAREST)
+            gl["vertex_occlusion"] = texture
+            gl["vertex_occlusion_fbo"] = self.ctx.framebuffer([texture])
+            gl["vertex_occlusion_fbo"].clear(0.0, 0.0, 0.0, 0.0)
+        return texture
+
+    def _draw_vertex_occlusion(self) -> None:
+        """Each vertex's outside occlusion (occlusion_points.*) from the occlusion maps."""
+        mgl = self._moderngl
+        b = self._curtain_buffers
+        texture = self._vertex_occlusion_target(self._vertex_count)
+        fbo = self._room_gl["vertex_occlusion_fbo"]
+        fbo.use()
+        self.ctx.viewport = (0, 0, *texture.size)
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        program = self._program("occlusion_points.vert", "occlusion_points.frag",
+                                {"OCCLUSION_MAPS": True, "N_OCCLUSION": room_light.OCCLUSION_DIRECTIONS})
+        self._occlusion_uniforms(program)
+        self._set(program, "u_mesh_offset", self._mesh_offset)
+        self._set(program, "u_target_size", tuple(int(v) for v in texture.size))
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        self._curtain_vao(program).render(mgl.POINTS)
+
     def _occlusion_uniforms(self, program) -> None:
-        """curtain.frag's SKY_OCCLUSION: the occlusion maps and each direction's frame."""
+        """common.glsl's outside_occlusion: the occlusion maps and each direction's frame."""
         gl = self._room_resources()
         gl["occlusion"].use(location=OCCLUSION_UNIT)
         s = self._set
@@ -1209,6 +1255,7 @@ class FrameRenderer:
             self._draw_key_front(inputs, patterned, self._room_colours(inputs))
         if self.sky_occlusion:
             self._draw_occlusion_maps()
+            self._draw_vertex_occlusion()
 
     def _draw_occlusion_maps(self) -> None:
         """SKY_OCCLUSION's maps: per direction of room_light.occlusion_directions, the depth
@@ -1226,7 +1273,7 @@ class FrameRenderer:
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.CULL_FACE)
-        vao = self._shadow_vao(program, fine=True)
+        vao = self._shadow_vao(program)   # the coarse grid: the occlusion is a fold's, not a pixel's
         for j, direction in enumerate(room_light.occlusion_directions()):
             self.ctx.viewport = ((j % grid) * n, (j // grid) * n, n, n)
             self._set(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(direction)))
