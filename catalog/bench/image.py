@@ -50,13 +50,18 @@ SCENES = (
 QUICK_SCENES = SCENES[1:2]
 SIZE = (192, 144)
 QUICK_SIZE = (64, 48)
-SPP = 256
+SPP = 512
 QUICK_SPP = 16
 #: (label, bands, fluorescence mode, supersample factor, anti-aliasing (None: the frame's
 #: default, FXAA)). The first is the frame's default.
 OPTIONS = (
     ("default (physical, 3 bands, FXAA)", 3, "physical", 1, None),
     ("room lighting off", 3, "physical", 1, None, False),
+    ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
+    ("sky occlusion off (issue 11)", 3, "physical", 1, None, None, {"sky_occlusion": False}),
+    ("ambient by view off (issue 11)", 3, "physical", 1, None, None, {"ambient_by_view": False}),
+    ("issue 11's three off", 3, "physical", 1, None, None,
+     {"key_shadow": False, "sky_occlusion": False, "ambient_by_view": False}),
     ("FXAA off", 3, "physical", 1, "off"),
     ("6 bands", 6, "physical", 1, None),
     ("16 bands", 16, "physical", 1, None),
@@ -85,7 +90,7 @@ def light_name(key: str) -> str:
 
 def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
                  antialiasing: str | None = None, room_lighting: bool | None = None,
-                 repeats: int = 5) -> dict:
+                 repeats: int = 5, switches: dict | None = None) -> dict:
     """The real-time frame at desc.size: ``linear`` radiance (H, W, 3), ``display`` (the
     frame's own display image, sRGB in [0, 1]), the ``exposure`` and ``white_balance`` its
     display step used, and ``seconds``, the median wall time of render + glFinish.
@@ -105,6 +110,8 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
             renderer.set_antialiasing(antialiasing)
         if room_lighting is not None:
             renderer.set_room_lighting(room_lighting)
+        for name, on in (switches or {}).items():   # issue 11's terms: set_key_shadow, ...
+            getattr(renderer, f"set_{name}")(on)
         cam = desc.info["camera"]
         renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
         renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
@@ -176,10 +183,11 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
         noise_curtain = metrics.noise_between(a, b, masks["curtain"])
         option_rows = []
         default = None
-        for opt_label, bands, mode, supersample, antialiasing, *room in options:
+        for opt_label, bands, mode, supersample, antialiasing, *extra in options:
             frame = frame_images(ctx, desc, preset, light, bands, mode, supersample,
-                                 antialiasing, room[0] if room else None,
-                                 repeats=3 if quick else 7)
+                                 antialiasing, extra[0] if extra else None,
+                                 repeats=3 if quick else 7,
+                                 switches=extra[1] if len(extra) > 1 else None)
             if default is None:  # the default frame's exposure and white balance show both
                 exposure, white_balance = frame["exposure"], frame["white_balance"]
             result = compare(frame, reference, masks, desc.inputs, exposure, white_balance)

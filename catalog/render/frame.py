@@ -258,6 +258,8 @@ class FrameRenderer:
         #: issue 11: the cloth's own folds hide part of the outside from its ambient term
         #: (curtain.frag SKY_OCCLUSION; False: every fragment sees the whole outside)
         self.sky_occlusion = True
+        #: issue 11: the ambient term by view (False: the normal view's at every angle)
+        self.ambient_by_view = True
         self.curtain_open = False
         self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
         self._room_gl = None
@@ -414,6 +416,11 @@ class FrameRenderer:
         """Shade the key light on the cloth by the window wall and the folds nearer the light
         (issue 11; curtain.frag KEY_SHADOW), or let it reach every fragment (the earlier frame)."""
         self.key_shadow = bool(on)
+
+    def set_ambient_by_view(self, on: bool) -> None:
+        """The cloth's ambient term by view (issue 11; the lobes integrated for the view's
+        angle to the normal), or the normal view's at every angle (the earlier frame)."""
+        self.ambient_by_view = bool(on)
 
     def set_sky_occlusion(self, on: bool) -> None:
         """Let the cloth's own folds hide part of the outside from its ambient term (issue 11;
@@ -663,6 +670,9 @@ class FrameRenderer:
         }
         for name, value in self._band_uniforms().items():
             values[name] = tuple(float(v) for v in value) if isinstance(value, tuple) else value
+        if not self.ambient_by_view:   # the normal view's ambient at every angle
+            for name in ("u_ambient_view_outside", "u_ambient_view_room"):
+                values[name] = np.ones_like(values[name])
         return values
 
     def room_lamp_values(self) -> dict:
@@ -1765,7 +1775,7 @@ class FrameRenderer:
             "white_balance_adapted": not np.allclose(self.white_balance_matrix(), np.eye(3)),
             "size": list(self.size),
             "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
-            "sky_occlusion": self.sky_occlusion,
+            "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
             "environment": None if self.environment is None else self.environment[0],
