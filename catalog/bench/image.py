@@ -72,7 +72,8 @@ ABSENT_OPTIONS = ("shadow map size (catalog.render.room_light.SHADOW_TEXELS, not
 #: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
 #: curtain (noise falls as 1 / sqrt(spp): the spp that reaches it is spp (noise / 1 %)^2).
 NOISE_TARGET = 0.01
-#: The committed figures (tools/docs_figures.py): {"runs": {"baseline": section, "after_12_16": section}}.
+#: The committed figures (tools/docs_figures.py): {"runs": {"baseline": section, "after_12_16": section,
+#: "after_11": section}} (after_11: issue 11's fixes, the references at 512 spp).
 RESULT_JSON = "benchmarks/bench_image.json"
 GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
 REGIONS = ("curtain", "floor", "walls")
@@ -341,6 +342,21 @@ def table(rows: list[dict], columns: list[str], headers: list[str]) -> str:
     return "\n".join(lines)
 
 
+def summary_line(result: dict) -> str:
+    """One sentence of a run's ranges (for the README and BENCHMARKS.md)."""
+    rows = result["rows"]
+    flips = [r["mean_flip"] for r in rows]
+    des = [r["curtain_delta_e_mean"] for r in rows if r["curtain_delta_e_mean"] is not None]
+    speed = [r["speedup"] for r in rows]
+    noise = [r["reference_flip_noise_bound"] for r in rows]
+    s = result["summary"]
+    return (f"Mean FLIP {_cell(min(flips))}-{_cell(max(flips))}, curtain Delta E 2000 mean "
+            f"{_cell(min(des))}-{_cell(max(des))}, the frame {_cell(min(speed))}-{_cell(max(speed))}x "
+            f"faster than the reference ({result['settings']['spp']} spp); the FLIP of the reference's "
+            f"two half renders (its noise's share) {_cell(min(noise))}-{_cell(max(noise))}. "
+            f"Goal met on {s['scenes_meeting_goal']} of {s['scenes']} scenes.")
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run; of the
     committed JSON (``{"runs": {...}}``) the baseline's, and ``image-after`` the run after
@@ -351,6 +367,15 @@ def markdown_tables(result: dict) -> dict[str, str]:
         blocks["image-after"] = (after["image"] + "\n\nReal-time options:\n\n" + after["image-options"]
                                  + "\n\n![six scenes after issues 12-16: real-time | reference | FLIP]"
                                  "(img/pathtrace_scenes_after_13.png)")
+        if "after_11" in result["runs"]:
+            run = result["runs"]["after_11"]
+            latest = markdown_tables(run)
+            blocks["image-after-11"] = (
+                latest["image"] + "\n\nReal-time options (issue 11's terms switched off one at a time "
+                "against the same references):\n\n" + latest["image-options"]
+                + "\n\n![six scenes after issue 11's fixes: real-time | reference | FLIP]"
+                "(img/pathtrace_scenes_after_11.png)")
+            blocks["image-after-11-summary"] = summary_line(run)
         return blocks
 
     s = result["summary"]

@@ -31,7 +31,9 @@ per vertex, from the photons the cloth absorbs there: the key light's at its inc
 half-space's sky and ground (the room's light, with almost no UV, is left out), through
 the same absorptance, quantum yield, saturation and emission spectrum as the real-time
 frame (catalog.render.scene.with_physical_emission), M / (2 pi) per side. It enters the
-scene as two emitting, null-scattering shells 0.5 mm either side of the cloth.
+scene as two emitting, null-scattering shells 0.5 mm either side of the cloth; with a pattern
+their radiance is that emission times c(uv) / mean(c) (the ``patterned_glow`` texture of
+catalog/pathtrace/woven.py): the glow leaves through the threads, as the frame draws it.
 """
 
 from __future__ import annotations
