@@ -217,7 +217,7 @@ def test_direct_light_matches_the_float64_reference_per_pixel(mi):
     integrator = {"type": "aov", "aovs": "p:position,n:sh_normal,t:dp_du",
                   "radiance": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0}}
     zero = np.zeros_like(desc.inputs.ambient_radiance)
-    base = replace(desc.inputs, direct=0.0, ambient_radiance=zero)
+    base = replace(desc.inputs, direct=0.0, ambient_radiance=zero, ambient_outside_radiance=zero)
     for light, inputs in (("key", replace(base, fill_irradiance=zero)),
                           ("fill", replace(base, key_irradiance=zero))):
         scene = build_mitsuba_scene(mi, desc, integrator=integrator, room=False,

@@ -1130,7 +1130,8 @@ class FrameRenderer:
 
     def _vertex_occlusion_target(self, vertices: int):
         """The per-vertex occlusion texture for ``vertices`` (VERTEX_OCCLUSION_WIDTH a row),
-        made or remade when the count needs more rows; cleared to no occlusion."""
+        made or remade when the count needs more rows (its texels are written by
+        _draw_vertex_occlusion, which clears it first)."""
         mgl, gl = self._moderngl, self._room_resources()
         rows = max(1, -(-int(vertices) // VERTEX_OCCLUSION_WIDTH))
         texture = gl.get("vertex_occlusion")
@@ -1142,7 +1143,6 @@ class FrameRenderer:
             texture.filter = (mgl.NEAREST, mgl.NEAREST)
             gl["vertex_occlusion"] = texture
             gl["vertex_occlusion_fbo"] = self.ctx.framebuffer([texture])
-            gl["vertex_occlusion_fbo"].clear(0.0, 0.0, 0.0, 0.0)
         return texture
 
     def _draw_vertex_occlusion(self) -> None:
@@ -1274,6 +1274,7 @@ class FrameRenderer:
         n = room_light.OCCLUSION_TEXELS
         grid = self._occlusion_grid()
         gl["occlusion_fbo"].use()
+        self.ctx.viewport = (0, 0, grid * n, grid * n)   # the whole atlas (use() restores the last tile's)
         gl["occlusion_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
         program = self._program("room_shadow.vert", "room_shadow.frag",
                                 {"HAS_UV": True, "PATTERN": False, "FRONT_LAYER": True})
@@ -1288,6 +1289,7 @@ class FrameRenderer:
             self.ctx.viewport = ((j % grid) * n, (j // grid) * n, n, n)
             self._set(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(direction)))
             vao.render(mgl.TRIANGLES)
+        self.ctx.viewport = (0, 0, grid * n, grid * n)
         self.ctx.disable(mgl.DEPTH_TEST)
 
     def _draw_key_front(self, inputs, patterned: bool, colours: dict) -> None:
