@@ -436,24 +436,3 @@ def test_the_reference_builds_the_frames_shading_inputs(gl, light):
     if desc.sky is not None:
         assert np.allclose(r.sky_model_for(frame).scale_rgb, desc.sky.scale_rgb, rtol=1e-12)
     r.release()
-
-
-def test_patterned_glow_leaves_through_the_threads(mi):
-    """Issue 11: the fluorescence shells' radiance is the per-vertex emission times c / mean(c)
-    of the pattern (the frame draws the glow on the threads only): 0 in a hole, 2x the base on
-    a thread of a half-covered pattern, exactly (1e-6)."""
-    import drjit as dr
-
-    coverage = np.zeros((4, 4), dtype=np.float32)
-    coverage[:, 2:] = 1.0  # left half holes, right half thread; mean 0.5
-    texture = mi.load_dict({"type": "patterned_glow",
-                            "base": {"type": "rgb", "value": [0.1, 0.2, 0.3]},
-                            "coverage": {"type": "bitmap", "raw": True, "filter_type": "nearest",
-                                         "bitmap": mi.Bitmap(coverage[..., None])},
-                            "coverage_mean": 0.5, "uv_scale_u": 1.0, "uv_scale_v": 1.0})
-    si = dr.zeros(mi.SurfaceInteraction3f, 2)
-    si.uv = mi.Point2f([0.2, 0.8], [0.5, 0.5])
-    value = np.asarray(texture.eval(si))
-    value = value if value.shape[0] == 3 else value.T
-    assert np.allclose(value[:, 0], 0.0, atol=1e-6)
-    assert np.allclose(value[:, 1], [0.2, 0.4, 0.6], rtol=1e-6)

@@ -31,9 +31,12 @@ per vertex, from the photons the cloth absorbs there: the key light's at its inc
 half-space's sky and ground (the room's light, with almost no UV, is left out), through
 the same absorptance, quantum yield, saturation and emission spectrum as the real-time
 frame (catalog.render.scene.with_physical_emission), M / (2 pi) per side. It enters the
-scene as two emitting, null-scattering shells 0.5 mm either side of the cloth; with a pattern
-their radiance is that emission times c(uv) / mean(c) (the ``patterned_glow`` texture of
-catalog/pathtrace/woven.py): the glow leaves through the threads, as the frame draws it.
+scene as two emitting, null-scattering shells 0.5 mm either side of the cloth. They carry
+no pattern (the glow is the repeat's average; the frame draws it on the threads only): a
+Python texture (mi.Texture) modulating the per-vertex emission by c(uv) / mean(c) was tried
+(issue 11) and lit the room 1.9x brighter even with the factor set to 1 (the cloth seen
+directly unchanged): next-event estimation did not see the wrapped per-vertex value
+(presumably Mitsuba takes such a texture's mean; not resolved).
 """
 
 from __future__ import annotations
@@ -402,20 +405,15 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     weights = emitter_sampling_weights(desc, emission)
     if environment:
         scene["environment"]["sampling_weight"] = weights["environment"]
-    radiance = {"type": "mesh_attribute", "name": "vertex_fluorescence"}
-    if desc.pattern is not None:  # the glow leaves through the threads (c / mean(c)), not the holes
-        glow = woven_bsdf_dict(desc.fabric, desc.pattern)
-        radiance = {"type": "patterned_glow", "base": radiance, "coverage": glow["coverage"],
-                    "coverage_mean": glow["coverage_mean"], "uv_scale_u": glow["uv_scale_u"],
-                    "uv_scale_v": glow["uv_scale_v"]}
     for side, sign in (("front", 1.0), ("back", -1.0)):
         shell_props = mi.Properties()
         shell_props["bsdf"] = mi.load_dict({"type": "null"})
         shell_props["emitter"] = mi.load_dict({"type": "area", "sampling_weight": weights["shell"],
-                                               "radiance": radiance})
+                                               "radiance": {"type": "mesh_attribute",
+                                                            "name": "vertex_fluorescence"}})
         faces = tri if sign > 0 else tri[:, ::-1]
         shell = _mesh(mi, f"fluorescence_{side}", p + sign * SHELL_OFFSET_M * n, faces,
-                      sign * n, uvs if desc.pattern is not None else None, shell_props)
+                      sign * n, None, shell_props)
         shell.add_attribute("vertex_fluorescence", 3,
                             np.ascontiguousarray(emission, dtype=np.float32).ravel())
         scene[f"fluorescence_{side}"] = shell
