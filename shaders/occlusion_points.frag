@@ -1,5 +1,6 @@
 #version 430
 // occlusion_points.vert's value into its texel.
+#include "common.glsl"
 in vec2 v_occlusion;
 
 layout(location = 0) out vec4 out_occlusion;
