@@ -164,6 +164,27 @@ vec3 thread_normal(vec3 n, vec3 tangent, vec3 m) {
 }
 #endif
 
+// A front-layer map (room_shadow.frag FRONT_LAYER: r = the nearest layer's coverage, a = its
+// depth) at map point q (xy: texture coordinates, z: depth, 0..1): the coverage of the layer
+// in front of q, 0 where q is that layer itself. The depth test is a ramp from half to one
+// and a half times the bias and the four nearest texels are blended bilinearly (percentage-
+// closer filtering), so that the answer changes continuously across a shadow's edge and
+// along a fold's flank instead of flipping on rounding.
+float front_layer_coverage(sampler2D map, vec3 q, float bias) {
+    vec2 size = vec2(textureSize(map, 0));
+    vec2 st = q.xy * size - 0.5;
+    vec2 f = fract(st);
+    ivec2 i0 = ivec2(floor(st));
+    ivec2 top = ivec2(size) - 1;
+    float c[4];
+    for (int k = 0; k < 4; ++k) {
+        ivec2 texel = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), top);
+        vec4 front = texelFetch(map, texel, 0);
+        c[k] = front.r * smoothstep(0.5 * bias, 1.5 * bias, q.z - front.a);
+    }
+    return mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y);
+}
+
 #ifdef OCCLUSION_MAPS
 // The outside hidden from a point p of the cloth (normal `normal`; issue 11, model.md
 // section 9): of N_OCCLUSION directions (cosine-weighted about the window's normal,
@@ -195,9 +216,21 @@ vec2 outside_occlusion(vec3 p, vec3 normal) {
         vec3 q = p + (u_occlusion_offset_m * sign(dot(ng, d))) * ng;
         vec4 clip = u_occlusion_view_proj[j] * vec4(q, 1.0);
         vec2 tile = vec2(mod(float(j), u_occlusion_grid), floor(float(j) / u_occlusion_grid));
-        vec2 uv = (tile + clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0)) / u_occlusion_grid;
-        float depth = textureLod(u_occlusion_maps, uv, 0.0).a;
-        hidden += open * step(depth + u_occlusion_depth_bias[j], clip.z * 0.5 + 0.5);
+        // the tile's texels (the atlas holds tiles side by side): a ramp in depth over
+        // 0.5..1.5 times the bias, the four nearest texels of the tile blended bilinearly
+        float n = float(textureSize(u_occlusion_maps, 0).x) / u_occlusion_grid;
+        vec2 st = clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0) * n - 0.5;
+        vec2 f = fract(st);
+        ivec2 i0 = ivec2(floor(st));
+        float z = clip.z * 0.5 + 0.5;
+        float b = u_occlusion_depth_bias[j];
+        float h[4];
+        for (int k = 0; k < 4; ++k) {
+            ivec2 texel = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), ivec2(int(n) - 1))
+                        + ivec2(tile * n);
+            h[k] = smoothstep(0.5 * b, 1.5 * b, z - texelFetch(u_occlusion_maps, texel, 0).a);
+        }
+        hidden += open * mix(mix(h[0], h[1], f.x), mix(h[2], h[3], f.x), f.y);
         walled += 1.0 - open;
     }
     return vec2(hidden, walled) / float(N_OCCLUSION);

@@ -220,8 +220,7 @@ void main() {
                    ? room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius)
                    : 1.0;
         vec4 clip = u_light_view_proj * vec4(v_position, 1.0);
-        vec4 front = texture(u_key_front, clip.xy * 0.5 + 0.5);
-        g_front_coverage = front.r * step(front.a + u_key_depth_bias, clip.z * 0.5 + 0.5);
+        g_front_coverage = front_layer_coverage(u_key_front, clip.xyz * 0.5 + 0.5, u_key_depth_bias);
         key_uv = g_key_beam * (1.0 - g_front_coverage);   // UV passes the holes only
     }
 #endif
