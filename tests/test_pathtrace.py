@@ -406,6 +406,7 @@ def test_a_sun_brings_the_frames_clear_sky_into_the_environment():
 
 
 @pytest.mark.gl
+@pytest.mark.slow   # 0.8 s for the sun (its clear sky), 0.15 s for a lamp
 @pytest.mark.parametrize("light", ["sun:100", "D65", "UV-A"])
 def test_the_reference_builds_the_frames_shading_inputs(gl, light):
     """Issue 11: every field of the reference's ShadingInputs equals the frame's for the same
