@@ -165,6 +165,79 @@ vec3 thread_normal(vec3 n, vec3 tangent, vec3 m) {
 }
 #endif
 
+// A front-layer map (room_shadow.frag FRONT_LAYER: r = the nearest layer's coverage, a = its
+// depth) at map point q (xy: texture coordinates, z: depth, 0..1): the coverage of the layer
+// in front of q, 0 where q is that layer itself. The depth test is a ramp from half to one
+// and a half times the bias and the four nearest texels are blended bilinearly (percentage-
+// closer filtering), so that the answer changes continuously across a shadow's edge and
+// along a fold's flank instead of flipping on rounding.
+float front_layer_coverage(sampler2D map, vec3 q, float bias) {
+    vec2 size = vec2(textureSize(map, 0));
+    vec2 st = q.xy * size - 0.5;
+    vec2 f = fract(st);
+    ivec2 i0 = ivec2(floor(st));
+    ivec2 top = ivec2(size) - 1;
+    float c[4];
+    for (int k = 0; k < 4; ++k) {
+        ivec2 texel = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), top);
+        vec4 front = texelFetch(map, texel, 0);
+        c[k] = front.r * smoothstep(0.5 * bias, 1.5 * bias, q.z - front.a);
+    }
+    return mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y);
+}
+
+#ifdef OCCLUSION_MAPS
+// The outside hidden from a point p of the cloth (normal `normal`; issue 11, model.md
+// section 9): of N_OCCLUSION directions (cosine-weighted about the window's normal,
+// catalog/render/room_light.py), the fraction in which a layer of cloth lies between p and
+// the outside (one front-layer depth map per direction, tiles of u_occlusion_maps), and the
+// fraction that does not leave through the window opening (the wall). Returns (cloth, wall).
+uniform sampler2D u_occlusion_maps; // a: the nearest layer's depth, tile j of a square grid
+uniform mat4 u_occlusion_view_proj[N_OCCLUSION];
+uniform float u_occlusion_depth_bias[N_OCCLUSION];
+uniform vec3 u_occlusion_direction[N_OCCLUSION];   // towards the outside
+uniform float u_occlusion_grid;     // tiles per side
+uniform float u_occlusion_offset_m; // the lookup moved off the surface towards the direction
+uniform vec4 u_occlusion_window;    // the opening (x0, x1, y0, y1), m
+uniform vec2 u_occlusion_wall_z;    // the window wall's inner and outer planes, m
+
+vec2 outside_occlusion(vec3 p, vec3 normal) {
+    vec3 ng = normalize(normal);
+    float hidden = 0.0;
+    float walled = 0.0;
+    for (int j = 0; j < N_OCCLUSION; ++j) {
+        vec3 d = u_occlusion_direction[j];
+        // through the opening? (the ray must cross it in both of the wall's planes)
+        vec2 q_in = p.xy + ((u_occlusion_wall_z.x - p.z) / d.z) * d.xy;
+        vec2 q_out = p.xy + ((u_occlusion_wall_z.y - p.z) / d.z) * d.xy;
+        vec4 inside = step(u_occlusion_window.xzxz, vec4(q_in, q_out))
+                    * step(vec4(q_in, q_out), u_occlusion_window.ywyw);
+        float open = inside.x * inside.y * inside.z * inside.w;
+        // off the surface on the direction's side (normal offset: no self-shadowing)
+        vec3 q = p + (u_occlusion_offset_m * sign(dot(ng, d))) * ng;
+        vec4 clip = u_occlusion_view_proj[j] * vec4(q, 1.0);
+        vec2 tile = vec2(mod(float(j), u_occlusion_grid), floor(float(j) / u_occlusion_grid));
+        // the tile's texels (the atlas holds tiles side by side): a ramp in depth over
+        // 0.5..1.5 times the bias, the four nearest texels of the tile blended bilinearly
+        float n = float(textureSize(u_occlusion_maps, 0).x) / u_occlusion_grid;
+        vec2 st = clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0) * n - 0.5;
+        vec2 f = fract(st);
+        ivec2 i0 = ivec2(floor(st));
+        float z = clip.z * 0.5 + 0.5;
+        float b = u_occlusion_depth_bias[j];
+        float h[4];
+        for (int k = 0; k < 4; ++k) {
+            ivec2 texel = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), ivec2(int(n) - 1))
+                        + ivec2(tile * n);
+            h[k] = smoothstep(0.5 * b, 1.5 * b, z - texelFetch(u_occlusion_maps, texel, 0).a);
+        }
+        hidden += open * mix(mix(h[0], h[1], f.x), mix(h[2], h[3], f.x), f.y);
+        walled += 1.0 - open;
+    }
+    return vec2(hidden, walled) / float(N_OCCLUSION);
+}
+#endif
+
 // Weighted blended order-independent transparency (McGuire & Bavoil 2013, JCGT 2(2)): each
 // layer adds C a w and a w, and multiplies the revealage by (1 - a); nearer layers weigh more.
 // depth_m: view distance beyond the reference, clamped to [0, 3] m; 2^(-30 m^-1 depth) keeps the
@@ -228,16 +301,17 @@ float soft_rect(vec2 q, vec4 box, float half_width) {
 
 // The key light's beam through the window opening at room point p (to_light.z < 0: the light
 // is outside): the ray p + s to_light must cross the opening (x0, x1, y0, y1) = rect in both
-// the wall's inner plane z = wall_z.x and outer plane z = wall_z.y (the reveals shade). The
-// edge is soft by the penumbra of a source of angular radius atan(tan_radius) at the distance
-// travelled (PCSS's estimate for a distant disc).
+// the wall's inner plane z = wall_z.x and outer plane z = wall_z.y (the reveals shade); a
+// point within the wall's depth (the reveals themselves, the sill) only in the planes still
+// ahead of it. The edge is soft by the penumbra of a source of angular radius
+// atan(tan_radius) at the distance travelled (PCSS's estimate for a distant disc).
 float room_window_beam(vec3 p, vec3 to_light, vec4 opening, vec2 wall_z, float tan_radius) {
     float s_in = (wall_z.x - p.z) / to_light.z;
     float s_out = (wall_z.y - p.z) / to_light.z;
     vec2 q_in = p.xy + s_in * to_light.xy;
     vec2 q_out = p.xy + s_out * to_light.xy;
-    return step(0.0, s_in) * soft_rect(q_in, opening, s_in * tan_radius + 1e-3)
-         * soft_rect(q_out, opening, s_out * tan_radius + 1e-3);
+    float inner = s_in > 0.0 ? soft_rect(q_in, opening, s_in * tan_radius + 1e-3) : 1.0;
+    return step(0.0, s_out) * inner * soft_rect(q_out, opening, s_out * tan_radius + 1e-3);
 }
 
 

@@ -24,7 +24,7 @@ uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to th
 #ifdef OIT
 uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
 INTERPOLATION in vec3 v_position;
 #endif
 
@@ -53,6 +53,13 @@ SCENE_VALUE(float, u_anisotropy, S_ANISOTROPY);
 SCENE_VALUE(vec4, u_key_dyed[NV4], S_KEY_DYED);             // key light normal irradiance x dye
 SCENE_VALUE(vec4, u_fill_dyed[NV4], S_FILL_DYED);           // fill light (viewer side) x dye
 SCENE_VALUE(vec4, u_ambient[NV4], S_AMBIENT);               // cloth radiance from the diffuse surroundings
+SCENE_VALUE(vec4, u_ambient_outside[NV4], S_AMBIENT_OUTSIDE); // the outside's share of it
+// the ambient by view (issue 11, model.md section 9): its ratio to the normal view's at
+// mu = |n . v| = i / (AMBIENT_VIEW_NODES - 1), the outside's share and the room's
+SCENE_VALUE(vec4, u_ambient_view_outside[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_OUTSIDE);
+SCENE_VALUE(vec4, u_ambient_view_room[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_ROOM);
+float g_view_outside = 1.0;   // set in main
+float g_view_room = 1.0;
 SCENE_VALUE(vec4, u_sky[NV4], S_SKY);
 SCENE_VALUE(vec4, u_ground[NV4], S_GROUND);
 SCENE_VALUE(vec4, u_sun_disc[NV4], S_SUN_DISC);
@@ -72,6 +79,7 @@ layout(location = 1) out vec4 out_oit_weight;
 layout(location = 1) out vec4 out_position;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_tangent;
+layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, the outside's occlusion: cloth, wall
 #endif
 
 // One chunk of 4 bands: eq. 8's terms summed, then projected to display colour. Called with a
@@ -96,14 +104,61 @@ uniform vec4 u_room_lamp_dyed[N_ROOM_LAMPS * NV4];
 float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set in main)
 #endif
 
+#ifdef KEY_SHADOW
+// The key light's visibility on the cloth (issue 11, model.md section 9): the window wall's
+// shadow (the opening's soft mask, room_window_beam) times the folds' shadow: the key's
+// front-layer map (room_shadow.frag, FRONT_LAYER: per texel the thread coverage c of the
+// layer of cloth nearest the light and its depth); a fragment behind that layer receives the
+// beam through it, (1 - c) key dye + c key dye thread (u_key_thread: c = 1), the float64
+// twin's layer_beam_transmittance, and the excitation through its holes, 1 - c.
+SCENE_VALUE(vec4, u_key_thread[NV4], S_KEY_THREAD);
+uniform sampler2D u_key_front;     // r: the nearest layer's coverage, a: its depth (0..1)
+uniform mat4 u_light_view_proj;
+uniform float u_key_depth_bias;    // depth (0..1 units) a fragment must lie behind to be shaded
+uniform vec4 u_window_rect;
+uniform vec2 u_wall_z;
+uniform float u_tan_sun_radius;
+float g_key_beam = 1.0;            // the window's mask (set in main)
+float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
+#endif
+#ifdef SKY_OCCLUSION
+// The outside hidden by the cloth's own folds and by the window wall (issue 11, model.md
+// section 9), per vertex (curtain.vert) and interpolated: the ambient term loses that
+// fraction of what a layer of cloth does not pass (u_ambient_occluded: the float64 twin's
+// outside_occluded_radiance), and all of the outside where the wall hides it.
+SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
+INTERPOLATION in vec2 v_occlusion;  // the cloth's share, the window wall's
+float g_occlusion = 0.0;            // set in main
+float g_wall_occlusion = 0.0;
+#endif
+
+// A table of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes.
+float ambient_view(vec4 table[AMBIENT_VIEW_VEC4], float mu) {
+    float x = clamp(mu, 0.0, 1.0) * float(AMBIENT_VIEW_NODES - 1);
+    int i = min(int(x), AMBIENT_VIEW_NODES - 2);
+    float a = table[i / 4][i % 4];
+    float b = table[(i + 1) / 4][(i + 1) % 4];
+    return a + (x - float(i)) * (b - a);
+}
+
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
+#ifdef KEY_SHADOW
+    vec4 key_seen = g_key_beam * ((1.0 - g_front_coverage) * u_key_dyed[k]
+                                  + g_front_coverage * u_key_thread[k]);
+    vec4 band = g_key * key_seen + g_fill * u_fill_dyed[k];
+#else
     vec4 band = g_key * u_key_dyed[k] + g_fill * u_fill_dyed[k];
+#endif
 #ifdef N_ROOM_LAMPS
     for (int j = 0; j < N_ROOM_LAMPS; ++j) {
         band += g_room_lamp[j] * u_room_lamp_dyed[j * NV4 + k];
     }
 #endif
-    vec4 constant = u_ambient[k];
+    vec4 constant = g_view_room * u_ambient[k] + (g_view_outside - g_view_room) * u_ambient_outside[k];
+#ifdef SKY_OCCLUSION
+    constant -= g_view_outside * (g_occlusion * u_ambient_occluded[k]
+                                  + g_wall_occlusion * u_ambient_outside[k]);
+#endif
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
 #endif
@@ -148,16 +203,35 @@ void main() {
 #endif
     float cos_key = dot(n, u_key_to_light);
     float cos_fill = dot(n, u_fill_to_light);
+    float mu_view = abs(dot(n, ray));
+    g_view_outside = ambient_view(u_ambient_view_outside, mu_view);
+    g_view_room = ambient_view(u_ambient_view_room, mu_view);
     vec2 key = woven_transmission_ratio(u_key_to_light, cos_key, tan_key, view,
                                         u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
     vec2 fill = woven_transmission_ratio(u_fill_to_light, cos_fill, tan_fill, view,
                                          u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
     // eq. 8 fluorescence, physical: fluorescence_effective_photons, N / (1 + N / N_sat), with its
     // denominator kept apart so that SHARED_DIVISION can fold it into the one division
+    float key_uv = 1.0;   // the key's excitation reaching the fragment (KEY_SHADOW)
+#ifdef KEY_SHADOW
+    {
+        // the window's mask where the key shines through it (a light in the room: none)
+        g_key_beam = u_key_to_light.z < 0.0
+                   ? room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius)
+                   : 1.0;
+        vec4 clip = u_light_view_proj * vec4(v_position, 1.0);
+        g_front_coverage = front_layer_coverage(u_key_front, clip.xyz * 0.5 + 0.5, u_key_depth_bias);
+        key_uv = g_key_beam * (1.0 - g_front_coverage);   // UV passes the holes only
+    }
+#endif
+#ifdef SKY_OCCLUSION
+    g_occlusion = v_occlusion.x;
+    g_wall_occlusion = v_occlusion.y;
+#endif
     float absorbed = 0.0;
     float saturation = 1.0;
 #ifdef FLUORESCENCE_PHYSICAL
-    absorbed = abs(cos_key) * u_absorbed_photons.x + abs(cos_fill) * u_absorbed_photons.y
+    absorbed = abs(cos_key) * key_uv * u_absorbed_photons.x + abs(cos_fill) * u_absorbed_photons.y
              + u_absorbed_photons.z;
     saturation = 1.0 + absorbed * u_inv_saturation;
 #endif
@@ -224,5 +298,13 @@ void main() {
     out_position = vec4(v_position, 1.0);
     out_normal = vec4(n, 1.0);
     out_tangent = vec4(normalize(v_tangent - dot(v_tangent, n) * n), 1.0);
+    vec4 shadows = vec4(1.0, 0.0, 0.0, 0.0);
+#ifdef KEY_SHADOW
+    shadows.xy = vec2(g_key_beam, g_front_coverage);
+#endif
+#ifdef SKY_OCCLUSION
+    shadows.zw = vec2(g_occlusion, g_wall_occlusion);
+#endif
+    out_shadows = shadows;
 #endif
 }

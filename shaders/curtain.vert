@@ -1,4 +1,5 @@
 #version 430
+#include "common.glsl"
 // The curtain mesh: positions (moved into the scene by u_mesh_offset: the cloth simulation's
 // own frame has the rod elsewhere), normals and the weft tangent; shared by the shading pass,
 // the G-buffer variant and the trivial floor shader. The view ray (position - camera) is
@@ -20,6 +21,16 @@ uniform vec2 u_uv_to_repeats;        // fabric size / pattern repeat: uv -> patt
 INTERPOLATION out vec2 v_pattern_uv;
 #endif
 
+#ifdef SKY_OCCLUSION
+// The outside hidden from this vertex by the cloth and by the window wall (issue 11,
+// common.glsl outside_occlusion), computed once per update of the room's light by
+// occlusion_points.vert into one texel per vertex (u_vertex_occlusion, u_vertex_occlusion_width
+// texels a row) and read here by the vertex's index.
+uniform sampler2D u_vertex_occlusion;
+uniform int u_vertex_occlusion_width;
+INTERPOLATION out vec2 v_occlusion; // the cloth's share, the wall's
+#endif
+
 uniform mat4 u_view_proj;
 uniform vec3 u_mesh_offset;
 uniform vec3 u_camera_position;
@@ -29,7 +40,7 @@ INTERPOLATION out vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 INTERPOLATION out vec3 v_tangent;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
 INTERPOLATION out vec3 v_position;
 #endif
 
@@ -43,8 +54,12 @@ void main() {
 #ifdef PATTERN
     v_pattern_uv = in_uv * u_uv_to_repeats;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
     v_position = position;
+#endif
+#ifdef SKY_OCCLUSION
+    v_occlusion = texelFetch(u_vertex_occlusion, ivec2(gl_VertexID % u_vertex_occlusion_width,
+                                                       gl_VertexID / u_vertex_occlusion_width), 0).xy;
 #endif
     gl_Position = u_view_proj * vec4(position, 1.0);
 }

@@ -34,5 +34,11 @@ float curtain_coverage(vec2 uv) {
 
 void main() {
     float c = curtain_coverage(v_uv);
+#ifdef FRONT_LAYER
+    // the front-layer map (curtain.frag, KEY_SHADOW and SKY_OCCLUSION): the nearest layer's
+    // thread coverage and its depth, kept by the depth test (no blending)
+    out_transmittance = vec4(c, 0.0, 0.0, gl_FragCoord.z);
+#else
     out_transmittance = vec4(vec3(1.0 - c) + c * u_thread_beam_rgb, 1.0);
+#endif
 }

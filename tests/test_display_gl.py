@@ -84,7 +84,8 @@ def _exact_mean_linear(renderer, mask, like):
     gbuffer = renderer.render_gbuffer()
     exact = ref.reference_linear_srgb(renderer.shading_inputs(), gbuffer["position"][mask],
                                       gbuffer["normal"][mask], gbuffer["tangent"][mask],
-                                      renderer.camera.position).mean(axis=0)
+                                      renderer.camera.position,
+                                      **ref.shadow_terms(gbuffer["shadows"][mask])).mean(axis=0)
     exact = renderer.white_balance_matrix() @ exact
     luminance = display.matrices().luminance
     return exact * (like @ luminance) / (exact @ luminance)

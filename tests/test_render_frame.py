@@ -37,7 +37,8 @@ def _compare(renderer):
     assert mask.sum() > 0.3 * mask.size  # the curtain fills most of the frame
     reference = ref.reference_linear_srgb(renderer.shading_inputs(), gbuffer["position"][mask],
                                           gbuffer["normal"][mask], gbuffer["tangent"][mask],
-                                          renderer.camera.position)
+                                          renderer.camera.position,
+                                          **ref.shadow_terms(gbuffer["shadows"][mask]))
     return gbuffer["radiance"][mask].astype(np.float64), reference
 
 
@@ -267,7 +268,8 @@ def test_band_shader_arithmetic_matches_float64_bands(gl, make_preset, n_bands):
     mask = gbuffer["mask"]
     inputs = renderer.shading_inputs()
     spectral = ref.shade_spectral(inputs, gbuffer["position"][mask], gbuffer["normal"][mask],
-                                  gbuffer["tangent"][mask], renderer.camera.position)
+                                  gbuffer["tangent"][mask], renderer.camera.position,
+                                  **ref.shadow_terms(gbuffer["shadows"][mask]))
     weights, to_rgb = band_weights(n_bands, inputs.key_irradiance)
     expected = (spectral @ weights.T) @ to_rgb.T
     error = _relative_error(gbuffer["radiance"][mask].astype(np.float64), expected)

@@ -50,13 +50,18 @@ SCENES = (
 QUICK_SCENES = SCENES[1:2]
 SIZE = (192, 144)
 QUICK_SIZE = (64, 48)
-SPP = 256
+SPP = 512
 QUICK_SPP = 16
 #: (label, bands, fluorescence mode, supersample factor, anti-aliasing (None: the frame's
 #: default, FXAA)). The first is the frame's default.
 OPTIONS = (
     ("default (physical, 3 bands, FXAA)", 3, "physical", 1, None),
     ("room lighting off", 3, "physical", 1, None, False),
+    ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
+    ("sky occlusion off (issue 11)", 3, "physical", 1, None, None, {"sky_occlusion": False}),
+    ("ambient by view off (issue 11)", 3, "physical", 1, None, None, {"ambient_by_view": False}),
+    ("issue 11's three off", 3, "physical", 1, None, None,
+     {"key_shadow": False, "sky_occlusion": False, "ambient_by_view": False}),
     ("FXAA off", 3, "physical", 1, "off"),
     ("6 bands", 6, "physical", 1, None),
     ("16 bands", 16, "physical", 1, None),
@@ -67,7 +72,8 @@ ABSENT_OPTIONS = ("shadow map size (catalog.render.room_light.SHADOW_TEXELS, not
 #: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
 #: curtain (noise falls as 1 / sqrt(spp): the spp that reaches it is spp (noise / 1 %)^2).
 NOISE_TARGET = 0.01
-#: The committed figures (tools/docs_figures.py): {"runs": {"baseline": section, "after_12_16": section}}.
+#: The committed figures (tools/docs_figures.py): {"runs": {"baseline": section, "after_12_16": section,
+#: "after_11": section}} (after_11: issue 11's fixes, the references at 512 spp).
 RESULT_JSON = "benchmarks/bench_image.json"
 GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
 REGIONS = ("curtain", "floor", "walls")
@@ -85,7 +91,7 @@ def light_name(key: str) -> str:
 
 def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
                  antialiasing: str | None = None, room_lighting: bool | None = None,
-                 repeats: int = 5) -> dict:
+                 repeats: int = 5, switches: dict | None = None) -> dict:
     """The real-time frame at desc.size: ``linear`` radiance (H, W, 3), ``display`` (the
     frame's own display image, sRGB in [0, 1]), the ``exposure`` and ``white_balance`` its
     display step used, and ``seconds``, the median wall time of render + glFinish.
@@ -105,6 +111,8 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
             renderer.set_antialiasing(antialiasing)
         if room_lighting is not None:
             renderer.set_room_lighting(room_lighting)
+        for name, on in (switches or {}).items():   # issue 11's terms: set_key_shadow, ...
+            getattr(renderer, f"set_{name}")(on)
         cam = desc.info["camera"]
         renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
         renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
@@ -176,10 +184,11 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
         noise_curtain = metrics.noise_between(a, b, masks["curtain"])
         option_rows = []
         default = None
-        for opt_label, bands, mode, supersample, antialiasing, *room in options:
+        for opt_label, bands, mode, supersample, antialiasing, *extra in options:
             frame = frame_images(ctx, desc, preset, light, bands, mode, supersample,
-                                 antialiasing, room[0] if room else None,
-                                 repeats=3 if quick else 7)
+                                 antialiasing, extra[0] if extra else None,
+                                 repeats=3 if quick else 7,
+                                 switches=extra[1] if len(extra) > 1 else None)
             if default is None:  # the default frame's exposure and white balance show both
                 exposure, white_balance = frame["exposure"], frame["white_balance"]
             result = compare(frame, reference, masks, desc.inputs, exposure, white_balance)
@@ -352,6 +361,21 @@ def ranges_sentence(before: dict, after: dict) -> str:
             f"{GOAL['speedup_at_least']:g}x: {'met' if min(speed) >= GOAL['speedup_at_least'] else 'NOT met'}).")
 
 
+def summary_line(result: dict) -> str:
+    """One sentence of a run's ranges (for the README and BENCHMARKS.md)."""
+    rows = result["rows"]
+    flips = [r["mean_flip"] for r in rows]
+    des = [r["curtain_delta_e_mean"] for r in rows if r["curtain_delta_e_mean"] is not None]
+    speed = [r["speedup"] for r in rows]
+    noise = [r["reference_flip_noise_bound"] for r in rows]
+    s = result["summary"]
+    return (f"Mean FLIP {_cell(min(flips))}-{_cell(max(flips))}, curtain Delta E 2000 mean "
+            f"{_cell(min(des))}-{_cell(max(des))}, the frame {_cell(min(speed))}-{_cell(max(speed))}x "
+            f"faster than the reference ({result['settings']['spp']} spp); the FLIP of the reference's "
+            f"two half renders (its noise's share) {_cell(min(noise))}-{_cell(max(noise))}. "
+            f"Goal met on {s['scenes_meeting_goal']} of {s['scenes']} scenes.")
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run; of the
     committed JSON (``{"runs": {...}}``) the baseline's, and ``image-after`` the run after
@@ -363,6 +387,15 @@ def markdown_tables(result: dict) -> dict[str, str]:
                                  + "\n\n![six scenes after issues 12-16: real-time | reference | FLIP]"
                                  "(img/pathtrace_scenes_after_13.png)")
         blocks["image-ranges"] = ranges_sentence(result["runs"]["baseline"], result["runs"]["after_12_16"])
+        if "after_11" in result["runs"]:
+            run = result["runs"]["after_11"]
+            latest = markdown_tables(run)
+            blocks["image-after-11"] = (
+                latest["image"] + "\n\nReal-time options (issue 11's terms switched off one at a time "
+                "against the same references):\n\n" + latest["image-options"]
+                + "\n\n![six scenes after issue 11's fixes: real-time | reference | FLIP]"
+                "(img/pathtrace_scenes_after_11.png)")
+            blocks["image-after-11-summary"] = summary_line(run)
         return blocks
 
     s = result["summary"]

@@ -195,7 +195,8 @@ def band_errors(ctx, preset) -> dict:
                 m = gb["mask"]
                 inputs = renderer.shading_inputs()
                 reference = ref.reference_linear_srgb(inputs, gb["position"][m], gb["normal"][m],
-                                                      gb["tangent"][m], renderer.camera.position)
+                                                      gb["tangent"][m], renderer.camera.position,
+                                                      **ref.shadow_terms(gb["shadows"][m]))
                 de = delta_e_2000(linear_srgb_to_xyz(gb["radiance"][m].astype(np.float64)),
                                   linear_srgb_to_xyz(reference), ref.white_xyz(inputs))
                 rows[f"{light}|{inputs.fluorescence_mode}|{n}"] = (float(de.mean()), float(de.max()))

@@ -175,7 +175,8 @@ def render_sweep(ctx, scales, quick: bool) -> list[dict]:
                     bad += int(np.sum(~np.isfinite(rgb)))
                     truth = xyz_to_linear_srgb(ref.spectral_to_xyz(ref.shade_spectral(
                         renderer.shading_inputs(), gb["position"][m], gb["normal"][m],
-                        gb["tangent"][m], renderer.camera.position)))
+                        gb["tangent"][m], renderer.camera.position,
+                        **ref.shadow_terms(gb["shadows"][m]))))
                     # relative to each pixel's luminance: a dark channel's rounding counts
                     # against the pixel, not against its own near-zero value
                     luminance = np.maximum(np.abs(truth @ LUMINANCE_WEIGHTS), 1e-300)

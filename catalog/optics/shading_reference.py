@@ -21,12 +21,13 @@ Colour: ``linear_srgb = 683 * M_sRGB . sum_l cmf(l) L(l) dl`` (cd m^-2 scale for
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from catalog.core.constants import LUMINOUS_EFFICACY_LM_W
+from catalog.core.constants import AMBIENT_VIEW_NODE_COUNT, LUMINOUS_EFFICACY_LM_W
 from catalog.optics.btdf import hg_denominator_robust, hg_phase_of_d
 from catalog.optics.spectra import GRID_NM
 
@@ -66,6 +67,11 @@ class ShadingInputs:
     absorbed_photons: tuple[float, float, float] = (0.0, 0.0, 0.0)  # key, fill (normal incidence), ambient; m^-2 s^-1
     saturation_photons: float = math.inf  # N_sat, m^-2 s^-1
     emission_per_photon: np.ndarray | None = None     # radiance per effective absorbed photon m^-2 s^-1, per side
+    ambient_outside_radiance: np.ndarray | None = None  # the outside's share of ambient_radiance (None: 0)
+    # the ambient term's dependence on the view (issue 11): ratio to the normal view's at
+    # mu = |n . v| = AMBIENT_VIEW_NODES, for the outside's share and the room's (None: 1)
+    ambient_view_outside: np.ndarray | None = None
+    ambient_view_room: np.ndarray | None = None
 
 
 # --------------------------------------------------------------------------- terms
@@ -145,11 +151,110 @@ def hg_hemisphere_factors(g: float) -> tuple[float, float]:
     return (1.0 + g) / 2.0 - shared, (1.0 - g) / 2.0 - shared
 
 
+# --------------------------------------------------------------------------- the ambient by view (issue 11)
+
+#: mu = |n . v| at which the ambient term's view dependence is tabulated (linear between).
+AMBIENT_VIEW_NODES = np.linspace(0.0, 1.0, AMBIENT_VIEW_NODE_COUNT)
+
+
+@functools.lru_cache(maxsize=64)
+def hg_hemisphere_factors_by_view(g: float, nodes: tuple = tuple(AMBIENT_VIEW_NODES)) -> tuple[np.ndarray, np.ndarray]:
+    """(forward, backward) at each node mu: cloth radiance per unit radiance of a uniform
+    hemisphere for a view at cos = mu from the normal (model.md section 9). forward: the light
+    comes from the hemisphere behind the cloth, F(mu) = integral over t.n > 0 of
+    ph(t . v) (t . n) d omega; backward: from the viewer's side, the same over t.n < 0 with
+    |t . n|. In coordinates about the view (t . v = cos gamma), the azimuthal integral of the
+    clamped cosine max(a + b cos psi, 0), a = mu cos gamma, b = sqrt(1 - mu^2) sin gamma, is
+    closed (2 (a psi0 + b sin psi0), cos psi0 = -a / b), leaving a 1-D integral over cos gamma
+    (midpoint rule, nodes finer towards the peak at cos gamma = 1 for g > 0). At mu = 1 these
+    are :func:`hg_hemisphere_factors` (a test checks 1e-4)."""
+    # nodes in u = cos gamma: uniform plus a geometric cluster at the peak
+    edges = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 40001),
+                                      1.0 - np.geomspace(1e-7, 2.0, 4001),
+                                      -1.0 + np.geomspace(1e-7, 2.0, 4001)]))
+    edges = np.clip(edges, -1.0, 1.0)
+    u = 0.5 * (edges[1:] + edges[:-1])
+    du = np.diff(edges)
+    sin_g = np.sqrt(np.maximum(1.0 - u * u, 0.0))
+    phase = hg_phase_chords(2.0 * (1.0 - u), 2.0 * (1.0 + u), g)
+    out = []
+    for sign in (1.0, -1.0):
+        values = []
+        for mu in nodes:
+            a = sign * mu * u
+            b = np.abs(math.sqrt(max(1.0 - mu * mu, 0.0)) * sin_g)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                psi0 = np.arccos(np.clip(np.where(b > 0, -a / np.where(b > 0, b, 1.0), 0.0), -1.0, 1.0))
+            clamped = np.where(a >= b, 2 * math.pi * a,
+                               np.where(a <= -b, 0.0, 2.0 * (a * psi0 + b * np.sin(psi0))))
+            values.append(float(np.sum(phase * clamped * du)))
+        out.append(np.asarray(values))
+    return out[0], out[1]
+
+
+def ambient_view_ratios(a_diff: float, g_diff: float, a_spec: float, g_spec: float,
+                        backward: bool) -> np.ndarray:
+    """The ambient term's ratio to the normal view's at AMBIENT_VIEW_NODES, for light from the
+    hemisphere behind the cloth (``backward`` False) or from the viewer's side (True): the
+    lobes' (a_diff F_diff(mu) + a_spec F_spec(mu)) over the same at mu = 1 in closed form."""
+    k = 1 if backward else 0
+    by_view = (a_diff * hg_hemisphere_factors_by_view(g_diff)[k]
+               + a_spec * hg_hemisphere_factors_by_view(g_spec)[k])
+    normal = (a_diff * hg_hemisphere_factors(g_diff)[k] + a_spec * hg_hemisphere_factors(g_spec)[k])
+    if not normal > 0:
+        return np.ones_like(AMBIENT_VIEW_NODES)
+    return by_view / normal
+
+
+def ambient_view_ratio(table, mu) -> np.ndarray:
+    """A table of :func:`ambient_view_ratios` at mu (linear between nodes; None: 1)."""
+    mu = np.asarray(mu, dtype=np.float64)
+    if table is None:
+        return np.ones_like(mu)
+    return np.interp(np.clip(mu, 0.0, 1.0), AMBIENT_VIEW_NODES, np.asarray(table, dtype=np.float64))
+
+
+# --------------------------------------------------------------------------- the cloth's own shadow (issue 11)
+
+def layer_beam_transmittance(inputs: ShadingInputs, coverage) -> np.ndarray:
+    """(P, L): the key light's beam after one layer of cloth of thread coverage ``coverage``
+    (P,) (model.md section 9): the holes pass it, a thread passes the directional lobe's
+    forward-scattered part in the dye's colour per unit of mean coverage,
+    T = (1 - c) + c a_spec forward(g_spec) dye / (1 - LD). c = 0: no layer (T = 1)."""
+    c = np.asarray(coverage, dtype=np.float64).reshape(-1, 1)
+    forward = hg_hemisphere_factors(inputs.g_spec)[0]
+    thread = inputs.a_spec * forward * inputs.dye_transmittance / max(1.0 - inputs.direct, 1e-6)
+    return (1.0 - c) + c * thread[None, :]
+
+
+def outside_occluded_radiance(inputs: ShadingInputs) -> np.ndarray:
+    """(L,): the ambient radiance a fully occluded outside takes away (model.md section 9):
+    the outside's share of the ambient term times what a layer of cloth in the way does not
+    pass of diffuse light, 1 - (LD + dye (a_diff forward(g_diff) + a_spec forward(g_spec)))."""
+    if inputs.ambient_outside_radiance is None:
+        return np.zeros_like(inputs.ambient_radiance)
+    forward_d = hg_hemisphere_factors(inputs.g_diff)[0]
+    forward_s = hg_hemisphere_factors(inputs.g_spec)[0]
+    passed = inputs.direct + inputs.dye_transmittance * (inputs.a_diff * forward_d
+                                                         + inputs.a_spec * forward_s)
+    return (1.0 - passed) * inputs.ambient_outside_radiance
+
+
 # --------------------------------------------------------------------------- shading
 
 def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
-                   camera_position) -> np.ndarray:
-    """Spectral radiance (P, len(GRID_NM)) W m^-2 sr^-1 nm^-1 at world positions (P, 3)."""
+                   camera_position, key_beam=None, front_coverage=None,
+                   outside_occlusion=None, wall_occlusion=None) -> np.ndarray:
+    """Spectral radiance (P, len(GRID_NM)) W m^-2 sr^-1 nm^-1 at world positions (P, 3).
+
+    The cloth's shadows (issue 11, model.md section 9), per position (P,), default none:
+    ``key_beam`` the window's mask on the key light (0..1), ``front_coverage`` the thread
+    coverage of the layer of cloth between the position and the key light (0: none; the beam
+    is multiplied by :func:`layer_beam_transmittance`, the excitation by 1 - c),
+    ``outside_occlusion`` the fraction of the outside hidden by the cloth itself (the ambient
+    term loses that fraction of :func:`outside_occluded_radiance`), ``wall_occlusion`` the
+    fraction hidden by the window wall (the ambient loses that fraction of the outside's
+    share, ``inputs.ambient_outside_radiance``)."""
     p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     n = n / np.linalg.norm(n, axis=1, keepdims=True)
@@ -165,8 +270,25 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
     g_fill = woven_transmission(inputs.fill_to_light, to_viewer, t, b, n, inputs)
     dyed_key = inputs.key_irradiance * inputs.dye_transmittance
     dyed_fill = inputs.fill_irradiance * inputs.dye_transmittance
-    radiance = (g_key[:, None] * dyed_key + g_fill[:, None] * dyed_fill
-                + inputs.ambient_radiance[None, :])
+    count = p.shape[0]
+    beam = np.ones(count) if key_beam is None else np.asarray(key_beam, dtype=np.float64).reshape(-1)
+    cover = np.zeros(count) if front_coverage is None else np.asarray(front_coverage, dtype=np.float64).reshape(-1)
+    key_seen = beam[:, None] * layer_beam_transmittance(inputs, cover) * dyed_key[None, :]
+    # the ambient term by view (ratios to the normal view's): the room's share r_room, the
+    # outside's r_out, the occlusions' losses with the outside's
+    mu = np.abs(np.einsum("pi,pi->p", to_viewer, n))
+    r_out = ambient_view_ratio(inputs.ambient_view_outside, mu)[:, None]
+    r_room = ambient_view_ratio(inputs.ambient_view_room, mu)[:, None]
+    outside_share = (inputs.ambient_outside_radiance if inputs.ambient_outside_radiance is not None
+                     else np.zeros_like(inputs.ambient_radiance))
+    radiance = (g_key[:, None] * key_seen + g_fill[:, None] * dyed_fill
+                + r_room * inputs.ambient_radiance[None, :] + (r_out - r_room) * outside_share[None, :])
+    if outside_occlusion is not None:
+        radiance -= (r_out * np.asarray(outside_occlusion, dtype=np.float64).reshape(-1, 1)
+                     * outside_occluded_radiance(inputs)[None, :])
+    if wall_occlusion is not None:
+        radiance -= (r_out * np.asarray(wall_occlusion, dtype=np.float64).reshape(-1, 1)
+                     * outside_share[None, :])
     if inputs.direct > 0:
         w = inputs.direct * background_weights(ray, inputs.key_to_light, *inputs.sun_chord2)
         radiance += (w[:, 0:1] * inputs.sky_radiance + w[:, 1:2] * inputs.ground_radiance
@@ -175,11 +297,20 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
         radiance += inputs.paper_radiance[None, :]  # eq. 8: a constant per light
     elif inputs.fluorescence_mode == "physical":
         n_key, n_fill, n_ambient = inputs.absorbed_photons
-        absorbed = (np.abs(n @ np.asarray(inputs.key_to_light)) * n_key
+        absorbed = (np.abs(n @ np.asarray(inputs.key_to_light)) * (beam * (1.0 - cover)) * n_key
                     + np.abs(n @ np.asarray(inputs.fill_to_light)) * n_fill + n_ambient)
         effective = absorbed / (1.0 + absorbed / inputs.saturation_photons)
         radiance += effective[:, None] * inputs.emission_per_photon[None, :]
     return radiance
+
+
+def shadow_terms(shadows) -> dict:
+    """:func:`shade_spectral`'s shadow arguments from the frame's G-buffer ``shadows`` (P, 4):
+    the key's window mask, the coverage of the layer in front of the key, the outside's
+    occlusion by the cloth and by the window wall."""
+    s = np.asarray(shadows, dtype=np.float64).reshape(-1, 4)
+    return {"key_beam": s[:, 0], "front_coverage": s[:, 1], "outside_occlusion": s[:, 2],
+            "wall_occlusion": s[:, 3]}
 
 
 def spectral_to_linear_srgb(radiance: np.ndarray) -> np.ndarray:
@@ -197,10 +328,11 @@ def spectral_to_xyz(radiance: np.ndarray) -> np.ndarray:
 
 
 def reference_linear_srgb(inputs: ShadingInputs, positions, normals, tangents,
-                          camera_position) -> np.ndarray:
-    """The full-spectral (1 nm) float64 reference colour of the given pixels, (P, 3)."""
+                          camera_position, **shadows) -> np.ndarray:
+    """The full-spectral (1 nm) float64 reference colour of the given pixels, (P, 3);
+    ``shadows``: :func:`shade_spectral`'s key_beam, front_coverage, outside_occlusion."""
     return spectral_to_linear_srgb(shade_spectral(inputs, positions, normals, tangents,
-                                                  camera_position))
+                                                  camera_position, **shadows))
 
 
 def white_xyz(inputs: ShadingInputs) -> np.ndarray:

@@ -31,7 +31,12 @@ per vertex, from the photons the cloth absorbs there: the key light's at its inc
 half-space's sky and ground (the room's light, with almost no UV, is left out), through
 the same absorptance, quantum yield, saturation and emission spectrum as the real-time
 frame (catalog.render.scene.with_physical_emission), M / (2 pi) per side. It enters the
-scene as two emitting, null-scattering shells 0.5 mm either side of the cloth.
+scene as two emitting, null-scattering shells 0.5 mm either side of the cloth. They carry
+no pattern (the glow is the repeat's average; the frame draws it on the threads only): a
+Python texture (mi.Texture) modulating the per-vertex emission by c(uv) / mean(c) was tried
+(issue 11) and lit the room 1.9x brighter even with the factor set to 1 (the cloth seen
+directly unchanged): next-event estimation did not see the wrapped per-vertex value
+(presumably Mitsuba takes such a texture's mean; not resolved).
 """
 
 from __future__ import annotations
@@ -112,9 +117,11 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
                          distance_m=float(distance_m))
     to_light, is_sun = key_light_for(light)
     inside = bool(camera.position[2] > scene_lib.WINDOW_Z)
+    # as the frame builds them (FrameRenderer.shading_inputs): a ``sun:PATH_KM`` light is the
+    # paper's beam, whose sky and ground are that beam Rayleigh-scattered (paper_beam)
     inputs, decision = scene_lib.build_shading_inputs(
         preset, light.irradiance_w_m2_nm, to_light, is_sun=is_sun, fluorescence=fluorescence,
-        viewer_inside=inside)
+        paper_beam=light.name.startswith("sun:"), viewer_inside=inside)
     fabric_size = None
     rings: tuple = ()
     if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth

@@ -21,8 +21,11 @@ import math
 
 import numpy as np
 
+from catalog.core.constants import SHADER_DEFINES
 from catalog.core.errors import CatalogError
-from catalog.optics.shading_reference import LUMINOUS_EFFICACY_LM_W, PHOTON_UNIT, STEP_NM, ShadingInputs
+from catalog.optics.shading_reference import (LUMINOUS_EFFICACY_LM_W, PHOTON_UNIT, STEP_NM, ShadingInputs,
+                                              AMBIENT_VIEW_NODES, layer_beam_transmittance,
+                                              outside_occluded_radiance)
 from catalog.optics.spectra import GRID_NM
 
 #: Band counts the shaders are built for.
@@ -75,6 +78,19 @@ def _pack(values: np.ndarray, n_chunks: int) -> np.ndarray:
     return out
 
 
+def _view_table(table) -> np.ndarray:
+    """An ambient-by-view table (AMBIENT_VIEW_NODES values; None: all 1) as AMBIENT_VIEW_VEC4
+    vec4s, padded with its last value (curtain.frag's ambient_view)."""
+    values = np.ones(AMBIENT_VIEW_NODES.size) if table is None else np.asarray(table, dtype=np.float64)
+    out = np.full(4 * AMBIENT_VIEW_VEC4, values[-1], dtype=np.float32)
+    out[:values.size] = values
+    return out
+
+
+#: vec4s holding an ambient-by-view table (the shaders' AMBIENT_VIEW_VEC4).
+AMBIENT_VIEW_VEC4 = SHADER_DEFINES["AMBIENT_VIEW_VEC4"]
+
+
 def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray | float | tuple]:
     """The curtain shader's uniforms for ``inputs`` in ``n_bands`` bands (float32 arrays)."""
     weights, to_rgb = band_weights(n_bands, inputs.key_irradiance)
@@ -95,6 +111,14 @@ def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray |
         "u_key_dyed": band(inputs.key_irradiance * inputs.dye_transmittance),
         "u_fill_dyed": band(inputs.fill_irradiance * inputs.dye_transmittance),
         "u_ambient": band(inputs.ambient_radiance),
+        # issue 11's shadows on the cloth (KEY_SHADOW, SKY_OCCLUSION in curtain.frag)
+        "u_key_thread": band(inputs.key_irradiance * inputs.dye_transmittance
+                             * layer_beam_transmittance(inputs, [1.0])[0]),
+        "u_ambient_occluded": band(outside_occluded_radiance(inputs)),
+        "u_ambient_outside": band(inputs.ambient_outside_radiance
+                                  if inputs.ambient_outside_radiance is not None else zeros),
+        "u_ambient_view_outside": _view_table(inputs.ambient_view_outside),
+        "u_ambient_view_room": _view_table(inputs.ambient_view_room),
         "u_sky": band(inputs.sky_radiance),
         "u_ground": band(inputs.ground_radiance),
         "u_sun_disc": band(inputs.sun_disc_radiance),

@@ -74,6 +74,20 @@ MAX_SPECIALISED = 8
 PATTERN_UNIT = 3
 #: Texture unit of the environment image (background and the curtain's see-through).
 ENVIRONMENT_UNIT = 5
+#: Texture unit of the key light's front-layer map (the curtain's KEY_SHADOW).
+KEY_FRONT_UNIT = 6
+#: How far (m, along the key's travel) a fragment must lie behind the cloth layer nearest the
+#: key light to be in that layer's shadow: a little over one texel of the front-layer map on a
+#: fold's flank (room_light.SHADOW_TEXELS over ~2.4 m: 1 cm), so a layer does not shade itself.
+KEY_SHADOW_BIAS_M = 0.02
+#: Texture unit of the occlusion maps (the curtain's SKY_OCCLUSION).
+OCCLUSION_UNIT = 7
+#: SKY_OCCLUSION's depth bias (m) and its lookup's offset off the surface (m): a texel and a
+#: half of an occlusion map (room_light.OCCLUSION_TEXELS over ~2.4 m: 2 cm each).
+OCCLUSION_BIAS_M = 0.01
+OCCLUSION_OFFSET_M = 0.03
+#: Texels a row of the per-vertex occlusion texture (curtain.vert reads texel index % width).
+VERTEX_OCCLUSION_WIDTH = 256
 PATTERN_ANISOTROPY = 4.0
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
@@ -257,6 +271,14 @@ class FrameRenderer:
         self._last = None  # (vw, vh, fbo, viewport)
         #: issue 13: the room lit through the curtain (False: the earlier constant room)
         self.room_lighting = True
+        #: issue 11: the key light on the cloth shaded by the window wall and by the folds
+        #: nearer the light (curtain.frag KEY_SHADOW; False: the key reaches every fragment)
+        self.key_shadow = True
+        #: issue 11: the cloth's own folds hide part of the outside from its ambient term
+        #: (curtain.frag SKY_OCCLUSION; False: every fragment sees the whole outside)
+        self.sky_occlusion = True
+        #: issue 11: the ambient term by view (False: the normal view's at every angle)
+        self.ambient_by_view = True
         self.curtain_open = False
         self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
         self._room_gl = None
@@ -408,6 +430,21 @@ class FrameRenderer:
         """Light the room through the curtain (shadow map, area light, bounce: issue 13) or
         keep the earlier constant room (a fraction of the key light plus the fill light)."""
         self.room_lighting = bool(on)
+
+    def set_key_shadow(self, on: bool) -> None:
+        """Shade the key light on the cloth by the window wall and the folds nearer the light
+        (issue 11; curtain.frag KEY_SHADOW), or let it reach every fragment (the earlier frame)."""
+        self.key_shadow = bool(on)
+
+    def set_ambient_by_view(self, on: bool) -> None:
+        """The cloth's ambient term by view (issue 11; the lobes integrated for the view's
+        angle to the normal), or the normal view's at every angle (the earlier frame)."""
+        self.ambient_by_view = bool(on)
+
+    def set_sky_occlusion(self, on: bool) -> None:
+        """Let the cloth's own folds hide part of the outside from its ambient term (issue 11;
+        curtain.frag SKY_OCCLUSION), or let every fragment see the whole outside."""
+        self.sky_occlusion = bool(on)
 
     def set_curtain_open(self, open_: bool) -> None:
         """Open: the curtain is drawn aside (not drawn, casts nothing, lights nothing)."""
@@ -634,6 +671,11 @@ class FrameRenderer:
             defines["CURTAIN_ENVIRONMENT"] = True  # the see-through shows the image
         if self.room_lamps:
             defines["N_ROOM_LAMPS"] = len(self.room_lamps)   # the lamps light the cloth too
+        if self.key_shadow and not self.curtain_open:
+            defines["KEY_SHADOW"] = True   # the wall's and the folds' shadow on the cloth
+        if self.sky_occlusion and not self.curtain_open:
+            defines["SKY_OCCLUSION"] = True   # the folds hide part of the outside
+            defines["N_OCCLUSION"] = room_light.OCCLUSION_DIRECTIONS
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -655,6 +697,9 @@ class FrameRenderer:
         }
         for name, value in self._band_uniforms().items():
             values[name] = tuple(float(v) for v in value) if isinstance(value, tuple) else value
+        if not self.ambient_by_view:   # the normal view's ambient at every angle
+            for name in ("u_ambient_view_outside", "u_ambient_view_room"):
+                values[name] = np.ones_like(values[name])
         return values
 
     def room_lamp_values(self) -> dict:
@@ -862,6 +907,10 @@ class FrameRenderer:
                 self.environment[1].use(location=ENVIRONMENT_UNIT)
                 self._set(program, "u_environment", ENVIRONMENT_UNIT)
                 self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
+            if "u_key_front" in program:
+                self._key_shadow_uniforms(program, self.shading_inputs())
+            if "u_vertex_occlusion" in program:
+                self._vertex_occlusion_uniforms(program)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
         self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
 
@@ -1043,7 +1092,19 @@ class FrameRenderer:
             ao = ctx.texture((aw, ah), 4, data=room_light.ao_and_mask_texture().tobytes(), dtype="f4")
             ao.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             ao.build_mipmaps()
+            key_front = ctx.texture((n, n), 4, dtype="f4")
+            key_front.filter = (mgl.NEAREST, mgl.NEAREST)
+            key_front.repeat_x = key_front.repeat_y = False
+            key_front_depth = ctx.depth_renderbuffer((n, n))
+            side = self._occlusion_grid() * room_light.OCCLUSION_TEXELS
+            occlusion = ctx.texture((side, side), 4, dtype="f4")
+            occlusion.filter = (mgl.NEAREST, mgl.NEAREST)
+            occlusion_depth = ctx.depth_renderbuffer((side, side))
             self._room_gl = {
+                "key_front": key_front, "key_front_depth": key_front_depth,
+                "key_front_fbo": ctx.framebuffer([key_front], key_front_depth),
+                "occlusion": occlusion, "occlusion_depth": occlusion_depth,
+                "occlusion_fbo": ctx.framebuffer([occlusion], occlusion_depth),
                 "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
                 "luminaire": luminaire, "luminaire_depth": luminaire_depth,
                 "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
@@ -1068,6 +1129,90 @@ class FrameRenderer:
         return {"u_key_rgb": tuple(float(v) for v in key), "u_mean_coverage": 1.0 - float(inputs.direct),
                 "u_thread_beam_rgb": tuple(float(v) for v in thread)}
 
+    def _key_shadow_uniforms(self, program, inputs) -> None:
+        """curtain.frag's KEY_SHADOW: the front-layer map, its frame and depth bias, the opening."""
+        gl = self._room_resources()
+        gl["key_front"].use(location=KEY_FRONT_UNIT)
+        s = self._set
+        s(program, "u_key_front", KEY_FRONT_UNIT)
+        matrix = room_light.light_view_projection(inputs.key_to_light)
+        s(program, "u_light_view_proj", gl_bytes(matrix))
+        # orthographic: window depth (0..1) = 0.5 ndc z + 0.5, ndc z = m[2, 2] z_view + ..:
+        # one metre along the travel is -m[2, 2] / 2 of depth
+        s(program, "u_key_depth_bias", KEY_SHADOW_BIAS_M * abs(float(matrix[2, 2])) / 2)
+        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+        z0 = scene_lib.ROOM_BOX[2][0]
+        s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
+        s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
+        s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
+
+    def _vertex_occlusion_uniforms(self, program) -> None:
+        """curtain.vert's SKY_OCCLUSION: the per-vertex occlusion texture."""
+        texture = self._room_resources().get("vertex_occlusion")
+        if texture is None:   # not drawn yet (a mesh bound after the last update): none
+            texture = self._vertex_occlusion_target(1)
+        texture.use(location=OCCLUSION_UNIT)
+        self._set(program, "u_vertex_occlusion", OCCLUSION_UNIT)
+        self._set(program, "u_vertex_occlusion_width", VERTEX_OCCLUSION_WIDTH)
+
+    def _vertex_occlusion_target(self, vertices: int):
+        """The per-vertex occlusion texture for ``vertices`` (VERTEX_OCCLUSION_WIDTH a row),
+        made or remade when the count needs more rows (its texels are written by
+        _draw_vertex_occlusion, which clears it first)."""
+        mgl, gl = self._moderngl, self._room_resources()
+        rows = max(1, -(-int(vertices) // VERTEX_OCCLUSION_WIDTH))
+        texture = gl.get("vertex_occlusion")
+        if texture is None or texture.size[1] < rows:
+            if texture is not None:
+                gl["vertex_occlusion_fbo"].release()
+                texture.release()
+            texture = self.ctx.texture((VERTEX_OCCLUSION_WIDTH, rows), 4, dtype="f4")
+            texture.filter = (mgl.NEAREST, mgl.NEAREST)
+            gl["vertex_occlusion"] = texture
+            gl["vertex_occlusion_fbo"] = self.ctx.framebuffer([texture])
+        return texture
+
+    def _draw_vertex_occlusion(self) -> None:
+        """Each vertex's outside occlusion (occlusion_points.*) from the occlusion maps."""
+        mgl = self._moderngl
+        b = self._curtain_buffers
+        texture = self._vertex_occlusion_target(self._vertex_count)
+        fbo = self._room_gl["vertex_occlusion_fbo"]
+        fbo.use()
+        self.ctx.viewport = (0, 0, *texture.size)
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        program = self._program("occlusion_points.vert", "occlusion_points.frag",
+                                {"OCCLUSION_MAPS": True, "N_OCCLUSION": room_light.OCCLUSION_DIRECTIONS})
+        self._occlusion_uniforms(program)
+        self._set(program, "u_mesh_offset", self._mesh_offset)
+        self._set(program, "u_target_size", tuple(int(v) for v in texture.size))
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        self._curtain_vao(program).render(mgl.POINTS)
+
+    def _occlusion_uniforms(self, program) -> None:
+        """common.glsl's outside_occlusion: the occlusion maps and each direction's frame."""
+        gl = self._room_resources()
+        gl["occlusion"].use(location=OCCLUSION_UNIT)
+        s = self._set
+        s(program, "u_occlusion_maps", OCCLUSION_UNIT)
+        directions = room_light.occlusion_directions()
+        matrices = [room_light.light_view_projection(d) for d in directions]
+        s(program, "u_occlusion_view_proj", b"".join(gl_bytes(m) for m in matrices))
+        s(program, "u_occlusion_depth_bias",
+          tuple(OCCLUSION_BIAS_M * abs(float(m[2, 2])) / 2 for m in matrices))
+        s(program, "u_occlusion_direction", np.asarray(directions, dtype="f4"))
+        s(program, "u_occlusion_grid", float(self._occlusion_grid()))
+        s(program, "u_occlusion_offset_m", OCCLUSION_OFFSET_M)
+        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+        z0 = scene_lib.ROOM_BOX[2][0]
+        s(program, "u_occlusion_window", (wx0, wx1, wy0, wy1))
+        s(program, "u_occlusion_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
+
+    @staticmethod
+    def _occlusion_grid() -> int:
+        return math.ceil(math.sqrt(room_light.OCCLUSION_DIRECTIONS))
+
     def _room_common_uniforms(self, program, inputs) -> None:
         s = self._set
         for name, value in room_light.face_uniforms().items():
@@ -1075,15 +1220,17 @@ class FrameRenderer:
         wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
         z0 = scene_lib.ROOM_BOX[2][0]
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
-        s(program, "u_wall_z", (z0, z0 - 0.1))
+        s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
         s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
         s(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_key_rgb", self._room_colours(inputs)["u_key_rgb"])
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
         s(program, "u_albedo", scene_lib.ROOM_ALBEDO)
 
-    def _shadow_vao(self, program):
-        key = ("shadow", id(program))
+    def _shadow_vao(self, program, fine: bool = False):
+        """The curtain from the key light (coarse grid; ``fine``: the drawn mesh itself, for
+        the cloth's own shadow, whose depth must match the shaded surface's)."""
+        key = ("shadow", id(program), fine)
         if key not in self._vaos:
             b = self._curtain_buffers
             if self._curtain_format == "interleaved":
@@ -1093,7 +1240,7 @@ class FrameRenderer:
             if "in_uv" in program and "uv" in b and self._curtain_format != "interleaved":
                 content.append((b["uv"], "2f", "in_uv"))
             self._vaos[key] = self.ctx.vertex_array(
-                program, content, index_buffer=b.get("coarse_index", b["index"]),
+                program, content, index_buffer=b["index"] if fine else b.get("coarse_index", b["index"]),
                 index_element_size=4)
         return self._vaos[key]
 
@@ -1131,6 +1278,72 @@ class FrameRenderer:
             self.ctx.blend_func = mgl.DEFAULT_BLENDING
             self.ctx.disable(mgl.BLEND)
         gl["shadow"].build_mipmaps()
+        self.draw_cloth_shadow_maps(inputs)
+
+    def draw_cloth_shadow_maps(self, inputs) -> None:
+        """The maps of the cloth's own shadows (issue 11): the key's front layer (KEY_SHADOW)
+        and the occlusion maps (SKY_OCCLUSION), when they are on and the curtain is drawn."""
+        if self.curtain_open:
+            return
+        pattern = getattr(self, "_pattern_texture", None)
+        patterned = (pattern is not None and getattr(self, "patterned", False)
+                     and self._curtain_format != "interleaved")
+        if self.key_shadow:
+            self._draw_key_front(inputs, patterned, self._room_colours(inputs))
+        if self.sky_occlusion:
+            self._draw_occlusion_maps()
+            self._draw_vertex_occlusion()
+
+    def _draw_occlusion_maps(self) -> None:
+        """SKY_OCCLUSION's maps: per direction of room_light.occlusion_directions, the depth
+        of the layer of cloth nearest the outside along it (one tile each)."""
+        mgl, gl = self._moderngl, self._room_resources()
+        n = room_light.OCCLUSION_TEXELS
+        grid = self._occlusion_grid()
+        gl["occlusion_fbo"].use()
+        self.ctx.viewport = (0, 0, grid * n, grid * n)   # the whole atlas (use() restores the last tile's)
+        gl["occlusion_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
+        program = self._program("room_shadow.vert", "room_shadow.frag",
+                                {"HAS_UV": True, "PATTERN": False, "FRONT_LAYER": True})
+        self._set(program, "u_mesh_offset", self._mesh_offset)
+        self._set(program, "u_mean_coverage", 1.0)
+        self._set(program, "u_thread_beam_rgb", (0.0, 0.0, 0.0))
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<"
+        self.ctx.disable(mgl.CULL_FACE)
+        vao = self._shadow_vao(program)   # the coarse grid: the occlusion is a fold's, not a pixel's
+        for j, direction in enumerate(room_light.occlusion_directions()):
+            self.ctx.viewport = ((j % grid) * n, (j // grid) * n, n, n)
+            self._set(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(direction)))
+            vao.render(mgl.TRIANGLES)
+        self.ctx.viewport = (0, 0, grid * n, grid * n)
+        self.ctx.disable(mgl.DEPTH_TEST)
+
+    def _draw_key_front(self, inputs, patterned: bool, colours: dict) -> None:
+        """The key light's front-layer map (curtain.frag KEY_SHADOW): per texel the layer of
+        cloth nearest the light, its transmittance (as the room's map, one layer) and depth."""
+        mgl, gl = self._moderngl, self._room_resources()
+        n = room_light.SHADOW_TEXELS
+        gl["key_front_fbo"].use()
+        self.ctx.viewport = (0, 0, n, n)
+        gl["key_front_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
+        program = self._program("room_shadow.vert", "room_shadow.frag",
+                                {"HAS_UV": True, "PATTERN": patterned, "FRONT_LAYER": True})
+        if patterned:
+            self._pattern_texture.use(location=3)
+            self._set(program, "u_pattern", 3)
+            self._set(program, "u_uv_to_repeats", tuple(
+                f / r for f, r in zip(self._fabric_size_m, self._pattern_repeat_m)))
+        self._set(program, "u_light_view_proj",
+                  gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+        self._set(program, "u_mesh_offset", self._mesh_offset)
+        self._set(program, "u_mean_coverage", colours["u_mean_coverage"])
+        self._set(program, "u_thread_beam_rgb", colours["u_thread_beam_rgb"])
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<"
+        self.ctx.disable(mgl.CULL_FACE)
+        self._shadow_vao(program, fine=True).render(mgl.TRIANGLES)
+        self.ctx.disable(mgl.DEPTH_TEST)
 
     def draw_room_luminaire(self, inputs) -> None:
         """Pass R2: what the room sees in the window (the curtain's room-side radiance, or the
@@ -1243,7 +1456,8 @@ class FrameRenderer:
 
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
-        key = (self._inputs_key, self.curtain_open, getattr(self, "patterned", None),
+        key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
+               getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
@@ -1283,10 +1497,13 @@ class FrameRenderer:
         inputs = self.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
-        if self.room_lighting and self._room_light_stale():
-            self._timed(profile, "room_shadow", lambda: self.draw_room_shadow(inputs))
-            self._timed(profile, "room_luminaire", lambda: self.draw_room_luminaire(inputs))
-            self._timed(profile, "room_lightmap", lambda: self.draw_room_lightmap(inputs))
+        if (self.room_lighting or self.key_shadow or self.sky_occlusion) and self._room_light_stale():
+            if self.room_lighting:   # the room's passes (the cloth's own shadow maps with them)
+                self._timed(profile, "room_shadow", lambda: self.draw_room_shadow(inputs))
+                self._timed(profile, "room_luminaire", lambda: self.draw_room_luminaire(inputs))
+                self._timed(profile, "room_lightmap", lambda: self.draw_room_lightmap(inputs))
+            else:
+                self._timed(profile, "cloth_shadow", lambda: self.draw_cloth_shadow_maps(inputs))
         msaa = self._msaa_targets() if self.antialiasing == "msaa" else None
         hdr_fbo = msaa["hdr_fbo"] if msaa else self._hdr_fbo
         hdr_fbo.use()
@@ -1533,12 +1750,16 @@ class FrameRenderer:
 
     def render_gbuffer(self) -> dict[str, np.ndarray]:
         """The curtain alone with the G-buffer variant: radiance and the per-pixel geometry the
-        shader used (world position, unit normal, weft tangent), float32 (H, W, 3) each, and a
-        boolean mask of curtain pixels. The reference shades these positions in float64."""
+        shader used (world position, unit normal, weft tangent), float32 (H, W, 3) each, a
+        boolean mask of curtain pixels, and ``shadows`` (H, W, 4): the key's window mask, the
+        coverage of the layer in front of the key and the outside's occlusion by the cloth and
+        by the window wall (issue 11; 1, 0, 0, 0 where those are off). The reference shades these positions in float64."""
         mgl = self._moderngl
         w, h = self.size
+        if self.key_shadow or self.sky_occlusion:   # the cloth's shadow maps of this mesh
+            self.draw_cloth_shadow_maps(self.shading_inputs())
         if self._gbuffer is None:
-            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(4)]
+            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(5)]
             depth = self.ctx.depth_renderbuffer((w, h))
             self._gbuffer = (textures, self.ctx.framebuffer(textures, depth))
         textures, fbo = self._gbuffer
@@ -1550,7 +1771,7 @@ class FrameRenderer:
         self.draw_curtain(self.camera.view_projection(w / h), gbuffer=True)
         self.ctx.disable(mgl.DEPTH_TEST)
         out = {}
-        for name, attachment in zip(("radiance", "position", "normal", "tangent"), range(4)):
+        for name, attachment in zip(("radiance", "position", "normal", "tangent", "shadows"), range(5)):
             data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
             out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
         out["mask"] = out["position"][..., 3] > 0.5
@@ -1582,7 +1803,9 @@ class FrameRenderer:
             "white_balance": self.white_balance,
             "white_balance_adapted": not np.allclose(self.white_balance_matrix(), np.eye(3)),
             "size": list(self.size),
-            "room_lighting": self.room_lighting, "curtain_open": self.curtain_open,
+            "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
+            "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
+            "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
             "environment": None if self.environment is None else self.environment[0],
             "room_lamps": [[light.name, list(position)] for light, position in self.room_lamps],

@@ -252,6 +252,24 @@ def light_view_projection(to_light: np.ndarray, margin_m: float = 0.05) -> np.nd
     return proj @ view
 
 
+#: The cloth's own occlusion of the outside (issue 11, curtain.frag SKY_OCCLUSION): directions,
+#: one front-layer depth map each (tiles of OCCLUSION_TEXELS, a square grid).
+OCCLUSION_DIRECTIONS = 16
+OCCLUSION_TEXELS = 128
+
+
+@functools.lru_cache(maxsize=4)
+def occlusion_directions(count: int = OCCLUSION_DIRECTIONS) -> np.ndarray:
+    """(count, 3) unit directions towards the outside (-z), cosine-weighted about -z: the
+    strata u = (j + 1/2) / count of a Fibonacci spiral, sin(theta) = sqrt(u), phi = j times
+    the golden angle (their mean visibility estimates the cosine-weighted visible fraction)."""
+    j = np.arange(count)
+    u = (j + 0.5) / count
+    r = np.sqrt(u)
+    phi = j * math.pi * (3.0 - math.sqrt(5.0))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), -np.sqrt(1.0 - u)], -1)
+
+
 def shadow_texel_m(to_light: np.ndarray) -> float:
     """World size (m) of one shadow-map texel (the larger of the two axes)."""
     m = light_view_projection(to_light)

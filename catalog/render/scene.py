@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
-from catalog.optics.shading_reference import ShadingInputs, hg_hemisphere_factors
+from catalog.optics.shading_reference import ShadingInputs, ambient_view_ratios, hg_hemisphere_factors
 from catalog.optics.spectra import GRID_NM
 
 WINDOW_Z = -0.2
@@ -39,6 +39,8 @@ WINDOW_RECT = (-0.95, 0.95, -0.9, 1.35)
 #: The room box (x, y, z extents), metres.
 ROOM_BOX = ((-2.2, 2.2), (-1.3, 1.7), (WINDOW_Z, 4.5))
 CURTAIN_TOP_Y = 1.25
+#: The walls' thickness (m): the window's reveals are this deep.
+WALL_THICKNESS_M = 0.1
 CURTAIN_Z = -0.08
 CURTAIN_WIDTH_M = 1.7
 CURTAIN_HEIGHT_M = 2.2
@@ -171,7 +173,7 @@ def ring_mesh(xs_m) -> tuple[np.ndarray, np.ndarray]:
 def _room_parts() -> list[np.ndarray]:
     (x0, x1), (y0, y1), (z0, z1) = ROOM_BOX
     wx0, wx1, wy0, wy1 = WINDOW_RECT
-    t = 0.1  # wall thickness
+    t = WALL_THICKNESS_M
     return [
         box_triangles(x0 - t, x1 + t, y0 - t, y0, z0 - t, z1 + t),       # floor
         box_triangles(x0 - t, x1 + t, y1, y1 + t, z0 - t, z1 + t),       # ceiling
@@ -519,6 +521,12 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
     fwd_s, back_s = hg_hemisphere_factors(btdf.g_spec)
     ambient = dye * (btdf.a_diff * (fwd_d * behind + back_d * front)
                      + btdf.a_spec * (fwd_s * behind + back_s * front))
+    # the outside's share of it (the cloth's own folds hide part of the outside: issue 11)
+    outside = 0.5 * (sky + ground)
+    if viewer_inside:
+        ambient_outside = dye * (btdf.a_diff * fwd_d + btdf.a_spec * fwd_s) * outside
+    else:
+        ambient_outside = dye * (btdf.a_diff * back_d + btdf.a_spec * back_s) * outside
 
     decision = decide_fluorescence(preset, key, fluorescence)
     paper = None
@@ -540,7 +548,12 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         g_spec=btdf.g_spec, anisotropy=anisotropy, dye_transmittance=dye,
         ambient_radiance=ambient, fluorescence_mode=decision.used, paper_radiance=paper,
         absorbed_photons=absorbed, saturation_photons=saturation,
-        emission_per_photon=emission_per_photon)
+        emission_per_photon=emission_per_photon, ambient_outside_radiance=ambient_outside,
+        # the ambient by view (issue 11): the outside lies behind the cloth for a viewer inside
+        ambient_view_outside=ambient_view_ratios(btdf.a_diff, btdf.g_diff, btdf.a_spec,
+                                                 btdf.g_spec, backward=not viewer_inside),
+        ambient_view_room=ambient_view_ratios(btdf.a_diff, btdf.g_diff, btdf.a_spec,
+                                              btdf.g_spec, backward=viewer_inside))
     if decision.used == "physical":
         residual = fluorescence_residual(preset)
         inputs = with_physical_emission(
