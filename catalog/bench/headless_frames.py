@@ -174,15 +174,18 @@ def markdown_table(result: dict) -> str:
 
 
 def _run_label(run: dict) -> str:
-    return "H200" if "NVIDIA" in run["machine"]["renderer"] else "llvmpipe (2 shared cores)"
+    """The machine, and for runs before issue 11's cloth shadows, that they were."""
+    machine = "H200" if "NVIDIA" in run["machine"]["renderer"] else "llvmpipe (2 shared cores)"
+    frame = run["settings"].get("frame", "before issue 11")
+    return machine if frame.startswith("with issue 11") else f"{machine}, before issue 11"
 
 
 #: the runs in the order the frame table lists them (today's GPU default first)
-FRAME_RUNS = ("h200_gpu_cloth_fxaa_uniforms", "h200_gpu_cloth_msaa_uniforms", "h200_gpu_cloth_fxaa",
+FRAME_RUNS = ("h200_gpu_cloth_fxaa_after11", "h200_gpu_cloth_msaa_after11", "h200_gpu_cloth_fxaa_uniforms", "h200_gpu_cloth_msaa_uniforms", "h200_gpu_cloth_fxaa",
               "h200_gpu_cloth", "h200_numba_cloth", "h200_numpy_cloth", "llvmpipe_numpy_cloth")
-PASS_RUNS = ("h200_passes_fxaa_uniforms", "h200_passes_fxaa", "h200_passes_msaa",
+PASS_RUNS = ("h200_passes_fxaa_after11", "h200_passes_fxaa_uniforms", "h200_passes_fxaa", "h200_passes_msaa",
              "h200_passes_voile", "llvmpipe_numpy_cloth")
-SUMMARY_RUNS = ("h200_gpu_cloth_fxaa_uniforms", "h200_gpu_cloth_msaa_uniforms",
+SUMMARY_RUNS = ("h200_gpu_cloth_fxaa_after11", "h200_gpu_cloth_msaa_after11", "h200_gpu_cloth_fxaa_uniforms", "h200_gpu_cloth_msaa_uniforms",
                 "h200_gpu_cloth_fxaa", "h200_numba_cloth", "llvmpipe_numpy_cloth")
 
 
@@ -200,6 +203,10 @@ def _findings(runs: dict) -> str:
     constants = row("h200_gpu_cloth_fxaa", hd, big)["total_ms"]
     uniforms = row("h200_gpu_cloth_fxaa_uniforms", hd, big)["total_ms"]
     msaa = row("h200_gpu_cloth_msaa_uniforms", hd, big)["total_ms"]
+    today = row("h200_gpu_cloth_fxaa_after11", hd, big)["total_ms"]
+    today_msaa = row("h200_gpu_cloth_msaa_after11", hd, big)["total_ms"]
+    shadow = [row(k, hd, big)["passes_ms"]["room_shadow"]
+              for k in ("h200_passes_fxaa_uniforms", "h200_passes_fxaa_after11")]
     fxaa_passes = row("h200_passes_fxaa", hd, big)["passes_ms"]
     msaa_passes = row("h200_passes_msaa", hd, big)["passes_ms"]
     display = [r["passes_ms"]["display"] for k, run in runs.items() if k.startswith("h200_passes")
@@ -213,9 +220,13 @@ def _findings(runs: dict) -> str:
              f"| numpy cloth, 48x64 / 128x128 | {numpy_[0]:.0f} / {numpy_[1]:.0f} ms |",
              f"| frame, 1920x1080, 128x128, FXAA: scene values as constants -> uniforms | "
              f"{constants:.1f} -> {uniforms:.1f} ms |",
-             f"| left of the {budget:.1f} ms budget for the panel and the swap (uniforms, FXAA) | "
-             f"{budget - uniforms:.1f} ms |",
              f"| the same frame with MSAA 4x (uniforms) | {msaa:.1f} ms |",
+             f"| with issue 11's cloth shadows, outside occlusion and ambient by view: FXAA / "
+             f"MSAA (uniforms) | {today:.1f} / {today_msaa:.1f} ms |",
+             f"| shadow pass (room, and since issue 11 the cloth's maps), FXAA: before -> with "
+             f"issue 11 | {shadow[0]:.1f} -> {shadow[1]:.1f} ms |",
+             f"| left of the {budget:.1f} ms budget for the panel and the swap (today's frame, "
+             f"uniforms, FXAA) | {budget - today:.1f} ms |",
              f"| curtain pass of the passes' sum, 1920x1080, constants: FXAA / MSAA | "
              f"{fxaa_passes['curtain']:.1f} of {sum(fxaa_passes.values()):.1f} / "
              f"{msaa_passes['curtain']:.1f} of {sum(msaa_passes.values()):.1f} ms |",
