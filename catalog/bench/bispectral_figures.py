@@ -102,6 +102,17 @@ def prose_figures(result: dict) -> dict[str, str]:
     out["bispectral-paper"] = (
         f"Paper mode on the goal set: {_pair(summary, 'paper', 1)} with k per material, "
         f"{_pair(summary, 'paper_global', 1)} with one k.")
+    rows = result["rows"]
+    calibration = [r for r in rows if r["light"] == "D65"]
+    exceptions = [r for r in rows if r["light"] != "D65" and r["physical"] >= r["paper"]]
+    out["bispectral-paper-exceptions"] = (
+        f"Under D65 (c) and (b) differ by at most "
+        f"{max(abs(r['physical'] - r['paper']) for r in calibration):.2f}; away from D65 (c) is "
+        f"below (b) in {sum(1 for r in rows if r['light'] != 'D65') - len(exceptions)} of "
+        f"{sum(1 for r in rows if r['light'] != 'D65')} cases; not in: "
+        + (", ".join(f"{r['material']} under {r['light']} ({r['physical']:.2f} against "
+                     f"{r['paper']:.2f}; the matrix's anti-Stokes part alone "
+                     f"{r['data_antistokes']:.2f})" for r in exceptions) or "none") + ".")
     uv = sorted((r for r in result["rows"] if r["light"] == "UV-A"), key=lambda r: r["physical"])
     out["bispectral-uv-a"] = ("Physical mode under UV-A: "
                               + ", ".join(f"{r['material']} {r['physical']:.1f}" for r in uv) + ".")

@@ -18,8 +18,8 @@ tools/docs_figures.py makes the docs' blocks:
    fit (reflectance, phi x a_peak, the entries' rms residual in noise sigmas).
 4. ``bispectral-refinement-variants``: the goal set (8 matrices x GOAL_LIGHTS, mean /
    max) and the study lights UV-A and sun:500 for the least-squares fit, the default
-   refinement, the entries weighted 3 times more, and the training set without some of its
-   lights; ``bispectral-refinement-study-lights``: the default refinement against the
+   refinement, the entries weighted 3 times more, no reflectance tolerance, and the
+   training set without some of its lights; ``bispectral-refinement-study-lights``: the default refinement against the
    least-squares fit under those two lights, the cases it makes better and worse;
    ``bispectral-refinement-whites``: what the refinement changes on the brightened whites,
    and both fits against the matrices without their anti-Stokes part.
@@ -167,6 +167,8 @@ def run() -> dict:
         "refined (default)": refined,
         "refined, entries weighted 3x": [refine_for_colour(m, f, entry_weight=3.0)
                                          for m, f in zip(matrices, lsq)],
+        "refined, reflectance tolerance 0": [refine_for_colour(m, f, reflectance_tolerance=0.0)
+                                             for m, f in zip(matrices, lsq)],
         "refined without the Planckians at 2200-3300 K": [
             refine_for_colour(m, f, lights=without(FOLDS["warm Planckians"]))
             for m, f in zip(matrices, lsq)],
