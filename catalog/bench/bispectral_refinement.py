@@ -22,7 +22,8 @@ tools/docs_figures.py makes the docs' blocks:
    training set without some of its lights; ``bispectral-refinement-study-lights``: the default refinement against the
    least-squares fit under those two lights, the cases it makes better and worse;
    ``bispectral-refinement-whites``: what the refinement changes on the brightened whites,
-   and both fits against the matrices without their anti-Stokes part.
+   and both fits against the matrices without their anti-Stokes part;
+   ``bispectral-islands-where``: the absorption islands the single-band rule drops.
 """
 
 from __future__ import annotations
@@ -145,6 +146,16 @@ def run() -> dict:
                                                       / f.yield_absorptance - 1.0),
                        **{f"{light}_{kind}": physical_delta_e(m, fit, light)
                           for light in ("A", "D65") for kind, fit in (("lsq", f), ("refined", r))}})
+    # the absorption islands the single-band rule drops (least squares without the rule)
+    islands = {}
+    for m, f in zip(matrices, lsq):
+        if m.name not in WHITES:
+            continue
+        free = fit_separable(m, single_band=False, colour_lights=None)
+        dropped = (free.absorption_weight > 0) & (f.absorption_weight == 0)
+        peak = float(np.max(free.absorption_weight))
+        islands[m.name] = [{"nm": float(nm), "of_peak": float(w / peak)} for nm, w in
+                           zip(free.excitation_nm[dropped], free.absorption_weight[dropped])]
     # both fits against the matrices without their anti-Stokes part, on the goal set
     cleaned = [study.without_antistokes(m) for m in matrices]
     no_antistokes = {}
@@ -187,7 +198,7 @@ def run() -> dict:
                        "goal_max": float(np.max(goal)), "extra": extra})
     return {"data": data, "folds": {k: list(v) for k, v in FOLDS.items()},
             "default_tolerance": REFLECTANCE_TOLERANCE, "cross_validation": cv,
-            "moves": moves, "whites": whites, "no_antistokes": no_antistokes,
+            "moves": moves, "whites": whites, "islands": islands, "no_antistokes": no_antistokes,
             "white_bands_nm": WHITE_BANDS_NM, "variants": scored, "extra_lights": list(EXTRA_LIGHTS),
             "goal_lights": list(study.GOAL_LIGHTS)}
 
@@ -264,7 +275,13 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"least squares {na['lsq']['mean']:.2f} / {na['lsq']['max']:.2f} (max: "
         f"{na['lsq']['max_case']}), refined {na['refined']['mean']:.2f} / "
         f"{na['refined']['max']:.2f} (max: {na['refined']['max_case']}).")
-    return {"bispectral-refinement-whites": white_text,
+    islands_text = ("Absorption islands kept without the single-band rule (least squares), "
+                    "nm and fraction of the absorption peak: " + "; ".join(
+                        f"{name} " + ", ".join(f"{i['nm']:.0f} nm {100 * i['of_peak']:.1f}%"
+                                               for i in found) if found else f"{name} none"
+                        for name, found in result["islands"].items()) + ".")
+    return {"bispectral-islands-where": islands_text,
+            "bispectral-refinement-whites": white_text,
             "bispectral-refinement-study-lights": study_lights,
             "bispectral-data": "\n".join(data), "bispectral-refinement-cv": "\n".join(cv),
             "bispectral-refinement-moves": moved,
