@@ -73,3 +73,45 @@ def test_record_figure_merges_into_the_named_json_only_when_asked(tmp_path):
     assert json.loads(target.read_text()) == {"figures": {"earlier": 2}}
     run(str(target))
     assert json.loads(target.read_text()) == {"figures": {"earlier": 2, "probe.value": 1.5}}
+
+
+def test_the_refinement_study_folds_hold_every_training_light_once():
+    """The cross-validation of docs/bispectral.md holds out every training light exactly
+    once, and never a goal light."""
+    from catalog.bench import bispectral_refinement as br
+    from catalog.optics.bispectral.matrix import COLOUR_TRAINING_LIGHTS
+    from catalog.optics.bispectral.study import GOAL_LIGHTS
+
+    held = [light for group in br.FOLDS.values() for light in group]
+    assert sorted(held) == sorted(COLOUR_TRAINING_LIGHTS)
+    assert not set(held) & set(GOAL_LIGHTS)
+
+
+def test_the_refinement_tables_mark_the_default_and_the_lowest():
+    from catalog.bench import bispectral_refinement as br
+
+    result = _load(br.RESULT_JSON)
+    made = br.markdown_tables(result)
+    assert {"bispectral-data", "bispectral-refinement-cv", "bispectral-refinement-moves",
+            "bispectral-refinement-variants", "bispectral-refinement-study-lights",
+            "bispectral-refinement-whites"} <= set(made)
+    lowest = min(result["cross_validation"], key=lambda r: r["held_out_mean"])
+    assert f"**{lowest['held_out_mean']:.3f}**" in made["bispectral-refinement-cv"]
+    assert "(default)" in made["bispectral-refinement-cv"]
+    assert made["bispectral-data"].count("\n") == 1 + len(result["data"])
+
+
+@pytest.mark.slow
+def test_the_refinement_study_reproduces_its_committed_json(shared_data):
+    """About 20 s: the study re-run gives the committed figures (the same code and data)."""
+    from catalog.bench import bispectral_refinement as br
+
+    committed = _load(br.RESULT_JSON)
+    fresh = json.loads(json.dumps(br.run()))
+    for a, b in zip(fresh["cross_validation"], committed["cross_validation"]):
+        assert a["held_out_mean"] == pytest.approx(b["held_out_mean"], rel=1e-6)
+    for a, b in zip(fresh["variants"], committed["variants"]):
+        assert (a["goal_mean"], a["goal_max"]) == pytest.approx((b["goal_mean"], b["goal_max"]),
+                                                                 rel=1e-6)
+    assert [d["noise_sigma"] for d in fresh["data"]] == pytest.approx(
+        [d["noise_sigma"] for d in committed["data"]], rel=1e-9)
