@@ -3,9 +3,10 @@ PYTHON ?= .venv/bin/python
 
 .PHONY: presets measurements fit-table
 
-# Regenerate every fabrics/*.toml with `catalog fit` (deterministic output).
+# Regenerate every fabrics/*.toml with `catalog fit` (deterministic output), then the preset
+# table of docs/fit.md made from them.
 presets:
-	$(PYTHON) tools/make_presets.py
+	$(PYTHON) tools/make_presets.py && $(PYTHON) -m catalog.bench.preset_table && $(PYTHON) tools/docs_figures.py
 
 # Regenerate the gonio measurement sets (and dye spectra) from the yarn-level model.
 measurements:
