@@ -28,14 +28,10 @@ tools/docs_figures.py makes the docs' blocks:
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
-from pathlib import Path
 
 import numpy as np
 
-from catalog.core.resources import PROJECT_ROOT
 
 RESULT_JSON = "benchmarks/bispectral_refinement.json"
 
@@ -289,23 +285,9 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json-out", type=Path, default=PROJECT_ROOT / RESULT_JSON,
-                        help=f"write the result here (default {RESULT_JSON})")
-    args = parser.parse_args(argv)
-    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
-    from catalog.core.errors import CatalogError  # noqa: PLC0415
+    from catalog.bench.results import study_main  # noqa: PLC0415
 
-    try:
-        result = run()
-    except CatalogError as exc:  # the matrices are absent: one line, exit 2
-        print(f"bispectral_refinement: error: {exc}", file=sys.stderr)
-        return exc.exit_code
-    write_text_atomic(args.json_out, json.dumps(result, indent=1) + "\n")
-    for name, text in markdown_tables(result).items():
-        print(f"<!-- generated:{name} -->\n{text}\n<!-- /generated:{name} -->\n")
-    print(f"wrote {args.json_out}")
-    return 0
+    return study_main(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":

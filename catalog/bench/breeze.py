@@ -13,12 +13,10 @@ the default wind, over 30 cm at 2 m/s).
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 
 from catalog.core.constants import FRAME_DT_S
-from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
+from catalog.core.resources import FABRIC_DIR
 
 RESULT_JSON = "benchmarks/breeze.json"
 #: (fabric preset, wind m/s): the lightest catalog cloth at the default and at the old
@@ -68,21 +66,20 @@ def markdown_tables(result: dict) -> dict[str, str]:
     return {"breeze": "\n".join(lines)}
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--grid", default="96x56")
-    parser.add_argument("--seconds", type=float, default=5.0)
-    parser.add_argument("--backend", default="numpy")
-    parser.add_argument("--json", default=str(PROJECT_ROOT / RESULT_JSON))
-    args = parser.parse_args(argv)
-    from catalog.core.atomic import write_text_atomic
-    from catalog.render.snapshot import parse_size
+def main(argv: list[str] | None = None) -> int:
+    from catalog.bench.results import study_main  # noqa: PLC0415
 
-    result = run(parse_size(args.grid), args.seconds, args.backend)
-    write_text_atomic(args.json, json.dumps(result, indent=1) + "\n")
-    print(markdown_tables(result)["breeze"])
-    print(f"wrote {args.json}")
-    return 0
+    def options(parser) -> None:
+        parser.add_argument("--grid", default="96x56")
+        parser.add_argument("--seconds", type=float, default=5.0)
+        parser.add_argument("--backend", default="numpy")
+
+    def result(args) -> dict:
+        from catalog.render.snapshot import parse_size  # noqa: PLC0415
+
+        return run(parse_size(args.grid), args.seconds, args.backend)
+
+    return study_main(sys.modules[__name__], argv, result, options)
 
 
 if __name__ == "__main__":

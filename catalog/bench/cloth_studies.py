@@ -20,15 +20,12 @@ time, and the resting strain of stiff XPBD springs.
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import subprocess
 import sys
 import tempfile
 
 from catalog.core.constants import FRAME_DT_S
-from catalog.core.resources import PROJECT_ROOT
 
 RESULT_JSON = "benchmarks/cloth_studies.json"
 OPENINGS = (1.0, 0.8, 0.5)
@@ -146,29 +143,27 @@ def markdown_tables(result: dict) -> dict[str, str]:
             "cloth_gale_strain": gale, "cloth_backend_agreement": "\n".join(agree)}
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--grid", default="64x64")
-    parser.add_argument("--seconds", type=float, default=6.0)
-    parser.add_argument("--gale-seconds", type=float, default=5.0)
-    parser.add_argument("--backend", default="cpu")
-    parser.add_argument("--json", default=str(PROJECT_ROOT / RESULT_JSON))
-    args = parser.parse_args(argv)
-    from catalog.core.atomic import write_text_atomic
-    from catalog.render.snapshot import parse_size
+def main(argv: list[str] | None = None) -> int:
+    from catalog.bench.results import study_main  # noqa: PLC0415
 
-    grid = parse_size(args.grid)
-    result = {"numba": numba_times(),
-              "strain": {"grid": list(grid), "seconds": args.seconds, "backend": args.backend,
-                         "stiffness_n_m": STIFFNESS_N_M,
-                         "rows": strain_rows(grid, args.seconds, args.backend)},
-              "gale": gale_strain(args.gale_seconds, args.backend),
-              "agreement": agreement_rows()}
-    write_text_atomic(args.json, json.dumps(result, indent=1) + "\n")
-    for text in markdown_tables(result).values():
-        print(text + "\n")
-    print(f"wrote {args.json}")
-    return 0
+    def options(parser) -> None:
+        parser.add_argument("--grid", default="64x64")
+        parser.add_argument("--seconds", type=float, default=6.0)
+        parser.add_argument("--gale-seconds", type=float, default=5.0)
+        parser.add_argument("--backend", default="cpu")
+
+    def result(args) -> dict:
+        from catalog.render.snapshot import parse_size  # noqa: PLC0415
+
+        grid = parse_size(args.grid)
+        return {"numba": numba_times(),
+                "strain": {"grid": list(grid), "seconds": args.seconds, "backend": args.backend,
+                           "stiffness_n_m": STIFFNESS_N_M,
+                           "rows": strain_rows(grid, args.seconds, args.backend)},
+                "gale": gale_strain(args.gale_seconds, args.backend),
+                "agreement": agreement_rows()}
+
+    return study_main(sys.modules[__name__], argv, result, options)
 
 
 if __name__ == "__main__":

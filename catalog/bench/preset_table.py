@@ -12,8 +12,7 @@ table and the sentences from it. Nothing is fitted here: ``make presets`` does t
 
 from __future__ import annotations
 
-import argparse
-import json
+import sys
 import tomllib
 from pathlib import Path
 
@@ -104,20 +103,9 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m catalog.bench.preset_table",
-                                     description=__doc__.split("\n\n")[0])
-    parser.add_argument("--json-out", type=Path, default=None,
-                        help=f"where to write the JSON (default: {RESULT_JSON} in the checkout)")
-    args = parser.parse_args(argv)
-    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
-    from catalog.core.resources import PROJECT_ROOT  # noqa: PLC0415
+    from catalog.bench.results import study_main  # noqa: PLC0415
 
-    result = run()
-    target = args.json_out or PROJECT_ROOT / RESULT_JSON
-    write_text_atomic(target, json.dumps(result, indent=1) + "\n")
-    for text in markdown_tables(result).values():
-        print(text + "\n")
-    return 0
+    return study_main(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":

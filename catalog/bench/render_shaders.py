@@ -28,6 +28,7 @@ import numpy as np
 
 from catalog.core.resources import PROJECT_ROOT as ROOT  # noqa: E402
 
+from catalog.core.constants import FLUORESCENCE_MODES  # noqa: E402
 from catalog.core.resources import FABRIC_DIR  # noqa: E402
 
 RESULT_JSON = "benchmarks/bench_render.json"
@@ -255,7 +256,10 @@ def main(argv=None) -> int:
         if see_through and direct == 0.0:
             direct = 0.01
         variant_renderer = FrameRenderer(ctx, size, specialise="uniforms" not in label)
-        variant_renderer.set_fabric(replace(base, btdf=replace(base.btdf, direct=direct)))
+        variant = replace(base, btdf=replace(base.btdf, direct=direct))
+        if direct != base.btdf.direct:   # a pattern's open area must equal LD: the flat cloth
+            variant = replace(variant, raw={k: v for k, v in base.raw.items() if k != "pattern"})
+        variant_renderer.set_fabric(variant)
         variant_renderer.set_light("D65")
         variant_renderer.set_fluorescence(mode)
         variant_renderer.set_bands(n_bands)

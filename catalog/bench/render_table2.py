@@ -11,13 +11,10 @@ than 5 % and 5x the change of red and green); this writes the figures the docs s
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 
-import numpy as np
 
-from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
+from catalog.core.resources import FABRIC_DIR
 
 RESULT_JSON = "benchmarks/render_table2.json"
 MODES = ("physical", "paper")
@@ -71,19 +68,18 @@ def markdown_tables(result: dict) -> dict[str, str]:
     return {"render_table2": "\n".join(lines)}
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", default="320x180")
-    parser.add_argument("--json", default=str(PROJECT_ROOT / RESULT_JSON))
-    args = parser.parse_args(argv)
-    from catalog.core.atomic import write_text_atomic
-    from catalog.render.snapshot import parse_size
+def main(argv: list[str] | None = None) -> int:
+    from catalog.bench.results import study_main  # noqa: PLC0415
 
-    result = run(parse_size(args.size))
-    write_text_atomic(args.json, json.dumps(result, indent=1, default=float) + "\n")
-    print(markdown_tables(result)["render_table2"])
-    print(f"wrote {args.json}")
-    return 0
+    def options(parser) -> None:
+        parser.add_argument("--size", default="320x180")
+
+    def result(args) -> dict:
+        from catalog.render.snapshot import parse_size  # noqa: PLC0415
+
+        return run(parse_size(args.size))
+
+    return study_main(sys.modules[__name__], argv, result, options)
 
 
 if __name__ == "__main__":

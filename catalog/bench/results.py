@@ -97,3 +97,37 @@ def _run_section(name: str, module, args) -> int:
         print(f"<!-- generated:{table_name} -->\n{text}\n<!-- /generated:{table_name} -->\n")
     print(f"wrote {args.json_out}")
     return 0
+
+
+def study_main(module, argv: list[str] | None = None, make_result=None,
+               add_arguments=None) -> int:
+    """``python -m catalog.bench.<study>`` for a study module that is not a section of
+    ``catalog bench``: its options (``add_arguments(parser)``), ``--json-out FILE`` (default
+    the module's committed ``RESULT_JSON``), the result (``make_result(args)``, default
+    ``module.run()``) written atomically, and the blocks the docs are generated from printed.
+    Missing data or no EGL: one line and the documented exit code, nothing written."""
+    import argparse  # noqa: PLC0415
+
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+    from catalog.core.resources import PROJECT_ROOT  # noqa: PLC0415
+
+    name = module.__spec__.name if getattr(module, "__spec__", None) else module.__name__
+    short = name.rsplit(".", 1)[-1]
+    parser = argparse.ArgumentParser(prog=f"python -m {name}",
+                                     description=(module.__doc__ or short).splitlines()[0])
+    if add_arguments is not None:
+        add_arguments(parser)
+    parser.add_argument("--json-out", type=Path, default=PROJECT_ROOT / module.RESULT_JSON,
+                        metavar="FILE", help=f"write the result here (default {module.RESULT_JSON})")
+    args = parser.parse_args(argv)
+    try:
+        result = make_result(args) if make_result is not None else module.run()
+    except CatalogError as exc:
+        print(f"{short}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    write_text_atomic(args.json_out, json.dumps(result, indent=1, default=float) + "\n")
+    for name, text in module.markdown_tables(result).items():
+        print(f"<!-- generated:{name} -->\n{text}\n<!-- /generated:{name} -->\n")
+    print(f"wrote {args.json_out}")
+    return 0

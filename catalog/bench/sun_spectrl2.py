@@ -9,11 +9,8 @@ tests/test_sun.py holds the bounds on the same measures.
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 
-from catalog.core.resources import PROJECT_ROOT
 
 RESULT_JSON = "benchmarks/sun_spectrl2.json"
 
@@ -44,17 +41,10 @@ def markdown_tables(result: dict) -> dict[str, str]:
     return {"sun_spectrl2": "\n".join(lines), "sun_spectrl2_full": "\n".join(full)}
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", default=str(PROJECT_ROOT / RESULT_JSON))
-    args = parser.parse_args(argv)
-    from catalog.core.atomic import write_text_atomic
+def main(argv: list[str] | None = None) -> int:
+    from catalog.bench.results import study_main  # noqa: PLC0415
 
-    result = run()
-    write_text_atomic(args.json, json.dumps(result, indent=1) + "\n")
-    print(markdown_tables(result)["sun_spectrl2"])
-    print(f"wrote {args.json}")
-    return 0
+    return study_main(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":

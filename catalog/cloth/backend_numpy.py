@@ -26,13 +26,9 @@ from catalog.cloth.topology import SELECTORS
 from catalog.cloth.wind import wind_velocity
 
 
-def grid_normals(x: np.ndarray) -> np.ndarray:
-    """Unit normals (H, W, 3) by central differences (one-sided at the edges).
-
-    n = (x[r+1] - x[r-1]) x (x[c+1] - x[c-1]), normalised: +z for the flat rest pose
-    (rows run down, columns along +x).
-    """
-    h, w = x.shape[:2]
+def grid_differences(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(down, across): central differences of an (H, W, 3) grid along its rows and columns,
+    one-sided at the edges (the tangents the normals and the weft tangents are made from)."""
     down = np.empty_like(x)
     across = np.empty_like(x)
     down[1:-1] = x[2:] - x[:-2]
@@ -41,6 +37,16 @@ def grid_normals(x: np.ndarray) -> np.ndarray:
     across[:, 1:-1] = x[:, 2:] - x[:, :-2]
     across[:, 0] = x[:, 1] - x[:, 0]
     across[:, -1] = x[:, -1] - x[:, -2]
+    return down, across
+
+
+def grid_normals(x: np.ndarray) -> np.ndarray:
+    """Unit normals (H, W, 3) by central differences (one-sided at the edges).
+
+    n = (x[r+1] - x[r-1]) x (x[c+1] - x[c-1]), normalised: +z for the flat rest pose
+    (rows run down, columns along +x).
+    """
+    down, across = grid_differences(x)
     n = np.cross(down, across)
     length = np.sqrt(np.sum(n * n, axis=-1, keepdims=True))
     return n / np.where(length > 0.0, length, 1.0)

@@ -243,14 +243,9 @@ def frames_of_grid(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     is across made orthogonal to n), with every sum written out left to right, the order in
     which the page's JavaScript evaluates them (numpy's reductions may associate otherwise), so
     that both give the same float64 values."""
-    down = np.empty_like(x)
-    across = np.empty_like(x)
-    down[1:-1] = x[2:] - x[:-2]
-    down[0] = x[1] - x[0]
-    down[-1] = x[-1] - x[-2]
-    across[:, 1:-1] = x[:, 2:] - x[:, :-2]
-    across[:, 0] = x[:, 1] - x[:, 0]
-    across[:, -1] = x[:, -1] - x[:, -2]
+    from catalog.cloth.backend_numpy import grid_differences  # noqa: PLC0415
+
+    down, across = grid_differences(x)   # element-wise: no reduction whose order could differ
     d0, d1, d2 = down[..., 0], down[..., 1], down[..., 2]
     a0, a1, a2 = across[..., 0], across[..., 1], across[..., 2]
     n0, n1, n2 = d1 * a2 - d2 * a1, d2 * a0 - d0 * a2, d0 * a1 - d1 * a0
