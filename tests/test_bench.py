@@ -316,3 +316,19 @@ def test_a_section_run_alone_without_its_data_says_so_in_one_line(tmp_path, monk
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--data" in err[0] and "nowhere" in err[0]
     assert not out.exists()
+
+
+@pytest.mark.slow
+@pytest.mark.gl
+def test_render_shaders_bench_runs_every_variant(tmp_path):
+    """The shader benchmark end to end at a small size: it broke twice unseen (a constant
+    moved to core.constants without its import; a variant that changed LD under a pattern)."""
+    from catalog.bench import render_shaders
+
+    out = tmp_path / "render.json"
+    assert render_shaders.main(["--quick", "--size", "96x64", "--repeats", "1", "--draws", "1",
+                                "--json", str(out)]) == 0
+    result = json.loads(out.read_text())
+    labels = json.dumps(result)
+    for needed in ("trivial", "rgb physical", "rgb off, no see-through", "16 bands physical"):
+        assert needed in labels
