@@ -80,23 +80,11 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 def main(argv=None) -> int:
-    import argparse  # noqa: PLC0415
-    import json  # noqa: PLC0415
-    from pathlib import Path  # noqa: PLC0415
+    import sys  # noqa: PLC0415
 
-    from catalog.core.resources import PROJECT_ROOT  # noqa: PLC0415
+    from catalog.bench.results import study_main  # noqa: PLC0415
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json-out", type=Path,
-                        default=PROJECT_ROOT / "benchmarks" / "bench_a2c.json")
-    args = parser.parse_args(argv)
-    result = run()
-    print(markdown_tables(result)["a2c_layers"])
-    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
-
-    write_text_atomic(args.json_out, json.dumps(result, indent=1) + "\n")
-    print(f"wrote {args.json_out}")
-    return 0
+    return study_main(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":
