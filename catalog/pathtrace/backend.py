@@ -49,7 +49,7 @@ _LOADED: dict[str, object] = {}
 
 
 def load_mitsuba(variant: str = DEFAULT_VARIANT):
-    """The ``mitsuba`` module with ``variant`` set (and the woven BSDF registered)."""
+    """The ``mitsuba`` module with ``variant`` set (the woven BSDF and the glow texture registered)."""
     check_variant(variant)
     if variant in _LOADED:
         import mitsuba as mi  # noqa: PLC0415
@@ -75,8 +75,9 @@ def load_mitsuba(variant: str = DEFAULT_VARIANT):
         raise EnvironmentFailure(f"Mitsuba variant {variant} is unavailable: "
                                  f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}"
                                  f" (LLVM library {library})") from None
-    from catalog.pathtrace.woven import register  # noqa: PLC0415
+    from catalog.pathtrace import glow, woven  # noqa: PLC0415
 
-    register(mi)
+    woven.register(mi)
+    glow.register(mi)
     _LOADED[variant] = mi
     return mi

@@ -31,12 +31,13 @@ per vertex, from the photons the cloth absorbs there: the key light's at its inc
 half-space's sky and ground (the room's light, with almost no UV, is left out), through
 the same absorptance, quantum yield, saturation and emission spectrum as the real-time
 frame (catalog.render.scene.with_physical_emission), M / (2 pi) per side. It enters the
-scene as two emitting, null-scattering shells 0.5 mm either side of the cloth. They carry
-no pattern (the glow is the repeat's average; the frame draws it on the threads only): a
-Python texture (mi.Texture) modulating the per-vertex emission by c(uv) / mean(c) was tried
-(issue 11) and lit the room 1.9x brighter even with the factor set to 1 (the cloth seen
-directly unchanged): next-event estimation did not see the wrapped per-vertex value
-(presumably Mitsuba takes such a texture's mean; not resolved).
+scene as two emitting, null-scattering shells 0.5 mm either side of the cloth, whose
+radiance (catalog.pathtrace.glow) is the per-vertex emission times c(uv) / mean(c) where
+the fabric has a pattern: the threads glow, the holes do not, as the frame draws it. Issue 11
+found that Mitsuba's built-in ``mesh_attribute`` radiance, used before, was seen about 10x
+too faint by next-event estimation (the room's glow came almost only from BSDF-sampled hits);
+the glow texture samples the shell in uv and tests/test_pathtrace.py checks that emitter
+and BSDF sampling agree.
 """
 
 from __future__ import annotations
@@ -45,6 +46,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from catalog.pathtrace.glow import ATTRIBUTE
 
 #: Environment map size (lat-long, width = 2 height). 2048 x 1024: 0.18 deg texels.
 ENV_WIDTH = 2048
@@ -405,16 +408,26 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     weights = emitter_sampling_weights(desc, emission)
     if environment:
         scene["environment"]["sampling_weight"] = weights["environment"]
+    glow = {"type": "patterned_glow",
+            "mean_radiance": float(np.mean(np.abs(emission))),
+            "max_radiance": float(np.max(np.abs(emission))) if emission.size else 0.0}
+    if desc.pattern is not None:  # the threads glow, the holes do not (module doc)
+        coverage = np.asarray(desc.pattern["coverage"], dtype=np.float32)
+        su, sv = desc.pattern.get("uv_scale", (1.0, 1.0))
+        glow.update({"coverage": {"type": "bitmap", "raw": True, "bitmap": mi.Bitmap(coverage[..., None])},
+                     "coverage_mean": float(coverage.mean()), "uv_scale_u": float(su),
+                     "uv_scale_v": float(sv)})
     for side, sign in (("front", 1.0), ("back", -1.0)):
         shell_props = mi.Properties()
         shell_props["bsdf"] = mi.load_dict({"type": "null"})
+        radiance = mi.load_dict(glow)
         shell_props["emitter"] = mi.load_dict({"type": "area", "sampling_weight": weights["shell"],
-                                               "radiance": {"type": "mesh_attribute",
-                                                            "name": "vertex_fluorescence"}})
+                                               "radiance": radiance})
         faces = tri if sign > 0 else tri[:, ::-1]
+        # the curtain's uv: the glow texture samples its emitter in uv (catalog.pathtrace.glow)
         shell = _mesh(mi, f"fluorescence_{side}", p + sign * SHELL_OFFSET_M * n, faces,
-                      sign * n, None, shell_props)
-        shell.add_attribute("vertex_fluorescence", 3,
-                            np.ascontiguousarray(emission, dtype=np.float32).ravel())
+                      sign * n, uvs, shell_props)
+        shell.add_attribute(ATTRIBUTE, 3, np.ascontiguousarray(emission, dtype=np.float32).ravel())
+        radiance.attach(shell)
         scene[f"fluorescence_{side}"] = shell
     return mi.load_dict(scene)
