@@ -1,8 +1,10 @@
 #version 430
-// The room's light map, one diffuse bounce (issue 13): per atlas texel, the direct light map
-// adds the light that the room's own walls reflect onto it, gathered from its coarse mip
-// level, the key's beam included (patches of face area / RC^2): E_1 = sum_j (rho / pi) E_j m_j cos_r cos_j A_j / max(r^2, A_j),
-// with m_j the patch's wall fraction (0 in the window opening). The room is a convex box, so
+// The room's light map, the diffuse bounces (issues 13 and 11): per atlas texel, the direct
+// light map adds the light that the room's own walls reflect onto it, gathered from the
+// coarse patches (face area / RC^2): E = sum_j (rho / pi) T_j m_j cos_r cos_j A_j / max(r^2, A_j),
+// with m_j the patch's wall fraction (0 in the window opening) and T_j the patch's
+// irradiance: with ALL_BOUNCES its total (room_radiosity.frag), else its direct light, the
+// coarse mip of the direct map plus the key's beam (one bounce, issue 13's frame). The room is a convex box, so
 // every patch sees every other; the precomputed ambient occlusion (corners, the window's
 // reveals) scales the bounce.
 #include "common.glsl"
@@ -17,6 +19,7 @@ uniform vec3 u_face_normal[6];
 
 uniform sampler2D u_direct;          // the direct light map (area light, lamps), mipmapped
 uniform sampler2D u_beam;            // the key's beam at the light map's texels, mipmapped
+uniform sampler2D u_total;           // ALL_BOUNCES: each coarse patch's total irradiance
 uniform sampler2D u_ao_mask;         // r: ambient occlusion, g: wall fraction; mipmapped
 uniform int u_bounce_level;          // the mip level gathered
 uniform int u_coarse_texels;         // face texels at that level
@@ -52,8 +55,12 @@ void main() {
                 float geometry = max(dot(n, d) * inv_r, 0.0) * max(-dot(nf, d) * inv_r, 0.0)
                                * area / max(r2, area);
                 float wall = texelFetch(u_ao_mask, texel, u_bounce_level).g;
+#ifdef ALL_BOUNCES
+                vec3 source = texelFetch(u_total, texel, 0).rgb;
+#else
                 vec3 source = texelFetch(u_direct, texel, u_bounce_level).rgb
                             + texelFetch(u_beam, texel, u_bounce_level).rgb;
+#endif
                 bounce += source * (wall * geometry);
             }
         }

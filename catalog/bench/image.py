@@ -18,7 +18,8 @@ description and curtain mesh. Measured:
 
 Real-time options (the Pareto plot): spectral bands 3/6/16, paper vs physical
 fluorescence, anti-aliasing (FXAA, the default; none; 2x2 supersampling), the room lit
-through the curtain (issue 13, the default) or the earlier constant room. The shadow map's size
+through the curtain (issue 13, the default) or the earlier constant room, the room's
+bounces (all, by radiosity, the default; or one, as before). The shadow map's size
 is a module constant, not a frame option: listed as absent.
 
 The goal of issue 11 (stated before measuring): on every scene mean FLIP <= 0.10, curtain
@@ -57,6 +58,7 @@ QUICK_SPP = 16
 OPTIONS = (
     ("default (physical, 3 bands, FXAA)", 3, "physical", 1, None),
     ("room lighting off", 3, "physical", 1, None, False),
+    ("one room bounce (before)", 3, "physical", 1, None, None, {"room_bounces": "one"}),
     ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
     ("sky occlusion off (issue 11)", 3, "physical", 1, None, None, {"sky_occlusion": False}),
     ("ambient by view off (issue 11)", 3, "physical", 1, None, None, {"ambient_by_view": False}),
@@ -432,3 +434,36 @@ def markdown_tables(result: dict) -> dict[str, str]:
                 f"{', '.join(s['absent_options'])}.")
     return {"image": per_scene, "image-options": options}
 
+
+
+def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path = Path(RESULT_JSON)) -> dict:
+    """Run the full section and keep it in ``json_path`` under ``runs[name]`` (the earlier
+    runs stay), with its six triptychs stacked in ``image_folder/pathtrace_scenes_NAME.png``
+    and its Pareto plot in ``pathtrace_pareto_NAME.png``; both written atomically."""
+    import json  # noqa: PLC0415
+    import shutil  # noqa: PLC0415
+    import tempfile  # noqa: PLC0415
+
+    from catalog.bench.plots import pyplot  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path, write_text_atomic  # noqa: PLC0415
+
+    result = run()
+    images = result["_images"]
+    stacked = np.concatenate([triptych(images[label]) for label, *_ in SCENES], axis=0)
+    with tempfile.TemporaryDirectory() as scratch:
+        pareto = plot_pareto(result, scratch)
+        with atomic_path(image_folder / f"pathtrace_pareto_{name}.png") as tmp:
+            shutil.copyfile(pareto, tmp)
+    result.pop("_images")
+    with atomic_path(image_folder / f"pathtrace_scenes_{name}.png") as tmp:
+        pyplot().imsave(tmp, stacked, format="png")
+    committed = json.loads(json_path.read_text())
+    committed["runs"][name] = result
+    write_text_atomic(json_path, json.dumps(committed, indent=1) + "\n")
+    return result
+
+
+if __name__ == "__main__":
+    import sys
+
+    print(summary_line(record_run(sys.argv[1])))

@@ -44,7 +44,7 @@ import math
 import numpy as np
 
 from catalog.core.constants import FLUORESCENCE_MODES
-from catalog.core.errors import CatalogError
+from catalog.core.errors import CatalogError, InputError
 from catalog.render import bands as band_lib
 from catalog.render import display as display_lib
 from catalog.render import room_light
@@ -279,6 +279,8 @@ class FrameRenderer:
         self.sky_occlusion = True
         #: issue 11: the ambient term by view (False: the normal view's at every angle)
         self.ambient_by_view = True
+        #: issue 11: the room's bounces, "all" (radiosity, room_radiosity.frag) or "one"
+        self.room_bounces = "all"
         self.curtain_open = False
         self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
         self._room_gl = None
@@ -440,6 +442,15 @@ class FrameRenderer:
         """The cloth's ambient term by view (issue 11; the lobes integrated for the view's
         angle to the normal), or the normal view's at every angle (the earlier frame)."""
         self.ambient_by_view = bool(on)
+
+    def set_room_bounces(self, bounces: str) -> None:
+        """The room's diffuse bounces: "all" (the radiosity solve of
+        :func:`catalog.render.room_light.radiosity_operator`, issue 11) or "one" (issue 13's
+        single bounce, which left the walls and the floor too dark)."""
+        if bounces not in room_light.ROOM_BOUNCES:
+            raise InputError(f"{bounces!r}: choose one of {', '.join(room_light.ROOM_BOUNCES)}",
+                             field="room bounces")
+        self.room_bounces = bounces
 
     def set_sky_occlusion(self, on: bool) -> None:
         """Let the cloth's own folds hide part of the outside from its ambient term (issue 11;
@@ -1111,6 +1122,15 @@ class FrameRenderer:
                 "direct": direct, "beam": beam, "direct_fbo": ctx.framebuffer([direct, beam]),
                 "lightmap": lightmap, "lightmap_fbo": ctx.framebuffer([lightmap]), "ao": ao,
             }
+            rc = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
+            operator = room_light.radiosity_operator(scene_lib.ROOM_ALBEDO).astype("f4")
+            bounces = ctx.texture(operator.shape[::-1], 1, data=np.ascontiguousarray(operator).tobytes(),
+                                  dtype="f4")
+            bounces.filter = (mgl.NEAREST, mgl.NEAREST)
+            total = ctx.texture((len(room_light.FACE_NAMES) * rc, rc), 4, dtype="f4")
+            total.filter = (mgl.NEAREST, mgl.NEAREST)
+            self._room_gl.update({"radiosity_operator": bounces, "total": total,
+                                  "total_fbo": ctx.framebuffer([total])})
         return self._room_gl
 
     def _room_colours(self, inputs) -> dict:
@@ -1375,8 +1395,9 @@ class FrameRenderer:
         gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
 
     def draw_room_lightmap(self, inputs) -> None:
-        """Passes R3 and R4: the light map's direct part (area light, beam, lamps), then one
-        bounce with ambient occlusion into the light map the room reads."""
+        """Passes R3 and R4: the light map's direct part (area light, beam, lamps), then (R3b,
+        with every bounce) the coarse patches' total irradiance, then the bounces gathered
+        with ambient occlusion into the light map the room reads."""
         mgl, gl = self._moderngl, self._room_resources()
         aw, ah = room_light.atlas_size()
         self.ctx.disable(mgl.DEPTH_TEST)
@@ -1409,9 +1430,29 @@ class FrameRenderer:
         self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
         gl["direct"].build_mipmaps()
         gl["beam"].build_mipmaps()
+        rc = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
+        all_bounces = self.room_bounces == "all"
+        if all_bounces:   # the coarse patches' total irradiance (room_radiosity.frag)
+            gl["total_fbo"].use()
+            self.ctx.viewport = (0, 0, len(room_light.FACE_NAMES) * rc, rc)
+            program = self._program("fullscreen.vert", "room_radiosity.frag")
+            gl["direct"].use(location=1)
+            self._set(program, "u_direct", 1)
+            gl["beam"].use(location=3)
+            self._set(program, "u_beam", 3)
+            gl["radiosity_operator"].use(location=4)
+            self._set(program, "u_operator", 4)
+            self._set(program, "u_bounce_level", room_light.BOUNCE_LEVEL)
+            self._set(program, "u_coarse_texels", rc)
+            self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+            self.ctx.viewport = (0, 0, aw, ah)
 
         gl["lightmap_fbo"].use()
-        program = self._program("fullscreen.vert", "room_bounce.frag")
+        program = self._program("fullscreen.vert", "room_bounce.frag",
+                                {"ALL_BOUNCES": True} if all_bounces else None)
+        if all_bounces:
+            gl["total"].use(location=4)
+            self._set(program, "u_total", 4)
         for name, value in room_light.face_uniforms().items():
             self._set(program, name, value)
         gl["direct"].use(location=1)
@@ -1457,7 +1498,7 @@ class FrameRenderer:
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
-               getattr(self, "patterned", None),
+               self.room_bounces, getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
@@ -1805,7 +1846,7 @@ class FrameRenderer:
             "size": list(self.size),
             "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
             "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
-            "curtain_open": self.curtain_open,
+            "room_bounces": self.room_bounces, "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
             "environment": None if self.environment is None else self.environment[0],
             "room_lamps": [[light.name, list(position)] for light, position in self.room_lamps],
