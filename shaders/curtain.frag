@@ -114,7 +114,8 @@ float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set
 SCENE_VALUE(vec4, u_key_thread[NV4], S_KEY_THREAD);
 uniform sampler2D u_key_front;     // r: the nearest layer's coverage, a: its depth (0..1)
 uniform mat4 u_light_view_proj;
-uniform float u_key_depth_bias;    // depth (0..1 units) a fragment must lie behind to be shaded
+uniform vec3 u_key_depth_bias;     // depth (0..1 units) a fragment must lie behind to be shaded:
+                                   // x + y tan(normal, key), the tangent at most z (slope-scaled)
 uniform vec4 u_window_rect;
 uniform vec2 u_wall_z;
 uniform float u_tan_sun_radius;
@@ -220,7 +221,11 @@ void main() {
                    ? room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius)
                    : 1.0;
         vec4 clip = u_light_view_proj * vec4(v_position, 1.0);
-        g_front_coverage = front_layer_coverage(u_key_front, clip.xyz * 0.5 + 0.5, u_key_depth_bias);
+        float cos_surface = abs(dot(normalize(v_normal), u_key_to_light));
+        float tan_surface = min(sqrt(max(1.0 - cos_surface * cos_surface, 0.0)) / max(cos_surface, 1e-3),
+                                u_key_depth_bias.z);
+        g_front_coverage = front_layer_coverage(u_key_front, clip.xyz * 0.5 + 0.5,
+                                                u_key_depth_bias.x + u_key_depth_bias.y * tan_surface);
         key_uv = g_key_beam * (1.0 - g_front_coverage);   // UV passes the holes only
     }
 #endif

@@ -24,6 +24,8 @@ from catalog.optics import shading_reference as ref
 from catalog.render import room_light
 from catalog.render import scene as scene_lib
 from catalog.render.frame import FrameRenderer
+from catalog.bench import key_shadow_bias
+from catalog.render.raycast import first_hit, mesh_triangles
 
 pytestmark = [pytest.mark.gl, pytest.mark.slow]   # each takes 0.5 s or more
 
@@ -56,31 +58,6 @@ def _through_opening(p, d):
     return margin > 0, margin
 
 
-def _first_hit(origins, direction, triangles, chunk=64):
-    """(P,) distance to the nearest triangle along one direction (inf: none), Moller-Trumbore."""
-    v0, v1, v2 = triangles[:, 0], triangles[:, 1], triangles[:, 2]
-    e1, e2 = v1 - v0, v2 - v0
-    pvec = np.cross(np.broadcast_to(direction, e2.shape), e2)
-    det = np.einsum("ti,ti->t", e1, pvec)
-    ok = np.abs(det) > 1e-12
-    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    out = np.full(origins.shape[0], np.inf)
-    for start in range(0, origins.shape[0], chunk):
-        o = origins[start:start + chunk]
-        tvec = o[:, None, :] - v0[None]
-        u = np.einsum("pti,ti->pt", tvec, pvec) * inv
-        qvec = np.cross(tvec, e1[None])
-        v = np.einsum("pti,i->pt", qvec, direction) * inv
-        t = np.einsum("pti,ti->pt", qvec, e2) * inv
-        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
-        out[start:start + chunk] = np.where(hit, t, np.inf).min(axis=1)
-    return out
-
-
-def _triangles(mesh):
-    return np.asarray(mesh.positions, dtype=np.float64)[np.asarray(mesh.indices).reshape(-1, 3)]
-
-
 def test_window_wall_shades_the_upper_curtain(gl, make_preset):
     """A flat curtain under a key 60 deg high: the G-buffer's window mask is 1 where the ray
     to the light leaves through the opening and 0 where the wall stops it, within 1e-3 at
@@ -110,13 +87,14 @@ def test_window_wall_shades_the_upper_curtain(gl, make_preset):
 def test_folds_shade_the_cloth_behind_them(gl, make_preset):
     """The default drape under a key 20 deg high and 60 deg aside (across the folds): a pixel
     counts as behind a fold (front coverage > 0.5 in the G-buffer: the maps are read with a
-    depth ramp and a 2x2 filter since a later change, > 0 before) exactly where a ray cast in
-    numpy towards the light meets the mesh more than 3 cm away, on at least 95 % of the
-    pixels whose nearest hit is not within 1 cm of the map's 2 cm bias and which lie more
-    than 1.5 map texels from a shadow's edge (the edge condition was added after a first run
-    gave 94.7 % with the edges counted: the map is looked up at its nearest texel); the shaded pixels'
-    key light is dimmed to the layer's transmittance: their luminance falls by more than 20 %
-    against the shadow off, the rest changes by less than 1e-3."""
+    depth ramp and a 2x2 filter) exactly where a ray cast in numpy towards the light meets the
+    mesh more than 3 mm away, on at least 98 % of the pixels more than 1.5 map texels from a
+    shadow's edge (the map is looked up at its nearest texels). Issue 11 replaced the constant
+    2 cm depth bias, which this test had to exclude (occluders within 1-3 cm), by a
+    slope-scaled one chosen on this drape (catalog/bench/key_shadow_bias.py: 100 % here, the
+    2 cm bias 99.2 %; the bound 98 % was set with the choice). The shaded pixels' key light is
+    dimmed to the layer's transmittance: their luminance falls by more than 20 % against the
+    shadow off, the rest changes by less than 1e-3."""
     mesh = scene_lib.draped_curtain(columns=60, rows=40)
     r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh)
     r.set_key_direction(elevation_deg=20.0, azimuth_deg=60.0)
@@ -124,21 +102,11 @@ def test_folds_shade_the_cloth_behind_them(gl, make_preset):
     mask = g["mask"]
     p = g["position"][mask].astype(np.float64)
     to_light = np.asarray(r.shading_inputs().key_to_light, dtype=np.float64)
-    triangles = _triangles(mesh)
-    distance = _first_hit(p + 1e-4 * to_light, to_light, triangles)
-    expected = np.isfinite(distance) & (distance > 0.03)
-    clear = np.abs(distance - 0.02) > 0.01
-    # away from a shadow's edge: the same answer for the ray moved a map texel aside
-    texel = room_light.shadow_texel_m(to_light)
-    side = np.cross(to_light, [0.0, 1.0, 0.0])
-    side /= np.linalg.norm(side)
-    for offset in (-1.5 * texel, 1.5 * texel):
-        moved = _first_hit(p + 1e-4 * to_light + offset * side, to_light, triangles)
-        clear &= (np.isfinite(moved) & (moved > 0.03)) == expected
+    expected, clear = key_shadow_bias.shadow_truth(p, to_light, mesh)
     behind = g["shadows"][mask][:, 1] > 0.5   # coverage 1 (LD 0): the ramp's and the 2x2 filter's midpoint
     beam = g["shadows"][mask][:, 0]
     assert expected[clear].mean() > 0.05   # the light really crosses folds
-    assert (behind[clear] == expected[clear]).mean() > 0.95
+    assert (behind[clear] == expected[clear]).mean() > 0.98
     on = g["radiance"][mask] @ LUMA
     r.set_key_shadow(False)
     off = r.render_gbuffer()["radiance"][mask] @ LUMA
@@ -169,13 +137,13 @@ def test_outside_occlusion_matches_rays_cast_in_numpy(gl, make_preset):
     rng = np.random.default_rng(0)
     pick = rng.choice(p.shape[0], size=min(400, p.shape[0]), replace=False)
     q = p[pick]
-    triangles = _triangles(mesh)
+    triangles = mesh_triangles(mesh)
     cloth = np.zeros(q.shape[0])
     wall = np.zeros(q.shape[0])
     directions = room_light.occlusion_directions()
     for d in directions:
         opening, _ = _through_opening(q, np.repeat(d[None], q.shape[0], 0))
-        hit = np.isfinite(_first_hit(q + 0.03 * d, d, triangles))
+        hit = np.isfinite(first_hit(q + 0.03 * d, d, triangles))
         cloth += opening & hit
         wall += ~opening
     cloth /= len(directions)

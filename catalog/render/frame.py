@@ -77,9 +77,15 @@ ENVIRONMENT_UNIT = 5
 #: Texture unit of the key light's front-layer map (the curtain's KEY_SHADOW).
 KEY_FRONT_UNIT = 6
 #: How far (m, along the key's travel) a fragment must lie behind the cloth layer nearest the
-#: key light to be in that layer's shadow: a little over one texel of the front-layer map on a
-#: fold's flank (room_light.SHADOW_TEXELS over ~2.4 m: 1 cm), so a layer does not shade itself.
-KEY_SHADOW_BIAS_M = 0.02
+#: key light to be in that layer's shadow, slope-scaled: KEY_SHADOW_BIAS_M plus
+#: KEY_SHADOW_SLOPE_TEXELS front-map texels (room_light.shadow_texel_m, ~1 cm) times the
+#: tangent of the angle between the cloth's normal and the key (at most KEY_SHADOW_SLOPE_CAP),
+#: the depth a layer itself spans across that many texels, so a layer does not shade itself.
+#: Issue 11: the constant 2 cm used before let a fold lying closer than that behind another
+#: (the trough lines of the close-ups) escape the nearer fold's shadow.
+KEY_SHADOW_BIAS_M = 0.004
+KEY_SHADOW_SLOPE_TEXELS = 1.5
+KEY_SHADOW_SLOPE_CAP = 4.0
 #: Texture unit of the occlusion maps (the curtain's SKY_OCCLUSION).
 OCCLUSION_UNIT = 7
 #: SKY_OCCLUSION's depth bias (m) and its lookup's offset off the surface (m): a texel and a
@@ -1159,7 +1165,9 @@ class FrameRenderer:
         s(program, "u_light_view_proj", gl_bytes(matrix))
         # orthographic: window depth (0..1) = 0.5 ndc z + 0.5, ndc z = m[2, 2] z_view + ..:
         # one metre along the travel is -m[2, 2] / 2 of depth
-        s(program, "u_key_depth_bias", KEY_SHADOW_BIAS_M * abs(float(matrix[2, 2])) / 2)
+        metre = abs(float(matrix[2, 2])) / 2
+        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light)
+        s(program, "u_key_depth_bias", (KEY_SHADOW_BIAS_M * metre, slope_m * metre, KEY_SHADOW_SLOPE_CAP))
         wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
         z0 = scene_lib.ROOM_BOX[2][0]
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
