@@ -1,8 +1,9 @@
 #version 430
 // The room's light map, the diffuse bounces (issues 13 and 11): per atlas texel, the direct
 // light map adds the light that the room's own walls reflect onto it, gathered from the
-// coarse patches (face area / RC^2): E = sum_j (rho / pi) T_j m_j cos_r cos_j A_j / max(r^2, A_j),
-// with m_j the patch's wall fraction (0 in the window opening) and T_j the patch's
+// coarse patches (face area / RC^2): E = sum_j (rho_j / pi) T_j cos_r cos_j A_j / max(r^2, A_j),
+// with rho_j = m_j rho + (1 - m_j) rho_curtain (m_j the patch's wall fraction, 0 in the window
+// opening, where the closed curtain reflects part of the room's light) and T_j the patch's
 // irradiance: with ALL_BOUNCES its total (room_radiosity.frag), else its direct light, the
 // coarse mip of the direct map plus the key's beam (one bounce, issue 13's frame). The room is a convex box, so
 // every patch sees every other; the precomputed ambient occlusion (corners, the window's
@@ -24,6 +25,7 @@ uniform sampler2D u_ao_mask;         // r: ambient occlusion, g: wall fraction; 
 uniform int u_bounce_level;          // the mip level gathered
 uniform int u_coarse_texels;         // face texels at that level
 uniform float u_albedo;
+uniform vec3 u_window_albedo;       // the closed curtain's room-side reflectance (0: open)
 
 layout(location = 0) out vec4 out_irradiance;
 
@@ -61,9 +63,9 @@ void main() {
                 vec3 source = texelFetch(u_direct, texel, u_bounce_level).rgb
                             + texelFetch(u_beam, texel, u_bounce_level).rgb;
 #endif
-                bounce += source * (wall * geometry);
+                bounce += source * ((wall * u_albedo + (1.0 - wall) * u_window_albedo) * geometry);
             }
         }
     }
-    out_irradiance = vec4(direct + ao * (u_albedo / PI) * bounce, 1.0);
+    out_irradiance = vec4(direct + ao * (1.0 / PI) * bounce, 1.0);
 }

@@ -11,7 +11,7 @@ in vec2 v_uv;
 
 uniform sampler2D u_direct;          // the direct light map (area light, lamps), mipmapped
 uniform sampler2D u_beam;            // the key's beam at the light map's texels, mipmapped
-uniform sampler2D u_operator;        // (N, N) op_ik: row i, column k (r channel)
+uniform sampler2D u_operator;        // (N, N) op_ik per colour channel: row i, column k
 uniform int u_bounce_level;          // the coarse mip level
 uniform int u_coarse_texels;         // face texels at that level (RC)
 
@@ -34,7 +34,7 @@ void main() {
     vec3 total = coarse_source(i);
     int count = ROOM_FACES * rc * rc;
     for (int k = 0; k < count; ++k) {
-        total += texelFetch(u_operator, ivec2(k, i), 0).r * coarse_source(k);
+        total += texelFetch(u_operator, ivec2(k, i), 0).rgb * coarse_source(k);
     }
     out_total = vec4(total, 1.0);
 }

@@ -753,11 +753,23 @@ class FrameRenderer:
         return values
 
     def _no_disc_overrides(self) -> dict:
-        """The curtain's values without the sun's disc seen through it (the luminaire capture:
-        the key light's beam reaches the room through the shadow map instead)."""
-        disc = self.scene_values()["u_sun_disc"]
-        return {"u_sun_disc": np.zeros_like(disc) if isinstance(disc, np.ndarray)
-                else tuple(0.0 for _ in disc)}
+        """The curtain's values for the luminaire capture: without the sun's disc seen through
+        it (the key light's beam reaches the room through the shadow map instead) and without
+        the room's light on its room side (the fill light and the room's share of the ambient
+        term, stand-ins for it, and the lamps): the radiosity pass reflects the room's own
+        light off the closed curtain (:meth:`window_albedo_rgb`), so the capture holds only
+        what comes from outside and the glow."""
+        values = self.scene_values()
+
+        def zeros(value):
+            return np.zeros_like(value) if isinstance(value, np.ndarray) else tuple(0.0 for _ in value)
+
+        out = {"u_sun_disc": zeros(values["u_sun_disc"]), "u_fill_dyed": zeros(values["u_fill_dyed"]),
+               "u_ambient": values["u_ambient_outside"]}
+        if self.room_lamps:
+            dyed = self.room_lamp_values()["u_room_lamp_dyed"]
+            out["u_room_lamp_dyed"] = np.zeros_like(dyed)
+        return out
 
     def _program(self, vertex: str, fragment: str, defines: dict | None = None):
         key = (vertex, fragment, tuple(sorted((defines or {}).items())))
@@ -919,6 +931,8 @@ class FrameRenderer:
                     self._set(program, name, value)
             if self.room_lamps:
                 for name, value in self.room_lamp_values().items():
+                    if overrides and name in overrides:
+                        value = overrides[name]
                     self._set(program, name, value)
             if "u_environment" in program:
                 self.environment[1].use(location=ENVIRONMENT_UNIT)
@@ -1129,14 +1143,14 @@ class FrameRenderer:
                 "lightmap": lightmap, "lightmap_fbo": ctx.framebuffer([lightmap]), "ao": ao,
             }
             rc = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
-            operator = room_light.radiosity_operator(scene_lib.ROOM_ALBEDO).astype("f4")
-            bounces = ctx.texture(operator.shape[::-1], 1, data=np.ascontiguousarray(operator).tobytes(),
-                                  dtype="f4")
+            patches = len(room_light.FACE_NAMES) * rc * rc
+            bounces = ctx.texture((patches, patches), 3, dtype="f4")   # written by _radiosity_operator
             bounces.filter = (mgl.NEAREST, mgl.NEAREST)
             total = ctx.texture((len(room_light.FACE_NAMES) * rc, rc), 4, dtype="f4")
             total.filter = (mgl.NEAREST, mgl.NEAREST)
             self._room_gl.update({"radiosity_operator": bounces, "total": total,
                                   "total_fbo": ctx.framebuffer([total])})
+            self._operator_albedo = None
         return self._room_gl
 
     def _room_colours(self, inputs) -> dict:
@@ -1402,6 +1416,31 @@ class FrameRenderer:
         self.ctx.disable(mgl.DEPTH_TEST)
         gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
 
+    def window_albedo_rgb(self, inputs) -> tuple[float, float, float]:
+        """The closed curtain's room-side reflectance under diffuse light (linear sRGB): the
+        lobes scattering back, dye (a_diff backward(g_diff) + a_spec backward(g_spec)), the
+        dye per channel under the key as the room's colours take it; 0 when the curtain is
+        open (the window reflects nothing)."""
+        from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
+
+        if self.curtain_open:
+            return (0.0, 0.0, 0.0)
+        colours = self._display_colours(inputs)
+        key = np.asarray(colours["u_key_rgb"])
+        dyed = np.asarray(colours["key_dyed_rgb"])
+        dye_rgb = np.where(key > 1e-6 * max(float(key.max()), 1e-30), dyed / np.where(key > 0, key, 1.0), 1.0)
+        back = (float(inputs.a_diff) * hg_hemisphere_factors(float(inputs.g_diff))[1]
+                + float(inputs.a_spec) * hg_hemisphere_factors(float(inputs.g_spec))[1])
+        return tuple(float(v) for v in np.clip(dye_rgb * back, 0.0, 1.0))
+
+    def _radiosity_operator(self, window_albedo) -> None:
+        """Upload room_light.radiosity_operator_rgb for this window reflectance (when it changed)."""
+        key = tuple(round(v, 4) for v in window_albedo)
+        if key != self._operator_albedo:
+            operator = room_light.radiosity_operator_rgb(scene_lib.ROOM_ALBEDO, key)
+            self._room_resources()["radiosity_operator"].write(np.ascontiguousarray(operator).tobytes())
+            self._operator_albedo = key
+
     def draw_room_lightmap(self, inputs) -> None:
         """Passes R3 and R4: the light map's direct part (area light, beam, lamps), then (R3b,
         with every bounce) the coarse patches' total irradiance, then the bounces gathered
@@ -1440,7 +1479,9 @@ class FrameRenderer:
         gl["beam"].build_mipmaps()
         rc = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
         all_bounces = self.room_bounces == "all"
+        window_albedo = self.window_albedo_rgb(inputs)
         if all_bounces:   # the coarse patches' total irradiance (room_radiosity.frag)
+            self._radiosity_operator(window_albedo)
             gl["total_fbo"].use()
             self.ctx.viewport = (0, 0, len(room_light.FACE_NAMES) * rc, rc)
             program = self._program("fullscreen.vert", "room_radiosity.frag")
@@ -1472,6 +1513,7 @@ class FrameRenderer:
         self._set(program, "u_bounce_level", room_light.BOUNCE_LEVEL)
         self._set(program, "u_coarse_texels", room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL)
         self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
+        self._set(program, "u_window_albedo", window_albedo)
         self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
 
     def draw_room_light(self, inputs) -> None:

@@ -16,8 +16,9 @@ Irradiance (linear sRGB, the renderer's cd m^-2 scale times pi) is stored per te
 - bounces, all of them: the coarse patches' total irradiance ``T = (I - K)^-1 S`` (the radiosity
   solve of model.md section 9, :func:`radiosity_operator`: S the direct light of each coarse patch, K
   the patch-to-patch transfer below, precomputed once as the matrix ``(I - K)^-1 - I``),
-  then per texel ``E(x) = E_direct(x) + ao(x) rho / pi sum_j T_j m_j cos_x cos_j A_j / r^2``
-  over the coarse patches (the room is a convex box: every patch sees every other), with
+  then per texel ``E(x) = E_direct(x) + ao(x) / pi sum_j rho_j T_j cos_x cos_j A_j / r^2``
+  over the coarse patches (rho_j the wall's albedo, or in the window opening the closed
+  curtain's room-side reflectance: the cloth sends part of the room's light back) (the room is a convex box: every patch sees every other), with
   the ambient occlusion below. One bounce alone (issue 13's frame) left the walls 30 % and
   the floor 45 % darker than the path-traced reference (issue 11): with walls of albedo 0.6
   the bounces after the first double the first.
@@ -273,18 +274,35 @@ def patch_geometry(points: np.ndarray, normals: np.ndarray, point_faces: np.ndar
     return geometry
 
 
-@functools.lru_cache(maxsize=4)
-def radiosity_operator(albedo: float, face_texels: int = FACE_TEXELS,
+def patch_reflectance(albedo: float, window_albedo: float, wall: np.ndarray) -> np.ndarray:
+    """Reflectance of patches whose wall fraction is ``wall``: the wall's ``albedo`` where it
+    is wall, the closed curtain's room-side reflectance ``window_albedo`` in the opening
+    (0 when it is open: the light leaves)."""
+    return albedo * wall + window_albedo * (1.0 - wall)
+
+
+@functools.lru_cache(maxsize=16)
+def radiosity_operator(albedo: float, window_albedo: float = 0.0, face_texels: int = FACE_TEXELS,
                        level: int = BOUNCE_LEVEL) -> np.ndarray:
     """(N, N) float64: the bounces the coarse patches add to their direct light,
-    ``(I - K)^-1 - I`` with ``K_ij = ao_i rho / pi G_ij m_j`` (the patch-to-patch form of
-    room_bounce.frag's gather, a radiosity system as model.md section 9 names it; G from :func:`patch_geometry`, m the wall fraction:
-    the window opening reflects nothing). T = S + op @ S is every patch's total irradiance."""
+    ``(I - K)^-1 - I`` with ``K_ij = ao_i / pi G_ij rho_j`` (the patch-to-patch form of
+    room_bounce.frag's gather, a radiosity system as model.md section 9 names it; G from
+    :func:`patch_geometry`, rho_j from :func:`patch_reflectance`: the wall's albedo, the closed
+    curtain's reflectance in the window opening). T = S + op @ S is every patch's total
+    irradiance. One colour channel: call it per channel when the curtain is dyed."""
     patches = coarse_patches(face_texels, level)
     geometry = patch_geometry(patches["centre"], patches["normal"], patches["face"], patches)
-    transfer = (albedo / math.pi) * patches["ao"][:, None] * geometry * patches["wall"][None, :]
+    rho = patch_reflectance(albedo, window_albedo, patches["wall"])
+    transfer = patches["ao"][:, None] / math.pi * geometry * rho[None, :]
     count = transfer.shape[0]
     return np.linalg.inv(np.eye(count) - transfer) - np.eye(count)
+
+
+def radiosity_operator_rgb(albedo: float, window_albedo_rgb) -> np.ndarray:
+    """(N, N, 3) float32: :func:`radiosity_operator` per colour channel (the window's
+    reflectance rounded to 1e-4, so that a cache serves a fabric under a light)."""
+    return np.stack([radiosity_operator(albedo, round(float(w), 4)) for w in window_albedo_rgb],
+                    axis=-1).astype(np.float32)
 
 
 # --------------------------------------------------------------------------- the key's shadow map
