@@ -76,14 +76,16 @@ def test_open_window_beam_is_the_key_irradiance(gl):
 
 def test_closing_the_lace_dims_the_patch_by_its_transmittance(gl):
     """Closing lace-fwa leaves the beam's transmittance LD + a_spec fwd(g_spec) (0.65): the
-    patch's closed/open ratio is at least that and at most 0.08 above it (the glowing curtain
-    lights the patch a little more than the open window's sky)."""
+    patch's closed/open ratio is within -0.03 / +0.08 of it (the rest is the window as an area
+    light, the glowing curtain against the open window's sky, and the bounces). The lower
+    bound was 0 until issue 11 took the key's directional lobe out of the window's capture
+    (the beam carries it; it had been counted twice): the ratio is now 0.003 below."""
     r = _renderer(gl)
     patch, _ = _floor_regions(r)
     open_y = _luma(_frame(r, True)[patch]).mean()
     closed_y = _luma(_frame(r, False)[patch]).mean()
     t = _beam_transmittance(r.shading_inputs())
-    assert t <= closed_y / open_y <= t + 0.08
+    assert t - 0.03 <= closed_y / open_y <= t + 0.08
     r.release()
 
 
@@ -301,17 +303,20 @@ def test_room_lamp_outside_the_room_is_refused(gl):
 
 @pytest.mark.slow
 def test_room_light_is_stable_as_the_cloth_moves(gl):
-    """The drape slid sideways 2 cm at a time (folds 31 cm apart): no texel of the room's light
-    map changes by more than 5 % a step. Each window patch is the mean of 4 x 4 capture samples;
-    a 12 x 9 point capture changes by ~22 % (folds flickering through its samples)."""
+    """The folds slid sideways 2 cm at a time inside the curtain's fixed outline (folds 31 cm
+    apart): no texel of the room's light map changes by more than 5 % a step. Each window
+    patch is the mean of 4 x 4 capture samples; a 12 x 9 point capture (LUMINAIRE_LEVEL 0)
+    fails it (6 %: folds flickering through its samples; ~22 % before issue 11's changes). Issue 11: the whole drape slid before, moving its outline
+    too; once the key's directional lobe left the window's capture, the strip of sky opening
+    beside the curtain changed the ceiling over the window's corner by 7.5 % in one step, a
+    real change of the light, not the flicker this test is about."""
     r = FrameRenderer(gl, (64, 36))
     r.set_fabric("lace-fwa")
     r.set_light("sun:60")
-    mesh = scene_lib.draped_curtain()
     previous, worst = None, 0.0
     for step in range(5):
-        shift = np.array([0.02 * step, 0.0, 0.0], dtype="f4")
-        r.set_mesh(mesh.positions + shift, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices)
+        mesh = scene_lib.draped_curtain(fold_shift_m=0.02 * step)
+        r.set_mesh(mesh.positions, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices)
         r.render()
         light = _luma(r.read_room_lightmap())
         if previous is not None:

@@ -754,9 +754,11 @@ class FrameRenderer:
 
     def _no_disc_overrides(self) -> dict:
         """The curtain's values for the luminaire capture: without the sun's disc seen through
-        it (the key light's beam reaches the room through the shadow map instead) and without
-        the room's light on its room side (the fill light and the room's share of the ambient
-        term, stand-ins for it, and the lamps): the radiosity pass reflects the room's own
+        it (the key light's beam reaches the room through the shadow map instead), without the
+        key light scattered by the directional lobe (the beam carries it: counted in both, the
+        room was up to 1.6x too bright under a low key), and without the room's light on its
+        room side (the fill light and the room's share of the ambient term, stand-ins for it,
+        and the lamps): the radiosity pass reflects the room's own
         light off the closed curtain (:meth:`window_albedo_rgb`), so the capture holds only
         what comes from outside and the glow."""
         values = self.scene_values()
@@ -766,6 +768,9 @@ class FrameRenderer:
 
         out = {"u_sun_disc": zeros(values["u_sun_disc"]), "u_fill_dyed": zeros(values["u_fill_dyed"]),
                "u_ambient": values["u_ambient_outside"]}
+        # the directional lobe's share of the key travels in the beam (room_shadow.frag's
+        # thread part), not in the window's radiance
+        out["u_a_spec"] = 0.0
         if self.room_lamps:
             dyed = self.room_lamp_values()["u_room_lamp_dyed"]
             out["u_room_lamp_dyed"] = np.zeros_like(dyed)

@@ -43,8 +43,11 @@ from catalog.render import scene as scene_lib
 FACE_TEXELS = 16
 #: Faces of the room, in atlas order.
 FACE_NAMES = ("floor", "ceiling", "left", "right", "back", "window_wall")
-#: Coarse mip level of the direct light map used as the bounce's sources (16 -> 4 per side).
-BOUNCE_LEVEL = 2
+#: Coarse mip level of the direct light map used as the bounce's sources (16 -> 8 per side:
+#: 384 patches). Issue 11 went from 4 per side: a patch 1.1 m across gathers as if all its
+#: light sat at its centre, so a sunlit strip by the window wall lit that wall as if from
+#: half a metre out (the noon room's window wall was 1.5-2x the reference's).
+BOUNCE_LEVEL = 1
 #: The luminaire capture: patches across and down the window opening, each the mean of
 #: 2^LUMINAIRE_LEVEL x 2^LUMINAIRE_LEVEL samples (the capture's mip level), so that a fold
 #: moving across a patch changes its radiance smoothly (no shimmer in the room's light).

@@ -77,8 +77,9 @@ class Mesh:
 
 
 def draped_curtain(columns: int = 120, rows: int = 80, folds: float = 5.5,
-                   depth_m: float = 0.07) -> Mesh:
+                   depth_m: float = 0.07, fold_shift_m: float = 0.0) -> Mesh:
     """A static draped curtain: sinusoidal folds hanging from a rod, deepest at the top.
+    ``fold_shift_m`` slides the folds sideways (towards +x) inside a fixed outline.
 
     u runs along the weft (across, x), v along the warp (down from the rod, -y). The
     tangent is dP/du (weft); the normal dP/du x dP/dv' faces the room (+z) on average.
@@ -89,7 +90,7 @@ def draped_curtain(columns: int = 120, rows: int = 80, folds: float = 5.5,
     v = np.linspace(0.0, 1.0, rows)
     uu, vv = np.meshgrid(u, v)  # (rows, columns)
     amplitude = depth_m * (1.0 - 0.45 * vv)  # folds open up towards the hem
-    phase = 2 * math.pi * folds * uu
+    phase = 2 * math.pi * folds * (uu - fold_shift_m / CURTAIN_WIDTH_M)
     x = (uu - 0.5) * CURTAIN_WIDTH_M
     y = CURTAIN_TOP_Y - vv * CURTAIN_HEIGHT_M
     z = CURTAIN_Z + amplitude * np.sin(phase)
