@@ -475,3 +475,26 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
     assert np.all(added.sum(-1) > 0.0)
     assert np.allclose(added[big], expected[big], rtol=1e-2, atol=1e-3 * expected.max())
     r.release()
+
+
+def test_shadow_map_size_is_a_frame_option(gl):
+    """set_shadow_map_size (issue 11's Pareto): the maps are made again at the new side (read
+    back at that size), the room's beam patch keeps its mean within 2 % (the map's resolution
+    moves its edges, not its light), and a size outside SHADOW_MAP_SIZES is one InputError."""
+    from catalog.core.errors import InputError
+    from catalog.render.frame import SHADOW_MAP_SIZES
+
+    r = _renderer(gl)
+    patch, _ = _floor_regions(r)
+    means = {}
+    for texels in (128, 512):
+        r.set_shadow_map_size(texels)
+        image = _frame(r, False)
+        assert r.read_room_shadow().shape == (texels, texels, 3)
+        means[texels] = _luma(image[patch]).mean()
+    assert means[128] == pytest.approx(means[512], rel=0.02)
+    assert r.info()["shadow_map_size"] == 512
+    with pytest.raises(InputError, match="shadow map size"):
+        r.set_shadow_map_size(300)
+    assert 300 not in SHADOW_MAP_SIZES
+    r.release()

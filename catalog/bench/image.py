@@ -19,8 +19,9 @@ description and curtain mesh. Measured:
 Real-time options (the Pareto plot): spectral bands 3/6/16, paper vs physical
 fluorescence, anti-aliasing (FXAA, the default; none; 2x2 supersampling), the room lit
 through the curtain (issue 13, the default) or the earlier constant room, the room's
-bounces (all, by radiosity, the default; or one, as before). The shadow map's size
-is a module constant, not a frame option: listed as absent.
+bounces (all, by radiosity, the default; or one, as before), the key light's shadow maps
+at 128 and 512 texels a side (256 the default). The shadow map's size
+was a module constant until issue 11 made it a frame option (set_shadow_map_size).
 
 The goal of issue 11 (stated before measuring): on every scene mean FLIP <= 0.10, curtain
 Delta E 2000 mean <= 2, and the frame >= 1000x faster than the reference.
@@ -59,6 +60,8 @@ OPTIONS = (
     ("default (physical, 3 bands, FXAA)", 3, "physical", 1, None),
     ("room lighting off", 3, "physical", 1, None, False),
     ("one room bounce (before)", 3, "physical", 1, None, None, {"room_bounces": "one"}),
+    ("shadow maps 128", 3, "physical", 1, None, None, {"shadow_map_size": 128}),
+    ("shadow maps 512", 3, "physical", 1, None, None, {"shadow_map_size": 512}),
     ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
     ("sky occlusion off (issue 11)", 3, "physical", 1, None, None, {"sky_occlusion": False}),
     ("ambient by view off (issue 11)", 3, "physical", 1, None, None, {"ambient_by_view": False}),
@@ -70,13 +73,17 @@ OPTIONS = (
     ("paper fluorescence", 3, "paper", 1, None),
     ("2x2 supersampled", 3, "physical", 2, "off"),
 )
-ABSENT_OPTIONS = ("shadow map size (catalog.render.room_light.SHADOW_TEXELS, not a frame option)",)
+#: Options the frame does not have (none since issue 11 made the shadow maps' size one).
+ABSENT_OPTIONS: tuple = ()
 #: The stated noise level of a converged reference: 1 % relative RMS of luminance on the
 #: curtain (noise falls as 1 / sqrt(spp): the spp that reaches it is spp (noise / 1 %)^2).
 NOISE_TARGET = 0.01
 #: The committed figures (tools/docs_figures.py): {"runs": {"baseline": section, "after_12_16": section,
 #: "after_11": section}} (after_11: issue 11's fixes, the references at 512 spp).
 RESULT_JSON = "benchmarks/bench_image.json"
+#: The run after issue 11's second round (the reference's glow, the room's bounces, the fold
+#: shadows' bias): ``runs[ROUND_2]`` of RESULT_JSON, made by ``python -m catalog.bench.image ROUND_2``.
+ROUND_2 = "after_11_round_2"
 GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
 REGIONS = ("curtain", "floor", "walls")
 #: The hour of "noon sun" (local solar time, the scene's date and latitude).
@@ -378,6 +385,19 @@ def summary_line(result: dict) -> str:
             f"Goal met on {s['scenes_meeting_goal']} of {s['scenes']} scenes.")
 
 
+def round_changes(before: dict, after: dict) -> str:
+    """Per scene: mean FLIP and curtain dE mean before -> after, and whether the goal is met."""
+    lines = ["| scene | mean FLIP before | after | curtain dE before | after | goal met after |",
+             "|---|---|---|---|---|---|"]
+    earlier = {r["scene"]: r for r in before["rows"]}
+    for row in after["rows"]:
+        old = earlier.get(row["scene"], {})
+        lines.append(f"| {row['scene']} | {_cell(old.get('mean_flip'))} | {_cell(row['mean_flip'])} | "
+                     f"{_cell(old.get('curtain_delta_e_mean'))} | {_cell(row['curtain_delta_e_mean'])} | "
+                     f"{_cell(row['meets_goal'])} |")
+    return "\n".join(lines)
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run; of the
     committed JSON (``{"runs": {...}}``) the baseline's, and ``image-after`` the run after
@@ -398,6 +418,17 @@ def markdown_tables(result: dict) -> dict[str, str]:
                 + "\n\n![six scenes after issue 11's fixes: real-time | reference | FLIP]"
                 "(img/pathtrace_scenes_after_11.png)")
             blocks["image-after-11-summary"] = summary_line(run)
+        if ROUND_2 in result["runs"]:
+            run = result["runs"][ROUND_2]
+            latest = markdown_tables(run)
+            blocks["image-after-11-round-2"] = (
+                latest["image"] + "\n\nReal-time options against the same references:\n\n"
+                + latest["image-options"]
+                + f"\n\n![six scenes after issue 11's second round: real-time | reference | FLIP]"
+                f"(img/pathtrace_scenes_{ROUND_2}.png)\n\n"
+                f"![real-time options against the reference](img/pathtrace_pareto_{ROUND_2}.png)")
+            blocks["image-after-11-round-2-summary"] = summary_line(run)
+            blocks["image-after-11-round-2-changes"] = round_changes(result["runs"]["after_11"], run)
         return blocks
 
     s = result["summary"]
@@ -430,8 +461,9 @@ def markdown_tables(result: dict) -> dict[str, str]:
     options += "\n\n" + table(option_rows, ["scene", "option", "mean_flip", "curtain_mean_delta_e",
                                             "frame_ms"],
                                ["scene", "real-time option", "mean FLIP", "curtain dE mean", "frame ms"])
-    options += (f"\n\nNot yet in the frame (measured when they land): "
-                f"{', '.join(s['absent_options'])}.")
+    if s.get("absent_options"):
+        options += (f"\n\nNot yet in the frame (measured when they land): "
+                    f"{', '.join(s['absent_options'])}.")
     return {"image": per_scene, "image-options": options}
 
 

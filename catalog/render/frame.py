@@ -84,6 +84,8 @@ KEY_FRONT_UNIT = 6
 #: Issue 11: the constant 2 cm used before let a fold lying closer than that behind another
 #: (the trough lines of the close-ups) escape the nearer fold's shadow.
 KEY_SHADOW_BIAS_M = 0.004
+#: The key light's map sides set_shadow_map_size accepts (texels).
+SHADOW_MAP_SIZES = (64, 128, 256, 512, 1024, 2048)
 KEY_SHADOW_SLOPE_TEXELS = 1.5
 KEY_SHADOW_SLOPE_CAP = 4.0
 #: Texture unit of the occlusion maps (the curtain's SKY_OCCLUSION).
@@ -287,6 +289,9 @@ class FrameRenderer:
         self.ambient_by_view = True
         #: issue 11: the room's bounces, "all" (radiosity, room_radiosity.frag) or "one"
         self.room_bounces = "all"
+        #: the side (texels) of the key light's maps: the room's transmittance map and the
+        #: cloth's front-layer map (set_shadow_map_size)
+        self.shadow_texels = room_light.SHADOW_TEXELS
         self.curtain_open = False
         self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
         self._room_gl = None
@@ -457,6 +462,28 @@ class FrameRenderer:
             raise InputError(f"{bounces!r}: choose one of {', '.join(room_light.ROOM_BOUNCES)}",
                              field="room bounces")
         self.room_bounces = bounces
+
+    def set_shadow_map_size(self, texels: int) -> None:
+        """The side of the key light's maps (the room's transmittance map and the cloth's
+        front-layer map): a power of two in SHADOW_MAP_SIZES' range (issue 11's Pareto)."""
+        texels = int(texels)
+        if texels not in SHADOW_MAP_SIZES:
+            raise InputError(f"{texels}: choose one of {', '.join(map(str, SHADOW_MAP_SIZES))}",
+                             field="shadow map size")
+        if texels != self.shadow_texels:
+            self.shadow_texels = texels
+            self._release_room_resources()
+
+    def _release_room_resources(self) -> None:
+        """Free the room lighting's GL objects (made again on next use, e.g. at a new size)."""
+        if self._room_gl is None:
+            return
+        if self.ctx.fbo in [obj for name, obj in self._room_gl.items() if name.endswith("_fbo")]:
+            (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
+        for obj in self._room_gl.values():
+            obj.release()
+        self._room_gl = None
+        self._room_key = None
 
     def set_sky_occlusion(self, on: bool) -> None:
         """Let the cloth's own folds hide part of the outside from its ambient term (issue 11;
@@ -1101,7 +1128,7 @@ class FrameRenderer:
         self._set(program, "u_lightmap", 1)
         gl["shadow"].use(location=2)
         self._set(program, "u_shadow", 2)
-        self._set(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light))
+        self._set(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels))
         self._set(program, "u_curtain_z", scene_lib.CURTAIN_Z)
 
     # ------------------------------------------------------------------ the room's light (issue 13)
@@ -1109,7 +1136,7 @@ class FrameRenderer:
         """The room lighting's GL objects, made on first use (docs/room.md)."""
         if self._room_gl is None:
             mgl, ctx = self._moderngl, self.ctx
-            n = room_light.SHADOW_TEXELS
+            n = self.shadow_texels
             shadow = ctx.texture((n, n), 4, dtype="f2")
             shadow.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
             shadow.repeat_x = shadow.repeat_y = False
@@ -1185,7 +1212,7 @@ class FrameRenderer:
         # orthographic: window depth (0..1) = 0.5 ndc z + 0.5, ndc z = m[2, 2] z_view + ..:
         # one metre along the travel is -m[2, 2] / 2 of depth
         metre = abs(float(matrix[2, 2])) / 2
-        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light)
+        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels)
         s(program, "u_key_depth_bias", (KEY_SHADOW_BIAS_M * metre, slope_m * metre, KEY_SHADOW_SLOPE_CAP))
         wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
         z0 = scene_lib.ROOM_BOX[2][0]
@@ -1294,7 +1321,7 @@ class FrameRenderer:
     def draw_room_shadow(self, inputs) -> None:
         """Pass R1: the key light's transmittance through the curtain (room_shadow.frag)."""
         mgl, gl = self._moderngl, self._room_resources()
-        n = room_light.SHADOW_TEXELS
+        n = self.shadow_texels
         gl["shadow_fbo"].use()
         self.ctx.viewport = (0, 0, n, n)
         gl["shadow_fbo"].clear(1.0, 1.0, 1.0, 1.0)
@@ -1370,7 +1397,7 @@ class FrameRenderer:
         """The key light's front-layer map (curtain.frag KEY_SHADOW): per texel the layer of
         cloth nearest the light, its transmittance (as the room's map, one layer) and depth."""
         mgl, gl = self._moderngl, self._room_resources()
-        n = room_light.SHADOW_TEXELS
+        n = self.shadow_texels
         gl["key_front_fbo"].use()
         self.ctx.viewport = (0, 0, n, n)
         gl["key_front_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
@@ -1468,7 +1495,7 @@ class FrameRenderer:
         (x0, x1), _, _ = scene_lib.ROOM_BOX
         texel_m = (x1 - x0) / room_light.FACE_TEXELS
         self._set(program, "u_shadow_lod",
-                  max(0.0, math.log2(texel_m / room_light.shadow_texel_m(inputs.key_to_light))))
+                  max(0.0, math.log2(texel_m / room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels))))
         self._set(program, "u_key_on", 1.0)
         lamps = self.room_lamps
         positions = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
@@ -1530,7 +1557,7 @@ class FrameRenderer:
     def read_room_shadow(self) -> np.ndarray:
         """The last transmittance shadow map, float32 (N, N, 3), row 0 = the map's bottom."""
         gl = self._room_resources()
-        n = room_light.SHADOW_TEXELS
+        n = self.shadow_texels
         data = gl["shadow"].read(level=0)
         return np.frombuffer(data, dtype=np.float16).reshape(n, n, 4)[..., :3].astype(np.float32)
 
@@ -1901,7 +1928,8 @@ class FrameRenderer:
             "size": list(self.size),
             "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
             "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
-            "room_bounces": self.room_bounces, "curtain_open": self.curtain_open,
+            "room_bounces": self.room_bounces, "shadow_map_size": self.shadow_texels,
+            "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
             "environment": None if self.environment is None else self.environment[0],
             "room_lamps": [[light.name, list(position)] for light, position in self.room_lamps],

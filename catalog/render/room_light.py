@@ -357,10 +357,10 @@ def occlusion_directions(count: int = OCCLUSION_DIRECTIONS) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), -np.sqrt(1.0 - u)], -1)
 
 
-def shadow_texel_m(to_light: np.ndarray) -> float:
-    """World size (m) of one shadow-map texel (the larger of the two axes)."""
+def shadow_texel_m(to_light: np.ndarray, texels: int = SHADOW_TEXELS) -> float:
+    """World size (m) of one texel of a ``texels``-wide shadow map (the larger of the two axes)."""
     m = light_view_projection(to_light)
-    return float(2.0 / min(m[0, :3] @ m[0, :3], m[1, :3] @ m[1, :3]) ** 0.5 / SHADOW_TEXELS)
+    return float(2.0 / min(m[0, :3] @ m[0, :3], m[1, :3] @ m[1, :3]) ** 0.5 / texels)
 
 
 # --------------------------------------------------------------------------- the luminaire capture
