@@ -7,7 +7,7 @@
 //    blocker distance known: the curtain hangs in the plane u_curtain_z; the filter is the
 //    map's mip level of that width, one tap), times the opening's soft mask (room_window_beam);
 //  - the light map (room_lightmap.frag + room_bounce.frag): the curtain as an area light,
-//    lamps in the room, one bounce, ambient occlusion.
+//    lamps in the room, the room's bounces, ambient occlusion.
 // Without it, the earlier scene design: a constant fraction of the key plus the fill light.
 #include "common.glsl"
 

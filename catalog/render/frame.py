@@ -8,8 +8,8 @@ Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 0. the room's light (issue 13, docs/room.md; when the scene, cloth or lamps changed): the key
    light's transmittance shadow map through the curtain (room_shadow.*, the pattern's holes
    projected), the window as the room sees it (the flat curtain's capture), the light map of
-   the room box (room_lightmap.frag: area light, lamps; room_bounce.frag: one bounce, ambient
-   occlusion);
+   the room box (room_lightmap.frag: area light, lamps; room_radiosity.frag and room_bounce.frag:
+   every bounce, ambient occlusion);
 1. room props (room.vert/.frag): walls around the window, the curtain rod, lit by the light
    map and the key's beam through the window and the curtain (or, switched off, the earlier
    constant room);
