@@ -58,8 +58,15 @@ SCENE_VALUE(vec4, u_ambient_outside[NV4], S_AMBIENT_OUTSIDE); // the outside's s
 // mu = |n . v| = i / (AMBIENT_VIEW_NODES - 1), the outside's share and the room's
 SCENE_VALUE(vec4, u_ambient_view_outside[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_OUTSIDE);
 SCENE_VALUE(vec4, u_ambient_view_room[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_ROOM);
+// the outside through the lobes by the view's height (issue 11): the sky's share at
+// x = (ray_y + 1) / 2 = i / (AMBIENT_VIEW_NODES - 1), and the ambient's change per unit of
+// it away from 1/2 (dye (a_diff fwd + a_spec fwd) (sky - ground); 0 with the viewer outside)
+SCENE_VALUE(vec4, u_outside_sky_share[AMBIENT_VIEW_VEC4], S_OUTSIDE_SKY_SHARE);
+SCENE_VALUE(vec4, u_ambient_tilt[NV4], S_AMBIENT_TILT);
 float g_view_outside = 1.0;   // set in main
 float g_view_room = 1.0;
+float g_sky_tilt = 0.0;       // the sky's share minus 1/2, times g_view_outside (and the outside's
+                              // share the wall leaves, SKY_OCCLUSION)
 SCENE_VALUE(vec4, u_sky[NV4], S_SKY);
 SCENE_VALUE(vec4, u_ground[NV4], S_GROUND);
 SCENE_VALUE(vec4, u_sun_disc[NV4], S_SUN_DISC);
@@ -155,7 +162,8 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
         band += g_room_lamp[j] * u_room_lamp_dyed[j * NV4 + k];
     }
 #endif
-    vec4 constant = g_view_room * u_ambient[k] + (g_view_outside - g_view_room) * u_ambient_outside[k];
+    vec4 constant = g_view_room * u_ambient[k] + (g_view_outside - g_view_room) * u_ambient_outside[k]
+                  + g_sky_tilt * u_ambient_tilt[k];
 #ifdef SKY_OCCLUSION
     constant -= g_view_outside * (g_occlusion * u_ambient_occluded[k]
                                   + g_wall_occlusion * u_ambient_outside[k]);
@@ -207,6 +215,7 @@ void main() {
     float mu_view = abs(dot(n, ray));
     g_view_outside = ambient_view(u_ambient_view_outside, mu_view);
     g_view_room = ambient_view(u_ambient_view_room, mu_view);
+    g_sky_tilt = g_view_outside * (ambient_view(u_outside_sky_share, 0.5 * (ray.y + 1.0)) - 0.5);
     vec2 key = woven_transmission_ratio(u_key_to_light, cos_key, tan_key, view,
                                         u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
     vec2 fill = woven_transmission_ratio(u_fill_to_light, cos_fill, tan_fill, view,
@@ -232,6 +241,7 @@ void main() {
 #ifdef SKY_OCCLUSION
     g_occlusion = v_occlusion.x;
     g_wall_occlusion = v_occlusion.y;
+    g_sky_tilt *= 1.0 - g_wall_occlusion;   // where the wall hides the outside, no sky or ground
 #endif
     float absorbed = 0.0;
     float saturation = 1.0;

@@ -194,6 +194,34 @@ def test_ambient_by_view_against_a_brute_force_quadrature():
     assert grazing < forward[-1] / 3
 
 
+def test_sky_share_against_a_brute_force_quadrature():
+    """hg_sky_share (issue 11, round 2): the share of an HG lobe about r above the horizon
+    against a 2-D midpoint rule over the sphere (1200 x 2400 cells) within 2e-3 at r_y = 0.5,
+    -0.25 and 0.875 for g = 0.83 and -0.3; 1/2 at r_y = 0 and for g = 0 at any r_y (1e-9 and
+    1e-6); the forward lobe looking up sees mostly sky, looking down mostly ground."""
+    n_t, n_p = 1200, 2400
+    theta = (np.arange(n_t) + 0.5) * math.pi / n_t
+    phi = (np.arange(n_p) + 0.5) * 2 * math.pi / n_p
+    tt, pp = np.meshgrid(theta, phi, indexing="ij")
+    t = np.stack([np.sin(tt) * np.cos(pp), np.cos(tt), np.sin(tt) * np.sin(pp)], -1)  # y = cos theta
+    weight = np.sin(tt) * (math.pi / n_t) * (2 * math.pi / n_p)
+    nodes = ref.AMBIENT_VIEW_NODES
+    for g in (0.83, -0.3):
+        table = ref.hg_sky_share(g)
+        assert abs(table[len(nodes) // 2] - 0.5) < 1e-9
+        for ry in (0.5, -0.25, 0.875):
+            node = int(round((ry + 1) / 2 * (len(nodes) - 1)))
+            assert abs(2 * nodes[node] - 1 - ry) < 1e-12
+            r = np.array([math.sqrt(1 - ry * ry), ry, 0.0])
+            cos_g = t @ r
+            phase = (1 - g * g) / (4 * math.pi * (1 + g * g - 2 * g * cos_g) ** 1.5)
+            brute = float(np.sum(phase * weight * (t[..., 1] > 0)) / np.sum(phase * weight))
+            assert abs(table[node] - brute) < 2e-3, (g, ry, table[node], brute)
+    assert np.allclose(ref.hg_sky_share(0.0), 0.5, atol=1e-6)
+    forward = ref.hg_sky_share(0.83)
+    assert forward[-1] > 0.9 and forward[0] < 0.1
+
+
 @pytest.mark.slow
 def test_the_sill_is_lit_by_the_sun(gl, make_preset):
     """Curtain open, a key 60 deg high: the sill (the opening's bottom face, within the wall's

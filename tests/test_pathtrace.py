@@ -217,7 +217,8 @@ def test_direct_light_matches_the_float64_reference_per_pixel(mi):
     integrator = {"type": "aov", "aovs": "p:position,n:sh_normal,t:dp_du",
                   "radiance": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0}}
     zero = np.zeros_like(desc.inputs.ambient_radiance)
-    base = replace(desc.inputs, direct=0.0, ambient_radiance=zero, ambient_outside_radiance=zero)
+    base = replace(desc.inputs, direct=0.0, ambient_radiance=zero, ambient_outside_radiance=zero,
+                   ambient_tilt_radiance=None)
     for light, inputs in (("key", replace(base, fill_irradiance=zero)),
                           ("fill", replace(base, key_irradiance=zero))):
         scene = build_mitsuba_scene(mi, desc, integrator=integrator, room=False,
@@ -497,3 +498,28 @@ def test_glow_reaches_the_room_alike_by_emitter_and_by_bsdf_sampling(mi):
     emitter, bsdf = means
     assert bsdf[2] > 0   # the brightener's blue (linear sRGB: green is slightly negative)
     assert np.allclose(emitter, bsdf, rtol=0.06), (emitter, bsdf)
+
+
+@pytest.mark.parametrize("fabric", ["lace-fwa", "safety-yellow"])
+@pytest.mark.parametrize("light", ["UV-A", "D65"])
+def test_the_dye_per_channel_reproduces_the_dyed_key(fabric, light):
+    """The reference's dye per channel times the key's RGB is RGB(key x dye), the frame's dyed
+    key, in every channel whatever its sign (rtol 1e-9): under the UV-A lamp the key's green
+    is negative (outside sRGB), and that channel's dye was once set to 0 (issue 11); a
+    saturated dye may be negative in a channel (safety-yellow's blue under D65), as the
+    frame's linear bands carry it."""
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace.scene import describe_scene, rgb_weights
+
+    d = scene_lib_draped()
+    desc = describe_scene(desc_preset(fabric), get_light(light), size=(8, 6), curtain=d)
+    w = rgb_weights(desc.inputs.key_irradiance)
+    dyed = w @ (desc.inputs.key_irradiance * desc.inputs.dye_transmittance)
+    assert np.allclose(desc.fabric["dye_rgb"] * desc.key_rgb, dyed, rtol=1e-9, atol=1e-12)
+
+
+def scene_lib_draped():
+    from catalog.render import scene as scene_lib
+
+    d = scene_lib.draped_curtain(20, 10)
+    return (d.positions, d.normals, d.uvs, d.tangents, d.indices)

@@ -65,6 +65,7 @@ OPTIONS = (
     ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
     ("sky occlusion off (issue 11)", 3, "physical", 1, None, None, {"sky_occlusion": False}),
     ("ambient by view off (issue 11)", 3, "physical", 1, None, None, {"ambient_by_view": False}),
+    ("outside by view off (issue 11, round 2)", 3, "physical", 1, None, None, {"outside_by_view": False}),
     ("issue 11's three off", 3, "physical", 1, None, None,
      {"key_shadow": False, "sky_occlusion": False, "ambient_by_view": False}),
     ("FXAA off", 3, "physical", 1, "off"),

@@ -72,6 +72,12 @@ class ShadingInputs:
     # mu = |n . v| = AMBIENT_VIEW_NODES, for the outside's share and the room's (None: 1)
     ambient_view_outside: np.ndarray | None = None
     ambient_view_room: np.ndarray | None = None
+    # the outside seen through the lobes by the view's elevation (issue 11): the sky's share
+    # of the lobes at x = (ray_y + 1) / 2 = AMBIENT_VIEW_NODES (ray: camera to cloth, its
+    # continuation behind the cloth), and the ambient's change per unit of that share away
+    # from 1/2, dye (a_diff fwd + a_spec fwd) (sky - ground) (None: the outside averaged)
+    outside_sky_share: np.ndarray | None = None
+    ambient_tilt_radiance: np.ndarray | None = None
 
 
 # --------------------------------------------------------------------------- terms
@@ -206,6 +212,56 @@ def ambient_view_ratios(a_diff: float, g_diff: float, a_spec: float, g_spec: flo
     return by_view / normal
 
 
+@functools.lru_cache(maxsize=64)
+def hg_sky_share(g: float, nodes: tuple = tuple(AMBIENT_VIEW_NODES)) -> np.ndarray:
+    """The share of eq. 6's lobe about a direction r that lies above the horizon, at
+    x = (r_y + 1) / 2 = each node (model.md section 9: the outside seen through the cloth is
+    the sky above the horizon and the ground below). About r (t . r = cos gamma = u), a
+    direction's height is r_y u + sqrt(1 - r_y^2) sqrt(1 - u^2) cos psi, positive on a
+    fraction arccos(-a / b) / pi of the azimuths (a = r_y u, b = the sine terms; 1 or 0
+    beyond |a| >= b), leaving a 1-D integral of ph(u) 2 pi over u (midpoint rule, nodes
+    clustered at the peak). 1/2 at r_y = 0 by symmetry; r_y = +-1 gives 1 or 0."""
+    edges = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 20001),
+                                      1.0 - np.geomspace(1e-7, 2.0, 4001),
+                                      -1.0 + np.geomspace(1e-7, 2.0, 4001)]))
+    edges = np.clip(edges, -1.0, 1.0)
+    u = 0.5 * (edges[1:] + edges[:-1])
+    du = np.diff(edges)
+    phase = hg_phase_chords(2.0 * (1.0 - u), 2.0 * (1.0 + u), g) * 2.0 * math.pi * du
+    sin_u = np.sqrt(np.maximum(1.0 - u * u, 0.0))
+    out = []
+    for x in nodes:
+        ry = 2.0 * float(x) - 1.0
+        a = ry * u
+        b = math.sqrt(max(1.0 - ry * ry, 0.0)) * sin_u
+        with np.errstate(divide="ignore", invalid="ignore"):
+            frac = np.where(a >= b, 1.0, np.where(a <= -b, 0.0,
+                            np.arccos(np.clip(-a / np.where(b > 0, b, 1.0), -1.0, 1.0)) / math.pi))
+        out.append(float(np.sum(phase * frac) / np.sum(phase)))
+    return np.asarray(out)
+
+
+def outside_sky_share(a_diff: float, g_diff: float, a_spec: float, g_spec: float) -> np.ndarray:
+    """The sky's share of the light the lobes bring from behind the cloth, by the view's
+    elevation (AMBIENT_VIEW_NODES over x = (ray_y + 1) / 2): :func:`hg_sky_share` of each
+    lobe weighted by its share of that light, a forward(g)."""
+    w_diff = a_diff * hg_hemisphere_factors(g_diff)[0]
+    w_spec = a_spec * hg_hemisphere_factors(g_spec)[0]
+    if not w_diff + w_spec > 0:
+        return np.full(AMBIENT_VIEW_NODES.size, 0.5)
+    return (w_diff * hg_sky_share(g_diff) + w_spec * hg_sky_share(g_spec)) / (w_diff + w_spec)
+
+
+def sky_share_at(table, ray_y) -> np.ndarray:
+    """A table of :func:`outside_sky_share` at the view ray's height ray_y (linear between
+    nodes; None: 1/2, the outside averaged)."""
+    ray_y = np.asarray(ray_y, dtype=np.float64)
+    if table is None:
+        return np.full_like(ray_y, 0.5)
+    x = np.clip(0.5 * (ray_y + 1.0), 0.0, 1.0)
+    return np.interp(x, AMBIENT_VIEW_NODES, np.asarray(table, dtype=np.float64))
+
+
 def ambient_view_ratio(table, mu) -> np.ndarray:
     """A table of :func:`ambient_view_ratios` at mu (linear between nodes; None: 1)."""
     mu = np.asarray(mu, dtype=np.float64)
@@ -283,6 +339,11 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
                      else np.zeros_like(inputs.ambient_radiance))
     radiance = (g_key[:, None] * key_seen + g_fill[:, None] * dyed_fill
                 + r_room * inputs.ambient_radiance[None, :] + (r_out - r_room) * outside_share[None, :])
+    if inputs.ambient_tilt_radiance is not None:   # the sky above the view's line, the ground below
+        tilt = sky_share_at(inputs.outside_sky_share, ray[:, 1]) - 0.5
+        if wall_occlusion is not None:   # where the wall hides the outside, neither
+            tilt = tilt * (1.0 - np.asarray(wall_occlusion, dtype=np.float64).reshape(-1))
+        radiance += (r_out * tilt[:, None]) * inputs.ambient_tilt_radiance[None, :]
     if outside_occlusion is not None:
         radiance -= (r_out * np.asarray(outside_occlusion, dtype=np.float64).reshape(-1, 1)
                      * outside_occluded_radiance(inputs)[None, :])

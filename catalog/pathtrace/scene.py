@@ -151,9 +151,14 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
     w = rgb_weights(inputs.key_irradiance)
     key_rgb = w @ inputs.key_irradiance
     dyed = w @ (inputs.key_irradiance * inputs.dye_transmittance)
-    dye_rgb = np.where(key_rgb > 0, dyed / np.where(key_rgb > 0, key_rgb, 1.0), 0.0)
-    if not np.any(key_rgb > 0):  # a light with nothing visible (UV): the dye's own mean
-        dye_rgb = w @ inputs.dye_transmittance / np.maximum(w @ np.ones_like(inputs.key_irradiance), 1e-30)
+    # per channel RGB(key x dye) / RGB(key), whatever the channel's sign: a UV lamp's faint
+    # visible leak is outside the sRGB gamut (green < 0), and its green was once set to 0
+    # here (issue 11), which took the negative green out of every light the cloth scattered
+    own_mean = w @ inputs.dye_transmittance / np.maximum(w @ np.ones_like(inputs.key_irradiance), 1e-30)
+    usable = np.abs(key_rgb) > 1e-6 * max(float(np.abs(key_rgb).max()), 1e-30)
+    # (a saturated dye under a white light can be outside it too: safety-yellow's blue under
+    # D65 is about -0.04 of the key's, carried as the frame's bands carry it)
+    dye_rgb = np.where(usable, dyed / np.where(usable, key_rgb, 1.0), own_mean)
     fabric = {"direct": inputs.direct, "a_diff": inputs.a_diff, "g_diff": inputs.g_diff,
               "a_spec": inputs.a_spec, "g_spec": inputs.g_spec, "anisotropy": inputs.anisotropy,
               "dye_rgb": dye_rgb}

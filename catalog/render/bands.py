@@ -119,6 +119,11 @@ def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray |
                                   if inputs.ambient_outside_radiance is not None else zeros),
         "u_ambient_view_outside": _view_table(inputs.ambient_view_outside),
         "u_ambient_view_room": _view_table(inputs.ambient_view_room),
+        "u_ambient_tilt": band(inputs.ambient_tilt_radiance
+                               if inputs.ambient_tilt_radiance is not None else zeros),
+        "u_outside_sky_share": _view_table(inputs.outside_sky_share
+                                           if inputs.outside_sky_share is not None
+                                           else np.full(AMBIENT_VIEW_NODES.size, 0.5)),
         "u_sky": band(inputs.sky_radiance),
         "u_ground": band(inputs.ground_radiance),
         "u_sun_disc": band(inputs.sun_disc_radiance),

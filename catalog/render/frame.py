@@ -287,6 +287,9 @@ class FrameRenderer:
         self.sky_occlusion = True
         #: issue 11: the ambient term by view (False: the normal view's at every angle)
         self.ambient_by_view = True
+        #: issue 11: the outside through the lobes by the view's height, the sky above the
+        #: view's line and the ground below (False: the outside averaged)
+        self.outside_by_view = True
         #: issue 11: the room's bounces, "all" (radiosity, room_radiosity.frag) or "one"
         self.room_bounces = "all"
         #: the side (texels) of the key light's maps: the room's transmittance map and the
@@ -484,6 +487,11 @@ class FrameRenderer:
             obj.release()
         self._room_gl = None
         self._room_key = None
+
+    def set_outside_by_view(self, on: bool) -> None:
+        """The outside the lobes bring by the view's height (issue 11: the sky above the view's
+        line, the ground below; u_ambient_tilt), or the outside averaged (the earlier frame)."""
+        self.outside_by_view = bool(on)
 
     def set_sky_occlusion(self, on: bool) -> None:
         """Let the cloth's own folds hide part of the outside from its ambient term (issue 11;
@@ -744,6 +752,8 @@ class FrameRenderer:
         if not self.ambient_by_view:   # the normal view's ambient at every angle
             for name in ("u_ambient_view_outside", "u_ambient_view_room"):
                 values[name] = np.ones_like(values[name])
+        if not self.outside_by_view:   # the outside averaged, sky and ground alike
+            values["u_ambient_tilt"] = np.zeros_like(values["u_ambient_tilt"])
         return values
 
     def room_lamp_values(self) -> dict:
@@ -1928,6 +1938,7 @@ class FrameRenderer:
             "size": list(self.size),
             "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
             "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
+            "outside_by_view": self.outside_by_view,
             "room_bounces": self.room_bounces, "shadow_map_size": self.shadow_texels,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,

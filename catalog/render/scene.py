@@ -30,7 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
-from catalog.optics.shading_reference import ShadingInputs, ambient_view_ratios, hg_hemisphere_factors
+from catalog.optics.shading_reference import (ShadingInputs, ambient_view_ratios, hg_hemisphere_factors,
+                                              outside_sky_share)
 from catalog.optics.spectra import GRID_NM
 
 WINDOW_Z = -0.2
@@ -524,8 +525,13 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
                      + btdf.a_spec * (fwd_s * behind + back_s * front))
     # the outside's share of it (the cloth's own folds hide part of the outside: issue 11)
     outside = 0.5 * (sky + ground)
+    tilt = share = None
     if viewer_inside:
         ambient_outside = dye * (btdf.a_diff * fwd_d + btdf.a_spec * fwd_s) * outside
+        # the lobes bring the sky from above the view's line and the ground from below it
+        # (issue 11; the ambient's share of each, outside_sky_share, by the view's height)
+        tilt = dye * (btdf.a_diff * fwd_d + btdf.a_spec * fwd_s) * (sky - ground)
+        share = outside_sky_share(btdf.a_diff, btdf.g_diff, btdf.a_spec, btdf.g_spec)
     else:
         ambient_outside = dye * (btdf.a_diff * back_d + btdf.a_spec * back_s) * outside
 
@@ -554,7 +560,8 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
         ambient_view_outside=ambient_view_ratios(btdf.a_diff, btdf.g_diff, btdf.a_spec,
                                                  btdf.g_spec, backward=not viewer_inside),
         ambient_view_room=ambient_view_ratios(btdf.a_diff, btdf.g_diff, btdf.a_spec,
-                                              btdf.g_spec, backward=viewer_inside))
+                                              btdf.g_spec, backward=viewer_inside),
+        outside_sky_share=share, ambient_tilt_radiance=tilt)
     if decision.used == "physical":
         residual = fluorescence_residual(preset)
         inputs = with_physical_emission(
