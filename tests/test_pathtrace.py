@@ -389,6 +389,25 @@ def test_image_section_tables_and_pareto_front_from_a_result():
     assert "| s |" in tables["image"] and "256" in tables["image"] and "shadow map size" in tables["image-options"]
 
 
+def test_the_pareto_plot_numbers_its_points(tmp_path):
+    """plot_pareto runs on a dozen options and writes a PNG with its key beside the axes (wider
+    than tall): the points carry numbers and the key the names, since names at the points
+    overlapped when a dozen options sat within a few ms."""
+    from matplotlib import image as mpimg
+
+    from catalog.bench import image
+
+    def option(label, flip, ms):
+        return {"option": label, "mean_flip": flip, "curtain_mean_delta_e": 1.0, "frame_s": ms / 1e3}
+
+    result = {"rows": [{"scene": "s"}],
+              "pareto": [{"scene": "s", "options": [option(f"o{k}", 0.1 + 0.01 * k, 10 + k)
+                                                    for k in range(12)]}]}
+    path = image.plot_pareto(result, tmp_path)
+    pixels = mpimg.imread(path)
+    assert pixels.shape[0] > 100 and pixels.shape[1] > pixels.shape[0]   # the key beside the axes
+
+
 def test_a_sun_brings_the_frames_clear_sky_into_the_environment():
     from catalog.optics.lights import get_light
     from catalog.pathtrace.scene import describe_scene, environment_map, texel_directions

@@ -312,12 +312,18 @@ def plot_pareto(result: dict, folder) -> Path:
 
     plt = pyplot()
     rows = option_summary(result)
-    fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    for row in rows:
+    # numbered points and a key beside the axes: with a dozen options within a few ms and
+    # a few hundredths of FLIP, labels at the points overlap
+    fig, (ax, key) = plt.subplots(1, 2, figsize=(9.5, 4.4), gridspec_kw={"width_ratios": [3, 2]})
+    for number, row in enumerate(rows, 1):
         ax.scatter(row["frame_ms"], row["mean_flip"], s=40,
                    marker="o" if row["pareto"] else "x", color="C0" if row["pareto"] else "C3")
-        ax.annotate(row["option"], (row["frame_ms"], row["mean_flip"]), fontsize=7,
-                    xytext=(4, 3), textcoords="offset points")
+        ax.annotate(str(number), (row["frame_ms"], row["mean_flip"]), fontsize=7,
+                    xytext=(3, 3), textcoords="offset points")
+    key.axis("off")
+    key.text(0.0, 1.0, "\n".join(f"{n}  {r['option']}" + ("  (Pareto)" if r["pareto"] else "")
+                                 for n, r in enumerate(rows, 1)),
+             fontsize=7.5, va="top", ha="left", transform=key.transAxes, family="monospace")
     front = sorted((r for r in rows if r["pareto"]), key=lambda r: r["frame_ms"])
     ax.plot([r["frame_ms"] for r in front], [r["mean_flip"] for r in front], color="C0", lw=0.8)
     ax.axhline(GOAL["mean_flip_at_most"], color="grey", ls="--", lw=0.8)
