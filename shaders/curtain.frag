@@ -121,6 +121,7 @@ float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set
 SCENE_VALUE(vec4, u_key_thread[NV4], S_KEY_THREAD);
 uniform sampler2D u_key_front;     // r: the nearest layer's coverage, a: its depth (0..1)
 uniform mat4 u_light_view_proj;
+uniform float u_key_normal_offset; // m: the lookup's offset along the normal at a grazing key
 uniform vec3 u_key_depth_bias;     // depth (0..1 units) a fragment must lie behind to be shaded:
                                    // x + y tan(normal, key), the tangent at most z (slope-scaled)
 uniform vec4 u_window_rect;
@@ -229,8 +230,16 @@ void main() {
         g_key_beam = u_key_to_light.z < 0.0
                    ? room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius)
                    : 1.0;
-        vec4 clip = u_light_view_proj * vec4(v_position, 1.0);
-        float cos_surface = abs(dot(normalize(v_normal), u_key_to_light));
+        // the lookup moved off the cloth towards the light along its normal, by
+        // u_key_normal_offset x sin(normal, key) (normal-offset shadows: a flank lit at a
+        // grazing angle does not shade itself, without a depth bias that would let a fold
+        // close in front of it through)
+        vec3 n_geometric = normalize(v_normal);
+        float facing = dot(n_geometric, u_key_to_light);
+        float cos_surface = abs(facing);
+        vec3 offset = n_geometric * ((facing >= 0.0 ? 1.0 : -1.0) * u_key_normal_offset
+                                     * sqrt(max(1.0 - cos_surface * cos_surface, 0.0)));
+        vec4 clip = u_light_view_proj * vec4(v_position + offset, 1.0);
         float tan_surface = min(sqrt(max(1.0 - cos_surface * cos_surface, 0.0)) / max(cos_surface, 1e-3),
                                 u_key_depth_bias.z);
         g_front_coverage = front_layer_coverage(u_key_front, clip.xyz * 0.5 + 0.5,

@@ -3,8 +3,10 @@
 A fragment is in a fold's shadow when it lies more than a bias behind the cloth layer nearest
 the key light (the front-layer map). Too small a bias and a layer shades itself on its
 flanks; too large and a fold lying close behind another escapes its shadow (the trough lines
-of the close-ups). Candidates: constant biases and slope-scaled ones (a base plus a number of
-map texels times the tangent of the angle between the cloth's normal and the key, capped).
+of the close-ups). Candidates: constant biases, slope-scaled ones (a base plus a number of
+map texels times the tangent of the angle between the cloth's normal and the key, capped),
+and normal-offset lookups (the map read at a point moved towards the light along the
+cloth's normal by a number of texels times the sine of that angle).
 
 Chosen on data disjoint from the image section's scenes: the test drape
 (:func:`catalog.render.scene.draped_curtain`, 60 x 40, not the simulated drapes of the
@@ -19,10 +21,15 @@ from __future__ import annotations
 
 import numpy as np
 
-#: (base bias m, slope texels, tangent cap); the first is the frame's earlier constant 2 cm.
-CANDIDATES = ((0.02, 0.0, 0.0), (0.008, 0.0, 0.0), (0.004, 0.0, 0.0), (0.004, 1.5, 4.0),
-              (0.004, 1.0, 2.0), (0.004, 1.0, 4.0), (0.002, 1.0, 4.0), (0.006, 0.5, 4.0),
-              (0.004, 1.5, 1.5), (0.004, 1.0, 1.0), (0.003, 1.5, 2.0))
+#: (base bias m, slope texels, tangent cap, normal offset texels); the first is the frame's
+#: earlier constant 2 cm.
+CANDIDATES = ((0.02, 0.0, 0.0, 0.0), (0.008, 0.0, 0.0, 0.0), (0.004, 0.0, 0.0, 0.0),
+              (0.004, 1.5, 4.0, 0.0), (0.004, 1.0, 2.0, 0.0), (0.004, 1.0, 4.0, 0.0),
+              (0.002, 1.0, 4.0, 0.0), (0.006, 0.5, 4.0, 0.0), (0.004, 1.5, 1.5, 0.0),
+              (0.004, 1.0, 1.0, 0.0), (0.003, 1.5, 2.0, 0.0),
+              # normal-offset lookups (the last number: texels x sin(normal, key))
+              (0.004, 0.0, 0.0, 1.0), (0.004, 0.0, 0.0, 1.5), (0.002, 0.0, 0.0, 1.5),
+              (0.004, 0.5, 2.0, 1.0), (0.004, 1.5, 4.0, 1.0))
 #: The test drapes (draped_curtain's folds and depth): the default, and deeper, narrower folds
 #: like the simulated drapes' (their flanks lie close behind one another).
 DRAPES = ((5.5, 0.07), (8.0, 0.12))
@@ -66,13 +73,14 @@ def run(ctx=None, size=(96, 72), fabric: str = "voile-white") -> dict:
         ctx = create_headless_context()
     preset = load_preset(find_preset(fabric))
     meshes = [scene_lib.draped_curtain(columns=60, rows=40, folds=f, depth_m=d) for f, d in DRAPES]
-    saved = (frame_lib.KEY_SHADOW_BIAS_M, frame_lib.KEY_SHADOW_SLOPE_TEXELS, frame_lib.KEY_SHADOW_SLOPE_CAP)
+    saved = (frame_lib.KEY_SHADOW_BIAS_M, frame_lib.KEY_SHADOW_SLOPE_TEXELS, frame_lib.KEY_SHADOW_SLOPE_CAP,
+             frame_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS)
     truth: dict = {}
     rows = []
     try:
         for candidate in CANDIDATES:
             (frame_lib.KEY_SHADOW_BIAS_M, frame_lib.KEY_SHADOW_SLOPE_TEXELS,
-             frame_lib.KEY_SHADOW_SLOPE_CAP) = candidate
+             frame_lib.KEY_SHADOW_SLOPE_CAP, frame_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS) = candidate
             scores, shaded = [], []
             for (elevation, azimuth), (m, mesh) in [(k, d) for d in enumerate(meshes) for k in KEYS]:
                 renderer = frame_lib.FrameRenderer(ctx, size)
@@ -96,17 +104,19 @@ def run(ctx=None, size=(96, 72), fabric: str = "voile-white") -> dict:
                 scores.append(float((seen[clear] == behind[clear]).mean()))
                 shaded.append(float(behind[clear].mean()))
             rows.append({"bias_m": candidate[0], "slope_texels": candidate[1], "tangent_cap": candidate[2],
+                         "normal_offset_texels": candidate[3],
                          "agreement": scores, "mean_agreement": float(np.mean(scores)),
                          "truly_shaded_share": shaded})
     finally:
         (frame_lib.KEY_SHADOW_BIAS_M, frame_lib.KEY_SHADOW_SLOPE_TEXELS,
-         frame_lib.KEY_SHADOW_SLOPE_CAP) = saved
+         frame_lib.KEY_SHADOW_SLOPE_CAP, frame_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS) = saved
     best = max(rows, key=lambda r: r["mean_agreement"])   # the first of equals: CANDIDATES' order
     return {"machine": machine_info(), "fabric": fabric, "keys": [list(k) for k in KEYS],
             "drapes": [{"folds": f, "depth_m": d} for f, d in DRAPES],
             "truth_min_m": TRUTH_MIN_M, "rows": rows,
-            "best": {k: best[k] for k in ("bias_m", "slope_texels", "tangent_cap", "mean_agreement")},
-            "frame_uses": dict(zip(("bias_m", "slope_texels", "tangent_cap"), saved))}
+            "best": {k: best[k] for k in ("bias_m", "slope_texels", "tangent_cap",
+                                          "normal_offset_texels", "mean_agreement")},
+            "frame_uses": dict(zip(("bias_m", "slope_texels", "tangent_cap", "normal_offset_texels"), saved))}
 
 
 def markdown_tables(result: dict) -> dict[str, str]:
@@ -114,10 +124,12 @@ def markdown_tables(result: dict) -> dict[str, str]:
     keys = ", ".join(f"{e:g} deg high, {a:g} deg aside" for e, a in result["keys"])
     drapes = " and ".join(f"{d['folds']:g} folds {100 * d['depth_m']:g} cm deep"
                           for d in result.get("drapes", [{"folds": 5.5, "depth_m": 0.07}]))
-    lines = ["| base bias (mm) | slope (texels x tan) | tan cap | agreement per drape and key | mean |",
-             "|---|---|---|---|---|"]
+    lines = ["| base bias (mm) | slope (texels x tan) | tan cap | normal offset (texels x sin) "
+             "| agreement per drape and key | mean |",
+             "|---|---|---|---|---|---|"]
     for r in result["rows"]:
         lines.append(f"| {1e3 * r['bias_m']:g} | {r['slope_texels']:g} | {r['tangent_cap']:g} | "
+                     f"{r.get('normal_offset_texels', 0.0):g} | "
                      + " / ".join(f"{100 * a:.2f} %" for a in r["agreement"])
                      + f" | {100 * r['mean_agreement']:.2f} % |")
     used = result["frame_uses"]
@@ -126,7 +138,8 @@ def markdown_tables(result: dict) -> dict[str, str]:
     lines.append(f"Drapes: {drapes}; keys: {keys}; the share of pixels truly behind a fold: "
                  + " / ".join(f"{100 * s:.1f} %" for s in shaded)
                  + f". The frame uses {1e3 * used['bias_m']:g} mm + {used['slope_texels']:g} texels x tan "
-                 f"(cap {used['tangent_cap']:g}).")
+                 f"(cap {used['tangent_cap']:g}), the lookup offset "
+                 f"{used.get('normal_offset_texels', 0.0):g} texels x sin.")
     return {"key-shadow-bias": "\n".join(lines)}
 
 

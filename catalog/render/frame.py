@@ -88,6 +88,9 @@ KEY_SHADOW_BIAS_M = 0.004
 SHADOW_MAP_SIZES = (64, 128, 256, 512, 1024, 2048)
 KEY_SHADOW_SLOPE_TEXELS = 1.5
 KEY_SHADOW_SLOPE_CAP = 4.0
+#: The front-layer map's lookup moved towards the light along the cloth's normal by this many
+#: texels times sin(normal, key) (normal-offset shadows; 0: none).
+KEY_SHADOW_NORMAL_OFFSET_TEXELS = 0.0
 #: Texture unit of the occlusion maps (the curtain's SKY_OCCLUSION).
 OCCLUSION_UNIT = 7
 #: SKY_OCCLUSION's depth bias (m) and its lookup's offset off the surface (m): a texel and a
@@ -1224,6 +1227,8 @@ class FrameRenderer:
         metre = abs(float(matrix[2, 2])) / 2
         slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels)
         s(program, "u_key_depth_bias", (KEY_SHADOW_BIAS_M * metre, slope_m * metre, KEY_SHADOW_SLOPE_CAP))
+        s(program, "u_key_normal_offset", KEY_SHADOW_NORMAL_OFFSET_TEXELS
+          * room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels))
         wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
         z0 = scene_lib.ROOM_BOX[2][0]
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
