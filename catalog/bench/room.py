@@ -72,7 +72,10 @@ def work_counts(size) -> dict[str, float]:
     return {
         "room_shadow": 0.6 * n * n,
         "room_luminaire": float(lw * lh),
-        "room_lightmap": float(aw * ah * (lw * lh + 5 * coarse * coarse)),
+        # the direct part and the gather per atlas texel, and the radiosity pass (issue 11):
+        # one fragment per coarse patch, summing over every patch
+        "room_lightmap": float(aw * ah * (lw * lh + 5 * coarse * coarse)
+                               + (len(room_light.FACE_NAMES) * coarse * coarse) ** 2),
         "room": 0.5 * w * h,
         "curtain": 0.5 * w * h * 4,
         "background": 0.2 * w * h,
