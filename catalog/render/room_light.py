@@ -284,6 +284,14 @@ def patch_reflectance(albedo: float, window_albedo: float, wall: np.ndarray) -> 
     return albedo * wall + window_albedo * (1.0 - wall)
 
 
+@functools.lru_cache(maxsize=2)
+def _patch_transfer(face_texels: int, level: int) -> tuple[np.ndarray, np.ndarray]:
+    """ao_i / pi G_ij and the patches' wall fractions (the room's part of K, made once)."""
+    patches = coarse_patches(face_texels, level)
+    geometry = patch_geometry(patches["centre"], patches["normal"], patches["face"], patches)
+    return patches["ao"][:, None] / math.pi * geometry, patches["wall"]
+
+
 @functools.lru_cache(maxsize=16)
 def radiosity_operator(albedo: float, window_albedo: float = 0.0, face_texels: int = FACE_TEXELS,
                        level: int = BOUNCE_LEVEL) -> np.ndarray:
@@ -293,10 +301,8 @@ def radiosity_operator(albedo: float, window_albedo: float = 0.0, face_texels: i
     :func:`patch_geometry`, rho_j from :func:`patch_reflectance`: the wall's albedo, the closed
     curtain's reflectance in the window opening). T = S + op @ S is every patch's total
     irradiance. One colour channel: call it per channel when the curtain is dyed."""
-    patches = coarse_patches(face_texels, level)
-    geometry = patch_geometry(patches["centre"], patches["normal"], patches["face"], patches)
-    rho = patch_reflectance(albedo, window_albedo, patches["wall"])
-    transfer = patches["ao"][:, None] / math.pi * geometry * rho[None, :]
+    geometry, wall = _patch_transfer(face_texels, level)
+    transfer = geometry * patch_reflectance(albedo, window_albedo, wall)[None, :]
     count = transfer.shape[0]
     return np.linalg.inv(np.eye(count) - transfer) - np.eye(count)
 
