@@ -389,6 +389,7 @@ def test_image_section_tables_and_pareto_front_from_a_result():
     assert "| s |" in tables["image"] and "256" in tables["image"] and "shadow map size" in tables["image-options"]
 
 
+@pytest.mark.slow
 def test_the_pareto_plot_numbers_its_points(tmp_path):
     """plot_pareto runs on a dozen options and writes a PNG with its key beside the axes (wider
     than tall): the points carry numbers and the key the names, since names at the points
