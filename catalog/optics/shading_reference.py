@@ -163,6 +163,16 @@ def hg_hemisphere_factors(g: float) -> tuple[float, float]:
 AMBIENT_VIEW_NODES = np.linspace(0.0, 1.0, AMBIENT_VIEW_NODE_COUNT)
 
 
+def _cos_gamma_cells(uniform: int) -> tuple[np.ndarray, np.ndarray]:
+    """Midpoint-rule cells over u = cos gamma in [-1, 1] for integrals of eq. 6: ``uniform``
+    uniform edges plus geometric clusters at both ends (a lobe's peak). Returns (u, du)."""
+    edges = np.unique(np.concatenate([np.linspace(-1.0, 1.0, uniform),
+                                      1.0 - np.geomspace(1e-7, 2.0, 4001),
+                                      -1.0 + np.geomspace(1e-7, 2.0, 4001)]))
+    edges = np.clip(edges, -1.0, 1.0)
+    return 0.5 * (edges[1:] + edges[:-1]), np.diff(edges)
+
+
 @functools.lru_cache(maxsize=64)
 def hg_hemisphere_factors_by_view(g: float, nodes: tuple = tuple(AMBIENT_VIEW_NODES)) -> tuple[np.ndarray, np.ndarray]:
     """(forward, backward) at each node mu: cloth radiance per unit radiance of a uniform
@@ -174,13 +184,7 @@ def hg_hemisphere_factors_by_view(g: float, nodes: tuple = tuple(AMBIENT_VIEW_NO
     closed (2 (a psi0 + b sin psi0), cos psi0 = -a / b), leaving a 1-D integral over cos gamma
     (midpoint rule, nodes finer towards the peak at cos gamma = 1 for g > 0). At mu = 1 these
     are :func:`hg_hemisphere_factors` (a test checks 1e-4)."""
-    # nodes in u = cos gamma: uniform plus a geometric cluster at the peak
-    edges = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 40001),
-                                      1.0 - np.geomspace(1e-7, 2.0, 4001),
-                                      -1.0 + np.geomspace(1e-7, 2.0, 4001)]))
-    edges = np.clip(edges, -1.0, 1.0)
-    u = 0.5 * (edges[1:] + edges[:-1])
-    du = np.diff(edges)
+    u, du = _cos_gamma_cells(40001)
     sin_g = np.sqrt(np.maximum(1.0 - u * u, 0.0))
     phase = hg_phase_chords(2.0 * (1.0 - u), 2.0 * (1.0 + u), g)
     out = []
@@ -221,12 +225,7 @@ def hg_sky_share(g: float, nodes: tuple = tuple(AMBIENT_VIEW_NODES)) -> np.ndarr
     fraction arccos(-a / b) / pi of the azimuths (a = r_y u, b = the sine terms; 1 or 0
     beyond |a| >= b), leaving a 1-D integral of ph(u) 2 pi over u (midpoint rule, nodes
     clustered at the peak). 1/2 at r_y = 0 by symmetry; r_y = +-1 gives 1 or 0."""
-    edges = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 20001),
-                                      1.0 - np.geomspace(1e-7, 2.0, 4001),
-                                      -1.0 + np.geomspace(1e-7, 2.0, 4001)]))
-    edges = np.clip(edges, -1.0, 1.0)
-    u = 0.5 * (edges[1:] + edges[:-1])
-    du = np.diff(edges)
+    u, du = _cos_gamma_cells(20001)
     phase = hg_phase_chords(2.0 * (1.0 - u), 2.0 * (1.0 + u), g) * 2.0 * math.pi * du
     sin_u = np.sqrt(np.maximum(1.0 - u * u, 0.0))
     out = []

@@ -1532,14 +1532,9 @@ class FrameRenderer:
             gl["total_fbo"].use()
             self.ctx.viewport = (0, 0, len(room_light.FACE_NAMES) * rc, rc)
             program = self._program("fullscreen.vert", "room_radiosity.frag")
-            gl["direct"].use(location=1)
-            self._set(program, "u_direct", 1)
-            gl["beam"].use(location=3)
-            self._set(program, "u_beam", 3)
+            self._bind_bounce_sources(program)
             gl["radiosity_operator"].use(location=4)
             self._set(program, "u_operator", 4)
-            self._set(program, "u_bounce_level", room_light.BOUNCE_LEVEL)
-            self._set(program, "u_coarse_texels", rc)
             self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
             self.ctx.viewport = (0, 0, aw, ah)
 
@@ -1551,17 +1546,23 @@ class FrameRenderer:
             self._set(program, "u_total", 4)
         for name, value in room_light.face_uniforms().items():
             self._set(program, name, value)
-        gl["direct"].use(location=1)
-        self._set(program, "u_direct", 1)
+        self._bind_bounce_sources(program)
         gl["ao"].use(location=2)
         self._set(program, "u_ao_mask", 2)
+        self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
+        self._set(program, "u_window_albedo", window_albedo)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+
+    def _bind_bounce_sources(self, program) -> None:
+        """The bounces' sources for room_radiosity.frag and room_bounce.frag: the direct map and
+        the beam (units 1 and 3), read at the coarse level BOUNCE_LEVEL."""
+        gl = self._room_resources()
+        gl["direct"].use(location=1)
+        self._set(program, "u_direct", 1)
         gl["beam"].use(location=3)
         self._set(program, "u_beam", 3)
         self._set(program, "u_bounce_level", room_light.BOUNCE_LEVEL)
         self._set(program, "u_coarse_texels", room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL)
-        self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
-        self._set(program, "u_window_albedo", window_albedo)
-        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
 
     def draw_room_light(self, inputs) -> None:
         """All the room lighting's passes before the frame (R1-R4)."""
