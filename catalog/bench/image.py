@@ -392,6 +392,10 @@ def summary_line(result: dict) -> str:
             f"Goal met on {s['scenes_meeting_goal']} of {s['scenes']} scenes.")
 
 
+def _flip4(value) -> str:
+    return "-" if value is None else f"{value:.4f}"
+
+
 def round_changes(before: dict, after: dict) -> str:
     """Per scene: mean FLIP and curtain dE mean before -> after, and whether the goal is met."""
     lines = ["| scene | mean FLIP before | after | curtain dE before | after | goal met after |",
@@ -399,7 +403,8 @@ def round_changes(before: dict, after: dict) -> str:
     earlier = {r["scene"]: r for r in before["rows"]}
     for row in after["rows"]:
         old = earlier.get(row["scene"], {})
-        lines.append(f"| {row['scene']} | {_cell(old.get('mean_flip'))} | {_cell(row['mean_flip'])} | "
+        # FLIP to 4 places: the goal's bound is 0.10, and 3 significant digits round 0.1001 to it
+        lines.append(f"| {row['scene']} | {_flip4(old.get('mean_flip'))} | {_flip4(row['mean_flip'])} | "
                      f"{_cell(old.get('curtain_delta_e_mean'))} | {_cell(row['curtain_delta_e_mean'])} | "
                      f"{_cell(row['meets_goal'])} |")
     return "\n".join(lines)
