@@ -792,7 +792,7 @@ class FrameRenderer:
             values = {**values, **overrides}
         return values
 
-    def _no_disc_overrides(self) -> dict:
+    def _capture_overrides(self) -> dict:
         """The curtain's values for the luminaire capture: without the sun's disc seen through
         it (the key light's beam reaches the room through the shadow map instead), without the
         key light scattered by the directional lobe (the beam carries it: counted in both, the
@@ -1198,6 +1198,14 @@ class FrameRenderer:
             self._operator_albedo = None
         return self._room_gl
 
+    @staticmethod
+    def _room_dye_rgb(colours: dict) -> np.ndarray:
+        """The dye per display channel under the key, RGB(key x dye) / RGB(key) (1 where the
+        key has next to nothing), as the room's beam and the curtain's reflectance take it."""
+        key = np.asarray(colours["u_key_rgb"])
+        dyed = np.asarray(colours["key_dyed_rgb"])
+        return np.where(key > 1e-6 * max(float(key.max()), 1e-30), dyed / np.where(key > 0, key, 1.0), 1.0)
+
     def _room_colours(self, inputs) -> dict:
         """Linear sRGB of the key light (irradiance) and of the beam a thread passes: the
         directional lobe's forward-scattered part, a_spec forward(g_spec), in the dye's colour
@@ -1206,8 +1214,7 @@ class FrameRenderer:
 
         colours = self._display_colours(inputs)
         key = np.asarray(colours["u_key_rgb"])
-        dyed = np.asarray(colours["key_dyed_rgb"])
-        dye_rgb = np.where(key > 1e-6 * max(float(key.max()), 1e-30), dyed / np.where(key > 0, key, 1.0), 1.0)
+        dye_rgb = self._room_dye_rgb(colours)
         coverage = max(1.0 - float(inputs.direct), 1e-6)
         forward = hg_hemisphere_factors(float(inputs.g_spec))[0]
         thread = np.clip(float(inputs.a_spec) * forward * dye_rgb / coverage, 0.0, 1.0)
@@ -1454,7 +1461,7 @@ class FrameRenderer:
                 self.patterned = False
             try:
                 self.draw_curtain(view_proj, camera_position=eye,
-                                  overrides=self._no_disc_overrides(), coarse=True)
+                                  overrides=self._capture_overrides(), coarse=True)
             finally:
                 if patterned:
                     self.patterned = patterned
@@ -1472,10 +1479,7 @@ class FrameRenderer:
 
         if self.curtain_open:
             return (0.0, 0.0, 0.0)
-        colours = self._display_colours(inputs)
-        key = np.asarray(colours["u_key_rgb"])
-        dyed = np.asarray(colours["key_dyed_rgb"])
-        dye_rgb = np.where(key > 1e-6 * max(float(key.max()), 1e-30), dyed / np.where(key > 0, key, 1.0), 1.0)
+        dye_rgb = self._room_dye_rgb(self._display_colours(inputs))
         back = (float(inputs.a_diff) * hg_hemisphere_factors(float(inputs.g_diff))[1]
                 + float(inputs.a_spec) * hg_hemisphere_factors(float(inputs.g_spec))[1])
         return tuple(float(v) for v in np.clip(dye_rgb * back, 0.0, 1.0))
@@ -1981,9 +1985,9 @@ class FrameRenderer:
         for program in self._programs.values():
             program.release()
         self._programs.clear()
-        for obj in list((self._room_gl or {}).values()) + list((self._bloom_gl or {}).values()):
+        self._release_room_resources()
+        for obj in (self._bloom_gl or {}).values():
             obj.release()
-        self._room_gl = None
         self._bloom_gl = None
         if self.environment is not None:
             self.environment[1].release()
