@@ -315,6 +315,29 @@ float room_window_beam(vec3 p, vec3 to_light, vec4 opening, vec2 wall_z, float t
 }
 
 
+// ---- The room's light between surfaces (issue 11; room_light.rectangle_irradiance_factor is
+// the float64 twin). pi times the form factor from a point x with normal n to a uniformly
+// emitting rectangle corner + [0,1] s + [0,1] t: E(x) = L * factor. Lambert's formula for a
+// polygon (the vector irradiance): half the sum over its edges of the angle each subtends at x
+// times the cosine between n and the normal of the plane through x and that edge. Exact near
+// the patch, where the point form cos cos A / r^2 of its centre is not (a 55 cm patch of the
+// floor seen from the wall beside it); the rectangle must lie on n's side of x's plane
+// (every face of the convex room does for every other).
+float polygon_edge_term(vec3 a, vec3 b, vec3 n) {
+    vec3 c = cross(a, b);
+    float sine = length(c);
+    return sine > 1e-9 ? atan(sine, dot(a, b)) * dot(c, n) / sine : 0.0;
+}
+
+float rectangle_irradiance_factor(vec3 x, vec3 n, vec3 corner, vec3 s, vec3 t) {
+    vec3 v0 = normalize(corner - x);
+    vec3 v1 = normalize(corner + s - x);
+    vec3 v2 = normalize(corner + s + t - x);
+    vec3 v3 = normalize(corner + t - x);
+    return 0.5 * abs(polygon_edge_term(v0, v1, n) + polygon_edge_term(v1, v2, n)
+                     + polygon_edge_term(v2, v3, n) + polygon_edge_term(v3, v0, n));
+}
+
 // ---- An environment image (issue 13): latitude-longitude, v = 0 at the nadir, u = 0 towards
 // -z (catalog/render/environment.py); the radiance towards dir, times its scale to the sky.
 vec3 environment_lookup(sampler2D image, float scale, vec3 dir) {

@@ -1,7 +1,8 @@
 #version 430
 // The room's light map, the diffuse bounces (issues 13 and 11): per atlas texel, the direct
 // light map adds the light that the room's own walls reflect onto it, gathered from the
-// coarse patches (face area / RC^2): E = sum_j (rho_j / pi) T_j cos_r cos_j A_j / max(r^2, A_j),
+// coarse patches (face area / RC^2): E = sum_j (rho_j / pi) T_j F_j, F_j pi times the exact
+// form factor of patch j (rectangle_irradiance_factor, common.glsl),
 // with rho_j = m_j rho + (1 - m_j) rho_curtain (m_j the patch's wall fraction, 0 in the window
 // opening, where the closed curtain reflects part of the room's light) and T_j the patch's
 // irradiance: with ALL_BOUNCES its total (room_radiosity.frag), else its direct light, the
@@ -44,18 +45,13 @@ void main() {
         if (f == face) {
             continue;  // a flat face does not light itself
         }
-        vec3 nf = u_face_normal[f];
-        float area = length(cross(u_face_s[f], u_face_t[f])) / (rc * rc);
         for (int v = 0; v < u_coarse_texels; ++v) {
             for (int u = 0; u < u_coarse_texels; ++u) {
                 ivec2 texel = ivec2(f * u_coarse_texels + u, v);
-                vec3 q = u_face_origin[f] + ((float(u) + 0.5) / rc) * u_face_s[f]
-                       + ((float(v) + 0.5) / rc) * u_face_t[f];
-                vec3 d = q - p;
-                float r2 = dot(d, d);
-                float inv_r = inversesqrt(r2);
-                float geometry = max(dot(n, d) * inv_r, 0.0) * max(-dot(nf, d) * inv_r, 0.0)
-                               * area / max(r2, area);
+                vec3 corner = u_face_origin[f] + (float(u) / rc) * u_face_s[f]
+                            + (float(v) / rc) * u_face_t[f];
+                float geometry = rectangle_irradiance_factor(p, n, corner, u_face_s[f] / rc,
+                                                             u_face_t[f] / rc);
                 float wall = texelFetch(u_ao_mask, texel, u_bounce_level).g;
 #ifdef ALL_BOUNCES
                 vec3 source = texelFetch(u_total, texel, 0).rgb;

@@ -2,8 +2,10 @@
 // The room's light map, direct part (issue 13, model.md section 9): per atlas texel (a point
 // of the room box's inside, catalog/render/room_light.py), the irradiance (linear sRGB) from
 //  - the window as an area light: the luminaire capture's texels are patches of the opening
-//    (area u_patch_area_m2, normal +z) with the radiance the curtain (or the sky through the
-//    opening) sends towards the room, E = sum L cos_p cos_r A / max(r^2, A);
+//    (normal +z) with the radiance the curtain (or the sky through the opening) sends towards
+//    the room, E = sum L F (F pi times the patch's exact form factor,
+//    rectangle_irradiance_factor in common.glsl); behind the curtain's plane, the patches of
+//    its window side (issue 11);
 //  - the key light's beam through the window and the curtain (the transmittance shadow map,
 //    read at the mip level of a light-map texel);
 //  - lamps in the room (isotropic points): E = I cos_r / r^2.
@@ -22,7 +24,11 @@ uniform ivec2 u_luminaire_size;
 uniform int u_luminaire_level;
 uniform vec4 u_window_rect;          // x0, x1, y0, y1 of the opening (m)
 uniform vec2 u_wall_z;               // the window wall's inner and outer planes (m)
-uniform float u_patch_area_m2;
+uniform float u_face_texels;         // light-map texels per face side
+uniform float u_supersample_m;       // room_light.WINDOW_SUPERSAMPLE_M
+uniform sampler2D u_luminaire_back;  // the closed curtain's window side (0 where no cloth)
+uniform int u_luminaire_back_level;  // its level of one texel a patch
+uniform float u_back_plane_z;        // its patches' plane (m), normal -z
 
 uniform sampler2D u_shadow;
 uniform mat4 u_light_view_proj;
@@ -40,28 +46,62 @@ layout(location = 0) out vec4 out_irradiance;   // area light and lamps (the roo
 layout(location = 1) out vec4 out_beam;         // the key's beam (per pixel in room.frag; here
                                                 // only as a source of the bounce)
 
+// The window's light at point p (normal n): the room side's patches in the opening and,
+// behind the curtain's plane (the window wall beside the opening, in the gap between wall and
+// cloth), the patches of its window side: the glow and the light it scatters back.
+vec3 window_irradiance(vec3 p, vec3 n, vec2 cell) {
+    vec3 e = vec3(0.0);
+    vec3 s = vec3(cell.x, 0.0, 0.0);
+    vec3 t = vec3(0.0, cell.y, 0.0);
+    for (int j = 0; j < u_luminaire_size.y; ++j) {
+        for (int i = 0; i < u_luminaire_size.x; ++i) {
+            vec3 corner = vec3(u_window_rect.x + float(i) * cell.x,
+                               u_window_rect.z + float(j) * cell.y, u_wall_z.x);
+            e += texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level).rgb
+               * rectangle_irradiance_factor(p, n, corner, s, t);
+        }
+    }
+    if (p.z < u_back_plane_z) {
+        for (int j = 0; j < u_luminaire_size.y; ++j) {
+            for (int i = 0; i < u_luminaire_size.x; ++i) {
+                vec3 corner = vec3(u_window_rect.x + float(i) * cell.x,
+                                   u_window_rect.z + float(j) * cell.y, u_back_plane_z);
+                e += texelFetch(u_luminaire_back, ivec2(i, j), u_luminaire_back_level).rgb
+                   * rectangle_irradiance_factor(p, n, corner, s, t);
+            }
+        }
+    }
+    return e;
+}
+
 void main() {
     float x = v_uv.x * float(ROOM_FACES);
     int face = min(int(floor(x)), ROOM_FACES - 1);
     vec3 p = u_face_origin[face] + fract(x) * u_face_s[face] + v_uv.y * u_face_t[face];
     vec3 n = u_face_normal[face];
 
-    vec3 e = vec3(0.0);
+    // the texel's mean over 2x2 points, not its centre's value: a texel beside the opening
+    // spans irradiance that falls several-fold across it
     vec2 cell = vec2(u_window_rect.y - u_window_rect.x, u_window_rect.w - u_window_rect.z)
               / vec2(u_luminaire_size);
-    for (int j = 0; j < u_luminaire_size.y; ++j) {
-        for (int i = 0; i < u_luminaire_size.x; ++i) {
-            vec3 q = vec3(u_window_rect.x + (float(i) + 0.5) * cell.x,
-                          u_window_rect.z + (float(j) + 0.5) * cell.y, u_wall_z.x);
-            vec3 d = q - p;
-            float r2 = dot(d, d);
-            float inv_r = inversesqrt(r2);
-            float cos_r = max(dot(n, d) * inv_r, 0.0);
-            float cos_p = max(-d.z * inv_r, 0.0);
-            e += texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level).rgb
-               * (cos_r * cos_p * u_patch_area_m2 / max(r2, u_patch_area_m2));
+    // (the points on the wall: none inside the opening, where there is no surface). Texels
+    // further than WINDOW_SUPERSAMPLE_M (room_light.py) from the window's plane vary slowly
+    // across: their centre suffices.
+    vec3 sum = vec3(0.0);
+    float count = 0.0;
+    int samples = p.z < u_wall_z.x + u_supersample_m ? 4 : 1;
+    for (int k = 0; k < samples; ++k) {
+        vec2 offset = samples == 1 ? vec2(0.0)
+                    : (vec2(float(k & 1), float(k >> 1)) - 0.5) * (0.5 / u_face_texels);
+        vec3 q = p + offset.x * u_face_s[face] + offset.y * u_face_t[face];
+        bool in_opening = q.z < u_wall_z.x + 1e-4 && q.x > u_window_rect.x && q.x < u_window_rect.y
+                          && q.y > u_window_rect.z && q.y < u_window_rect.w;
+        if (!in_opening) {
+            sum += window_irradiance(q, n, cell);
+            count += 1.0;
         }
     }
+    vec3 e = count > 0.0 ? sum / count : vec3(0.0);
 
     vec3 e_beam = vec3(0.0);
     float cos_key = dot(n, u_key_to_light);

@@ -816,6 +816,17 @@ class FrameRenderer:
             out["u_room_lamp_dyed"] = np.zeros_like(dyed)
         return out
 
+    def _back_capture_overrides(self) -> dict:
+        """The curtain's values for the capture of its window side (issue 11): as the room
+        side's (:meth:`_capture_overrides`) but with the directional lobe (its backward part is
+        reflection, which the beam does not carry) and without the see-through (from outside,
+        the cloth's holes show the room, which is not a source of the window wall's light)."""
+        values = self.scene_values()
+        out = self._capture_overrides()
+        out["u_a_spec"] = values["u_a_spec"]
+        out["u_direct"] = 0.0
+        return out
+
     def _program(self, vertex: str, fragment: str, defines: dict | None = None):
         key = (vertex, fragment, tuple(sorted((defines or {}).items())))
         if key not in self._programs:
@@ -1157,6 +1168,10 @@ class FrameRenderer:
             luminaire = ctx.texture((lw, lh), 4, dtype="f4")
             luminaire.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             luminaire_depth = ctx.depth_renderbuffer((lw, lh))
+            bw, bh = room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)
+            luminaire_back = ctx.texture((bw, bh), 4, dtype="f4")
+            luminaire_back.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            luminaire_back_depth = ctx.depth_renderbuffer((bw, bh))
             aw, ah = room_light.atlas_size()
             direct = ctx.texture((aw, ah), 4, dtype="f4")
             direct.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
@@ -1184,6 +1199,8 @@ class FrameRenderer:
                 "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
                 "luminaire": luminaire, "luminaire_depth": luminaire_depth,
                 "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
+                "luminaire_back": luminaire_back,
+                "luminaire_back_fbo": ctx.framebuffer([luminaire_back], luminaire_back_depth),
                 "direct": direct, "beam": beam, "direct_fbo": ctx.framebuffer([direct, beam]),
                 "lightmap": lightmap, "lightmap_fbo": ctx.framebuffer([lightmap]), "ao": ao,
             }
@@ -1466,9 +1483,26 @@ class FrameRenderer:
                 if patterned:
                     self.patterned = patterned
         self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False)
+        gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
+        # the window side, from outside: nothing where there is no cloth (the room behind it
+        # is not a source), and no see-through (it would show the outside, not the room)
+        gl["luminaire_back_fbo"].use()
+        self.ctx.viewport = (0, 0) + room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)
+        gl["luminaire_back_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        if not self.curtain_open:
+            patterned = getattr(self, "patterned", None)
+            if patterned:
+                self.patterned = False
+            try:
+                self.draw_curtain(room_light.back_luminaire_view_projection(),
+                                  camera_position=room_light.BACK_LUMINAIRE_EYE,
+                                  overrides=self._back_capture_overrides(), coarse=True)
+            finally:
+                if patterned:
+                    self.patterned = patterned
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
-        gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
+        gl["luminaire_back"].build_mipmaps()
 
     def window_albedo_rgb(self, inputs) -> tuple[float, float, float]:
         """The closed curtain's room-side reflectance under diffuse light (linear sRGB): the
@@ -1508,7 +1542,12 @@ class FrameRenderer:
         self._set(program, "u_luminaire", 1)
         self._set(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)
         self._set(program, "u_luminaire_level", room_light.LUMINAIRE_LEVEL)
-        self._set(program, "u_patch_area_m2", room_light.window_patch_area_m2())
+        self._set(program, "u_face_texels", float(room_light.FACE_TEXELS))
+        self._set(program, "u_supersample_m", room_light.WINDOW_SUPERSAMPLE_M)
+        gl["luminaire_back"].use(location=3)
+        self._set(program, "u_luminaire_back", 3)
+        self._set(program, "u_luminaire_back_level", room_light.BACK_LUMINAIRE_LEVEL)
+        self._set(program, "u_back_plane_z", scene_lib.CURTAIN_Z)
         gl["shadow"].use(location=2)
         self._set(program, "u_shadow", 2)
         (x0, x1), _, _ = scene_lib.ROOM_BOX

@@ -16,7 +16,8 @@ Irradiance (linear sRGB, the renderer's cd m^-2 scale times pi) is stored per te
 - bounces, all of them: the coarse patches' total irradiance ``T = (I - K)^-1 S`` (the radiosity
   solve of model.md section 9, :func:`radiosity_operator`: S the direct light of each coarse patch, K
   the patch-to-patch transfer below, precomputed once as the matrix ``(I - K)^-1 - I``),
-  then per texel ``E(x) = E_direct(x) + ao(x) / pi sum_j rho_j T_j cos_x cos_j A_j / r^2``
+  then per texel ``E(x) = E_direct(x) + ao(x) / pi sum_j rho_j T_j F_j(x)`` (F_j pi times the
+  exact form factor of patch j, :func:`rectangle_irradiance_factor`)
   over the coarse patches (rho_j the wall's albedo, or in the window opening the closed
   curtain's room-side reflectance: the cloth sends part of the room's light back) (the room is a convex box: every patch sees every other), with
   the ambient occlusion below. One bounce alone (issue 13's frame) left the walls 30 % and
@@ -24,8 +25,10 @@ Irradiance (linear sRGB, the renderer's cd m^-2 scale times pi) is stored per te
   the bounces after the first double the first.
 
 Ambient occlusion (precomputed once, the room is static): the cosine-weighted fraction of
-the hemisphere over a texel that is free of room geometry within AO_RADIUS_M (obscurance:
-corners and the window reveals darken), by ray casting against the room's boxes in numpy.
+the hemisphere over a texel that is free of the window's reveals and the rod within
+AO_RADIUS_M (obscurance), by ray casting against their boxes in numpy. The room's faces are
+not occluders: the bounce's form factors are exact (Lambert's polygon formula,
+:func:`rectangle_irradiance_factor`), so a corner gets the light of the faces that meet there.
 """
 
 from __future__ import annotations
@@ -55,6 +58,16 @@ LUMINAIRE_TEXELS = (12, 9)
 LUMINAIRE_LEVEL = 2
 #: Where the luminaire capture looks from (metres): the middle of the room, eye height.
 LUMINAIRE_EYE = (0.0, 0.2, 2.0)
+#: The closed curtain's window side (issue 11): its radiance is captured from outside, from the
+#: room eye mirrored through the rod's plane, and sent from patches in that plane
+#: (scene.CURTAIN_Z, the drape's mean depth) to what lies behind it: the window wall beside
+#: the opening, in the gap between the wall and the cloth.
+BACK_LUMINAIRE_EYE = (LUMINAIRE_EYE[0], LUMINAIRE_EYE[1],
+                      2.0 * scene_lib.CURTAIN_Z - LUMINAIRE_EYE[2])
+#: Its samples per patch side, 2^level: the window wall beside the opening sees the nearest
+#: patches from a few centimetres, so a fold sliding through one of 4 x 4 samples changed a
+#: texel there by 6 % a 2 cm step; 8 x 8 keeps it under 5 % (the room's stability test).
+BACK_LUMINAIRE_LEVEL = 3
 #: ``room_bounce.frag``'s bounces: "all" (the radiosity solve) or "one" (issue 13's first).
 ROOM_BOUNCES = ("all", "one")
 #: The transmittance shadow map's side (texels).
@@ -62,6 +75,9 @@ SHADOW_TEXELS = 256
 #: Ambient occlusion: rays per texel and the distance within which geometry occludes.
 AO_RAYS = 96
 AO_RADIUS_M = 0.6
+#: What the obscurance counts, part of the stored table's key: 1 the room's faces and the
+#: occluder boxes (issue 13), 2 the occluder boxes alone (issue 11: the form factors are exact).
+AO_METHOD = 2
 #: Room lamps: at most this many (uniform arrays in room_lightmap.frag).
 MAX_ROOM_LAMPS = 4
 
@@ -169,10 +185,12 @@ def _frame(normal: np.ndarray) -> np.ndarray:
 def ambient_occlusion(face_texels: int = FACE_TEXELS, rays: int = AO_RAYS,
                       radius_m: float = AO_RADIUS_M) -> np.ndarray:
     """Obscurance per atlas texel, (R, 6R) float32 in [0, 1]: the cosine-weighted fraction of
-    rays that travel ``radius_m`` without meeting the room's faces or the occluder boxes."""
-    positions, normals = texel_points(face_texels)
-    (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
-    lo_room, hi_room = np.array([x0, y0, z0]), np.array([x1, y1, z1])
+    rays that travel ``radius_m`` without meeting the occluder boxes (the window's reveals and
+    the rod). The room's own faces are not occluders: the gather's exact form factors
+    (:func:`patch_geometry`) already give each face the light of the faces beside it, and
+    counting them again (issue 13's obscurance did) left every edge texel of the room at
+    0.3-0.6x the path-traced irradiance (issue 11)."""
+    positions, _ = texel_points(face_texels)
     boxes = _occluder_boxes()
     local = _cosine_directions(rays)
     out = np.empty(positions.shape[:2], dtype=np.float32)
@@ -181,9 +199,7 @@ def ambient_occlusion(face_texels: int = FACE_TEXELS, rays: int = AO_RAYS,
         p = positions[:, cols].reshape(-1, 1, 3) + 1e-4 * face.normal
         d = (local @ _frame(face.normal))[None, :, :]  # (1, rays, 3)
         d = np.where(np.abs(d) < 1e-9, 1e-9, d)
-        # leaving the room box: the nearest exit distance
-        exit_t = np.min(np.maximum((lo_room - p) / d, (hi_room - p) / d), axis=-1)
-        hit = np.minimum(exit_t, np.inf)
+        hit = np.full((p.shape[0], rays), np.inf)
         for lo, hi in boxes:
             t_near = np.max(np.minimum((lo - p) / d, (hi - p) / d), axis=-1)
             t_far = np.min(np.maximum((lo - p) / d, (hi - p) / d), axis=-1)
@@ -200,7 +216,7 @@ AO_TABLE_PATH = Path(__file__).resolve().parent / "data" / "room_ao.npz"
 
 def ao_table_key(face_texels: int = FACE_TEXELS) -> np.ndarray:
     """What the stored table was computed for: texels, rays, radius, the room's geometry."""
-    return np.array([face_texels, AO_RAYS, AO_RADIUS_M, *np.ravel(scene_lib.ROOM_BOX),
+    return np.array([face_texels, AO_RAYS, AO_RADIUS_M, AO_METHOD, *np.ravel(scene_lib.ROOM_BOX),
                      *scene_lib.WINDOW_RECT, scene_lib.CURTAIN_TOP_Y, scene_lib.CURTAIN_Z,
                      scene_lib.CURTAIN_WIDTH_M], dtype=np.float64)
 
@@ -249,30 +265,58 @@ def coarse_patches(face_texels: int = FACE_TEXELS, level: int = BOUNCE_LEVEL) ->
 
     ao, wall = coarse(0), coarse(1)
     centres, normals, areas, faces, ao_p, wall_p = [], [], [], [], [], []
+    corners, edge_s, edge_t = [], [], []
     for f, face in enumerate(room_faces()):
         for v in range(rc):
             for u in range(rc):
                 centres.append(face.origin + (u + 0.5) / rc * face.axis_s + (v + 0.5) / rc * face.axis_t)
+                corners.append(face.origin + u / rc * face.axis_s + v / rc * face.axis_t)
+                edge_s.append(face.axis_s / rc)
+                edge_t.append(face.axis_t / rc)
                 normals.append(face.normal)
                 areas.append(face.area_m2 / rc ** 2)
                 faces.append(f)
                 ao_p.append(ao[v, f * rc + u])
                 wall_p.append(wall[v, f * rc + u])
     return {"centre": np.array(centres), "normal": np.array(normals), "area": np.array(areas),
-            "face": np.array(faces), "ao": np.array(ao_p), "wall": np.array(wall_p)}
+            "face": np.array(faces), "ao": np.array(ao_p), "wall": np.array(wall_p),
+            "corner": np.array(corners), "s": np.array(edge_s), "t": np.array(edge_t)}
+
+
+def rectangle_irradiance_factor(points: np.ndarray, normals: np.ndarray, corners: np.ndarray,
+                                s: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """pi times the form factor from points x (P, 3) with normals (P, 3) to rectangles
+    ``corner + [0,1] s + [0,1] t`` (N, 3 each), (P, N) float64: Lambert's polygon formula, half
+    the sum over the edges of the angle each subtends at x times the cosine between x's normal
+    and the normal of the plane through x and the edge. A uniformly emitting rectangle of
+    radiance L gives E(x) = L * factor, exactly. The float64 twin of common.glsl's
+    ``rectangle_irradiance_factor``; the rectangle must lie on the normal's side of x's plane."""
+    points = np.asarray(points, dtype=np.float64)[:, None, :]
+    normals = np.asarray(normals, dtype=np.float64)
+    vertices = [corners, corners + s, corners + s + t, corners + t]
+    unit = []
+    for vertex in vertices:
+        v = np.asarray(vertex, dtype=np.float64)[None, :, :] - points
+        unit.append(v / np.linalg.norm(v, axis=-1, keepdims=True))
+    total = np.zeros(unit[0].shape[:2])
+    for k in range(4):
+        a, b = unit[k], unit[(k + 1) % 4]
+        c = np.cross(a, b)
+        sine = np.linalg.norm(c, axis=-1)
+        angle = np.arctan2(sine, np.einsum("pjk,pjk->pj", a, b))
+        cosine = np.einsum("pjk,pk->pj", c, normals) / np.maximum(sine, 1e-300)
+        total += np.where(sine > 1e-9, angle * cosine, 0.0)
+    return 0.5 * np.abs(total)
 
 
 def patch_geometry(points: np.ndarray, normals: np.ndarray, point_faces: np.ndarray,
                    patches: dict) -> np.ndarray:
-    """(P, N) cos_x cos_j A_j / max(r^2, A_j) from points x (on faces ``point_faces``) to the
-    coarse patches j, 0 on the point's own face (room_bounce.frag's geometry term)."""
-    d = patches["centre"][None, :, :] - points[:, None, :]
-    r2 = np.einsum("pjk,pjk->pj", d, d)
-    inv_r = 1.0 / np.sqrt(np.maximum(r2, 1e-30))
-    cos_x = np.maximum(np.einsum("pjk,pk->pj", d, normals) * inv_r, 0.0)
-    cos_j = np.maximum(-np.einsum("pjk,jk->pj", d, patches["normal"]) * inv_r, 0.0)
-    area = patches["area"][None, :]
-    geometry = cos_x * cos_j * area / np.maximum(r2, area)
+    """(P, N) pi times the form factor from points x (on faces ``point_faces``) to the coarse
+    patches j (:func:`rectangle_irradiance_factor`: exact for a uniform patch, however near),
+    0 on the point's own face (room_bounce.frag's geometry term). The point form of the
+    patch's centre, cos_x cos_j A_j / max(r^2, A_j), which the frame used before, lost most of
+    a patch's light near it: the wall's strip beside a sunlit floor was 3-5x too dark."""
+    geometry = rectangle_irradiance_factor(points, normals, patches["corner"], patches["s"], patches["t"])
     geometry[point_faces[:, None] == patches["face"][None, :]] = 0.0
     return geometry
 
@@ -371,39 +415,117 @@ def shadow_texel_m(to_light: np.ndarray, texels: int = SHADOW_TEXELS) -> float:
 
 # --------------------------------------------------------------------------- the luminaire capture
 
-def luminaire_view_projection(eye=LUMINAIRE_EYE) -> np.ndarray:
-    """Off-axis perspective from ``eye`` whose frustum is exactly the window opening (its
-    near rectangle in the wall plane z = WINDOW_Z): texel (i, j) of the capture is the radiance
-    of the window patch (i, j) towards the room."""
-    eye = np.asarray(eye, dtype=np.float64)
+def window_view_projection(eye, plane_z: float, near: float = 0.05, far: float = 60.0) -> np.ndarray:
+    """Off-axis perspective from ``eye`` whose frustum is exactly the window opening's
+    rectangle in the plane z = ``plane_z``, looking towards that plane from either side: texel
+    (i, j) of a capture is the radiance of window patch (i, j) towards the eye, i counting
+    along +x and j along +y whichever side the eye is on (the clip space is written out, not
+    a camera's view matrix, which would mirror x for an eye looking along +z)."""
+    ex, ey, ez = (float(v) for v in eye)
     wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-    z0 = scene_lib.ROOM_BOX[2][0]
-    dist = eye[2] - z0
-    near, far = 0.05, 60.0
-    scale = near / dist
-    left, right = (wx0 - eye[0]) * scale, (wx1 - eye[0]) * scale
-    bottom, top = (wy0 - eye[1]) * scale, (wy1 - eye[1]) * scale
-    proj = np.zeros((4, 4))
-    proj[0, 0] = 2 * near / (right - left)
-    proj[0, 2] = (right + left) / (right - left)
-    proj[1, 1] = 2 * near / (top - bottom)
-    proj[1, 2] = (top + bottom) / (top - bottom)
-    proj[2, 2] = -(far + near) / (far - near)
-    proj[2, 3] = -2 * far * near / (far - near)
-    proj[3, 2] = -1.0
-    view = np.eye(4)
-    view[:3, 3] = -eye  # axes aligned with the world: looking down -z
-    return proj @ view
+    sign = 1.0 if ez < plane_z else -1.0         # the view axis: +z or -z
+    to_plane = sign * (plane_z - ez)             # > 0
+    if to_plane <= near:
+        raise ValueError(f"eye {eye} is within {near} m of the plane z = {plane_z}")
+    # w = sign (z - ez): the distance along the view axis
+    w_row = np.array([0.0, 0.0, sign, -sign * ez])
+
+    def lateral(axis, e, lo, hi):
+        # clip = w ndc, ndc = 2 (crossing - lo) / (hi - lo) - 1, crossing = e + (q - e) D / w
+        row = np.zeros(4)
+        row[axis] = 2.0 * to_plane / (hi - lo)
+        row[3] = -2.0 * to_plane * e / (hi - lo)
+        return row + (2.0 * (e - lo) / (hi - lo) - 1.0) * w_row
+
+    a, b = (far + near) / (far - near), -2.0 * far * near / (far - near)
+    z_row = a * w_row + np.array([0.0, 0.0, 0.0, b])
+    return np.stack([lateral(0, ex, wx0, wx1), lateral(1, ey, wy0, wy1), z_row, w_row])
 
 
-def luminaire_capture_size() -> tuple[int, int]:
-    """The capture's render size: LUMINAIRE_TEXELS supersampled by 2^LUMINAIRE_LEVEL."""
-    return LUMINAIRE_TEXELS[0] << LUMINAIRE_LEVEL, LUMINAIRE_TEXELS[1] << LUMINAIRE_LEVEL
+def luminaire_view_projection(eye=LUMINAIRE_EYE) -> np.ndarray:
+    """The room side's capture: the opening in the wall plane z = WINDOW_Z seen from ``eye``
+    in the room, texel (i, j) the radiance of window patch (i, j) towards the room."""
+    return window_view_projection(eye, scene_lib.ROOM_BOX[2][0])
+
+
+def back_luminaire_view_projection(eye=BACK_LUMINAIRE_EYE) -> np.ndarray:
+    """The curtain's window side, captured from outside through the rod's plane
+    (scene.CURTAIN_Z): texel (i, j) the radiance that patch (i, j) of that plane sends back
+    towards the window wall."""
+    return window_view_projection(eye, scene_lib.CURTAIN_Z)
+
+
+def luminaire_capture_size(level: int = LUMINAIRE_LEVEL) -> tuple[int, int]:
+    """A capture's render size: LUMINAIRE_TEXELS supersampled by 2^level."""
+    return LUMINAIRE_TEXELS[0] << level, LUMINAIRE_TEXELS[1] << level
 
 
 def window_patch_area_m2() -> float:
     wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
     return (wx1 - wx0) * (wy1 - wy0) / (LUMINAIRE_TEXELS[0] * LUMINAIRE_TEXELS[1])
+
+
+#: room_lightmap.frag averages the window's light over 2 x 2 points of a texel within this
+#: distance of the window's plane (m), its centre alone further away.
+WINDOW_SUPERSAMPLE_M = 1.0
+
+
+def window_patch_rectangles(plane_z: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The luminaire's patches in the plane z = ``plane_z``, in capture order (row j, column
+    i: index j * 12 + i): corners (N, 3) and edges s, t (N, 3 each)."""
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    nx, ny = LUMINAIRE_TEXELS
+    cx, cy = (wx1 - wx0) / nx, (wy1 - wy0) / ny
+    j, i = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
+    corners = np.stack([wx0 + i.ravel() * cx, wy0 + j.ravel() * cy,
+                        np.full(i.size, float(plane_z))], axis=-1)
+    s = np.broadcast_to([cx, 0.0, 0.0], corners.shape)
+    t = np.broadcast_to([0.0, cy, 0.0], corners.shape)
+    return corners, np.array(s), np.array(t)
+
+
+def window_irradiance(radiance_front: np.ndarray, radiance_back: np.ndarray,
+                      face_texels: int = FACE_TEXELS) -> np.ndarray:
+    """The float64 twin of room_lightmap.frag's window term, (R, 6R, 3): per atlas texel, the
+    mean over its sample points on a wall (2 x 2 within WINDOW_SUPERSAMPLE_M of the window's
+    plane, else the centre; none inside the opening) of the room side's patches (in the
+    opening, ``radiance_front`` (9, 12, 3), the capture at its patch level) and, behind the
+    curtain's plane, its window side's (``radiance_back``), each E = L F with F from
+    :func:`rectangle_irradiance_factor`."""
+    positions, normals = texel_points(face_texels)
+    wall_z = scene_lib.ROOM_BOX[2][0]
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    front = window_patch_rectangles(wall_z)
+    back = window_patch_rectangles(scene_lib.CURTAIN_Z)
+    lf = np.asarray(radiance_front, dtype=np.float64).reshape(-1, 3)
+    lb = np.asarray(radiance_back, dtype=np.float64).reshape(-1, 3)
+    out = np.zeros(positions.shape[:2] + (3,))
+    for k, face in enumerate(room_faces()):
+        cols = slice(k * face_texels, (k + 1) * face_texels)
+        centres = positions[:, cols].reshape(-1, 3)
+        near = centres[:, 2] < wall_z + WINDOW_SUPERSAMPLE_M
+        total = np.zeros((centres.shape[0], 3))
+        count = np.zeros(centres.shape[0])
+        offsets = [(0.0, 0.0, True)] + [((a - 0.5) * 0.5, (b - 0.5) * 0.5, False)
+                                         for b in (0, 1) for a in (0, 1)]
+        for ds, dt, is_centre in offsets:
+            use = ~near if is_centre else near
+            q = centres + (ds * face.axis_s + dt * face.axis_t) / face_texels
+            in_opening = ((q[:, 2] < wall_z + 1e-4) & (q[:, 0] > wx0) & (q[:, 0] < wx1)
+                          & (q[:, 1] > wy0) & (q[:, 1] < wy1))
+            use = use & ~in_opening
+            if not use.any():
+                continue
+            n = np.broadcast_to(face.normal, q.shape)
+            e = rectangle_irradiance_factor(q[use], n[use], *front) @ lf
+            behind = q[use, 2] < scene_lib.CURTAIN_Z
+            if behind.any():
+                e[behind] += rectangle_irradiance_factor(q[use][behind], n[use][behind], *back) @ lb
+            total[use] += e
+            count[use] += 1
+        mean = np.where(count[:, None] > 0, total / np.maximum(count, 1)[:, None], 0.0)
+        out[:, cols] = mean.reshape(face_texels, face_texels, 3)
+    return out
 
 
 #: The room's passes (shadow map, capture) draw the curtain from a grid with at most this many
