@@ -65,19 +65,27 @@ vec3 environment_radiance(vec3 dir) {
 
 layout(location = 0) out vec4 out_radiance;
 
+// ROOM_CAPTURE (the room's window capture, issue 11): alpha 0, no cloth here (the capture's
+// alpha is the key's irradiance on the cloth, curtain.frag)
+#ifdef ROOM_CAPTURE
+const float BACKGROUND_ALPHA = 0.0;
+#else
+const float BACKGROUND_ALPHA = 1.0;
+#endif
+
 void main() {
     vec4 far_point = u_inverse_view_proj * vec4(v_ndc, 1.0, 1.0);
     vec3 ray = normalize(far_point.xyz / far_point.w - u_camera_position);
     vec4 w = background_weights(ray, u_sun_direction, u_sun_chord2.x, u_sun_chord2.y);
 #if defined(ENVIRONMENT)
     vec3 outside = environment_radiance(ray);
-    out_radiance = vec4((w.x + w.y) * outside + w.z * u_sun_disc_rgb + w.w * u_room_rgb, 1.0);
+    out_radiance = vec4((w.x + w.y) * outside + w.z * u_sun_disc_rgb + w.w * u_room_rgb, BACKGROUND_ALPHA);
 #elif defined(SKY_MODEL)
     vec3 sky = sky_radiance(ray);
     float fade = exp(-asin(clamp(-ray.y, 0.0, 1.0)) / u_haze_rad);
     vec3 below = fade * sky + (1.0 - fade) * u_ground_rgb;
-    out_radiance = vec4(w.x * sky + w.y * below + w.z * u_sun_disc_rgb + w.w * u_room_rgb, 1.0);
+    out_radiance = vec4(w.x * sky + w.y * below + w.z * u_sun_disc_rgb + w.w * u_room_rgb, BACKGROUND_ALPHA);
 #else
-    out_radiance = vec4(w.x * u_sky_rgb + w.y * u_ground_rgb + w.z * u_sun_disc_rgb + w.w * u_room_rgb, 1.0);
+    out_radiance = vec4(w.x * u_sky_rgb + w.y * u_ground_rgb + w.z * u_sun_disc_rgb + w.w * u_room_rgb, BACKGROUND_ALPHA);
 #endif
 }

@@ -130,6 +130,10 @@ uniform float u_tan_sun_radius;
 float g_key_beam = 1.0;            // the window's mask (set in main)
 float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
 #endif
+#ifdef ROOM_CAPTURE
+uniform float u_capture_thread;    // the key a thread passes, a_spec forward(g_spec) / (1 - LD)
+float g_key_reach = 1.0;           // set in main: see out_radiance.a below
+#endif
 #ifdef SKY_OCCLUSION
 // The outside hidden by the cloth's own folds and by the window wall (issue 11, model.md
 // section 9), per vertex (curtain.vert) and interpolated: the ambient term loses that
@@ -245,7 +249,13 @@ void main() {
         g_front_coverage = front_layer_coverage(u_key_front, clip.xyz * 0.5 + 0.5,
                                                 u_key_depth_bias.x + u_key_depth_bias.y * tan_surface);
         key_uv = g_key_beam * (1.0 - g_front_coverage);   // UV passes the holes only
+#ifdef ROOM_CAPTURE
+        g_key_reach = g_key_beam * (1.0 - g_front_coverage * (1.0 - u_capture_thread));
+#endif
     }
+#endif
+#ifdef ROOM_CAPTURE
+    g_key_reach *= abs(cos_key);
 #endif
 #ifdef SKY_OCCLUSION
     g_occlusion = v_occlusion.x;
@@ -315,6 +325,11 @@ void main() {
     float w = oit_weight(length(v_view_ray) - u_oit_depth_ref);
     out_radiance = vec4(rgb * (alpha * w), alpha);
     out_oit_weight = vec4(alpha * w, 0.0, 0.0, 0.0);
+#elif defined(ROOM_CAPTURE)
+    // the room's window capture (issue 11): alpha is the key's irradiance on this fragment per
+    // unit of its normal irradiance, |cos_i| x the window's mask x what a layer nearer the
+    // light passes; room_lightmap.frag spreads the key's directional lobe by its patch mean
+    out_radiance = vec4(rgb, g_key_reach);
 #else
     out_radiance = vec4(rgb, 1.0);
 #endif

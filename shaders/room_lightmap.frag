@@ -26,6 +26,8 @@ uniform vec4 u_window_rect;          // x0, x1, y0, y1 of the opening (m)
 uniform vec2 u_wall_z;               // the window wall's inner and outer planes (m)
 uniform float u_face_texels;         // light-map texels per face side
 uniform float u_supersample_m;       // room_light.WINDOW_SUPERSAMPLE_M
+uniform vec3 u_lobe_rgb;             // key x a_spec x dye (0: the lobe travels in the beam)
+uniform float u_g_spec;
 uniform sampler2D u_luminaire_back;  // the closed curtain's window side (0 where no cloth)
 uniform int u_luminaire_back_level;  // its level of one texel a patch
 uniform float u_back_plane_z;        // its patches' plane (m), normal -z
@@ -53,12 +55,25 @@ vec3 window_irradiance(vec3 p, vec3 n, vec2 cell) {
     vec3 e = vec3(0.0);
     vec3 s = vec3(cell.x, 0.0, 0.0);
     vec3 t = vec3(0.0, cell.y, 0.0);
+    float hg_k = (1.0 - u_g_spec) * (1.0 + u_g_spec) / (4.0 * PI);
     for (int j = 0; j < u_luminaire_size.y; ++j) {
         for (int i = 0; i < u_luminaire_size.x; ++i) {
             vec3 corner = vec3(u_window_rect.x + float(i) * cell.x,
                                u_window_rect.z + float(j) * cell.y, u_wall_z.x);
-            e += texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level).rgb
-               * rectangle_irradiance_factor(p, n, corner, s, t);
+            vec4 captured = texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level);
+            vec3 radiance = captured.rgb;
+            if (u_lobe_rgb != vec3(0.0) && u_key_on > 0.0) {
+                // the key's directional lobe through the cloth of this patch, towards p (eq. 7:
+                // E cos_i a_spec ph(theta), theta between the key's travel and the way to p
+                // from the patch's centre in the opening, where its rectangle is); the key's
+                // irradiance on the patch's cloth, |cos_i| x the window's mask x what a layer
+                // nearer the light passes, is the capture's alpha (its mean over the patch)
+                vec3 w = normalize(p - vec3(corner.xy + 0.5 * cell, u_wall_z.x));
+                float chord2 = dot(w + u_key_to_light, w + u_key_to_light);
+                float d = (1.0 - u_g_spec) * (1.0 - u_g_spec) + u_g_spec * chord2;
+                radiance += u_lobe_rgb * (captured.a * hg_k / (d * sqrt(d)));
+            }
+            e += radiance * rectangle_irradiance_factor(p, n, corner, s, t);
         }
     }
     if (p.z < u_back_plane_z) {

@@ -295,6 +295,10 @@ class FrameRenderer:
         self.outside_by_view = True
         #: issue 11: the room's bounces, "all" (radiosity, room_radiosity.frag) or "one"
         self.room_bounces = "all"
+        #: issue 11: the key's directional lobe through the cloth reaches the room spread over
+        #: its HG lobe, from the window's patches (room_lightmap.frag); False: collimated in
+        #: the beam, a_spec forward(g_spec) per thread (issue 13's frame)
+        self.room_lobe = True
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -468,6 +472,12 @@ class FrameRenderer:
             raise InputError(f"{bounces!r}: choose one of {', '.join(room_light.ROOM_BOUNCES)}",
                              field="room bounces")
         self.room_bounces = bounces
+
+    def set_room_lobe(self, on: bool) -> None:
+        """The key's directional lobe in the room: spread over its HG lobe from the window's
+        patches (True, issue 11: the path-traced floor by a voile under a low key was 1.5x the
+        collimated beam's light) or kept in the collimated beam (False, issue 13's frame)."""
+        self.room_lobe = bool(on)
 
     def set_shadow_map_size(self, texels: int) -> None:
         """The side of the key light's maps (the room's transmittance map and the cloth's
@@ -996,6 +1006,9 @@ class FrameRenderer:
                 self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
             if "u_key_front" in program:
                 self._key_shadow_uniforms(program, self.shading_inputs())
+            if "u_capture_thread" in program:
+                inputs = self.shading_inputs()
+                self._set(program, "u_capture_thread", float(self._room_colours(inputs)["capture_thread"]))
             if "u_vertex_occlusion" in program:
                 self._vertex_occlusion_uniforms(program)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
@@ -1070,12 +1083,15 @@ class FrameRenderer:
                                         (0.2126, 0.7152, 0.0722)))
         return target / self.environment[2]
 
-    def _draw_background(self, view_proj, inputs, camera_position=None, sun_disc=True) -> None:
+    def _draw_background(self, view_proj, inputs, camera_position=None, sun_disc=True,
+                         capture: bool = False) -> None:
+        """The outside by direction; ``capture``: for the room's window capture (alpha 0)."""
         sky = None if self.environment is not None else self._sky(inputs)
         program = self._program("fullscreen.vert", "background.frag",
                                 {"SKY_MODEL": sky is not None,
                                  "SKY_BANDS": sky is not None and self.n_bands != 3,
-                                 "ENVIRONMENT": self.environment is not None})
+                                 "ENVIRONMENT": self.environment is not None,
+                                 "ROOM_CAPTURE": capture})
         self._scene_uniforms(program, view_proj, inputs, camera_position)
         if self.environment is not None:
             self.environment[1].use(location=ENVIRONMENT_UNIT)
@@ -1235,8 +1251,11 @@ class FrameRenderer:
         coverage = max(1.0 - float(inputs.direct), 1e-6)
         forward = hg_hemisphere_factors(float(inputs.g_spec))[0]
         thread = np.clip(float(inputs.a_spec) * forward * dye_rgb / coverage, 0.0, 1.0)
+        lobe = key * float(inputs.a_spec) * dye_rgb
         return {"u_key_rgb": tuple(float(v) for v in key), "u_mean_coverage": 1.0 - float(inputs.direct),
-                "u_thread_beam_rgb": tuple(float(v) for v in thread)}
+                "capture_thread": min(float(inputs.a_spec) * forward / coverage, 1.0),
+                "u_thread_beam_rgb": tuple(float(v) for v in thread),
+                "u_lobe_rgb": tuple(float(v) for v in lobe)}
 
     def _key_shadow_uniforms(self, program, inputs) -> None:
         """curtain.frag's KEY_SHADOW: the front-layer map, its frame and depth bias, the opening."""
@@ -1382,7 +1401,8 @@ class FrameRenderer:
                       gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
             self._set(program, "u_mesh_offset", self._mesh_offset)
             self._set(program, "u_mean_coverage", colours["u_mean_coverage"])
-            self._set(program, "u_thread_beam_rgb", colours["u_thread_beam_rgb"])
+            self._set(program, "u_thread_beam_rgb", (0.0, 0.0, 0.0) if self.room_lobe
+                      else colours["u_thread_beam_rgb"])
             self.ctx.disable(mgl.DEPTH_TEST)
             self.ctx.disable(mgl.CULL_FACE)
             self.ctx.enable(mgl.BLEND)
@@ -1465,7 +1485,8 @@ class FrameRenderer:
         lw, lh = room_light.luminaire_capture_size()
         gl["luminaire_fbo"].use()
         self.ctx.viewport = (0, 0, lw, lh)
-        gl["luminaire_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        # alpha: the key's irradiance on the cloth (curtain.frag ROOM_CAPTURE), 0 where none
+        gl["luminaire_fbo"].clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<="
         view_proj = room_light.luminaire_view_projection()
@@ -1482,7 +1503,7 @@ class FrameRenderer:
             finally:
                 if patterned:
                     self.patterned = patterned
-        self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False)
+        self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
         gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
         # the window side, from outside: nothing where there is no cloth (the room behind it
         # is not a source), and no see-through (it would show the outside, not the room)
@@ -1544,6 +1565,10 @@ class FrameRenderer:
         self._set(program, "u_luminaire_level", room_light.LUMINAIRE_LEVEL)
         self._set(program, "u_face_texels", float(room_light.FACE_TEXELS))
         self._set(program, "u_supersample_m", room_light.WINDOW_SUPERSAMPLE_M)
+        colours = self._room_colours(inputs)
+        self._set(program, "u_lobe_rgb", colours["u_lobe_rgb"] if self.room_lobe and not self.curtain_open
+                  else (0.0, 0.0, 0.0))
+        self._set(program, "u_g_spec", float(inputs.g_spec))
         gl["luminaire_back"].use(location=3)
         self._set(program, "u_luminaire_back", 3)
         self._set(program, "u_luminaire_back_level", room_light.BACK_LUMINAIRE_LEVEL)
@@ -1639,7 +1664,7 @@ class FrameRenderer:
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
-               self.room_bounces, getattr(self, "patterned", None),
+               self.room_bounces, self.room_lobe, getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
@@ -1988,7 +2013,8 @@ class FrameRenderer:
             "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
             "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
             "outside_by_view": self.outside_by_view,
-            "room_bounces": self.room_bounces, "shadow_map_size": self.shadow_texels,
+            "room_bounces": self.room_bounces, "room_lobe": self.room_lobe,
+            "shadow_map_size": self.shadow_texels,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
             "environment": None if self.environment is None else self.environment[0],

@@ -484,14 +484,73 @@ def window_patch_rectangles(plane_z: float) -> tuple[np.ndarray, np.ndarray, np.
     return corners, np.array(s), np.array(t)
 
 
+def _smoothstep(edge0, edge1, x):
+    t = np.clip((x - edge0) / (edge1 - edge0), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+def window_beam_mask(points: np.ndarray, to_light, tan_radius: float = math.tan(scene_lib.SUN_RADIUS_RAD)) -> np.ndarray:
+    """The float64 twin of common.glsl's ``room_window_beam``: the fraction of the key's beam
+    that reaches ``points`` (P, 3) through the opening (its inner and outer planes, edges
+    softened by the light's angular radius x the distance to each plane)."""
+    p = np.asarray(points, dtype=np.float64)
+    to_light = np.asarray(to_light, dtype=np.float64)
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    z_in = scene_lib.ROOM_BOX[2][0]
+    z_out = z_in - scene_lib.WALL_THICKNESS_M
+
+    def soft_rect(q, half):
+        lo_x = _smoothstep(wx0 - half, wx0 + half, q[:, 0])
+        lo_y = _smoothstep(wy0 - half, wy0 + half, q[:, 1])
+        hi_x = 1.0 - _smoothstep(wx1 - half, wx1 + half, q[:, 0])
+        hi_y = 1.0 - _smoothstep(wy1 - half, wy1 + half, q[:, 1])
+        return lo_x * lo_y * hi_x * hi_y
+
+    s_in = (z_in - p[:, 2]) / to_light[2]
+    s_out = (z_out - p[:, 2]) / to_light[2]
+    q_in = p[:, :2] + s_in[:, None] * to_light[:2]
+    q_out = p[:, :2] + s_out[:, None] * to_light[:2]
+    inner = np.where(s_in > 0.0, soft_rect(q_in, s_in * tan_radius + 1e-3), 1.0)
+    return (s_out >= 0.0) * inner * soft_rect(q_out, s_out * tan_radius + 1e-3)
+
+
+def lobe_radiance(points: np.ndarray, lobe_rgb, g_spec: float, to_light,
+                  key_factor=None) -> np.ndarray:
+    """(P, N, 3): the key's directional lobe leaving each window patch towards each point,
+    eq. 7's E cos_i a_spec ph(theta) with ``lobe_rgb`` = key x a_spec x dye and theta between
+    the key's travel and the way from the patch's centre in the opening (where its rectangle
+    lies; from the curtain's plane instead, 6 % of the flux missed the room) to the point.
+    ``key_factor`` (N,): the key's irradiance on the patch's cloth per unit of its normal
+    irradiance, the room capture's alpha (curtain.frag ROOM_CAPTURE: |cos_i| x the window's
+    mask x what a layer nearer the light passes, averaged over the patch, 0 where no cloth);
+    None: the flat cloth, |cos_i| x the beam's share through the opening at the patch's
+    centre in the curtain's plane (:func:`window_beam_mask`)."""
+    corners, s, t = window_patch_rectangles(scene_lib.ROOM_BOX[2][0])
+    centres = corners + 0.5 * (s + t)
+    to_light = np.asarray(to_light, dtype=np.float64)
+    if key_factor is None:
+        on_cloth = centres.copy()
+        on_cloth[:, 2] = scene_lib.CURTAIN_Z
+        key_factor = abs(to_light[2]) * window_beam_mask(on_cloth, to_light)
+    w = np.asarray(points, dtype=np.float64)[:, None, :] - centres[None, :, :]
+    w /= np.linalg.norm(w, axis=-1, keepdims=True)
+    chord2 = np.sum((w + to_light) ** 2, axis=-1)
+    g = float(g_spec)
+    d = (1.0 - g) ** 2 + g * chord2
+    phase = (1.0 - g) * (1.0 + g) / (4.0 * math.pi) / (d * np.sqrt(d))
+    factor = np.asarray(key_factor, dtype=np.float64).reshape(-1)
+    return (factor[None, :] * phase)[..., None] * np.asarray(lobe_rgb, dtype=np.float64)
+
+
 def window_irradiance(radiance_front: np.ndarray, radiance_back: np.ndarray,
-                      face_texels: int = FACE_TEXELS) -> np.ndarray:
+                      face_texels: int = FACE_TEXELS, lobe: dict | None = None) -> np.ndarray:
     """The float64 twin of room_lightmap.frag's window term, (R, 6R, 3): per atlas texel, the
     mean over its sample points on a wall (2 x 2 within WINDOW_SUPERSAMPLE_M of the window's
     plane, else the centre; none inside the opening) of the room side's patches (in the
     opening, ``radiance_front`` (9, 12, 3), the capture at its patch level) and, behind the
     curtain's plane, its window side's (``radiance_back``), each E = L F with F from
-    :func:`rectangle_irradiance_factor`."""
+    :func:`rectangle_irradiance_factor`; with ``lobe`` (keywords of :func:`lobe_radiance`),
+    the room side's patches add the key's directional lobe."""
     positions, normals = texel_points(face_texels)
     wall_z = scene_lib.ROOM_BOX[2][0]
     wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
@@ -517,7 +576,10 @@ def window_irradiance(radiance_front: np.ndarray, radiance_back: np.ndarray,
             if not use.any():
                 continue
             n = np.broadcast_to(face.normal, q.shape)
-            e = rectangle_irradiance_factor(q[use], n[use], *front) @ lf
+            factors = rectangle_irradiance_factor(q[use], n[use], *front)
+            e = factors @ lf
+            if lobe is not None:
+                e += np.einsum("pj,pjc->pc", factors, lobe_radiance(q[use], **lobe))
             behind = q[use, 2] < scene_lib.CURTAIN_Z
             if behind.any():
                 e[behind] += rectangle_irradiance_factor(q[use][behind], n[use][behind], *back) @ lb
