@@ -29,10 +29,15 @@ import statistics
 import time
 from pathlib import Path
 
+import numpy as np
+
 #: Nominal GPU throughput for the estimate: shaded fragment-iterations per second (a
 #: mid-range discrete GPU runs ~1e11 simple fragment operations/s; a loop iteration of the
 #: light-map gather is ~10 of them).
 GPU_ITERATIONS_PER_S = 1.0e10
+#: An exact form factor (room_light.rectangle_irradiance_factor: four edges, an arc tangent
+#: each) in units of the point form's loop iteration, for the estimate.
+EXACT_FACTOR_ITERATIONS = 5.0
 
 #: moving: the room's light is redrawn every this many frames (0: never, a still cloth).
 CONFIGS = (
@@ -64,17 +69,31 @@ def work_counts(size) -> dict[str, float]:
     """Fragment-iterations per pass (the GPU estimate's numerator)."""
     from catalog.render import room_light  # noqa: PLC0415
 
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
     w, h = size
     aw, ah = room_light.atlas_size()
     lw, lh = room_light.LUMINAIRE_TEXELS
     coarse = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
     n = room_light.SHADOW_TEXELS
+    # issue 11's third round: an exact form factor (four edges, an arc tangent each) costs
+    # about EXACT_FACTOR point-form iterations; the window's term is the mean of 4 points on
+    # the texels near the window, and the window wall's texels add the curtain's window side
+    exact = EXACT_FACTOR_ITERATIONS
+    points, _ = room_light.texel_points()
+    z = points[..., 2]
+    wall_z = scene_lib.ROOM_BOX[2][0]
+    samples = float(np.where(z < wall_z + room_light.WINDOW_SUPERSAMPLE_M, 4, 1).sum())
+    behind = float(np.where(z < scene_lib.CURTAIN_Z, 4, 0).sum())
     return {
         "room_shadow": 0.6 * n * n,
-        "room_luminaire": float(lw * lh),
-        # the direct part and the gather per atlas texel, and the radiosity pass (issue 11):
+        # the two captures' curtain fragments (room side and window side)
+        "room_luminaire": float(lw * lh * (4 ** room_light.LUMINAIRE_LEVEL
+                                           + 4 ** room_light.BACK_LUMINAIRE_LEVEL)),
+        # the window's term and the gather per atlas texel, and the radiosity pass (issue 11):
         # one fragment per coarse patch, summing over every patch
-        "room_lightmap": float(aw * ah * (lw * lh + 5 * coarse * coarse)
+        "room_lightmap": float((samples + behind) * lw * lh * exact
+                               + aw * ah * 5 * coarse * coarse * exact
                                + (len(room_light.FACE_NAMES) * coarse * coarse) ** 2),
         "room": 0.5 * w * h,
         "curtain": 0.5 * w * h * 4,
