@@ -66,17 +66,21 @@ class DesktopFrames:
         self.renderer.set_ev(self.renderer.current_ev100())
 
     def times(self, frames: int) -> list[float]:
-        """ms of each of ``frames`` frames (render + finish)."""
+        """ms of each of ``frames`` frames (render + finish). Two of these frames run side by
+        side, each on its own EGL context: this one is made current first (GL calls go to
+        the current context; drawn on the other, a frame's objects crashed llvmpipe)."""
         out = []
-        for _ in range(frames):
-            start = time.perf_counter()
-            self.renderer.render()
-            self.ctx.finish()
-            out.append(1000.0 * (time.perf_counter() - start))
+        with self.ctx:
+            for _ in range(frames):
+                start = time.perf_counter()
+                self.renderer.render()
+                self.ctx.finish()
+                out.append(1000.0 * (time.perf_counter() - start))
         return out
 
     def release(self) -> None:
-        self.renderer.release()
+        with self.ctx:
+            self.renderer.release()
         self.ctx.release()
 
 
