@@ -418,6 +418,24 @@ def round_changes(before: dict, after: dict) -> str:
     return "\n".join(lines)
 
 
+def _round_blocks(runs: dict, name: str, ordinal: str, previous: str) -> dict[str, str]:
+    """The blocks of one of issue 11's later rounds (``runs[name]``, named
+    ``image-after-11-round-N``): its table, options and images, its summary line, and its
+    changes against ``runs[previous]``."""
+    run = runs[name]
+    latest = markdown_tables(run)
+    prefix = "image-after-11-round-" + name.rsplit("_", 1)[-1]
+    return {
+        prefix: (latest["image"] + "\n\nReal-time options against the same references:\n\n"
+                 + latest["image-options"]
+                 + f"\n\n![six scenes after issue 11's {ordinal} round: real-time | reference | FLIP]"
+                 f"(img/pathtrace_scenes_{name}.png)\n\n"
+                 f"![real-time options against the reference](img/pathtrace_pareto_{name}.png)"),
+        prefix + "-summary": summary_line(run),
+        prefix + "-changes": round_changes(runs[previous], run),
+    }
+
+
 def markdown_tables(result: dict) -> dict[str, str]:
     """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run; of the
     committed JSON (``{"runs": {...}}``) the baseline's, and ``image-after`` the run after
@@ -438,28 +456,9 @@ def markdown_tables(result: dict) -> dict[str, str]:
                 + "\n\n![six scenes after issue 11's fixes: real-time | reference | FLIP]"
                 "(img/pathtrace_scenes_after_11.png)")
             blocks["image-after-11-summary"] = summary_line(run)
-        if ROUND_2 in result["runs"]:
-            run = result["runs"][ROUND_2]
-            latest = markdown_tables(run)
-            blocks["image-after-11-round-2"] = (
-                latest["image"] + "\n\nReal-time options against the same references:\n\n"
-                + latest["image-options"]
-                + f"\n\n![six scenes after issue 11's second round: real-time | reference | FLIP]"
-                f"(img/pathtrace_scenes_{ROUND_2}.png)\n\n"
-                f"![real-time options against the reference](img/pathtrace_pareto_{ROUND_2}.png)")
-            blocks["image-after-11-round-2-summary"] = summary_line(run)
-            blocks["image-after-11-round-2-changes"] = round_changes(result["runs"]["after_11"], run)
-        if ROUND_3 in result["runs"]:
-            run = result["runs"][ROUND_3]
-            latest = markdown_tables(run)
-            blocks["image-after-11-round-3"] = (
-                latest["image"] + "\n\nReal-time options against the same references:\n\n"
-                + latest["image-options"]
-                + f"\n\n![six scenes after issue 11's third round: real-time | reference | FLIP]"
-                f"(img/pathtrace_scenes_{ROUND_3}.png)\n\n"
-                f"![real-time options against the reference](img/pathtrace_pareto_{ROUND_3}.png)")
-            blocks["image-after-11-round-3-summary"] = summary_line(run)
-            blocks["image-after-11-round-3-changes"] = round_changes(result["runs"][ROUND_2], run)
+        for name, ordinal, previous in ((ROUND_2, "second", "after_11"), (ROUND_3, "third", ROUND_2)):
+            if name in result["runs"]:
+                blocks.update(_round_blocks(result["runs"], name, ordinal, previous))
         return blocks
 
     s = result["summary"]
