@@ -1492,17 +1492,7 @@ class FrameRenderer:
         view_proj = room_light.luminaire_view_projection()
         eye = room_light.LUMINAIRE_EYE
         if not self.curtain_open:
-            # the flat cloth (the pattern averaged, model.md section 9): each capture texel is
-            # a 4x4 mean over a window patch anyway, and the flat variant draws in one pass
-            patterned = getattr(self, "patterned", None)
-            if patterned:
-                self.patterned = False
-            try:
-                self.draw_curtain(view_proj, camera_position=eye,
-                                  overrides=self._capture_overrides(), coarse=True)
-            finally:
-                if patterned:
-                    self.patterned = patterned
+            self._draw_flat_curtain(view_proj, eye, self._capture_overrides())
         self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
         gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
         # the window side, from outside: nothing where there is no cloth (the room behind it
@@ -1511,19 +1501,24 @@ class FrameRenderer:
         self.ctx.viewport = (0, 0) + room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)
         gl["luminaire_back_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
         if not self.curtain_open:
-            patterned = getattr(self, "patterned", None)
-            if patterned:
-                self.patterned = False
-            try:
-                self.draw_curtain(room_light.back_luminaire_view_projection(),
-                                  camera_position=room_light.BACK_LUMINAIRE_EYE,
-                                  overrides=self._back_capture_overrides(), coarse=True)
-            finally:
-                if patterned:
-                    self.patterned = patterned
+            self._draw_flat_curtain(room_light.back_luminaire_view_projection(),
+                                    room_light.BACK_LUMINAIRE_EYE, self._back_capture_overrides())
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         gl["luminaire_back"].build_mipmaps()
+
+    def _draw_flat_curtain(self, view_proj, eye, overrides: dict) -> None:
+        """The room's captures draw the flat cloth (the pattern averaged, model.md section 9):
+        each capture texel is a mean over a window patch anyway, and the flat variant draws in
+        one pass."""
+        patterned = getattr(self, "patterned", None)
+        if patterned:
+            self.patterned = False
+        try:
+            self.draw_curtain(view_proj, camera_position=eye, overrides=overrides, coarse=True)
+        finally:
+            if patterned:
+                self.patterned = patterned
 
     def window_albedo_rgb(self, inputs) -> tuple[float, float, float]:
         """The closed curtain's room-side reflectance under diffuse light (linear sRGB): the

@@ -460,11 +460,6 @@ def luminaire_capture_size(level: int = LUMINAIRE_LEVEL) -> tuple[int, int]:
     return LUMINAIRE_TEXELS[0] << level, LUMINAIRE_TEXELS[1] << level
 
 
-def window_patch_area_m2() -> float:
-    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-    return (wx1 - wx0) * (wy1 - wy0) / (LUMINAIRE_TEXELS[0] * LUMINAIRE_TEXELS[1])
-
-
 #: room_lightmap.frag averages the window's light over 2 x 2 points of a texel within this
 #: distance of the window's plane (m), its centre alone further away.
 WINDOW_SUPERSAMPLE_M = 1.0
