@@ -24,7 +24,7 @@ uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to th
 #ifdef OIT
 uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW) || defined(ROOM_SIDE)
 INTERPOLATION in vec3 v_position;
 #endif
 
@@ -129,6 +129,19 @@ uniform vec2 u_wall_z;
 uniform float u_tan_sun_radius;
 float g_key_beam = 1.0;            // the window's mask (set in main)
 float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
+#endif
+#ifdef ROOM_SIDE
+// The curtain's room side lit by the room's own light (issue 11, fourth round), not by the
+// stand-ins (the fill light and the room's share of the ambient term, which frame.py then
+// leaves out: scene.with_room_solved): the irradiance the room's faces send to the window
+// (room_bounce.frag CURTAIN_SIDE, every bounce), read at the fragment's place over the
+// opening, scattered back towards the viewer by the lobes' backward hemisphere factors as the
+// room's share of eq. 8's ambient term is (u_room_side_reflectance: dye (a_diff backward(g_diff)
+// + a_spec backward(g_spec)) in display RGB, the radiosity's curtain reflectance), by the
+// view's ratio g_view_room. RGB like the room's light, so added after the bands' conversion.
+uniform sampler2D u_room_side;     // irradiance, linear sRGB (x pi cd m^-2)
+uniform vec4 u_room_side_rect;     // the grid: x from, y from, 1 / width, 1 / height (m)
+uniform vec3 u_room_side_reflectance;
 #endif
 #ifdef ROOM_CAPTURE
 uniform float u_capture_thread;    // the key a thread passes, a_spec forward(g_spec) / (1 - LD)
@@ -311,6 +324,11 @@ void main() {
 #endif
 #if defined(SEE_THROUGH) && defined(CURTAIN_ENVIRONMENT)
     rgb += (bg.x * u_direct) * environment_lookup(u_environment, u_environment_scale, ray);
+#endif
+#ifdef ROOM_SIDE
+    vec2 side_uv = (v_position.xy - u_room_side_rect.xy) * u_room_side_rect.zw;
+    rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance
+         * textureLod(u_room_side, side_uv, 0.0).rgb;
 #endif
 #ifdef PATTERN
     // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole

@@ -40,7 +40,7 @@ INTERPOLATION out vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 INTERPOLATION out vec3 v_tangent;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW) || defined(ROOM_SIDE)
 INTERPOLATION out vec3 v_position;
 #endif
 
@@ -54,7 +54,7 @@ void main() {
 #ifdef PATTERN
     v_pattern_uv = in_uv * u_uv_to_repeats;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW) || defined(ROOM_SIDE)
     v_position = position;
 #endif
 #ifdef SKY_OCCLUSION

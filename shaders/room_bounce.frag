@@ -9,6 +9,10 @@
 // coarse mip of the direct map plus the key's beam (one bounce, issue 13's frame). The room is a convex box, so
 // every patch sees every other; the precomputed ambient occlusion (corners, the window's
 // reveals) scales the bounce.
+// CURTAIN_SIDE (issue 11, fourth round): the same gather at a grid of points over the window
+// opening in the wall's plane, facing the room, from every face but the window wall: the
+// irradiance the room sends to the curtain's room side (curtain.frag ROOM_SIDE), with no
+// direct light and no obscurance (the room's own light, every bounce, no stand-in).
 #include "common.glsl"
 
 in vec2 v_ndc;
@@ -27,10 +31,21 @@ uniform int u_bounce_level;          // the mip level gathered
 uniform int u_coarse_texels;         // face texels at that level
 uniform float u_albedo;
 uniform vec3 u_window_albedo;       // the closed curtain's room-side reflectance (0: open)
+#ifdef CURTAIN_SIDE
+uniform vec4 u_side_rect;            // the grid's extent: x from, y from, width, height (m)
+uniform float u_side_z;              // its plane (m): the window wall's
+#endif
 
 layout(location = 0) out vec4 out_irradiance;
 
 void main() {
+#ifdef CURTAIN_SIDE
+    int face = ROOM_FACES - 1;   // the window wall, left out below: the cloth lies in front of it
+    vec3 p = vec3(u_side_rect.xy + v_uv * u_side_rect.zw, u_side_z);
+    vec3 n = vec3(0.0, 0.0, 1.0);
+    vec3 direct = vec3(0.0);
+    float ao = 1.0;
+#else
     float x = v_uv.x * float(ROOM_FACES);
     int face = min(int(floor(x)), ROOM_FACES - 1);
     vec3 p = u_face_origin[face] + fract(x) * u_face_s[face] + v_uv.y * u_face_t[face];
@@ -38,6 +53,7 @@ void main() {
     ivec2 own = ivec2(v_uv * vec2(textureSize(u_direct, 0)));
     vec3 direct = texelFetch(u_direct, own, 0).rgb;
     float ao = texelFetch(u_ao_mask, own, 0).r;
+#endif
 
     vec3 bounce = vec3(0.0);
     float rc = float(u_coarse_texels);

@@ -79,13 +79,9 @@ def _displayed_mean_linear(renderer, mask):
 
 def _exact_mean_linear(renderer, mask, like):
     """The float64 spectral colour of the curtain pixels, white-balanced, scaled to ``like``'s Y."""
-    from catalog.optics import shading_reference as ref
 
     gbuffer = renderer.render_gbuffer()
-    exact = ref.reference_linear_srgb(renderer.shading_inputs(), gbuffer["position"][mask],
-                                      gbuffer["normal"][mask], gbuffer["tangent"][mask],
-                                      renderer.camera.position,
-                                      **ref.shadow_terms(gbuffer["shadows"][mask])).mean(axis=0)
+    exact = renderer.twin_linear_srgb(gbuffer, mask).mean(axis=0)
     exact = renderer.white_balance_matrix() @ exact
     luminance = display.matrices().luminance
     return exact * (like @ luminance) / (exact @ luminance)

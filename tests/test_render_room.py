@@ -455,8 +455,10 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
     pixel seen from the room eq. 8 with the lamp as the light: the band values of
     I(l) x dye(l) times G(to_lamp, view) / r^2 (catalog.optics.shading_reference.
     woven_transmission, float64, at the G-buffer's own positions and normals), shown through
-    the bands' display matrix; read back within 1 % (float32) where the added radiance is
-    above 1 % of its largest value. Without the lamp term the added radiance would be 0."""
+    the bands' display matrix, plus the lamp's light the room sends back to the cloth's room
+    side (ROOM_SIDE: its twin from the gathered grid); read back within 1 % (float32) where
+    the added radiance is above 1 % of its largest value. Without the lamp term the added
+    radiance would be 0."""
     from catalog.optics.shading_reference import woven_transmission
     from catalog.render import bands as band_lib
 
@@ -464,6 +466,7 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
     r.set_bands(n_bands)
     r.set_curtain_open(False)
     before = r.render_gbuffer()
+    side_before = r.twin_room_side_rgb(before, before["mask"])
     faces = room_light.room_faces()
     floor = faces[0]
     centre = floor.origin + 0.5 * floor.axis_s + 0.5 * floor.axis_t
@@ -472,6 +475,11 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
     after = r.render_gbuffer()
     mask = before["mask"] & after["mask"]
     assert mask.sum() > 500
+    # the lamp lights the room too, and the room the cloth's room side (ROOM_SIDE's twin)
+    room_side = np.zeros(after["mask"].shape + (3,))
+    room_side[after["mask"]] = r.twin_room_side_rgb(after, after["mask"])
+    room_side[before["mask"]] -= side_before
+    assert room_side[mask].sum() > 0.0
     inputs = r.shading_inputs()
     p = after["position"][mask].astype(np.float64)
     n = after["normal"][mask].astype(np.float64)
@@ -486,7 +494,7 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
                   for i in range(len(p))]) / r2
     weights, to_rgb = band_lib.band_weights(n_bands, inputs.key_irradiance)
     lamp_rgb = to_rgb @ (weights @ (r.room_lamps[0][0].irradiance_w_m2_nm * inputs.dye_transmittance))
-    expected = g[:, None] * lamp_rgb
+    expected = g[:, None] * lamp_rgb + room_side[mask]
     added = (after["radiance"][mask] - before["radiance"][mask]).astype(np.float64)
     big = expected.sum(-1) > 0.01 * expected.sum(-1).max()
     assert big.sum() > 0.5 * mask.sum()
@@ -669,4 +677,76 @@ def test_capture_alpha_is_the_key_on_the_nearest_cloth(gl):
         r.render()
         alpha = np.frombuffer(res["luminaire"].read(level=lvl), dtype=np.float32).reshape(h, w, 4)[..., 3]
         assert np.allclose(alpha[3:6, 4:8], expected, atol=2e-3)
+    r.release()
+
+
+def test_curtain_side_gather_closes_over_the_room():
+    """The room-side grid's geometry (room_light.curtain_side_points, the window wall's plane,
+    facing the room): the exact factors of the coarse patches of the other five faces sum to
+    pi at every point (the room closes the hemisphere in front of the window), 1e-9."""
+    patches = room_light.coarse_patches()
+    keep = patches["face"] != room_light.FACE_NAMES.index("window_wall")
+    points = room_light.curtain_side_points().reshape(-1, 3)
+    normals = np.broadcast_to(np.array([0.0, 0.0, 1.0]), points.shape)
+    factors = room_light.rectangle_irradiance_factor(points, normals, patches["corner"][keep],
+                                                     patches["s"][keep], patches["t"][keep])
+    assert np.allclose(factors.sum(axis=1), math.pi, rtol=0.0, atol=1e-9)
+
+
+def test_sample_bilinear_is_gl_linear_with_clamp():
+    """The twin's texture read: exact at texel centres, the mean of four between them, the edge
+    texel beyond the edge (clamp), linear in between (closed forms on a ramp)."""
+    tex = np.arange(12.0).reshape(3, 4, 1)   # value = 4 row + column
+    uv = np.array([[0.5 / 4, 0.5 / 3], [1.0 / 4, 1.0 / 3], [-0.2, 1.3], [0.3, 0.5]])
+    got = room_light.sample_bilinear(tex, uv)[:, 0]
+    x = 0.3 * 4 - 0.5
+    assert np.allclose(got, [0.0, 2.5, 8.0, 4.0 + x], atol=1e-12)
+
+
+@pytest.mark.parametrize("light", ["sun:60", "UV-A"])
+def test_room_side_grid_matches_float64_gather(gl, light):
+    """Pass R4b (issue 11, fourth round): the room's irradiance on the curtain's room side,
+    gathered on the GPU from the coarse patches' total irradiance, against its float64 twin
+    (room_light.curtain_side_irradiance from the same read-back totals) within 1e-3 of the
+    grid's largest value; and it is light (above 0) everywhere, the glow's under UV-A too."""
+    r = _renderer(gl, light=light)
+    r.set_curtain_open(False)
+    r.render()
+    assert r.room_side_active()
+    side = r.read_room_side()
+    twin = room_light.curtain_side_irradiance(r.read_room_total(), scene_lib.ROOM_ALBEDO,
+                                              r.window_albedo_rgb(r.shading_inputs()))
+    assert np.all(_luma(twin) > 0.0)
+    assert np.abs(side - twin).max() < 1e-3 * np.abs(twin).max()
+    r.release()
+
+
+def test_room_side_replaces_the_stand_ins(gl):
+    """With the room lit and the viewer inside, the curtain program drops the stand-ins (no fill
+    light, the ambient's outside share alone, neither exciting the glow: scene.with_room_solved)
+    and compiles ROOM_SIDE; switched off, with the room unlit or the viewer outside, the stand-ins
+    stay. Under UV-A the room lit by the safety-yellow's glow sends the cloth's room side far more
+    than the stand-ins did (they knew nothing of the glow: more than 10x, measured about 100x).
+    The shading itself is held to its twin per pixel by test_render_frame."""
+    r = _renderer(gl, fabric="safety-yellow", light="UV-A")
+    r.set_curtain_open(False)
+    inputs, solved = r.shading_inputs(), r.curtain_inputs()
+    assert r.variant_defines().get("ROOM_SIDE")
+    assert not np.any(solved.fill_irradiance) and inputs.fill_irradiance.max() > 0
+    assert np.allclose(solved.ambient_radiance, inputs.ambient_outside_radiance)
+    assert solved.absorbed_photons[1] == 0.0
+    assert solved.absorbed_photons[2] == pytest.approx(inputs.absorbed_photons[2] - inputs.absorbed_room_photons)
+    r.render()
+    side = r.read_room_side()
+    colours = r._display_colours(inputs)
+    stand_in = math.pi * _luma(colours["u_room_rgb"]) + math.pi / scene_lib.ROOM_ALBEDO * _luma(colours["u_fill_rgb"])
+    assert _luma(side).mean() > 10.0 * stand_in
+    r.set_room_side(False)
+    assert not r.variant_defines().get("ROOM_SIDE") and r.curtain_inputs() is r.shading_inputs()
+    r.set_room_side(True)
+    r.set_room_lighting(False)
+    assert not r.room_side_active()
+    r.set_room_lighting(True)
+    r.set_camera(180.0, 0.0, 2.0)   # yaw 180: from outside, looking in
+    assert not r.viewer_inside and not r.room_side_active()
     r.release()

@@ -194,10 +194,8 @@ def band_errors(ctx, preset) -> dict:
                 renderer.set_bands(n)
                 gb = renderer.render_gbuffer()
                 m = gb["mask"]
-                inputs = renderer.shading_inputs()
-                reference = ref.reference_linear_srgb(inputs, gb["position"][m], gb["normal"][m],
-                                                      gb["tangent"][m], renderer.camera.position,
-                                                      **ref.shadow_terms(gb["shadows"][m]))
+                inputs = renderer.curtain_inputs()
+                reference = renderer.twin_linear_srgb(gb, m)
                 de = delta_e_2000(linear_srgb_to_xyz(gb["radiance"][m].astype(np.float64)),
                                   linear_srgb_to_xyz(reference), ref.white_xyz(inputs))
                 rows[f"{light}|{inputs.fluorescence_mode}|{n}"] = (float(de.mean()), float(de.max()))

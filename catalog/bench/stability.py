@@ -147,8 +147,6 @@ def fluorescence_sweep(scales) -> list[dict]:
 def render_sweep(ctx, scales, quick: bool) -> list[dict]:
     """Float32 frames against the float64 reference over 12 decades of light and edge
     values of tau and g."""
-    from catalog.optics import shading_reference as ref  # noqa: PLC0415
-    from catalog.optics.colorimetry import xyz_to_linear_srgb  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
@@ -173,10 +171,7 @@ def render_sweep(ctx, scales, quick: bool) -> list[dict]:
                     m = gb["mask"]
                     rgb = gb["radiance"][m].astype(np.float64)
                     bad += int(np.sum(~np.isfinite(rgb)))
-                    truth = xyz_to_linear_srgb(ref.spectral_to_xyz(ref.shade_spectral(
-                        renderer.shading_inputs(), gb["position"][m], gb["normal"][m],
-                        gb["tangent"][m], renderer.camera.position,
-                        **ref.shadow_terms(gb["shadows"][m]))))
+                    truth = renderer.twin_linear_srgb(gb, m)
                     # relative to each pixel's luminance: a dark channel's rounding counts
                     # against the pixel, not against its own near-zero value
                     luminance = np.maximum(np.abs(truth @ LUMINANCE_WEIGHTS), 1e-300)

@@ -65,6 +65,7 @@ class ShadingInputs:
     fluorescence_mode: str                # "off" | "paper" | "physical" (after the "needed" judgement)
     paper_radiance: np.ndarray | None = None          # eq. 8: I_fluor F as a radiance
     absorbed_photons: tuple[float, float, float] = (0.0, 0.0, 0.0)  # key, fill (normal incidence), ambient; m^-2 s^-1
+    absorbed_room_photons: float = 0.0   # the room's part of absorbed_photons[2] (its stand-in's), m^-2 s^-1
     saturation_photons: float = math.inf  # N_sat, m^-2 s^-1
     emission_per_photon: np.ndarray | None = None     # radiance per effective absorbed photon m^-2 s^-1, per side
     ambient_outside_radiance: np.ndarray | None = None  # the outside's share of ambient_radiance (None: 0)
@@ -362,6 +363,24 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
         effective = absorbed / (1.0 + absorbed / inputs.saturation_photons)
         radiance += effective[:, None] * inputs.emission_per_photon[None, :]
     return radiance
+
+
+def room_side_linear_srgb(inputs: ShadingInputs, positions, normals, camera_position,
+                         irradiance_rgb, reflectance_rgb) -> np.ndarray:
+    """(P, 3) linear sRGB: the room's solved light on the curtain's room side (issue 11, fourth
+    round; curtain.frag ROOM_SIDE), the twin of the term the frame adds to the shading of
+    ``catalog.render.scene.with_room_solved(inputs)``: the room's irradiance at each position
+    (P, 3; linear sRGB, x pi cd m^-2) over pi, times the cloth's reflectance of diffuse light
+    from the room's side (3,), times the ambient's ratio by view for the room's hemisphere."""
+    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    n = n / np.linalg.norm(n, axis=1, keepdims=True)
+    to_viewer = np.asarray(camera_position, dtype=np.float64) - p
+    to_viewer = to_viewer / np.linalg.norm(to_viewer, axis=1, keepdims=True)
+    mu = np.abs(np.einsum("pi,pi->p", to_viewer, n))
+    r_room = ambient_view_ratio(inputs.ambient_view_room, mu)
+    return (r_room[:, None] / math.pi) * np.asarray(irradiance_rgb, dtype=np.float64).reshape(-1, 3) \
+        * np.asarray(reflectance_rgb, dtype=np.float64)[None, :]
 
 
 def shadow_terms(shadows) -> dict:

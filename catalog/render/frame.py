@@ -93,6 +93,8 @@ KEY_SHADOW_SLOPE_CAP = 4.0
 KEY_SHADOW_NORMAL_OFFSET_TEXELS = 0.0
 #: Texture unit of the occlusion maps (the curtain's SKY_OCCLUSION).
 OCCLUSION_UNIT = 7
+#: Texture unit of the room's irradiance on the curtain's room side (the curtain's ROOM_SIDE).
+ROOM_SIDE_UNIT = 8
 #: SKY_OCCLUSION's depth bias (m) and its lookup's offset off the surface (m): a texel and a
 #: half of an occlusion map (room_light.OCCLUSION_TEXELS over ~2.4 m: 2 cm each).
 OCCLUSION_BIAS_M = 0.01
@@ -299,6 +301,10 @@ class FrameRenderer:
         #: its HG lobe, from the window's patches (room_lightmap.frag); False: collimated in
         #: the beam, a_spec forward(g_spec) per thread (issue 13's frame)
         self.room_lobe = True
+        #: issue 11 (fourth round): the curtain's room side lit by the room's solved light
+        #: (curtain.frag ROOM_SIDE, with the room lighting and the viewer inside); False: by
+        #: the stand-ins, the fill light and the room's share of the ambient term
+        self.room_side_solved = True
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -478,6 +484,32 @@ class FrameRenderer:
         patches (True, issue 11: the path-traced floor by a voile under a low key was 1.5x the
         collimated beam's light) or kept in the collimated beam (False, issue 13's frame)."""
         self.room_lobe = bool(on)
+
+    def set_room_side(self, solved: bool) -> None:
+        """Light the curtain's room side by the room's solved light (True, issue 11's fourth
+        round: the stand-ins were 1.5-2.5x the room's light under daylight and 1 % of it under
+        UV-A, where the room is lit by the glow) or by the stand-ins (False: the fill light
+        and the room's share of the ambient term, the earlier frame)."""
+        self.room_side_solved = bool(solved)
+
+    def room_side_active(self) -> bool:
+        """Whether the curtain's room side takes the room's solved light this frame: with the
+        room lighting, the option on and the viewer in the room (from outside, the room lies
+        behind the cloth and the stand-ins stay)."""
+        return bool(self.room_lighting and self.room_side_solved and self.viewer_inside)
+
+    def curtain_inputs(self):
+        """The :class:`ShadingInputs` the curtain program shades with: :meth:`shading_inputs`,
+        without the stand-ins for the room's light when :meth:`room_side_active`
+        (:func:`catalog.render.scene.with_room_solved`). The float64 twin of a frame takes these."""
+        inputs = self.shading_inputs()
+        if not self.room_side_active():
+            return inputs
+        key = (self._inputs_key, "room_solved")
+        if getattr(self, "_curtain_inputs_key", None) != key:
+            self._curtain_inputs = scene_lib.with_room_solved(inputs)
+            self._curtain_inputs_key = key
+        return self._curtain_inputs
 
     def set_shadow_map_size(self, texels: int) -> None:
         """The side of the key light's maps (the room's transmittance map and the cloth's
@@ -717,8 +749,8 @@ class FrameRenderer:
         return self._inputs
 
     def _band_uniforms(self):
-        inputs = self.shading_inputs()
-        key = (self._inputs_key, self.n_bands)
+        inputs = self.curtain_inputs()
+        key = (self._inputs_key, self.n_bands, self.room_side_active())
         if key != self._uniforms_key:
             self._uniforms = band_lib.band_uniforms(inputs, self.n_bands)
             self._uniforms_key = key
@@ -741,6 +773,8 @@ class FrameRenderer:
         if self.sky_occlusion and not self.curtain_open:
             defines["SKY_OCCLUSION"] = True   # the folds hide part of the outside
             defines["N_OCCLUSION"] = room_light.OCCLUSION_DIRECTIONS
+        if self.room_side_active():
+            defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -791,6 +825,7 @@ class FrameRenderer:
         defines = self.variant_defines(gbuffer)
         if overrides:
             defines["ROOM_CAPTURE"] = True  # the room's window capture (issue 13), not the frame's
+            defines.pop("ROOM_SIDE", None)  # the radiosity reflects the room's light off the cloth
         if self.specialise:
             for name, value in self._scene_values_with(overrides).items():
                 defines["S_" + name[2:].upper()] = glsl_literal(value)
@@ -1006,6 +1041,8 @@ class FrameRenderer:
                 self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
             if "u_key_front" in program:
                 self._key_shadow_uniforms(program, self.shading_inputs())
+            if "u_room_side" in program:
+                self._room_side_uniforms(program)
             if "u_capture_thread" in program:
                 inputs = self.shading_inputs()
                 self._set(program, "u_capture_thread", float(self._room_colours(inputs)["capture_thread"]))
@@ -1226,8 +1263,13 @@ class FrameRenderer:
             bounces.filter = (mgl.NEAREST, mgl.NEAREST)
             total = ctx.texture((len(room_light.FACE_NAMES) * rc, rc), 4, dtype="f4")
             total.filter = (mgl.NEAREST, mgl.NEAREST)
+            tw, th = room_light.CURTAIN_SIDE_TEXELS
+            side_light = ctx.texture((tw, th), 4, data=np.zeros((th, tw, 4), "f4").tobytes(), dtype="f4")
+            side_light.filter = (mgl.LINEAR, mgl.LINEAR)
+            side_light.repeat_x = side_light.repeat_y = False
             self._room_gl.update({"radiosity_operator": bounces, "total": total,
-                                  "total_fbo": ctx.framebuffer([total])})
+                                  "total_fbo": ctx.framebuffer([total]),
+                                  "room_side": side_light, "room_side_fbo": ctx.framebuffer([side_light])})
             self._operator_albedo = None
         return self._room_gl
 
@@ -1529,6 +1571,15 @@ class FrameRenderer:
 
         if self.curtain_open:
             return (0.0, 0.0, 0.0)
+        return self.curtain_room_reflectance_rgb(inputs)
+
+    def curtain_room_reflectance_rgb(self, inputs) -> tuple[float, float, float]:
+        """The cloth's reflectance under the room's diffuse light (linear sRGB), dye (a_diff
+        backward(g_diff) + a_spec backward(g_spec)), the dye per channel under the key as the
+        room's colours take it: what the radiosity's window reflects and what the curtain's
+        room side sends back of the room's light (curtain.frag ROOM_SIDE)."""
+        from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
+
         dye_rgb = self._room_dye_rgb(self._display_colours(inputs))
         back = (float(inputs.a_diff) * hg_hemisphere_factors(float(inputs.g_diff))[1]
                 + float(inputs.a_spec) * hg_hemisphere_factors(float(inputs.g_spec))[1])
@@ -1615,6 +1666,54 @@ class FrameRenderer:
         self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
         self._set(program, "u_window_albedo", window_albedo)
         self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        if self.room_side_active():
+            self._draw_room_side(all_bounces, window_albedo)
+
+    def _draw_room_side(self, all_bounces: bool, window_albedo) -> None:
+        """Pass R4b (issue 11, fourth round): the room's irradiance on the curtain's room side,
+        room_bounce.frag's gather at CURTAIN_SIDE_TEXELS points over the opening."""
+        mgl, gl = self._moderngl, self._room_resources()
+        defines = {"CURTAIN_SIDE": True}
+        if all_bounces:
+            defines["ALL_BOUNCES"] = True
+        gl["room_side_fbo"].use()
+        self.ctx.viewport = (0, 0, *room_light.CURTAIN_SIDE_TEXELS)
+        program = self._program("fullscreen.vert", "room_bounce.frag", defines)
+        if all_bounces:
+            gl["total"].use(location=4)
+            self._set(program, "u_total", 4)
+        for name, value in room_light.face_uniforms().items():
+            self._set(program, name, value)
+        self._bind_bounce_sources(program)
+        gl["ao"].use(location=2)
+        self._set(program, "u_ao_mask", 2)
+        self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
+        self._set(program, "u_window_albedo", window_albedo)
+        self._set(program, "u_side_rect", room_light.curtain_side_rect())
+        self._set(program, "u_side_z", scene_lib.ROOM_BOX[2][0])
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+
+    def _room_side_uniforms(self, program) -> None:
+        """curtain.frag's ROOM_SIDE: the room-side irradiance grid, its extent, the cloth's
+        reflectance of the room's light."""
+        gl = self._room_resources()
+        gl["room_side"].use(location=ROOM_SIDE_UNIT)
+        self._set(program, "u_room_side", ROOM_SIDE_UNIT)
+        x0, y0, w, h = room_light.curtain_side_rect()
+        self._set(program, "u_room_side_rect", (x0, y0, 1.0 / w, 1.0 / h))
+        self._set(program, "u_room_side_reflectance", self.curtain_room_reflectance_rgb(self.shading_inputs()))
+
+    def read_room_total(self) -> np.ndarray:
+        """The coarse patches' last total irradiance (radiosity pass), float32 (RC, 6 RC, 3)."""
+        rc = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
+        data = self._room_resources()["total"].read()
+        return np.frombuffer(data, dtype="f4").reshape(rc, len(room_light.FACE_NAMES) * rc, 4)[..., :3].copy()
+
+    def read_room_side(self) -> np.ndarray:
+        """The last room-side irradiance grid, float32 (H, W, 3), row 0 = the opening's bottom."""
+        tw, th = room_light.CURTAIN_SIDE_TEXELS
+        data = self._room_resources()["room_side"].read()
+        return np.frombuffer(data, dtype="f4").reshape(th, tw, 4)[..., :3].copy()
 
     def _bind_bounce_sources(self, program) -> None:
         """The bounces' sources for room_radiosity.frag and room_bounce.frag: the direct map and
@@ -1659,7 +1758,7 @@ class FrameRenderer:
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
-               self.room_bounces, self.room_lobe, getattr(self, "patterned", None),
+               self.room_bounces, self.room_lobe, self.room_side_active(), getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
@@ -1950,6 +2049,41 @@ class FrameRenderer:
                             components=3)
         return np.frombuffer(data, dtype=np.uint8).reshape(vh, vw, 3)[::-1].copy()
 
+    def room_side_irradiance_at(self, positions) -> np.ndarray:
+        """(P, 3) the room-side grid's last irradiance read as curtain.frag ROOM_SIDE reads it
+        at world ``positions`` (bilinear, clamped to the opening's edge), float64."""
+        return room_light.sample_bilinear(self.read_room_side(), room_light.curtain_side_uv(positions))
+
+    def twin_spectral(self, gbuffer: dict, mask) -> np.ndarray:
+        """The float64 twin's spectral radiance (P, L) at the G-buffer pixels ``mask``: eq. 8 with
+        :meth:`curtain_inputs` and the pixels' shadows (without the room side's RGB term,
+        :meth:`twin_room_side_rgb`)."""
+        from catalog.optics import shading_reference as ref  # noqa: PLC0415
+
+        return ref.shade_spectral(self.curtain_inputs(), gbuffer["position"][mask], gbuffer["normal"][mask],
+                                  gbuffer["tangent"][mask], self.camera.position,
+                                  **ref.shadow_terms(gbuffer["shadows"][mask]))
+
+    def twin_room_side_rgb(self, gbuffer: dict, mask) -> np.ndarray:
+        """The twin of ROOM_SIDE's term (P, 3) linear sRGB at the G-buffer pixels (0 when the
+        room side takes the stand-ins), from the grid the GPU gathered (its own twin:
+        room_light.curtain_side_irradiance)."""
+        from catalog.optics import shading_reference as ref  # noqa: PLC0415
+
+        positions = gbuffer["position"][mask]
+        if not self.room_side_active():
+            return np.zeros((positions.shape[0], 3))
+        return ref.room_side_linear_srgb(
+            self.curtain_inputs(), positions, gbuffer["normal"][mask], self.camera.position,
+            self.room_side_irradiance_at(positions), self.curtain_room_reflectance_rgb(self.shading_inputs()))
+
+    def twin_linear_srgb(self, gbuffer: dict, mask) -> np.ndarray:
+        """The float64 twin of the curtain's linear sRGB (P, 3) at the G-buffer pixels ``mask``
+        (1 nm spectral eq. 8 plus the room side's term; tests hold the shader to it)."""
+        from catalog.optics import shading_reference as ref  # noqa: PLC0415
+
+        return ref.spectral_to_linear_srgb(self.twin_spectral(gbuffer, mask)) + self.twin_room_side_rgb(gbuffer, mask)
+
     def render_gbuffer(self) -> dict[str, np.ndarray]:
         """The curtain alone with the G-buffer variant: radiance and the per-pixel geometry the
         shader used (world position, unit normal, weft tangent), float32 (H, W, 3) each, a
@@ -1958,7 +2092,9 @@ class FrameRenderer:
         by the window wall (issue 11; 1, 0, 0, 0 where those are off). The reference shades these positions in float64."""
         mgl = self._moderngl
         w, h = self.size
-        if self.key_shadow or self.sky_occlusion:   # the cloth's shadow maps of this mesh
+        if self.room_side_active():   # the room's light on the cloth's room side (and its maps)
+            self.draw_room_light(self.shading_inputs())
+        elif self.key_shadow or self.sky_occlusion:   # the cloth's shadow maps of this mesh
             self.draw_cloth_shadow_maps(self.shading_inputs())
         if self._gbuffer is None:
             textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(5)]
@@ -2009,6 +2145,7 @@ class FrameRenderer:
             "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
             "outside_by_view": self.outside_by_view,
             "room_bounces": self.room_bounces, "room_lobe": self.room_lobe,
+            "room_side_solved": self.room_side_solved,
             "shadow_map_size": self.shadow_texels,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,

@@ -358,6 +358,81 @@ def radiosity_operator_rgb(albedo: float, window_albedo_rgb) -> np.ndarray:
                     axis=-1).astype(np.float32)
 
 
+#: The curtain's room side (issue 11, fourth round): the room's irradiance on it is gathered at
+#: this many points across and down the window opening, in the window wall's plane (every
+#: other face lies wholly in front of that plane, as Lambert's formula needs; the closed
+#: curtain hangs 12 cm in front of it), and read bilinearly per fragment (curtain.frag
+#: ROOM_SIDE). The room's light varies over metres: 12 x 12 points are 16 x 19 cm apart.
+CURTAIN_SIDE_TEXELS = (12, 12)
+
+
+def curtain_side_rect() -> tuple[float, float, float, float]:
+    """The room-side grid's extent (x from, y from, width, height; metres): the opening."""
+    x0, x1, y0, y1 = scene_lib.WINDOW_RECT
+    return (x0, y0, x1 - x0, y1 - y0)
+
+
+def curtain_side_points(texels: tuple[int, int] = CURTAIN_SIDE_TEXELS) -> np.ndarray:
+    """(H, W, 3) the grid's points (texel centres, row 0 = the opening's bottom), in the window
+    wall's plane."""
+    x0, y0, w, h = curtain_side_rect()
+    tw, th = texels
+    xs = x0 + (np.arange(tw) + 0.5) / tw * w
+    ys = y0 + (np.arange(th) + 0.5) / th * h
+    gx, gy = np.meshgrid(xs, ys)
+    return np.stack([gx, gy, np.full_like(gx, scene_lib.ROOM_BOX[2][0])], axis=-1)
+
+
+def curtain_side_irradiance(total_rgb: np.ndarray, albedo: float, window_albedo_rgb,
+                            texels: tuple[int, int] = CURTAIN_SIDE_TEXELS) -> np.ndarray:
+    """The float64 twin of room_bounce.frag's CURTAIN_SIDE gather, (H, W, 3): at each grid point
+    (facing the room), E = sum_j (rho_j / pi) T_j G_j over the coarse patches of every face but
+    the window wall, with ``total_rgb`` (RC, 6 RC, 3) the patches' total irradiance (the
+    radiosity pass's texture, row = v) and G_j from :func:`rectangle_irradiance_factor`."""
+    patches = coarse_patches()
+    rc = FACE_TEXELS >> BOUNCE_LEVEL
+    total = np.asarray(total_rgb, dtype=np.float64)
+    # atlas texel (f rc + u, v) of patch (f, v, u)
+    t_patch = np.stack([total[v, f * rc + u] for f in range(len(FACE_NAMES))
+                        for v in range(rc) for u in range(rc)])
+    keep = patches["face"] != FACE_NAMES.index("window_wall")
+    points = curtain_side_points(texels).reshape(-1, 3)
+    normals = np.broadcast_to(np.array([0.0, 0.0, 1.0]), points.shape)
+    geometry = rectangle_irradiance_factor(points, normals, patches["corner"][keep],
+                                           patches["s"][keep], patches["t"][keep])
+    out = np.zeros((points.shape[0], 3))
+    for c in range(3):
+        rho = patch_reflectance(albedo, float(np.asarray(window_albedo_rgb)[c]), patches["wall"][keep])
+        out[:, c] = geometry @ (rho * t_patch[keep, c]) / math.pi
+    return out.reshape(texels[1], texels[0], 3)
+
+
+def sample_bilinear(texture: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """GL's LINEAR filter with clamp to edge: ``texture`` (H, W, C) read at ``uv`` (P, 2) in
+    [0, 1] (texel centres at (i + 0.5) / W), float64 (P, C)."""
+    tex = np.asarray(texture, dtype=np.float64)
+    h, w = tex.shape[:2]
+    uv = np.asarray(uv, dtype=np.float64)
+    x = np.clip(uv[:, 0] * w - 0.5, 0.0, w - 1.0)
+    y = np.clip(uv[:, 1] * h - 0.5, 0.0, h - 1.0)
+    x0 = np.minimum(np.floor(x).astype(int), w - 2) if w > 1 else np.zeros(len(x), int)
+    y0 = np.minimum(np.floor(y).astype(int), h - 2) if h > 1 else np.zeros(len(y), int)
+    fx = (x - x0)[:, None]
+    fy = (y - y0)[:, None]
+    x1 = np.minimum(x0 + 1, w - 1)
+    y1 = np.minimum(y0 + 1, h - 1)
+    return ((1 - fy) * ((1 - fx) * tex[y0, x0] + fx * tex[y0, x1])
+            + fy * ((1 - fx) * tex[y1, x0] + fx * tex[y1, x1]))
+
+
+def curtain_side_uv(positions: np.ndarray) -> np.ndarray:
+    """(P, 2) where fragments at ``positions`` (P, 3) read the room-side grid: their x, y over
+    the opening (curtain.frag ROOM_SIDE; outside it, clamped to the edge)."""
+    x0, y0, w, h = curtain_side_rect()
+    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    return np.stack([(p[:, 0] - x0) / w, (p[:, 1] - y0) / h], axis=-1)
+
+
 # --------------------------------------------------------------------------- the key's shadow map
 
 def light_view_projection(to_light: np.ndarray, margin_m: float = 0.05) -> np.ndarray:

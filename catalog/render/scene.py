@@ -593,14 +593,35 @@ def with_physical_emission(inputs: ShadingInputs, material,
     absorbed = (absorbed_photon_irradiance(material, inputs.key_irradiance),
                 absorbed_photon_irradiance(material, inputs.fill_irradiance),
                 absorbed_photon_irradiance(material, ambient_irradiance))
+    absorbed_room = absorbed_photon_irradiance(material, math.pi * inputs.room_radiance)
     emission = (material.quantum_yield * material.emission_pdf_per_nm
                 * photon_energy_j(GRID_NM) / (2 * math.pi))
     if residual_exitance is not None and absorbed[0] > 0:
         effective_key = absorbed[0] / (1.0 + absorbed[0] / material.saturation_photon_irradiance)
         emission = emission + np.asarray(residual_exitance, dtype=np.float64) / (2 * math.pi * effective_key)
     return replace(inputs, fluorescence_mode="physical", absorbed_photons=absorbed,
+                   absorbed_room_photons=absorbed_room,
                    saturation_photons=material.saturation_photon_irradiance,
                    emission_per_photon=emission)
+
+
+def with_room_solved(inputs: ShadingInputs) -> ShadingInputs:
+    """``inputs`` without the stand-ins for the room's light on the curtain's room side (issue
+    11, fourth round), for a viewer in the room whose frame lights that side by the room's
+    solved light instead (curtain.frag ROOM_SIDE, an RGB term the float64 twin adds with
+    :func:`catalog.optics.shading_reference.room_side_linear_srgb`): no fill light, the
+    ambient term's outside share alone, and neither exciting the fluorescence (the room's
+    light excites next to nothing: under daylight it is the daylight's, weaker, under UV-A
+    the visible glow). The path-traced reference has no stand-ins either."""
+    from dataclasses import replace  # noqa: PLC0415
+
+    outside = (inputs.ambient_outside_radiance if inputs.ambient_outside_radiance is not None
+               else np.zeros_like(inputs.ambient_radiance))
+    key, _fill, ambient = inputs.absorbed_photons
+    return replace(inputs, fill_irradiance=np.zeros_like(inputs.fill_irradiance),
+                   ambient_radiance=np.array(outside, dtype=np.float64),
+                   absorbed_photons=(key, 0.0, max(ambient - inputs.absorbed_room_photons, 0.0)),
+                   absorbed_room_photons=0.0)
 
 
 def _excitation_on_grid(preset) -> np.ndarray:
