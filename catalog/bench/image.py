@@ -65,6 +65,7 @@ OPTIONS = (
     ("room lighting off", 3, "physical", 1, None, False),
     ("one room bounce (before)", 3, "physical", 1, None, None, {"room_bounces": "one"}),
     ("lobe in the beam (before round 3)", 3, "physical", 1, None, None, {"room_lobe": False}),
+    ("room side by stand-ins (before round 4)", 3, "physical", 1, None, None, {"room_side": False}),
     ("shadow maps 128", 3, "physical", 1, None, None, {"shadow_map_size": 128}),
     ("shadow maps 512", 3, "physical", 1, None, None, {"shadow_map_size": 512}),
     ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
@@ -93,6 +94,9 @@ ROUND_2 = "after_11_round_2"
 #: The run after its third round (the curtain's window side, exact form factors, the lobe
 #: spread from the window; the references at 2048 spp): ``runs[ROUND_3]``.
 ROUND_3 = "after_11_round_3"
+#: The run after its fourth round (the curtain's room side lit by the room's solved light
+#: instead of the fill light and the room's ambient share): ``runs[ROUND_4]``.
+ROUND_4 = "after_11_round_4"
 GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
 REGIONS = ("curtain", "floor", "walls")
 #: The hour of "noon sun" (local solar time, the scene's date and latitude).
@@ -456,7 +460,8 @@ def markdown_tables(result: dict) -> dict[str, str]:
                 + "\n\n![six scenes after issue 11's fixes: real-time | reference | FLIP]"
                 "(img/pathtrace_scenes_after_11.png)")
             blocks["image-after-11-summary"] = summary_line(run)
-        for name, ordinal, previous in ((ROUND_2, "second", "after_11"), (ROUND_3, "third", ROUND_2)):
+        for name, ordinal, previous in ((ROUND_2, "second", "after_11"), (ROUND_3, "third", ROUND_2),
+                                        (ROUND_4, "fourth", ROUND_3)):
             if name in result["runs"]:
                 blocks.update(_round_blocks(result["runs"], name, ordinal, previous))
         return blocks
