@@ -6,6 +6,7 @@
 //    sun's angular radius casts at the receiver's distance from the curtain (PCSS with the
 //    blocker distance known: the curtain hangs in the plane u_curtain_z; the filter is the
 //    map's mip level of that width, one tap), times the opening's soft mask (room_window_beam);
+//    the window's reveals, outside the wall's inner plane, lie before the cloth: undimmed;
 //  - the light map (room_lightmap.frag + room_bounce.frag): the curtain as an area light,
 //    lamps in the room, the room's bounces, ambient occlusion.
 // Without it, the earlier scene design: a constant fraction of the key plus the fill light.
@@ -51,7 +52,12 @@ vec3 key_beam(vec3 p, vec3 n) {
     // the penumbra as a prefiltered lookup: the mip level whose texel spans its diameter
     // (one trilinear tap where PCF would take many; a CPU rasteriser pays per tap)
     vec3 t = textureLod(u_shadow, uv, log2(max(2.0 * radius_m / u_shadow_texel_m, 1.0))).rgb;
-    return u_key_rgb * (cos_key * beam) * t;
+    // the map holds no depth: it dims whatever lies in the beam's path behind the window. The
+    // window's reveals lie outside the wall's inner plane, on the light's side of every fold
+    // (the cloth hangs in the room), so a key from outside reaches them undimmed (issue 11,
+    // fourth round: the sunlit sill, seen through the lace's holes, was 0.2x the traced one)
+    bool before_cloth = u_key_to_light.z < 0.0 && p.z < u_wall_z.x - 1e-4;
+    return u_key_rgb * (cos_key * beam) * (before_cloth ? vec3(1.0) : t);
 }
 #else
 // faces turned away from the key light (frame.py draws them apart: a CPU rasteriser runs

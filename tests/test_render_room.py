@@ -750,3 +750,54 @@ def test_room_side_replaces_the_stand_ins(gl):
     r.set_camera(180.0, 0.0, 2.0)   # yaw 180: from outside, looking in
     assert not r.viewer_inside and not r.room_side_active()
     r.release()
+
+
+def test_the_sill_before_the_cloth_takes_the_key_undimmed(gl):
+    """The window's reveals lie outside the wall's inner plane, on the light's side of the
+    cloth: the transmittance map (which holds no depth) must not dim them. Under a key 5 deg
+    high square to the window, the sill's line along the beam meets the closed curtain's hem,
+    so the map there holds the cloth's transmittance (before the fix the closed curtain's sill
+    was 0.51x the open one's). Seen from outside, each sill pixel (found by a ray in numpy,
+    2 cm inside its edges) against its twin, albedo / pi (light map at the floor texel the
+    sill's normal reads, clamped into the face; bilinear) + albedo / pi key cos mask
+    (room_light.window_beam_mask), within 1 %."""
+    r = FrameRenderer(gl, (160, 120))
+    r.set_fabric("lace-fwa")
+    r.set_light("sun:60")
+    r.set_key_direction(5.0, 0.0)
+    r.set_camera(180.0, 35.0, 1.6)   # outside, above the sill
+    r.set_curtain_open(False)
+    r.render()
+    image = r.read_linear()
+    w, h = 160, 120
+    inverse = np.linalg.inv(r.camera.view_projection(w / h))
+    ys, xs = np.mgrid[0:h, 0:w]
+    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)), np.ones((h, w))], -1)
+    far = ndc @ inverse.T
+    eye = np.asarray(r.camera.position, dtype=np.float64)
+    d = far[..., :3] / far[..., 3:] - eye
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    wx0, wx1, wy0, _wy1 = scene_lib.WINDOW_RECT
+    z_in = scene_lib.ROOM_BOX[2][0]
+    z_out = z_in - scene_lib.WALL_THICKNESS_M
+    t = (wy0 - eye[1]) / d[..., 1]
+    q = eye + t[..., None] * d
+    sill = ((t > 0) & (q[..., 2] < z_in - 0.02) & (q[..., 2] > z_out + 0.02)
+            & (q[..., 0] > wx0 + 0.02) & (q[..., 0] < wx1 - 0.02))
+    assert sill.sum() > 100
+    p = q[sill]
+    inputs = r.shading_inputs()
+    to_light = np.asarray(inputs.key_to_light, dtype=np.float64)
+    key_rgb = np.asarray(r._display_colours(inputs)["u_key_rgb"])
+    floor = room_light.room_faces()[0]
+    edge = 0.5 / room_light.FACE_TEXELS
+    s = np.clip((p[:, 0] - floor.origin[0]) / floor.axis_s[0], edge, 1 - edge)
+    tt = np.clip((p[:, 2] - floor.origin[2]) / floor.axis_t[2], edge, 1 - edge)
+    uv = np.stack([s / len(room_light.FACE_NAMES), tt], -1)
+    lightmap = room_light.sample_bilinear(r.read_room_lightmap(), uv)
+    beam = room_light.window_beam_mask(p, to_light)
+    expected = scene_lib.ROOM_ALBEDO / math.pi * (lightmap + (to_light[1] * beam)[:, None] * key_rgb)
+    assert beam.mean() > 0.9
+    got = image[sill].astype(np.float64)
+    assert np.abs(_luma(got) / _luma(expected) - 1).max() < 0.01
+    r.release()
