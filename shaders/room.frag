@@ -33,6 +33,25 @@ uniform vec2 u_wall_z;
 uniform float u_curtain_z;
 uniform float u_tan_sun_radius;
 uniform float u_albedo;
+// The window's reveals and the wall's outer face, outside the wall's inner plane (issue 11,
+// fourth round): not in the room's light map (its faces are the box's), they take the outside
+// on the half of their hemisphere facing it (the sky above the horizon, the ground below:
+// 0.5 pi L each quarter, the outer face the whole) and the closed curtain's window side on the
+// half facing the room (the window-side capture at the reveal's place, a texel of 2 x 2
+// patches); the path-traced reveals were 20x the light map's clamped edge they read before.
+uniform vec3 u_reveal_sky;           // 0.5 pi x the sky's radiance (linear sRGB)
+uniform vec3 u_reveal_ground;        // 0.5 pi x the ground's
+uniform sampler2D u_luminaire_back;  // the curtain's window side (0 where no cloth, or open)
+uniform int u_reveal_back_level;
+uniform ivec2 u_reveal_back_size;    // that level's texels
+
+vec3 reveal_irradiance(vec3 p, vec3 n) {
+    float up = 0.5 + 0.5 * n.y;
+    vec3 outside = (1.0 + max(-n.z, 0.0)) * (up * u_reveal_sky + (1.0 - up) * u_reveal_ground);
+    vec2 f = clamp((p.xy - u_window_rect.xz) / (u_window_rect.yw - u_window_rect.xz), 0.0, 0.999);
+    vec3 back = texelFetch(u_luminaire_back, ivec2(f * vec2(u_reveal_back_size)), u_reveal_back_level).rgb;
+    return outside + (0.5 * PI * (1.0 - abs(n.z))) * back;
+}
 
 #ifdef KEY_BEAM
 vec3 key_beam(vec3 p, vec3 n) {
@@ -40,7 +59,9 @@ vec3 key_beam(vec3 p, vec3 n) {
     if (cos_key <= 0.0) {
         return vec3(0.0);
     }
-    float beam = room_window_beam(p, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius);
+    // the wall's outer face meets the key before the opening does: nothing of the window shades it
+    float beam = p.z < u_wall_z.y + 1e-4 ? 1.0
+               : room_window_beam(p, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius);
     if (beam <= 0.0) {
         return vec3(0.0);
     }
@@ -74,7 +95,9 @@ void main() {
     vec3 n = normalize(v_normal);
 #ifdef ROOM_LIGHTING
     vec2 uv = clamp(v_atlas, v_atlas_box.xz, v_atlas_box.yw);
-    vec3 irradiance = texture(u_lightmap, uv).rgb + key_beam(v_position, n);
+    vec3 diffuse = v_position.z < u_wall_z.x - 1e-4 ? reveal_irradiance(v_position, n)
+                                                   : texture(u_lightmap, uv).rgb;
+    vec3 irradiance = diffuse + key_beam(v_position, n);
     out_radiance = vec4((u_albedo / PI) * irradiance, 1.0);
 #else
     out_radiance = vec4(u_room_rgb + max(dot(n, u_fill_to_light), 0.0) * u_fill_rgb, 1.0);

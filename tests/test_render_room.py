@@ -752,15 +752,18 @@ def test_room_side_replaces_the_stand_ins(gl):
     r.release()
 
 
-def test_the_sill_before_the_cloth_takes_the_key_undimmed(gl):
-    """The window's reveals lie outside the wall's inner plane, on the light's side of the
-    cloth: the transmittance map (which holds no depth) must not dim them. Under a key 5 deg
-    high square to the window, the sill's line along the beam meets the closed curtain's hem,
-    so the map there holds the cloth's transmittance (before the fix the closed curtain's sill
-    was 0.51x the open one's). Seen from outside, each sill pixel (found by a ray in numpy,
-    2 cm inside its edges) against its twin, albedo / pi (light map at the floor texel the
-    sill's normal reads, clamped into the face; bilinear) + albedo / pi key cos mask
-    (room_light.window_beam_mask), within 1 %."""
+def test_the_window_outside_the_wall_is_lit_by_the_outside_and_the_key(gl):
+    """The window's reveals and the wall's outer face lie outside the wall's inner plane, on the
+    light's side of the cloth (issue 11, fourth round). Under a key 5 deg high square to the
+    window the sill's line along the beam meets the closed curtain's hem, so the transmittance
+    map there holds the cloth's transmittance, which holds no depth and must not dim the sill
+    (before, the closed curtain's sill was 0.51x its twin); the outer face takes the whole key.
+    Their diffuse light: the outside on the half of their hemisphere facing it (0.5 pi L_sky for
+    the sill, pi (L_sky + L_ground) / 2 for the outer face) and, on the half facing the room,
+    the curtain's window side (the window-side capture's texel of 2 x 2 patches at the
+    reveal's place). Seen from outside, each sill and outer-face pixel (found by a ray in numpy,
+    2 cm inside the edges) against this twin, albedo / pi x (diffuse + key cos mask
+    (room_light.window_beam_mask; 1 on the outer face)), within 1 %."""
     r = FrameRenderer(gl, (160, 120))
     r.set_fabric("lace-fwa")
     r.set_light("sun:60")
@@ -777,27 +780,37 @@ def test_the_sill_before_the_cloth_takes_the_key_undimmed(gl):
     eye = np.asarray(r.camera.position, dtype=np.float64)
     d = far[..., :3] / far[..., 3:] - eye
     d /= np.linalg.norm(d, axis=-1, keepdims=True)
-    wx0, wx1, wy0, _wy1 = scene_lib.WINDOW_RECT
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
     z_in = scene_lib.ROOM_BOX[2][0]
     z_out = z_in - scene_lib.WALL_THICKNESS_M
     t = (wy0 - eye[1]) / d[..., 1]
     q = eye + t[..., None] * d
     sill = ((t > 0) & (q[..., 2] < z_in - 0.02) & (q[..., 2] > z_out + 0.02)
             & (q[..., 0] > wx0 + 0.02) & (q[..., 0] < wx1 - 0.02))
-    assert sill.sum() > 100
-    p = q[sill]
+    t_face = (z_out - eye[2]) / d[..., 2]
+    q_face = eye + t_face[..., None] * d
+    (x0, x1), (y0, y1), _ = scene_lib.ROOM_BOX
+    beside = ((q_face[..., 0] < wx0 - 0.02) | (q_face[..., 0] > wx1 + 0.02)
+              | (q_face[..., 1] < wy0 - 0.02) | (q_face[..., 1] > wy1 + 0.02))
+    outer = ((t_face > 0) & beside & (q_face[..., 1] > y0 + 0.02) & (q_face[..., 1] < y1 - 0.02)
+             & (q_face[..., 0] > x0 + 0.02) & (q_face[..., 0] < x1 - 0.02)) & ~sill
+    assert sill.sum() > 100 and outer.sum() > 100
     inputs = r.shading_inputs()
     to_light = np.asarray(inputs.key_to_light, dtype=np.float64)
-    key_rgb = np.asarray(r._display_colours(inputs)["u_key_rgb"])
-    floor = room_light.room_faces()[0]
-    edge = 0.5 / room_light.FACE_TEXELS
-    s = np.clip((p[:, 0] - floor.origin[0]) / floor.axis_s[0], edge, 1 - edge)
-    tt = np.clip((p[:, 2] - floor.origin[2]) / floor.axis_t[2], edge, 1 - edge)
-    uv = np.stack([s / len(room_light.FACE_NAMES), tt], -1)
-    lightmap = room_light.sample_bilinear(r.read_room_lightmap(), uv)
+    colours = r._display_colours(inputs)
+    key_rgb, sky, ground = (np.asarray(colours[k]) for k in ("u_key_rgb", "u_sky_rgb", "u_ground_rgb"))
+    level = room_light.BACK_LUMINAIRE_LEVEL + 1
+    back = r.read_luminaire_back(level)
+    p = q[sill]
+    f = np.clip((p[:, 0] - wx0) / (wx1 - wx0), 0.0, 0.999)
+    back_at = back[0, (f * back.shape[1]).astype(int)]
     beam = room_light.window_beam_mask(p, to_light)
-    expected = scene_lib.ROOM_ALBEDO / math.pi * (lightmap + (to_light[1] * beam)[:, None] * key_rgb)
     assert beam.mean() > 0.9
-    got = image[sill].astype(np.float64)
-    assert np.abs(_luma(got) / _luma(expected) - 1).max() < 0.01
+    sill_expected = scene_lib.ROOM_ALBEDO / math.pi * (
+        0.5 * math.pi * (sky + back_at) + (to_light[1] * beam)[:, None] * key_rgb)
+    outer_expected = scene_lib.ROOM_ALBEDO / math.pi * (
+        0.5 * math.pi * (sky + ground) + (-to_light[2]) * key_rgb)
+    for mask, expected in ((sill, sill_expected), (outer, outer_expected)):
+        got = image[mask].astype(np.float64)
+        assert np.abs(_luma(got) / _luma(expected) - 1).max() < 0.01
     r.release()

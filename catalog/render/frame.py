@@ -1207,6 +1207,21 @@ class FrameRenderer:
         self._set(program, "u_shadow", 2)
         self._set(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels))
         self._set(program, "u_curtain_z", scene_lib.CURTAIN_Z)
+        colours = self._display_colours(inputs)
+        self._set(program, "u_reveal_sky", tuple(0.5 * math.pi * v for v in colours["u_sky_rgb"]))
+        self._set(program, "u_reveal_ground", tuple(0.5 * math.pi * v for v in colours["u_ground_rgb"]))
+        gl["luminaire_back"].use(location=3)
+        self._set(program, "u_luminaire_back", 3)
+        level = room_light.BACK_LUMINAIRE_LEVEL + 1
+        self._set(program, "u_reveal_back_level", level)
+        self._set(program, "u_reveal_back_size", tuple(max(v >> level, 1) for v in room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)))
+
+    def read_luminaire_back(self, level: int) -> np.ndarray:
+        """The window-side capture at mip ``level``, float32 (H, W, 3), row 0 = the opening's bottom."""
+        texture = self._room_resources()["luminaire_back"]
+        w, h = (max(v >> level, 1) for v in texture.size)
+        data = texture.read(level=level)
+        return np.frombuffer(data, dtype="f4").reshape(h, w, 4)[..., :3].copy()
 
     # ------------------------------------------------------------------ the room's light (issue 13)
     def _room_resources(self) -> dict:
