@@ -190,9 +190,12 @@ float front_layer_coverage(sampler2D map, vec3 q, float bias) {
 // The outside hidden from a point p of the cloth (normal `normal`; issue 11, model.md
 // section 9): of N_OCCLUSION directions (cosine-weighted about the window's normal,
 // catalog/render/room_light.py), the fraction in which a layer of cloth lies between p and
-// the outside (one front-layer depth map per direction, tiles of u_occlusion_maps), and the
-// fraction that does not leave through the window opening (the wall). Returns (cloth, wall).
-uniform sampler2D u_occlusion_maps; // a: the nearest layer's depth, tile j of a square grid
+// the outside (one depth map per direction, tiles of u_occlusion_maps: the layer nearest the
+// outside), and the fraction that does not leave through the window opening (the wall); and
+// (issue 11, fourth round) the room's side: of the opposite directions (cosine-weighted about
+// the room's normal), the fraction in which a layer lies between p and the room (the same
+// maps' farthest layer). Returns (cloth, wall, cloth towards the room).
+uniform sampler2D u_occlusion_maps; // a: the nearest layer's depth, g: the farthest's; tile j of a square grid
 uniform mat4 u_occlusion_view_proj[N_OCCLUSION];
 uniform float u_occlusion_depth_bias[N_OCCLUSION];
 uniform vec3 u_occlusion_direction[N_OCCLUSION];   // towards the outside
@@ -201,10 +204,33 @@ uniform float u_occlusion_offset_m; // the lookup moved off the surface towards 
 uniform vec4 u_occlusion_window;    // the opening (x0, x1, y0, y1), m
 uniform vec2 u_occlusion_wall_z;    // the window wall's inner and outer planes, m
 
-vec2 outside_occlusion(vec3 p, vec3 normal) {
+// Tile j's four nearest texels at q (moved off the surface), a ramp in depth over 0.5..1.5
+// times the bias, blended bilinearly: how far a layer lies in front of q (towards the outside,
+// the nearest layer: room = false) or behind it (towards the room, the farthest: room = true).
+float occlusion_lookup(int j, vec3 q, bool room) {
+    vec4 clip = u_occlusion_view_proj[j] * vec4(q, 1.0);
+    vec2 tile = vec2(mod(float(j), u_occlusion_grid), floor(float(j) / u_occlusion_grid));
+    float n = float(textureSize(u_occlusion_maps, 0).x) / u_occlusion_grid;
+    vec2 st = clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0) * n - 0.5;
+    vec2 f = fract(st);
+    ivec2 i0 = ivec2(floor(st));
+    float z = clip.z * 0.5 + 0.5;
+    float b = u_occlusion_depth_bias[j];
+    float h[4];
+    for (int k = 0; k < 4; ++k) {
+        ivec2 texel = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), ivec2(int(n) - 1))
+                    + ivec2(tile * n);
+        vec4 layers = texelFetch(u_occlusion_maps, texel, 0);
+        h[k] = smoothstep(0.5 * b, 1.5 * b, room ? layers.g - z : z - layers.a);
+    }
+    return mix(mix(h[0], h[1], f.x), mix(h[2], h[3], f.x), f.y);
+}
+
+vec3 outside_occlusion(vec3 p, vec3 normal) {
     vec3 ng = normalize(normal);
     float hidden = 0.0;
     float walled = 0.0;
+    float hidden_room = 0.0;
     for (int j = 0; j < N_OCCLUSION; ++j) {
         vec3 d = u_occlusion_direction[j];
         // through the opening? (the ray must cross it in both of the wall's planes)
@@ -214,27 +240,12 @@ vec2 outside_occlusion(vec3 p, vec3 normal) {
                     * step(vec4(q_in, q_out), u_occlusion_window.ywyw);
         float open = inside.x * inside.y * inside.z * inside.w;
         // off the surface on the direction's side (normal offset: no self-shadowing)
-        vec3 q = p + (u_occlusion_offset_m * sign(dot(ng, d))) * ng;
-        vec4 clip = u_occlusion_view_proj[j] * vec4(q, 1.0);
-        vec2 tile = vec2(mod(float(j), u_occlusion_grid), floor(float(j) / u_occlusion_grid));
-        // the tile's texels (the atlas holds tiles side by side): a ramp in depth over
-        // 0.5..1.5 times the bias, the four nearest texels of the tile blended bilinearly
-        float n = float(textureSize(u_occlusion_maps, 0).x) / u_occlusion_grid;
-        vec2 st = clamp(clip.xy * 0.5 + 0.5, 0.0, 1.0) * n - 0.5;
-        vec2 f = fract(st);
-        ivec2 i0 = ivec2(floor(st));
-        float z = clip.z * 0.5 + 0.5;
-        float b = u_occlusion_depth_bias[j];
-        float h[4];
-        for (int k = 0; k < 4; ++k) {
-            ivec2 texel = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), ivec2(int(n) - 1))
-                        + ivec2(tile * n);
-            h[k] = smoothstep(0.5 * b, 1.5 * b, z - texelFetch(u_occlusion_maps, texel, 0).a);
-        }
-        hidden += open * mix(mix(h[0], h[1], f.x), mix(h[2], h[3], f.x), f.y);
+        float side = sign(dot(ng, d));
+        hidden += open * occlusion_lookup(j, p + (u_occlusion_offset_m * side) * ng, false);
         walled += 1.0 - open;
+        hidden_room += occlusion_lookup(j, p - (u_occlusion_offset_m * side) * ng, true);
     }
-    return vec2(hidden, walled) / float(N_OCCLUSION);
+    return vec3(hidden, walled, hidden_room) / float(N_OCCLUSION);
 }
 #endif
 

@@ -87,6 +87,7 @@ layout(location = 1) out vec4 out_position;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_tangent;
 layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, the outside's occlusion: cloth, wall
+layout(location = 5) out vec4 out_room_occlusion;   // x: the room's side hidden by the cloth
 #endif
 
 // One chunk of 4 bands: eq. 8's terms summed, then projected to display colour. Called with a
@@ -142,7 +143,19 @@ float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; s
 uniform sampler2D u_room_side;     // irradiance, linear sRGB (x pi cd m^-2)
 uniform vec4 u_room_side_rect;     // the grid: x from, y from, 1 / width, 1 / height (m)
 uniform vec3 u_room_side_reflectance;
+uniform sampler2D u_room_side_cloth; // the room's capture of the cloth's room side (the window's patches)
+uniform int u_room_side_cloth_level; // its level of one texel a patch
+uniform ivec2 u_room_side_cloth_size;
+// and on the window's side: where the folds hide the outside (g_occlusion, SKY_OCCLUSION), the
+// cloth's window side is lit by the folds in the way (the capture of the window side, its patch
+// here: their glow and the key they scatter back), passed towards the viewer by the lobes'
+// forward factors (u_window_side_transmittance: dye (a_diff forward(g_diff) + a_spec
+// forward(g_spec)), display RGB)
+uniform sampler2D u_window_side_cloth;
+uniform int u_window_side_cloth_level;
+uniform vec3 u_window_side_transmittance;
 #endif
+float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own folds (SKY_OCCLUSION)
 #ifdef ROOM_CAPTURE
 uniform float u_capture_thread;    // the key a thread passes, a_spec forward(g_spec) / (1 - LD)
 float g_key_reach = 1.0;           // set in main: see out_radiance.a below
@@ -153,7 +166,7 @@ float g_key_reach = 1.0;           // set in main: see out_radiance.a below
 // fraction of what a layer of cloth does not pass (u_ambient_occluded: the float64 twin's
 // outside_occluded_radiance), and all of the outside where the wall hides it.
 SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
-INTERPOLATION in vec2 v_occlusion;  // the cloth's share, the window wall's
+INTERPOLATION in vec3 v_occlusion;  // the cloth's share, the window wall's, the cloth's towards the room
 float g_occlusion = 0.0;            // set in main
 float g_wall_occlusion = 0.0;
 #endif
@@ -273,6 +286,7 @@ void main() {
 #ifdef SKY_OCCLUSION
     g_occlusion = v_occlusion.x;
     g_wall_occlusion = v_occlusion.y;
+    g_room_occlusion = v_occlusion.z;
     g_sky_tilt *= 1.0 - g_wall_occlusion;   // where the wall hides the outside, no sky or ground
 #endif
     float absorbed = 0.0;
@@ -326,9 +340,17 @@ void main() {
     rgb += (bg.x * u_direct) * environment_lookup(u_environment, u_environment_scale, ray);
 #endif
 #ifdef ROOM_SIDE
+    // where the cloth's own folds hide the room, the fraction g_room_occlusion of the room's
+    // side sees the cloth instead: the room's capture of it at this place (its patch's mean
+    // room-side radiance: the glow and the outside it passes), pi L as an irradiance
     vec2 side_uv = (v_position.xy - u_room_side_rect.xy) * u_room_side_rect.zw;
+    vec3 room_light = textureLod(u_room_side, side_uv, 0.0).rgb;
+    ivec2 cloth_patch = ivec2(clamp(side_uv, 0.0, 0.999) * vec2(u_room_side_cloth_size));
+    vec3 cloth_light = PI * texelFetch(u_room_side_cloth, cloth_patch, u_room_side_cloth_level).rgb;
     rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance
-         * textureLod(u_room_side, side_uv, 0.0).rgb;
+         * mix(room_light, cloth_light, g_room_occlusion);
+    rgb += (g_view_outside * g_occlusion) * u_window_side_transmittance
+         * texelFetch(u_window_side_cloth, cloth_patch, u_window_side_cloth_level).rgb;
 #endif
 #ifdef PATTERN
     // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole
@@ -363,5 +385,6 @@ void main() {
     shadows.zw = vec2(g_occlusion, g_wall_occlusion);
 #endif
     out_shadows = shadows;
+    out_room_occlusion = vec4(g_room_occlusion, 0.0, 0.0, 0.0);
 #endif
 }

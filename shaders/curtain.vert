@@ -28,7 +28,7 @@ INTERPOLATION out vec2 v_pattern_uv;
 // texels a row) and read here by the vertex's index.
 uniform sampler2D u_vertex_occlusion;
 uniform int u_vertex_occlusion_width;
-INTERPOLATION out vec2 v_occlusion; // the cloth's share, the wall's
+INTERPOLATION out vec3 v_occlusion; // the cloth's share, the wall's, the cloth's towards the room
 #endif
 
 uniform mat4 u_view_proj;
@@ -59,7 +59,7 @@ void main() {
 #endif
 #ifdef SKY_OCCLUSION
     v_occlusion = texelFetch(u_vertex_occlusion, ivec2(gl_VertexID % u_vertex_occlusion_width,
-                                                       gl_VertexID / u_vertex_occlusion_width), 0).xy;
+                                                       gl_VertexID / u_vertex_occlusion_width), 0).xyz;
 #endif
     gl_Position = u_view_proj * vec4(position, 1.0);
 }

@@ -11,7 +11,7 @@ in vec3 in_normal;
 uniform vec3 u_mesh_offset;
 uniform ivec2 u_target_size;        // the per-vertex texture (texels)
 
-out vec2 v_occlusion;
+out vec3 v_occlusion;
 
 void main() {
     v_occlusion = outside_occlusion(in_position + u_mesh_offset, in_normal);

@@ -34,7 +34,12 @@ float curtain_coverage(vec2 uv) {
 
 void main() {
     float c = curtain_coverage(v_uv);
-#ifdef FRONT_LAYER
+#if defined(FRONT_LAYER) && defined(BOTH_LAYERS)
+    // the occlusion maps (curtain.frag SKY_OCCLUSION, ROOM_SIDE): blended without a depth test,
+    // rgb by MAX and alpha by MIN (frame.py), so g keeps the layer farthest from the light (the
+    // one nearest the room) and a the nearest
+    out_transmittance = vec4(0.0, gl_FragCoord.z, 0.0, gl_FragCoord.z);
+#elif defined(FRONT_LAYER)
     // the front-layer map (curtain.frag, KEY_SHADOW and SKY_OCCLUSION): the nearest layer's
     // thread coverage and its depth, kept by the depth test (no blending)
     out_transmittance = vec4(c, 0.0, 0.0, gl_FragCoord.z);

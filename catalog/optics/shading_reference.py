@@ -383,6 +383,22 @@ def room_side_linear_srgb(inputs: ShadingInputs, positions, normals, camera_posi
         * np.asarray(reflectance_rgb, dtype=np.float64)[None, :]
 
 
+def window_side_linear_srgb(inputs: ShadingInputs, positions, normals, camera_position,
+                           irradiance_rgb, transmittance_rgb) -> np.ndarray:
+    """(P, 3) linear sRGB: light on the curtain's window side from the folds in front of it (issue
+    11, fourth round; curtain.frag ROOM_SIDE), irradiance (P, 3) over pi times the lobes'
+    forward transmittance (3,) times the ambient's ratio by view for the outside's hemisphere."""
+    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    n = n / np.linalg.norm(n, axis=1, keepdims=True)
+    to_viewer = np.asarray(camera_position, dtype=np.float64) - p
+    to_viewer = to_viewer / np.linalg.norm(to_viewer, axis=1, keepdims=True)
+    mu = np.abs(np.einsum("pi,pi->p", to_viewer, n))
+    r_out = ambient_view_ratio(inputs.ambient_view_outside, mu)
+    return (r_out[:, None] / math.pi) * np.asarray(irradiance_rgb, dtype=np.float64).reshape(-1, 3) \
+        * np.asarray(transmittance_rgb, dtype=np.float64)[None, :]
+
+
 def shadow_terms(shadows) -> dict:
     """:func:`shade_spectral`'s shadow arguments from the frame's G-buffer ``shadows`` (P, 4):
     the key's window mask, the coverage of the layer in front of the key, the outside's

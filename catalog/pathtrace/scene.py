@@ -297,13 +297,43 @@ def woven_bsdf_dict(fabric: dict, pattern: dict | None = None) -> dict:
     return out
 
 
-def fluorescence_per_vertex(desc: SceneDescription, scene=None, mi=None) -> np.ndarray | None:
-    """Emitted radiance per side (V, 3) RGB at the curtain's vertices (module doc), or None.
-    ``scene``: a Mitsuba scene holding the curtain, for the key light's shadow rays."""
+#: The glow shells' mesh: the curtain's triangles split in four this many times (midpoint
+#: subdivision, the new vertices on the flat triangles, normals and uvs interpolated). The glow
+#: is evaluated per vertex and interpolated, so a fold's shadow edge on the cloth was a ramp one
+#: triangle (2 cm) wide, against the frame's per-pixel edge: issue 11's fourth round found the
+#: lace's UV-A close-up lighter just inside each edge and darker just outside; 2 levels make the
+#: ramp 5 mm, below a close-up pixel's 4 mm at 192 px (levels 2 and 3 differ by less than 0.5 %
+#: in the curtain's mean there: docs/pathtrace.md).
+GLOW_SUBDIVISIONS = 2
+
+
+def glow_shell_mesh(desc: SceneDescription, levels: int = GLOW_SUBDIVISIONS):
+    """(positions, normals (unit), uvs, triangles) of the glow shells' mesh: the curtain's,
+    subdivided ``levels`` times (trimesh's midpoint subdivision: every new vertex lies on the
+    curtain's own triangles)."""
+    from trimesh import remesh  # noqa: PLC0415
+
+    positions, normals, uvs, _tangents, indices = desc.curtain
+    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    uv = np.asarray(uvs, dtype=np.float64).reshape(-1, 2)
+    tri = np.asarray(indices).reshape(-1, 3)
+    for _ in range(levels):
+        p, tri, attributes = remesh.subdivide(p, tri, vertex_attributes={"normal": n, "uv": uv})
+        n, uv = attributes["normal"], attributes["uv"]
+    n = n / np.linalg.norm(n, axis=1, keepdims=True)
+    return p, n, uv, tri
+
+
+def fluorescence_per_vertex(desc: SceneDescription, scene=None, mi=None,
+                            mesh=None) -> np.ndarray | None:
+    """Emitted radiance per side (V, 3) RGB at the vertices of ``mesh`` (positions, normals;
+    default the curtain's), or None (module doc). ``scene``: a Mitsuba scene holding the
+    curtain, for the key light's shadow rays."""
     fl = desc.fluorescence
     if fl is None:
         return None
-    positions, normals = desc.curtain[0], desc.curtain[1]
+    positions, normals = (desc.curtain[0], desc.curtain[1]) if mesh is None else (mesh[0], mesh[1])
     count = np.asarray(positions).reshape(-1, 3).shape[0]
     if fl["mode"] == "paper":
         return np.repeat(np.asarray(fl["radiance_rgb"])[None, :], count, axis=0)
@@ -406,10 +436,8 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     loaded = mi.load_dict(scene)
     if desc.fluorescence is None:
         return loaded
-    emission = fluorescence_per_vertex(desc, loaded, mi)
-    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
-    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-    tri = np.asarray(indices).reshape(-1, 3)
+    p, n, shell_uvs, tri = glow_shell_mesh(desc)
+    emission = fluorescence_per_vertex(desc, loaded, mi, mesh=(p, n))
     weights = emitter_sampling_weights(desc, emission)
     if environment:
         scene["environment"]["sampling_weight"] = weights["environment"]
@@ -431,7 +459,7 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
         faces = tri if sign > 0 else tri[:, ::-1]
         # the curtain's uv: the glow texture samples its emitter in uv (catalog.pathtrace.glow)
         shell = _mesh(mi, f"fluorescence_{side}", p + sign * SHELL_OFFSET_M * n, faces,
-                      sign * n, uvs, shell_props)
+                      sign * n, shell_uvs, shell_props)
         shell.add_attribute(ATTRIBUTE, 3, np.ascontiguousarray(emission, dtype=np.float32).ravel())
         radiance.attach(shell)
         scene[f"fluorescence_{side}"] = shell

@@ -95,6 +95,12 @@ KEY_SHADOW_NORMAL_OFFSET_TEXELS = 0.0
 OCCLUSION_UNIT = 7
 #: Texture unit of the room's irradiance on the curtain's room side (the curtain's ROOM_SIDE).
 ROOM_SIDE_UNIT = 8
+#: Texture unit of the room's capture of the cloth's room side (ROOM_SIDE: what a fold sees of
+#: its neighbours where they hide the room).
+ROOM_SIDE_CLOTH_UNIT = 9
+#: Texture unit of the capture of the cloth's window side (ROOM_SIDE: the folds in front of
+#: the outside light the cloth behind them).
+WINDOW_SIDE_CLOTH_UNIT = 10
 #: SKY_OCCLUSION's depth bias (m) and its lookup's offset off the surface (m): a texel and a
 #: half of an occlusion map (room_light.OCCLUSION_TEXELS over ~2.4 m: 2 cm each).
 OCCLUSION_BIAS_M = 0.01
@@ -870,7 +876,38 @@ class FrameRenderer:
         out = self._capture_overrides()
         out["u_a_spec"] = values["u_a_spec"]
         out["u_direct"] = 0.0
+        out.update(self._window_side_ambient())
         return out
+
+    def _window_side_ambient(self) -> dict:
+        """The ambient term of the cloth's window side seen from outside (issue 11, fourth
+        round): the outside reflected by the lobes' backward factors, dye (a_diff backward(g_diff)
+        + a_spec backward(g_spec)) x the outside's mean radiance, at the normal view's ratio, the
+        sky and ground not split (the room eye's own terms, kept before, sent the outside's
+        forward-scattered share, the light that crosses to the room, back out of the window)."""
+        from dataclasses import replace  # noqa: PLC0415
+
+        from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
+
+        key = (self._inputs_key, self.n_bands, self.room_side_active())
+        if getattr(self, "_window_side_key", None) != key:
+            inputs = self.curtain_inputs()
+            backward = (inputs.a_diff * hg_hemisphere_factors(inputs.g_diff)[1]
+                        + inputs.a_spec * hg_hemisphere_factors(inputs.g_spec)[1])
+            reflected = (inputs.dye_transmittance * backward
+                         * 0.5 * (inputs.sky_radiance + inputs.ground_radiance))
+            banded = band_lib.band_uniforms(replace(inputs, ambient_radiance=reflected,
+                                                    ambient_outside_radiance=reflected,
+                                                    ambient_tilt_radiance=None), self.n_bands)
+            values = self.scene_values()
+            self._window_side_values = {
+                "u_ambient": banded["u_ambient"], "u_ambient_outside": banded["u_ambient_outside"],
+                "u_ambient_occluded": banded["u_ambient_occluded"],
+                "u_ambient_tilt": np.zeros_like(values["u_ambient_tilt"]),
+                "u_ambient_view_outside": np.ones_like(values["u_ambient_view_outside"]),
+                "u_ambient_view_room": np.ones_like(values["u_ambient_view_room"])}
+            self._window_side_key = key
+        return self._window_side_values
 
     def _program(self, vertex: str, fragment: str, defines: dict | None = None):
         key = (vertex, fragment, tuple(sorted((defines or {}).items())))
@@ -1218,7 +1255,12 @@ class FrameRenderer:
 
     def read_luminaire_back(self, level: int) -> np.ndarray:
         """The window-side capture at mip ``level``, float32 (H, W, 3), row 0 = the opening's bottom."""
-        texture = self._room_resources()["luminaire_back"]
+        return self.read_luminaire(level, "luminaire_back")
+
+    def read_luminaire(self, level: int, name: str = "luminaire") -> np.ndarray:
+        """The room-side capture (or ``name``) at mip ``level``, float32 (H, W, 3), row 0 = the
+        opening's bottom."""
+        texture = self._room_resources()[name]
         w, h = (max(v >> level, 1) for v in texture.size)
         data = texture.read(level=level)
         return np.frombuffer(data, dtype="f4").reshape(h, w, 4)[..., :3].copy()
@@ -1492,14 +1534,18 @@ class FrameRenderer:
         grid = self._occlusion_grid()
         gl["occlusion_fbo"].use()
         self.ctx.viewport = (0, 0, grid * n, grid * n)   # the whole atlas (use() restores the last tile's)
-        gl["occlusion_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
+        gl["occlusion_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
         program = self._program("room_shadow.vert", "room_shadow.frag",
-                                {"HAS_UV": True, "PATTERN": False, "FRONT_LAYER": True})
+                                {"HAS_UV": True, "PATTERN": False, "FRONT_LAYER": True,
+                                 "BOTH_LAYERS": True})
         self._set(program, "u_mesh_offset", self._mesh_offset)
         self._set(program, "u_mean_coverage", 1.0)
         self._set(program, "u_thread_beam_rgb", (0.0, 0.0, 0.0))
-        self.ctx.enable(mgl.DEPTH_TEST)
-        self.ctx.depth_func = "<"
+        # the nearest layer (alpha, MIN) and the farthest (g, MAX) in one pass, no depth test
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.enable(mgl.BLEND)
+        self.ctx.blend_func = (mgl.ONE, mgl.ONE)
+        self.ctx.blend_equation = (mgl.MAX, mgl.MIN)
         self.ctx.disable(mgl.CULL_FACE)
         vao = self._shadow_vao(program)   # the coarse grid: the occlusion is a fold's, not a pixel's
         for j, direction in enumerate(room_light.occlusion_directions()):
@@ -1507,7 +1553,9 @@ class FrameRenderer:
             self._set(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(direction)))
             vao.render(mgl.TRIANGLES)
         self.ctx.viewport = (0, 0, grid * n, grid * n)
-        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.blend_equation = mgl.FUNC_ADD
+        self.ctx.blend_func = mgl.DEFAULT_BLENDING
+        self.ctx.disable(mgl.BLEND)
 
     def _draw_key_front(self, inputs, patterned: bool, colours: dict) -> None:
         """The key light's front-layer map (curtain.frag KEY_SHADOW): per texel the layer of
@@ -1587,6 +1635,18 @@ class FrameRenderer:
         if self.curtain_open:
             return (0.0, 0.0, 0.0)
         return self.curtain_room_reflectance_rgb(inputs)
+
+    def curtain_forward_rgb(self, inputs) -> tuple[float, float, float]:
+        """The cloth's transmittance of diffuse light by its lobes (linear sRGB), dye (a_diff
+        forward(g_diff) + a_spec forward(g_spec)), the dye per channel under the key: what passes
+        towards a viewer in the room of the light on the cloth's window side (curtain.frag
+        ROOM_SIDE, the folds' light where they hide the outside)."""
+        from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
+
+        dye_rgb = self._room_dye_rgb(self._display_colours(inputs))
+        forward = (float(inputs.a_diff) * hg_hemisphere_factors(float(inputs.g_diff))[0]
+                   + float(inputs.a_spec) * hg_hemisphere_factors(float(inputs.g_spec))[0])
+        return tuple(float(v) for v in np.clip(dye_rgb * forward, 0.0, 1.0))
 
     def curtain_room_reflectance_rgb(self, inputs) -> tuple[float, float, float]:
         """The cloth's reflectance under the room's diffuse light (linear sRGB), dye (a_diff
@@ -1717,6 +1777,14 @@ class FrameRenderer:
         x0, y0, w, h = room_light.curtain_side_rect()
         self._set(program, "u_room_side_rect", (x0, y0, 1.0 / w, 1.0 / h))
         self._set(program, "u_room_side_reflectance", self.curtain_room_reflectance_rgb(self.shading_inputs()))
+        gl["luminaire"].use(location=ROOM_SIDE_CLOTH_UNIT)
+        self._set(program, "u_room_side_cloth", ROOM_SIDE_CLOTH_UNIT)
+        self._set(program, "u_room_side_cloth_level", room_light.LUMINAIRE_LEVEL)
+        self._set(program, "u_room_side_cloth_size", room_light.LUMINAIRE_TEXELS)
+        gl["luminaire_back"].use(location=WINDOW_SIDE_CLOTH_UNIT)
+        self._set(program, "u_window_side_cloth", WINDOW_SIDE_CLOTH_UNIT)
+        self._set(program, "u_window_side_cloth_level", room_light.BACK_LUMINAIRE_LEVEL)
+        self._set(program, "u_window_side_transmittance", self.curtain_forward_rgb(self.shading_inputs()))
 
     def read_room_total(self) -> np.ndarray:
         """The coarse patches' last total irradiance (radiosity pass), float32 (RC, 6 RC, 3)."""
@@ -2088,9 +2156,23 @@ class FrameRenderer:
         positions = gbuffer["position"][mask]
         if not self.room_side_active():
             return np.zeros((positions.shape[0], 3))
-        return ref.room_side_linear_srgb(
-            self.curtain_inputs(), positions, gbuffer["normal"][mask], self.camera.position,
-            self.room_side_irradiance_at(positions), self.curtain_room_reflectance_rgb(self.shading_inputs()))
+        # where the folds hide the room, the room's capture of the cloth there (its patch); where
+        # they hide the outside, the capture of the cloth's window side there
+        hidden = gbuffer["room_occlusion"][mask].astype(np.float64)[:, None]
+        hidden_outside = gbuffer["shadows"][mask][:, 2].astype(np.float64)[:, None]
+        uv = np.clip(room_light.curtain_side_uv(positions), 0.0, 0.999)
+        columns = (uv[:, 0] * room_light.LUMINAIRE_TEXELS[0]).astype(int)
+        rows = (uv[:, 1] * room_light.LUMINAIRE_TEXELS[1]).astype(int)
+        room_side = self.read_luminaire(room_light.LUMINAIRE_LEVEL)[rows, columns].astype(np.float64)
+        window_side = self.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL)[rows, columns].astype(np.float64)
+        irradiance = ((1.0 - hidden) * self.room_side_irradiance_at(positions)
+                      + hidden * math.pi * room_side)
+        inputs, normals = self.curtain_inputs(), gbuffer["normal"][mask]
+        return (ref.room_side_linear_srgb(inputs, positions, normals, self.camera.position, irradiance,
+                                          self.curtain_room_reflectance_rgb(self.shading_inputs()))
+                + ref.window_side_linear_srgb(inputs, positions, normals, self.camera.position,
+                                              math.pi * hidden_outside * window_side,
+                                              self.curtain_forward_rgb(self.shading_inputs())))
 
     def twin_linear_srgb(self, gbuffer: dict, mask) -> np.ndarray:
         """The float64 twin of the curtain's linear sRGB (P, 3) at the G-buffer pixels ``mask``
@@ -2112,7 +2194,7 @@ class FrameRenderer:
         elif self.key_shadow or self.sky_occlusion:   # the cloth's shadow maps of this mesh
             self.draw_cloth_shadow_maps(self.shading_inputs())
         if self._gbuffer is None:
-            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(5)]
+            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(6)]
             depth = self.ctx.depth_renderbuffer((w, h))
             self._gbuffer = (textures, self.ctx.framebuffer(textures, depth))
         textures, fbo = self._gbuffer
@@ -2124,10 +2206,12 @@ class FrameRenderer:
         self.draw_curtain(self.camera.view_projection(w / h), gbuffer=True)
         self.ctx.disable(mgl.DEPTH_TEST)
         out = {}
-        for name, attachment in zip(("radiance", "position", "normal", "tangent", "shadows"), range(5)):
+        for name, attachment in zip(("radiance", "position", "normal", "tangent", "shadows",
+                                     "room_occlusion"), range(6)):
             data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
             out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
         out["mask"] = out["position"][..., 3] > 0.5
+        out["room_occlusion"] = out["room_occlusion"][..., 0]
         for name in ("radiance", "position", "normal", "tangent"):
             out[name] = out[name][..., :3]
         return out
