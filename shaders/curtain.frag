@@ -87,7 +87,7 @@ layout(location = 1) out vec4 out_position;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_tangent;
 layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, the outside's occlusion: cloth, wall
-layout(location = 5) out vec4 out_room_occlusion;   // x: the room's side hidden by the cloth
+layout(location = 5) out vec4 out_room_occlusion;   // x: the room's side hidden by the cloth, y: the view's continuation
 #endif
 
 // One chunk of 4 bands: eq. 8's terms summed, then projected to display colour. Called with a
@@ -151,9 +151,14 @@ uniform ivec2 u_room_side_cloth_size;
 // here: their glow and the key they scatter back), passed towards the viewer by the lobes'
 // forward factors (u_window_side_transmittance: dye (a_diff forward(g_diff) + a_spec
 // forward(g_spec)), display RGB)
+// The broad diffuse lobe takes that share by the hemisphere's occlusion; the directional
+// lobe, tens of degrees wide about the view's continuation, by the occlusion along that
+// continuation (OCCLUSION_MAPS: the map whose direction lies nearest it, read here)
 uniform sampler2D u_window_side_cloth;
 uniform int u_window_side_cloth_level;
-uniform vec3 u_window_side_transmittance;
+uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
+uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
+float g_view_occlusion = 0.0;            // the view's continuation hidden by the cloth
 #endif
 float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own folds (SKY_OCCLUSION)
 #ifdef ROOM_CAPTURE
@@ -349,7 +354,23 @@ void main() {
     vec3 cloth_light = PI * texelFetch(u_room_side_cloth, cloth_patch, u_room_side_cloth_level).rgb;
     rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance
          * mix(room_light, cloth_light, g_room_occlusion);
-    rgb += (g_view_outside * g_occlusion) * u_window_side_transmittance
+#if defined(SKY_OCCLUSION) && defined(OCCLUSION_MAPS)
+    if (ray.z < 0.0) {   // the view goes on towards the window
+        int nearest = 0;
+        float best = -2.0;
+        for (int j = 0; j < N_OCCLUSION; ++j) {
+            float c = dot(u_occlusion_direction[j], ray);
+            if (c > best) {
+                best = c;
+                nearest = j;
+            }
+        }
+        vec3 ng = normalize(v_normal);
+        g_view_occlusion = occlusion_lookup(nearest, v_position
+                                            + (u_occlusion_offset_m * sign(dot(ng, ray))) * ng, false);
+    }
+#endif
+    rgb += g_view_outside * (g_occlusion * u_window_side_diffuse + g_view_occlusion * u_window_side_directional)
          * texelFetch(u_window_side_cloth, cloth_patch, u_window_side_cloth_level).rgb;
 #endif
 #ifdef PATTERN
@@ -385,6 +406,10 @@ void main() {
     shadows.zw = vec2(g_occlusion, g_wall_occlusion);
 #endif
     out_shadows = shadows;
+#ifdef ROOM_SIDE
+    out_room_occlusion = vec4(g_room_occlusion, g_view_occlusion, 0.0, 0.0);
+#else
     out_room_occlusion = vec4(g_room_occlusion, 0.0, 0.0, 0.0);
+#endif
 #endif
 }

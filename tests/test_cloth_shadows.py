@@ -133,7 +133,9 @@ def test_outside_occlusion_matches_rays_cast_in_numpy(gl, make_preset):
     it). A flat curtain hides nothing of itself (cloth share < 0.02 everywhere). The room's
     side (issue 11, fourth round: the opposite directions, from the same maps' farthest layer):
     within 0.15 of the numpy rays in the mean, the folds' room-side troughs (the cloth nearest the
-    window) hidden more than their crests by at least 0.1, and nothing on the flat curtain."""
+    window) hidden more than their crests by at least 0.1, and nothing on the flat curtain; the
+    view's continuation (ROOM_SIDE: the map nearest the view ray) within 0.15 in the mean of a
+    ray cast along that direction."""
     mesh = scene_lib.draped_curtain(columns=60, rows=40, depth_m=0.15)
     r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh)
     g = r.render_gbuffer()
@@ -161,6 +163,23 @@ def test_outside_occlusion_matches_rays_cast_in_numpy(gl, make_preset):
     assert (np.abs(shadows[pick, 3] - wall) < 0.1).mean() > 0.95
     assert np.abs(shadows[pick, 2] - cloth).mean() < 0.15
     assert np.abs(hidden_room[pick] - room).mean() < 0.15
+    # ROOM_SIDE's view's continuation, seen obliquely across the folds: the direction nearest
+    # the view ray, cast from the pixel
+    r.set_camera(55.0, 0.0, 2.0)
+    oblique = r.render_gbuffer()
+    assert r.room_side_active()
+    all_o = oblique["position"][oblique["mask"]].astype(np.float64)
+    chosen = rng.choice(all_o.shape[0], size=min(400, all_o.shape[0]), replace=False)
+    qo = all_o[chosen]
+    ray = qo - np.asarray(r.camera.position, dtype=np.float64)
+    ray /= np.linalg.norm(ray, axis=1, keepdims=True)
+    nearest = directions[np.argmax(ray @ directions.T, axis=1)]
+    view_hit = np.array([np.isfinite(first_hit(qo[k:k + 1] + 0.03 * nearest[k], nearest[k], triangles))[0]
+                         for k in range(qo.shape[0])])
+    assert view_hit.mean() > 0.1   # the folds hide part of the continuations
+    seen = oblique["room_occlusion_view"][oblique["mask"]][chosen]
+    assert np.abs(seen - view_hit).mean() < 0.15
+    r.set_camera(0.0, 0.0, 2.0)
     amplitude = np.ptp(np.asarray(mesh.positions)[:, 2]) / 2
     trough = p[:, 2] > scene_lib.CURTAIN_Z + 0.6 * amplitude
     crest = p[:, 2] < scene_lib.CURTAIN_Z - 0.6 * amplitude

@@ -505,8 +505,9 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path = Path(RESULT_JSON)) -> dict:
     """Run the full section and keep it in ``json_path`` under ``runs[name]`` (the earlier
-    runs stay), with its six triptychs stacked in ``image_folder/pathtrace_scenes_NAME.png``
-    and its Pareto plot in ``pathtrace_pareto_NAME.png``; both written atomically."""
+    runs stay), with its six triptychs stacked in ``image_folder/pathtrace_scenes_NAME.png``,
+    its Pareto plot in ``pathtrace_pareto_NAME.png`` and the first scene's triptych in
+    ``pathtrace_triptych.png`` (the README's figure); each written atomically."""
     import json  # noqa: PLC0415
     import shutil  # noqa: PLC0415
     import tempfile  # noqa: PLC0415
@@ -524,6 +525,9 @@ def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path
     result.pop("_images")
     with atomic_path(image_folder / f"pathtrace_scenes_{name}.png") as tmp:
         pyplot().imsave(tmp, stacked, format="png")
+    # the README's figure: the first scene's triptych of the latest run
+    with atomic_path(image_folder / "pathtrace_triptych.png") as tmp:
+        pyplot().imsave(tmp, triptych(images[SCENES[0][0]]), format="png")
     committed = json.loads(json_path.read_text())
     committed["runs"][name] = result
     write_text_atomic(json_path, json.dumps(committed, indent=1) + "\n")

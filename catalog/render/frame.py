@@ -101,6 +101,8 @@ ROOM_SIDE_CLOTH_UNIT = 9
 #: Texture unit of the capture of the cloth's window side (ROOM_SIDE: the folds in front of
 #: the outside light the cloth behind them).
 WINDOW_SIDE_CLOTH_UNIT = 10
+#: Texture unit of the occlusion maps in the curtain pass (ROOM_SIDE: the view's continuation).
+OCCLUSION_MAPS_UNIT = 11
 #: SKY_OCCLUSION's depth bias (m) and its lookup's offset off the surface (m): a texel and a
 #: half of an occlusion map (room_light.OCCLUSION_TEXELS over ~2.4 m: 2 cm each).
 OCCLUSION_BIAS_M = 0.01
@@ -781,6 +783,8 @@ class FrameRenderer:
             defines["N_OCCLUSION"] = room_light.OCCLUSION_DIRECTIONS
         if self.room_side_active():
             defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
+            if defines.get("SKY_OCCLUSION"):
+                defines["OCCLUSION_MAPS"] = True   # the view's continuation hidden by the folds
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -832,6 +836,7 @@ class FrameRenderer:
         if overrides:
             defines["ROOM_CAPTURE"] = True  # the room's window capture (issue 13), not the frame's
             defines.pop("ROOM_SIDE", None)  # the radiosity reflects the room's light off the cloth
+            defines.pop("OCCLUSION_MAPS", None)
         if self.specialise:
             for name, value in self._scene_values_with(overrides).items():
                 defines["S_" + name[2:].upper()] = glsl_literal(value)
@@ -1421,12 +1426,13 @@ class FrameRenderer:
         self.ctx.disable(mgl.BLEND)
         self._curtain_vao(program).render(mgl.POINTS)
 
-    def _occlusion_uniforms(self, program) -> None:
-        """common.glsl's outside_occlusion: the occlusion maps and each direction's frame."""
+    def _occlusion_uniforms(self, program, unit: int = OCCLUSION_UNIT) -> None:
+        """common.glsl's outside_occlusion: the occlusion maps (at texture ``unit``) and each
+        direction's frame."""
         gl = self._room_resources()
-        gl["occlusion"].use(location=OCCLUSION_UNIT)
+        gl["occlusion"].use(location=unit)
         s = self._set
-        s(program, "u_occlusion_maps", OCCLUSION_UNIT)
+        s(program, "u_occlusion_maps", unit)
         directions = room_light.occlusion_directions()
         matrices = [room_light.light_view_projection(d) for d in directions]
         s(program, "u_occlusion_view_proj", b"".join(gl_bytes(m) for m in matrices))
@@ -1636,17 +1642,18 @@ class FrameRenderer:
             return (0.0, 0.0, 0.0)
         return self.curtain_room_reflectance_rgb(inputs)
 
-    def curtain_forward_rgb(self, inputs) -> tuple[float, float, float]:
-        """The cloth's transmittance of diffuse light by its lobes (linear sRGB), dye (a_diff
-        forward(g_diff) + a_spec forward(g_spec)), the dye per channel under the key: what passes
-        towards a viewer in the room of the light on the cloth's window side (curtain.frag
-        ROOM_SIDE, the folds' light where they hide the outside)."""
+    def curtain_forward_rgb(self, inputs) -> tuple[tuple, tuple]:
+        """The cloth's transmittance of diffuse light by each lobe (linear sRGB), dye a_diff
+        forward(g_diff) and dye a_spec forward(g_spec), the dye per channel under the key: what
+        passes towards a viewer in the room of the light on the cloth's window side (curtain.frag
+        ROOM_SIDE, the folds' light where they hide the outside: the diffuse lobe's by the
+        hemisphere's occlusion, the directional lobe's by the view's continuation)."""
         from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
 
         dye_rgb = self._room_dye_rgb(self._display_colours(inputs))
-        forward = (float(inputs.a_diff) * hg_hemisphere_factors(float(inputs.g_diff))[0]
-                   + float(inputs.a_spec) * hg_hemisphere_factors(float(inputs.g_spec))[0])
-        return tuple(float(v) for v in np.clip(dye_rgb * forward, 0.0, 1.0))
+        diffuse = float(inputs.a_diff) * hg_hemisphere_factors(float(inputs.g_diff))[0]
+        directional = float(inputs.a_spec) * hg_hemisphere_factors(float(inputs.g_spec))[0]
+        return tuple(tuple(float(v) for v in np.clip(dye_rgb * f, 0.0, 1.0)) for f in (diffuse, directional))
 
     def curtain_room_reflectance_rgb(self, inputs) -> tuple[float, float, float]:
         """The cloth's reflectance under the room's diffuse light (linear sRGB), dye (a_diff
@@ -1784,7 +1791,11 @@ class FrameRenderer:
         gl["luminaire_back"].use(location=WINDOW_SIDE_CLOTH_UNIT)
         self._set(program, "u_window_side_cloth", WINDOW_SIDE_CLOTH_UNIT)
         self._set(program, "u_window_side_cloth_level", room_light.BACK_LUMINAIRE_LEVEL)
-        self._set(program, "u_window_side_transmittance", self.curtain_forward_rgb(self.shading_inputs()))
+        diffuse, directional = self.curtain_forward_rgb(self.shading_inputs())
+        self._set(program, "u_window_side_diffuse", diffuse)
+        self._set(program, "u_window_side_directional", directional)
+        if "u_occlusion_maps" in program:   # beside the per-vertex occlusion (OCCLUSION_UNIT)
+            self._occlusion_uniforms(program, OCCLUSION_MAPS_UNIT)
 
     def read_room_total(self) -> np.ndarray:
         """The coarse patches' last total irradiance (radiosity pass), float32 (RC, 6 RC, 3)."""
@@ -2160,6 +2171,7 @@ class FrameRenderer:
         # they hide the outside, the capture of the cloth's window side there
         hidden = gbuffer["room_occlusion"][mask].astype(np.float64)[:, None]
         hidden_outside = gbuffer["shadows"][mask][:, 2].astype(np.float64)[:, None]
+        hidden_view = gbuffer["room_occlusion_view"][mask].astype(np.float64)[:, None]
         uv = np.clip(room_light.curtain_side_uv(positions), 0.0, 0.999)
         columns = (uv[:, 0] * room_light.LUMINAIRE_TEXELS[0]).astype(int)
         rows = (uv[:, 1] * room_light.LUMINAIRE_TEXELS[1]).astype(int)
@@ -2170,9 +2182,10 @@ class FrameRenderer:
         inputs, normals = self.curtain_inputs(), gbuffer["normal"][mask]
         return (ref.room_side_linear_srgb(inputs, positions, normals, self.camera.position, irradiance,
                                           self.curtain_room_reflectance_rgb(self.shading_inputs()))
-                + ref.window_side_linear_srgb(inputs, positions, normals, self.camera.position,
-                                              math.pi * hidden_outside * window_side,
-                                              self.curtain_forward_rgb(self.shading_inputs())))
+                + sum(ref.window_side_linear_srgb(inputs, positions, normals, self.camera.position,
+                                                  math.pi * share * window_side, transmittance)
+                      for share, transmittance in zip((hidden_outside, hidden_view),
+                                                      self.curtain_forward_rgb(self.shading_inputs()))))
 
     def twin_linear_srgb(self, gbuffer: dict, mask) -> np.ndarray:
         """The float64 twin of the curtain's linear sRGB (P, 3) at the G-buffer pixels ``mask``
@@ -2211,6 +2224,7 @@ class FrameRenderer:
             data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
             out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
         out["mask"] = out["position"][..., 3] > 0.5
+        out["room_occlusion_view"] = out["room_occlusion"][..., 1]
         out["room_occlusion"] = out["room_occlusion"][..., 0]
         for name in ("radiance", "position", "normal", "tangent"):
             out[name] = out[name][..., :3]
