@@ -172,9 +172,9 @@ float g_key_reach = 1.0;           // set in main: see out_radiance.a below
 // outside_occluded_radiance), and all of the outside where the wall hides it.
 SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
 INTERPOLATION in vec3 v_occlusion;  // the cloth's share, the window wall's, the cloth's towards the room
-float g_occlusion = 0.0;            // set in main
-float g_wall_occlusion = 0.0;
 #endif
+float g_occlusion = 0.0;            // set in main (SKY_OCCLUSION; ROOM_SIDE reads it too)
+float g_wall_occlusion = 0.0;
 
 // A table of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes.
 float ambient_view(vec4 table[AMBIENT_VIEW_VEC4], float mu) {

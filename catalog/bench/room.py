@@ -85,6 +85,7 @@ def work_counts(size) -> dict[str, float]:
     wall_z = scene_lib.ROOM_BOX[2][0]
     samples = float(np.where(z < wall_z + room_light.WINDOW_SUPERSAMPLE_M, 4, 1).sum())
     behind = float(np.where(z < scene_lib.CURTAIN_Z, 4, 0).sum())
+    side_points = float(np.prod(room_light.CURTAIN_SIDE_TEXELS))
     return {
         "room_shadow": 0.6 * n * n,
         # the two captures' curtain fragments (room side and window side)
@@ -94,9 +95,14 @@ def work_counts(size) -> dict[str, float]:
         # one fragment per coarse patch, summing over every patch
         "room_lightmap": float((samples + behind) * lw * lh * exact
                                + aw * ah * 5 * coarse * coarse * exact
-                               + (len(room_light.FACE_NAMES) * coarse * coarse) ** 2),
+                               + (len(room_light.FACE_NAMES) * coarse * coarse) ** 2
+                               # issue 11's fourth round: R4b, the room's light on the
+                               # curtain's room side, the same gather at a grid's points
+                               + side_points * 5 * coarse * coarse * exact),
         "room": 0.5 * w * h,
-        "curtain": 0.5 * w * h * 4,
+        # the fourth round's ROOM_SIDE: the grid, two captures' patches, the view's continuation
+        # (16 directions compared, one occlusion map read bilinearly): about one iteration more
+        "curtain": 0.5 * w * h * 5,
         "background": 0.2 * w * h,
         "bloom": w * h * (0.25 + 6 / 16 + 1),
         "meter": float(w * h) / 16,
