@@ -341,15 +341,44 @@ def fluorescence_per_vertex(desc: SceneDescription, scene=None, mi=None,
     cos_key = np.abs(n @ desc.key_to_light)
     visible = np.ones(count)
     if scene is not None:
-        p = np.asarray(positions, dtype=np.float64).reshape(-1, 3) + 1e-3 * desc.key_to_light
-        d = np.repeat(desc.key_to_light[None, :], count, axis=0)
-        ray = mi.Ray3f(mi.Point3f(p.T.astype(np.float32)), mi.Vector3f(d.T.astype(np.float32)))
-        visible = 1.0 - np.asarray(scene.ray_test(ray), dtype=np.float64)
-        # the cloth lets LD through its gaps: a fold in front dims the key, not blacks it out
-        visible = visible + (1.0 - visible) * desc.fabric["direct"]
+        visible = key_visibility(desc, scene, mi, positions)
     absorbed = cos_key * visible * fl["key_photons"] + fl["outside_photons"]
     effective = absorbed / (1.0 + absorbed / fl["saturation_photons"])
     return effective[:, None] * np.asarray(fl["emission_rgb_per_photon"])[None, :]
+
+
+#: Rays towards the key pass at most this many layers of cloth before the answer is kept.
+MAX_KEY_LAYERS = 4
+
+
+def key_visibility(desc: SceneDescription, scene, mi, positions) -> np.ndarray:
+    """(V,) the key's excitation reaching ``positions`` (module doc): 1 in the open, LD behind
+    cloth (a fold in front dims the key through its gaps, it does not black it out), 0 where
+    the window wall (anything outside the wall's inner plane) stops the ray, whether or not
+    cloth lies before it (issue 11, fourth round: the wall had passed LD as the cloth does)."""
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3) + 1e-3 * desc.key_to_light
+    d = np.repeat(desc.key_to_light[None, :], p.shape[0], axis=0)
+    wall_z = scene_lib.ROOM_BOX[2][0] + 1e-3
+    blocked = np.zeros(p.shape[0], dtype=bool)
+    behind_cloth = np.zeros(p.shape[0], dtype=bool)
+    active = np.ones(p.shape[0], dtype=bool)
+    for _ in range(MAX_KEY_LAYERS):
+        ray = mi.Ray3f(mi.Point3f(p.T.astype(np.float32)), mi.Vector3f(d.T.astype(np.float32)))
+        si = scene.ray_intersect(ray)
+        hit = np.asarray(si.is_valid(), dtype=bool) & active
+        hit_p = np.asarray(si.p, dtype=np.float64).T
+        wall = hit & (hit_p[:, 2] < wall_z)
+        blocked |= wall
+        cloth = hit & ~wall
+        behind_cloth |= cloth
+        active = cloth
+        if not active.any():
+            break
+        p = np.where(cloth[:, None], hit_p + 1e-4 * d, p)
+    visible = np.where(behind_cloth, float(desc.fabric["direct"]), 1.0)
+    return np.where(blocked, 0.0, visible)
 
 
 #: The least share of next-event samples an emitter gets (none is starved).
