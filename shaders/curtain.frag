@@ -88,6 +88,8 @@ layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_tangent;
 layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, the outside's occlusion: cloth, wall
 layout(location = 5) out vec4 out_room_occlusion;   // x: the room's side hidden by the cloth, y: the view's continuation
+layout(location = 6) out vec4 out_room_side_light;  // ROOM_SIDE's per-vertex light, interpolated
+layout(location = 7) out vec4 out_window_side_light;
 #endif
 
 // One chunk of 4 bands: eq. 8's terms summed, then projected to display colour. Called with a
@@ -134,31 +136,23 @@ float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; s
 #ifdef ROOM_SIDE
 // The curtain's room side lit by the room's own light (issue 11, fourth round), not by the
 // stand-ins (the fill light and the room's share of the ambient term, which frame.py then
-// leaves out: scene.with_room_solved): the irradiance the room's faces send to the window
-// (room_bounce.frag CURTAIN_SIDE, every bounce), read at the fragment's place over the
-// opening, scattered back towards the viewer by the lobes' backward hemisphere factors as the
-// room's share of eq. 8's ambient term is (u_room_side_reflectance: dye (a_diff backward(g_diff)
-// + a_spec backward(g_spec)) in display RGB, the radiosity's curtain reflectance), by the
-// view's ratio g_view_room. RGB like the room's light, so added after the bands' conversion.
-uniform sampler2D u_room_side;     // irradiance, linear sRGB (x pi cd m^-2)
-uniform vec4 u_room_side_rect;     // the grid: x from, y from, 1 / width, 1 / height (m)
+// leaves out: scene.with_room_solved), and the cloth by its own folds; curtain.vert reads the
+// light per vertex (it varies over the room's grid and the captures' patches, 16 cm apart):
+// v_room_side_light, the irradiance on the room side, scattered back towards the viewer by
+// the lobes' backward factors as the room's share of eq. 8's ambient term is
+// (u_room_side_reflectance: dye (a_diff backward(g_diff) + a_spec backward(g_spec)) in display
+// RGB, the radiosity's curtain reflectance) at the view's ratio g_view_room; and
+// v_window_side_light, the radiance of the folds in front of the window side, passed towards
+// the viewer where they hide the outside: by the diffuse lobe over the hemisphere's share
+// they hide (g_occlusion), by the directional lobe, tens of degrees about the view's
+// continuation, where they hide that continuation (v_view_occlusion). RGB like the room's
+// light, so added after the bands' conversion.
+INTERPOLATION in vec3 v_room_side_light;
+INTERPOLATION in vec3 v_window_side_light;
+INTERPOLATION in float v_view_occlusion;
 uniform vec3 u_room_side_reflectance;
-uniform sampler2D u_room_side_cloth; // the room's capture of the cloth's room side (the window's patches)
-uniform int u_room_side_cloth_level; // its level of one texel a patch
-uniform ivec2 u_room_side_cloth_size;
-// and on the window's side: where the folds hide the outside (g_occlusion, SKY_OCCLUSION), the
-// cloth's window side is lit by the folds in the way (the capture of the window side, its patch
-// here: their glow and the key they scatter back), passed towards the viewer by the lobes'
-// forward factors (u_window_side_transmittance: dye (a_diff forward(g_diff) + a_spec
-// forward(g_spec)), display RGB)
-// The broad diffuse lobe takes that share by the hemisphere's occlusion; the directional
-// lobe, tens of degrees wide about the view's continuation, by the occlusion along that
-// continuation (OCCLUSION_MAPS: the map whose direction lies nearest it, read here)
-uniform sampler2D u_window_side_cloth;
-uniform int u_window_side_cloth_level;
 uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
 uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
-float g_view_occlusion = 0.0;            // the view's continuation hidden by the cloth
 #endif
 float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own folds (SKY_OCCLUSION)
 #ifdef ROOM_CAPTURE
@@ -345,33 +339,9 @@ void main() {
     rgb += (bg.x * u_direct) * environment_lookup(u_environment, u_environment_scale, ray);
 #endif
 #ifdef ROOM_SIDE
-    // where the cloth's own folds hide the room, the fraction g_room_occlusion of the room's
-    // side sees the cloth instead: the room's capture of it at this place (its patch's mean
-    // room-side radiance: the glow and the outside it passes), pi L as an irradiance
-    vec2 side_uv = (v_position.xy - u_room_side_rect.xy) * u_room_side_rect.zw;
-    vec3 room_light = textureLod(u_room_side, side_uv, 0.0).rgb;
-    ivec2 cloth_patch = ivec2(clamp(side_uv, 0.0, 0.999) * vec2(u_room_side_cloth_size));
-    vec3 cloth_light = PI * texelFetch(u_room_side_cloth, cloth_patch, u_room_side_cloth_level).rgb;
-    rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance
-         * mix(room_light, cloth_light, g_room_occlusion);
-#if defined(SKY_OCCLUSION) && defined(OCCLUSION_MAPS)
-    if (ray.z < 0.0) {   // the view goes on towards the window
-        int nearest = 0;
-        float best = -2.0;
-        for (int j = 0; j < N_OCCLUSION; ++j) {
-            float c = dot(u_occlusion_direction[j], ray);
-            if (c > best) {
-                best = c;
-                nearest = j;
-            }
-        }
-        vec3 ng = normalize(v_normal);
-        g_view_occlusion = occlusion_lookup(nearest, v_position
-                                            + (u_occlusion_offset_m * sign(dot(ng, ray))) * ng, false);
-    }
-#endif
-    rgb += g_view_outside * (g_occlusion * u_window_side_diffuse + g_view_occlusion * u_window_side_directional)
-         * texelFetch(u_window_side_cloth, cloth_patch, u_window_side_cloth_level).rgb;
+    rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance * v_room_side_light;
+    rgb += g_view_outside * (g_occlusion * u_window_side_diffuse + v_view_occlusion * u_window_side_directional)
+         * v_window_side_light;
 #endif
 #ifdef PATTERN
     // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole
@@ -407,9 +377,13 @@ void main() {
 #endif
     out_shadows = shadows;
 #ifdef ROOM_SIDE
-    out_room_occlusion = vec4(g_room_occlusion, g_view_occlusion, 0.0, 0.0);
+    out_room_occlusion = vec4(g_room_occlusion, v_view_occlusion, 0.0, 0.0);
+    out_room_side_light = vec4(v_room_side_light, 1.0);
+    out_window_side_light = vec4(v_window_side_light, 1.0);
 #else
     out_room_occlusion = vec4(g_room_occlusion, 0.0, 0.0, 0.0);
+    out_room_side_light = vec4(0.0);
+    out_window_side_light = vec4(0.0);
 #endif
 #endif
 }

@@ -35,6 +35,25 @@ uniform mat4 u_view_proj;
 uniform vec3 u_mesh_offset;
 uniform vec3 u_camera_position;
 
+#ifdef ROOM_SIDE
+// The light on the cloth's two sides (issue 11, fourth round; curtain.frag ROOM_SIDE), per
+// vertex: the room's irradiance (room_bounce.frag CURTAIN_SIDE's grid over the opening,
+// bilinear) where the folds leave the room's side open, and where they hide it (the per-vertex
+// occlusion's z) the cloth's room side, pi x the room's capture at this patch; the radiance of
+// the cloth's window side at this patch (the window-side capture); and whether the view's
+// continuation meets a fold (OCCLUSION_MAPS: the occlusion map whose direction lies nearest it).
+uniform sampler2D u_room_side;       // irradiance, linear sRGB (x pi cd m^-2)
+uniform vec4 u_room_side_rect;       // the grid: x from, y from, 1 / width, 1 / height (m)
+uniform sampler2D u_room_side_cloth; // the room's capture of the cloth (the window's patches)
+uniform int u_room_side_cloth_level; // its level of one texel a patch
+uniform ivec2 u_room_side_cloth_size;
+uniform sampler2D u_window_side_cloth;
+uniform int u_window_side_cloth_level;
+INTERPOLATION out vec3 v_room_side_light;
+INTERPOLATION out vec3 v_window_side_light;
+INTERPOLATION out float v_view_occlusion;
+#endif
+
 INTERPOLATION out vec3 v_view_ray;
 INTERPOLATION out vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
@@ -60,6 +79,36 @@ void main() {
 #ifdef SKY_OCCLUSION
     v_occlusion = texelFetch(u_vertex_occlusion, ivec2(gl_VertexID % u_vertex_occlusion_width,
                                                        gl_VertexID / u_vertex_occlusion_width), 0).xyz;
+#endif
+#ifdef ROOM_SIDE
+    vec2 side_uv = (position.xy - u_room_side_rect.xy) * u_room_side_rect.zw;
+    ivec2 cloth_patch = ivec2(clamp(side_uv, 0.0, 0.999) * vec2(u_room_side_cloth_size));
+    vec3 room_light = textureLod(u_room_side, side_uv, 0.0).rgb;
+    vec3 cloth_light = PI * texelFetch(u_room_side_cloth, cloth_patch, u_room_side_cloth_level).rgb;
+#ifdef SKY_OCCLUSION
+    v_room_side_light = mix(room_light, cloth_light, v_occlusion.z);
+#else
+    v_room_side_light = room_light;
+#endif
+    v_window_side_light = texelFetch(u_window_side_cloth, cloth_patch, u_window_side_cloth_level).rgb;
+    v_view_occlusion = 0.0;
+#if defined(SKY_OCCLUSION) && defined(OCCLUSION_MAPS)
+    vec3 ray = normalize(v_view_ray);
+    if (ray.z < 0.0) {   // the view goes on towards the window
+        int nearest = 0;
+        float best = -2.0;
+        for (int j = 0; j < N_OCCLUSION; ++j) {
+            float c = dot(u_occlusion_direction[j], ray);
+            if (c > best) {
+                best = c;
+                nearest = j;
+            }
+        }
+        vec3 ng = normalize(in_normal);
+        v_view_occlusion = occlusion_lookup(nearest, position
+                                            + (u_occlusion_offset_m * sign(dot(ng, ray))) * ng, false);
+    }
+#endif
 #endif
     gl_Position = u_view_proj * vec4(position, 1.0);
 }

@@ -2148,6 +2148,19 @@ class FrameRenderer:
         at world ``positions`` (bilinear, clamped to the opening's edge), float64."""
         return room_light.sample_bilinear(self.read_room_side(), room_light.curtain_side_uv(positions))
 
+    def room_side_light_at(self, positions, room_hidden) -> tuple[np.ndarray, np.ndarray]:
+        """curtain.vert ROOM_SIDE's light evaluated in numpy at ``positions`` (P, 3) with the
+        room's side hidden by ``room_hidden`` (P,): the irradiance on the room side (the grid,
+        bilinear, where open; pi x the room's capture at the patch where hidden) and the
+        window-side capture's radiance at the patch, float64 (P, 3) each."""
+        uv = np.clip(room_light.curtain_side_uv(positions), 0.0, 0.999)
+        columns = (uv[:, 0] * room_light.LUMINAIRE_TEXELS[0]).astype(int)
+        rows = (uv[:, 1] * room_light.LUMINAIRE_TEXELS[1]).astype(int)
+        hidden = np.asarray(room_hidden, dtype=np.float64).reshape(-1, 1)
+        room = self.read_luminaire(room_light.LUMINAIRE_LEVEL)[rows, columns].astype(np.float64)
+        window = self.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL)[rows, columns].astype(np.float64)
+        return (1.0 - hidden) * self.room_side_irradiance_at(positions) + hidden * math.pi * room, window
+
     def twin_spectral(self, gbuffer: dict, mask) -> np.ndarray:
         """The float64 twin's spectral radiance (P, L) at the G-buffer pixels ``mask``: eq. 8 with
         :meth:`curtain_inputs` and the pixels' shadows (without the room side's RGB term,
@@ -2160,27 +2173,22 @@ class FrameRenderer:
 
     def twin_room_side_rgb(self, gbuffer: dict, mask) -> np.ndarray:
         """The twin of ROOM_SIDE's term (P, 3) linear sRGB at the G-buffer pixels (0 when the
-        room side takes the stand-ins), from the grid the GPU gathered (its own twin:
-        room_light.curtain_side_irradiance)."""
+        room side takes the stand-ins), from the per-vertex light the G-buffer carries (its
+        values against their numpy evaluation: :meth:`room_side_light_at`)."""
         from catalog.optics import shading_reference as ref  # noqa: PLC0415
 
         positions = gbuffer["position"][mask]
         if not self.room_side_active():
             return np.zeros((positions.shape[0], 3))
-        # where the folds hide the room, the room's capture of the cloth there (its patch); where
-        # they hide the outside, the capture of the cloth's window side there
-        hidden = gbuffer["room_occlusion"][mask].astype(np.float64)[:, None]
+        # the per-vertex light curtain.vert read (the G-buffer's, interpolated; its values are
+        # held to their numpy evaluation by tests/test_render_room.py), where the folds hide the
+        # outside (the hemisphere's share, the view's continuation) passed by each lobe
+        inputs, normals = self.curtain_inputs(), gbuffer["normal"][mask]
         hidden_outside = gbuffer["shadows"][mask][:, 2].astype(np.float64)[:, None]
         hidden_view = gbuffer["room_occlusion_view"][mask].astype(np.float64)[:, None]
-        uv = np.clip(room_light.curtain_side_uv(positions), 0.0, 0.999)
-        columns = (uv[:, 0] * room_light.LUMINAIRE_TEXELS[0]).astype(int)
-        rows = (uv[:, 1] * room_light.LUMINAIRE_TEXELS[1]).astype(int)
-        room_side = self.read_luminaire(room_light.LUMINAIRE_LEVEL)[rows, columns].astype(np.float64)
-        window_side = self.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL)[rows, columns].astype(np.float64)
-        irradiance = ((1.0 - hidden) * self.room_side_irradiance_at(positions)
-                      + hidden * math.pi * room_side)
-        inputs, normals = self.curtain_inputs(), gbuffer["normal"][mask]
-        return (ref.room_side_linear_srgb(inputs, positions, normals, self.camera.position, irradiance,
+        window_side = gbuffer["window_side_light"][mask].astype(np.float64)
+        return (ref.room_side_linear_srgb(inputs, positions, normals, self.camera.position,
+                                          gbuffer["room_side_light"][mask].astype(np.float64),
                                           self.curtain_room_reflectance_rgb(self.shading_inputs()))
                 + sum(ref.window_side_linear_srgb(inputs, positions, normals, self.camera.position,
                                                   math.pi * share * window_side, transmittance)
@@ -2207,7 +2215,7 @@ class FrameRenderer:
         elif self.key_shadow or self.sky_occlusion:   # the cloth's shadow maps of this mesh
             self.draw_cloth_shadow_maps(self.shading_inputs())
         if self._gbuffer is None:
-            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(6)]
+            textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(8)]
             depth = self.ctx.depth_renderbuffer((w, h))
             self._gbuffer = (textures, self.ctx.framebuffer(textures, depth))
         textures, fbo = self._gbuffer
@@ -2220,13 +2228,13 @@ class FrameRenderer:
         self.ctx.disable(mgl.DEPTH_TEST)
         out = {}
         for name, attachment in zip(("radiance", "position", "normal", "tangent", "shadows",
-                                     "room_occlusion"), range(6)):
+                                     "room_occlusion", "room_side_light", "window_side_light"), range(8)):
             data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
             out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
         out["mask"] = out["position"][..., 3] > 0.5
         out["room_occlusion_view"] = out["room_occlusion"][..., 1]
         out["room_occlusion"] = out["room_occlusion"][..., 0]
-        for name in ("radiance", "position", "normal", "tangent"):
+        for name in ("radiance", "position", "normal", "tangent", "room_side_light", "window_side_light"):
             out[name] = out[name][..., :3]
         return out
 
