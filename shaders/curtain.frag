@@ -24,7 +24,7 @@ uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to th
 #ifdef OIT
 uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW) || defined(ROOM_SIDE)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
 INTERPOLATION in vec3 v_position;
 #endif
 

@@ -59,7 +59,7 @@ INTERPOLATION out vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 INTERPOLATION out vec3 v_tangent;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW) || defined(ROOM_SIDE)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
 INTERPOLATION out vec3 v_position;
 #endif
 
@@ -73,7 +73,7 @@ void main() {
 #ifdef PATTERN
     v_pattern_uv = in_uv * u_uv_to_repeats;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW) || defined(ROOM_SIDE)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
     v_position = position;
 #endif
 #ifdef SKY_OCCLUSION
@@ -95,18 +95,30 @@ void main() {
 #if defined(SKY_OCCLUSION) && defined(OCCLUSION_MAPS)
     vec3 ray = normalize(v_view_ray);
     if (ray.z < 0.0) {   // the view goes on towards the window
-        int nearest = 0;
-        float best = -2.0;
+        // the two maps nearest it, blended by how near each is: where the nearest changes
+        // from one map to the next the value does not jump (a choice that flips between two
+        // near-equal directions, as two GPUs' rounding may, would change a whole triangle)
+        int first = 0;
+        int second = 0;
+        float c1 = -2.0;
+        float c2 = -2.0;
         for (int j = 0; j < N_OCCLUSION; ++j) {
             float c = dot(u_occlusion_direction[j], ray);
-            if (c > best) {
-                best = c;
-                nearest = j;
+            if (c > c1) {
+                second = first;
+                c2 = c1;
+                first = j;
+                c1 = c;
+            } else if (c > c2) {
+                second = j;
+                c2 = c;
             }
         }
         vec3 ng = normalize(in_normal);
-        v_view_occlusion = occlusion_lookup(nearest, position
-                                            + (u_occlusion_offset_m * sign(dot(ng, ray))) * ng, false);
+        vec3 q = position + (u_occlusion_offset_m * sign(dot(ng, ray))) * ng;
+        float w = clamp(0.5 + (c1 - c2) * 20.0, 0.5, 1.0);   // all the nearest's beyond 0.025 apart
+        v_view_occlusion = w * occlusion_lookup(first, q, false)
+                         + (1.0 - w) * occlusion_lookup(second, q, false);
     }
 #endif
 #endif

@@ -365,38 +365,38 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
     return radiance
 
 
-def room_side_linear_srgb(inputs: ShadingInputs, positions, normals, camera_position,
-                         irradiance_rgb, reflectance_rgb) -> np.ndarray:
-    """(P, 3) linear sRGB: the room's solved light on the curtain's room side (issue 11, fourth
-    round; curtain.frag ROOM_SIDE), the twin of the term the frame adds to the shading of
-    ``catalog.render.scene.with_room_solved(inputs)``: the room's irradiance at each position
-    (P, 3; linear sRGB, x pi cd m^-2) over pi, times the cloth's reflectance of diffuse light
-    from the room's side (3,), times the ambient's ratio by view for the room's hemisphere."""
+def _side_light_linear_srgb(table, positions, normals, camera_position, irradiance_rgb,
+                            factor_rgb) -> np.ndarray:
+    """(P, 3): irradiance (P, 3) over pi, times a lobe factor (3,), times the ambient's ratio by
+    view ``table`` at each position's |n . v|."""
     p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     n = n / np.linalg.norm(n, axis=1, keepdims=True)
     to_viewer = np.asarray(camera_position, dtype=np.float64) - p
     to_viewer = to_viewer / np.linalg.norm(to_viewer, axis=1, keepdims=True)
-    mu = np.abs(np.einsum("pi,pi->p", to_viewer, n))
-    r_room = ambient_view_ratio(inputs.ambient_view_room, mu)
-    return (r_room[:, None] / math.pi) * np.asarray(irradiance_rgb, dtype=np.float64).reshape(-1, 3) \
-        * np.asarray(reflectance_rgb, dtype=np.float64)[None, :]
+    ratio = ambient_view_ratio(table, np.abs(np.einsum("pi,pi->p", to_viewer, n)))
+    return (ratio[:, None] / math.pi) * np.asarray(irradiance_rgb, dtype=np.float64).reshape(-1, 3) \
+        * np.asarray(factor_rgb, dtype=np.float64)[None, :]
+
+
+def room_side_linear_srgb(inputs: ShadingInputs, positions, normals, camera_position,
+                          irradiance_rgb, reflectance_rgb) -> np.ndarray:
+    """(P, 3) linear sRGB: the room's solved light on the curtain's room side (issue 11, fourth
+    round; curtain.frag ROOM_SIDE), the twin of the term the frame adds to the shading of
+    ``catalog.render.scene.with_room_solved(inputs)``: the irradiance on the room side at each
+    position (P, 3; linear sRGB, x pi cd m^-2) over pi, times the cloth's reflectance of diffuse
+    light from the room's side (3,), times the ambient's ratio by view for the room's hemisphere."""
+    return _side_light_linear_srgb(inputs.ambient_view_room, positions, normals, camera_position,
+                                   irradiance_rgb, reflectance_rgb)
 
 
 def window_side_linear_srgb(inputs: ShadingInputs, positions, normals, camera_position,
-                           irradiance_rgb, transmittance_rgb) -> np.ndarray:
+                            irradiance_rgb, transmittance_rgb) -> np.ndarray:
     """(P, 3) linear sRGB: light on the curtain's window side from the folds in front of it (issue
-    11, fourth round; curtain.frag ROOM_SIDE), irradiance (P, 3) over pi times the lobes'
-    forward transmittance (3,) times the ambient's ratio by view for the outside's hemisphere."""
-    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
-    n = n / np.linalg.norm(n, axis=1, keepdims=True)
-    to_viewer = np.asarray(camera_position, dtype=np.float64) - p
-    to_viewer = to_viewer / np.linalg.norm(to_viewer, axis=1, keepdims=True)
-    mu = np.abs(np.einsum("pi,pi->p", to_viewer, n))
-    r_out = ambient_view_ratio(inputs.ambient_view_outside, mu)
-    return (r_out[:, None] / math.pi) * np.asarray(irradiance_rgb, dtype=np.float64).reshape(-1, 3) \
-        * np.asarray(transmittance_rgb, dtype=np.float64)[None, :]
+    11, fourth round; curtain.frag ROOM_SIDE), irradiance (P, 3) over pi times a lobe's forward
+    transmittance (3,) times the ambient's ratio by view for the outside's hemisphere."""
+    return _side_light_linear_srgb(inputs.ambient_view_outside, positions, normals, camera_position,
+                                   irradiance_rgb, transmittance_rgb)
 
 
 def shadow_terms(shadows) -> dict:

@@ -361,7 +361,7 @@ def radiosity_operator_rgb(albedo: float, window_albedo_rgb) -> np.ndarray:
 #: The curtain's room side (issue 11, fourth round): the room's irradiance on it is gathered at
 #: this many points across and down the window opening, in the window wall's plane (every
 #: other face lies wholly in front of that plane, as Lambert's formula needs; the closed
-#: curtain hangs 12 cm in front of it), and read bilinearly per fragment (curtain.frag
+#: curtain hangs 12 cm in front of it), and read bilinearly per vertex (curtain.vert
 #: ROOM_SIDE). The room's light varies over metres: 12 x 12 points are 16 x 19 cm apart.
 CURTAIN_SIDE_TEXELS = (12, 12)
 
@@ -392,9 +392,8 @@ def curtain_side_irradiance(total_rgb: np.ndarray, albedo: float, window_albedo_
     patches = coarse_patches()
     rc = FACE_TEXELS >> BOUNCE_LEVEL
     total = np.asarray(total_rgb, dtype=np.float64)
-    # atlas texel (f rc + u, v) of patch (f, v, u)
-    t_patch = np.stack([total[v, f * rc + u] for f in range(len(FACE_NAMES))
-                        for v in range(rc) for u in range(rc)])
+    # patch (f, v, u), index (f rc + v) rc + u, is atlas texel (f rc + u, v)
+    t_patch = total.reshape(rc, len(FACE_NAMES), rc, 3).transpose(1, 0, 2, 3).reshape(-1, 3)
     keep = patches["face"] != FACE_NAMES.index("window_wall")
     points = curtain_side_points(texels).reshape(-1, 3)
     normals = np.broadcast_to(np.array([0.0, 0.0, 1.0]), points.shape)
