@@ -1735,8 +1735,20 @@ class FrameRenderer:
             self.ctx.viewport = (0, 0, aw, ah)
 
         gl["lightmap_fbo"].use()
-        program = self._program("fullscreen.vert", "room_bounce.frag",
-                                {"ALL_BOUNCES": True} if all_bounces else None)
+        program = self._bounce_gather_program(all_bounces, window_albedo)
+        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        if self.room_side_active():
+            self._draw_room_side(all_bounces, window_albedo)
+
+    def _bounce_gather_program(self, all_bounces: bool, window_albedo, defines: dict | None = None):
+        """room_bounce.frag (with ``defines``) and its inputs bound: the coarse patches' totals
+        (every bounce) or their direct light, the faces, the obscurance and wall fraction, the
+        albedos; for pass R4 and R4b."""
+        gl = self._room_resources()
+        defines = dict(defines or {})
+        if all_bounces:
+            defines["ALL_BOUNCES"] = True
+        program = self._program("fullscreen.vert", "room_bounce.frag", defines or None)
         if all_bounces:
             gl["total"].use(location=4)
             self._set(program, "u_total", 4)
@@ -1747,30 +1759,15 @@ class FrameRenderer:
         self._set(program, "u_ao_mask", 2)
         self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
         self._set(program, "u_window_albedo", window_albedo)
-        self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
-        if self.room_side_active():
-            self._draw_room_side(all_bounces, window_albedo)
+        return program
 
     def _draw_room_side(self, all_bounces: bool, window_albedo) -> None:
         """Pass R4b (issue 11, fourth round): the room's irradiance on the curtain's room side,
         room_bounce.frag's gather at CURTAIN_SIDE_TEXELS points over the opening."""
         mgl, gl = self._moderngl, self._room_resources()
-        defines = {"CURTAIN_SIDE": True}
-        if all_bounces:
-            defines["ALL_BOUNCES"] = True
         gl["room_side_fbo"].use()
         self.ctx.viewport = (0, 0, *room_light.CURTAIN_SIDE_TEXELS)
-        program = self._program("fullscreen.vert", "room_bounce.frag", defines)
-        if all_bounces:
-            gl["total"].use(location=4)
-            self._set(program, "u_total", 4)
-        for name, value in room_light.face_uniforms().items():
-            self._set(program, name, value)
-        self._bind_bounce_sources(program)
-        gl["ao"].use(location=2)
-        self._set(program, "u_ao_mask", 2)
-        self._set(program, "u_albedo", scene_lib.ROOM_ALBEDO)
-        self._set(program, "u_window_albedo", window_albedo)
+        program = self._bounce_gather_program(all_bounces, window_albedo, {"CURTAIN_SIDE": True})
         self._set(program, "u_side_rect", room_light.curtain_side_rect())
         self._set(program, "u_side_z", scene_lib.ROOM_BOX[2][0])
         self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
