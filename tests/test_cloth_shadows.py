@@ -267,12 +267,8 @@ def test_the_sill_is_lit_by_the_sun(gl, make_preset):
     r.render()
     img = r.read_linear()
     w, h = r.size
-    inv = np.linalg.inv(r.camera.view_projection(w / h))
-    ys, xs = np.mgrid[0:h, 0:w]
-    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)), np.ones((h, w))], -1)
-    far = ndc @ inv.T
     eye = np.asarray(r.camera.position, dtype=np.float64)
-    d = far[..., :3] / far[..., 3:] - eye
+    d = room_light.pixel_rays(r.camera.view_projection(w / h), eye, r.size)
     wx0, wx1, wy0, _ = scene_lib.WINDOW_RECT
     z0 = scene_lib.ROOM_BOX[2][0]
     s = (wy0 - eye[1]) / d[..., 1]

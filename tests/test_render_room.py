@@ -772,14 +772,9 @@ def test_the_window_outside_the_wall_is_lit_by_the_outside_and_the_key(gl):
     r.set_curtain_open(False)
     r.render()
     image = r.read_linear()
-    w, h = 160, 120
-    inverse = np.linalg.inv(r.camera.view_projection(w / h))
-    ys, xs = np.mgrid[0:h, 0:w]
-    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)), np.ones((h, w))], -1)
-    far = ndc @ inverse.T
+    w, h = r.size
     eye = np.asarray(r.camera.position, dtype=np.float64)
-    d = far[..., :3] / far[..., 3:] - eye
-    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    d = room_light.pixel_rays(r.camera.view_projection(w / h), eye, r.size)
     wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
     z_in = scene_lib.ROOM_BOX[2][0]
     z_out = z_in - scene_lib.WALL_THICKNESS_M

@@ -20,13 +20,10 @@ SIZE = (96, 64)
 
 
 def _rays(r):
+    from catalog.render.room_light import pixel_rays
+
     w, h = r.size
-    inv = np.linalg.inv(r.camera.view_projection(w / h))
-    ys, xs = np.mgrid[0:h, 0:w]
-    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)), np.ones((h, w))], -1)
-    far = ndc @ inv.T
-    d = far[..., :3] / far[..., 3:] - r.camera.position
-    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+    return pixel_rays(r.camera.view_projection(w / h), r.camera.position, r.size)
 
 
 def test_sky_illuminance_is_the_atmospheres_diffuse():

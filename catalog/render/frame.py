@@ -495,7 +495,7 @@ class FrameRenderer:
 
     def set_room_side(self, solved: bool) -> None:
         """Light the curtain's room side by the room's solved light (True, issue 11's fourth
-        round: the stand-ins were 1.5-2.5x the room's light under daylight and 1 % of it under
+        round: the stand-ins were 1.6-3x the room's light under daylight and 1 % of it under
         UV-A, where the room is lit by the glow) or by the stand-ins (False: the fill light
         and the room's share of the ambient term, the earlier frame)."""
         self.room_side_solved = bool(solved)

@@ -724,6 +724,19 @@ def check_lamp_position(position_m) -> tuple[float, float, float]:
 REGION_NAMES = ("floor_patch", "floor_away", "window_wall_strips")
 
 
+def pixel_rays(view_projection: np.ndarray, eye, size) -> np.ndarray:
+    """(H, W, 3) unit directions from ``eye`` through each pixel's centre (row 0 = top) of a
+    view ``size`` = (W, H) pixels: the far plane's points unprojected."""
+    w, h = size
+    inv = np.linalg.inv(np.asarray(view_projection, dtype=np.float64))
+    ys, xs = np.mgrid[0:h, 0:w]
+    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)),
+                    np.ones((h, w))], -1)
+    far = ndc @ inv.T
+    d = far[..., :3] / far[..., 3:] - np.asarray(eye, dtype=np.float64)
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
 def view_regions(view_projection: np.ndarray, eye, size, to_light) -> dict[str, np.ndarray]:
     """Boolean (H, W) masks of a view (row 0 = top), found by geometry, not by shading:
 
@@ -735,14 +748,8 @@ def view_regions(view_projection: np.ndarray, eye, size, to_light) -> dict[str, 
       the default view).
     """
     w, h = size
-    inv = np.linalg.inv(np.asarray(view_projection, dtype=np.float64))
-    ys, xs = np.mgrid[0:h, 0:w]
-    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2, np.ones((h, w)),
-                    np.ones((h, w))], -1)
-    far = ndc @ inv.T
     eye = np.asarray(eye, dtype=np.float64)
-    d = far[..., :3] / far[..., 3:] - eye
-    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    d = pixel_rays(view_projection, eye, size)
     (x0, x1), (y0, _), (z0, z1) = scene_lib.ROOM_BOX
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (y0 - eye[1]) / d[..., 1]
