@@ -326,6 +326,22 @@ float room_window_beam(vec3 p, vec3 to_light, vec4 opening, vec2 wall_z, float t
 }
 
 
+// The irradiance of a point p with normal n on the window's reveals or the wall's outer face,
+// outside the wall's inner plane (issue 11, fourth round; room_light.reveal_irradiance is the
+// float64 twin), the key left out: the outside over the half of its hemisphere facing it (the
+// sky above the horizon, the ground below: sky_half and ground_half are 0.5 pi x their
+// radiance; the outer face takes the whole) and the closed curtain's window side over the half
+// facing the room (``back``: the window-side capture at ``level``, ``size`` texels, read at
+// p's place in the opening).
+vec3 reveal_irradiance(vec3 p, vec3 n, vec4 opening, vec3 sky_half, vec3 ground_half,
+                       sampler2D back, int level, ivec2 size) {
+    float up = 0.5 + 0.5 * n.y;
+    vec3 outside = (1.0 + max(-n.z, 0.0)) * (up * sky_half + (1.0 - up) * ground_half);
+    vec2 f = clamp((p.xy - opening.xz) / (opening.yw - opening.xz), 0.0, 0.999);
+    vec3 window_side = texelFetch(back, ivec2(f * vec2(size)), level).rgb;
+    return outside + (0.5 * PI * (1.0 - abs(n.z))) * window_side;
+}
+
 // ---- The room's light between surfaces (issue 11; room_light.rectangle_irradiance_factor is
 // the float64 twin). pi times the form factor from a point x with normal n to a uniformly
 // emitting rectangle corner + [0,1] s + [0,1] t: E(x) = L * factor. Lambert's formula for a
@@ -370,5 +386,91 @@ vec3 perez_xyY(float cos_theta, float gamma, vec3 a, vec3 b, vec3 c, vec3 d, vec
 vec3 xyY_to_XYZ(vec3 xyY) {
     return vec3(xyY.x * xyY.z / xyY.y, xyY.z, (1.0 - xyY.x - xyY.y) * xyY.z / xyY.y);
 }
+
+
+#ifdef WALL_LIGHT
+// What the window wall and its reveals show the cloth's window side (issue 11, fifth round;
+// room_light.wall_radiance_along and walled_radiance are the float64 twins). The outside's
+// occlusion (outside_occlusion) counts the directions that miss the opening as dark; in the
+// path-traced room they meet the wall's inner face (the room's light) or a reveal (the
+// outside, the key, the cloth's window side): the sunlit sill, seen through the directional
+// lobe from a room view looking down, was 40-57 % of the curtain's bottom. Names apart from
+// the passes' own (curtain.frag declares the window's rectangle and the key's direction).
+uniform sampler2D u_wall_lightmap;   // the room's light map (irradiance, linear sRGB)
+uniform vec3 u_wall_face_origin[6];
+uniform vec3 u_wall_face_s[6];
+uniform vec3 u_wall_face_t[6];
+uniform float u_wall_face_texels;
+uniform vec3 u_wall_box_lo;          // the room box (m)
+uniform vec3 u_wall_box_hi;
+uniform vec4 u_wall_opening;         // the window opening (x0, x1, y0, y1), m
+uniform vec2 u_wall_planes;          // the wall's inner and outer planes (z, m)
+uniform vec3 u_wall_sky_half;        // 0.5 pi x the sky's radiance (linear sRGB)
+uniform vec3 u_wall_ground_half;     // 0.5 pi x the ground's
+uniform sampler2D u_wall_back;       // the window-side capture (reveal_irradiance)
+uniform int u_wall_back_level;
+uniform ivec2 u_wall_back_size;
+uniform vec3 u_wall_key_to_light;
+uniform vec3 u_wall_key_rgb;         // the key's normal irradiance, linear sRGB
+uniform float u_wall_tan_sun;
+uniform float u_wall_albedo;
+
+// The distance along d from p to the plane lo or hi of one axis that the ray leaves by.
+float axis_exit(float p, float d, float lo, float hi) {
+    return abs(d) > 1e-12 ? ((d > 0.0 ? hi : lo) - p) / d : 1e30;
+}
+
+// The radiance met from p along d (towards the window, d.z < 0) where it misses the opening
+// (a: 1), 0 where it passes (a: 0): the room's face where it leaves the room box (albedo / pi x the light
+// map), or, through the wall's inner plane inside the opening but not its outer plane, the
+// reveal it meets (albedo / pi x (reveal_irradiance + the key, cos x the window's mask,
+// undimmed: the reveals lie before the cloth)).
+vec4 wall_radiance_along(vec3 p, vec3 d) {
+    float t_x = axis_exit(p.x, d.x, u_wall_box_lo.x, u_wall_box_hi.x);
+    float t_y = axis_exit(p.y, d.y, u_wall_box_lo.y, u_wall_box_hi.y);
+    float t_z = (u_wall_planes.x - p.z) / d.z;
+    vec2 q_in = p.xy + t_z * d.xy;
+    vec2 q_out = p.xy + ((u_wall_planes.y - p.z) / d.z) * d.xy;
+    bool inner = all(greaterThanEqual(q_in, u_wall_opening.xz)) && all(lessThanEqual(q_in, u_wall_opening.yw));
+    bool outer = all(greaterThanEqual(q_out, u_wall_opening.xz)) && all(lessThanEqual(q_out, u_wall_opening.yw));
+    bool tunnel = inner && t_z <= min(t_x, t_y);
+    if (tunnel && outer) {
+        return vec4(0.0);
+    }
+    vec3 irradiance;
+    if (tunnel) {
+        float tx = axis_exit(p.x, d.x, u_wall_opening.x, u_wall_opening.y);
+        float ty = axis_exit(p.y, d.y, u_wall_opening.z, u_wall_opening.w);
+        vec3 n = tx <= ty ? vec3(-sign(d.x), 0.0, 0.0) : vec3(0.0, -sign(d.y), 0.0);
+        vec3 hit = p + min(tx, ty) * d;
+        irradiance = reveal_irradiance(hit, n, u_wall_opening, u_wall_sky_half, u_wall_ground_half,
+                                       u_wall_back, u_wall_back_level, u_wall_back_size);
+        if (u_wall_key_to_light.z < 0.0) {
+            irradiance += u_wall_key_rgb * (max(dot(n, u_wall_key_to_light), 0.0)
+                * room_window_beam(hit, u_wall_key_to_light, u_wall_opening, u_wall_planes, u_wall_tan_sun));
+        }
+    } else {
+        float t = min(min(t_x, t_y), t_z);
+        int face = t == t_z ? 5 : (t_x <= t_y ? (d.x > 0.0 ? 3 : 2) : (d.y > 0.0 ? 1 : 0));
+        vec2 uv = room_atlas_uv(face, p + t * d, u_wall_face_origin[face], u_wall_face_s[face],
+                                u_wall_face_t[face], u_wall_face_texels);
+        irradiance = textureLod(u_wall_lightmap, uv, 0.0).rgb;
+    }
+    return vec4((u_wall_albedo / PI) * irradiance, 1.0);
+}
+
+#ifdef OCCLUSION_MAPS
+// Over the outside's occlusion directions (cosine-weighted about -z), the mean radiance of
+// the wall they meet (0 for those through the opening): the light the walled share of the
+// cloth's window-side hemisphere receives, per unit of that hemisphere's cosine weight.
+vec3 walled_radiance(vec3 p) {
+    vec3 total = vec3(0.0);
+    for (int j = 0; j < N_OCCLUSION; ++j) {
+        total += wall_radiance_along(p, u_occlusion_direction[j]).rgb;
+    }
+    return total / float(N_OCCLUSION);
+}
+#endif
+#endif
 
 #endif

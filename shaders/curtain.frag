@@ -87,7 +87,7 @@ layout(location = 1) out vec4 out_position;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_tangent;
 layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, the outside's occlusion: cloth, wall
-layout(location = 5) out vec4 out_room_occlusion;   // x: the room's side hidden by the cloth, y: the view's continuation
+layout(location = 5) out vec4 out_wall_light;      // WALL_LIGHT's per-vertex light, interpolated
 layout(location = 6) out vec4 out_room_side_light;  // ROOM_SIDE's per-vertex light, interpolated
 layout(location = 7) out vec4 out_window_side_light;
 #endif
@@ -153,6 +153,9 @@ INTERPOLATION in float v_view_occlusion;
 uniform vec3 u_room_side_reflectance;
 uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
 uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
+#ifdef WALL_LIGHT
+INTERPOLATION in vec3 v_wall_light;   // curtain.vert: the wall and its reveals, each lobe's share passed
+#endif
 #endif
 float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own folds (SKY_OCCLUSION)
 #ifdef ROOM_CAPTURE
@@ -342,6 +345,9 @@ void main() {
     rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance * v_room_side_light;
     rgb += g_view_outside * (g_occlusion * u_window_side_diffuse + v_view_occlusion * u_window_side_directional)
          * v_window_side_light;
+#ifdef WALL_LIGHT
+    rgb += g_view_outside * v_wall_light;   // the wall and its reveals where the outside is walled
+#endif
 #endif
 #ifdef PATTERN
     // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole
@@ -366,8 +372,14 @@ void main() {
 #endif
 #ifdef GBUFFER
     out_position = vec4(v_position, 1.0);
-    out_normal = vec4(n, 1.0);
-    out_tangent = vec4(normalize(v_tangent - dot(v_tangent, n) * n), 1.0);
+    // w: the room's side hidden by the folds (normal), the view's continuation hidden (tangent)
+    float room_hidden = g_room_occlusion;
+    float view_hidden = 0.0;
+#ifdef ROOM_SIDE
+    view_hidden = v_view_occlusion;
+#endif
+    out_normal = vec4(n, room_hidden);
+    out_tangent = vec4(normalize(v_tangent - dot(v_tangent, n) * n), view_hidden);
     vec4 shadows = vec4(1.0, 0.0, 0.0, 0.0);
 #ifdef KEY_SHADOW
     shadows.xy = vec2(g_key_beam, g_front_coverage);
@@ -376,12 +388,14 @@ void main() {
     shadows.zw = vec2(g_occlusion, g_wall_occlusion);
 #endif
     out_shadows = shadows;
+    out_wall_light = vec4(0.0);
 #ifdef ROOM_SIDE
-    out_room_occlusion = vec4(g_room_occlusion, v_view_occlusion, 0.0, 0.0);
     out_room_side_light = vec4(v_room_side_light, 1.0);
     out_window_side_light = vec4(v_window_side_light, 1.0);
+#ifdef WALL_LIGHT
+    out_wall_light = vec4(v_wall_light, 1.0);
+#endif
 #else
-    out_room_occlusion = vec4(g_room_occlusion, 0.0, 0.0, 0.0);
     out_room_side_light = vec4(0.0);
     out_window_side_light = vec4(0.0);
 #endif

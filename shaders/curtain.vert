@@ -52,6 +52,25 @@ uniform int u_window_side_cloth_level;
 INTERPOLATION out vec3 v_room_side_light;
 INTERPOLATION out vec3 v_window_side_light;
 INTERPOLATION out float v_view_occlusion;
+#ifdef WALL_LIGHT
+// What the window wall and its reveals show the cloth's window side (issue 11, fifth round),
+// each lobe's share passed by its forward transmittance:
+//  - the diffuse lobe: over the walled share of the hemisphere, the per-vertex walled_radiance
+//    the room's update drew (read like the occlusion);
+//  - the directional lobe: over WALL_LOBE_SAMPLES directions drawn from its HG lobe about the
+//    view's continuation, the wall's radiance where they meet it, less the outside (the sky
+//    above the horizon, the ground below) the frame's outside term gave them; and back the
+//    directional lobe's part of what the outside's occlusion took for the walled share (it
+//    takes both lobes' hemisphere mean: right for the diffuse lobe, while the directional
+//    lobe sees the wall only where its samples meet it). From a room view looking down, the
+//    continuation meets the sunlit sill; through the view's one ray instead of the lobe's
+//    spread, the curtain's bottom was 1.1-1.3x the path tracer's.
+uniform sampler2D u_vertex_wall_light;
+uniform vec3 u_wall_lobe[WALL_LOBE_SAMPLES];   // the directional lobe's directions about +z
+uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
+uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
+INTERPOLATION out vec3 v_wall_light;
+#endif
 #endif
 
 INTERPOLATION out vec3 v_view_ray;
@@ -92,6 +111,27 @@ void main() {
 #endif
     v_window_side_light = texelFetch(u_window_side_cloth, cloth_patch, u_window_side_cloth_level).rgb;
     v_view_occlusion = 0.0;
+#ifdef WALL_LIGHT
+    {
+        vec3 walled = texelFetch(u_vertex_wall_light, ivec2(gl_VertexID % u_vertex_occlusion_width,
+                                                             gl_VertexID / u_vertex_occlusion_width), 0).rgb;
+        vec3 view = normalize(v_view_ray);
+        vec3 across = normalize(cross(abs(view.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0), view));
+        vec3 up = cross(view, across);
+        vec3 sky = (2.0 / PI) * u_wall_sky_half;
+        vec3 ground = (2.0 / PI) * u_wall_ground_half;
+        vec3 lobe = vec3(0.0);
+        for (int k = 0; k < WALL_LOBE_SAMPLES; ++k) {
+            vec3 d = u_wall_lobe[k].x * across + u_wall_lobe[k].y * up + u_wall_lobe[k].z * view;
+            if (d.z < -1e-6) {
+                vec4 wall = wall_radiance_along(position, d);
+                lobe += wall.a * (wall.rgb - (d.y > 0.0 ? sky : ground));
+            }
+        }
+        vec3 directional = lobe / float(WALL_LOBE_SAMPLES) + v_occlusion.y * 0.5 * (sky + ground);
+        v_wall_light = u_window_side_diffuse * walled + u_window_side_directional * directional;
+    }
+#endif
 #if defined(SKY_OCCLUSION) && defined(OCCLUSION_MAPS)
     vec3 ray = normalize(v_view_ray);
     if (ray.z < 0.0) {   // the view goes on towards the window

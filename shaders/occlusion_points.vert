@@ -1,8 +1,9 @@
 #version 430
-// The outside's occlusion per vertex of the curtain (issue 11, curtain.vert SKY_OCCLUSION):
-// each vertex drawn as one point onto texel (index % width, index / width) of a float texture,
-// carrying common.glsl's outside_occlusion at its position and normal. Drawn when the room's
-// light is updated (the maps change), not every frame.
+// Per vertex of the curtain, a value drawn as one point onto texel (index % width,
+// index / width) of a float texture, when the room's light is updated (not every frame):
+// common.glsl's outside_occlusion at the vertex's position and normal (issue 11, curtain.vert
+// SKY_OCCLUSION) or, with WALL_LIGHT, walled_radiance at its position (curtain.vert ROOM_SIDE:
+// what the window wall and its reveals show the cloth's window side).
 #include "common.glsl"
 
 in vec3 in_position;
@@ -11,10 +12,14 @@ in vec3 in_normal;
 uniform vec3 u_mesh_offset;
 uniform ivec2 u_target_size;        // the per-vertex texture (texels)
 
-out vec3 v_occlusion;
+out vec3 v_value;
 
 void main() {
-    v_occlusion = outside_occlusion(in_position + u_mesh_offset, in_normal);
+#ifdef WALL_LIGHT
+    v_value = walled_radiance(in_position + u_mesh_offset);
+#else
+    v_value = outside_occlusion(in_position + u_mesh_offset, in_normal);
+#endif
     ivec2 texel = ivec2(gl_VertexID % u_target_size.x, gl_VertexID / u_target_size.x);
     gl_Position = vec4((vec2(texel) + 0.5) / vec2(u_target_size) * 2.0 - 1.0, 0.0, 1.0);
     gl_PointSize = 1.0;

@@ -45,14 +45,6 @@ uniform sampler2D u_luminaire_back;  // the curtain's window side (0 where no cl
 uniform int u_reveal_back_level;
 uniform ivec2 u_reveal_back_size;    // that level's texels
 
-vec3 reveal_irradiance(vec3 p, vec3 n) {
-    float up = 0.5 + 0.5 * n.y;
-    vec3 outside = (1.0 + max(-n.z, 0.0)) * (up * u_reveal_sky + (1.0 - up) * u_reveal_ground);
-    vec2 f = clamp((p.xy - u_window_rect.xz) / (u_window_rect.yw - u_window_rect.xz), 0.0, 0.999);
-    vec3 back = texelFetch(u_luminaire_back, ivec2(f * vec2(u_reveal_back_size)), u_reveal_back_level).rgb;
-    return outside + (0.5 * PI * (1.0 - abs(n.z))) * back;
-}
-
 #ifdef KEY_BEAM
 vec3 key_beam(vec3 p, vec3 n) {
     float cos_key = dot(n, u_key_to_light);
@@ -95,7 +87,9 @@ void main() {
     vec3 n = normalize(v_normal);
 #ifdef ROOM_LIGHTING
     vec2 uv = clamp(v_atlas, v_atlas_box.xz, v_atlas_box.yw);
-    vec3 diffuse = v_position.z < u_wall_z.x - 1e-4 ? reveal_irradiance(v_position, n)
+    vec3 diffuse = v_position.z < u_wall_z.x - 1e-4 ? reveal_irradiance(v_position, n, u_window_rect, u_reveal_sky,
+                                                                       u_reveal_ground, u_luminaire_back,
+                                                                       u_reveal_back_level, u_reveal_back_size)
                                                    : texture(u_lightmap, uv).rgb;
     vec3 irradiance = diffuse + key_beam(v_position, n);
     out_radiance = vec4((u_albedo / PI) * irradiance, 1.0);

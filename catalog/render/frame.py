@@ -103,6 +103,10 @@ ROOM_SIDE_CLOTH_UNIT = 9
 WINDOW_SIDE_CLOTH_UNIT = 10
 #: Texture unit of the occlusion maps in the curtain pass (ROOM_SIDE: the view's continuation).
 OCCLUSION_MAPS_UNIT = 11
+#: Texture units of the room's light map and the per-vertex walled radiance in the curtain pass
+#: (WALL_LIGHT: what the window wall and its reveals show the cloth's window side).
+WALL_LIGHTMAP_UNIT = 12
+VERTEX_WALL_LIGHT_UNIT = 13
 #: SKY_OCCLUSION's depth bias (m) and its lookup's offset off the surface (m): a texel and a
 #: half of an occlusion map (room_light.OCCLUSION_TEXELS over ~2.4 m: 2 cm each).
 OCCLUSION_BIAS_M = 0.01
@@ -785,6 +789,8 @@ class FrameRenderer:
             defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
             if defines.get("SKY_OCCLUSION"):
                 defines["OCCLUSION_MAPS"] = True   # the view's continuation hidden by the folds
+                defines["WALL_LIGHT"] = True       # the wall and its reveals where the outside is walled
+                defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -837,6 +843,8 @@ class FrameRenderer:
             defines["ROOM_CAPTURE"] = True  # the room's window capture (issue 13), not the frame's
             defines.pop("ROOM_SIDE", None)  # the radiosity reflects the room's light off the cloth
             defines.pop("OCCLUSION_MAPS", None)
+            defines.pop("WALL_LIGHT", None)
+            defines.pop("WALL_LOBE_SAMPLES", None)
         if self.specialise:
             for name, value in self._scene_values_with(overrides).items():
                 defines["S_" + name[2:].upper()] = glsl_literal(value)
@@ -1739,6 +1747,8 @@ class FrameRenderer:
         self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
         if self.room_side_active():
             self._draw_room_side(all_bounces, window_albedo)
+            if self.sky_occlusion and not self.curtain_open:
+                self._draw_vertex_wall_light(inputs)
 
     def _bounce_gather_program(self, all_bounces: bool, window_albedo, defines: dict | None = None):
         """room_bounce.frag (with ``defines``) and its inputs bound: the coarse patches' totals
@@ -1793,6 +1803,102 @@ class FrameRenderer:
         self._set(program, "u_window_side_directional", directional)
         if "u_occlusion_maps" in program:   # beside the per-vertex occlusion (OCCLUSION_UNIT)
             self._occlusion_uniforms(program, OCCLUSION_MAPS_UNIT)
+        if "u_vertex_wall_light" in program:
+            self._wall_light_uniforms(program, self.shading_inputs())
+            self._set(program, "u_wall_lobe", np.asarray(
+                room_light.wall_lobe_directions(float(self.shading_inputs().g_spec)), dtype="f4"))
+            texture = gl.get("vertex_wall_light")
+            if texture is None:   # not drawn yet (a mesh bound after the last update): none
+                texture = self._vertex_wall_light_target(1)
+            texture.use(location=VERTEX_WALL_LIGHT_UNIT)
+            self._set(program, "u_vertex_wall_light", VERTEX_WALL_LIGHT_UNIT)
+
+    def _wall_light_uniforms(self, program, inputs) -> None:
+        """common.glsl's WALL_LIGHT inputs: the light map (WALL_LIGHTMAP_UNIT), the room's faces
+        and box, the opening and the wall's planes, the reveals' outside and the window-side
+        capture (bound at WINDOW_SIDE_CLOTH_UNIT, read at the reveals' level), the key."""
+        gl = self._room_resources()
+        s = self._set
+        gl["lightmap"].use(location=WALL_LIGHTMAP_UNIT)
+        s(program, "u_wall_lightmap", WALL_LIGHTMAP_UNIT)
+        faces = room_light.face_uniforms()
+        for name in ("origin", "s", "t"):
+            s(program, f"u_wall_face_{name}", faces[f"u_face_{name}"])
+        s(program, "u_wall_face_texels", float(room_light.FACE_TEXELS))
+        (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
+        s(program, "u_wall_box_lo", (x0, y0, z0))
+        s(program, "u_wall_box_hi", (x1, y1, z1))
+        s(program, "u_wall_opening", tuple(scene_lib.WINDOW_RECT))
+        s(program, "u_wall_planes", (z0, z0 - scene_lib.WALL_THICKNESS_M))
+        colours = self._display_colours(inputs)
+        s(program, "u_wall_sky_half", tuple(0.5 * math.pi * v for v in colours["u_sky_rgb"]))
+        s(program, "u_wall_ground_half", tuple(0.5 * math.pi * v for v in colours["u_ground_rgb"]))
+        gl["luminaire_back"].use(location=WINDOW_SIDE_CLOTH_UNIT)
+        s(program, "u_wall_back", WINDOW_SIDE_CLOTH_UNIT)
+        level = room_light.BACK_LUMINAIRE_LEVEL + 1
+        s(program, "u_wall_back_level", level)
+        s(program, "u_wall_back_size", tuple(max(v >> level, 1) for v in
+                                             room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)))
+        s(program, "u_wall_key_to_light", tuple(float(v) for v in inputs.key_to_light))
+        s(program, "u_wall_key_rgb", self._room_colours(inputs)["u_key_rgb"])
+        s(program, "u_wall_tan_sun", math.tan(scene_lib.SUN_RADIUS_RAD))
+        s(program, "u_wall_albedo", scene_lib.ROOM_ALBEDO)
+
+    def _vertex_wall_light_target(self, vertices: int):
+        """The per-vertex walled radiance texture (as :meth:`_vertex_occlusion_target`)."""
+        mgl, gl = self._moderngl, self._room_resources()
+        rows = max(1, -(-int(vertices) // VERTEX_OCCLUSION_WIDTH))
+        texture = gl.get("vertex_wall_light")
+        if texture is None or texture.size[1] < rows:
+            if texture is not None:
+                gl["vertex_wall_light_fbo"].release()
+                texture.release()
+            texture = self.ctx.texture((VERTEX_OCCLUSION_WIDTH, rows), 4, dtype="f4")
+            texture.filter = (mgl.NEAREST, mgl.NEAREST)
+            gl["vertex_wall_light"] = texture
+            gl["vertex_wall_light_fbo"] = self.ctx.framebuffer([texture])
+        return texture
+
+    def _draw_vertex_wall_light(self, inputs) -> None:
+        """Each vertex's walled radiance (occlusion_points.* with WALL_LIGHT): what the window
+        wall and its reveals show its window side, from the light map just drawn."""
+        mgl = self._moderngl
+        texture = self._vertex_wall_light_target(self._vertex_count)
+        fbo = self._room_gl["vertex_wall_light_fbo"]
+        fbo.use()
+        self.ctx.viewport = (0, 0, *texture.size)
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        program = self._program("occlusion_points.vert", "occlusion_points.frag",
+                                {"OCCLUSION_MAPS": True, "N_OCCLUSION": room_light.OCCLUSION_DIRECTIONS,
+                                 "WALL_LIGHT": True})
+        self._occlusion_uniforms(program)
+        self._wall_light_uniforms(program, inputs)
+        self._set(program, "u_mesh_offset", self._mesh_offset)
+        self._set(program, "u_target_size", tuple(int(v) for v in texture.size))
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        self._curtain_vao(program).render(mgl.POINTS)
+
+    def wall_light_at(self, positions, walled_share) -> np.ndarray:
+        """curtain.vert WALL_LIGHT's light evaluated in numpy at world ``positions`` (P, 3) with
+        the outside's walled share ``walled_share`` (P,) (the per-vertex occlusion's y), float64
+        (P, 3): the diffuse lobe's forward transmittance times the walled hemisphere's radiance
+        (:func:`room_light.walled_radiance`), the directional lobe's times its samples about
+        the view's continuation (:func:`room_light.wall_lobe_radiance`) plus the walled share
+        of the outside's mean; 0 where the room side takes the stand-ins or the outside's
+        occlusion is off."""
+        p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+        if not self.variant_defines().get("WALL_LIGHT"):
+            return np.zeros_like(p)
+        sources = self.wall_light_sources()
+        view = p - np.asarray(self.camera.position, dtype=np.float64)
+        view /= np.linalg.norm(view, axis=-1, keepdims=True)
+        inputs = self.shading_inputs()
+        lobe = room_light.wall_lobe_radiance(p, view, sources, room_light.wall_lobe_directions(float(inputs.g_spec)))
+        outside_mean = (np.asarray(sources.reveal_sky) + np.asarray(sources.reveal_ground)) / math.pi
+        share = np.asarray(walled_share, dtype=np.float64).reshape(-1, 1)
+        diffuse, directional = (np.asarray(v, dtype=np.float64) for v in self.curtain_forward_rgb(inputs))
+        return diffuse * room_light.walled_radiance(p, sources) + directional * (lobe + share * outside_mean)
 
     def read_room_total(self) -> np.ndarray:
         """The coarse patches' last total irradiance (radiosity pass), float32 (RC, 6 RC, 3)."""
@@ -2158,6 +2264,19 @@ class FrameRenderer:
         window = self.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL)[rows, columns].astype(np.float64)
         return (1.0 - hidden) * self.room_side_irradiance_at(positions) + hidden * math.pi * room, window
 
+    def wall_light_sources(self) -> room_light.WallLightSources:
+        """What the window wall and its reveals show the cloth's window side, from the room's
+        last light (:func:`room_light.walled_radiance`'s inputs, as the GL pass binds them)."""
+        inputs = self.shading_inputs()
+        colours = self._display_colours(inputs)
+        return room_light.WallLightSources(
+            lightmap=self.read_room_lightmap(),
+            back=self.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL + 1),
+            reveal_sky=0.5 * math.pi * np.asarray(colours["u_sky_rgb"], dtype=np.float64),
+            reveal_ground=0.5 * math.pi * np.asarray(colours["u_ground_rgb"], dtype=np.float64),
+            key_rgb=np.asarray(self._room_colours(inputs)["u_key_rgb"], dtype=np.float64),
+            to_light=np.asarray(inputs.key_to_light, dtype=np.float64))
+
     def twin_spectral(self, gbuffer: dict, mask) -> np.ndarray:
         """The float64 twin's spectral radiance (P, L) at the G-buffer pixels ``mask``: eq. 8 with
         :meth:`curtain_inputs` and the pixels' shadows (without the room side's RGB term,
@@ -2190,7 +2309,11 @@ class FrameRenderer:
                 + sum(ref.window_side_linear_srgb(inputs, positions, normals, self.camera.position,
                                                   math.pi * share * window_side, transmittance)
                       for share, transmittance in zip((hidden_outside, hidden_view),
-                                                      self.curtain_forward_rgb(self.shading_inputs()))))
+                                                      self.curtain_forward_rgb(self.shading_inputs())))
+                # the window wall and its reveals (WALL_LIGHT), each lobe's share already passed
+                + ref.window_side_linear_srgb(inputs, positions, normals, self.camera.position,
+                                              math.pi * gbuffer["wall_light"][mask].astype(np.float64),
+                                              (1.0, 1.0, 1.0)))
 
     def twin_linear_srgb(self, gbuffer: dict, mask) -> np.ndarray:
         """The float64 twin of the curtain's linear sRGB (P, 3) at the G-buffer pixels ``mask``
@@ -2225,13 +2348,14 @@ class FrameRenderer:
         self.ctx.disable(mgl.DEPTH_TEST)
         out = {}
         for name, attachment in zip(("radiance", "position", "normal", "tangent", "shadows",
-                                     "room_occlusion", "room_side_light", "window_side_light"), range(8)):
+                                     "wall_light", "room_side_light", "window_side_light"), range(8)):
             data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
             out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
         out["mask"] = out["position"][..., 3] > 0.5
-        out["room_occlusion_view"] = out["room_occlusion"][..., 1]
-        out["room_occlusion"] = out["room_occlusion"][..., 0]
-        for name in ("radiance", "position", "normal", "tangent", "room_side_light", "window_side_light"):
+        out["room_occlusion"] = out["normal"][..., 3].copy()        # curtain.frag: normal.w
+        out["room_occlusion_view"] = out["tangent"][..., 3].copy()  # and tangent.w
+        for name in ("radiance", "position", "normal", "tangent", "room_side_light", "window_side_light",
+                     "wall_light"):
             out[name] = out[name][..., :3]
         return out
 

@@ -777,3 +777,170 @@ def view_regions(view_projection: np.ndarray, eye, size, to_light) -> dict[str, 
     return {"floor_patch": floor & in_window & through, "floor_away": floor & away,
             "window_wall_strips": strips}
 
+
+
+# --------------------------------------------------------------------------- the wall beside the cloth
+
+@dataclass(frozen=True)
+class WallLightSources:
+    """What the window wall and its reveals show the cloth's window side (walled_radiance):
+    the light map (irradiance, linear sRGB, (R, 6R, 3), row 0 = t = 0), the window-side
+    capture at the reveals' level ((H, W, 3), row 0 = the opening's bottom), 0.5 pi x the
+    sky's and the ground's radiance, the key's normal irradiance (linear sRGB) and its
+    direction towards the light, the walls' albedo."""
+
+    lightmap: np.ndarray
+    back: np.ndarray
+    reveal_sky: np.ndarray
+    reveal_ground: np.ndarray
+    key_rgb: np.ndarray
+    to_light: np.ndarray
+    albedo: float = scene_lib.ROOM_ALBEDO
+
+
+def reveal_irradiance(points: np.ndarray, normals: np.ndarray, back: np.ndarray,
+                      reveal_sky, reveal_ground) -> np.ndarray:
+    """The float64 twin of common.glsl's ``reveal_irradiance`` (issue 11, fourth round): on a
+    reveal (or the wall's outer face) the outside over the half of its hemisphere facing it
+    (the sky above the horizon, the ground below) and the curtain's window side (``back``'s
+    texel at the point's place in the opening) over the half facing the room, (P, 3)."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    up = (0.5 + 0.5 * n[:, 1])[:, None]
+    outside = (1.0 + np.maximum(-n[:, 2], 0.0))[:, None] * (
+        up * np.asarray(reveal_sky, dtype=np.float64) + (1.0 - up) * np.asarray(reveal_ground, dtype=np.float64))
+    fx = np.clip((p[:, 0] - wx0) / (wx1 - wx0), 0.0, 0.999)
+    fy = np.clip((p[:, 1] - wy0) / (wy1 - wy0), 0.0, 0.999)
+    h, w = back.shape[:2]
+    seen = np.asarray(back, dtype=np.float64)[(fy * h).astype(int), (fx * w).astype(int)]
+    return outside + (0.5 * math.pi * (1.0 - np.abs(n[:, 2])))[:, None] * seen
+
+
+def wall_radiance_along(points: np.ndarray, directions: np.ndarray, sources: WallLightSources,
+                        with_walled: bool = False):
+    """(P, 3) the radiance met from ``points`` (P, 3) along ``directions`` (P, 3) (towards the
+    window, d.z < 0) where they miss the opening, 0 where they pass it (``with_walled``: and
+    the (P,) mask of the directions that miss it): the room's face where
+    the ray leaves the room box (albedo / pi x the light map, bilinear), or, through the wall's
+    inner plane inside the opening but not its outer one, the reveal it meets (albedo / pi x
+    (:func:`reveal_irradiance` + the key, cos x the window's mask, undimmed: the reveals lie
+    before the cloth)). The float64 twin of common.glsl's ``wall_radiance_along``."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    (x0, x1), (y0, y1), (z0, _) = scene_lib.ROOM_BOX
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    z_out = z0 - scene_lib.WALL_THICKNESS_M
+    faces = room_faces()
+    lightmap = np.asarray(sources.lightmap, dtype=np.float64)
+    texels = lightmap.shape[0]
+    to_light = np.asarray(sources.to_light, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        def plane_t(lo, hi, axis):
+            t = (np.where(d[:, axis] > 0, hi, lo) - p[:, axis]) / d[:, axis]
+            return np.where(np.abs(d[:, axis]) > 1e-12, t, np.inf)
+
+        t_x, t_y = plane_t(x0, x1, 0), plane_t(y0, y1, 1)
+        t_z = (z0 - p[:, 2]) / d[:, 2]
+        q_in = p + t_z[:, None] * d
+        q_out = p + ((z_out - p[:, 2]) / d[:, 2])[:, None] * d
+
+        def inside(q):
+            return (q[:, 0] >= wx0) & (q[:, 0] <= wx1) & (q[:, 1] >= wy0) & (q[:, 1] <= wy1)
+
+        through_inner = (t_z <= np.minimum(t_x, t_y)) & inside(q_in)
+        opening = through_inner & inside(q_out)
+        reveal = through_inner & ~opening
+        # the room's faces
+        t_exit = np.minimum(np.minimum(t_x, t_y), t_z)
+        q = p + t_exit[:, None] * d
+        face = np.where(t_exit == t_z, 5, np.where(t_x <= t_y, np.where(d[:, 0] > 0, 3, 2),
+                                                   np.where(d[:, 1] > 0, 1, 0)))
+        out = np.zeros((p.shape[0], 3))
+        edge = 0.5 / texels
+        for k, f in enumerate(faces):
+            on = (face == k) & ~through_inner
+            if on.any():
+                rel = q[on] - f.origin
+                s = np.clip(rel @ f.axis_s / (f.axis_s @ f.axis_s), edge, 1 - edge)
+                t = np.clip(rel @ f.axis_t / (f.axis_t @ f.axis_t), edge, 1 - edge)
+                out[on] = sample_bilinear(lightmap, np.stack([(k + s) / len(faces), t], -1))
+        # the reveals: where the ray leaves the opening's tunnel, between the wall's planes
+        if reveal.any():
+            pr, dr = p[reveal], d[reveal]
+            tx_r = np.where(np.abs(dr[:, 0]) > 1e-12, (np.where(dr[:, 0] > 0, wx1, wx0) - pr[:, 0]) / dr[:, 0], np.inf)
+            ty_r = np.where(np.abs(dr[:, 1]) > 1e-12, (np.where(dr[:, 1] > 0, wy1, wy0) - pr[:, 1]) / dr[:, 1], np.inf)
+            side_x = (tx_r <= ty_r)[:, None]
+            hit = pr + np.minimum(tx_r, ty_r)[:, None] * dr
+            zero = np.zeros(len(pr))
+            normal = np.where(side_x, np.stack([-np.sign(dr[:, 0]), zero, zero], -1),
+                              np.stack([zero, -np.sign(dr[:, 1]), zero], -1))
+            e = reveal_irradiance(hit, normal, sources.back, sources.reveal_sky, sources.reveal_ground)
+            if to_light[2] < 0.0:
+                cos_key = np.maximum(normal @ to_light, 0.0)
+                e = e + (cos_key * window_beam_mask(hit, to_light))[:, None] * np.asarray(sources.key_rgb, dtype=np.float64)
+            out[reveal] = e
+        out[opening] = 0.0
+    radiance = sources.albedo / math.pi * out
+    return (radiance, ~opening) if with_walled else radiance
+
+
+def walled_radiance(points: np.ndarray, sources: WallLightSources,
+                    directions: np.ndarray | None = None) -> np.ndarray:
+    """(P, 3) the float64 twin of common.glsl's ``walled_radiance``: over the occlusion's
+    directions (cosine-weighted about -z, :func:`occlusion_directions`), the mean of
+    :func:`wall_radiance_along` (0 where a direction passes the opening). The cloth's own folds
+    along a walled direction are not looked for."""
+    d_all = occlusion_directions() if directions is None else np.asarray(directions, dtype=np.float64)
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    total = np.zeros((p.shape[0], 3))
+    for d in d_all:
+        total += wall_radiance_along(p, np.broadcast_to(d, p.shape), sources)
+    return total / len(d_all)
+
+
+#: The directional lobe's samples about the view's continuation (curtain.vert WALL_LIGHT).
+WALL_LOBE_SAMPLES = 16
+
+
+@functools.lru_cache(maxsize=8)
+def wall_lobe_directions(g: float, count: int = WALL_LOBE_SAMPLES) -> np.ndarray:
+    """(count, 3) directions about +z drawn from Henyey-Greenstein's phase function with
+    asymmetry ``g`` (model.md eq. 6) by its closed-form inverse at stratified u = (k + 1/2) /
+    count, the azimuth k times the golden ratio's fraction of a turn (|g| < 1e-3: uniform
+    over the sphere)."""
+    u = (np.arange(count) + 0.5) / count
+    phi = 2.0 * math.pi * ((np.arange(count) * 0.6180339887498949) % 1.0)
+    if abs(g) < 1e-3:
+        cos = 1.0 - 2.0 * u
+    else:
+        s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u)
+        cos = np.clip((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0)
+    sin = np.sqrt(np.maximum(0.0, 1.0 - cos * cos))
+    return np.stack([sin * np.cos(phi), sin * np.sin(phi), cos], -1)
+
+
+def wall_lobe_radiance(points: np.ndarray, views: np.ndarray, sources: WallLightSources,
+                       lobe: np.ndarray) -> np.ndarray:
+    """(P, 3) the float64 twin of curtain.vert WALL_LIGHT's directional sum: over ``lobe``'s
+    directions (:func:`wall_lobe_directions`) turned about each unit view continuation
+    ``views`` (P, 3) (the shader's frame: across = normalize(cross(x or y, view)), up = cross(
+    view, across)), the mean over all of them of the wall's radiance less the outside's (sky
+    above the horizon, ground below) where one towards the window meets the wall."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    v = np.asarray(views, dtype=np.float64).reshape(-1, 3)
+    axis = np.where((np.abs(v[:, 0]) < 0.9)[:, None], np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    across = np.cross(axis, v)
+    across /= np.linalg.norm(across, axis=-1, keepdims=True)
+    up = np.cross(v, across)
+    sky = np.asarray(sources.reveal_sky, dtype=np.float64) / (0.5 * math.pi)
+    ground = np.asarray(sources.reveal_ground, dtype=np.float64) / (0.5 * math.pi)
+    total = np.zeros((p.shape[0], 3))
+    for local in np.asarray(lobe, dtype=np.float64):
+        d = local[0] * across + local[1] * up + local[2] * v
+        towards = d[:, 2] < -1e-6
+        safe = np.where(towards[:, None], d, np.array([0.0, 0.0, -1.0]))
+        radiance, walled = wall_radiance_along(p, safe, sources, with_walled=True)
+        outside = np.where(safe[:, 1:2] > 0.0, sky, ground)
+        total += np.where((towards & walled)[:, None], radiance - outside, 0.0)
+    return total / len(lobe)
