@@ -200,6 +200,34 @@ def test_bloom_keeps_the_frames_energy_and_glows_around_the_sun(gl):
     r.release()
 
 
+@pytest.mark.slow
+def test_another_image_shown_through_the_frames_display_step(gl):
+    """FrameRenderer.display_of (the image bench shows the path-traced reference through it):
+    the frame's own radiance shown again gives the frame's display image (FXAA off: display_of
+    leaves out the anti-aliasing) within one 8-bit level, glare included; the same radiance
+    through metrics.display (no glare) differs by more around the sun; and an image of the
+    wrong size is refused with one line naming the size."""
+    from catalog.core.errors import CatalogError
+    from catalog.pathtrace import metrics
+
+    r = FrameRenderer(gl, (128, 96))
+    r.set_fabric("lace-fwa")
+    r.set_light("sun:60")
+    r.set_curtain_open(True)
+    r.set_camera(0.0, -10.0, 1.0)
+    r.set_antialiasing("off")
+    r.render()
+    own = r.read_srgb8().astype(int)
+    linear = r.read_linear()
+    again = r.display_of(linear).astype(int)
+    assert np.abs(again - own).max() <= 1
+    plain = np.round(255 * metrics.display(linear, r.exposure_scale(), r.white_balance_matrix())).astype(int)
+    assert np.abs(plain - own).max() > 8   # the glare
+    with pytest.raises(CatalogError, match="64x48"):
+        r.display_of(np.zeros((48, 64, 3)))
+    r.release()
+
+
 def test_a_dated_sun_stands_where_it_stands_then():
     """sun@WHEN,LAT,LON: the key light (and so the sky behind the window) at the elevation
     catalog.optics.sun.model.sun_position gives for that time and place (it stood at a lamp's 25 deg)."""

@@ -317,6 +317,7 @@ class FrameRenderer:
         #: (curtain.frag ROOM_SIDE, with the room lighting and the viewer inside); False: by
         #: the stand-ins, the fill light and the room's share of the ambient term
         self.room_side_solved = True
+        self.wall_light = True     # the window wall and its reveals light the cloth (WALL_LIGHT)
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -503,6 +504,14 @@ class FrameRenderer:
         UV-A, where the room is lit by the glow) or by the stand-ins (False: the fill light
         and the room's share of the ambient term, the earlier frame)."""
         self.room_side_solved = bool(solved)
+
+    def set_wall_light(self, on: bool) -> None:
+        """Light the cloth's window side by the window wall and its reveals where they hide
+        the outside (True, issue 11's fifth round: the sunlit sill seen through the
+        directional lobe was 40-57 % of the path-traced lace noon room's curtain bottom) or
+        count those directions dark (False, before). Needs the room side's solved light and
+        the outside's occlusion."""
+        self.wall_light = bool(on)
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -789,8 +798,9 @@ class FrameRenderer:
             defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
             if defines.get("SKY_OCCLUSION"):
                 defines["OCCLUSION_MAPS"] = True   # the view's continuation hidden by the folds
-                defines["WALL_LIGHT"] = True       # the wall and its reveals where the outside is walled
-                defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
+                if self.wall_light:   # the wall and its reveals where the outside is walled
+                    defines["WALL_LIGHT"] = True
+                    defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
         if self.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
@@ -1747,7 +1757,7 @@ class FrameRenderer:
         self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
         if self.room_side_active():
             self._draw_room_side(all_bounces, window_albedo)
-            if self.sky_occlusion and not self.curtain_open:
+            if self.sky_occlusion and self.wall_light and not self.curtain_open:
                 self._draw_vertex_wall_light(inputs)
 
     def _bounce_gather_program(self, all_bounces: bool, window_albedo, defines: dict | None = None):
@@ -1955,7 +1965,8 @@ class FrameRenderer:
     def _room_light_stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
-               self.room_bounces, self.room_lobe, self.room_side_active(), getattr(self, "patterned", None),
+               self.room_bounces, self.room_lobe, self.room_side_active(), self.wall_light,
+               getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
@@ -2233,6 +2244,31 @@ class FrameRenderer:
         vw, vh = self._last[:2]
         data = self._hdr_fbo.read(viewport=(0, 0, vw, vh), components=4, dtype="f4")
         return np.frombuffer(data, dtype=np.float32).reshape(vh, vw, 4)[::-1, :, :3].copy()
+
+    def display_of(self, linear) -> np.ndarray:
+        """Another radiance image (H, W, 3) linear sRGB at this renderer's size shown through
+        the last frame's own display step: the glare when on (bloom), its exposure and white
+        balance, the tone curve and the sRGB encoding, not its anti-aliasing (a rendering
+        approximation, not a display one). uint8 (H, W, 3), row 0 = top. Overwrites the
+        frame's HDR target and display image: read those first. The image bench shows the
+        path-traced reference through it, so that the frame's glare is not counted as error."""
+        w, h = self.size
+        image = np.asarray(linear, dtype=np.float32)
+        if image.shape != (h, w, 3):
+            size = f"{image.shape[1]}x{image.shape[0]}" if image.ndim == 3 else str(image.shape)
+            raise CatalogError(f"display_of: the image is {size} px, the frame {w}x{h} (H, W, 3 needed)")
+        if self._last is None:
+            raise CatalogError("display_of: render a frame first (its exposure shows the image)")
+        rgba = np.concatenate([image[::-1], np.ones((h, w, 1), dtype=np.float32)], axis=-1)
+        self._hdr.write(np.ascontiguousarray(rgba).tobytes())
+        texture = self.draw_bloom(w, h) if self.bloom else self._hdr
+        mode = self.antialiasing
+        self.antialiasing = "off"
+        try:
+            self.display_pass(w, h, hdr=texture)
+        finally:
+            self.antialiasing = mode
+        return self.read_srgb8()
 
     def read_srgb8(self) -> np.ndarray:
         """The last frame tone-mapped and sRGB-encoded: uint8 (H, W, 3), row 0 = top."""
