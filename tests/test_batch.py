@@ -45,8 +45,10 @@ def _sha(path: Path) -> str:
 
 
 def _images(folder: Path) -> dict[str, Path]:
+    """The images under their final names (a killed run's temporary files, hidden names that
+    end in the image's suffix too, are not images yet: the next run removes them)."""
     return {str(p.relative_to(folder)): p for p in sorted(folder.glob("*/*"))
-            if p.suffix in (".png", ".exr")}
+            if p.suffix in (".png", ".exr") and not p.name.startswith(".")}
 
 
 def _run(args, **kw):
