@@ -1404,45 +1404,52 @@ class FrameRenderer:
         """curtain.vert's SKY_OCCLUSION: the per-vertex occlusion texture."""
         texture = self._room_resources().get("vertex_occlusion")
         if texture is None:   # not drawn yet (a mesh bound after the last update): none
-            texture = self._vertex_occlusion_target(1)
+            texture = self._vertex_target("vertex_occlusion", 1)
         texture.use(location=OCCLUSION_UNIT)
         self._set(program, "u_vertex_occlusion", OCCLUSION_UNIT)
         self._set(program, "u_vertex_occlusion_width", VERTEX_OCCLUSION_WIDTH)
 
-    def _vertex_occlusion_target(self, vertices: int):
-        """The per-vertex occlusion texture for ``vertices`` (VERTEX_OCCLUSION_WIDTH a row),
-        made or remade when the count needs more rows (its texels are written by
-        _draw_vertex_occlusion, which clears it first)."""
+    def _vertex_target(self, name: str, vertices: int):
+        """A per-vertex texture ``name`` (the room's resources: "vertex_occlusion",
+        "vertex_wall_light") for ``vertices`` (VERTEX_OCCLUSION_WIDTH a row), made or remade
+        when the count needs more rows (its texels are written by :meth:`_draw_vertex_points`,
+        which clears it first)."""
         mgl, gl = self._moderngl, self._room_resources()
         rows = max(1, -(-int(vertices) // VERTEX_OCCLUSION_WIDTH))
-        texture = gl.get("vertex_occlusion")
+        texture = gl.get(name)
         if texture is None or texture.size[1] < rows:
             if texture is not None:
-                gl["vertex_occlusion_fbo"].release()
+                gl[name + "_fbo"].release()
                 texture.release()
             texture = self.ctx.texture((VERTEX_OCCLUSION_WIDTH, rows), 4, dtype="f4")
             texture.filter = (mgl.NEAREST, mgl.NEAREST)
-            gl["vertex_occlusion"] = texture
-            gl["vertex_occlusion_fbo"] = self.ctx.framebuffer([texture])
+            gl[name] = texture
+            gl[name + "_fbo"] = self.ctx.framebuffer([texture])
         return texture
 
-    def _draw_vertex_occlusion(self) -> None:
-        """Each vertex's outside occlusion (occlusion_points.*) from the occlusion maps."""
+    def _draw_vertex_points(self, name: str, defines: dict, bind) -> None:
+        """occlusion_points.* with ``defines`` into the per-vertex texture ``name``, one point
+        a vertex of the curtain's mesh; ``bind(program)`` sets the pass's own inputs."""
         mgl = self._moderngl
-        b = self._curtain_buffers
-        texture = self._vertex_occlusion_target(self._vertex_count)
-        fbo = self._room_gl["vertex_occlusion_fbo"]
+        texture = self._vertex_target(name, self._vertex_count)
+        fbo = self._room_gl[name + "_fbo"]
         fbo.use()
         self.ctx.viewport = (0, 0, *texture.size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         program = self._program("occlusion_points.vert", "occlusion_points.frag",
-                                {"OCCLUSION_MAPS": True, "N_OCCLUSION": room_light.OCCLUSION_DIRECTIONS})
+                                {"OCCLUSION_MAPS": True, "N_OCCLUSION": room_light.OCCLUSION_DIRECTIONS,
+                                 **defines})
         self._occlusion_uniforms(program)
+        bind(program)
         self._set(program, "u_mesh_offset", self._mesh_offset)
         self._set(program, "u_target_size", tuple(int(v) for v in texture.size))
         self.ctx.disable(mgl.DEPTH_TEST)
         self.ctx.disable(mgl.BLEND)
         self._curtain_vao(program).render(mgl.POINTS)
+
+    def _draw_vertex_occlusion(self) -> None:
+        """Each vertex's outside occlusion (occlusion_points.*) from the occlusion maps."""
+        self._draw_vertex_points("vertex_occlusion", {}, lambda program: None)
 
     def _occlusion_uniforms(self, program, unit: int = OCCLUSION_UNIT) -> None:
         """common.glsl's outside_occlusion: the occlusion maps (at texture ``unit``) and each
@@ -1819,7 +1826,7 @@ class FrameRenderer:
                 room_light.wall_lobe_directions(float(self.shading_inputs().g_spec)), dtype="f4"))
             texture = gl.get("vertex_wall_light")
             if texture is None:   # not drawn yet (a mesh bound after the last update): none
-                texture = self._vertex_wall_light_target(1)
+                texture = self._vertex_target("vertex_wall_light", 1)
             texture.use(location=VERTEX_WALL_LIGHT_UNIT)
             self._set(program, "u_vertex_wall_light", VERTEX_WALL_LIGHT_UNIT)
 
@@ -1854,40 +1861,11 @@ class FrameRenderer:
         s(program, "u_wall_tan_sun", math.tan(scene_lib.SUN_RADIUS_RAD))
         s(program, "u_wall_albedo", scene_lib.ROOM_ALBEDO)
 
-    def _vertex_wall_light_target(self, vertices: int):
-        """The per-vertex walled radiance texture (as :meth:`_vertex_occlusion_target`)."""
-        mgl, gl = self._moderngl, self._room_resources()
-        rows = max(1, -(-int(vertices) // VERTEX_OCCLUSION_WIDTH))
-        texture = gl.get("vertex_wall_light")
-        if texture is None or texture.size[1] < rows:
-            if texture is not None:
-                gl["vertex_wall_light_fbo"].release()
-                texture.release()
-            texture = self.ctx.texture((VERTEX_OCCLUSION_WIDTH, rows), 4, dtype="f4")
-            texture.filter = (mgl.NEAREST, mgl.NEAREST)
-            gl["vertex_wall_light"] = texture
-            gl["vertex_wall_light_fbo"] = self.ctx.framebuffer([texture])
-        return texture
-
     def _draw_vertex_wall_light(self, inputs) -> None:
         """Each vertex's walled radiance (occlusion_points.* with WALL_LIGHT): what the window
         wall and its reveals show its window side, from the light map just drawn."""
-        mgl = self._moderngl
-        texture = self._vertex_wall_light_target(self._vertex_count)
-        fbo = self._room_gl["vertex_wall_light_fbo"]
-        fbo.use()
-        self.ctx.viewport = (0, 0, *texture.size)
-        fbo.clear(0.0, 0.0, 0.0, 0.0)
-        program = self._program("occlusion_points.vert", "occlusion_points.frag",
-                                {"OCCLUSION_MAPS": True, "N_OCCLUSION": room_light.OCCLUSION_DIRECTIONS,
-                                 "WALL_LIGHT": True})
-        self._occlusion_uniforms(program)
-        self._wall_light_uniforms(program, inputs)
-        self._set(program, "u_mesh_offset", self._mesh_offset)
-        self._set(program, "u_target_size", tuple(int(v) for v in texture.size))
-        self.ctx.disable(mgl.DEPTH_TEST)
-        self.ctx.disable(mgl.BLEND)
-        self._curtain_vao(program).render(mgl.POINTS)
+        self._draw_vertex_points("vertex_wall_light", {"WALL_LIGHT": True},
+                                 lambda program: self._wall_light_uniforms(program, inputs))
 
     def wall_light_at(self, positions, walled_share) -> np.ndarray:
         """curtain.vert WALL_LIGHT's light evaluated in numpy at world ``positions`` (P, 3) with
