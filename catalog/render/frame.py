@@ -1267,14 +1267,25 @@ class FrameRenderer:
         self._set(program, "u_shadow", 2)
         self._set(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels))
         self._set(program, "u_curtain_z", scene_lib.CURTAIN_Z)
-        colours = self._display_colours(inputs)
-        self._set(program, "u_reveal_sky", tuple(0.5 * math.pi * v for v in colours["u_sky_rgb"]))
-        self._set(program, "u_reveal_ground", tuple(0.5 * math.pi * v for v in colours["u_ground_rgb"]))
+        reveals = self._reveal_inputs(inputs)
+        self._set(program, "u_reveal_sky", reveals["sky_half"])
+        self._set(program, "u_reveal_ground", reveals["ground_half"])
         gl["luminaire_back"].use(location=3)
         self._set(program, "u_luminaire_back", 3)
+        self._set(program, "u_reveal_back_level", reveals["back_level"])
+        self._set(program, "u_reveal_back_size", reveals["back_size"])
+
+    def _reveal_inputs(self, inputs) -> dict:
+        """common.glsl reveal_irradiance's inputs besides the point (room.frag's reveals and
+        WALL_LIGHT's): 0.5 pi x the sky's and the ground's radiance (linear sRGB), and the
+        window-side capture's level of 2 x 2 patches a texel and that level's size."""
+        colours = self._display_colours(inputs)
         level = room_light.BACK_LUMINAIRE_LEVEL + 1
-        self._set(program, "u_reveal_back_level", level)
-        self._set(program, "u_reveal_back_size", tuple(max(v >> level, 1) for v in room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)))
+        return {"sky_half": tuple(0.5 * math.pi * v for v in colours["u_sky_rgb"]),
+                "ground_half": tuple(0.5 * math.pi * v for v in colours["u_ground_rgb"]),
+                "back_level": level,
+                "back_size": tuple(max(v >> level, 1) for v in
+                                   room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL))}
 
     def read_luminaire_back(self, level: int) -> np.ndarray:
         """The window-side capture at mip ``level``, float32 (H, W, 3), row 0 = the opening's bottom."""
@@ -1847,15 +1858,13 @@ class FrameRenderer:
         s(program, "u_wall_box_hi", (x1, y1, z1))
         s(program, "u_wall_opening", tuple(scene_lib.WINDOW_RECT))
         s(program, "u_wall_planes", (z0, z0 - scene_lib.WALL_THICKNESS_M))
-        colours = self._display_colours(inputs)
-        s(program, "u_wall_sky_half", tuple(0.5 * math.pi * v for v in colours["u_sky_rgb"]))
-        s(program, "u_wall_ground_half", tuple(0.5 * math.pi * v for v in colours["u_ground_rgb"]))
+        reveals = self._reveal_inputs(inputs)
+        s(program, "u_wall_sky_half", reveals["sky_half"])
+        s(program, "u_wall_ground_half", reveals["ground_half"])
         gl["luminaire_back"].use(location=WINDOW_SIDE_CLOTH_UNIT)
         s(program, "u_wall_back", WINDOW_SIDE_CLOTH_UNIT)
-        level = room_light.BACK_LUMINAIRE_LEVEL + 1
-        s(program, "u_wall_back_level", level)
-        s(program, "u_wall_back_size", tuple(max(v >> level, 1) for v in
-                                             room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)))
+        s(program, "u_wall_back_level", reveals["back_level"])
+        s(program, "u_wall_back_size", reveals["back_size"])
         s(program, "u_wall_key_to_light", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_wall_key_rgb", self._room_colours(inputs)["u_key_rgb"])
         s(program, "u_wall_tan_sun", math.tan(scene_lib.SUN_RADIUS_RAD))
@@ -2282,12 +2291,12 @@ class FrameRenderer:
         """What the window wall and its reveals show the cloth's window side, from the room's
         last light (:func:`room_light.walled_radiance`'s inputs, as the GL pass binds them)."""
         inputs = self.shading_inputs()
-        colours = self._display_colours(inputs)
+        reveals = self._reveal_inputs(inputs)
         return room_light.WallLightSources(
             lightmap=self.read_room_lightmap(),
-            back=self.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL + 1),
-            reveal_sky=0.5 * math.pi * np.asarray(colours["u_sky_rgb"], dtype=np.float64),
-            reveal_ground=0.5 * math.pi * np.asarray(colours["u_ground_rgb"], dtype=np.float64),
+            back=self.read_luminaire_back(reveals["back_level"]),
+            reveal_sky=np.asarray(reveals["sky_half"], dtype=np.float64),
+            reveal_ground=np.asarray(reveals["ground_half"], dtype=np.float64),
             key_rgb=np.asarray(self._room_colours(inputs)["u_key_rgb"], dtype=np.float64),
             to_light=np.asarray(inputs.key_to_light, dtype=np.float64))
 
