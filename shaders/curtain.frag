@@ -158,6 +158,16 @@ INTERPOLATION in vec3 v_wall_light;   // curtain.vert: the wall and its reveals,
 #endif
 #endif
 float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own folds (SKY_OCCLUSION)
+#ifdef FOLDS_BEHIND
+// The room's window capture (issue 11, sixth round; with ROOM_SIDE and OCCLUSION_MAPS): the
+// share of the view's continuation that a fold hides, set in main. Through the holes (LD) the
+// capture then sees that fold's window side (the window-side capture at the patch) where it
+// saw the outside. The frame's own patterned curtain composites the folds behind (OIT), but
+// the capture draws the flat cloth: from the side eyes, looking across the folds, the holes
+// of a safety-yellow mesh (LD 0.36) show the glowing folds behind, and without them the
+// capture was 0.55x the path tracer's radiance there.
+float g_fold_behind = 0.0;
+#endif
 #ifdef ROOM_CAPTURE
 uniform float u_capture_thread;    // the key a thread passes, a_spec forward(g_spec) / (1 - LD)
 float g_key_reach = 1.0;           // set in main: see out_radiance.a below
@@ -208,6 +218,13 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
     vec4 outside = bg.y * bg.z * (u_direct * u_sun_disc[k]) - u_direct * u_room[k];
     band += bg.x * outside;
     constant += u_direct * u_room[k];
+#elif defined(SEE_THROUGH) && defined(FOLDS_BEHIND)
+    // the room's window capture: where a fold hides the view's continuation, the holes show
+    // that fold (main adds it), not the outside; the room's share stays 1 - bg.x
+    vec4 outside = bg.y * (u_direct * (u_sky[k] - u_ground[k]) + bg.z * (u_direct * u_sun_disc[k]))
+                 + u_direct * (u_ground[k] - u_room[k]);
+    band += (bg.x * (1.0 - g_fold_behind)) * outside;
+    constant += (u_direct * (1.0 - bg.x * g_fold_behind)) * u_room[k];
 #elif defined(SEE_THROUGH)
     vec4 outside = bg.y * (u_direct * (u_sky[k] - u_ground[k]) + bg.z * (u_direct * u_sun_disc[k]))
                  + u_direct * (u_ground[k] - u_room[k]);
@@ -327,6 +344,9 @@ void main() {
 #ifdef SEE_THROUGH
     bg = background_terms(ray, u_sun_direction, u_sun_chord2.x, u_sun_chord2.y);
 #endif
+#ifdef FOLDS_BEHIND
+    g_fold_behind = v_view_occlusion;
+#endif
 
     vec3 rgb = shade_chunk(0, g_key, g_fill, bg, effective);
 #if NV4 > 1
@@ -347,6 +367,9 @@ void main() {
          * v_window_side_light;
 #ifdef WALL_LIGHT
     rgb += g_view_outside * v_wall_light;   // the wall and its reveals where the outside is walled
+#endif
+#if defined(FOLDS_BEHIND) && defined(SEE_THROUGH)
+    rgb += (u_direct * bg.x * g_fold_behind) * v_window_side_light;   // the fold behind, through the holes
 #endif
 #endif
 #ifdef PATTERN

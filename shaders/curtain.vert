@@ -102,12 +102,19 @@ void main() {
 #ifdef ROOM_SIDE
     vec2 side_uv = (position.xy - u_room_side_rect.xy) * u_room_side_rect.zw;
     ivec2 cloth_patch = ivec2(clamp(side_uv, 0.0, 0.999) * vec2(u_room_side_cloth_size));
+#ifdef ROOM_CAPTURE
+    // the room's window capture (FOLDS_BEHIND) takes only the folds' window side: the room's
+    // light off the cloth is the radiosity's (room_radiosity.frag), and the room's capture of
+    // the cloth is the target being drawn
+    v_room_side_light = vec3(0.0);
+#else
     vec3 room_light = textureLod(u_room_side, side_uv, 0.0).rgb;
     vec3 cloth_light = PI * texelFetch(u_room_side_cloth, cloth_patch, u_room_side_cloth_level).rgb;
 #ifdef SKY_OCCLUSION
     v_room_side_light = mix(room_light, cloth_light, v_occlusion.z);
 #else
     v_room_side_light = room_light;
+#endif
 #endif
     v_window_side_light = texelFetch(u_window_side_cloth, cloth_patch, u_window_side_cloth_level).rgb;
     v_view_occlusion = 0.0;

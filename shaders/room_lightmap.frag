@@ -22,6 +22,14 @@ uniform vec3 u_face_normal[6];
 uniform sampler2D u_luminaire;       // mipmapped; level u_luminaire_level = one texel a patch
 uniform ivec2 u_luminaire_size;
 uniform int u_luminaire_level;
+#ifdef SIDE_EYES
+// The same capture from two eyes towards the side walls (issue 11, sixth round; left then
+// right, side by side, room_light.CAPTURE_SIDE_EYES): the folds' flanks face either way and
+// glow unequally, so a wall seeing the window obliquely sees mostly one kind.
+uniform sampler2D u_luminaire_sides;
+uniform vec3 u_side_eye[2];
+uniform vec3 u_middle_eye;
+#endif
 uniform vec4 u_window_rect;          // x0, x1, y0, y1 of the opening (m)
 uniform vec2 u_wall_z;               // the window wall's inner and outer planes (m)
 uniform float u_face_texels;         // light-map texels per face side
@@ -48,6 +56,32 @@ layout(location = 0) out vec4 out_irradiance;   // area light and lamps (the roo
 layout(location = 1) out vec4 out_beam;         // the key's beam (per pixel in room.frag; here
                                                 // only as a source of the bounce)
 
+// The radiance window patch (i, j), centred at c, sends towards p: the middle capture's or,
+// SIDE_EYES, the three captures blended piecewise linearly in the horizontal angle of the way
+// from c to p between the angles at which c sees the eyes, clamped beyond the side eyes
+// (float64 twin: room_light.capture_eye_weights); alpha (the key's reach on the patch's
+// cloth) always the middle's.
+vec4 captured_towards(int i, int j, vec3 c, vec3 p) {
+    vec4 middle = texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level);
+#ifdef SIDE_EYES
+    float a = atan(p.x - c.x, max(p.z - c.z, 1e-6));
+    float a_left = atan(u_side_eye[0].x - c.x, max(u_side_eye[0].z - c.z, 1e-6));
+    float a_mid = atan(u_middle_eye.x - c.x, max(u_middle_eye.z - c.z, 1e-6));
+    float a_right = atan(u_side_eye[1].x - c.x, max(u_side_eye[1].z - c.z, 1e-6));
+    vec3 rgb;
+    if (a <= a_mid) {
+        vec3 left = texelFetch(u_luminaire_sides, ivec2(i, j), u_luminaire_level).rgb;
+        rgb = mix(middle.rgb, left, clamp((a_mid - a) / (a_mid - a_left), 0.0, 1.0));
+    } else {
+        vec3 right = texelFetch(u_luminaire_sides, ivec2(i + u_luminaire_size.x, j), u_luminaire_level).rgb;
+        rgb = mix(middle.rgb, right, clamp((a - a_mid) / (a_right - a_mid), 0.0, 1.0));
+    }
+    return vec4(rgb, middle.a);
+#else
+    return middle;
+#endif
+}
+
 // The window's light at point p (normal n): the room side's patches in the opening and,
 // behind the curtain's plane (the window wall beside the opening, in the gap between wall and
 // cloth), the patches of its window side: the glow and the light it scatters back.
@@ -60,7 +94,7 @@ vec3 window_irradiance(vec3 p, vec3 n, vec2 cell) {
         for (int i = 0; i < u_luminaire_size.x; ++i) {
             vec3 corner = vec3(u_window_rect.x + float(i) * cell.x,
                                u_window_rect.z + float(j) * cell.y, u_wall_z.x);
-            vec4 captured = texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level);
+            vec4 captured = captured_towards(i, j, vec3(corner.xy + 0.5 * cell, u_wall_z.x), p);
             vec3 radiance = captured.rgb;
             if (u_lobe_rgb != vec3(0.0) && u_key_on > 0.0) {
                 // the key's directional lobe through the cloth of this patch, towards p (eq. 7:

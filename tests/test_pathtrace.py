@@ -606,3 +606,67 @@ def test_two_layer_study_reproduces_eq7_alone_and_tabulates(mi, monkeypatch):
     assert row["alone_traced"] == pytest.approx(row["alone_eq7"], rel=0.03)
     assert row["behind_traced"] < row["alone_traced"]
     assert "| 40 | 30 |" in two_layers.markdown_tables(result)["two-layers"]
+
+
+@pytest.mark.gl
+@pytest.mark.slow   # ~4 s: a 12 cm drape, 3 x 108 x 64 rays
+def test_the_rooms_window_captures_match_traced_radiance_along_their_rays(gl, mi):
+    """Issue 11, sixth round: the room's captures of the window (R2 from the room's middle,
+    and from the two side eyes, room_light.CAPTURE_SIDE_EYES) against the path tracer's
+    radiance along rays from the same eye through the same window patch (64 a patch,
+    max_depth 2: the glow seen and the outside once scattered; the room's own light off the
+    cloth, which the radiosity adds, is about 1 % here). Safety-yellow under the UV lamp,
+    folded 12 cm deep: the light is the glow, the see-through LD 0.36. The median over the
+    108 patches of capture / traced lies within [0.8, 1.25] for every eye (the key's disc, seen
+    through the holes by the tracer and carried by the beam in the frame, sits in a few
+    patches: hence the median). Before this round, the capture drew the coarse grid (whose
+    chords the fine mesh's front-layer map shadowed) and the flat cloth's holes showed the
+    outside where folds lie behind: on the bench's room scene the middle eye's mean ratio was
+    0.78 and a side eye's 0.55 over half its patches; the bounds were set from that probe
+    (docs/pathtrace.md, sixth round). Measured here: left 1.07, middle 0.98, right 0.89; with
+    the folds behind left out, 0.84, 0.98 and 0.69 (the right eye fails)."""
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
+    from catalog.render import room_light
+    from catalog.render import scene as scene_lib
+    from catalog.render.frame import FrameRenderer
+
+    d = scene_lib.draped_curtain(depth_m=0.12)
+    curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
+    preset = desc_preset("safety-yellow")
+    light = get_light("UV-A")
+    desc = describe_scene(preset, light, size=(8, 6), curtain=curtain)
+    r = FrameRenderer(gl, (8, 6))
+    r.set_fabric(preset)
+    r.set_light(light)
+    r.set_fluorescence("physical")
+    r.set_mesh(*curtain)
+    r.render()
+    res = r._room_resources()
+    lvl = room_light.LUMINAIRE_LEVEL
+    nx, ny = room_light.LUMINAIRE_TEXELS
+    middle = np.frombuffer(res["luminaire"].read(level=lvl), dtype=np.float32).reshape(ny, nx, 4)[..., :3]
+    sides = np.frombuffer(res["luminaire_sides"].read(level=lvl), dtype=np.float32).reshape(ny, 2 * nx, 4)[..., :3]
+    r.release()
+    captures = {"left": sides[:, :nx], "middle": middle, "right": sides[:, nx:]}
+    eyes = {"left": room_light.CAPTURE_SIDE_EYES[0], "middle": room_light.LUMINAIRE_EYE,
+            "right": room_light.CAPTURE_SIDE_EYES[1]}
+    scene = build_mitsuba_scene(mi, desc, max_depth=2)
+    corners, s, t = room_light.window_patch_rectangles(scene_lib.ROOM_BOX[2][0])
+    rng = np.random.default_rng(3)
+    luma = np.array([0.2126, 0.7152, 0.0722])
+    per = 64
+    for name, eye in eyes.items():
+        eye = np.asarray(eye, dtype=np.float64)
+        u = rng.random((len(corners), per, 2))
+        target = corners[:, None, :] + u[..., 0:1] * s[:, None, :] + u[..., 1:2] * t[:, None, :]
+        d = (target - eye).reshape(-1, 3)
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        sampler = mi.load_dict({"type": "independent"})
+        sampler.seed(1, len(d))
+        ray = mi.Ray3f(mi.Point3f(np.repeat(eye[None], len(d), 0).T.astype(np.float32)),
+                       mi.Vector3f(d.T.astype(np.float32)))
+        radiance, _valid, _aov = scene.integrator().sample(scene, sampler, ray)
+        traced = np.asarray(radiance, dtype=np.float64).T.reshape(ny, nx, per, 3).mean(axis=2) @ luma
+        ratio = np.median((captures[name].astype(np.float64) @ luma) / np.maximum(traced, 1e-9))
+        assert 0.8 <= ratio <= 1.25, (name, ratio)

@@ -318,6 +318,12 @@ class FrameRenderer:
         #: the stand-ins, the fill light and the room's share of the ambient term
         self.room_side_solved = True
         self.wall_light = True     # the window wall and its reveals light the cloth (WALL_LIGHT)
+        #: issue 11 (sixth round): the room's capture of the window from three eyes, blended
+        #: per receiving point (room_lightmap.frag SIDE_EYES); False: from the middle alone
+        self.side_eyes = True
+        #: issue 11 (sixth round): the room's captures see the folds behind through the holes
+        #: (curtain.frag FOLDS_BEHIND); False: the outside there
+        self.capture_folds = True
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -512,6 +518,21 @@ class FrameRenderer:
         count those directions dark (False, before). Needs the room side's solved light and
         the outside's occlusion."""
         self.wall_light = bool(on)
+
+    def set_side_eyes(self, on: bool) -> None:
+        """Capture the window for the room's direct light from the middle and two eyes towards
+        the side walls, blended by the angle to each receiving point (True, issue 11's sixth
+        round: under the UV lamp the folds' lit flanks, facing one way, glow about three times
+        the shadowed, and the path-traced left wall got 1.3x the right's direct light while the
+        one capture from the middle lit both alike) or from the middle alone (False, before)."""
+        self.side_eyes = bool(on)
+
+    def set_capture_folds(self, on: bool) -> None:
+        """Let the room's captures of the window see, through the cloth's holes, the folds
+        behind where they hide the outside (True, issue 11's sixth round: the frame's own
+        patterned curtain composites them, the captures draw the flat cloth and showed the
+        outside there, dark under the UV lamp) or the outside (False, before)."""
+        self.capture_folds = bool(on)
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -847,7 +868,7 @@ class FrameRenderer:
             self._lamp_values_key = key
         return self._lamp_values
 
-    def _curtain_program(self, gbuffer: bool, overrides: dict | None = None):
+    def _curtain_program(self, gbuffer: bool, overrides: dict | None = None, folds_behind: bool = False):
         defines = self.variant_defines(gbuffer)
         if overrides:
             defines["ROOM_CAPTURE"] = True  # the room's window capture (issue 13), not the frame's
@@ -855,6 +876,10 @@ class FrameRenderer:
             defines.pop("OCCLUSION_MAPS", None)
             defines.pop("WALL_LIGHT", None)
             defines.pop("WALL_LOBE_SAMPLES", None)
+            if folds_behind and defines.get("SKY_OCCLUSION"):
+                # the folds' window side where they hide the outside (curtain.frag FOLDS_BEHIND;
+                # ROOM_SIDE without the room's part under ROOM_CAPTURE)
+                defines.update({"ROOM_SIDE": True, "OCCLUSION_MAPS": True, "FOLDS_BEHIND": True})
         if self.specialise:
             for name, value in self._scene_values_with(overrides).items():
                 defines["S_" + name[2:].upper()] = glsl_literal(value)
@@ -1058,7 +1083,7 @@ class FrameRenderer:
 
     def draw_curtain(self, view_proj, fragment: str | None = None, gbuffer: bool = False,
                      camera_position=None, overrides: dict | None = None,
-                     coarse: bool = False) -> None:
+                     coarse: bool = False, folds_behind: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer.
 
         ``fragment``: draw the same mesh (same vertex shader and uniforms of the mesh and
@@ -1067,7 +1092,8 @@ class FrameRenderer:
         ``camera_position``: the eye for the view-dependent terms (default the camera's; the
         room's passes draw the curtain as seen from the key light or the room);
         ``overrides``: scene values replaced for this draw; ``coarse``: the coarser grid the
-        room's passes use."""
+        room's passes use; ``folds_behind``: with ``overrides``, the room capture's variant that
+        shows the folds behind through the holes (curtain.frag FOLDS_BEHIND)."""
         eye = tuple(float(v) for v in (self.camera.position if camera_position is None
                                        else camera_position))
         if fragment is not None:
@@ -1076,7 +1102,7 @@ class FrameRenderer:
             self._set(program, "u_mesh_offset", self._mesh_offset)
             self._set(program, "u_camera_position", eye)
         else:
-            program = self._curtain_program(gbuffer, overrides)
+            program = self._curtain_program(gbuffer, overrides, folds_behind)
             self._set(program, "u_view_proj", gl_bytes(view_proj))
             self._set(program, "u_camera_position", eye)
             self._set(program, "u_mesh_offset", self._mesh_offset)
@@ -1101,7 +1127,7 @@ class FrameRenderer:
                 self._set(program, "u_environment_scale", self.environment_scale(self.shading_inputs()))
             if "u_key_front" in program:
                 self._key_shadow_uniforms(program, self.shading_inputs())
-            if "u_room_side" in program:
+            if "u_room_side" in program or "u_window_side_cloth" in program:   # (FOLDS_BEHIND: no room part)
                 self._room_side_uniforms(program)
             if "u_capture_thread" in program:
                 inputs = self.shading_inputs()
@@ -1312,6 +1338,9 @@ class FrameRenderer:
             luminaire = ctx.texture((lw, lh), 4, dtype="f4")
             luminaire.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             luminaire_depth = ctx.depth_renderbuffer((lw, lh))
+            sides = ctx.texture((2 * lw, lh), 4, dtype="f4")   # the side eyes', left then right
+            sides.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            sides_depth = ctx.depth_renderbuffer((2 * lw, lh))
             bw, bh = room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)
             luminaire_back = ctx.texture((bw, bh), 4, dtype="f4")
             luminaire_back.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
@@ -1343,6 +1372,7 @@ class FrameRenderer:
                 "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
                 "luminaire": luminaire, "luminaire_depth": luminaire_depth,
                 "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
+                "luminaire_sides": sides, "luminaire_sides_fbo": ctx.framebuffer([sides], sides_depth),
                 "luminaire_back": luminaire_back,
                 "luminaire_back_fbo": ctx.framebuffer([luminaire_back], luminaire_back_depth),
                 "direct": direct, "beam": beam, "direct_fbo": ctx.framebuffer([direct, beam]),
@@ -1627,42 +1657,56 @@ class FrameRenderer:
 
     def draw_room_luminaire(self, inputs) -> None:
         """Pass R2: what the room sees in the window (the curtain's room-side radiance, or the
-        outside where it is open), one texel per window patch, the sun's disc left out."""
+        outside where it is open), one texel per window patch, the sun's disc left out; from
+        the room's middle and (side_eyes) from two eyes towards the side walls. The window
+        side's capture R2b first: through the holes, the room's captures see it on the folds
+        behind (curtain.frag FOLDS_BEHIND)."""
         mgl, gl = self._moderngl, self._room_resources()
-        lw, lh = room_light.luminaire_capture_size()
-        gl["luminaire_fbo"].use()
-        self.ctx.viewport = (0, 0, lw, lh)
-        # alpha: the key's irradiance on the cloth (curtain.frag ROOM_CAPTURE), 0 where none
-        gl["luminaire_fbo"].clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        self.ctx.enable(mgl.DEPTH_TEST)
-        self.ctx.depth_func = "<="
-        view_proj = room_light.luminaire_view_projection()
-        eye = room_light.LUMINAIRE_EYE
-        if not self.curtain_open:
-            self._draw_flat_curtain(view_proj, eye, self._capture_overrides())
-        self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
-        gl["luminaire"].build_mipmaps()  # level LUMINAIRE_LEVEL: each patch's mean radiance
         # the window side, from outside: nothing where there is no cloth (the room behind it
         # is not a source), and no see-through (it would show the outside, not the room)
         gl["luminaire_back_fbo"].use()
         self.ctx.viewport = (0, 0) + room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)
         gl["luminaire_back_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<="
         if not self.curtain_open:
             self._draw_flat_curtain(room_light.back_luminaire_view_projection(),
                                     room_light.BACK_LUMINAIRE_EYE, self._back_capture_overrides())
+        gl["luminaire_back"].build_mipmaps()
+        lw, lh = room_light.luminaire_capture_size()
+        # alpha: the key's irradiance on the cloth (curtain.frag ROOM_CAPTURE), 0 where none
+        targets = [("luminaire", room_light.LUMINAIRE_EYE, 0)]
+        if self.side_eyes:   # side by side, a tile a power of 2 wide at the patch level: the
+            targets += [("luminaire_sides", eye, k)   # mipmaps keep them apart
+                        for k, eye in enumerate(room_light.CAPTURE_SIDE_EYES)]
+        for name, eye, tile in targets:
+            if tile == 0:
+                gl[name + "_fbo"].use()
+                gl[name + "_fbo"].clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            self.ctx.viewport = (tile * lw, 0, lw, lh)
+            view_proj = room_light.luminaire_view_projection(eye)
+            if not self.curtain_open:
+                self._draw_flat_curtain(view_proj, eye, self._capture_overrides(),
+                                        folds_behind=self.capture_folds)
+            self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
+        for name in {name for name, _eye, _tile in targets}:
+            gl[name].build_mipmaps()   # level LUMINAIRE_LEVEL: each patch's mean radiance
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
-        gl["luminaire_back"].build_mipmaps()
 
-    def _draw_flat_curtain(self, view_proj, eye, overrides: dict) -> None:
+    def _draw_flat_curtain(self, view_proj, eye, overrides: dict, folds_behind: bool = False) -> None:
         """The room's captures draw the flat cloth (the pattern averaged, model.md section 9):
         each capture texel is a mean over a window patch anyway, and the flat variant draws in
-        one pass."""
+        one pass. The whole mesh, not the coarse grid of the shadow map: under the UV lamp the
+        grid's chords cut into the folds, which its front-layer map then shadowed, and the
+        room's capture was 0.78x the path tracer's radiance along the same rays (0.93x with
+        the mesh)."""
         patterned = getattr(self, "patterned", None)
         if patterned:
             self.patterned = False
         try:
-            self.draw_curtain(view_proj, camera_position=eye, overrides=overrides, coarse=True)
+            self.draw_curtain(view_proj, camera_position=eye, overrides=overrides, coarse=False,
+                              folds_behind=folds_behind)
         finally:
             if patterned:
                 self.patterned = patterned
@@ -1721,10 +1765,16 @@ class FrameRenderer:
         self.ctx.disable(mgl.BLEND)
         gl["direct_fbo"].use()
         self.ctx.viewport = (0, 0, aw, ah)
-        program = self._program("fullscreen.vert", "room_lightmap.frag")
+        program = self._program("fullscreen.vert", "room_lightmap.frag",
+                                {"SIDE_EYES": True} if self.side_eyes else None)
         self._room_common_uniforms(program, inputs)
         gl["luminaire"].use(location=1)
         self._set(program, "u_luminaire", 1)
+        if self.side_eyes:
+            gl["luminaire_sides"].use(location=4)
+            self._set(program, "u_luminaire_sides", 4)
+            self._set(program, "u_side_eye", np.asarray(room_light.CAPTURE_SIDE_EYES, dtype="f4"))
+            self._set(program, "u_middle_eye", room_light.LUMINAIRE_EYE)
         self._set(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)
         self._set(program, "u_luminaire_level", room_light.LUMINAIRE_LEVEL)
         self._set(program, "u_face_texels", float(room_light.FACE_TEXELS))
@@ -1953,6 +2003,7 @@ class FrameRenderer:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
                self.room_bounces, self.room_lobe, self.room_side_active(), self.wall_light,
+               self.side_eyes, self.capture_folds,
                getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
@@ -2410,7 +2461,8 @@ class FrameRenderer:
             "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
             "outside_by_view": self.outside_by_view,
             "room_bounces": self.room_bounces, "room_lobe": self.room_lobe,
-            "room_side_solved": self.room_side_solved,
+            "room_side_solved": self.room_side_solved, "side_eyes": self.side_eyes,
+            "capture_folds": self.capture_folds,
             "shadow_map_size": self.shadow_texels,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,

@@ -58,6 +58,13 @@ LUMINAIRE_TEXELS = (12, 9)
 LUMINAIRE_LEVEL = 2
 #: Where the luminaire capture looks from (metres): the middle of the room, eye height.
 LUMINAIRE_EYE = (0.0, 0.2, 2.0)
+#: Two more captures of the room side (issue 11, sixth round), from eyes towards the side walls
+#: (metres): the folds' flanks face either way, and the lit ones glow about three times the
+#: shadowed under a low UV lamp, so a wall that sees the window obliquely sees mostly one kind;
+#: from the room's middle alone the left wall got 0.68x the path tracer's direct light and the
+#: right 0.98x. room_lightmap.frag blends the three by the horizontal angle from each window
+#: patch to the receiving point (:func:`capture_eye_weights`). Left first.
+CAPTURE_SIDE_EYES = ((-1.7, 0.2, 0.8), (1.7, 0.2, 0.8))
 #: The closed curtain's window side (issue 11): its radiance is captured from outside, from the
 #: room eye mirrored through the rod's plane, and sent from patches in that plane
 #: (scene.CURTAIN_Z, the drape's mean depth) to what lies behind it: the window wall beside
@@ -529,6 +536,29 @@ def back_luminaire_view_projection(eye=BACK_LUMINAIRE_EYE) -> np.ndarray:
     return window_view_projection(eye, scene_lib.CURTAIN_Z)
 
 
+def capture_eye_weights(points: np.ndarray, centres: np.ndarray,
+                        side_eyes=CAPTURE_SIDE_EYES, middle_eye=LUMINAIRE_EYE) -> np.ndarray:
+    """(P, N, 3): the weights of the left, middle and right captures for the radiance that
+    window patch n (centre ``centres[n]``, in the opening) sends to point p: piecewise linear
+    in the horizontal angle atan2(dx, dz) of the way from the patch to the point, between the
+    angles at which the patch sees the three eyes, clamped beyond the side eyes (the float64
+    twin of room_lightmap.frag's ``captured_towards``)."""
+    points = np.asarray(points, dtype=np.float64)
+    centres = np.asarray(centres, dtype=np.float64)
+
+    def angle(at):   # of the way from every patch's centre to ``at`` ((3,) or (P, 1, 3))
+        d = np.asarray(at, dtype=np.float64) - centres
+        return np.arctan2(d[..., 0], np.maximum(d[..., 2], 1e-6))
+
+    a = angle(points[:, None, :])
+    a_left, a_mid, a_right = angle(side_eyes[0]), angle(middle_eye), angle(side_eyes[1])
+    to_left = np.clip((a_mid - a) / (a_mid - a_left), 0.0, 1.0)
+    to_right = np.clip((a - a_mid) / (a_right - a_mid), 0.0, 1.0)
+    left = np.where(a <= a_mid, to_left, 0.0)
+    right = np.where(a > a_mid, to_right, 0.0)
+    return np.stack([left, 1.0 - left - right, right], axis=-1)
+
+
 def luminaire_capture_size(level: int = LUMINAIRE_LEVEL) -> tuple[int, int]:
     """A capture's render size: LUMINAIRE_TEXELS supersampled by 2^level."""
     return LUMINAIRE_TEXELS[0] << level, LUMINAIRE_TEXELS[1] << level
@@ -612,14 +642,17 @@ def lobe_radiance(points: np.ndarray, lobe_rgb, g_spec: float, to_light,
 
 
 def window_irradiance(radiance_front: np.ndarray, radiance_back: np.ndarray,
-                      face_texels: int = FACE_TEXELS, lobe: dict | None = None) -> np.ndarray:
+                      face_texels: int = FACE_TEXELS, lobe: dict | None = None,
+                      radiance_sides: np.ndarray | None = None) -> np.ndarray:
     """The float64 twin of room_lightmap.frag's window term, (R, 6R, 3): per atlas texel, the
     mean over its sample points on a wall (2 x 2 within WINDOW_SUPERSAMPLE_M of the window's
     plane, else the centre; none inside the opening) of the room side's patches (in the
     opening, ``radiance_front`` (9, 12, 3), the capture at its patch level) and, behind the
     curtain's plane, its window side's (``radiance_back``), each E = L F with F from
     :func:`rectangle_irradiance_factor`; with ``lobe`` (keywords of :func:`lobe_radiance`),
-    the room side's patches add the key's directional lobe."""
+    the room side's patches add the key's directional lobe. ``radiance_sides`` (2, 9, 12, 3):
+    the side eyes' captures (:data:`CAPTURE_SIDE_EYES`), blended with the middle's per point
+    and patch by :func:`capture_eye_weights`; None: the middle's alone."""
     positions, normals = texel_points(face_texels)
     wall_z = scene_lib.ROOM_BOX[2][0]
     wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
@@ -646,7 +679,14 @@ def window_irradiance(radiance_front: np.ndarray, radiance_back: np.ndarray,
                 continue
             n = np.broadcast_to(face.normal, q.shape)
             factors = rectangle_irradiance_factor(q[use], n[use], *front)
-            e = factors @ lf
+            if radiance_sides is None:
+                e = factors @ lf
+            else:
+                sides = np.asarray(radiance_sides, dtype=np.float64).reshape(2, -1, 3)
+                weights = capture_eye_weights(q[use], front[0] + 0.5 * (front[1] + front[2]))
+                radiance = (weights[..., 0:1] * sides[0][None] + weights[..., 1:2] * lf[None]
+                            + weights[..., 2:3] * sides[1][None])
+                e = np.einsum("pn,pnc->pc", factors, radiance)
             if lobe is not None:
                 e += np.einsum("pj,pjc->pc", factors, lobe_radiance(q[use], **lobe))
             behind = q[use, 2] < scene_lib.CURTAIN_Z
