@@ -42,7 +42,8 @@ uniform float u_back_plane_z;        // its patches' plane (m), normal -z
 
 uniform sampler2D u_shadow;
 uniform mat4 u_light_view_proj;
-uniform float u_shadow_lod;
+uniform float u_beam_shadow_lod;     // the beam's samples' level (their spacing)
+// BEAM_SAMPLES: the beam's samples a texel side (frame.py defines room_light.BEAM_SAMPLES)
 uniform vec3 u_key_to_light;
 uniform vec3 u_key_rgb;              // key light: normal irradiance as linear sRGB (x pi cd m^-2)
 uniform float u_tan_sun_radius;
@@ -152,13 +153,24 @@ void main() {
     }
     vec3 e = count > 0.0 ? sum / count : vec3(0.0);
 
+    // the beam (the bounces' source only): the mean over BEAM_SAMPLES^2 points of the texel of
+    // the opening's mask times the map's transmittance at their spacing's level (issue 11,
+    // sixth round: from the texel's centre at the texel's level, the map's clear border blurred
+    // into the footprint's edge and the beam's flux into the room was 1.3x the path tracer's
+    // under the voile's low key)
     vec3 e_beam = vec3(0.0);
     float cos_key = dot(n, u_key_to_light);
     if (cos_key > 0.0 && u_key_on > 0.0) {
-        float beam = room_window_beam(p, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius);
-        vec4 clip = u_light_view_proj * vec4(p, 1.0);
-        vec3 t = textureLod(u_shadow, clip.xy * 0.5 + 0.5, u_shadow_lod).rgb;
-        e_beam = u_key_rgb * (cos_key * beam) * t;
+        vec3 t_sum = vec3(0.0);
+        for (int k = 0; k < BEAM_SAMPLES * BEAM_SAMPLES; ++k) {
+            vec2 offset = (vec2(float(k % BEAM_SAMPLES), float(k / BEAM_SAMPLES)) + 0.5)
+                        / float(BEAM_SAMPLES) - 0.5;
+            vec3 q = p + (offset.x * u_face_s[face] + offset.y * u_face_t[face]) / u_face_texels;
+            float beam = room_window_beam(q, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius);
+            vec4 clip = u_light_view_proj * vec4(q, 1.0);
+            t_sum += beam * textureLod(u_shadow, clip.xy * 0.5 + 0.5, u_beam_shadow_lod).rgb;
+        }
+        e_beam = u_key_rgb * cos_key * t_sum / float(BEAM_SAMPLES * BEAM_SAMPLES);
     }
 
     for (int k = 0; k < u_lamp_count; ++k) {

@@ -1766,7 +1766,8 @@ class FrameRenderer:
         gl["direct_fbo"].use()
         self.ctx.viewport = (0, 0, aw, ah)
         program = self._program("fullscreen.vert", "room_lightmap.frag",
-                                {"SIDE_EYES": True} if self.side_eyes else None)
+                                {"BEAM_SAMPLES": room_light.BEAM_SAMPLES,
+                                 **({"SIDE_EYES": True} if self.side_eyes else {})})
         self._room_common_uniforms(program, inputs)
         gl["luminaire"].use(location=1)
         self._set(program, "u_luminaire", 1)
@@ -1790,9 +1791,9 @@ class FrameRenderer:
         gl["shadow"].use(location=2)
         self._set(program, "u_shadow", 2)
         (x0, x1), _, _ = scene_lib.ROOM_BOX
-        texel_m = (x1 - x0) / room_light.FACE_TEXELS
-        self._set(program, "u_shadow_lod",
-                  max(0.0, math.log2(texel_m / room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels))))
+        spacing_m = (x1 - x0) / room_light.FACE_TEXELS / room_light.BEAM_SAMPLES   # the beam's samples'
+        self._set(program, "u_beam_shadow_lod",
+                  max(0.0, math.log2(spacing_m / room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels))))
         self._set(program, "u_key_on", 1.0)
         lamps = self.room_lamps
         positions = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
