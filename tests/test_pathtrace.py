@@ -670,3 +670,53 @@ def test_the_rooms_window_captures_match_traced_radiance_along_their_rays(gl, mi
         traced = np.asarray(radiance, dtype=np.float64).T.reshape(ny, nx, per, 3).mean(axis=2) @ luma
         ratio = np.median((captures[name].astype(np.float64) @ luma) / np.maximum(traced, 1e-9))
         assert 0.8 <= ratio <= 1.25, (name, ratio)
+
+
+@pytest.mark.gl
+@pytest.mark.slow   # ~6 s: 96 x 72 at 128 spp
+def test_the_folds_light_the_shadowed_flanks_as_the_path_tracer_does(gl, mi):
+    """Issue 11, sixth round: on the lace under the UV lamp, the flanks the key barely reaches
+    (|cos| x its visibility in [0.15, 0.35)) are lit by the neighbouring folds' glow across
+    the valleys, most of it through the directional lobe (a_spec forward 0.27 against the
+    diffuse lobe's 0.06). The frame passes the window-side capture's light by both lobes over
+    the hemisphere's share the folds hide (the share the outside's term takes away); by the
+    directional lobe only where a fold hides the view's continuation, as before, those flanks
+    were 0.85x the path tracer's on this drape and view (not the bench's; 0.83x from a view
+    at 25 deg), and 0.90x now (0.88x). Bound: the frame's mean luminance there at least 0.87x
+    the reference's (curtain pixels by the reference's own masks; 128 spp: about 1 % noise on
+    the class's mean). One view: a second render of the glow's scene in the same test
+    crashed Mitsuba's JIT here (a segfault; each view alone passes)."""
+    yaw_deg = -15.0
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import MAX_DEPTH, region_masks, render_radiance
+    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
+    from catalog.render import scene as scene_lib
+    from catalog.render.frame import FrameRenderer
+
+    d = scene_lib.draped_curtain(depth_m=0.12, fold_shift_m=0.05)
+    curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
+    preset = desc_preset("lace-fwa")
+    light = get_light("UV-A")
+    size = (96, 72)
+    desc = describe_scene(preset, light, size=size, yaw_deg=yaw_deg, pitch_deg=5.0, distance_m=1.1,
+                          curtain=curtain)
+    reference = render_radiance(mi, build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH), 128, seed=0)
+    masks = region_masks(mi, build_mitsuba_scene(mi, desc, max_depth=2), desc)
+    r = FrameRenderer(gl, size)
+    r.set_fabric(preset)
+    r.set_light(light)
+    r.set_fluorescence("physical")
+    cam = desc.info["camera"]
+    r.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
+    r.set_mesh(*curtain, fabric_size_m=desc.fabric_size_m)
+    r.render()
+    frame = r.read_linear()
+    g = r.render_gbuffer()
+    r.release()
+    luma = np.array([0.2126, 0.7152, 0.0722])
+    shadows = g["shadows"]
+    lit = np.abs(g["normal"] @ desc.key_to_light) * shadows[..., 0] * (1.0 - shadows[..., 1])
+    chosen = g["mask"] & masks["curtain"] & (lit >= 0.15) & (lit < 0.35)
+    assert chosen.sum() > 200
+    ratio = float((frame[chosen] @ luma).mean() / (reference[chosen] @ luma).mean())
+    assert ratio >= 0.87, ratio

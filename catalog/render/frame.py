@@ -2373,17 +2373,17 @@ class FrameRenderer:
             return np.zeros((positions.shape[0], 3))
         # the per-vertex light curtain.vert read (the G-buffer's, interpolated; its values are
         # held to their numpy evaluation by tests/test_render_room.py), where the folds hide the
-        # outside (the hemisphere's share, the view's continuation) passed by each lobe
+        # outside (the hemisphere's share, for both lobes since issue 11's sixth round) passed
+        # by each lobe
         inputs, normals = self.curtain_inputs(), gbuffer["normal"][mask]
         hidden_outside = gbuffer["shadows"][mask][:, 2].astype(np.float64)[:, None]
-        hidden_view = gbuffer["room_occlusion_view"][mask].astype(np.float64)[:, None]
         window_side = gbuffer["window_side_light"][mask].astype(np.float64)
         return (ref.room_side_linear_srgb(inputs, positions, normals, self.camera.position,
                                           gbuffer["room_side_light"][mask].astype(np.float64),
                                           self.curtain_room_reflectance_rgb(self.shading_inputs()))
                 + sum(ref.window_side_linear_srgb(inputs, positions, normals, self.camera.position,
                                                   math.pi * share * window_side, transmittance)
-                      for share, transmittance in zip((hidden_outside, hidden_view),
+                      for share, transmittance in zip((hidden_outside, hidden_outside),
                                                       self.curtain_forward_rgb(self.shading_inputs())))
                 # the window wall and its reveals (WALL_LIGHT), each lobe's share already passed
                 + ref.window_side_linear_srgb(inputs, positions, normals, self.camera.position,
