@@ -27,6 +27,7 @@ uniform int u_luminaire_level;
 // right, side by side, room_light.CAPTURE_SIDE_EYES): the folds' flanks face either way and
 // glow unequally, so a wall seeing the window obliquely sees mostly one kind.
 uniform sampler2D u_luminaire_sides;
+uniform int u_luminaire_sides_level; // their level of one texel a patch
 uniform vec3 u_side_eye[2];
 uniform vec3 u_middle_eye;
 #endif
@@ -71,10 +72,10 @@ vec4 captured_towards(int i, int j, vec3 c, vec3 p) {
     float a_right = atan(u_side_eye[1].x - c.x, max(u_side_eye[1].z - c.z, 1e-6));
     vec3 rgb;
     if (a <= a_mid) {
-        vec3 left = texelFetch(u_luminaire_sides, ivec2(i, j), u_luminaire_level).rgb;
+        vec3 left = texelFetch(u_luminaire_sides, ivec2(i, j), u_luminaire_sides_level).rgb;
         rgb = mix(middle.rgb, left, clamp((a_mid - a) / (a_mid - a_left), 0.0, 1.0));
     } else {
-        vec3 right = texelFetch(u_luminaire_sides, ivec2(i + u_luminaire_size.x, j), u_luminaire_level).rgb;
+        vec3 right = texelFetch(u_luminaire_sides, ivec2(i + u_luminaire_size.x, j), u_luminaire_sides_level).rgb;
         rgb = mix(middle.rgb, right, clamp((a - a_mid) / (a_right - a_mid), 0.0, 1.0));
     }
     return vec4(rgb, middle.a);

@@ -642,13 +642,11 @@ def test_the_rooms_window_captures_match_traced_radiance_along_their_rays(gl, mi
     r.set_fluorescence("physical")
     r.set_mesh(*curtain)
     r.render()
-    res = r._room_resources()
-    lvl = room_light.LUMINAIRE_LEVEL
     nx, ny = room_light.LUMINAIRE_TEXELS
-    middle = np.frombuffer(res["luminaire"].read(level=lvl), dtype=np.float32).reshape(ny, nx, 4)[..., :3]
-    sides = np.frombuffer(res["luminaire_sides"].read(level=lvl), dtype=np.float32).reshape(ny, 2 * nx, 4)[..., :3]
+    middle = r.read_luminaire(room_light.LUMINAIRE_LEVEL)
+    sides = r.read_side_captures()
     r.release()
-    captures = {"left": sides[:, :nx], "middle": middle, "right": sides[:, nx:]}
+    captures = {"left": sides[0], "middle": middle, "right": sides[1]}
     eyes = {"left": room_light.CAPTURE_SIDE_EYES[0], "middle": room_light.LUMINAIRE_EYE,
             "right": room_light.CAPTURE_SIDE_EYES[1]}
     scene = build_mitsuba_scene(mi, desc, max_depth=2)

@@ -88,12 +88,16 @@ def work_counts(size) -> dict[str, float]:
     side_points = float(np.prod(room_light.CURTAIN_SIDE_TEXELS))
     return {
         "room_shadow": 0.6 * n * n,
-        # the two captures' curtain fragments (room side and window side)
+        # the captures' curtain fragments (room side from the middle and, since issue 11's
+        # sixth round, two side eyes; window side)
         "room_luminaire": float(lw * lh * (4 ** room_light.LUMINAIRE_LEVEL
+                                           + 2 * 4 ** room_light.SIDE_LUMINAIRE_LEVEL
                                            + 4 ** room_light.BACK_LUMINAIRE_LEVEL)),
         # the window's term and the gather per atlas texel, and the radiosity pass (issue 11):
-        # one fragment per coarse patch, summing over every patch
+        # one fragment per coarse patch, summing over every patch; the beam's samples (sixth
+        # round: BEAM_SAMPLES^2 map reads a texel, about a fifth of an exact factor each)
         "room_lightmap": float((samples + behind) * lw * lh * exact
+                               + aw * ah * room_light.BEAM_SAMPLES ** 2 * 0.2
                                + aw * ah * 5 * coarse * coarse * exact
                                + (len(room_light.FACE_NAMES) * coarse * coarse) ** 2
                                # issue 11's fourth round: R4b, the room's light on the

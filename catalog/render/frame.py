@@ -1317,6 +1317,14 @@ class FrameRenderer:
         """The window-side capture at mip ``level``, float32 (H, W, 3), row 0 = the opening's bottom."""
         return self.read_luminaire(level, "luminaire_back")
 
+    def read_side_captures(self) -> np.ndarray:
+        """The side eyes' captures at their patch level, float32 (2, H, W, 3) (left, right; row
+        0 = the opening's bottom), as room_lightmap.frag reads them."""
+        level = room_light.SIDE_LUMINAIRE_LEVEL
+        both = self.read_luminaire(level, "luminaire_sides")
+        width = both.shape[1] // 2
+        return np.stack([both[:, :width], both[:, width:]])
+
     def read_luminaire(self, level: int, name: str = "luminaire") -> np.ndarray:
         """The room-side capture (or ``name``) at mip ``level``, float32 (H, W, 3), row 0 = the
         opening's bottom."""
@@ -1338,9 +1346,10 @@ class FrameRenderer:
             luminaire = ctx.texture((lw, lh), 4, dtype="f4")
             luminaire.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             luminaire_depth = ctx.depth_renderbuffer((lw, lh))
-            sides = ctx.texture((2 * lw, lh), 4, dtype="f4")   # the side eyes', left then right
+            sw, sh = room_light.luminaire_capture_size(room_light.SIDE_LUMINAIRE_LEVEL)
+            sides = ctx.texture((2 * sw, sh), 4, dtype="f4")   # the side eyes', left then right
             sides.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
-            sides_depth = ctx.depth_renderbuffer((2 * lw, lh))
+            sides_depth = ctx.depth_renderbuffer((2 * sw, sh))
             bw, bh = room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)
             luminaire_back = ctx.texture((bw, bh), 4, dtype="f4")
             luminaire_back.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
@@ -1673,13 +1682,13 @@ class FrameRenderer:
             self._draw_flat_curtain(room_light.back_luminaire_view_projection(),
                                     room_light.BACK_LUMINAIRE_EYE, self._back_capture_overrides())
         gl["luminaire_back"].build_mipmaps()
-        lw, lh = room_light.luminaire_capture_size()
         # alpha: the key's irradiance on the cloth (curtain.frag ROOM_CAPTURE), 0 where none
-        targets = [("luminaire", room_light.LUMINAIRE_EYE, 0)]
+        targets = [("luminaire", room_light.LUMINAIRE_EYE, 0, room_light.LUMINAIRE_LEVEL)]
         if self.side_eyes:   # side by side, a tile a power of 2 wide at the patch level: the
-            targets += [("luminaire_sides", eye, k)   # mipmaps keep them apart
-                        for k, eye in enumerate(room_light.CAPTURE_SIDE_EYES)]
-        for name, eye, tile in targets:
+            targets += [("luminaire_sides", eye, k, room_light.SIDE_LUMINAIRE_LEVEL)  # mipmaps
+                        for k, eye in enumerate(room_light.CAPTURE_SIDE_EYES)]   # keep them apart
+        for name, eye, tile, level in targets:
+            lw, lh = room_light.luminaire_capture_size(level)
             if tile == 0:
                 gl[name + "_fbo"].use()
                 gl[name + "_fbo"].clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
@@ -1689,7 +1698,7 @@ class FrameRenderer:
                 self._draw_flat_curtain(view_proj, eye, self._capture_overrides(),
                                         folds_behind=self.capture_folds)
             self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
-        for name in {name for name, _eye, _tile in targets}:
+        for name in {name for name, _eye, _tile, _level in targets}:
             gl[name].build_mipmaps()   # level LUMINAIRE_LEVEL: each patch's mean radiance
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
@@ -1774,6 +1783,7 @@ class FrameRenderer:
         if self.side_eyes:
             gl["luminaire_sides"].use(location=4)
             self._set(program, "u_luminaire_sides", 4)
+            self._set(program, "u_luminaire_sides_level", room_light.SIDE_LUMINAIRE_LEVEL)
             self._set(program, "u_side_eye", np.asarray(room_light.CAPTURE_SIDE_EYES, dtype="f4"))
             self._set(program, "u_middle_eye", room_light.LUMINAIRE_EYE)
         self._set(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)

@@ -53,9 +53,11 @@ FACE_NAMES = ("floor", "ceiling", "left", "right", "back", "window_wall")
 BOUNCE_LEVEL = 1
 #: The luminaire capture: patches across and down the window opening, each the mean of
 #: 2^LUMINAIRE_LEVEL x 2^LUMINAIRE_LEVEL samples (the capture's mip level), so that a fold
-#: moving across a patch changes its radiance smoothly (no shimmer in the room's light).
+#: moving across a patch changes its radiance smoothly (no shimmer in the room's light; 8 x 8
+#: since issue 11's sixth round drew the captures from the whole mesh: 4 x 4 moved a texel of
+#: the light map by 5 % a 2 cm step).
 LUMINAIRE_TEXELS = (12, 9)
-LUMINAIRE_LEVEL = 2
+LUMINAIRE_LEVEL = 3
 #: Where the luminaire capture looks from (metres): the middle of the room, eye height.
 LUMINAIRE_EYE = (0.0, 0.2, 2.0)
 #: Two more captures of the room side (issue 11, sixth round), from eyes towards the side walls
@@ -65,6 +67,9 @@ LUMINAIRE_EYE = (0.0, 0.2, 2.0)
 #: right 0.98x. room_lightmap.frag blends the three by the horizontal angle from each window
 #: patch to the receiving point (:func:`capture_eye_weights`). Left first.
 CAPTURE_SIDE_EYES = ((-1.7, 0.2, 0.8), (1.7, 0.2, 0.8))
+#: Their samples per patch side, 2^level (as the middle's: 4 x 4 samples moved a floor texel
+#: by 5.1 % a 2 cm step, over the room's stability bound).
+SIDE_LUMINAIRE_LEVEL = 3
 #: The closed curtain's window side (issue 11): its radiance is captured from outside, from the
 #: room eye mirrored through the rod's plane, and sent from patches in that plane
 #: (scene.CURTAIN_Z, the drape's mean depth) to what lies behind it: the window wall beside
