@@ -681,7 +681,7 @@ class FrameRenderer:
             "index": self.ctx.buffer(indices.tobytes()),
         }
         coarse = room_light.coarse_grid_indices(uvs)
-        if coarse is not None:  # the room's passes draw this coarser grid
+        if coarse is not None:  # the room's shadow map and occlusion maps draw this coarser grid
             self._curtain_buffers["coarse_index"] = self.ctx.buffer(coarse.tobytes())
         self._own_buffers = list(self._curtain_buffers.values())  # the cloth's are not ours
         self._curtain_format = "3f"
@@ -969,10 +969,9 @@ class FrameRenderer:
         specialised = [k for k in self._programs if dict(k[2]).get("SPECIALISED")]
         for key in specialised[:max(0, len(specialised) - MAX_SPECIALISED + 1)]:
             program = self._programs.pop(key)
-            for vao_key in (("curtain", id(program)), ("curtain", id(program), "coarse")):
-                vao = self._vaos.pop(vao_key, None)
-                if vao is not None:
-                    vao.release()
+            vao = self._vaos.pop(("curtain", id(program)), None)
+            if vao is not None:
+                vao.release()
             program.release()
 
     def compiled_variants(self) -> list[dict]:
@@ -982,9 +981,8 @@ class FrameRenderer:
                 for k2 in self._programs
                 if k2[1] == "curtain.frag" and not dict(k2[2]).get("ROOM_CAPTURE")]
 
-    def _curtain_vao(self, program, coarse: bool = False):
-        coarse = coarse and "coarse_index" in self._curtain_buffers
-        key = ("curtain", id(program)) + (("coarse",) if coarse else ())
+    def _curtain_vao(self, program):
+        key = ("curtain", id(program))
         if key not in self._vaos:
             b = self._curtain_buffers
             if self._curtain_format == "interleaved":
@@ -1001,8 +999,7 @@ class FrameRenderer:
             if "in_uv" in program:
                 content.append((b["uv"], "2f", "in_uv"))
             self._vaos[key] = self.ctx.vertex_array(
-                program, content, index_buffer=b["coarse_index" if coarse else "index"],
-                index_element_size=4)
+                program, content, index_buffer=b["index"], index_element_size=4)
         return self._vaos[key]
 
     def _room_vao(self, program):
@@ -1083,7 +1080,7 @@ class FrameRenderer:
 
     def draw_curtain(self, view_proj, fragment: str | None = None, gbuffer: bool = False,
                      camera_position=None, overrides: dict | None = None,
-                     coarse: bool = False, folds_behind: bool = False) -> None:
+                     folds_behind: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer.
 
         ``fragment``: draw the same mesh (same vertex shader and uniforms of the mesh and
@@ -1091,8 +1088,7 @@ class FrameRenderer:
         measures the rasteriser's floor with shaders of its own (catalog/bench/shaders/).
         ``camera_position``: the eye for the view-dependent terms (default the camera's; the
         room's passes draw the curtain as seen from the key light or the room);
-        ``overrides``: scene values replaced for this draw; ``coarse``: the coarser grid the
-        room's passes use; ``folds_behind``: with ``overrides``, the room capture's variant that
+        ``overrides``: scene values replaced for this draw; ``folds_behind``: with ``overrides``, the room capture's variant that
         shows the folds behind through the holes (curtain.frag FOLDS_BEHIND)."""
         eye = tuple(float(v) for v in (self.camera.position if camera_position is None
                                        else camera_position))
@@ -1135,7 +1131,7 @@ class FrameRenderer:
             if "u_vertex_occlusion" in program:
                 self._vertex_occlusion_uniforms(program)
         self.ctx.disable(self._moderngl.CULL_FACE)  # two-sided cloth
-        self._curtain_vao(program, coarse).render(self._moderngl.TRIANGLES)
+        self._curtain_vao(program).render(self._moderngl.TRIANGLES)
 
     def _display_colours(self, inputs) -> dict[str, tuple]:
         """Exact linear sRGB of the background and room radiances (once per scene change)."""
@@ -1714,7 +1710,7 @@ class FrameRenderer:
         if patterned:
             self.patterned = False
         try:
-            self.draw_curtain(view_proj, camera_position=eye, overrides=overrides, coarse=False,
+            self.draw_curtain(view_proj, camera_position=eye, overrides=overrides,
                               folds_behind=folds_behind)
         finally:
             if patterned:

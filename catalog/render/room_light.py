@@ -707,7 +707,7 @@ def window_irradiance(radiance_front: np.ndarray, radiance_back: np.ndarray,
     return out
 
 
-#: The room's passes (shadow map, capture) draw the curtain from a grid with at most this many
+#: The room's shadow map and the occlusion maps draw the curtain from a grid with at most this many
 #: vertices a side: on a CPU rasteriser a draw costs per triangle, and the beam's pattern
 #: needs the folds (5.5 across), not every vertex.
 COARSE_GRID_SIDE = 40
