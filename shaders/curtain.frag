@@ -169,6 +169,8 @@ float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own
 // of a safety-yellow mesh (LD 0.36) show the glowing folds behind, and without them the
 // capture was 0.55x the path tracer's radiance there.
 float g_fold_behind = 0.0;
+#else
+const float g_fold_behind = 0.0;
 #endif
 #ifdef ROOM_CAPTURE
 uniform float u_capture_thread;    // the key a thread passes, a_spec forward(g_spec) / (1 - LD)
@@ -220,18 +222,14 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
     vec4 outside = bg.y * bg.z * (u_direct * u_sun_disc[k]) - u_direct * u_room[k];
     band += bg.x * outside;
     constant += u_direct * u_room[k];
-#elif defined(SEE_THROUGH) && defined(FOLDS_BEHIND)
-    // the room's window capture: where a fold hides the view's continuation, the holes show
-    // that fold (main adds it), not the outside; the room's share stays 1 - bg.x
+#elif defined(SEE_THROUGH)
+    // FOLDS_BEHIND (the room's window capture): where a fold hides the view's continuation, the
+    // holes show that fold (main adds it), not the outside; the room's share stays 1 - bg.x.
+    // Elsewhere g_fold_behind is the constant 0 and this is the plain see-through.
     vec4 outside = bg.y * (u_direct * (u_sky[k] - u_ground[k]) + bg.z * (u_direct * u_sun_disc[k]))
                  + u_direct * (u_ground[k] - u_room[k]);
     band += (bg.x * (1.0 - g_fold_behind)) * outside;
     constant += (u_direct * (1.0 - bg.x * g_fold_behind)) * u_room[k];
-#elif defined(SEE_THROUGH)
-    vec4 outside = bg.y * (u_direct * (u_sky[k] - u_ground[k]) + bg.z * (u_direct * u_sun_disc[k]))
-                 + u_direct * (u_ground[k] - u_room[k]);
-    band += bg.x * outside;
-    constant += u_direct * u_room[k];
 #endif
     band += constant;
 #ifdef FLUORESCENCE_PHYSICAL
