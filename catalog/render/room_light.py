@@ -81,7 +81,7 @@ BACK_LUMINAIRE_EYE = (LUMINAIRE_EYE[0], LUMINAIRE_EYE[1],
 #: texel there by 6 % a 2 cm step; 8 x 8 keeps it under 5 % (the room's stability test).
 BACK_LUMINAIRE_LEVEL = 3
 #: room_lightmap.frag's beam (the bounces' source): the mean over BEAM_SAMPLES x BEAM_SAMPLES
-#: points of a light-map texel (issue 11, sixth round; the shader's #define must match).
+#: points of a light-map texel (issue 11, sixth round; frame.py passes it to the shader as a define).
 BEAM_SAMPLES = 8
 #: ``room_bounce.frag``'s bounces: "all" (the radiosity solve) or "one" (issue 13's first).
 ROOM_BOUNCES = ("all", "one")
