@@ -20,6 +20,8 @@ estimators agree.
 
 from __future__ import annotations
 
+import numpy as np
+
 #: The mesh attribute holding the per-vertex emission (linear sRGB radiance per side).
 ATTRIBUTE = "vertex_fluorescence"
 
@@ -38,6 +40,20 @@ def register(mi) -> None:
             self.mean_radiance = float(props.get("mean_radiance", 1.0))
             self.max_radiance = float(props.get("max_radiance", 1.0))
             self.mesh = None
+            self.spectrum = None   # spectral variants: set_spectrum
+
+        def set_spectrum(self, wavelengths_nm, values, luminance) -> None:
+            """Spectral variants: the glow's spectral shape (``values`` on the evenly spaced
+            ``wavelengths_nm``) whose sRGB luminance, as Mitsuba's film converts it, is
+            ``luminance``. A point then emits the shape times its RGB attribute's luminance
+            over ``luminance``: every vertex's RGB is the same colour scaled (the effective
+            photons, module doc), so the spectrum the film sees converts back to it."""
+            wavelengths = np.asarray(wavelengths_nm, dtype=np.float64)
+            self.spectrum = mi.Float(np.asarray(values, dtype=np.float32))
+            self.spectrum_size = int(wavelengths.size)
+            self.first_nm = float(wavelengths[0])
+            self.step_nm = float(wavelengths[1] - wavelengths[0])
+            self.inv_luminance = 1.0 / max(float(luminance), 1e-30)
 
         def attach(self, mesh) -> None:
             """The shell whose ATTRIBUTE this texture reads (set once the mesh exists)."""
@@ -53,7 +69,20 @@ def register(mi) -> None:
             return value
 
         def eval(self, si, active=True):
-            return dr.select(active, mi.Spectrum(self._value(si, active)), 0.0)
+            if self.spectrum is None:
+                return dr.select(active, mi.Spectrum(self._value(si, active)), 0.0)
+            rgb = self._value(si, active)
+            scale = (0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z) * self.inv_luminance
+            lanes = []
+            for k in range(len(si.wavelengths)):
+                x = (si.wavelengths[k] - self.first_nm) / self.step_nm
+                inside = active & (x >= 0.0) & (x <= self.spectrum_size - 1)
+                i = mi.UInt32(dr.clip(dr.floor(x), 0, self.spectrum_size - 2))
+                f = x - mi.Float(i)
+                a = dr.gather(mi.Float, self.spectrum, i, inside)
+                b = dr.gather(mi.Float, self.spectrum, i + 1, inside)
+                lanes.append(dr.select(inside, a + f * (b - a), 0.0) * scale)
+            return dr.select(active, mi.Spectrum(*lanes), 0.0)
 
         def eval_3(self, si, active=True):
             return dr.select(active, mi.Color3f(self._value(si, active)), 0.0)

@@ -171,9 +171,11 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         fl = {"mode": "physical", "key_photons": float(inputs.absorbed_photons[0]),
               "outside_photons": absorbed_photon_irradiance(material, outside),
               "saturation_photons": float(inputs.saturation_photons),
-              "emission_rgb_per_photon": w @ inputs.emission_per_photon}
+              "emission_rgb_per_photon": w @ inputs.emission_per_photon,
+              "emission_spectrum": np.asarray(inputs.emission_per_photon, dtype=np.float64)}
     elif inputs.fluorescence_mode == "paper":
-        fl = {"mode": "paper", "radiance_rgb": w @ inputs.paper_radiance}
+        fl = {"mode": "paper", "radiance_rgb": w @ inputs.paper_radiance,
+              "emission_spectrum": np.asarray(inputs.paper_radiance, dtype=np.float64)}
     return SceneDescription(
         size=tuple(int(v) for v in size), camera_position=camera.position,
         camera_target=np.asarray(camera.target, dtype=np.float64), fov_y_deg=camera.fov_y_deg,
@@ -323,6 +325,29 @@ def glow_shell_mesh(desc: SceneDescription, levels: int = GLOW_SUBDIVISIONS):
         n, uv = attributes["normal"], attributes["uv"]
     n = n / np.linalg.norm(n, axis=1, keepdims=True)
     return p, n, uv, tri
+
+
+#: Mitsuba's normalisation of the CIE 1931 y-bar integral (its film divides by it: a constant
+#: radiance of 1 has Y = 1).
+MITSUBA_CIE_Y_INTEGRAL = 106.856895
+
+
+def glow_spectrum(mi, desc: SceneDescription) -> tuple[np.ndarray, np.ndarray, float]:
+    """For a spectral variant: the glow's emission spectrum over the visible range the variant
+    samples (wavelengths nm, values) and its luminance Y as Mitsuba's film takes it, the CIE
+    1931 ybar integral over Mitsuba's CIE_Y_INTEGRAL (catalog.pathtrace.glow's
+    ``set_spectrum``). Not mi.spectrum_list_to_srgb: it clamps the channels at 0, and a
+    brightener's blue glow lies outside sRGB (its green is negative), while the film keeps
+    the negative channel."""
+    from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
+    from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
+
+    visible = GRID_NM >= 360.0
+    wavelengths = GRID_NM[visible]
+    values = np.clip(np.asarray(desc.fluorescence["emission_spectrum"], dtype=np.float64)[visible], 0.0, None)
+    ybar = cmfs(wavelengths)[:, 1]
+    step_nm = float(wavelengths[1] - wavelengths[0])
+    return wavelengths, values, float((ybar * values).sum() * step_nm / MITSUBA_CIE_Y_INTEGRAL)
 
 
 def fluorescence_per_vertex(desc: SceneDescription, scene=None, mi=None,
@@ -483,6 +508,8 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
         shell_props = mi.Properties()
         shell_props["bsdf"] = mi.load_dict({"type": "null"})
         radiance = mi.load_dict(glow)
+        if mi.is_spectral:   # the glow's own spectrum, not the RGB it converts to
+            radiance.set_spectrum(*glow_spectrum(mi, desc))
         shell_props["emitter"] = mi.load_dict({"type": "area", "sampling_weight": weights["shell"],
                                                "radiance": radiance})
         faces = tri if sign > 0 else tri[:, ::-1]
