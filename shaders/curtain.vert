@@ -41,7 +41,8 @@ uniform vec3 u_camera_position;
 // bilinear) where the folds leave the room's side open, and where they hide it (the per-vertex
 // occlusion's z) the cloth's room side, pi x the room's capture at this patch; the radiance of
 // the cloth's window side at this patch (the window-side capture); and whether the view's
-// continuation meets a fold (OCCLUSION_MAPS: the occlusion map whose direction lies nearest it).
+// continuation meets a fold (OCCLUSION_MAPS: the occlusion map whose direction lies nearest it;
+// the room's captures and the G-buffer only).
 uniform sampler2D u_room_side;       // irradiance, linear sRGB (x pi cd m^-2)
 uniform vec4 u_room_side_rect;       // the grid: x from, y from, 1 / width, 1 / height (m)
 uniform sampler2D u_room_side_cloth; // the room's capture of the cloth (the window's patches)
@@ -139,7 +140,9 @@ void main() {
         v_wall_light = u_window_side_diffuse * walled + u_window_side_directional * directional;
     }
 #endif
-#if defined(SKY_OCCLUSION) && defined(OCCLUSION_MAPS)
+#if defined(SKY_OCCLUSION) && defined(OCCLUSION_MAPS) && (defined(FOLDS_BEHIND) || defined(GBUFFER))
+    // (read by the room's captures, FOLDS_BEHIND, and written to the G-buffer; the frame's
+    // own shading has not used it since issue 11's sixth round)
     vec3 ray = normalize(v_view_ray);
     if (ray.z < 0.0) {   // the view goes on towards the window
         // the two maps nearest it, blended by how near each is: where the nearest changes

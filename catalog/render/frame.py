@@ -818,7 +818,7 @@ class FrameRenderer:
         if self.room_side_active():
             defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
             if defines.get("SKY_OCCLUSION"):
-                defines["OCCLUSION_MAPS"] = True   # the view's continuation hidden by the folds
+                defines["OCCLUSION_MAPS"] = True   # the folds' maps (the G-buffer's view continuation)
                 if self.wall_light:   # the wall and its reveals where the outside is walled
                     defines["WALL_LIGHT"] = True
                     defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
@@ -1679,6 +1679,7 @@ class FrameRenderer:
                                     room_light.BACK_LUMINAIRE_EYE, self._back_capture_overrides())
         gl["luminaire_back"].build_mipmaps()
         # alpha: the key's irradiance on the cloth (curtain.frag ROOM_CAPTURE), 0 where none
+        overrides = self._capture_overrides()
         targets = [("luminaire", room_light.LUMINAIRE_EYE, 0, room_light.LUMINAIRE_LEVEL)]
         if self.side_eyes:   # side by side, a tile a power of 2 wide at the patch level: the
             targets += [("luminaire_sides", eye, k, room_light.SIDE_LUMINAIRE_LEVEL)  # mipmaps
@@ -1691,8 +1692,7 @@ class FrameRenderer:
             self.ctx.viewport = (tile * lw, 0, lw, lh)
             view_proj = room_light.luminaire_view_projection(eye)
             if not self.curtain_open:
-                self._draw_flat_curtain(view_proj, eye, self._capture_overrides(),
-                                        folds_behind=self.capture_folds)
+                self._draw_flat_curtain(view_proj, eye, overrides, folds_behind=self.capture_folds)
             self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
         for name in {name for name, _eye, _tile, _level in targets}:
             gl[name].build_mipmaps()   # level LUMINAIRE_LEVEL: each patch's mean radiance
