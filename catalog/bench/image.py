@@ -107,6 +107,12 @@ ROUND_5 = "after_11_round_5"
 #: The run after its sixth round (the room's window captured from three eyes with the whole
 #: mesh, the folds behind seen through the holes): ``runs[ROUND_6]``.
 ROUND_6 = "after_11_round_6"
+#: The reference's Mitsuba variant since issue 11's seventh round: spectral, so that the light
+#: the cloth passes is filtered by its dye at each wavelength. Until the sixth round it was
+#: ``llvm_ad_rgb``, whose cloth carries one RGB dye, RGB(key x dye) / RGB(key): under the UV-A
+#: lamp that is 0.048 in every channel, while the safety-yellow's glow passes its dye at
+#: 0.11 / 0.91 / -0.11 (docs/pathtrace.md, sixth round, P13).
+REFERENCE_VARIANT = "llvm_ad_spectral"
 GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
 REGIONS = ("curtain", "floor", "walls")
 #: The hour of "noon sun" (local solar time, the scene's date and latitude).
@@ -204,7 +210,7 @@ def meets_goal(row: dict, mean_flip: float) -> bool:
 
 
 def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
-        out: Path | None = None) -> dict:
+        out: Path | None = None, variant: str = REFERENCE_VARIANT) -> dict:
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace import metrics  # noqa: PLC0415
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
@@ -220,7 +226,7 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
     size = tuple(size or (QUICK_SIZE if quick else SIZE))
     spp = int(spp or (QUICK_SPP if quick else SPP))
     options = OPTIONS[:2] if quick else OPTIONS
-    mi = load_mitsuba()
+    mi = load_mitsuba(variant)
     rows, pareto, images = [], [], {}
     for label, fabric, light_key, view in scenes:
         preset = load_preset(find_preset(fabric))
@@ -288,10 +294,10 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
         "max_reference_noise_rel": max(r["reference_noise_rel"] for r in rows),
         "absent_options": list(ABSENT_OPTIONS),
         "integrator": f"Mitsuba {mi.__version__} volpath, max_depth {MAX_DEPTH}, "
-                      f"{spp} spp (2 x {spp // 2}), llvm_ad_rgb",
+                      f"{spp} spp (2 x {spp // 2}), {variant}",
     }
     result = {"rows": rows, "pareto": pareto, "summary": summary,
-              "settings": {"size": list(size), "spp": spp, "quick": bool(quick)}}
+              "settings": {"size": list(size), "spp": spp, "quick": bool(quick), "variant": variant}}
     result["_images"] = images  # not JSON: plot() writes them and drops them
     if out is not None:
         plot(result, out)
@@ -549,7 +555,8 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 
-def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path = Path(RESULT_JSON)) -> dict:
+def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path = Path(RESULT_JSON),
+               variant: str = REFERENCE_VARIANT) -> dict:
     """Run the full section and keep it in ``json_path`` under ``runs[name]`` (the earlier
     runs stay), with its six triptychs stacked in ``image_folder/pathtrace_scenes_NAME.png``,
     its Pareto plot in ``pathtrace_pareto_NAME.png`` and the first scene's triptych in
@@ -561,7 +568,7 @@ def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path
     from catalog.bench.plots import pyplot  # noqa: PLC0415
     from catalog.core.atomic import atomic_path, write_text_atomic  # noqa: PLC0415
 
-    result = run()
+    result = run(variant=variant)
     images = result["_images"]
     stacked = np.concatenate([triptych(images[label]) for label, *_ in SCENES], axis=0)
     with tempfile.TemporaryDirectory() as scratch:
@@ -583,4 +590,4 @@ def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path
 if __name__ == "__main__":
     import sys
 
-    print(summary_line(record_run(sys.argv[1])))
+    print(summary_line(record_run(sys.argv[1], variant=sys.argv[2] if len(sys.argv) > 2 else REFERENCE_VARIANT)))
