@@ -332,6 +332,45 @@ def glow_shell_mesh(desc: SceneDescription, levels: int = GLOW_SUBDIVISIONS):
 MITSUBA_CIE_Y_INTEGRAL = 106.856895
 
 
+def film_luminance(wavelengths: np.ndarray, values: np.ndarray) -> float:
+    """The luminance Y Mitsuba's spectral film gives a spectrum (values on the evenly spaced
+    ``wavelengths``, nm): the CIE 1931 ybar integral (the project's tables) over
+    MITSUBA_CIE_Y_INTEGRAL."""
+    from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
+
+    step_nm = float(wavelengths[1] - wavelengths[0])
+    return float((cmfs(wavelengths)[:, 1] * values).sum() * step_nm / MITSUBA_CIE_Y_INTEGRAL)
+
+
+def key_spectrum(desc: SceneDescription) -> tuple[np.ndarray, np.ndarray]:
+    """For a spectral variant: the key light's normal irradiance over the visible range the
+    variant samples (wavelengths nm, values), scaled so that the film's luminance is the RGB
+    key's (``desc.key_rgb``, whose luminance is the spectrum's CIE Y by the project's
+    tables). Given to Mitsuba as a spectrum, not as the environment's RGB: a UV lamp's faint
+    visible leak lies outside sRGB (green -0.92 of red), and an RGB texel's upsampling clamps
+    it into the gamut, which made the lamp-lit outside 12x its luminance."""
+    from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
+
+    visible = (GRID_NM >= 360.0) & (GRID_NM <= 830.0)
+    wavelengths = GRID_NM[visible]
+    values = np.clip(np.asarray(desc.inputs.key_irradiance, dtype=np.float64)[visible], 0.0, None)
+    film = film_luminance(wavelengths, values)
+    target = float(np.asarray(desc.key_rgb) @ np.array([0.2126, 0.7152, 0.0722]))
+    return wavelengths, values * (max(target, 0.0) / film if film > 0 else 0.0)
+
+
+def in_gamut_same_luminance(rgb: np.ndarray) -> np.ndarray:
+    """Linear sRGB (..., 3) with its negative channels set to 0 and then scaled back to the
+    luminance it had (0 where that was <= 0): what a spectral variant's RGB upsampling can
+    carry of an out-of-gamut light (a UV lamp's violet leak) without changing its luminance."""
+    luma = np.array([0.2126, 0.7152, 0.0722])
+    rgb = np.asarray(rgb, dtype=np.float64)
+    clipped = np.clip(rgb, 0.0, None)
+    before, after = rgb @ luma, clipped @ luma
+    scale = np.where(after > 0, np.clip(before, 0.0, None) / np.where(after > 0, after, 1.0), 0.0)
+    return clipped * scale[..., None]
+
+
 def glow_spectrum(mi, desc: SceneDescription) -> tuple[np.ndarray, np.ndarray, float]:
     """For a spectral variant: the glow's emission spectrum over the visible range the variant
     samples (wavelengths nm, values) and its luminance Y as Mitsuba's film takes it, the CIE
@@ -339,15 +378,12 @@ def glow_spectrum(mi, desc: SceneDescription) -> tuple[np.ndarray, np.ndarray, f
     ``set_spectrum``). Not mi.spectrum_list_to_srgb: it clamps the channels at 0, and a
     brightener's blue glow lies outside sRGB (its green is negative), while the film keeps
     the negative channel."""
-    from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
     from catalog.optics.spectra import GRID_NM  # noqa: PLC0415
 
     visible = GRID_NM >= 360.0
     wavelengths = GRID_NM[visible]
     values = np.clip(np.asarray(desc.fluorescence["emission_spectrum"], dtype=np.float64)[visible], 0.0, None)
-    ybar = cmfs(wavelengths)[:, 1]
-    step_nm = float(wavelengths[1] - wavelengths[0])
-    return wavelengths, values, float((ybar * values).sum() * step_nm / MITSUBA_CIE_Y_INTEGRAL)
+    return wavelengths, values, film_luminance(wavelengths, values)
 
 
 def fluorescence_per_vertex(desc: SceneDescription, scene=None, mi=None,
@@ -411,8 +447,9 @@ MIN_SAMPLING_SHARE = 0.15
 
 
 def emitter_sampling_weights(desc: SceneDescription, emission: np.ndarray) -> dict[str, float]:
-    """Next-event estimation's choice between the environment (sky, ground, the key's disc)
-    and each fluorescence shell, in proportion to the luminous power each sends into the
+    """Next-event estimation's choice between the environment (sky, ground, the key's disc;
+    ``key`` and ``backdrop`` its two parts, for a spectral variant's separate key) and each
+    fluorescence shell, in proportion to the luminous power each sends into the
     room (the environment's through the window, a shell's pi L A), at least
     MIN_SAMPLING_SHARE each. Mitsuba's default, uniform over emitters, spends two thirds of
     the shadow rays on a faint glow under daylight and on a black sky under a UV lamp."""
@@ -421,9 +458,9 @@ def emitter_sampling_weights(desc: SceneDescription, emission: np.ndarray) -> di
     luma = np.array([0.2126, 0.7152, 0.0722])
     x0, x1, y0, y1 = scene_lib.WINDOW_RECT
     window_m2 = (x1 - x0) * (y1 - y0)
-    env = max(float(desc.key_rgb @ luma), 0.0) + math.pi * 0.5 * max(
-        float((desc.sky_rgb + desc.ground_rgb) @ luma), 0.0)
-    env *= window_m2
+    key = max(float(desc.key_rgb @ luma), 0.0) * window_m2
+    backdrop = math.pi * 0.5 * max(float((desc.sky_rgb + desc.ground_rgb) @ luma), 0.0) * window_m2
+    env = key + backdrop
     positions = np.asarray(desc.curtain[0], dtype=np.float64).reshape(-1, 3)
     tri = np.asarray(desc.curtain[4]).reshape(-1, 3)
     area = 0.5 * np.linalg.norm(np.cross(positions[tri[:, 1]] - positions[tri[:, 0]],
@@ -431,10 +468,9 @@ def emitter_sampling_weights(desc: SceneDescription, emission: np.ndarray) -> di
     shell = math.pi * max(float(np.mean(np.abs(emission @ luma))), 0.0) * area
     total = env + 2 * shell
     if not total > 0:
-        return {"environment": 1.0, "shell": 1.0}
-    env_w, shell_w = env / total, shell / total
-    env_w, shell_w = max(env_w, MIN_SAMPLING_SHARE), max(shell_w, MIN_SAMPLING_SHARE)
-    return {"environment": env_w, "shell": shell_w}
+        return {"environment": 1.0, "shell": 1.0, "key": 1.0, "backdrop": 1.0}
+    share = {"environment": env, "shell": shell, "key": key, "backdrop": backdrop}
+    return {name: max(value / total, MIN_SAMPLING_SHARE) for name, value in share.items()}
 
 
 def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
@@ -475,11 +511,22 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
             "type": "rgb", "value": [desc.room_albedo] * 3}})
         scene["room"] = _mesh(mi, "room", tris, np.arange(tris.shape[0]).reshape(-1, 3),
                               props=room_props)
+    # a spectral variant takes the key as its own spectrum (key_spectrum), a directional light
+    # (the disc's 0.27 degree radius gives penumbrae under 1 mm at the folds' distances)
+    spectral_key = bool(mi.is_spectral) and environment and not key_as_directional
     if environment:
         env = environment_map(desc.sky_rgb, desc.ground_rgb,
-                              np.zeros(3) if key_as_directional else desc.key_rgb,
+                              np.zeros(3) if key_as_directional or spectral_key else desc.key_rgb,
                               desc.key_to_light, desc.key_radius_rad, sky=desc.sky)
+        if mi.is_spectral:
+            env = in_gamut_same_luminance(env).astype(np.float32)
         scene["environment"] = {"type": "envmap", "bitmap": mi.Bitmap(env)}
+    if spectral_key:
+        wavelengths, values = key_spectrum(desc)
+        scene["key"] = {"type": "directional", "direction": [float(-v) for v in desc.key_to_light],
+                        "irradiance": {"type": "regular", "wavelength_min": float(wavelengths[0]),
+                                       "wavelength_max": float(wavelengths[-1]),
+                                       "values": ", ".join(f"{v:.6g}" for v in values)}}
     if key_as_directional:
         scene["key"] = {"type": "directional", "direction": [float(-v) for v in desc.key_to_light],
                         "irradiance": {"type": "rgb", "value": [float(v) for v in desc.key_rgb]}}
@@ -493,8 +540,10 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     p, n, shell_uvs, tri = glow_shell_mesh(desc)
     emission = fluorescence_per_vertex(desc, loaded, mi, mesh=(p, n))
     weights = emitter_sampling_weights(desc, emission)
-    if environment:
-        scene["environment"]["sampling_weight"] = weights["environment"]
+    if environment:   # with a key of its own (spectral) the environment is the backdrop alone
+        scene["environment"]["sampling_weight"] = weights["backdrop" if spectral_key else "environment"]
+    if spectral_key:
+        scene["key"]["sampling_weight"] = weights["key"]
     glow = {"type": "patterned_glow",
             "mean_radiance": float(np.mean(np.abs(emission))),
             "max_radiance": float(np.max(np.abs(emission))) if emission.size else 0.0}
