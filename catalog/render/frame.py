@@ -1140,8 +1140,7 @@ class FrameRenderer:
                        "u_sun_disc_rgb": inputs.sun_disc_radiance,
                        "u_room_rgb": inputs.room_radiance,
                        "u_fill_rgb": scene_lib.ROOM_ALBEDO * inputs.fill_irradiance / math.pi,
-                       "u_key_rgb": inputs.key_irradiance,
-                       "key_dyed_rgb": inputs.key_irradiance * inputs.dye_transmittance}
+                       "u_key_rgb": inputs.key_irradiance}
             self._display = {name: tuple(float(v) for v in band_lib.spectrum_to_display_rgb(s))
                              for name, s in spectra.items()}
             self._display_key = self._inputs_key
@@ -1399,13 +1398,17 @@ class FrameRenderer:
             self._operator_albedo = None
         return self._room_gl
 
-    @staticmethod
-    def _room_dye_rgb(colours: dict) -> np.ndarray:
-        """The dye per display channel under the key, RGB(key x dye) / RGB(key) (1 where the
-        key has next to nothing), as the room's beam and the curtain's reflectance take it."""
-        key = np.asarray(colours["u_key_rgb"])
-        dyed = np.asarray(colours["key_dyed_rgb"])
-        return np.where(key > 1e-6 * max(float(key.max()), 1e-30), dyed / np.where(key > 0, key, 1.0), 1.0)
+    def _dye_rgb(self, inputs, light: str) -> np.ndarray:
+        """The dye per display channel (catalog.optics.dye_colour), once per scene change:
+        ``"key"``, under the key, RGB(key x dye) / RGB(key), as the beam takes it; or
+        ``"secondary"``, under what the key-lit cloth sends on (the key's share it passes
+        and its glow), as the room's light and the folds' light between them take it."""
+        from catalog.optics import dye_colour  # noqa: PLC0415
+
+        if getattr(self, "_dye_key", None) != self._inputs_key:
+            self._dyes = {"key": dye_colour.key_dye_rgb(inputs), "secondary": dye_colour.secondary_dye_rgb(inputs)}
+            self._dye_key = self._inputs_key
+        return self._dyes[light]
 
     def _room_colours(self, inputs) -> dict:
         """Linear sRGB of the key light (irradiance) and of the beam a thread passes: the
@@ -1415,7 +1418,7 @@ class FrameRenderer:
 
         colours = self._display_colours(inputs)
         key = np.asarray(colours["u_key_rgb"])
-        dye_rgb = self._room_dye_rgb(colours)
+        dye_rgb = self._dye_rgb(inputs, "key")
         coverage = max(1.0 - float(inputs.direct), 1e-6)
         forward = hg_hemisphere_factors(float(inputs.g_spec))[0]
         thread = np.clip(float(inputs.a_spec) * forward * dye_rgb / coverage, 0.0, 1.0)
@@ -1729,25 +1732,28 @@ class FrameRenderer:
 
     def curtain_forward_rgb(self, inputs) -> tuple[tuple, tuple]:
         """The cloth's transmittance of diffuse light by each lobe (linear sRGB), dye a_diff
-        forward(g_diff) and dye a_spec forward(g_spec), the dye per channel under the key: what
-        passes towards a viewer in the room of the light on the cloth's window side (curtain.frag
-        ROOM_SIDE, the folds' light where they hide the outside: the diffuse lobe's by the
-        hemisphere's occlusion, the directional lobe's by the view's continuation)."""
+        forward(g_diff) and dye a_spec forward(g_spec): what passes towards a viewer in the
+        room of the light on the cloth's window side (curtain.frag ROOM_SIDE, the folds' light
+        where they hide the outside, both lobes by the hemisphere's occlusion; and the window
+        wall's, WALL_LIGHT). The dye per channel for the secondary light (:meth:`_dye_rgb`, since
+        issue 11's seventh round; the key's before): the folds' light is the cloth's own, and
+        the wall's reveals see the cloth's window side too. With no glow it is the key's."""
         from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
 
-        dye_rgb = self._room_dye_rgb(self._display_colours(inputs))
+        dye_rgb = self._dye_rgb(inputs, "secondary")
         diffuse = float(inputs.a_diff) * hg_hemisphere_factors(float(inputs.g_diff))[0]
         directional = float(inputs.a_spec) * hg_hemisphere_factors(float(inputs.g_spec))[0]
         return tuple(tuple(float(v) for v in np.clip(dye_rgb * f, 0.0, 1.0)) for f in (diffuse, directional))
 
     def curtain_room_reflectance_rgb(self, inputs) -> tuple[float, float, float]:
         """The cloth's reflectance under the room's diffuse light (linear sRGB), dye (a_diff
-        backward(g_diff) + a_spec backward(g_spec)), the dye per channel under the key as the
-        room's colours take it: what the radiosity's window reflects and what the curtain's
-        room side sends back of the room's light (curtain.frag ROOM_SIDE)."""
+        backward(g_diff) + a_spec backward(g_spec)), the dye per channel for the secondary
+        light (:meth:`_dye_rgb`; the key's before issue 11's seventh round): what the
+        radiosity's window reflects and what the curtain's room side sends back of the room's
+        light (curtain.frag ROOM_SIDE)."""
         from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
 
-        dye_rgb = self._room_dye_rgb(self._display_colours(inputs))
+        dye_rgb = self._dye_rgb(inputs, "secondary")
         back = (float(inputs.a_diff) * hg_hemisphere_factors(float(inputs.g_diff))[1]
                 + float(inputs.a_spec) * hg_hemisphere_factors(float(inputs.g_spec))[1])
         return tuple(float(v) for v in np.clip(dye_rgb * back, 0.0, 1.0))
