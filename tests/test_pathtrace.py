@@ -784,3 +784,42 @@ def test_the_spectral_variant_emits_the_glows_own_spectrum():
     # the lamp and the variant's upsampling clamped its negative green)
     room_rgb, room_spectral = np.array(out["room_llvm_ad_rgb"]), np.array(out["room_llvm_ad_spectral"])
     assert abs(room_spectral @ luma / (room_rgb @ luma) - 1.0) <= 0.05, room_spectral @ luma / (room_rgb @ luma)
+
+
+def test_a_spectral_render_leaves_a_pixels_nan_pass_out_of_its_mean():
+    """render_radiance in a spectral variant: SPECTRAL_PASSES passes with distinct seeds, each
+    pixel the spp-weighted mean of its finite passes (Mitsuba's spectral volpath returns NaN
+    for a rare sample); the count left out is reported; a pixel NaN in every pass stays NaN;
+    an RGB variant renders once."""
+    from catalog.pathtrace.render import SPECTRAL_PASSES, render_radiance
+
+    class FakeMitsuba:
+        is_spectral = True
+
+        def __init__(self):
+            self.calls = []
+
+        def render(self, scene, spp, seed):
+            self.calls.append((spp, seed))
+            image = np.full((2, 3, 4), float(seed), dtype=np.float32)
+            if seed % SPECTRAL_PASSES == 3:
+                image[0, 0, 1] = np.nan
+            image[1, 2] = np.nan   # in every pass
+            return image
+
+    mi = FakeMitsuba()
+    report = {}
+    image = render_radiance(mi, None, 20, seed=1, report=report)
+    counts = [spp for spp, _seed in mi.calls]
+    seeds = [seed for _spp, seed in mi.calls]
+    assert sum(counts) == 20 and len(counts) == SPECTRAL_PASSES and len(set(seeds)) == SPECTRAL_PASSES
+    weighted = sum(c * s for c, s in zip(counts, seeds)) / 20
+    assert np.isclose(image[0, 1, 0], weighted)
+    kept = [(c, s) for c, s in zip(counts, seeds) if s % SPECTRAL_PASSES != 3]
+    assert np.isclose(image[0, 0, 0], sum(c * s for c, s in kept) / sum(c for c, _ in kept))
+    assert np.isnan(image[1, 2]).all()
+    assert report["nan_pixel_passes"] == 1 + SPECTRAL_PASSES
+    mi.is_spectral = False
+    mi.calls.clear()
+    render_radiance(mi, None, 20, seed=1)
+    assert mi.calls == [(20, 1)]
