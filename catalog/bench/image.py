@@ -69,6 +69,8 @@ OPTIONS = (
     ("wall and reveals dark to the cloth (before round 5)", 3, "physical", 1, None, None, {"wall_light": False}),
     ("window captured from the middle, the outside through the holes (before round 6)", 3, "physical", 1,
      None, None, {"side_eyes": False, "capture_folds": False}),
+    ("room's and folds' light by the key's dye (before round 7)", 3, "physical", 1, None, None,
+     {"secondary_dye": False}),
     ("shadow maps 128", 3, "physical", 1, None, None, {"shadow_map_size": 128}),
     ("shadow maps 512", 3, "physical", 1, None, None, {"shadow_map_size": 512}),
     ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),

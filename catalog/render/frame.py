@@ -324,6 +324,9 @@ class FrameRenderer:
         #: issue 11 (sixth round): the room's captures see the folds behind through the holes
         #: (curtain.frag FOLDS_BEHIND); False: the outside there
         self.capture_folds = True
+        #: the room's and the folds' light passed by the dye of the lit cloth's own light
+        #: (set_secondary_dye)
+        self.secondary_dye = True
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -533,6 +536,12 @@ class FrameRenderer:
         patterned curtain composites them, the captures draw the flat cloth and showed the
         outside there, dark under the UV lamp) or the outside (False, before)."""
         self.capture_folds = bool(on)
+
+    def set_secondary_dye(self, on: bool) -> None:
+        """Pass the room's light and the folds' light through the cloth by the dye of what the
+        key-lit cloth sends on, its forward share of the key and its glow (True, issue 11's
+        seventh round, catalog.optics.dye_colour) or by the key's dye (False, before)."""
+        self.secondary_dye = bool(on)
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -1408,7 +1417,7 @@ class FrameRenderer:
         if getattr(self, "_dye_key", None) != self._inputs_key:
             self._dyes = {"key": dye_colour.key_dye_rgb(inputs), "secondary": dye_colour.secondary_dye_rgb(inputs)}
             self._dye_key = self._inputs_key
-        return self._dyes[light]
+        return self._dyes[light if self.secondary_dye else "key"]
 
     def _room_colours(self, inputs) -> dict:
         """Linear sRGB of the key light (irradiance) and of the beam a thread passes: the
@@ -2016,7 +2025,7 @@ class FrameRenderer:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
                self.room_bounces, self.room_lobe, self.room_side_active(), self.wall_light,
-               self.side_eyes, self.capture_folds,
+               self.side_eyes, self.capture_folds, self.secondary_dye,
                getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
@@ -2475,7 +2484,7 @@ class FrameRenderer:
             "outside_by_view": self.outside_by_view,
             "room_bounces": self.room_bounces, "room_lobe": self.room_lobe,
             "room_side_solved": self.room_side_solved, "side_eyes": self.side_eyes,
-            "capture_folds": self.capture_folds,
+            "capture_folds": self.capture_folds, "secondary_dye": self.secondary_dye,
             "shadow_map_size": self.shadow_texels,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
