@@ -109,6 +109,9 @@ ROUND_5 = "after_11_round_5"
 #: The run after its sixth round (the room's window captured from three eyes with the whole
 #: mesh, the folds behind seen through the holes): ``runs[ROUND_6]``.
 ROUND_6 = "after_11_round_6"
+#: The run after its seventh round (the reference spectral, its key light its own spectrum;
+#: the room's and the folds' light passed by the lit cloth's own dye): ``runs[ROUND_7]``.
+ROUND_7 = "after_11_round_7"
 #: The reference's Mitsuba variant since issue 11's seventh round: spectral, so that the light
 #: the cloth passes is filtered by its dye at each wavelength. Until the sixth round it was
 #: ``llvm_ad_rgb``, whose cloth carries one RGB dye, RGB(key x dye) / RGB(key): under the UV-A
@@ -516,7 +519,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
             blocks["image-after-11-summary"] = summary_line(run)
         for name, ordinal, previous in ((ROUND_2, "second", "after_11"), (ROUND_3, "third", ROUND_2),
                                         (ROUND_4, "fourth", ROUND_3), (ROUND_5, "fifth", ROUND_4),
-                                        (ROUND_6, "sixth", ROUND_5)):
+                                        (ROUND_6, "sixth", ROUND_5), (ROUND_7, "seventh", ROUND_6)):
             if name in result["runs"]:
                 blocks.update(_round_blocks(result["runs"], name, ordinal, previous))
         return blocks
