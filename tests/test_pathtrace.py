@@ -565,7 +565,34 @@ def test_the_key_reaches_the_glow_through_cloth_not_through_the_wall(mi):
     scene = build_mitsuba_scene(mi, desc)
     points = np.array([[0.0, 0.2, -0.6], [0.0, 0.2, 0.4], [0.0, -1.25, 0.3]])
     visible = key_visibility(desc, scene, mi, points)
-    assert np.allclose(visible, [1.0, desc.fabric["direct"], 0.0]), visible
+    # the draped curtain's middle: LD per layer crossed (issue 11, seventh round; three here)
+    assert np.isclose(visible[0], 1.0) and np.isclose(visible[2], 0.0), visible
+    assert any(np.isclose(visible[1], desc.fabric["direct"] ** k) for k in (1, 2, 3, 4)), visible
+
+
+def test_the_key_reaches_the_glow_through_each_layer_of_cloth(mi):
+    """key_visibility (issue 11, seventh round): two flat sheets 10 cm apart before the
+    window: LD between them, LD^2 behind both (LD before, for any number of layers), as the
+    frame's two-layer key shadow passes the excitation through the holes of each."""
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene, key_visibility
+    from catalog.presets import find_preset, load_preset
+    from catalog.render import scene as scene_lib
+
+    sheet = scene_lib.draped_curtain(columns=8, rows=6, depth_m=0.0)
+    count = sheet.positions.shape[0]
+    front = sheet.positions + np.array([0.0, 0.0, -0.05], dtype=sheet.positions.dtype)
+    back = sheet.positions + np.array([0.0, 0.0, 0.05], dtype=sheet.positions.dtype)
+    curtain = (np.concatenate([front, back]), np.concatenate([sheet.normals] * 2),
+               np.concatenate([sheet.uvs] * 2), np.concatenate([sheet.tangents] * 2),
+               np.concatenate([sheet.indices, sheet.indices + count]))
+    desc = describe_scene(load_preset(find_preset("voile-white")), get_light("D65"), size=(8, 8),
+                          curtain=curtain)
+    scene = build_mitsuba_scene(mi, desc)
+    z = float(np.mean(sheet.positions[:, 2]))
+    points = np.array([[0.0, 0.3, z], [0.0, 0.3, z + 0.3]])   # between the sheets, behind both
+    ld = desc.fabric["direct"]
+    assert np.allclose(key_visibility(desc, scene, mi, points), [ld, ld ** 2]), key_visibility(desc, scene, mi, points)
 
 
 @pytest.mark.parametrize("fabric", ["lace-fwa", "safety-yellow"])

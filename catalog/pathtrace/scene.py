@@ -413,17 +413,19 @@ MAX_KEY_LAYERS = 4
 
 
 def key_visibility(desc: SceneDescription, scene, mi, positions) -> np.ndarray:
-    """(V,) the key's excitation reaching ``positions`` (module doc): 1 in the open, LD behind
-    cloth (a fold in front dims the key through its gaps, it does not black it out), 0 where
-    the window wall (anything outside the wall's inner plane) stops the ray, whether or not
-    cloth lies before it (issue 11, fourth round: the wall had passed LD as the cloth does)."""
+    """(V,) the key's excitation reaching ``positions`` (module doc): 1 in the open, LD per
+    layer of cloth in the way (a fold in front dims the key through its gaps, it does not
+    black it out; behind two layers LD^2, since issue 11's seventh round: LD for any number
+    before, while the frame's two-layer shadow gives LD^2), 0 where the window wall (anything
+    outside the wall's inner plane) stops the ray, whether or not cloth lies before it (issue
+    11, fourth round: the wall had passed LD as the cloth does)."""
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
     p = np.asarray(positions, dtype=np.float64).reshape(-1, 3) + 1e-3 * desc.key_to_light
     d = np.repeat(desc.key_to_light[None, :], p.shape[0], axis=0)
     wall_z = scene_lib.ROOM_BOX[2][0] + 1e-3
     blocked = np.zeros(p.shape[0], dtype=bool)
-    behind_cloth = np.zeros(p.shape[0], dtype=bool)
+    layers = np.zeros(p.shape[0])
     active = np.ones(p.shape[0], dtype=bool)
     for _ in range(MAX_KEY_LAYERS):
         ray = mi.Ray3f(mi.Point3f(p.T.astype(np.float32)), mi.Vector3f(d.T.astype(np.float32)))
@@ -433,12 +435,12 @@ def key_visibility(desc: SceneDescription, scene, mi, positions) -> np.ndarray:
         wall = hit & (hit_p[:, 2] < wall_z)
         blocked |= wall
         cloth = hit & ~wall
-        behind_cloth |= cloth
+        layers += cloth
         active = cloth
         if not active.any():
             break
         p = np.where(cloth[:, None], hit_p + 1e-4 * d, p)
-    visible = np.where(behind_cloth, float(desc.fabric["direct"]), 1.0)
+    visible = float(desc.fabric["direct"]) ** layers
     return np.where(blocked, 0.0, visible)
 
 
