@@ -186,6 +186,28 @@ float front_layer_coverage(sampler2D map, vec3 q, float bias) {
     return mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y);
 }
 
+// The key's two layers in front of a point (issue 11, seventh round): the front-layer map
+// ``first`` and the second layer's ``second`` (room_shadow.frag SECOND_LAYER; r: a layer's
+// thread coverage, a: its depth). Returns (c1, c2): each layer's coverage where q lies behind
+// it by the bias, bilinear over the four nearest texels as front_layer_coverage. A third layer
+// is not seen.
+vec2 front_layers_coverage(sampler2D first, sampler2D second, vec3 q, float bias) {
+    vec2 size = vec2(textureSize(first, 0));
+    vec2 st = q.xy * size - 0.5;
+    vec2 f = fract(st);
+    ivec2 i0 = ivec2(floor(st));
+    ivec2 top = ivec2(size) - 1;
+    vec2 c[4];
+    for (int k = 0; k < 4; ++k) {
+        ivec2 texel = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), top);
+        vec4 one = texelFetch(first, texel, 0);
+        vec4 two = texelFetch(second, texel, 0);
+        c[k] = vec2(one.r * smoothstep(0.5 * bias, 1.5 * bias, q.z - one.a),
+                    two.r * smoothstep(0.5 * bias, 1.5 * bias, q.z - two.a));
+    }
+    return mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y);
+}
+
 #ifdef OCCLUSION_MAPS
 // The outside hidden from a point p of the cloth (normal `normal`; issue 11, model.md
 // section 9): of N_OCCLUSION directions (cosine-weighted about the window's normal,

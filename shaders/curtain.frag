@@ -120,9 +120,16 @@ float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set
 // front-layer map (room_shadow.frag, FRONT_LAYER: per texel the thread coverage c of the
 // layer of cloth nearest the light and its depth); a fragment behind that layer receives the
 // beam through it, (1 - c) key dye + c key dye thread (u_key_thread: c = 1), the float64
-// twin's layer_beam_transmittance, and the excitation through its holes, 1 - c.
+// twin's layer_beam_transmittance, and the excitation through its holes, 1 - c. Since issue
+// 11's seventh round a second layer too (u_key_second, the front-layer map peeled;
+// front_layers_coverage): the beam through both, the product of the two layers'
+// transmittances, (1 - c1)(1 - c2) key dye + ((1 - c1) c2 + c1 (1 - c2)) key dye thread +
+// c1 c2 key dye thread^2 (u_key_thread2). With one layer, a point behind two folds of voile
+// was 1.15-1.55x the path tracer's.
 SCENE_VALUE(vec4, u_key_thread[NV4], S_KEY_THREAD);
+SCENE_VALUE(vec4, u_key_thread2[NV4], S_KEY_THREAD2);
 uniform sampler2D u_key_front;     // r: the nearest layer's coverage, a: its depth (0..1)
+uniform sampler2D u_key_second;    // the same of the second layer (cleared: coverage 0)
 uniform mat4 u_light_view_proj;
 uniform float u_key_normal_offset; // m: the lookup's offset along the normal at a grazing key
 uniform vec3 u_key_depth_bias;     // depth (0..1 units) a fragment must lie behind to be shaded:
@@ -132,6 +139,9 @@ uniform vec2 u_wall_z;
 uniform float u_tan_sun_radius;
 float g_key_beam = 1.0;            // the window's mask (set in main)
 float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
+float g_second_coverage = 0.0;     // coverage of a second layer in front (0: none; set in main)
+#else
+const float g_second_coverage = 0.0;
 #endif
 #ifdef ROOM_SIDE
 // The curtain's room side lit by the room's own light (issue 11, fourth round), not by the
@@ -198,8 +208,11 @@ float ambient_view(vec4 table[AMBIENT_VIEW_VEC4], float mu) {
 
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
 #ifdef KEY_SHADOW
-    vec4 key_seen = g_key_beam * ((1.0 - g_front_coverage) * u_key_dyed[k]
-                                  + g_front_coverage * u_key_thread[k]);
+    float c1 = g_front_coverage;
+    float c2 = g_second_coverage;
+    vec4 key_seen = g_key_beam * ((1.0 - c1) * (1.0 - c2) * u_key_dyed[k]
+                                  + ((1.0 - c1) * c2 + c1 * (1.0 - c2)) * u_key_thread[k]
+                                  + (c1 * c2) * u_key_thread2[k]);
     vec4 band = g_key * key_seen + g_fill * u_fill_dyed[k];
 #else
     vec4 band = g_key * u_key_dyed[k] + g_fill * u_fill_dyed[k];
@@ -291,11 +304,14 @@ void main() {
         vec4 clip = u_light_view_proj * vec4(v_position + offset, 1.0);
         float tan_surface = min(sqrt(max(1.0 - cos_surface * cos_surface, 0.0)) / max(cos_surface, 1e-3),
                                 u_key_depth_bias.z);
-        g_front_coverage = front_layer_coverage(u_key_front, clip.xyz * 0.5 + 0.5,
-                                                u_key_depth_bias.x + u_key_depth_bias.y * tan_surface);
-        key_uv = g_key_beam * (1.0 - g_front_coverage);   // UV passes the holes only
+        vec2 layers = front_layers_coverage(u_key_front, u_key_second, clip.xyz * 0.5 + 0.5,
+                                            u_key_depth_bias.x + u_key_depth_bias.y * tan_surface);
+        g_front_coverage = layers.x;
+        g_second_coverage = layers.y;
+        key_uv = g_key_beam * (1.0 - g_front_coverage) * (1.0 - g_second_coverage);   // UV passes the holes only
 #ifdef ROOM_CAPTURE
-        g_key_reach = g_key_beam * (1.0 - g_front_coverage * (1.0 - u_capture_thread));
+        g_key_reach = g_key_beam * (1.0 - g_front_coverage * (1.0 - u_capture_thread))
+                                 * (1.0 - g_second_coverage * (1.0 - u_capture_thread));
 #endif
     }
 #endif
@@ -410,12 +426,12 @@ void main() {
     shadows.zw = vec2(g_occlusion, g_wall_occlusion);
 #endif
     out_shadows = shadows;
-    out_wall_light = vec4(0.0);
+    out_wall_light = vec4(0.0, 0.0, 0.0, g_second_coverage);   // w: the second layer's coverage
 #ifdef ROOM_SIDE
     out_room_side_light = vec4(v_room_side_light, 1.0);
     out_window_side_light = vec4(v_window_side_light, 1.0);
 #ifdef WALL_LIGHT
-    out_wall_light = vec4(v_wall_light, 1.0);
+    out_wall_light = vec4(v_wall_light, g_second_coverage);
 #endif
 #else
     out_room_side_light = vec4(0.0);

@@ -12,6 +12,10 @@ in vec2 v_uv;
 
 uniform float u_mean_coverage;       // 1 - LD
 uniform vec3 u_thread_beam_rgb;      // per thread: a_spec forward(g_spec) dye / (1 - LD)
+#ifdef SECOND_LAYER
+uniform sampler2D u_first_layer;     // the front-layer map (a: the nearest layer's depth)
+uniform float u_peel_bias;           // depth (0..1 units) the second layer lies behind the first, at least
+#endif
 
 layout(location = 0) out vec4 out_transmittance;
 
@@ -42,6 +46,17 @@ void main() {
 #elif defined(FRONT_LAYER)
     // the front-layer map (curtain.frag, KEY_SHADOW and SKY_OCCLUSION): the nearest layer's
     // thread coverage and its depth, kept by the depth test (no blending)
+    out_transmittance = vec4(c, 0.0, 0.0, gl_FragCoord.z);
+#elif defined(SECOND_LAYER)
+    // the second layer's map (issue 11, seventh round; curtain.frag KEY_SHADOW): the front-layer
+    // map peeled, the nearest layer behind the first by more than u_peel_bias plus the depth
+    // this surface spans across 1.5 texels (else a fold at a grazing angle to the light would
+    // count as its own second layer), kept by the depth test: its coverage and depth
+    float first = texelFetch(u_first_layer, ivec2(gl_FragCoord.xy), 0).a;
+    float span = PEEL_SPAN_TEXELS * (abs(dFdx(gl_FragCoord.z)) + abs(dFdy(gl_FragCoord.z)));
+    if (gl_FragCoord.z <= first + u_peel_bias + span) {
+        discard;
+    }
     out_transmittance = vec4(c, 0.0, 0.0, gl_FragCoord.z);
 #else
     out_transmittance = vec4(vec3(1.0 - c) + c * u_thread_beam_rgb, 1.0);

@@ -93,7 +93,7 @@ def case_errors(renderer, reference_inputs) -> tuple[dict[str, np.ndarray], dict
             positions = gbuffer["position"][mask]
             truth = ref.spectral_to_xyz(ref.shade_spectral(
                 reference_inputs, positions, gbuffer["normal"][mask], gbuffer["tangent"][mask],
-                renderer.camera.position, **ref.shadow_terms(gbuffer["shadows"][mask])))
+                renderer.camera.position, **ref.shadow_terms(gbuffer["shadows"][mask], gbuffer["second_coverage"][mask])))
             white = ref.white_xyz(reference_inputs)
             lit = truth[:, 1] > 1e-6 * max(white[1], 1e-30)
             white = adapted_white(white, truth[lit])

@@ -300,13 +300,15 @@ def outside_occluded_radiance(inputs: ShadingInputs) -> np.ndarray:
 
 def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
                    camera_position, key_beam=None, front_coverage=None,
-                   outside_occlusion=None, wall_occlusion=None) -> np.ndarray:
+                   outside_occlusion=None, wall_occlusion=None, second_coverage=None) -> np.ndarray:
     """Spectral radiance (P, len(GRID_NM)) W m^-2 sr^-1 nm^-1 at world positions (P, 3).
 
     The cloth's shadows (issue 11, model.md section 9), per position (P,), default none:
     ``key_beam`` the window's mask on the key light (0..1), ``front_coverage`` the thread
     coverage of the layer of cloth between the position and the key light (0: none; the beam
     is multiplied by :func:`layer_beam_transmittance`, the excitation by 1 - c),
+    ``second_coverage`` that of a second layer between them (issue 11, seventh round: the beam
+    multiplied by its transmittance too, the excitation by its 1 - c),
     ``outside_occlusion`` the fraction of the outside hidden by the cloth itself (the ambient
     term loses that fraction of :func:`outside_occluded_radiance`), ``wall_occlusion`` the
     fraction hidden by the window wall (the ambient loses that fraction of the outside's
@@ -329,7 +331,10 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
     count = p.shape[0]
     beam = np.ones(count) if key_beam is None else np.asarray(key_beam, dtype=np.float64).reshape(-1)
     cover = np.zeros(count) if front_coverage is None else np.asarray(front_coverage, dtype=np.float64).reshape(-1)
-    key_seen = beam[:, None] * layer_beam_transmittance(inputs, cover) * dyed_key[None, :]
+    cover2 = (np.zeros(count) if second_coverage is None
+              else np.asarray(second_coverage, dtype=np.float64).reshape(-1))
+    key_seen = (beam[:, None] * layer_beam_transmittance(inputs, cover)
+                * layer_beam_transmittance(inputs, cover2) * dyed_key[None, :])
     # the ambient term by view (ratios to the normal view's): the room's share r_room, the
     # outside's r_out, the occlusions' losses with the outside's
     mu = np.abs(np.einsum("pi,pi->p", to_viewer, n))
@@ -358,7 +363,7 @@ def shade_spectral(inputs: ShadingInputs, positions, normals, tangents,
         radiance += inputs.paper_radiance[None, :]  # eq. 8: a constant per light
     elif inputs.fluorescence_mode == "physical":
         n_key, n_fill, n_ambient = inputs.absorbed_photons
-        absorbed = (np.abs(n @ np.asarray(inputs.key_to_light)) * (beam * (1.0 - cover)) * n_key
+        absorbed = (np.abs(n @ np.asarray(inputs.key_to_light)) * (beam * (1.0 - cover) * (1.0 - cover2)) * n_key
                     + np.abs(n @ np.asarray(inputs.fill_to_light)) * n_fill + n_ambient)
         effective = absorbed / (1.0 + absorbed / inputs.saturation_photons)
         radiance += effective[:, None] * inputs.emission_per_photon[None, :]
@@ -399,13 +404,17 @@ def window_side_linear_srgb(inputs: ShadingInputs, positions, normals, camera_po
                                    irradiance_rgb, transmittance_rgb)
 
 
-def shadow_terms(shadows) -> dict:
+def shadow_terms(shadows, second_coverage=None) -> dict:
     """:func:`shade_spectral`'s shadow arguments from the frame's G-buffer ``shadows`` (P, 4):
     the key's window mask, the coverage of the layer in front of the key, the outside's
-    occlusion by the cloth and by the window wall."""
+    occlusion by the cloth and by the window wall; and ``second_coverage`` (P,), the G-buffer's
+    second layer in front of the key (None: none)."""
     s = np.asarray(shadows, dtype=np.float64).reshape(-1, 4)
-    return {"key_beam": s[:, 0], "front_coverage": s[:, 1], "outside_occlusion": s[:, 2],
-            "wall_occlusion": s[:, 3]}
+    out = {"key_beam": s[:, 0], "front_coverage": s[:, 1], "outside_occlusion": s[:, 2],
+           "wall_occlusion": s[:, 3]}
+    if second_coverage is not None:
+        out["second_coverage"] = np.asarray(second_coverage, dtype=np.float64).reshape(-1)
+    return out
 
 
 def spectral_to_linear_srgb(radiance: np.ndarray) -> np.ndarray:

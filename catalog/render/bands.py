@@ -114,6 +114,9 @@ def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray |
         # issue 11's shadows on the cloth (KEY_SHADOW, SKY_OCCLUSION in curtain.frag)
         "u_key_thread": band(inputs.key_irradiance * inputs.dye_transmittance
                              * layer_beam_transmittance(inputs, [1.0])[0]),
+        # through two threads (the second layer of KEY_SHADOW's front_layers_coverage)
+        "u_key_thread2": band(inputs.key_irradiance * inputs.dye_transmittance
+                              * layer_beam_transmittance(inputs, [1.0])[0] ** 2),
         "u_ambient_occluded": band(outside_occluded_radiance(inputs)),
         "u_ambient_outside": band(inputs.ambient_outside_radiance
                                   if inputs.ambient_outside_radiance is not None else zeros),

@@ -74,8 +74,16 @@ MAX_SPECIALISED = 8
 PATTERN_UNIT = 3
 #: Texture unit of the environment image (background and the curtain's see-through).
 ENVIRONMENT_UNIT = 5
-#: Texture unit of the key light's front-layer map (the curtain's KEY_SHADOW).
+#: Texture unit of the key light's front-layer map (the curtain's KEY_SHADOW), and of its
+#: second layer's (issue 11, seventh round).
 KEY_FRONT_UNIT = 6
+KEY_SECOND_UNIT = 14
+#: The key's second layer (room_shadow.frag SECOND_LAYER) lies behind the first by more than
+#: KEY_SHADOW_BIAS_M plus the depth its own surface spans across this many texels: the
+#: receiver's slope-scaled bias's KEY_SHADOW_SLOPE_TEXELS, set before measuring (0.5 was
+#: better on the bench's voile and safety-yellow scenes afterwards: not taken, being chosen
+#: on the scenes reported).
+KEY_PEEL_SPAN_TEXELS = 1.5
 #: How far (m, along the key's travel) a fragment must lie behind the cloth layer nearest the
 #: key light to be in that layer's shadow, slope-scaled: KEY_SHADOW_BIAS_M plus
 #: KEY_SHADOW_SLOPE_TEXELS front-map texels (room_light.shadow_texel_m, ~1 cm) times the
@@ -327,6 +335,8 @@ class FrameRenderer:
         #: the room's and the folds' light passed by the dye of the lit cloth's own light
         #: (set_secondary_dye)
         self.secondary_dye = True
+        #: the key's shadow on the cloth through two layers, not one (set_key_second_layer)
+        self.key_second_layer = True
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -542,6 +552,13 @@ class FrameRenderer:
         key-lit cloth sends on, its forward share of the key and its glow (True, issue 11's
         seventh round, catalog.optics.dye_colour) or by the key's dye (False, before)."""
         self.secondary_dye = bool(on)
+
+    def set_key_second_layer(self, on: bool) -> None:
+        """Shade the cloth behind two layers of its folds with the key's beam through both (True,
+        issue 11's seventh round: the front-layer map keeps the farthest layer's depth too, and
+        the second layer passes the beam at the mean coverage) or through the nearest alone
+        (False, before: a point of voile behind two folds was 1.15-1.55x the path tracer's)."""
+        self.key_second_layer = bool(on)
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -1373,6 +1390,10 @@ class FrameRenderer:
             key_front.filter = (mgl.NEAREST, mgl.NEAREST)
             key_front.repeat_x = key_front.repeat_y = False
             key_front_depth = ctx.depth_renderbuffer((n, n))
+            key_second = ctx.texture((n, n), 4, dtype="f4")   # the front-layer map peeled
+            key_second.filter = (mgl.NEAREST, mgl.NEAREST)
+            key_second.repeat_x = key_second.repeat_y = False
+            key_second_depth = ctx.depth_renderbuffer((n, n))
             side = self._occlusion_grid() * room_light.OCCLUSION_TEXELS
             occlusion = ctx.texture((side, side), 4, dtype="f4")
             occlusion.filter = (mgl.NEAREST, mgl.NEAREST)
@@ -1380,6 +1401,8 @@ class FrameRenderer:
             self._room_gl = {
                 "key_front": key_front, "key_front_depth": key_front_depth,
                 "key_front_fbo": ctx.framebuffer([key_front], key_front_depth),
+                "key_second": key_second, "key_second_depth": key_second_depth,
+                "key_second_fbo": ctx.framebuffer([key_second], key_second_depth),
                 "occlusion": occlusion, "occlusion_depth": occlusion_depth,
                 "occlusion_fbo": ctx.framebuffer([occlusion], occlusion_depth),
                 "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
@@ -1441,6 +1464,8 @@ class FrameRenderer:
         """curtain.frag's KEY_SHADOW: the front-layer map, its frame and depth bias, the opening."""
         gl = self._room_resources()
         gl["key_front"].use(location=KEY_FRONT_UNIT)
+        gl["key_second"].use(location=KEY_SECOND_UNIT)
+        self._set(program, "u_key_second", KEY_SECOND_UNIT)
         s = self._set
         s(program, "u_key_front", KEY_FRONT_UNIT)
         matrix = room_light.light_view_projection(inputs.key_to_light)
@@ -1656,6 +1681,29 @@ class FrameRenderer:
         gl["key_front_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
         program = self._program("room_shadow.vert", "room_shadow.frag",
                                 {"HAS_UV": True, "PATTERN": patterned, "FRONT_LAYER": True})
+        self._front_layer_uniforms(program, inputs, patterned, colours)
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.depth_func = "<"
+        self.ctx.disable(mgl.CULL_FACE)
+        self._shadow_vao(program, fine=True).render(mgl.TRIANGLES)
+        # the second layer (issue 11, seventh round): the map peeled; cleared to coverage 0
+        gl["key_second_fbo"].use()
+        gl["key_second_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        if self.key_second_layer:
+            program = self._program("room_shadow.vert", "room_shadow.frag",
+                                    {"HAS_UV": True, "PATTERN": patterned, "SECOND_LAYER": True,
+                                     "PEEL_SPAN_TEXELS": glsl_literal(KEY_PEEL_SPAN_TEXELS)})
+            self._front_layer_uniforms(program, inputs, patterned, colours)
+            gl["key_front"].use(location=KEY_FRONT_UNIT)
+            self._set(program, "u_first_layer", KEY_FRONT_UNIT)
+            matrix = room_light.light_view_projection(inputs.key_to_light)
+            self._set(program, "u_peel_bias", KEY_SHADOW_BIAS_M * abs(float(matrix[2, 2])) / 2)
+            self._shadow_vao(program, fine=True).render(mgl.TRIANGLES)
+        self.ctx.disable(mgl.DEPTH_TEST)
+
+    def _front_layer_uniforms(self, program, inputs, patterned: bool, colours: dict) -> None:
+        """room_shadow.frag's FRONT_LAYER and SECOND_LAYER inputs: the light's frame, the
+        pattern's coverage."""
         if patterned:
             self._pattern_texture.use(location=3)
             self._set(program, "u_pattern", 3)
@@ -1666,11 +1714,6 @@ class FrameRenderer:
         self._set(program, "u_mesh_offset", self._mesh_offset)
         self._set(program, "u_mean_coverage", colours["u_mean_coverage"])
         self._set(program, "u_thread_beam_rgb", colours["u_thread_beam_rgb"])
-        self.ctx.enable(mgl.DEPTH_TEST)
-        self.ctx.depth_func = "<"
-        self.ctx.disable(mgl.CULL_FACE)
-        self._shadow_vao(program, fine=True).render(mgl.TRIANGLES)
-        self.ctx.disable(mgl.DEPTH_TEST)
 
     def draw_room_luminaire(self, inputs) -> None:
         """Pass R2: what the room sees in the window (the curtain's room-side radiance, or the
@@ -2025,7 +2068,7 @@ class FrameRenderer:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
                self.room_bounces, self.room_lobe, self.room_side_active(), self.wall_light,
-               self.side_eyes, self.capture_folds, self.secondary_dye,
+               self.side_eyes, self.capture_folds, self.secondary_dye, self.key_second_layer,
                getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
@@ -2381,7 +2424,7 @@ class FrameRenderer:
 
         return ref.shade_spectral(self.curtain_inputs(), gbuffer["position"][mask], gbuffer["normal"][mask],
                                   gbuffer["tangent"][mask], self.camera.position,
-                                  **ref.shadow_terms(gbuffer["shadows"][mask]))
+                                  **ref.shadow_terms(gbuffer["shadows"][mask], gbuffer["second_coverage"][mask]))
 
     def twin_room_side_rgb(self, gbuffer: dict, mask) -> np.ndarray:
         """The twin of ROOM_SIDE's term (P, 3) linear sRGB at the G-buffer pixels (0 when the
@@ -2448,6 +2491,7 @@ class FrameRenderer:
             data = fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4", attachment=attachment)
             out[name] = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1].copy()
         out["mask"] = out["position"][..., 3] > 0.5
+        out["second_coverage"] = out["wall_light"][..., 3].copy()   # curtain.frag: wall_light.w
         out["room_occlusion"] = out["normal"][..., 3].copy()        # curtain.frag: normal.w
         out["room_occlusion_view"] = out["tangent"][..., 3].copy()  # and tangent.w
         for name in ("radiance", "position", "normal", "tangent", "room_side_light", "window_side_light",
@@ -2485,6 +2529,7 @@ class FrameRenderer:
             "room_bounces": self.room_bounces, "room_lobe": self.room_lobe,
             "room_side_solved": self.room_side_solved, "side_eyes": self.side_eyes,
             "capture_folds": self.capture_folds, "secondary_dye": self.secondary_dye,
+            "key_second_layer": self.key_second_layer,
             "shadow_map_size": self.shadow_texels,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,
