@@ -71,6 +71,8 @@ OPTIONS = (
      None, None, {"side_eyes": False, "capture_folds": False}),
     ("room's and folds' light by the key's dye (before round 7)", 3, "physical", 1, None, None,
      {"secondary_dye": False}),
+    ("key's shadow through one layer (before round 7)", 3, "physical", 1, None, None,
+     {"key_second_layer": False}),
     ("shadow maps 128", 3, "physical", 1, None, None, {"shadow_map_size": 128}),
     ("shadow maps 512", 3, "physical", 1, None, None, {"shadow_map_size": 512}),
     ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
@@ -109,8 +111,9 @@ ROUND_5 = "after_11_round_5"
 #: The run after its sixth round (the room's window captured from three eyes with the whole
 #: mesh, the folds behind seen through the holes): ``runs[ROUND_6]``.
 ROUND_6 = "after_11_round_6"
-#: The run after its seventh round (the reference spectral, its key light its own spectrum;
-#: the room's and the folds' light passed by the lit cloth's own dye): ``runs[ROUND_7]``.
+#: The run after its seventh round (the reference spectral, its key light its own spectrum,
+#: its glow excited through LD per layer; the room's and the folds' light passed by the lit
+#: cloth's own dye; the key's shadow through two layers): ``runs[ROUND_7]``.
 ROUND_7 = "after_11_round_7"
 #: The reference's Mitsuba variant since issue 11's seventh round: spectral, so that the light
 #: the cloth passes is filtered by its dye at each wavelength. Until the sixth round it was
