@@ -850,3 +850,27 @@ def test_a_spectral_render_leaves_a_pixels_nan_pass_out_of_its_mean():
     mi.calls.clear()
     render_radiance(mi, None, 20, seed=1)
     assert mi.calls == [(20, 1)]
+
+
+def test_the_spectral_key_and_backdrop_keep_their_luminance():
+    """scene.in_gamut_same_luminance: in-gamut colours unchanged (1e-12), out-of-gamut ones
+    with no negative channel and their luminance kept (1e-9), 0 where the luminance is <= 0;
+    scene.key_spectrum: the film's luminance of the key's spectrum (the CIE ybar integral over
+    Mitsuba's normalisation) equals the RGB key's, under the UV lamp (whose RGB is out of
+    gamut) and D65 (1e-9)."""
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace.scene import describe_scene, film_luminance, in_gamut_same_luminance, key_spectrum
+
+    luma = np.array([0.2126, 0.7152, 0.0722])
+    inside = np.array([[0.2, 0.5, 0.9], [1.0, 1.0, 1.0]])
+    np.testing.assert_allclose(in_gamut_same_luminance(inside), inside, rtol=1e-12)
+    outside = np.array([[7.7, -7.08, 53.9], [0.29, -0.27, 2.06], [-1.0, 0.5, 0.1]])
+    mapped = in_gamut_same_luminance(outside)
+    assert np.all(mapped >= 0)
+    np.testing.assert_allclose(mapped @ luma, np.clip(outside @ luma, 0, None), rtol=1e-9)
+    assert not in_gamut_same_luminance(np.array([[-1.0, -1.0, 0.5]])).any()
+    for light in ("UV-A", "D65"):
+        desc = describe_scene(desc_preset("voile-white"), get_light(light), size=(8, 6))
+        wavelengths, values = key_spectrum(desc)
+        assert np.all(values >= 0)
+        np.testing.assert_allclose(film_luminance(wavelengths, values), desc.key_rgb @ luma, rtol=1e-9)
