@@ -115,12 +115,23 @@ ROUND_6 = "after_11_round_6"
 #: its glow excited through LD per layer; the room's and the folds' light passed by the lit
 #: cloth's own dye; the key's shadow through two layers): ``runs[ROUND_7]``.
 ROUND_7 = "after_11_round_7"
-#: The reference's Mitsuba variant since issue 11's seventh round: spectral, so that the light
-#: the cloth passes is filtered by its dye at each wavelength. Until the sixth round it was
-#: ``llvm_ad_rgb``, whose cloth carries one RGB dye, RGB(key x dye) / RGB(key): under the UV-A
-#: lamp that is 0.048 in every channel, while the safety-yellow's glow passes its dye at
-#: 0.11 / 0.91 / -0.11 (docs/pathtrace.md, sixth round, P13).
-REFERENCE_VARIANT = "llvm_ad_spectral"
+#: Its second run: each scene's reference in the variant it needs (reference_variant_for;
+#: the first run took the spectral variant for all six): ``runs[ROUND_7B]``.
+ROUND_7B = "after_11_round_7b"
+#: The reference's Mitsuba variants. The RGB variant's cloth carries one RGB dye,
+#: RGB(key x dye) / RGB(key), exact for light of the key's spectrum; under the UV-A lamp that
+#: is 0.048 in every channel, while the safety-yellow's glow, most of the light there, passes
+#: its dye at 0.11 / 0.91 / -0.11 (docs/pathtrace.md, sixth round, P13). The spectral variant
+#: filters by the dye per wavelength, but its colour converges 2-5x slower in spp (seventh
+#: round, P12). So a scene takes the spectral variant where the dye of the light the lit cloth
+#: sends on (catalog.optics.dye_colour.secondary_dye_rgb: its forward share of the key and its
+#: glow) differs from the key's by more than SPECTRAL_DYE_DIFFERENCE in a channel, else the
+#: RGB one (:func:`reference_variant_for`; issue 11's seventh round's first run took the
+#: spectral variant for every scene, ``runs.after_11_round_7``). The criterion was set before
+#: the run it decides.
+REFERENCE_VARIANT = "llvm_ad_rgb"
+SPECTRAL_VARIANT = "llvm_ad_spectral"
+SPECTRAL_DYE_DIFFERENCE = 0.05
 GOAL = {"mean_flip_at_most": 0.10, "curtain_mean_delta_e_at_most": 2.0, "speedup_at_least": 1000.0}
 REGIONS = ("curtain", "floor", "walls")
 #: The hour of "noon sun" (local solar time, the scene's date and latitude).
@@ -133,6 +144,44 @@ def light_name(key: str) -> str:
 
         return sun_at_hour(NOON_HOUR).light_name
     return key
+
+
+def describe_bench_scene(fabric: str, light_key: str, view: str, size):
+    """The scene description of one of the section's scenes (fabric, light key of SCENES,
+    view of VIEWS) at ``size``."""
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+
+    yaw, pitch, distance = VIEWS[view]
+    return describe_scene(load_preset(find_preset(fabric)), get_light(light_name(light_key)),
+                          size=tuple(size), yaw_deg=yaw, pitch_deg=pitch, distance_m=distance)
+
+
+def reference_variant_for(inputs) -> str:
+    """SPECTRAL_VARIANT where the secondary light's dye differs from the key's by more than
+    SPECTRAL_DYE_DIFFERENCE in a channel (REFERENCE_VARIANT's doc), else REFERENCE_VARIANT."""
+    from catalog.optics import dye_colour  # noqa: PLC0415
+
+    difference = np.abs(dye_colour.secondary_dye_rgb(inputs) - dye_colour.key_dye_rgb(inputs)).max()
+    return SPECTRAL_VARIANT if difference > SPECTRAL_DYE_DIFFERENCE else REFERENCE_VARIANT
+
+
+def _reference_in_child(fabric: str, light_key: str, view: str, size, spp: int, variant: str) -> dict:
+    """catalog.bench.image_reference in a child process (Mitsuba's JIT crashed when its
+    variant was switched after renders in one process): the halves, masks, time, NaN count."""
+    import subprocess  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+    import tempfile  # noqa: PLC0415
+
+    with tempfile.TemporaryDirectory() as scratch:
+        out = Path(scratch) / "reference.npz"
+        subprocess.run([sys.executable, "-m", "catalog.bench.image_reference", fabric, light_key, view,
+                        str(size[0]), str(size[1]), str(spp), variant, str(out)], check=True)
+        with np.load(out) as data:
+            return {"a": data["a"], "b": data["b"], "seconds": float(data["seconds"]),
+                    "nan_pixel_passes": int(data["nan_pixel_passes"]),
+                    "masks": {k[5:]: data[k] for k in data.files if k.startswith("mask_")}}
 
 
 def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
@@ -210,6 +259,12 @@ def compare(frame: dict, reference: np.ndarray, masks: dict, inputs,
             "delta_e": metrics.region_stats(delta_e, {r: masks[r] for r in REGIONS})}
 
 
+def _mitsuba_version() -> str:
+    from importlib.metadata import version  # noqa: PLC0415
+
+    return version("mitsuba")
+
+
 def meets_goal(row: dict, mean_flip: float) -> bool:
     """Issue 11's goal on one scene's row with this mean FLIP."""
     return bool(mean_flip <= GOAL["mean_flip_at_most"]
@@ -218,12 +273,15 @@ def meets_goal(row: dict, mean_flip: float) -> bool:
 
 
 def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
-        out: Path | None = None, variant: str = REFERENCE_VARIANT) -> dict:
+        out: Path | None = None, variant: str | None = None) -> dict:
+    """The section. ``variant``: every reference in that Mitsuba variant; None (the default):
+    each scene's by :func:`reference_variant_for`, the RGB ones in this process and the
+    others in a child process (catalog.bench.image_reference)."""
+    from catalog.bench.image_reference import render_halves  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace import metrics  # noqa: PLC0415
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
-    from catalog.pathtrace.render import MAX_DEPTH, region_masks, render_radiance  # noqa: PLC0415
-    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene  # noqa: PLC0415
+    from catalog.pathtrace.render import MAX_DEPTH  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
     if ctx is None:
@@ -234,22 +292,22 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
     size = tuple(size or (QUICK_SIZE if quick else SIZE))
     spp = int(spp or (QUICK_SPP if quick else SPP))
     options = OPTIONS[:2] if quick else OPTIONS
-    mi = load_mitsuba(variant)
+    own_variant = variant or REFERENCE_VARIANT
+    mi = None
     rows, pareto, images = [], [], {}
     for label, fabric, light_key, view in scenes:
         preset = load_preset(find_preset(fabric))
         light = get_light(light_name(light_key))
         yaw, pitch, distance = VIEWS[view]
-        desc = describe_scene(preset, light, size=size, yaw_deg=yaw, pitch_deg=pitch,
-                              distance_m=distance)
-        scene = build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH)
-        start = time.perf_counter()
-        report_a, report_b = {}, {}
-        a = render_radiance(mi, scene, spp // 2, seed=0, report=report_a)
-        b = render_radiance(mi, scene, spp // 2, seed=1, report=report_b)
-        reference_s = time.perf_counter() - start
+        desc = describe_bench_scene(fabric, light_key, view, size)
+        scene_variant = variant or reference_variant_for(desc.inputs)
+        if scene_variant == own_variant:
+            mi = mi or load_mitsuba(own_variant)
+            halves = render_halves(mi, desc, spp)
+        else:
+            halves = _reference_in_child(fabric, light_key, view, size, spp, scene_variant)
+        a, b, masks, reference_s = halves["a"], halves["b"], halves["masks"], halves["seconds"]
         reference = 0.5 * (a + b)
-        masks = region_masks(mi, scene, desc)
         noise = metrics.noise_between(a, b)
         noise_curtain = metrics.noise_between(a, b, masks["curtain"])
         option_rows = []
@@ -284,7 +342,8 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
                "reference_noise_rel": noise, "reference_noise_curtain_rel": noise_curtain,
                "reference_flip_noise_bound": flip_noise,
                # pixel-passes of the two halves left out as NaN (pathtrace.render.SPECTRAL_PASSES)
-               "reference_nan_pixel_passes": report_a["nan_pixel_passes"] + report_b["nan_pixel_passes"],
+               "reference_nan_pixel_passes": halves["nan_pixel_passes"],
+               "reference_variant": scene_variant,
                "fluorescence": desc.info["fluorescence_variant"]}
         row["meets_goal"] = meets_goal(row, row["mean_flip"])
         # by the measure of rounds 1-4 (the reference shown without the frame's glare)
@@ -304,11 +363,14 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
         "median_speedup": float(np.median([r["speedup"] for r in rows])),
         "max_reference_noise_rel": max(r["reference_noise_rel"] for r in rows),
         "absent_options": list(ABSENT_OPTIONS),
-        "integrator": f"Mitsuba {mi.__version__} volpath, max_depth {MAX_DEPTH}, "
-                      f"{spp} spp (2 x {spp // 2}), {variant}",
+        "integrator": f"Mitsuba {_mitsuba_version()} volpath, max_depth {MAX_DEPTH}, "
+                      f"{spp} spp (2 x {spp // 2}), "
+                      + ", ".join(f"{v} ({', '.join(r['scene'] for r in rows if r['reference_variant'] == v)})"
+                                  for v in dict.fromkeys(r["reference_variant"] for r in rows)),
     }
     result = {"rows": rows, "pareto": pareto, "summary": summary,
-              "settings": {"size": list(size), "spp": spp, "quick": bool(quick), "variant": variant}}
+              "settings": {"size": list(size), "spp": spp, "quick": bool(quick),
+                           "variant": variant or "per scene"}}
     result["_images"] = images  # not JSON: plot() writes them and drops them
     if out is not None:
         plot(result, out)
@@ -522,7 +584,8 @@ def markdown_tables(result: dict) -> dict[str, str]:
             blocks["image-after-11-summary"] = summary_line(run)
         for name, ordinal, previous in ((ROUND_2, "second", "after_11"), (ROUND_3, "third", ROUND_2),
                                         (ROUND_4, "fourth", ROUND_3), (ROUND_5, "fifth", ROUND_4),
-                                        (ROUND_6, "sixth", ROUND_5), (ROUND_7, "seventh", ROUND_6)):
+                                        (ROUND_6, "sixth", ROUND_5), (ROUND_7, "seventh", ROUND_6),
+                                        (ROUND_7B, "seventh (each scene's variant)", ROUND_6)):
             if name in result["runs"]:
                 blocks.update(_round_blocks(result["runs"], name, ordinal, previous))
         return blocks
@@ -567,7 +630,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path = Path(RESULT_JSON),
-               variant: str = REFERENCE_VARIANT) -> dict:
+               variant: str | None = None) -> dict:
     """Run the full section and keep it in ``json_path`` under ``runs[name]`` (the earlier
     runs stay), with its six triptychs stacked in ``image_folder/pathtrace_scenes_NAME.png``,
     its Pareto plot in ``pathtrace_pareto_NAME.png`` and the first scene's triptych in
@@ -601,4 +664,4 @@ def record_run(name: str, image_folder: Path = Path("docs/img"), json_path: Path
 if __name__ == "__main__":
     import sys
 
-    print(summary_line(record_run(sys.argv[1], variant=sys.argv[2] if len(sys.argv) > 2 else REFERENCE_VARIANT)))
+    print(summary_line(record_run(sys.argv[1], variant=sys.argv[2] if len(sys.argv) > 2 else None)))
