@@ -165,32 +165,15 @@ vec3 thread_normal(vec3 n, vec3 tangent, vec3 m) {
 }
 #endif
 
-// A front-layer map (room_shadow.frag FRONT_LAYER: r = the nearest layer's coverage, a = its
-// depth) at map point q (xy: texture coordinates, z: depth, 0..1): the coverage of the layer
-// in front of q, 0 where q is that layer itself. The depth test is a ramp from half to one
-// and a half times the bias and the four nearest texels are blended bilinearly (percentage-
-// closer filtering), so that the answer changes continuously across a shadow's edge and
-// along a fold's flank instead of flipping on rounding.
-float front_layer_coverage(sampler2D map, vec3 q, float bias) {
-    vec2 size = vec2(textureSize(map, 0));
-    vec2 st = q.xy * size - 0.5;
-    vec2 f = fract(st);
-    ivec2 i0 = ivec2(floor(st));
-    ivec2 top = ivec2(size) - 1;
-    float c[4];
-    for (int k = 0; k < 4; ++k) {
-        ivec2 texel = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), top);
-        vec4 front = texelFetch(map, texel, 0);
-        c[k] = front.r * smoothstep(0.5 * bias, 1.5 * bias, q.z - front.a);
-    }
-    return mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y);
-}
-
-// The key's two layers in front of a point (issue 11, seventh round): the front-layer map
-// ``first`` and the second layer's ``second`` (room_shadow.frag SECOND_LAYER; r: a layer's
-// thread coverage, a: its depth). Returns (c1, c2): each layer's coverage where q lies behind
-// it by the bias, bilinear over the four nearest texels as front_layer_coverage. A third layer
-// is not seen.
+// The key's two layers of cloth in front of a point (issue 11; the second since its seventh
+// round): the front-layer map ``first`` (room_shadow.frag FRONT_LAYER) and the second layer's
+// ``second`` (SECOND_LAYER, the first peeled); r: a layer's thread coverage, a: its depth. At
+// map point q (xy: texture coordinates, z: depth, 0..1), returns (c1, c2): each layer's
+// coverage where q lies behind it, 0 where q is that layer itself. The depth test is a ramp
+// from half to one and a half times the bias and the four nearest texels are blended
+// bilinearly (percentage-closer filtering), so that the answer changes continuously across a
+// shadow's edge and along a fold's flank instead of flipping on rounding. A third layer is
+// not seen.
 vec2 front_layers_coverage(sampler2D first, sampler2D second, vec3 q, float bias) {
     vec2 size = vec2(textureSize(first, 0));
     vec2 st = q.xy * size - 0.5;

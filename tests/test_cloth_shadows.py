@@ -83,6 +83,20 @@ def test_window_wall_shades_the_upper_curtain(gl, make_preset):
     r.release()
 
 
+def _key_across_the_folds(gl, make_preset, mesh):
+    """A cloth with no holes on ``mesh`` under a key 20 deg high and 60 deg aside (across the
+    folds), the room's light on its room side off (the room's capture draws the cloth with the
+    key's shadows, and these tests are about the key on the cloth alone): the renderer, its
+    G-buffer, the curtain mask, the pixels' positions and the direction to the light."""
+    r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh)
+    r.set_key_direction(elevation_deg=20.0, azimuth_deg=60.0)
+    r.set_room_side(False)
+    g = r.render_gbuffer()
+    mask = g["mask"]
+    p = g["position"][mask].astype(np.float64)
+    return r, g, mask, p, np.asarray(r.shading_inputs().key_to_light, dtype=np.float64)
+
+
 @pytest.mark.slow
 def test_folds_shade_the_cloth_behind_them(gl, make_preset):
     """The default drape under a key 20 deg high and 60 deg aside (across the folds): a pixel
@@ -96,15 +110,7 @@ def test_folds_shade_the_cloth_behind_them(gl, make_preset):
     dimmed to the layer's transmittance: their luminance falls by more than 20 % against the
     shadow off, the rest changes by less than 1e-3."""
     mesh = scene_lib.draped_curtain(columns=60, rows=40)
-    r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh)
-    r.set_key_direction(elevation_deg=20.0, azimuth_deg=60.0)
-    # the room's light on the cloth's room side changes with the key's shadows too (the room's
-    # capture draws the cloth with them); this test is about the key on the cloth alone
-    r.set_room_side(False)
-    g = r.render_gbuffer()
-    mask = g["mask"]
-    p = g["position"][mask].astype(np.float64)
-    to_light = np.asarray(r.shading_inputs().key_to_light, dtype=np.float64)
+    r, g, mask, p, to_light = _key_across_the_folds(gl, make_preset, mesh)
     expected, clear = key_shadow_bias.shadow_truth(p, to_light, mesh)
     behind = g["shadows"][mask][:, 1] > 0.5   # coverage 1 (LD 0): the ramp's and the 2x2 filter's midpoint
     beam = g["shadows"][mask][:, 0]
@@ -146,13 +152,7 @@ def test_the_key_shadow_counts_a_second_layer(gl, make_preset):
     luminance behind two layers is below that with the second layer off (set_key_second_layer)
     in the median. Bounds set before the first run."""
     mesh = scene_lib.draped_curtain(columns=60, rows=40, depth_m=0.15)
-    r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh)
-    r.set_key_direction(elevation_deg=20.0, azimuth_deg=60.0)
-    r.set_room_side(False)
-    g = r.render_gbuffer()
-    mask = g["mask"]
-    p = g["position"][mask].astype(np.float64)
-    to_light = np.asarray(r.shading_inputs().key_to_light, dtype=np.float64)
+    r, g, mask, p, to_light = _key_across_the_folds(gl, make_preset, mesh)
     layers = _layers_towards(p, to_light, mesh_triangles(mesh))
     second = g["second_coverage"][mask]
     two, one = layers >= 2, layers == 1
