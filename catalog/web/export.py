@@ -81,7 +81,13 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: the same modes.
 #: ``antialiasing``: FXAA, a pass the page replays (the renderer's ``auto`` would take MSAA
 #: on a GPU: multisampled renderbuffers and resolves the recording refuses).
-DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa"}
+#: ``key_second_layer``: off (issue 11, seventh round). With the key's shadow through two
+#: layers, the page under SwiftShader and the desktop frame under llvmpipe differ on 194 edge
+#: pixels of 19 200 in the fluoro-pink D65 scene (182 with one layer), over the 1 % the
+#: browser test allows (web/browser.py); the peel's slope taken from the normal instead of
+#: depth derivatives gave 194 too. Not yet understood; the page keeps the one-layer shadow.
+DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa",
+                 "key_second_layer": False}
 
 
 def configure_desktop_frame(renderer) -> None:
