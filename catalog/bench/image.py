@@ -174,10 +174,12 @@ def _reference_in_child(fabric: str, light_key: str, view: str, size, spp: int, 
     import sys  # noqa: PLC0415
     import tempfile  # noqa: PLC0415
 
+    yaw, pitch, distance = VIEWS[view]
     with tempfile.TemporaryDirectory() as scratch:
         out = Path(scratch) / "reference.npz"
-        subprocess.run([sys.executable, "-m", "catalog.bench.image_reference", fabric, light_key, view,
-                        str(size[0]), str(size[1]), str(spp), variant, str(out)], check=True)
+        subprocess.run([sys.executable, "-m", "catalog.bench.image_reference", fabric, light_name(light_key),
+                        repr(yaw), repr(pitch), repr(distance), str(size[0]), str(size[1]), str(spp),
+                        variant, str(out)], check=True)
         with np.load(out) as data:
             return {"a": data["a"], "b": data["b"], "seconds": float(data["seconds"]),
                     "nan_pixel_passes": int(data["nan_pixel_passes"]),

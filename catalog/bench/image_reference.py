@@ -7,7 +7,9 @@ the bench process's own is rendered here, in a child process, and handed back as
 the two half renders ``a`` and ``b``, the region masks ``mask_*``, the render time
 ``seconds`` (the two halves, scene building excluded) and ``nan_pixel_passes``.
 
-    python -m catalog.bench.image_reference FABRIC LIGHT VIEW WIDTH HEIGHT SPP VARIANT OUT.npz
+    python -m catalog.bench.image_reference FABRIC LIGHT YAW PITCH DISTANCE WIDTH HEIGHT SPP VARIANT OUT.npz
+
+(LIGHT a light's name; YAW, PITCH in degrees and DISTANCE in metres: the view's camera.)
 """
 
 from __future__ import annotations
@@ -35,12 +37,15 @@ def render_halves(mi, desc, spp: int) -> dict:
 
 
 def main(argv=None) -> int:
-    from catalog.bench.image import describe_bench_scene  # noqa: PLC0415
     from catalog.core.atomic import atomic_path  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
+    from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
-    fabric, light_key, view, width, height, spp, variant, out = (argv or sys.argv[1:])
-    desc = describe_bench_scene(fabric, light_key, view, (int(width), int(height)))
+    fabric, light, yaw, pitch, distance, width, height, spp, variant, out = (argv or sys.argv[1:])
+    desc = describe_scene(load_preset(find_preset(fabric)), get_light(light), size=(int(width), int(height)),
+                          yaw_deg=float(yaw), pitch_deg=float(pitch), distance_m=float(distance))
     result = render_halves(load_mitsuba(variant), desc, int(spp))
     with atomic_path(out) as tmp:
         with open(tmp, "wb") as handle:
