@@ -122,6 +122,7 @@ def test_the_frame_passes_the_rooms_and_folds_light_by_the_secondary_dye(gl):
     undyed = inputs.a_spec * hg_hemisphere_factors(inputs.g_spec)[0] / (1.0 - inputs.direct)
     np.testing.assert_allclose(thread, np.clip(key * undyed, 0, 1), rtol=1e-6)
     assert thread[1] < 0.1 * undyed
+    r.release()
 
 
 @pytest.mark.gl
@@ -148,6 +149,7 @@ def test_the_secondary_dye_brightens_the_safety_yellow_under_the_uv_lamp(gl):
         r.render()
         linear = r.read_linear()
         mask = r.render_gbuffer()["mask"]
+        r.release()
         return float((linear[mask] @ luma).mean())
 
     assert curtain_luminance("safety-yellow", True) >= 1.03 * curtain_luminance("safety-yellow", False)
