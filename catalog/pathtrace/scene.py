@@ -148,17 +148,18 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         pattern = {"coverage": np.asarray(loaded.coverage, dtype=np.float32),
                    "uv_scale": (float(cloth_m[0]) / loaded.repeat_m[0],
                                 float(cloth_m[1]) / loaded.repeat_m[1])}
+    from catalog.optics.dye_colour import dye_rgb_under  # noqa: PLC0415
+
     w = rgb_weights(inputs.key_irradiance)
     key_rgb = w @ inputs.key_irradiance
-    dyed = w @ (inputs.key_irradiance * inputs.dye_transmittance)
-    # per channel RGB(key x dye) / RGB(key), whatever the channel's sign: a UV lamp's faint
-    # visible leak is outside the sRGB gamut (green < 0), and its green was once set to 0
-    # here (issue 11), which took the negative green out of every light the cloth scattered
+    # per channel RGB(key x dye) / RGB(key), whatever the channel's sign (the frame's beam
+    # takes the same, dye_colour.key_dye_rgb): a UV lamp's faint visible leak is outside the
+    # sRGB gamut (green < 0), and its green was once set to 0 here (issue 11), which took the
+    # negative green out of every light the cloth scattered; a saturated dye under a white
+    # light can be outside it too (safety-yellow's blue under D65 is about -0.04 of the key's).
+    # A channel the key leaves empty takes the dye's own mean there.
     own_mean = w @ inputs.dye_transmittance / np.maximum(w @ np.ones_like(inputs.key_irradiance), 1e-30)
-    usable = np.abs(key_rgb) > 1e-6 * max(float(np.abs(key_rgb).max()), 1e-30)
-    # (a saturated dye under a white light can be outside it too: safety-yellow's blue under
-    # D65 is about -0.04 of the key's, carried as the frame's bands carry it)
-    dye_rgb = np.where(usable, dyed / np.where(usable, key_rgb, 1.0), own_mean)
+    dye_rgb = dye_rgb_under(inputs.key_irradiance, inputs.dye_transmittance, own_mean)
     fabric = {"direct": inputs.direct, "a_diff": inputs.a_diff, "g_diff": inputs.g_diff,
               "a_spec": inputs.a_spec, "g_spec": inputs.g_spec, "anisotropy": inputs.anisotropy,
               "dye_rgb": dye_rgb}

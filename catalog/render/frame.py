@@ -555,9 +555,9 @@ class FrameRenderer:
 
     def set_key_second_layer(self, on: bool) -> None:
         """Shade the cloth behind two layers of its folds with the key's beam through both (True,
-        issue 11's seventh round: the front-layer map keeps the farthest layer's depth too, and
-        the second layer passes the beam at the mean coverage) or through the nearest alone
-        (False, before: a point of voile behind two folds was 1.15-1.55x the path tracer's)."""
+        issue 11's seventh round: the front-layer map peeled into a second map, each layer
+        passing the beam by its own coverage) or through the nearest alone (False, before: a
+        point of voile behind two folds was 1.15-1.55x the path tracer's)."""
         self.key_second_layer = bool(on)
 
     def room_side_active(self) -> bool:
@@ -1460,19 +1460,23 @@ class FrameRenderer:
                 "u_thread_beam_rgb": tuple(float(v) for v in thread),
                 "u_lobe_rgb": tuple(float(v) for v in lobe)}
 
+    @staticmethod
+    def _key_depth_per_metre(inputs) -> float:
+        """The key's maps' depth (0..1) per metre along the key's travel: orthographic, window
+        depth = 0.5 ndc z + 0.5 with ndc z = m[2, 2] z_view + .., so a metre is -m[2, 2] / 2."""
+        return abs(float(room_light.light_view_projection(inputs.key_to_light)[2, 2])) / 2
+
     def _key_shadow_uniforms(self, program, inputs) -> None:
         """curtain.frag's KEY_SHADOW: the front-layer map, its frame and depth bias, the opening."""
         gl = self._room_resources()
         gl["key_front"].use(location=KEY_FRONT_UNIT)
         gl["key_second"].use(location=KEY_SECOND_UNIT)
-        self._set(program, "u_key_second", KEY_SECOND_UNIT)
         s = self._set
         s(program, "u_key_front", KEY_FRONT_UNIT)
+        s(program, "u_key_second", KEY_SECOND_UNIT)
         matrix = room_light.light_view_projection(inputs.key_to_light)
         s(program, "u_light_view_proj", gl_bytes(matrix))
-        # orthographic: window depth (0..1) = 0.5 ndc z + 0.5, ndc z = m[2, 2] z_view + ..:
-        # one metre along the travel is -m[2, 2] / 2 of depth
-        metre = abs(float(matrix[2, 2])) / 2
+        metre = self._key_depth_per_metre(inputs)
         slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels)
         s(program, "u_key_depth_bias", (KEY_SHADOW_BIAS_M * metre, slope_m * metre, KEY_SHADOW_SLOPE_CAP))
         s(program, "u_key_normal_offset", KEY_SHADOW_NORMAL_OFFSET_TEXELS
@@ -1696,8 +1700,7 @@ class FrameRenderer:
             self._front_layer_uniforms(program, inputs, patterned, colours)
             gl["key_front"].use(location=KEY_FRONT_UNIT)
             self._set(program, "u_first_layer", KEY_FRONT_UNIT)
-            matrix = room_light.light_view_projection(inputs.key_to_light)
-            self._set(program, "u_peel_bias", KEY_SHADOW_BIAS_M * abs(float(matrix[2, 2])) / 2)
+            self._set(program, "u_peel_bias", KEY_SHADOW_BIAS_M * self._key_depth_per_metre(inputs))
             self._shadow_vao(program, fine=True).render(mgl.TRIANGLES)
         self.ctx.disable(mgl.DEPTH_TEST)
 
