@@ -144,9 +144,16 @@ vec3 background_terms(vec3 dir, vec3 to_sun, float sun_chord2_inner, float sun_c
 #ifdef PATTERN
 uniform sampler2D u_pattern;
 
+// The pattern's texel over one pixel (fragment stages: texture()'s LOD bias). The mip level the
+// hardware picks has texels about a pixel wide, and its bilinear tent spreads them: a filter
+// about three times the pixel's box in variance (T^2/12 + T^2/6 at texel side T). The frame
+// passes PATTERN_LOD_BIAS = log2(1/sqrt(3)), the level whose filter has the box's variance
+// (frame.py PATTERN_LOD_BIAS, issue 11's eighth round); a vertex stage #undefs it.
+#ifdef PATTERN_LOD_BIAS
 vec4 thread_texel(vec2 uv_repeats) {
-    return texture(u_pattern, uv_repeats);
+    return texture(u_pattern, uv_repeats, PATTERN_LOD_BIAS);
 }
+#endif
 
 // Thread coverage at uv (in pattern repeats), mip-filtered by the hardware's footprint.
 float thread_coverage(vec2 uv_repeats) {

@@ -1,4 +1,5 @@
 #version 430
+#undef PATTERN_LOD_BIAS   // texture()'s bias is a fragment stage's (common.glsl thread_texel)
 #include "common.glsl"
 // The curtain mesh: positions (moved into the scene by u_mesh_offset: the cloth simulation's
 // own frame has the rod elsewhere), normals and the weft tangent; shared by the shading pass,

@@ -122,6 +122,12 @@ OCCLUSION_OFFSET_M = 0.03
 #: Texels a row of the per-vertex occlusion texture (curtain.vert reads texel index % width).
 VERTEX_OCCLUSION_WIDTH = 256
 PATTERN_ANISOTROPY = 4.0
+#: The pattern's LOD bias (common.glsl thread_texel; issue 11, eighth round): the reference
+#: averages a pixel's box (variance 1/12 px^2), the hardware's trilinear filter at its level
+#: (texel side T about a pixel) is the mip's box and the bilinear tent, T^2/12 + T^2/6 = T^2/4:
+#: three times too wide, which blurs the lace's motifs; the level with T = 1/sqrt(3) px matches
+#: the box's variance. 0: the hardware's level (before).
+PATTERN_LOD_BIAS = math.log2(1.0 / math.sqrt(3.0))
 #: The largest image side we accept (also limited by the context's GL_MAX_TEXTURE_SIZE).
 MAX_SIDE_PX = 16384
 
@@ -337,6 +343,8 @@ class FrameRenderer:
         self.secondary_dye = True
         #: the key's shadow on the cloth through two layers, not one (set_key_second_layer)
         self.key_second_layer = True
+        #: the pattern's LOD bias (set_pattern_lod_bias)
+        self.pattern_lod_bias = PATTERN_LOD_BIAS
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -559,6 +567,16 @@ class FrameRenderer:
         passing the beam by its own coverage) or through the nearest alone (False, before: a
         point of voile behind two folds was 1.15-1.55x the path tracer's)."""
         self.key_second_layer = bool(on)
+
+    def set_pattern_lod_bias(self, bias: float | bool) -> None:
+        """The pattern's mip level bias (log2 of the filter's texel side): PATTERN_LOD_BIAS or
+        True, the level whose filter has the pixel's box's variance (issue 11's eighth round);
+        0 or False, the hardware's level (before: the lace's motifs blurred); any float in
+        [-4, 4]."""
+        bias = PATTERN_LOD_BIAS if bias is True else 0.0 if bias is False else float(bias)
+        if not -4.0 <= bias <= 4.0:
+            raise InputError(f"{bias}: a LOD bias in [-4, 4]", field="pattern LOD bias")
+        self.pattern_lod_bias = bias
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -852,7 +870,8 @@ class FrameRenderer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.patterned and not gbuffer:
             # the holes are drawn by the OIT composite: no see-through term in the shader
-            defines.update({"PATTERN": True, "OIT": True, "SEE_THROUGH": False})
+            defines.update({"PATTERN": True, "OIT": True, "SEE_THROUGH": False,
+                            "PATTERN_LOD_BIAS": glsl_literal(self.pattern_lod_bias)})
         return defines
 
     def scene_values(self) -> dict:
