@@ -752,7 +752,7 @@ import dataclasses, json, sys
 import numpy as np
 from catalog.optics.lights import get_light
 from catalog.pathtrace.backend import load_mitsuba
-from catalog.pathtrace.render import render_radiance
+from catalog.pathtrace.render import region_masks, render_radiance
 from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
 from catalog.presets import find_preset, load_preset
 from catalog.render import scene as scene_lib
@@ -766,12 +766,22 @@ out = {"emission": np.asarray(desc.fluorescence["emission_spectrum"]).tolist()}
 room = dataclasses.replace(describe_scene(load_preset(find_preset("voile-white")), get_light("UV-A"),
                                           size=(32, 24), yaw_deg=20.0, pitch_deg=15.0, distance_m=2.6,
                                           curtain=curtain), fluorescence=None)
+# the lamp-lit outside through the open window: the curtain moved behind the camera
+away = (d.positions + np.array([0.0, 0.0, 4.0]), d.normals, d.uvs, d.tangents, d.indices)
+outside = dataclasses.replace(describe_scene(load_preset(find_preset("voile-white")), get_light("UV-A"),
+                                             size=(32, 24), distance_m=2.0, curtain=away),
+                              fluorescence=None)
 for variant in ("llvm_ad_rgb", "llvm_ad_spectral"):
     m = load_mitsuba(variant)
     image = render_radiance(m, build_mitsuba_scene(m, desc, max_depth=1), 64, seed=0)
     out[variant] = image[6:18, 8:24].reshape(-1, 3).astype(np.float64).mean(axis=0).tolist()
     image = render_radiance(m, build_mitsuba_scene(m, room, max_depth=3), 64, seed=0)
     out["room_" + variant] = image.reshape(-1, 3).astype(np.float64).mean(axis=0).tolist()
+    scene = build_mitsuba_scene(m, outside, max_depth=1)
+    image = render_radiance(m, scene, 256, seed=0)   # the violet's few wavelengths: 256 spp
+    mask = region_masks(m, scene, outside)["outside"]
+    out["outside_" + variant] = image[mask].astype(np.float64).mean(axis=0).tolist()
+    out["outside_pixels_" + variant] = int(mask.sum())
 json.dump(out, sys.stdout)
 """
 
@@ -789,7 +799,7 @@ def test_the_spectral_variant_emits_the_glows_own_spectrum():
     The renders run in a child process: switching Mitsuba's variant after this module's
     other renders crashed its JIT (a segfault) in the test process. And the UV lamp's own
     visible light, with the glow left out, in the room: the two variants' mean luminance
-    within 5 %."""
+    within 5 %; the lamp-lit outside through the open window in its own colour."""
     import json
     import subprocess
     import sys
@@ -811,6 +821,14 @@ def test_the_spectral_variant_emits_the_glows_own_spectrum():
     # the lamp and the variant's upsampling clamped its negative green)
     room_rgb, room_spectral = np.array(out["room_llvm_ad_rgb"]), np.array(out["room_llvm_ad_spectral"])
     assert abs(room_spectral @ luma / (room_rgb @ luma) - 1.0) <= 0.05, room_spectral @ luma / (room_rgb @ luma)
+    # the lamp-lit outside seen through the window (issue 11, eighth round: the window
+    # filter): the spectral render's mean linear sRGB over the outside's pixels equals the RGB
+    # render's, negative green included, within 5 % of the largest channel per channel (the
+    # in-gamut stand-in it replaces had green >= 0 and blue 0.08 of this)
+    assert out["outside_pixels_llvm_ad_spectral"] == out["outside_pixels_llvm_ad_rgb"] >= 100
+    out_rgb, out_spectral = np.array(out["outside_llvm_ad_rgb"]), np.array(out["outside_llvm_ad_spectral"])
+    assert out_rgb[1] < 0
+    np.testing.assert_allclose(out_spectral, out_rgb, atol=0.05 * np.abs(out_rgb).max())
 
 
 def test_a_spectral_render_leaves_a_pixels_nan_pass_out_of_its_mean():
@@ -874,6 +892,37 @@ def test_the_spectral_key_and_backdrop_keep_their_luminance():
         wavelengths, values = key_spectrum(desc)
         assert np.all(values >= 0)
         np.testing.assert_allclose(film_luminance(wavelengths, values), desc.key_rgb @ luma, rtol=1e-9)
+
+
+def test_the_window_filter_gives_the_outside_the_keys_spectrum():
+    """catalog.pathtrace.window_filter (issue 11, eighth round): T = S / (Y(S) D65), so a grey
+    texel of luminance g times D65 leaves the sheet as g S / Y(S) and the key given as Y(S)
+    D65 leaves it as S (closed form, 1e-12, on a D65 stand-in); T = 0 for a dark key; the
+    sheet is used only where the outside is the key's spectrum times a scalar: under the UV
+    lamp and a D65 lamp, not under the sun (a tinted sky); the grey map keeps each
+    texel's luminance, negative channels included (1e-6)."""
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace import window_filter
+    from catalog.pathtrace.scene import describe_scene, film_luminance, key_spectrum
+
+    luma = np.array([0.2126, 0.7152, 0.0722])
+    desc = describe_scene(desc_preset("voile-white"), get_light("UV-A"), size=(8, 6))
+    wavelengths, values = key_spectrum(desc)
+    d65 = 1.0 + 0.3 * np.sin(wavelengths / 40.0)   # any positive spectrum stands in for it
+    y = film_luminance(wavelengths, values)
+    t = window_filter.transmission(values, y, d65)
+    np.testing.assert_allclose(0.37 * d65 * t, 0.37 * values / y, rtol=1e-12, atol=1e-300)
+    np.testing.assert_allclose((y * d65) * t, values, rtol=1e-12, atol=1e-300)
+    assert not window_filter.transmission(values, 0.0, d65).any()
+    assert window_filter.outside_carries_key_spectrum(desc)
+    assert window_filter.outside_carries_key_spectrum(
+        describe_scene(desc_preset("voile-white"), get_light("D65"), size=(8, 6)))
+    assert not window_filter.outside_carries_key_spectrum(
+        describe_scene(desc_preset("voile-white"), get_light("sun:1.5"), size=(8, 6)))
+    env = np.array([[[0.29, -0.27, 2.06], [0.1, 0.2, 0.3]]])
+    grey = window_filter.grey_environment(env)
+    np.testing.assert_allclose(grey[..., 0], env @ luma, rtol=1e-6)
+    assert np.all(grey[..., 0] == grey[..., 2])
 
 
 def test_the_bench_takes_the_spectral_reference_where_the_dye_of_the_secondary_light_differs():

@@ -49,7 +49,8 @@ _LOADED: dict[str, object] = {}
 
 
 def load_mitsuba(variant: str = DEFAULT_VARIANT):
-    """The ``mitsuba`` module with ``variant`` set (the woven BSDF and the glow texture registered)."""
+    """The ``mitsuba`` module with ``variant`` set (the woven BSDF, the glow texture and the
+    window filter registered)."""
     check_variant(variant)
     if variant in _LOADED:
         import mitsuba as mi  # noqa: PLC0415
@@ -75,9 +76,10 @@ def load_mitsuba(variant: str = DEFAULT_VARIANT):
         raise EnvironmentFailure(f"Mitsuba variant {variant} is unavailable: "
                                  f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}"
                                  f" (LLVM library {library})") from None
-    from catalog.pathtrace import glow, woven  # noqa: PLC0415
+    from catalog.pathtrace import glow, window_filter, woven  # noqa: PLC0415
 
     woven.register(mi)
     glow.register(mi)
+    window_filter.register(mi)
     _LOADED[variant] = mi
     return mi

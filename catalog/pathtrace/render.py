@@ -183,6 +183,7 @@ def region_masks(mi, scene, desc) -> dict[str, np.ndarray]:
     from a ray per pixel centre through the reference's own camera and geometry."""
     import drjit as dr  # noqa: PLC0415
 
+    from catalog.pathtrace.window_filter import SHEET_ID  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
     width, height = desc.size
@@ -199,6 +200,10 @@ def region_masks(mi, scene, desc) -> dict[str, np.ndarray]:
         if name == "curtain" or name.startswith("fluorescence_"):
             on_curtain |= np.asarray(si.shape == mi.ShapePtr(shape), dtype=bool)
     on_curtain &= valid
+    beyond = np.zeros(valid.shape, dtype=bool)   # the spectral outside's filter sheet (window_filter)
+    if SHEET_ID in shapes:
+        beyond = valid & np.asarray(si.shape == mi.ShapePtr(shapes[SHEET_ID]), dtype=bool)
+    valid = valid & ~beyond
     on_room = valid & ~on_curtain
     p = np.asarray(si.p, dtype=np.float64)
     p = p.T if p.shape[0] == 3 else p

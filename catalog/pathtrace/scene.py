@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from catalog.pathtrace import window_filter
 from catalog.pathtrace.glow import ATTRIBUTE
 
 #: Environment map size (lat-long, width = 2 height). 2048 x 1024: 0.18 deg texels.
@@ -517,15 +518,27 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     # a spectral variant takes the key as its own spectrum (key_spectrum), a directional light
     # (the disc's 0.27 degree radius gives penumbrae under 1 mm at the folds' distances)
     spectral_key = bool(mi.is_spectral) and environment and not key_as_directional
+    # the outside in the key's own spectrum through a filter across the window, where it is the
+    # key's spectrum times a scalar (catalog.pathtrace.window_filter, issue 11's eighth round)
+    filtered = spectral_key and window_filter.outside_carries_key_spectrum(desc)
     if environment:
         env = environment_map(desc.sky_rgb, desc.ground_rgb,
                               np.zeros(3) if key_as_directional or spectral_key else desc.key_rgb,
                               desc.key_to_light, desc.key_radius_rad, sky=desc.sky)
-        if mi.is_spectral:
+        if filtered:
+            env = window_filter.grey_environment(env)
+        elif mi.is_spectral:
             env = in_gamut_same_luminance(env).astype(np.float32)
         scene["environment"] = {"type": "envmap", "bitmap": mi.Bitmap(env)}
+    sheet_transmission = None
     if spectral_key:
         wavelengths, values = key_spectrum(desc)
+        if filtered:   # the key crosses the sheet too: given as its luminance times D65
+            luminance = max(float(np.asarray(desc.key_rgb) @ np.array([0.2126, 0.7152, 0.0722])), 0.0)
+            d65 = window_filter.mitsuba_d65(mi, wavelengths)
+            sheet_transmission = (wavelengths, window_filter.transmission(
+                values, film_luminance(wavelengths, values), d65))
+            values = luminance * d65
         scene["key"] = {"type": "directional", "direction": [float(-v) for v in desc.key_to_light],
                         "irradiance": {"type": "regular", "wavelength_min": float(wavelengths[0]),
                                        "wavelength_max": float(wavelengths[-1]),
@@ -537,9 +550,17 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
         scene["fill"] = {"type": "directional",
                          "direction": [float(-v) for v in desc.fill_to_light],
                          "irradiance": {"type": "rgb", "value": [float(v) for v in desc.fill_rgb]}}
-    loaded = mi.load_dict(scene)
+    loaded = mi.load_dict(scene)   # without the sheet: the glow's visibility rays (key_visibility)
+    if sheet_transmission is not None:
+        sheet_props = mi.Properties()
+        sheet_bsdf = mi.load_dict({"type": "window_filter"})
+        sheet_bsdf.set_transmission(*sheet_transmission)
+        sheet_props["bsdf"] = sheet_bsdf
+        positions_s, faces_s, normals_s = window_filter.sheet_geometry()
+        scene[window_filter.SHEET_ID] = _mesh(mi, window_filter.SHEET_ID, positions_s, faces_s,
+                                              normals_s, props=sheet_props)
     if desc.fluorescence is None:
-        return loaded
+        return loaded if sheet_transmission is None else mi.load_dict(scene)
     p, n, shell_uvs, tri = glow_shell_mesh(desc)
     emission = fluorescence_per_vertex(desc, loaded, mi, mesh=(p, n))
     weights = emitter_sampling_weights(desc, emission)
