@@ -73,6 +73,8 @@ OPTIONS = (
      {"secondary_dye": False}),
     ("key's shadow through one layer (before round 7)", 3, "physical", 1, None, None,
      {"key_second_layer": False}),
+    ("pattern at the hardware's mip level (before round 8)", 3, "physical", 1, None, None,
+     {"pattern_lod_bias": 0.0}),
     ("shadow maps 128", 3, "physical", 1, None, None, {"shadow_map_size": 128}),
     ("shadow maps 512", 3, "physical", 1, None, None, {"shadow_map_size": 512}),
     ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
@@ -118,6 +120,9 @@ ROUND_7 = "after_11_round_7"
 #: Its second run: each scene's reference in the variant it needs (reference_variant_for;
 #: the first run took the spectral variant for all six): ``runs[ROUND_7B]``.
 ROUND_7B = "after_11_round_7b"
+#: The run after its eighth round (the pattern at the mip level whose filter has a pixel box's
+#: variance; the spectral reference's outside in the lamp's own spectrum): ``runs[ROUND_8]``.
+ROUND_8 = "after_11_round_8"
 #: The reference's Mitsuba variants. The RGB variant's cloth carries one RGB dye,
 #: RGB(key x dye) / RGB(key), exact for light of the key's spectrum; under the UV-A lamp that
 #: is 0.048 in every channel, while the safety-yellow's glow, most of the light there, passes
@@ -587,7 +592,8 @@ def markdown_tables(result: dict) -> dict[str, str]:
         for name, ordinal, previous in ((ROUND_2, "second", "after_11"), (ROUND_3, "third", ROUND_2),
                                         (ROUND_4, "fourth", ROUND_3), (ROUND_5, "fifth", ROUND_4),
                                         (ROUND_6, "sixth", ROUND_5), (ROUND_7, "seventh", ROUND_6),
-                                        (ROUND_7B, "seventh (each scene's variant)", ROUND_6)):
+                                        (ROUND_7B, "seventh (each scene's variant)", ROUND_6),
+                                        (ROUND_8, "eighth", ROUND_7B)):
             if name in result["runs"]:
                 blocks.update(_round_blocks(result["runs"], name, ordinal, previous))
         return blocks
