@@ -115,6 +115,10 @@ def _pattern_checks(f: dict) -> tuple[str, str]:
         ("dolly 3 m -> 0.2 m, 40 frames, 128x96, one exposure",
          "filtered <= 0.6 x unfiltered, < 8 levels (6 under the old Reinhard display)",
          f"{dolly['filtered']:.1f} vs {dolly['unfiltered']:.1f} levels"),
+        ("the pattern's LOD bias (log2 1/sqrt 3) vs the hardware's level, lace at 0.8 m, 96x72, "
+         "against its 4x4 box (hardware level)", "mean relative luminance error <= 0.85 x",
+         (f"{lod['box variance']:.4f} vs {lod['hardware level']:.4f}"
+          if (lod := f.get("pattern.lod_bias_box_error")) else "not run")),
         ("FXAA vs a 4x4 supersampled frame, edge pixels", "<= 0.8 x no AA", edge("fxaa")),
         ("MSAA 4x vs the same reference, edge pixels", "<= 0.8 x no AA", edge("msaa")),
         ("MSAA vs one sample, curtain interior (HDR)", "mean relative difference < 2 %",
