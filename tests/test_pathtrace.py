@@ -899,7 +899,8 @@ def test_the_window_filter_gives_the_outside_the_keys_spectrum():
     texel of luminance g times D65 leaves the sheet as g S / Y(S) and the key given as Y(S)
     D65 leaves it as S (closed form, 1e-12, on a D65 stand-in); T = 0 for a dark key; the
     sheet is used only where the outside is the key's spectrum times a scalar: under the UV
-    lamp and a D65 lamp, not under the sun (a tinted sky); the grey map keeps each
+    lamp and a D65 lamp, not under the sun (a tinted sky), and only with the camera in the
+    room; the grey map keeps each
     texel's luminance, negative channels included (1e-6)."""
     from catalog.optics.lights import get_light
     from catalog.pathtrace import window_filter
@@ -919,6 +920,11 @@ def test_the_window_filter_gives_the_outside_the_keys_spectrum():
         describe_scene(desc_preset("voile-white"), get_light("D65"), size=(8, 6)))
     assert not window_filter.outside_carries_key_spectrum(
         describe_scene(desc_preset("voile-white"), get_light("sun:1.5"), size=(8, 6)))
+    # from outside the camera would see the room through the sheet: none there
+    assert window_filter.sheet_applies(desc)
+    outside = describe_scene(desc_preset("voile-white"), get_light("UV-A"), size=(8, 6), yaw_deg=180.0)
+    assert outside.camera_position[2] < -0.5
+    assert not window_filter.sheet_applies(outside)
     env = np.array([[[0.29, -0.27, 2.06], [0.1, 0.2, 0.3]]])
     grey = window_filter.grey_environment(env)
     np.testing.assert_allclose(grey[..., 0], env @ luma, rtol=1e-6)

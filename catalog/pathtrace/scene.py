@@ -520,7 +520,7 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     spectral_key = bool(mi.is_spectral) and environment and not key_as_directional
     # the outside in the key's own spectrum through a filter across the window, where it is the
     # key's spectrum times a scalar (catalog.pathtrace.window_filter, issue 11's eighth round)
-    filtered = spectral_key and window_filter.outside_carries_key_spectrum(desc)
+    filtered = spectral_key and window_filter.sheet_applies(desc)
     if environment:
         env = environment_map(desc.sky_rgb, desc.ground_rgb,
                               np.zeros(3) if key_as_directional or spectral_key else desc.key_rgb,

@@ -11,7 +11,8 @@ negative green, was bluer on every fold (the safety-yellow room under the lamp, 
 in the troughs).
 
 Where the outside's radiance is the key light's spectrum S times a scalar per direction (sky
-and ground lit by the key, no sky image: ``outside_carries_key_spectrum``), the reference
+and ground lit by the key, no sky image: ``outside_carries_key_spectrum``) and the camera is
+in the room (``sheet_applies``), the reference
 now renders it exactly: the environment map holds the scalar (the texel's luminance, as
 grey), which Mitsuba emits as luminance times its D65 (normalised to luminance 1), and a
 null-scattering sheet across the window's outer plane passes light by
@@ -121,6 +122,16 @@ def outside_carries_key_spectrum(desc) -> bool:
         if abs(rgb @ key) / (np.linalg.norm(rgb) * np.linalg.norm(key)) < 1.0 - 1e-6:
             return False
     return True
+
+
+def sheet_applies(desc) -> bool:
+    """Whether the reference takes the sheet: the outside carries the key's spectrum and the
+    camera is in the room. From outside, the camera would look into the room through the
+    sheet, and the room's light would reach it filtered; there the in-gamut stand-in stays."""
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    inside = float(np.asarray(desc.camera_position, dtype=np.float64)[2]) > scene_lib.WINDOW_Z
+    return inside and outside_carries_key_spectrum(desc)
 
 
 def mitsuba_d65(mi, wavelengths_nm: np.ndarray) -> np.ndarray:
