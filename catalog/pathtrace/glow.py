@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from catalog.pathtrace.tabulated import TabulatedSpectrum
+
 #: The mesh attribute holding the per-vertex emission (linear sRGB radiance per side).
 ATTRIBUTE = "vertex_fluorescence"
 
@@ -48,11 +50,7 @@ def register(mi) -> None:
             ``luminance``. A point then emits the shape times its RGB attribute's luminance
             over ``luminance``: every vertex's RGB is the same colour scaled (the effective
             photons, module doc), so the spectrum the film sees converts back to it."""
-            wavelengths = np.asarray(wavelengths_nm, dtype=np.float64)
-            self.spectrum = mi.Float(np.asarray(values, dtype=np.float32))
-            self.spectrum_size = int(wavelengths.size)
-            self.first_nm = float(wavelengths[0])
-            self.step_nm = float(wavelengths[1] - wavelengths[0])
+            self.spectrum = TabulatedSpectrum(mi, wavelengths_nm, values)
             self.inv_luminance = 1.0 / max(float(luminance), 1e-30)
 
         def attach(self, mesh) -> None:
@@ -73,16 +71,7 @@ def register(mi) -> None:
                 return dr.select(active, mi.Spectrum(self._value(si, active)), 0.0)
             rgb = self._value(si, active)
             scale = (0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z) * self.inv_luminance
-            lanes = []
-            for k in range(len(si.wavelengths)):
-                x = (si.wavelengths[k] - self.first_nm) / self.step_nm
-                inside = active & (x >= 0.0) & (x <= self.spectrum_size - 1)
-                i = mi.UInt32(dr.clip(dr.floor(x), 0, self.spectrum_size - 2))
-                f = x - mi.Float(i)
-                a = dr.gather(mi.Float, self.spectrum, i, inside)
-                b = dr.gather(mi.Float, self.spectrum, i + 1, inside)
-                lanes.append(dr.select(inside, a + f * (b - a), 0.0) * scale)
-            return dr.select(active, mi.Spectrum(*lanes), 0.0)
+            return dr.select(active, self.spectrum.at(mi, si.wavelengths, active) * scale, 0.0)
 
         def eval_3(self, si, active=True):
             return dr.select(active, mi.Color3f(self._value(si, active)), 0.0)

@@ -30,6 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from catalog.pathtrace.tabulated import TabulatedSpectrum
+
 #: The sheet's shape id (render.region_masks counts it as the outside).
 SHEET_ID = "window_filter"
 #: How far (m) the sheet lies outside the wall's outer plane, and how far beyond the window
@@ -52,25 +54,12 @@ def register(mi) -> None:
 
         def set_transmission(self, wavelengths_nm, values) -> None:
             """T on the evenly spaced ``wavelengths_nm`` (0 outside them)."""
-            wavelengths = np.asarray(wavelengths_nm, dtype=np.float64)
-            self.values = mi.Float(np.asarray(values, dtype=np.float32))
-            self.size = int(wavelengths.size)
-            self.first_nm = float(wavelengths[0])
-            self.step_nm = float(wavelengths[1] - wavelengths[0])
+            self.values = TabulatedSpectrum(mi, wavelengths_nm, values)
 
         def _transmission(self, si, active):
             if self.values is None:
                 return mi.Spectrum(1.0)
-            lanes = []
-            for k in range(len(si.wavelengths)):
-                x = (si.wavelengths[k] - self.first_nm) / self.step_nm
-                inside = active & (x >= 0.0) & (x <= self.size - 1)
-                i = mi.UInt32(dr.clip(dr.floor(x), 0, self.size - 2))
-                f = x - mi.Float(i)
-                a = dr.gather(mi.Float, self.values, i, inside)
-                b = dr.gather(mi.Float, self.values, i + 1, inside)
-                lanes.append(dr.select(inside, a + f * (b - a), 0.0))
-            return mi.Spectrum(*lanes)
+            return self.values.at(mi, si.wavelengths, active)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             bs = dr.zeros(mi.BSDFSample3f)
