@@ -200,10 +200,8 @@ def region_masks(mi, scene, desc) -> dict[str, np.ndarray]:
         if name == "curtain" or name.startswith("fluorescence_"):
             on_curtain |= np.asarray(si.shape == mi.ShapePtr(shape), dtype=bool)
     on_curtain &= valid
-    beyond = np.zeros(valid.shape, dtype=bool)   # the spectral outside's filter sheet (window_filter)
-    if SHEET_ID in shapes:
-        beyond = valid & np.asarray(si.shape == mi.ShapePtr(shapes[SHEET_ID]), dtype=bool)
-    valid = valid & ~beyond
+    if SHEET_ID in shapes:   # the spectral outside's filter sheet (window_filter) is the outside
+        valid &= ~np.asarray(si.shape == mi.ShapePtr(shapes[SHEET_ID]), dtype=bool)
     on_room = valid & ~on_curtain
     p = np.asarray(si.p, dtype=np.float64)
     p = p.T if p.shape[0] == 3 else p

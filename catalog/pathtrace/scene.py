@@ -534,10 +534,9 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
     if spectral_key:
         wavelengths, values = key_spectrum(desc)
         if filtered:   # the key crosses the sheet too: given as its luminance times D65
-            luminance = max(float(np.asarray(desc.key_rgb) @ np.array([0.2126, 0.7152, 0.0722])), 0.0)
+            luminance = film_luminance(wavelengths, values)
             d65 = window_filter.mitsuba_d65(mi, wavelengths)
-            sheet_transmission = (wavelengths, window_filter.transmission(
-                values, film_luminance(wavelengths, values), d65))
+            sheet_transmission = (wavelengths, window_filter.transmission(values, luminance, d65))
             values = luminance * d65
         scene["key"] = {"type": "directional", "direction": [float(-v) for v in desc.key_to_light],
                         "irradiance": {"type": "regular", "wavelength_min": float(wavelengths[0]),
@@ -550,7 +549,6 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
         scene["fill"] = {"type": "directional",
                          "direction": [float(-v) for v in desc.fill_to_light],
                          "irradiance": {"type": "rgb", "value": [float(v) for v in desc.fill_rgb]}}
-    loaded = mi.load_dict(scene)   # without the sheet: the glow's visibility rays (key_visibility)
     if sheet_transmission is not None:
         sheet_props = mi.Properties()
         sheet_bsdf = mi.load_dict({"type": "window_filter"})
@@ -560,7 +558,9 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
         scene[window_filter.SHEET_ID] = _mesh(mi, window_filter.SHEET_ID, positions_s, faces_s,
                                               normals_s, props=sheet_props)
     if desc.fluorescence is None:
-        return loaded if sheet_transmission is None else mi.load_dict(scene)
+        return mi.load_dict(scene)
+    # the glow's visibility rays (key_visibility) take the scene without the sheet
+    loaded = mi.load_dict({k: v for k, v in scene.items() if k != window_filter.SHEET_ID})
     p, n, shell_uvs, tri = glow_shell_mesh(desc)
     emission = fluorescence_per_vertex(desc, loaded, mi, mesh=(p, n))
     weights = emitter_sampling_weights(desc, emission)

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from catalog.core.constants import LUMA_REC709
 from catalog.pathtrace.tabulated import TabulatedSpectrum
 
 #: The sheet's shape id (render.region_masks counts it as the outside).
@@ -146,8 +147,7 @@ def transmission(key_values: np.ndarray, key_luminance: float, d65: np.ndarray) 
 def grey_environment(env_rgb: np.ndarray) -> np.ndarray:
     """The environment map as grey texels of each texel's luminance (linear sRGB weights;
     the out-of-gamut colour's luminance is its CIE Y, positive)."""
-    luminance = np.clip(np.asarray(env_rgb, dtype=np.float64) @ np.array([0.2126, 0.7152, 0.0722]),
-                        0.0, None)
+    luminance = np.clip(np.asarray(env_rgb, dtype=np.float64) @ np.array(LUMA_REC709), 0.0, None)
     return np.repeat(luminance[..., None], 3, axis=-1).astype(np.float32)
 
 
