@@ -377,6 +377,209 @@ float rectangle_irradiance_factor(vec3 x, vec3 n, vec3 corner, vec3 s, vec3 t) {
                      + polygon_edge_term(v2, v3, n) + polygon_edge_term(v3, v0, n));
 }
 
+#ifdef WINDOW_LIGHT
+// ---- The closed window as the room's area light (issue 13; issue 11's sixth and ninth
+// rounds; room_light.window_irradiance is the float64 twin). room_lightmap.frag evaluates it
+// at the light map's points; room.frag (WINDOW_NEAR) per pixel on the window wall beside the
+// opening, where it falls tenfold within a light-map texel.
+//
+// The room sees the curtain through a box around its folds: its front (the plane u_front_z,
+// the opening's rectangle in 12 x 9 patches) carries the room's captures (the middle eye's,
+// and with SIDE_EYES the three blended by angle); its sides (the opening's edges x = x0, x1,
+// from the curtain's plane u_back_plane_z to the front, normal -x and +x) the edge column of
+// the eye towards that side; its top and bottom (y = y1, y0) the middle's edge row; between
+// the window wall and the curtain's plane, the sides' gaps show the cloth's window side
+// (its capture's edge column) to points in front of that plane, and points behind it see
+// the window side's patches (plane u_back_plane_z, normal -z). Light leaving the folds
+// sideways, which a rectangle in the opening's plane sends nowhere, reaches the walls that
+// see the window edge-on. With u_front_z at the opening's plane (no box) the front alone,
+// as before the ninth round.
+uniform sampler2D u_luminaire;       // mipmapped; level u_luminaire_level = one texel a patch
+uniform ivec2 u_luminaire_size;
+uniform int u_luminaire_level;
+#ifdef SIDE_EYES
+// The same capture from two eyes towards the side walls (left then right, side by side,
+// room_light.CAPTURE_SIDE_EYES): the folds' flanks face either way and glow unequally.
+uniform sampler2D u_luminaire_sides;
+uniform int u_luminaire_sides_level; // their level of one texel a patch
+uniform vec3 u_side_eye[2];
+uniform vec3 u_middle_eye;
+#endif
+uniform sampler2D u_luminaire_back;  // the closed curtain's window side (0 where no cloth)
+uniform int u_luminaire_back_level;  // its level of one texel a patch
+uniform float u_back_plane_z;        // its patches' plane (m), normal -z: the curtain's
+uniform float u_front_z;             // the box's front (m); the opening's plane: no box
+uniform vec3 u_lobe_rgb;             // key x a_spec x dye (0: the lobe travels in the beam)
+uniform float u_g_spec;
+uniform int u_lamp_count;
+uniform vec3 u_lamp_position[4];
+uniform vec3 u_lamp_rgb[4];          // intensity as linear sRGB (irradiance at 1 m)
+
+// The radiance window patch (i, j), centred at c, sends towards p: the middle capture's or,
+// SIDE_EYES, the three captures blended piecewise linearly in the horizontal angle of the way
+// from c to p between the angles at which c sees the eyes, clamped beyond the side eyes
+// (float64 twin: room_light.capture_eye_weights); alpha (the key's reach on the patch's
+// cloth) always the middle's.
+vec4 captured_towards(int i, int j, vec3 c, vec3 p) {
+    vec4 middle = texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level);
+#ifdef SIDE_EYES
+    float a = atan(p.x - c.x, max(p.z - c.z, 1e-6));
+    float a_left = atan(u_side_eye[0].x - c.x, max(u_side_eye[0].z - c.z, 1e-6));
+    float a_mid = atan(u_middle_eye.x - c.x, max(u_middle_eye.z - c.z, 1e-6));
+    float a_right = atan(u_side_eye[1].x - c.x, max(u_side_eye[1].z - c.z, 1e-6));
+    vec3 rgb;
+    if (a <= a_mid) {
+        vec3 left = texelFetch(u_luminaire_sides, ivec2(i, j), u_luminaire_sides_level).rgb;
+        rgb = mix(middle.rgb, left, clamp((a_mid - a) / (a_mid - a_left), 0.0, 1.0));
+    } else {
+        vec3 right = texelFetch(u_luminaire_sides, ivec2(i + u_luminaire_size.x, j), u_luminaire_sides_level).rgb;
+        rgb = mix(middle.rgb, right, clamp((a - a_mid) / (a_right - a_mid), 0.0, 1.0));
+    }
+    return vec4(rgb, middle.a);
+#else
+    return middle;
+#endif
+}
+
+#ifdef WALL_EYES
+// The box's sides captured from eyes by the window wall (room_light.WALL_EYES; left then
+// right, a column of patch rows each): what the wall beside the opening sees through them.
+uniform sampler2D u_luminaire_walls;
+uniform int u_luminaire_walls_level; // their level of one texel a patch
+uniform vec3 u_wall_eye[2];
+#endif
+
+// The angle (rad) of the way from c on the box's side (right: x = x1, else x0) to q, up from
+// the side's outward normal towards +z (into the room).
+float box_side_angle(vec3 c, vec3 q, bool right) {
+    return atan(q.z - c.z, right ? q.x - c.x : c.x - q.x);
+}
+
+// What the box's left (or right) side, row j, centred at c, sends to p: the edge column of the
+// capture from the eye towards that side's wall (the middle's without SIDE_EYES); WALL_EYES,
+// blended with the wall eye's capture linearly in box_side_angle from the wall eye's angle
+// (the wall eye's alone) to level (the room's eye's alone), clamped: a way level with the
+// side's centre or falling crosses the folds as the room's eyes see them, one rising from
+// below it (from the window wall beside the opening) mostly passes in front of the folds and
+// leaves by the box's front (room_light.wall_eye_weight is the float64 twin). alpha (the
+// key's reach, for the lobe) the middle's edge column.
+vec4 box_side_radiance(int j, bool right, vec3 c, vec3 p) {
+    int column = right ? u_luminaire_size.x - 1 : 0;
+    float alpha = texelFetch(u_luminaire, ivec2(column, j), u_luminaire_level).a;
+#ifdef SIDE_EYES
+    vec3 rgb = texelFetch(u_luminaire_sides, ivec2(column + (right ? u_luminaire_size.x : 0), j),
+                          u_luminaire_sides_level).rgb;
+#else
+    vec3 rgb = texelFetch(u_luminaire, ivec2(column, j), u_luminaire_level).rgb;
+#endif
+#ifdef WALL_EYES
+    vec3 wall = texelFetch(u_luminaire_walls, ivec2(right ? 1 : 0, j), u_luminaire_walls_level).rgb;
+    float a_wall = box_side_angle(c, u_wall_eye[right ? 1 : 0], right);
+    rgb = mix(wall, rgb, clamp((box_side_angle(c, p, right) - a_wall) / (0.0 - a_wall), 0.0, 1.0));
+#endif
+    return vec4(rgb, alpha);
+}
+
+// The key's directional lobe through the cloth of a patch centred at c, towards p (eq. 7:
+// E cos_i a_spec ph(theta), theta between the key's travel and the way to p from the patch's
+// centre); alpha, the key's irradiance on the patch's cloth per unit of its normal irradiance
+// (|cos_i| x the window's mask x what a layer nearer the light passes), is the capture's.
+vec3 key_lobe(float alpha, vec3 c, vec3 p, vec3 key_to_light) {
+    if (u_lobe_rgb == vec3(0.0)) {
+        return vec3(0.0);
+    }
+    float hg_k = (1.0 - u_g_spec) * (1.0 + u_g_spec) / (4.0 * PI);
+    vec3 w = normalize(p - c);
+    float chord2 = dot(w + key_to_light, w + key_to_light);
+    float d = (1.0 - u_g_spec) * (1.0 - u_g_spec) + u_g_spec * chord2;
+    return u_lobe_rgb * (alpha * hg_k / (d * sqrt(d)));
+}
+
+// The window's light at point p (normal n) of the room, outside the opening: the box's
+// faces it lies in front of (E = sum L F, F pi times each rectangle's exact form factor),
+// and behind the curtain's plane the window side's patches. ``opening``: x0, x1, y0, y1 (m);
+// ``wall_z``: the window wall's inner plane.
+vec3 window_irradiance(vec3 p, vec3 n, vec4 opening, float wall_z, vec3 key_to_light) {
+    vec2 cell = vec2(opening.y - opening.x, opening.w - opening.z) / vec2(u_luminaire_size);
+    vec3 s = vec3(cell.x, 0.0, 0.0);
+    vec3 t = vec3(0.0, cell.y, 0.0);
+    vec3 e = vec3(0.0);
+    if (p.z > u_front_z + 1e-4) {
+        for (int j = 0; j < u_luminaire_size.y; ++j) {
+            for (int i = 0; i < u_luminaire_size.x; ++i) {
+                vec3 corner = vec3(opening.x + float(i) * cell.x, opening.z + float(j) * cell.y, u_front_z);
+                vec3 centre = corner + 0.5 * (s + t);
+                vec4 captured = captured_towards(i, j, centre, p);
+                e += (captured.rgb + key_lobe(captured.a, centre, p, key_to_light))
+                   * rectangle_irradiance_factor(p, n, corner, s, t);
+            }
+        }
+    }
+    if (u_front_z > u_back_plane_z) {
+        vec3 depth = vec3(0.0, 0.0, u_front_z - u_back_plane_z);
+        vec3 gap = vec3(0.0, 0.0, u_back_plane_z - wall_z);
+        bool before = p.z > u_back_plane_z;
+        for (int j = 0; j < u_luminaire_size.y; ++j) {   // the sides, row by row
+            float y = opening.z + float(j) * cell.y;
+            for (int k = 0; k < 2; ++k) {
+                bool right = k == 1;
+                float x = right ? opening.y : opening.x;
+                if (right ? p.x <= x + 1e-4 : p.x >= x - 1e-4) {
+                    continue;
+                }
+                vec3 corner = vec3(x, y, u_back_plane_z);
+                vec3 centre = corner + 0.5 * (depth + t);
+                vec4 side = box_side_radiance(j, right, centre, p);
+                e += (side.rgb + key_lobe(side.a, centre, p, key_to_light))
+                   * rectangle_irradiance_factor(p, n, corner, depth, t);
+                if (before) {
+                    int column = right ? u_luminaire_size.x - 1 : 0;
+                    e += texelFetch(u_luminaire_back, ivec2(column, j), u_luminaire_back_level).rgb
+                       * rectangle_irradiance_factor(p, n, vec3(x, y, wall_z), gap, t);
+                }
+            }
+        }
+        for (int i = 0; i < u_luminaire_size.x; ++i) {   // the bottom and the top
+            float x = opening.x + float(i) * cell.x;
+            for (int k = 0; k < 2; ++k) {
+                bool top = k == 1;
+                float y = top ? opening.w : opening.z;
+                if (top ? p.y <= y + 1e-4 : p.y >= y - 1e-4) {
+                    continue;
+                }
+                vec3 corner = vec3(x, y, u_back_plane_z);
+                vec3 centre = corner + 0.5 * (depth + s);
+                vec4 captured = captured_towards(i, top ? u_luminaire_size.y - 1 : 0, centre, p);
+                e += (captured.rgb + key_lobe(captured.a, centre, p, key_to_light))
+                   * rectangle_irradiance_factor(p, n, corner, depth, s);
+            }
+        }
+    }
+    if (p.z < u_back_plane_z) {
+        for (int j = 0; j < u_luminaire_size.y; ++j) {
+            for (int i = 0; i < u_luminaire_size.x; ++i) {
+                vec3 corner = vec3(opening.x + float(i) * cell.x, opening.z + float(j) * cell.y, u_back_plane_z);
+                e += texelFetch(u_luminaire_back, ivec2(i, j), u_luminaire_back_level).rgb
+                   * rectangle_irradiance_factor(p, n, corner, s, t);
+            }
+        }
+    }
+    return e;
+}
+
+// The room's direct light at p besides the key's beam: the window and the lamps in the room
+// (isotropic points, E = I cos_r / r^2).
+vec3 room_direct_irradiance(vec3 p, vec3 n, vec4 opening, float wall_z, vec3 key_to_light) {
+    vec3 e = window_irradiance(p, n, opening, wall_z, key_to_light);
+    for (int k = 0; k < u_lamp_count; ++k) {
+        vec3 d = u_lamp_position[k] - p;
+        float r2 = dot(d, d);
+        e += u_lamp_rgb[k] * (max(dot(n, d), 0.0) * inversesqrt(r2) / r2);
+    }
+    return e;
+}
+#endif
+
 // ---- An environment image (issue 13): latitude-longitude, v = 0 at the nadir, u = 0 towards
 // -z (catalog/render/environment.py); the radiance towards dir, times its scale to the sky.
 vec3 environment_lookup(sampler2D image, float scale, vec3 dir) {

@@ -10,6 +10,9 @@
 //  - the light map (room_lightmap.frag + room_bounce.frag): the curtain as an area light,
 //    lamps in the room, the room's bounces, ambient occlusion.
 // Without it, the earlier scene design: a constant fraction of the key plus the fill light.
+#ifdef ROOM_LIGHTING
+#define WINDOW_LIGHT   // common.glsl: the window's light (the reveals' window side, WINDOW_NEAR)
+#endif
 #include "common.glsl"
 
 in vec3 v_normal;
@@ -41,9 +44,49 @@ uniform float u_albedo;
 // patches); the path-traced reveals were 20x the light map's clamped edge they read before.
 uniform vec3 u_reveal_sky;           // 0.5 pi x the sky's radiance (linear sRGB)
 uniform vec3 u_reveal_ground;        // 0.5 pi x the ground's
-uniform sampler2D u_luminaire_back;  // the curtain's window side (0 where no cloth, or open)
+// (u_luminaire_back, the curtain's window side (0 where no cloth, or open): common.glsl
+// WINDOW_LIGHT, which frame.py defines with ROOM_LIGHTING)
 uniform int u_reveal_back_level;
 uniform ivec2 u_reveal_back_size;    // that level's texels
+
+#ifdef WINDOW_NEAR
+// The window wall beside the opening (issue 11, ninth round): the window's direct light there
+// from the finer grid of room_window_near.frag in place of the light map's direct part (it
+// falls tenfold within a light-map texel); the bounces stay the light map's. The grid fades
+// into the light map over the last u_near_fade_m before WINDOW_NEAR_M from the opening: a
+// switch at the grid's edge left a seam of a few levels.
+uniform sampler2D u_lightmap_direct; // the light map's direct part (room_lightmap.frag)
+uniform sampler2D u_window_near;     // room_window_near.frag's grid
+uniform vec4 u_near_rect;            // its rectangle on the wall (x0, x1, y0, y1, m)
+uniform float u_near_m;              // room_light.WINDOW_NEAR_M
+uniform float u_near_fade_m;         // room_light.WINDOW_NEAR_FADE_M
+
+// The direct part read as the light map itself is (bilinear at level 0): its texture filters
+// nearest (the bounces' gather fetches its texels), and a nearest read subtracted from the
+// bilinear light map left steps at its texels' edges.
+vec3 direct_bilinear(vec2 uv) {
+    ivec2 size = textureSize(u_lightmap_direct, 0);
+    vec2 st = uv * vec2(size) - 0.5;
+    ivec2 i = ivec2(floor(st));
+    vec2 f = st - floor(st);
+    ivec2 hi = size - 1;
+    vec3 a = texelFetch(u_lightmap_direct, clamp(i, ivec2(0), hi), 0).rgb;
+    vec3 b = texelFetch(u_lightmap_direct, clamp(i + ivec2(1, 0), ivec2(0), hi), 0).rgb;
+    vec3 c = texelFetch(u_lightmap_direct, clamp(i + ivec2(0, 1), ivec2(0), hi), 0).rgb;
+    vec3 d = texelFetch(u_lightmap_direct, clamp(i + ivec2(1, 1), ivec2(0), hi), 0).rgb;
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
+vec3 near_window_irradiance(vec3 p, vec3 n, vec2 uv, vec3 lightmap) {
+    vec2 outside = max(max(u_window_rect.xz - p.xy, p.xy - u_window_rect.yw), vec2(0.0));
+    float weight = 1.0 - smoothstep(u_near_m - u_near_fade_m, u_near_m, length(outside));
+    if (n.z < 0.5 || p.z > u_wall_z.x + 1e-3 || weight <= 0.0) {
+        return lightmap;
+    }
+    vec2 f = (p.xy - u_near_rect.xz) / (u_near_rect.yw - u_near_rect.xz);
+    return lightmap + weight * (texture(u_window_near, f).rgb - direct_bilinear(uv));
+}
+#endif
 
 #ifdef KEY_BEAM
 vec3 key_beam(vec3 p, vec3 n) {
@@ -91,6 +134,11 @@ void main() {
                                                                        u_reveal_ground, u_luminaire_back,
                                                                        u_reveal_back_level, u_reveal_back_size)
                                                    : texture(u_lightmap, uv).rgb;
+#ifdef WINDOW_NEAR
+    if (v_position.z >= u_wall_z.x - 1e-4) {
+        diffuse = near_window_irradiance(v_position, n, uv, diffuse);
+    }
+#endif
     vec3 irradiance = diffuse + key_beam(v_position, n);
     out_radiance = vec4((u_albedo / PI) * irradiance, 1.0);
 #else

@@ -418,9 +418,13 @@ ES_VARIANTS = [
     ("room.vert", {"ROOM_LIGHTING": True}), ("room.vert", {}),
     ("room.frag", {"ROOM_LIGHTING": True, "KEY_BEAM": True}),
     ("room.frag", {"ROOM_LIGHTING": True}), ("room.frag", {}),
+    ("room.frag", {"ROOM_LIGHTING": True, "KEY_BEAM": True, "SIDE_EYES": True, "WALL_EYES": True, "WINDOW_NEAR": True}),
     ("room_shadow.vert", {"HAS_UV": True}), ("room_shadow.frag", {}),
     ("room_lightmap.frag", {"BEAM_SAMPLES": room_light.BEAM_SAMPLES}),
-    ("room_lightmap.frag", {"BEAM_SAMPLES": room_light.BEAM_SAMPLES, "SIDE_EYES": True}), ("room_bounce.frag", {}), ("room_bounce.frag", {"ALL_BOUNCES": True}),
+    ("room_lightmap.frag", {"BEAM_SAMPLES": room_light.BEAM_SAMPLES, "SIDE_EYES": True}),
+    ("room_lightmap.frag", {"BEAM_SAMPLES": room_light.BEAM_SAMPLES, "SIDE_EYES": True, "WALL_EYES": True}),
+    ("background.frag", {"ROOM_CAPTURE": True}), ("room_bounce.frag", {}),
+    ("room_window_near.frag", {"SIDE_EYES": True, "WALL_EYES": True}), ("room_window_near.frag", {}), ("room_bounce.frag", {"ALL_BOUNCES": True}),
     ("room_radiosity.frag", {}),
     ("background.frag", {"SKY_MODEL": True}),
     ("background.frag", {"SKY_MODEL": True, "SKY_BANDS": True}), ("background.frag", {"ENVIRONMENT": True}),
@@ -585,13 +589,16 @@ def test_window_light_is_the_float64_sum_over_both_sides(gl, fabric, light):
     curtain's window side behind its plane, each E = L F (exact form
     factors; issue 11's sixth round: the room side's radiance blended from the three eyes'
     captures by room_light.capture_eye_weights), averaged over 2 x 2 points of the texels
-    near the window. Bound: 1e-3 of the
-    map's largest value (float32; measured 3e-5). The window wall beside the opening lies in
-    the opening's plane, so the room side gives it nothing: its direct light is the window
-    side's, which must be there with the curtain closed and gone with it open (below 1 % of
-    it: the sky's patches in the wall's own plane give round-off). Under the UV
+    near the window; since the ninth round the room side's patches lie at the front of a box
+    around the folds whose sides (captured from the side eyes and, towards the window wall,
+    the wall eyes) and top and bottom light the walls that see the window edge-on. Bound: 1e-3
+    of the map's largest value (float32; measured 3e-5). The window wall beside the opening
+    gets the box's sides and the window side's patches with the curtain closed; with it open
+    there is no box and the opening lies in the wall's plane, so nothing (below 1 % of the
+    closed curtain's: the sky's patches in the wall's own plane give round-off). Under the UV
     lamp the glow leaves both sides of the cloth alike: the two captures' means within 30 %
-    (measured 0.91)."""
+    (measured 0.91). The window wall's finer grid beside the opening (room_window_near.frag,
+    room_light.window_near_points) is the same sum at its points, same bound."""
     r = FrameRenderer(gl, (32, 18))
     r.set_fabric(fabric)
     r.set_light(light)
@@ -617,14 +624,24 @@ def test_window_light_is_the_float64_sum_over_both_sides(gl, fabric, light):
         back = level("luminaire_back", room_light.BACK_LUMINAIRE_LEVEL)[..., :3]
         inputs = r.shading_inputs()
         lobe = None if curtain_open else {"lobe_rgb": r._room_colours(inputs)["u_lobe_rgb"],
-                                          "g_spec": float(inputs.g_spec), "to_light": inputs.key_to_light,
-                                          "key_factor": captured[..., 3]}
+                                          "g_spec": float(inputs.g_spec), "to_light": inputs.key_to_light}
         sides = None
         if r.side_eyes:   # the side eyes' captures, left then right (the sky too when open)
             sides = r.read_side_captures()
-        expected = room_light.window_irradiance(front, back, lobe=lobe, radiance_sides=sides)
+        walls = r.read_wall_captures() if r.wall_eyes_active() else None
+        expected = room_light.window_irradiance(front, back, lobe=lobe, radiance_sides=sides,
+                                                alpha=captured[..., 3], front_z=r.window_front_z(),
+                                                radiance_walls=walls)
         scale = float(np.abs(expected[mask]).max())
         assert np.abs(direct[mask] - expected[mask]).max() <= 1e-3 * scale
+        assert r.window_near() == (not curtain_open)
+        if r.window_near():   # the window wall beside the opening's finer grid, the same sum
+            points = room_light.window_near_points().reshape(-1, 3)
+            near = room_light.window_irradiance_at(points, np.tile([0.0, 0.0, 1.0], (len(points), 1)), front,
+                                                   back, sides, lobe=lobe, alpha=captured[..., 3],
+                                                   front_z=r.window_front_z(), radiance_walls=walls)
+            got = r.read_window_near().reshape(-1, 3)
+            assert np.abs(got - near).max() <= 1e-3 * float(np.abs(near).max())
         wall = _luma(direct[:, cols][beside])
         if curtain_open:   # in-plane round-off of the sky's patches aside
             assert back.max() == 0.0 and wall.mean() < 0.01 * closed_wall.mean()
@@ -956,6 +973,68 @@ def test_the_wall_lights_lobe_samples_follow_henyey_greenstein():
         few = room_light.wall_lobe_directions(g, room_light.WALL_LOBE_SAMPLES)
         assert abs(few[:, 2].mean() - g) < 0.02, (g, few[:, 2].mean())
     assert np.abs(room_light.wall_lobe_directions(0.0, 4096).mean(axis=0)).max() < 1e-2
+
+
+def test_a_rectangles_capture_frames_exactly_that_rectangle():
+    """room_light.rectangle_view_projection (the box's sides' captures, issue 11's ninth
+    round): for the opening's rectangle in a plane z = const it is window_view_projection
+    (1e-12); for a box side (x = const) its corners land on the normalised device corners
+    (-1, -1) and (1, 1), its centre on (0, 0), and a point beyond the side along the way from
+    the eye keeps its device x, y (closed forms, 1e-12); an eye in the side's plane is refused."""
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    for eye in (room_light.LUMINAIRE_EYE, room_light.CAPTURE_SIDE_EYES[0], room_light.BACK_LUMINAIRE_EYE):
+        for z in (scene_lib.ROOM_BOX[2][0], room_light.WINDOW_FRONT_Z, scene_lib.CURTAIN_Z):
+            if abs(eye[2] - z) < 0.1:
+                continue
+            expected = room_light.window_view_projection(eye, z)
+            got = room_light.rectangle_view_projection(eye, (wx0, wy0, z), (wx1 - wx0, 0, 0), (0, wy1 - wy0, 0))
+            assert np.abs(got - expected).max() < 1e-12
+    for right in (False, True):
+        m = room_light.wall_eye_view_projection(right)
+        x = wx1 if right else wx0
+        z0, z1 = scene_lib.CURTAIN_Z, room_light.WINDOW_FRONT_Z
+
+        def ndc(q):
+            c = m @ np.append(np.asarray(q, dtype=np.float64), 1.0)
+            return c[:3] / c[3]
+        assert np.allclose(ndc((x, wy0, z0))[:2], (-1, -1), atol=1e-12)
+        assert np.allclose(ndc((x, wy1, z1))[:2], (1, 1), atol=1e-12)
+        centre = np.array([x, 0.5 * (wy0 + wy1), 0.5 * (z0 + z1)])
+        assert np.allclose(ndc(centre)[:2], 0.0, atol=1e-12)
+        eye = np.asarray(room_light.WALL_EYES[1 if right else 0], dtype=np.float64)
+        beyond = eye + 1.7 * (centre - eye)
+        assert np.allclose(ndc(beyond)[:2], 0.0, atol=1e-12) and -1 < ndc(beyond)[2] < 1
+    with pytest.raises(ValueError):
+        room_light.rectangle_view_projection((wx0, 0.2, 0.5), (wx0, wy0, 0.0), (0, 0, 0.1), (0, 1, 0))
+
+
+def test_wall_eye_weight_blends_the_box_sides_by_angle():
+    """room_light.wall_eye_weight (the float64 twin of common.glsl box_side_radiance's
+    blend): a point on the way from a side's row to its wall eye takes the wall eye's capture
+    alone (0); a point level with the row's centre or above it, the room's eye's (1); halfway
+    in angle, half; the weight lies in [0, 1] everywhere and the two sides mirror each other
+    (closed forms, 1e-12)."""
+    for right in (False, True):
+        corners, s, t = room_light.window_box_rectangles()["right" if right else "left"]
+        centres = corners + 0.5 * (s + t)
+        eye = np.asarray(room_light.WALL_EYES[1 if right else 0], dtype=np.float64)
+        out = 1.0 if right else -1.0
+        n = 4
+        w = room_light.wall_eye_weight(centres[n:n + 1], (centres[n] + 2.0 * (eye - centres[n]))[None], right)
+        assert abs(w[0, 0]) < 1e-12
+        level = centres[n] + np.array([out * 0.7, 0.3, 0.0])
+        above = centres[n] + np.array([out * 0.7, 0.0, 0.4])
+        assert np.allclose(room_light.wall_eye_weight(centres[n:n + 1], np.stack([level, above]), right), 1.0, atol=1e-12)
+        a_wall = math.atan2(eye[2] - centres[n][2], out * (eye[0] - centres[n][0]))
+        half = centres[n] + np.array([out * math.cos(0.5 * a_wall), 0.0, math.sin(0.5 * a_wall)])
+        assert abs(room_light.wall_eye_weight(centres[n:n + 1], half[None], right)[0, 0] - 0.5) < 1e-12
+    points = np.random.default_rng(7).uniform([-2.2, -1.3, -0.2], [2.2, 1.7, 4.5], (400, 3))
+    corners, s, t = room_light.window_box_rectangles()["left"]
+    w_left = room_light.wall_eye_weight(corners + 0.5 * (s + t), points, False)
+    assert w_left.min() >= 0.0 and w_left.max() <= 1.0
+    corners, s, t = room_light.window_box_rectangles()["right"]
+    mirrored = points * np.array([-1.0, 1.0, 1.0])
+    assert np.abs(room_light.wall_eye_weight(corners + 0.5 * (s + t), mirrored, True) - w_left).max() < 1e-12
 
 
 def test_capture_eye_weights_blend_the_three_eyes_by_angle():

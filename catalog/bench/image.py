@@ -75,6 +75,10 @@ OPTIONS = (
      {"key_second_layer": False}),
     ("pattern at the hardware's mip level (before round 8)", 3, "physical", 1, None, None,
      {"pattern_lod_bias": 0.0}),
+    ("window as the opening's plane (before round 9)", 3, "physical", 1, None, None, {"window_box": False}),
+    ("box's sides by the room's eyes alone (round 9)", 3, "physical", 1, None, None, {"wall_eyes": False}),
+    ("window wall beside the opening from the light map (round 9)", 3, "physical", 1, None, None,
+     {"window_near": False}),
     ("shadow maps 128", 3, "physical", 1, None, None, {"shadow_map_size": 128}),
     ("shadow maps 512", 3, "physical", 1, None, None, {"shadow_map_size": 512}),
     ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
@@ -123,6 +127,10 @@ ROUND_7B = "after_11_round_7b"
 #: The run after its eighth round (the pattern at the mip level whose filter has a pixel box's
 #: variance; the spectral reference's outside in the lamp's own spectrum): ``runs[ROUND_8]``.
 ROUND_8 = "after_11_round_8"
+#: The run after its ninth round (the room sees the closed curtain through a box around its
+#: folds: the patches at its front, its sides captured from the room's and the wall's side,
+#: the window wall beside the opening lit per pixel): ``runs[ROUND_9]``.
+ROUND_9 = "after_11_round_9"
 #: The reference's Mitsuba variants. The RGB variant's cloth carries one RGB dye,
 #: RGB(key x dye) / RGB(key), exact for light of the key's spectrum; under the UV-A lamp that
 #: is 0.048 in every channel, while the safety-yellow's glow, most of the light there, passes
@@ -593,7 +601,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
                                         (ROUND_4, "fourth", ROUND_3), (ROUND_5, "fifth", ROUND_4),
                                         (ROUND_6, "sixth", ROUND_5), (ROUND_7, "seventh", ROUND_6),
                                         (ROUND_7B, "seventh (each scene's variant)", ROUND_6),
-                                        (ROUND_8, "eighth", ROUND_7B)):
+                                        (ROUND_8, "eighth", ROUND_7B), (ROUND_9, "ninth", ROUND_8)):
             if name in result["runs"]:
                 blocks.update(_round_blocks(result["runs"], name, ordinal, previous))
         return blocks

@@ -335,6 +335,12 @@ class FrameRenderer:
         #: issue 11 (sixth round): the room's capture of the window from three eyes, blended
         #: per receiving point (room_lightmap.frag SIDE_EYES); False: from the middle alone
         self.side_eyes = True
+        #: the room sees the closed curtain through a box around its folds (set_window_box)
+        self.window_box = True
+        #: the box's sides also captured from eyes by the window wall (set_wall_eyes)
+        self.wall_eyes = True
+        #: the window wall beside the opening takes the window's light per pixel (set_window_near)
+        self.window_near_field = True
         #: issue 11 (sixth round): the room's captures see the folds behind through the holes
         #: (curtain.frag FOLDS_BEHIND); False: the outside there
         self.capture_folds = True
@@ -539,6 +545,44 @@ class FrameRenderer:
         count those directions dark (False, before). Needs the room side's solved light and
         the outside's occlusion."""
         self.wall_light = bool(on)
+
+    def window_front_z(self) -> float:
+        """The plane of the room side's window patches (m): the front of the box around the
+        closed curtain's folds (room_light.WINDOW_FRONT_Z), or the opening's when the curtain
+        is open or ``window_box`` is off (before issue 11's ninth round)."""
+        if self.window_box and not self.curtain_open:
+            return room_light.WINDOW_FRONT_Z
+        return scene_lib.ROOM_BOX[2][0]
+
+    def window_near(self) -> bool:
+        """Whether room.frag takes the window's light per pixel on the window wall beside the
+        opening (WINDOW_NEAR): with the box (its sides stand on that wall)."""
+        return self.window_near_field and self.window_front_z() > scene_lib.ROOM_BOX[2][0]
+
+    def set_window_near(self, on: bool) -> None:
+        """The window wall within room_light.WINDOW_NEAR_M of the opening takes the window's
+        light per pixel (True: it falls tenfold within a light-map texel there) or from the
+        light map (False)."""
+        self.window_near_field = bool(on)
+
+    def wall_eyes_active(self) -> bool:
+        """Whether the box's sides are captured from the wall eyes too (WALL_EYES)."""
+        return self.wall_eyes and self.window_front_z() > scene_lib.ROOM_BOX[2][0]
+
+    def set_wall_eyes(self, on: bool) -> None:
+        """Capture the box's sides also from eyes by the window wall (room_light.WALL_EYES) and
+        blend the two by the angle of the way to each receiving point (True); off: the side
+        eyes' edge columns alone."""
+        self.wall_eyes = bool(on)
+        self._room_key = None
+
+    def set_window_box(self, on: bool) -> None:
+        """The room sees the closed curtain through a box around its folds (the patches at the
+        folds' front, the box's sides at the opening's edges: a wall seeing the window edge-on
+        gets the flanks' light); off: through the opening's plane alone (before issue 11's
+        ninth round)."""
+        self.window_box = bool(on)
+        self._room_key = None
 
     def set_side_eyes(self, on: bool) -> None:
         """Capture the window for the room's direct light from the middle and two eyes towards
@@ -1269,6 +1313,9 @@ class FrameRenderer:
                 self._set(program, name, value)
         if not sun_disc:
             self._set(program, "u_sun_disc_rgb", (0.0, 0.0, 0.0))
+        if capture:
+            self._set(program, "u_capture_opening", scene_lib.WINDOW_RECT)
+            self._set(program, "u_capture_wall_z", scene_lib.ROOM_BOX[2][0])
         self._fullscreen_vao(program).render(self._moderngl.TRIANGLES, vertices=3)
 
     def _room_order(self, to_light) -> int:
@@ -1295,7 +1342,9 @@ class FrameRenderer:
             for beam, first, count in ((True, 0, facing), (False, facing, total - facing)):
                 if count:
                     program = self._program("room.vert", "room.frag",
-                                            {"ROOM_LIGHTING": True, "KEY_BEAM": beam})
+                                            {"ROOM_LIGHTING": True, "KEY_BEAM": beam,
+                                             **self._window_light_defines(),
+                                             **({"WINDOW_NEAR": True} if self.window_near() else {})})
                     self._room_lit_uniforms(program, view_proj, inputs)
                     self._room_vao(program).render(self._moderngl.TRIANGLES, vertices=count,
                                                    first=first)
@@ -1336,8 +1385,15 @@ class FrameRenderer:
         reveals = self._reveal_inputs(inputs)
         self._set(program, "u_reveal_sky", reveals["sky_half"])
         self._set(program, "u_reveal_ground", reveals["ground_half"])
-        gl["luminaire_back"].use(location=3)
-        self._set(program, "u_luminaire_back", 3)
+        self._window_light_uniforms(program, inputs)   # the window side on unit 3 (the reveals)
+        if self.window_near():
+            gl["direct"].use(location=6)
+            self._set(program, "u_lightmap_direct", 6)
+            gl["window_near"].use(location=8)
+            self._set(program, "u_window_near", 8)
+            self._set(program, "u_near_rect", room_light.window_near_rect())
+            self._set(program, "u_near_m", room_light.WINDOW_NEAR_M)
+            self._set(program, "u_near_fade_m", room_light.WINDOW_NEAR_FADE_M)
         self._set(program, "u_reveal_back_level", reveals["back_level"])
         self._set(program, "u_reveal_back_size", reveals["back_size"])
 
@@ -1356,6 +1412,18 @@ class FrameRenderer:
     def read_luminaire_back(self, level: int) -> np.ndarray:
         """The window-side capture at mip ``level``, float32 (H, W, 3), row 0 = the opening's bottom."""
         return self.read_luminaire(level, "luminaire_back")
+
+    def read_window_near(self) -> np.ndarray:
+        """room_window_near.frag's grid, float32 (N, N, 3), row 0 = its rectangle's bottom."""
+        texture = self._room_resources()["window_near"]
+        w, h = texture.size
+        return np.frombuffer(texture.read(), dtype="f2").reshape(h, w, 4)[..., :3].astype(np.float32)
+
+    def read_wall_captures(self) -> np.ndarray:
+        """The wall eyes' captures of the box's sides at their patch level, float32 (2, 9, 3)
+        (left, right; row 0 = the opening's bottom)."""
+        both = self.read_luminaire(room_light.WALL_EYE_LEVEL, "luminaire_walls")
+        return np.stack([both[:, 0], both[:, 1]])
 
     def read_side_captures(self) -> np.ndarray:
         """The side eyes' captures at their patch level, float32 (2, H, W, 3) (left, right; row
@@ -1390,6 +1458,16 @@ class FrameRenderer:
             sides = ctx.texture((2 * sw, sh), 4, dtype="f4")   # the side eyes', left then right
             sides.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             sides_depth = ctx.depth_renderbuffer((2 * sw, sh))
+            nt = room_light.WINDOW_NEAR_TEXELS
+            # room_window_near.frag's grid, half floats: a web page filters them linearly
+            # without OES_texture_float_linear (3e3 at most under the noon sun; 5e-4 relative)
+            window_near = ctx.texture((nt, nt), 4, dtype="f2")
+            window_near.filter = (mgl.LINEAR, mgl.LINEAR)
+            window_near.repeat_x = window_near.repeat_y = False
+            ww, wh = 1 << room_light.WALL_EYE_LEVEL, room_light.LUMINAIRE_TEXELS[1] << room_light.WALL_EYE_LEVEL
+            walls = ctx.texture((2 * ww, wh), 4, dtype="f4")   # the wall eyes', left then right
+            walls.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            walls_depth = ctx.depth_renderbuffer((2 * ww, wh))
             bw, bh = room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)
             luminaire_back = ctx.texture((bw, bh), 4, dtype="f4")
             luminaire_back.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
@@ -1428,6 +1506,8 @@ class FrameRenderer:
                 "luminaire": luminaire, "luminaire_depth": luminaire_depth,
                 "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
                 "luminaire_sides": sides, "luminaire_sides_fbo": ctx.framebuffer([sides], sides_depth),
+                "luminaire_walls": walls, "luminaire_walls_fbo": ctx.framebuffer([walls], walls_depth),
+                "window_near": window_near, "window_near_fbo": ctx.framebuffer([window_near]),
                 "luminaire_back": luminaire_back,
                 "luminaire_back_fbo": ctx.framebuffer([luminaire_back], luminaire_back_depth),
                 "direct": direct, "beam": beam, "direct_fbo": ctx.framebuffer([direct, beam]),
@@ -1767,12 +1847,21 @@ class FrameRenderer:
                 gl[name + "_fbo"].use()
                 gl[name + "_fbo"].clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
             self.ctx.viewport = (tile * lw, 0, lw, lh)
-            view_proj = room_light.luminaire_view_projection(eye)
+            view_proj = room_light.luminaire_view_projection(eye, self.window_front_z())
             if not self.curtain_open:
                 self._draw_flat_curtain(view_proj, eye, overrides, folds_behind=self.capture_folds)
             self._draw_background(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
         for name in {name for name, _eye, _tile, _level in targets}:
             gl[name].build_mipmaps()   # level LUMINAIRE_LEVEL: each patch's mean radiance
+        if self.wall_eyes_active():   # the box's sides from the wall eyes (no outside: their ways
+            gl["luminaire_walls_fbo"].use()   # through a side rise into the room)
+            gl["luminaire_walls_fbo"].clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            ww, wh = 1 << room_light.WALL_EYE_LEVEL, room_light.LUMINAIRE_TEXELS[1] << room_light.WALL_EYE_LEVEL
+            for k, eye in enumerate(room_light.WALL_EYES):
+                self.ctx.viewport = (k * ww, 0, ww, wh)
+                self._draw_flat_curtain(room_light.wall_eye_view_projection(k == 1, self.window_front_z()), eye,
+                                        overrides, folds_behind=self.capture_folds)
+            gl["luminaire_walls"].build_mipmaps()
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
 
@@ -1840,6 +1929,52 @@ class FrameRenderer:
             self._room_resources()["radiosity_operator"].write(np.ascontiguousarray(operator).tobytes())
             self._operator_albedo = key
 
+    def _window_light_defines(self) -> dict:
+        """common.glsl WINDOW_LIGHT's defines (room_lightmap.frag and the lit room.frag define
+        WINDOW_LIGHT itself): the window from three eyes (SIDE_EYES), the box's sides also
+        from the wall's side (WALL_EYES, with the box)."""
+        return {**({"SIDE_EYES": True} if self.side_eyes else {}),
+                **({"WALL_EYES": True} if self.wall_eyes_active() else {})}
+
+    def _window_light_uniforms(self, program, inputs) -> None:
+        """common.glsl WINDOW_LIGHT's inputs (the room's captures on units 3-5, the box, the
+        key's lobe, the lamps), for the light map (room_lightmap.frag) and the window wall
+        beside the opening per pixel (room.frag WINDOW_NEAR)."""
+        gl = self._room_resources()
+        gl["luminaire"].use(location=5)
+        self._set(program, "u_luminaire", 5)
+        if self.side_eyes:
+            gl["luminaire_sides"].use(location=4)
+            self._set(program, "u_luminaire_sides", 4)
+            self._set(program, "u_luminaire_sides_level", room_light.SIDE_LUMINAIRE_LEVEL)
+            self._set(program, "u_side_eye", np.asarray(room_light.CAPTURE_SIDE_EYES, dtype="f4"))
+            self._set(program, "u_middle_eye", room_light.LUMINAIRE_EYE)
+        self._set(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)
+        self._set(program, "u_luminaire_level", room_light.LUMINAIRE_LEVEL)
+        gl["luminaire_back"].use(location=3)
+        self._set(program, "u_luminaire_back", 3)
+        self._set(program, "u_luminaire_back_level", room_light.BACK_LUMINAIRE_LEVEL)
+        self._set(program, "u_back_plane_z", scene_lib.CURTAIN_Z)
+        self._set(program, "u_front_z", self.window_front_z())
+        if self.wall_eyes_active():   # the box's sides from the wall's side (WALL_EYES)
+            gl["luminaire_walls"].use(location=7)
+            self._set(program, "u_luminaire_walls", 7)
+            self._set(program, "u_luminaire_walls_level", room_light.WALL_EYE_LEVEL)
+            self._set(program, "u_wall_eye", np.asarray(room_light.WALL_EYES, dtype="f4"))
+        colours = self._room_colours(inputs)
+        self._set(program, "u_lobe_rgb", colours["u_lobe_rgb"] if self.room_lobe and not self.curtain_open
+                  else (0.0, 0.0, 0.0))
+        self._set(program, "u_g_spec", float(inputs.g_spec))
+        lamps = self.room_lamps
+        positions = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
+        rgbs = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
+        for k, (light, position) in enumerate(lamps):
+            positions[k] = position
+            rgbs[k] = band_lib.spectrum_to_display_rgb(light.irradiance_w_m2_nm)
+        self._set(program, "u_lamp_count", len(lamps))
+        self._set(program, "u_lamp_position", positions)
+        self._set(program, "u_lamp_rgb", rgbs)
+
     def draw_room_lightmap(self, inputs) -> None:
         """Passes R3 and R4: the light map's direct part (area light, beam, lamps), then (R3b,
         with every bounce) the coarse patches' total irradiance, then the bounces gathered
@@ -1851,29 +1986,11 @@ class FrameRenderer:
         gl["direct_fbo"].use()
         self.ctx.viewport = (0, 0, aw, ah)
         program = self._program("fullscreen.vert", "room_lightmap.frag",
-                                {"BEAM_SAMPLES": room_light.BEAM_SAMPLES,
-                                 **({"SIDE_EYES": True} if self.side_eyes else {})})
+                                {"BEAM_SAMPLES": room_light.BEAM_SAMPLES, **self._window_light_defines()})
         self._room_common_uniforms(program, inputs)
-        gl["luminaire"].use(location=1)
-        self._set(program, "u_luminaire", 1)
-        if self.side_eyes:
-            gl["luminaire_sides"].use(location=4)
-            self._set(program, "u_luminaire_sides", 4)
-            self._set(program, "u_luminaire_sides_level", room_light.SIDE_LUMINAIRE_LEVEL)
-            self._set(program, "u_side_eye", np.asarray(room_light.CAPTURE_SIDE_EYES, dtype="f4"))
-            self._set(program, "u_middle_eye", room_light.LUMINAIRE_EYE)
-        self._set(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)
-        self._set(program, "u_luminaire_level", room_light.LUMINAIRE_LEVEL)
+        self._window_light_uniforms(program, inputs)
         self._set(program, "u_face_texels", float(room_light.FACE_TEXELS))
         self._set(program, "u_supersample_m", room_light.WINDOW_SUPERSAMPLE_M)
-        colours = self._room_colours(inputs)
-        self._set(program, "u_lobe_rgb", colours["u_lobe_rgb"] if self.room_lobe and not self.curtain_open
-                  else (0.0, 0.0, 0.0))
-        self._set(program, "u_g_spec", float(inputs.g_spec))
-        gl["luminaire_back"].use(location=3)
-        self._set(program, "u_luminaire_back", 3)
-        self._set(program, "u_luminaire_back_level", room_light.BACK_LUMINAIRE_LEVEL)
-        self._set(program, "u_back_plane_z", scene_lib.CURTAIN_Z)
         gl["shadow"].use(location=2)
         self._set(program, "u_shadow", 2)
         (x0, x1), _, _ = scene_lib.ROOM_BOX
@@ -1881,16 +1998,19 @@ class FrameRenderer:
         self._set(program, "u_beam_shadow_lod",
                   max(0.0, math.log2(spacing_m / room_light.shadow_texel_m(inputs.key_to_light, self.shadow_texels))))
         self._set(program, "u_key_on", 1.0)
-        lamps = self.room_lamps
-        positions = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
-        rgbs = np.zeros((room_light.MAX_ROOM_LAMPS, 3), dtype="f4")
-        for k, (light, position) in enumerate(lamps):
-            positions[k] = position
-            rgbs[k] = band_lib.spectrum_to_display_rgb(light.irradiance_w_m2_nm)
-        self._set(program, "u_lamp_count", len(lamps))
-        self._set(program, "u_lamp_position", positions)
-        self._set(program, "u_lamp_rgb", rgbs)
         self._fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        if self.window_near():   # the window wall beside the opening, finer (room_window_near.frag)
+            gl["window_near_fbo"].use()
+            self.ctx.viewport = (0, 0, room_light.WINDOW_NEAR_TEXELS, room_light.WINDOW_NEAR_TEXELS)
+            near = self._program("fullscreen.vert", "room_window_near.frag", self._window_light_defines())
+            self._window_light_uniforms(near, inputs)
+            self._set(near, "u_near_rect", room_light.window_near_rect())
+            self._set(near, "u_window_rect", scene_lib.WINDOW_RECT)
+            self._set(near, "u_wall_z", scene_lib.ROOM_BOX[2][0])
+            self._set(near, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
+            self._fullscreen_vao(near).render(mgl.TRIANGLES, vertices=3)
+            gl["direct_fbo"].use()
+            self.ctx.viewport = (0, 0, aw, ah)
         gl["direct"].build_mipmaps()
         gl["beam"].build_mipmaps()
         rc = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
@@ -2090,7 +2210,7 @@ class FrameRenderer:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
                self.room_bounces, self.room_lobe, self.room_side_active(), self.wall_light,
-               self.side_eyes, self.capture_folds, self.secondary_dye, self.key_second_layer,
+               self.side_eyes, self.window_box, self.wall_eyes, self.capture_folds, self.secondary_dye, self.key_second_layer,
                getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))

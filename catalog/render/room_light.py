@@ -531,10 +531,97 @@ def window_view_projection(eye, plane_z: float, near: float = 0.05, far: float =
     return np.stack([lateral(0, ex, wx0, wx1), lateral(1, ey, wy0, wy1), z_row, w_row])
 
 
-def luminaire_view_projection(eye=LUMINAIRE_EYE) -> np.ndarray:
-    """The room side's capture: the opening in the wall plane z = WINDOW_Z seen from ``eye``
-    in the room, texel (i, j) the radiance of window patch (i, j) towards the room."""
-    return window_view_projection(eye, scene_lib.ROOM_BOX[2][0])
+#: The front of the box the room sees the closed curtain through (m): the drape's folds reach
+#: from the window wall (z = WINDOW_Z) to about this far into the room; the room side's patches
+#: lie in this plane and the box's sides join it to the opening's edges (issue 11, ninth round).
+WINDOW_FRONT_Z = 0.02
+
+#: room.frag takes the window's direct light on the window wall within this distance of the
+#: opening (m; about two light-map texels), where it falls tenfold within one texel, from a
+#: finer grid (room_window_near.frag) of this many texels a side.
+WINDOW_NEAR_M = 0.6
+WINDOW_NEAR_TEXELS = 64
+#: ... fading into the light map over this much before WINDOW_NEAR_M (m): no seam there.
+WINDOW_NEAR_FADE_M = 0.15
+
+
+def window_near_rect() -> tuple[float, float, float, float]:
+    """The window wall's rectangle round the opening that room_window_near.frag covers (x0, x1,
+    y0, y1, m): the opening widened by WINDOW_NEAR_M, within the room's walls."""
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    (bx0, bx1), (by0, by1), _ = scene_lib.ROOM_BOX
+    return (max(wx0 - WINDOW_NEAR_M, bx0), min(wx1 + WINDOW_NEAR_M, bx1),
+            max(wy0 - WINDOW_NEAR_M, by0), min(wy1 + WINDOW_NEAR_M, by1))
+
+
+def window_near_points(texels: int = WINDOW_NEAR_TEXELS) -> np.ndarray:
+    """(texels, texels, 3): room_window_near.frag's points (row 0 = the rectangle's bottom):
+    the texels' centres on the window wall, those inside the opening moved onto its nearest
+    edge, 1 mm out on the wall."""
+    x0, x1, y0, y1 = window_near_rect()
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    f = (np.arange(texels) + 0.5) / texels
+    y, x = np.meshgrid(y0 + f * (y1 - y0), x0 + f * (x1 - x0), indexing="ij")
+    q = np.stack([x, y], axis=-1).reshape(-1, 2)
+    inside = np.minimum(q - [wx0, wy0], [wx1, wy1] - q)
+    moved = inside.min(axis=1) > -1e-3
+    along_x = moved & (inside[:, 0] < inside[:, 1])
+    along_y = moved & ~along_x
+    q[along_x, 0] = np.where(q[along_x, 0] - wx0 < wx1 - q[along_x, 0], wx0 - 1e-3, wx1 + 1e-3)
+    q[along_y, 1] = np.where(q[along_y, 1] - wy0 < wy1 - q[along_y, 1], wy0 - 1e-3, wy1 + 1e-3)
+    z = np.full((q.shape[0], 1), scene_lib.ROOM_BOX[2][0])
+    return np.hstack([q, z]).reshape(texels, texels, 3)
+
+
+#: Eyes by the window wall that capture the box's sides as the wall beside the opening sees
+#: them (left, right; m): from behind the curtain's plane most ways through a side pass in
+#: front of the folds into the room, and the side eyes' radiance, seen from the room, lit that
+#: strip of wall 2-2.4x the path tracer's (issue 11, ninth round).
+WALL_EYES = ((-1.5, 0.2, -0.15), (1.5, 0.2, -0.15))
+#: The wall eyes' captures: a box side's 9 patch rows (one column) supersampled by 2^level.
+WALL_EYE_LEVEL = 3
+
+
+def rectangle_view_projection(eye, corner, s, t, near: float = 0.05, far: float = 60.0) -> np.ndarray:
+    """Off-axis perspective from ``eye`` whose frustum is exactly the rectangle
+    ``corner + [0,1] s + [0,1] t``: normalised device x runs along s and y along t, -1 to 1
+    across it (a capture's texel (i, j) is the radiance of the rectangle's cell (i, j) towards
+    the eye); the view axis is the rectangle's normal, away from the eye."""
+    e, c = np.asarray(eye, dtype=np.float64), np.asarray(corner, dtype=np.float64)
+    s, t = np.asarray(s, dtype=np.float64), np.asarray(t, dtype=np.float64)
+    axis = np.cross(s, t)
+    axis /= np.linalg.norm(axis)
+    if (c - e) @ axis < 0.0:
+        axis = -axis
+    to_plane = float((c - e) @ axis)
+    if to_plane <= near:
+        raise ValueError(f"eye {tuple(e)} is within {near} m of the rectangle's plane")
+    w_row = np.append(axis, -axis @ e)   # the distance along the view axis
+
+    def lateral(edge):   # clip = w ndc, ndc = 2 (crossing - corner).edge / |edge|^2 - 1
+        n2 = edge @ edge
+        return (2.0 * ((e - c) @ edge) / n2 - 1.0) * w_row + (2.0 * to_plane / n2) * np.append(edge, -edge @ e)
+
+    a, b = (far + near) / (far - near), -2.0 * far * near / (far - near)
+    return np.stack([lateral(s), lateral(t), a * w_row + np.array([0.0, 0.0, 0.0, b]), w_row])
+
+
+def wall_eye_view_projection(right: bool, front_z: float = None) -> np.ndarray:
+    """The capture of the box's left (or right) side from its wall eye (:data:`WALL_EYES`):
+    the side's rectangle (x = the opening's edge, y over the opening, z from the curtain's
+    plane to the box's front ``front_z``), x along +z, y along +y."""
+    front_z = WINDOW_FRONT_Z if front_z is None else front_z
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    corner = (wx1 if right else wx0, wy0, scene_lib.CURTAIN_Z)
+    return rectangle_view_projection(WALL_EYES[1 if right else 0], corner, (0.0, 0.0, front_z - scene_lib.CURTAIN_Z),
+                                     (0.0, wy1 - wy0, 0.0))
+
+
+def luminaire_view_projection(eye=LUMINAIRE_EYE, plane_z: float | None = None) -> np.ndarray:
+    """The room side's capture: the opening's rectangle in the plane ``plane_z`` (default the
+    box's front, :data:`WINDOW_FRONT_Z`) seen from ``eye`` in the room, texel (i, j) the
+    radiance of window patch (i, j) towards the room."""
+    return window_view_projection(eye, WINDOW_FRONT_Z if plane_z is None else plane_z)
 
 
 def back_luminaire_view_projection(eye=BACK_LUMINAIRE_EYE) -> np.ndarray:
@@ -649,25 +736,162 @@ def lobe_radiance(points: np.ndarray, lobe_rgb, g_spec: float, to_light,
     return (factor[None, :] * phase)[..., None] * np.asarray(lobe_rgb, dtype=np.float64)
 
 
+def _key_lobe(points: np.ndarray, centres: np.ndarray, alpha: np.ndarray, lobe: dict | None) -> np.ndarray:
+    """(P, N, 3): common.glsl ``key_lobe`` from rectangles centred at ``centres`` (N, 3) whose
+    cloth the key reaches by ``alpha`` (N,) towards ``points`` (P, 3); 0 without ``lobe``
+    (keywords lobe_rgb, g_spec, to_light)."""
+    if lobe is None:
+        return np.zeros((points.shape[0], centres.shape[0], 3))
+    to_light = np.asarray(lobe["to_light"], dtype=np.float64)
+    w = points[:, None, :] - centres[None, :, :]
+    w /= np.linalg.norm(w, axis=-1, keepdims=True)
+    chord2 = np.sum((w + to_light) ** 2, axis=-1)
+    g = float(lobe["g_spec"])
+    d = (1.0 - g) ** 2 + g * chord2
+    phase = (1.0 - g) * (1.0 + g) / (4.0 * math.pi) / (d * np.sqrt(d))
+    return (np.asarray(alpha, dtype=np.float64)[None, :] * phase)[..., None] \
+        * np.asarray(lobe["lobe_rgb"], dtype=np.float64)
+
+
+def window_box_rectangles(front_z: float = WINDOW_FRONT_Z) -> dict[str, tuple[np.ndarray, ...]]:
+    """The box the room sees the closed curtain through (common.glsl ``window_irradiance``),
+    each (corners, s, t) (N, 3): "front" the opening's 12 x 9 patches in the plane ``front_z``
+    (capture order); "left" and "right" the sides x = x0, x1 from the curtain's plane to the
+    front, a rectangle a patch row (9); "bottom" and "top" y = y0, y1, one a patch column
+    (12); "left_gap" and "right_gap" the sides between the window wall and the curtain's
+    plane (9 each); "back" the window side's patches in the curtain's plane."""
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    nx, ny = LUMINAIRE_TEXELS
+    cx, cy = (wx1 - wx0) / nx, (wy1 - wy0) / ny
+    wall_z, back_z = scene_lib.ROOM_BOX[2][0], scene_lib.CURTAIN_Z
+    rows, cols = np.arange(ny), np.arange(nx)
+    depth = np.array([0.0, 0.0, front_z - back_z])
+    gap = np.array([0.0, 0.0, back_z - wall_z])
+
+    def rects(corners, s, t):
+        corners = np.asarray(corners, dtype=np.float64)
+        return corners, np.broadcast_to(s, corners.shape).copy(), np.broadcast_to(t, corners.shape).copy()
+
+    def side(x, z0, edge):
+        return rects(np.stack([np.full(ny, x), wy0 + rows * cy, np.full(ny, z0)], -1), edge, [0.0, cy, 0.0])
+
+    def cap(y):
+        return rects(np.stack([wx0 + cols * cx, np.full(nx, y), np.full(nx, back_z)], -1), depth, [cx, 0.0, 0.0])
+
+    return {"front": window_patch_rectangles(front_z), "back": window_patch_rectangles(back_z),
+            "left": side(wx0, back_z, depth), "right": side(wx1, back_z, depth),
+            "left_gap": side(wx0, wall_z, gap), "right_gap": side(wx1, wall_z, gap),
+            "bottom": cap(wy0), "top": cap(wy1)}
+
+
+def box_side_angle(centres: np.ndarray, points: np.ndarray, right: bool) -> np.ndarray:
+    """common.glsl ``box_side_angle``: the angle (rad) of the way from ``centres`` on the box's
+    side (right: x = x1, else x0) to ``points`` (broadcast), up from the side's outward normal
+    towards +z."""
+    d = np.asarray(points, dtype=np.float64) - np.asarray(centres, dtype=np.float64)
+    return np.arctan2(d[..., 2], d[..., 0] if right else -d[..., 0])
+
+
+def wall_eye_weight(centres: np.ndarray, points: np.ndarray, right: bool) -> np.ndarray:
+    """The share of the box side's radiance (rows centred at ``centres`` (N, 3)) towards
+    ``points`` (P, 3) taken from the room's side eye, the rest from the wall eye, (P, N):
+    linear in :func:`box_side_angle` from the wall eye's angle (0) to level (1; a way level
+    with the side's centre or falling crosses the folds, one rising from below it leaves by
+    the box's front), clamped."""
+    eye = np.asarray(WALL_EYES[1 if right else 0], dtype=np.float64)
+    a_wall = box_side_angle(centres, eye, right)[None, :]
+    a = box_side_angle(centres[None, :, :], np.asarray(points, dtype=np.float64)[:, None, :], right)
+    return np.clip((a - a_wall) / (0.0 - a_wall), 0.0, 1.0)
+
+
+def window_irradiance_at(points: np.ndarray, normals: np.ndarray, radiance_front: np.ndarray,
+                         radiance_back: np.ndarray, radiance_sides: np.ndarray | None = None,
+                         lobe: dict | None = None, alpha=None,
+                         front_z: float = WINDOW_FRONT_Z, radiance_walls: np.ndarray | None = None) -> np.ndarray:
+    """The float64 twin of common.glsl's ``window_irradiance``, (P, 3), at ``points`` (P, 3)
+    of the room outside the opening with ``normals``: the front's patches (plane ``front_z``;
+    ``radiance_front`` (9, 12, 3), the middle capture at its patch level, blended per point
+    and patch with ``radiance_sides`` (2, 9, 12, 3), the side eyes' captures, by
+    :func:`capture_eye_weights`) where the point lies before that plane; with a box
+    (``front_z`` before the curtain's plane), its sides (the edge column of the side eye
+    towards them), bottom and top (the blended edge row) and, for points before the curtain's
+    plane, the sides' gaps (the window side's edge column); behind the curtain's plane, the
+    window side's patches (``radiance_back``). ``radiance_walls`` (2, 9, 3): the wall eyes'
+    captures of the sides, blended with the side eyes' by :func:`wall_eye_weight`. ``lobe``
+    (keywords lobe_rgb, g_spec, to_light) adds the key's directional lobe to the room side's
+    rectangles, scaled by ``alpha`` (9, 12), the middle capture's alpha. E = sum L F, F from
+    :func:`rectangle_irradiance_factor`."""
+    p = np.asarray(points, dtype=np.float64)
+    n = np.asarray(normals, dtype=np.float64)
+    lf = np.asarray(radiance_front, dtype=np.float64).reshape(LUMINAIRE_TEXELS[1], LUMINAIRE_TEXELS[0], 3)
+    lb = np.asarray(radiance_back, dtype=np.float64).reshape(-1, 3)
+    a = (np.zeros(lf.shape[:2]) if alpha is None else np.asarray(alpha, dtype=np.float64).reshape(lf.shape[:2]))
+    sides = None if radiance_sides is None else np.asarray(radiance_sides, dtype=np.float64).reshape((2,) + lf.shape)
+    box = window_box_rectangles(front_z)
+    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
+    back_z = scene_lib.CURTAIN_Z
+
+    def blended(rows, cols, centres, at):   # (A, N, 3): captured_towards
+        middle = lf[rows, cols]
+        if sides is None:
+            return np.broadcast_to(middle, (at.shape[0],) + middle.shape)
+        w = capture_eye_weights(at, centres)
+        return w[..., 0:1] * sides[0][rows, cols][None] + w[..., 1:2] * middle[None] + w[..., 2:3] * sides[1][rows, cols][None]
+
+    def add(e, mask, rect, radiance, alpha_n):   # radiance (A, N, 3) or (N, 3)
+        if not mask.any():
+            return
+        corners, s, t = rect
+        at = p[mask]
+        centres = corners + 0.5 * (s + t)
+        factors = rectangle_irradiance_factor(at, n[mask], corners, s, t)
+        total = np.broadcast_to(radiance, (at.shape[0],) + corners.shape) + _key_lobe(at, centres, alpha_n, lobe)
+        e[mask] += np.einsum("pn,pnc->pc", factors, total)
+
+    e = np.zeros(p.shape)
+    ny, nx = lf.shape[:2]
+    j, i = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
+    front = box["front"]
+    before_front = p[:, 2] > front_z + 1e-4
+    if before_front.any():
+        centres = front[0] + 0.5 * (front[1] + front[2])
+        add(e, before_front, front, blended(j.ravel(), i.ravel(), centres, p[before_front]), a.ravel())
+    if front_z > back_z:
+        rows, cols = np.arange(ny), np.arange(nx)
+        for name, col, mask in (("left", 0, p[:, 0] < wx0 - 1e-4), ("right", nx - 1, p[:, 0] > wx1 + 1e-4)):
+            right = name == "right"
+            edge = lf[rows, col] if sides is None else sides[1 if right else 0][rows, col]
+            if radiance_walls is not None and mask.any():
+                corners, s, t = box[name]
+                weight = wall_eye_weight(corners + 0.5 * (s + t), p[mask], right)[..., None]
+                walls = np.asarray(radiance_walls, dtype=np.float64).reshape(2, ny, 3)[1 if right else 0]
+                edge = weight * edge[None] + (1.0 - weight) * walls[None]
+            add(e, mask, box[name], edge, a[rows, col])
+            gap_radiance = lb.reshape(ny, nx, 3)[rows, col]
+            add(e, mask & (p[:, 2] > back_z), box[name + "_gap"], gap_radiance, np.zeros(ny))
+        for name, row, mask in (("bottom", 0, p[:, 1] < wy0 - 1e-4), ("top", ny - 1, p[:, 1] > wy1 + 1e-4)):
+            if mask.any():
+                corners, s, t = box[name]
+                centres = corners + 0.5 * (s + t)
+                add(e, mask, box[name], blended(np.full(nx, row), cols, centres, p[mask]), a[row, cols])
+    behind = p[:, 2] < back_z
+    if behind.any():
+        corners, s, t = box["back"]
+        e[behind] += rectangle_irradiance_factor(p[behind], n[behind], corners, s, t) @ lb
+    return e
+
+
 def window_irradiance(radiance_front: np.ndarray, radiance_back: np.ndarray,
                       face_texels: int = FACE_TEXELS, lobe: dict | None = None,
-                      radiance_sides: np.ndarray | None = None) -> np.ndarray:
+                      radiance_sides: np.ndarray | None = None, alpha=None,
+                      front_z: float = WINDOW_FRONT_Z, radiance_walls: np.ndarray | None = None) -> np.ndarray:
     """The float64 twin of room_lightmap.frag's window term, (R, 6R, 3): per atlas texel, the
     mean over its sample points on a wall (2 x 2 within WINDOW_SUPERSAMPLE_M of the window's
-    plane, else the centre; none inside the opening) of the room side's patches (in the
-    opening, ``radiance_front`` (9, 12, 3), the capture at its patch level) and, behind the
-    curtain's plane, its window side's (``radiance_back``), each E = L F with F from
-    :func:`rectangle_irradiance_factor`; with ``lobe`` (keywords of :func:`lobe_radiance`),
-    the room side's patches add the key's directional lobe. ``radiance_sides`` (2, 9, 12, 3):
-    the side eyes' captures (:data:`CAPTURE_SIDE_EYES`), blended with the middle's per point
-    and patch by :func:`capture_eye_weights`; None: the middle's alone."""
-    positions, normals = texel_points(face_texels)
+    plane, else the centre; none inside the opening) of :func:`window_irradiance_at` (its
+    arguments)."""
+    positions, _normals = texel_points(face_texels)
     wall_z = scene_lib.ROOM_BOX[2][0]
     wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-    front = window_patch_rectangles(wall_z)
-    back = window_patch_rectangles(scene_lib.CURTAIN_Z)
-    lf = np.asarray(radiance_front, dtype=np.float64).reshape(-1, 3)
-    lb = np.asarray(radiance_back, dtype=np.float64).reshape(-1, 3)
     out = np.zeros(positions.shape[:2] + (3,))
     for k, face in enumerate(room_faces()):
         cols = slice(k * face_texels, (k + 1) * face_texels)
@@ -685,22 +909,10 @@ def window_irradiance(radiance_front: np.ndarray, radiance_back: np.ndarray,
             use = use & ~in_opening
             if not use.any():
                 continue
-            n = np.broadcast_to(face.normal, q.shape)
-            factors = rectangle_irradiance_factor(q[use], n[use], *front)
-            if radiance_sides is None:
-                e = factors @ lf
-            else:
-                sides = np.asarray(radiance_sides, dtype=np.float64).reshape(2, -1, 3)
-                weights = capture_eye_weights(q[use], front[0] + 0.5 * (front[1] + front[2]))
-                radiance = (weights[..., 0:1] * sides[0][None] + weights[..., 1:2] * lf[None]
-                            + weights[..., 2:3] * sides[1][None])
-                e = np.einsum("pn,pnc->pc", factors, radiance)
-            if lobe is not None:
-                e += np.einsum("pj,pjc->pc", factors, lobe_radiance(q[use], **lobe))
-            behind = q[use, 2] < scene_lib.CURTAIN_Z
-            if behind.any():
-                e[behind] += rectangle_irradiance_factor(q[use][behind], n[use][behind], *back) @ lb
-            total[use] += e
+            n = np.broadcast_to(face.normal, q[use].shape)
+            total[use] += window_irradiance_at(q[use], n, radiance_front, radiance_back, radiance_sides,
+                                               lobe=lobe, alpha=alpha, front_z=front_z,
+                                               radiance_walls=radiance_walls)
             count[use] += 1
         mean = np.where(count[:, None] > 0, total / np.maximum(count, 1)[:, None], 0.0)
         out[:, cols] = mean.reshape(face_texels, face_texels, 3)
