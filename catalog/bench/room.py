@@ -92,11 +92,18 @@ def work_counts(size) -> dict[str, float]:
         # sixth round, two side eyes; window side)
         "room_luminaire": float(lw * lh * (4 ** room_light.LUMINAIRE_LEVEL
                                            + 2 * 4 ** room_light.SIDE_LUMINAIRE_LEVEL
-                                           + 4 ** room_light.BACK_LUMINAIRE_LEVEL)),
+                                           + 4 ** room_light.BACK_LUMINAIRE_LEVEL)
+                                # the ninth round's wall eyes: a column of patch rows each
+                                + 2 * lh * 4 ** room_light.WALL_EYE_LEVEL),
         # the window's term and the gather per atlas texel, and the radiosity pass (issue 11):
         # one fragment per coarse patch, summing over every patch; the beam's samples (sixth
         # round: BEAM_SAMPLES^2 map reads a texel, about a fifth of an exact factor each)
         "room_lightmap": float((samples + behind) * lw * lh * exact
+                               # the ninth round's box: a point meets one side's rows and
+                               # their gaps and one of top and bottom; and the window wall's
+                               # finer grid (the window side's patches, a side, top or bottom)
+                               + samples * (2 * lh + lw) * exact
+                               + room_light.WINDOW_NEAR_TEXELS ** 2 * (lw * lh + lh + lw) * exact
                                + aw * ah * room_light.BEAM_SAMPLES ** 2 * 0.2
                                + aw * ah * 5 * coarse * coarse * exact
                                + (len(room_light.FACE_NAMES) * coarse * coarse) ** 2
