@@ -635,6 +635,28 @@ def test_two_layer_study_reproduces_eq7_alone_and_tabulates(mi, monkeypatch):
     assert "| 40 | 30 |" in two_layers.markdown_tables(result)["two-layers"]
 
 
+def _safety_yellow_under_the_lamp(gl, depth_m: float):
+    """The safety-yellow under the UV lamp (physical fluorescence) on the static drape folded
+    ``depth_m`` deep, 8 x 6: (the renderer after one frame, the scene's description)."""
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace.scene import describe_scene
+    from catalog.render import scene as scene_lib
+    from catalog.render.frame import FrameRenderer
+
+    d = scene_lib.draped_curtain(depth_m=depth_m)
+    curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
+    preset = desc_preset("safety-yellow")
+    light = get_light("UV-A")
+    desc = describe_scene(preset, light, size=(8, 6), curtain=curtain)
+    r = FrameRenderer(gl, (8, 6))
+    r.set_fabric(preset)
+    r.set_light(light)
+    r.set_fluorescence("physical")
+    r.set_mesh(*curtain)
+    r.render()
+    return r, desc
+
+
 @pytest.mark.gl
 @pytest.mark.slow   # ~5 s: 16 points x 2048 rays
 def test_the_window_wall_beside_the_opening_gets_the_path_tracers_direct_light(gl, mi):
@@ -652,23 +674,11 @@ def test_the_window_wall_beside_the_opening_gets_the_path_tracers_direct_light(g
     rays a point at the same places: 0.98, 0.66, 2.23)."""
     import dataclasses
 
-    from catalog.optics.lights import get_light
-    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
+    from catalog.pathtrace.scene import build_mitsuba_scene
     from catalog.render import room_light
     from catalog.render import scene as scene_lib
-    from catalog.render.frame import FrameRenderer
 
-    d = scene_lib.draped_curtain()
-    curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
-    preset = desc_preset("safety-yellow")
-    light = get_light("UV-A")
-    desc = describe_scene(preset, light, size=(8, 6), curtain=curtain)
-    r = FrameRenderer(gl, (8, 6))
-    r.set_fabric(preset)
-    r.set_light(light)
-    r.set_fluorescence("physical")
-    r.set_mesh(*curtain)
-    r.render()
+    r, desc = _safety_yellow_under_the_lamp(gl, depth_m=0.07)
     captured = r.read_luminaire(room_light.LUMINAIRE_LEVEL)
     res = r._room_resources()
     w, h = room_light.LUMINAIRE_TEXELS
@@ -732,23 +742,10 @@ def test_the_rooms_window_captures_match_traced_radiance_along_their_rays(gl, mi
     the folds behind left out, 0.84, 0.98 and 0.69 (the right eye fails). Since the ninth round
     the patches lie at the box's front (room_light.WINDOW_FRONT_Z, 22 cm before the opening;
     this drape's crests reach 2 cm past it): 1.03, 1.00 and 0.83."""
-    from catalog.optics.lights import get_light
-    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
+    from catalog.pathtrace.scene import build_mitsuba_scene
     from catalog.render import room_light
-    from catalog.render import scene as scene_lib
-    from catalog.render.frame import FrameRenderer
 
-    d = scene_lib.draped_curtain(depth_m=0.12)
-    curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
-    preset = desc_preset("safety-yellow")
-    light = get_light("UV-A")
-    desc = describe_scene(preset, light, size=(8, 6), curtain=curtain)
-    r = FrameRenderer(gl, (8, 6))
-    r.set_fabric(preset)
-    r.set_light(light)
-    r.set_fluorescence("physical")
-    r.set_mesh(*curtain)
-    r.render()
+    r, desc = _safety_yellow_under_the_lamp(gl, depth_m=0.12)
     nx, ny = room_light.LUMINAIRE_TEXELS
     middle = r.read_luminaire(room_light.LUMINAIRE_LEVEL)
     sides = r.read_side_captures()
