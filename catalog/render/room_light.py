@@ -708,34 +708,6 @@ def window_beam_mask(points: np.ndarray, to_light, tan_radius: float = math.tan(
     return (s_out >= 0.0) * inner * soft_rect(q_out, s_out * tan_radius + 1e-3)
 
 
-def lobe_radiance(points: np.ndarray, lobe_rgb, g_spec: float, to_light,
-                  key_factor=None) -> np.ndarray:
-    """(P, N, 3): the key's directional lobe leaving each window patch towards each point,
-    eq. 7's E cos_i a_spec ph(theta) with ``lobe_rgb`` = key x a_spec x dye and theta between
-    the key's travel and the way from the patch's centre in the opening (where its rectangle
-    lies; from the curtain's plane instead, 6 % of the flux missed the room) to the point.
-    ``key_factor`` (N,): the key's irradiance on the patch's cloth per unit of its normal
-    irradiance, the room capture's alpha (curtain.frag ROOM_CAPTURE: |cos_i| x the window's
-    mask x what a layer nearer the light passes, averaged over the patch, 0 where no cloth);
-    None: the flat cloth, |cos_i| x the beam's share through the opening at the patch's
-    centre in the curtain's plane (:func:`window_beam_mask`)."""
-    corners, s, t = window_patch_rectangles(scene_lib.ROOM_BOX[2][0])
-    centres = corners + 0.5 * (s + t)
-    to_light = np.asarray(to_light, dtype=np.float64)
-    if key_factor is None:
-        on_cloth = centres.copy()
-        on_cloth[:, 2] = scene_lib.CURTAIN_Z
-        key_factor = abs(to_light[2]) * window_beam_mask(on_cloth, to_light)
-    w = np.asarray(points, dtype=np.float64)[:, None, :] - centres[None, :, :]
-    w /= np.linalg.norm(w, axis=-1, keepdims=True)
-    chord2 = np.sum((w + to_light) ** 2, axis=-1)
-    g = float(g_spec)
-    d = (1.0 - g) ** 2 + g * chord2
-    phase = (1.0 - g) * (1.0 + g) / (4.0 * math.pi) / (d * np.sqrt(d))
-    factor = np.asarray(key_factor, dtype=np.float64).reshape(-1)
-    return (factor[None, :] * phase)[..., None] * np.asarray(lobe_rgb, dtype=np.float64)
-
-
 def _key_lobe(points: np.ndarray, centres: np.ndarray, alpha: np.ndarray, lobe: dict | None) -> np.ndarray:
     """(P, N, 3): common.glsl ``key_lobe`` from rectangles centred at ``centres`` (N, 3) whose
     cloth the key reaches by ``alpha`` (N,) towards ``points`` (P, 3); 0 without ``lobe``
