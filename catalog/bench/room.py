@@ -94,7 +94,7 @@ def work_counts(size) -> dict[str, float]:
                                            + 2 * 4 ** room_light.SIDE_LUMINAIRE_LEVEL
                                            + 4 ** room_light.BACK_LUMINAIRE_LEVEL)
                                 # the ninth round's wall eyes: a column of patch rows each
-                                + 2 * lh * 4 ** room_light.WALL_EYE_LEVEL),
+                                + 2 * int(np.prod(room_light.wall_eye_capture_size()))),
         # the window's term and the gather per atlas texel, and the radiosity pass (issue 11):
         # one fragment per coarse patch, summing over every patch; the beam's samples (sixth
         # round: BEAM_SAMPLES^2 map reads a texel, about a fifth of an exact factor each)

@@ -554,10 +554,15 @@ class FrameRenderer:
             return room_light.WINDOW_FRONT_Z
         return scene_lib.ROOM_BOX[2][0]
 
+    def box_active(self) -> bool:
+        """Whether the room sees the curtain through the box round its folds (its front before
+        the opening's plane: ``window_box`` on and the curtain closed)."""
+        return self.window_front_z() > scene_lib.ROOM_BOX[2][0]
+
     def window_near(self) -> bool:
         """Whether room.frag takes the window's light per pixel on the window wall beside the
         opening (WINDOW_NEAR): with the box (its sides stand on that wall)."""
-        return self.window_near_field and self.window_front_z() > scene_lib.ROOM_BOX[2][0]
+        return self.window_near_field and self.box_active()
 
     def set_window_near(self, on: bool) -> None:
         """The window wall within room_light.WINDOW_NEAR_M of the opening takes the window's
@@ -567,14 +572,13 @@ class FrameRenderer:
 
     def wall_eyes_active(self) -> bool:
         """Whether the box's sides are captured from the wall eyes too (WALL_EYES)."""
-        return self.wall_eyes and self.window_front_z() > scene_lib.ROOM_BOX[2][0]
+        return self.wall_eyes and self.box_active()
 
     def set_wall_eyes(self, on: bool) -> None:
         """Capture the box's sides also from eyes by the window wall (room_light.WALL_EYES) and
         blend the two by the angle of the way to each receiving point (True); off: the side
         eyes' edge columns alone."""
         self.wall_eyes = bool(on)
-        self._room_key = None
 
     def set_window_box(self, on: bool) -> None:
         """The room sees the closed curtain through a box around its folds (the patches at the
@@ -582,7 +586,6 @@ class FrameRenderer:
         gets the flanks' light); off: through the opening's plane alone (before issue 11's
         ninth round)."""
         self.window_box = bool(on)
-        self._room_key = None
 
     def set_side_eyes(self, on: bool) -> None:
         """Capture the window for the room's direct light from the middle and two eyes towards
@@ -1464,7 +1467,7 @@ class FrameRenderer:
             window_near = ctx.texture((nt, nt), 4, dtype="f2")
             window_near.filter = (mgl.LINEAR, mgl.LINEAR)
             window_near.repeat_x = window_near.repeat_y = False
-            ww, wh = 1 << room_light.WALL_EYE_LEVEL, room_light.LUMINAIRE_TEXELS[1] << room_light.WALL_EYE_LEVEL
+            ww, wh = room_light.wall_eye_capture_size()
             walls = ctx.texture((2 * ww, wh), 4, dtype="f4")   # the wall eyes', left then right
             walls.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             walls_depth = ctx.depth_renderbuffer((2 * ww, wh))
@@ -1856,7 +1859,7 @@ class FrameRenderer:
         if self.wall_eyes_active():   # the box's sides from the wall eyes (no outside: their ways
             gl["luminaire_walls_fbo"].use()   # through a side rise into the room)
             gl["luminaire_walls_fbo"].clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            ww, wh = 1 << room_light.WALL_EYE_LEVEL, room_light.LUMINAIRE_TEXELS[1] << room_light.WALL_EYE_LEVEL
+            ww, wh = room_light.wall_eye_capture_size()
             for k, eye in enumerate(room_light.WALL_EYES):
                 self.ctx.viewport = (k * ww, 0, ww, wh)
                 self._draw_flat_curtain(room_light.wall_eye_view_projection(k == 1, self.window_front_z()), eye,
@@ -2210,7 +2213,8 @@ class FrameRenderer:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
         key = (self._inputs_key, self.curtain_open, self.key_shadow, self.sky_occlusion,
                self.room_bounces, self.room_lobe, self.room_side_active(), self.wall_light,
-               self.side_eyes, self.window_box, self.wall_eyes, self.capture_folds, self.secondary_dye, self.key_second_layer,
+               self.side_eyes, self.window_box, self.wall_eyes, self.window_near_field,
+               self.capture_folds, self.secondary_dye, self.key_second_layer,
                getattr(self, "patterned", None),
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))

@@ -582,6 +582,12 @@ WALL_EYES = ((-1.5, 0.2, -0.15), (1.5, 0.2, -0.15))
 WALL_EYE_LEVEL = 3
 
 
+def wall_eye_capture_size() -> tuple[int, int]:
+    """A wall eye's capture size: one column of the 9 patch rows supersampled by
+    2^WALL_EYE_LEVEL."""
+    return 1 << WALL_EYE_LEVEL, LUMINAIRE_TEXELS[1] << WALL_EYE_LEVEL
+
+
 def rectangle_view_projection(eye, corner, s, t, near: float = 0.05, far: float = 60.0) -> np.ndarray:
     """Off-axis perspective from ``eye`` whose frustum is exactly the rectangle
     ``corner + [0,1] s + [0,1] t``: normalised device x runs along s and y along t, -1 to 1
