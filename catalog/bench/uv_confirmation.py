@@ -169,8 +169,9 @@ def verdict(rows: list[dict]) -> dict:
             "cases": len(rows), "per_light": per_light}
 
 
-def markdown(result: dict) -> str:
-    """The per-light table and the verdict line (docs/bispectral.md, README)."""
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``uv-confirmation``: the per-light table and the verdict line (docs/bispectral.md,
+    README; tools/docs_figures.py fills them from RESULT_JSON)."""
     from catalog.optics.bispectral.bands import BANDS_CHOSEN, CHOSEN  # noqa: PLC0415
 
     v = result["verdict"]
@@ -194,7 +195,7 @@ def markdown(result: dict) -> str:
               f"against the raw matrices mean {v['bands_mean']:.2f} (no bound; the separable "
               f"fit {v['separable_mean']:.2f}), cases above their floor: {over}. "
               f"Models: {SEPARABLE}; {BANDS_CHOSEN}; {CHOSEN}."]
-    return "\n".join(lines)
+    return {"uv-confirmation": "\n".join(lines)}
 
 
 def main(argv=None) -> int:
@@ -210,7 +211,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     result = run(quick=args.quick)
     write_text_atomic(Path(args.out), json.dumps(result, indent=1) + "\n")
-    print(f"<!-- generated:uv-confirmation -->\n{markdown(result)}\n<!-- /generated:uv-confirmation -->")
+    for name, table in markdown_tables(result).items():
+        print(f"<!-- generated:{name} -->\n{table}\n<!-- /generated:{name} -->")
     return 0
 
 
