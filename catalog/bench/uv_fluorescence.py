@@ -505,6 +505,8 @@ def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> d
 
         fit = fit_banded(read_bfc(find_bfc("CIBA12")), residual=DEFAULT_RESIDUAL,
                          residual_rank=DEFAULT_RESIDUAL_RANK)
+        from catalog.optics.bispectral.preset import banded_preset  # noqa: PLC0415
+
         banded = banded_preset(single, fit, folder)
         what = (f"lace-fwa cloth with CIBA12's {len(fit.components)}-band fit"
                 + ("" if fit.residual is None else " and its measured residual"))
@@ -598,37 +600,6 @@ def frame_table(frame: dict) -> str:
     lines.append(f"\nBanded fabric: {frame['what']}; {frame['repeats']} interleaved rounds of "
                  f"{frame['draws']} frames.")
     return "\n".join(lines)
-
-
-def banded_preset(base_preset, fit, folder, name: str | None = None):
-    """A preset like ``base_preset`` (its cloth, BTDF, paper-mode colour) whose physical-mode
-    fluorescence is ``fit``'s bands, written with its spectra into ``folder``; returns the
-    loaded :class:`catalog.presets.Preset`. For tests and benchmarks: the measured matrices
-    are not shipped, so no catalog fabric is made this way."""
-    from pathlib import Path  # noqa: PLC0415
-
-    from catalog.optics.bispectral.bands import band_materials_table  # noqa: PLC0415
-    from catalog.presets import preset_to_dict, save_preset_dict  # noqa: PLC0415
-
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    doc = preset_to_dict(base_preset)
-    name = name or f"{base_preset.name}-{fit.matrix_name.lower()}-banded"
-    doc["name"] = name
-    doc["display_name"] = f"{base_preset.display_name} ({fit.matrix_name}, {len(fit.components)} bands)"
-    doc.pop("fit", None)
-    source_folder = Path(base_preset.path).parent if base_preset.path is not None else None
-    pattern = dict(doc.get("pattern", {}))
-    for key in ("coverage", "height"):  # the base's pattern images, where they lie
-        if isinstance(pattern.get(key), str) and source_folder is not None:
-            pattern[key] = str((source_folder / pattern[key]).resolve())
-    if pattern:
-        doc["pattern"] = pattern
-    fluorescence = {k: v for k, v in doc["fluorescence"].items()
-                    if k in ("xyz", "rgb", "saturation_photon_irradiance")}
-    fluorescence.update(band_materials_table(fit, folder))
-    doc["fluorescence"] = fluorescence
-    return save_preset_dict(doc, folder / f"{name}.toml")
 
 
 def main(argv=None) -> int:

@@ -4,8 +4,11 @@ colour error (Delta E 2000) of each fluorescence model against the exact matrix 
 FILE is a BFC-450 matrix file, or the name of one in the validation data's bispectral/ folder
 (``CIBA12``; ``--data DIR``). The eight measured matrices there also set eq. 8's global scale,
 so the command needs the validation data (docs/formats.md).
-``--export DIR`` writes excitation.csv, emission.csv and reflectance.csv there, so the
-measured material can become a catalog fabric (docs/bispectral.md).
+``--export DIR`` writes excitation.csv, emission.csv and reflectance.csv there (the
+separable fit). With ``--preset BASE`` it writes instead a whole fabric: BASE's cloth with
+this matrix's fluorescence as the renderer carries it (the banded model and, unless
+``--residual none``, the measured residual): ``DIR/BASE-NAME-banded.toml`` with its spectra
+and pattern in ``DIR/BASE-NAME-banded/``, ready for ``--fabrics DIR`` (docs/bispectral.md).
 """
 
 from __future__ import annotations
@@ -29,6 +32,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "model the renderer carries, and their Delta E 2000")
     parser.add_argument("--export", metavar="DIR",
                         help="write excitation.csv, emission.csv, reflectance.csv into DIR")
+    parser.add_argument("--preset", metavar="BASE",
+                        help="with --export: write a fabric preset instead, BASE's cloth "
+                             "(a catalog name or a .toml) with this matrix's banded "
+                             "fluorescence")
+    parser.add_argument("--residual", choices=("whole", "none"), default=None,
+                        help="with --preset: keep the measured residual (whole, the "
+                             "default: the model reproduces the matrix as measured) or "
+                             "render the physical bands alone (none)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead")
 
 
@@ -36,6 +47,16 @@ def run(args: argparse.Namespace) -> int:
     from catalog.optics.bispectral import bands as bispectral_bands, matrix as bispectral, study
     from catalog.core.errors import InputError
 
+    if args.preset is not None and not args.export:
+        raise InputError("needs --export DIR (the folder the fabric is written to)",
+                         field="--preset")
+    if args.residual is not None and args.preset is None:
+        raise InputError("only applies with --preset BASE", field="--residual")
+    base = None
+    if args.preset is not None:
+        from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+
+        base = load_preset(find_preset(args.preset))
     path = bispectral.find_bfc(args.file)
     matrix = bispectral.read_bfc(path)
     lights = study.STUDY_LIGHTS
@@ -61,9 +82,20 @@ def run(args: argparse.Namespace) -> int:
 
         from catalog.core.atomic import staged_folder  # noqa: PLC0415
 
-        with staged_folder(args.export) as stage:  # all three files, or none
-            written = bispectral.to_fabric_measurements(matrix, stage, fit)
-        exported = {k: str(Path(args.export) / Path(v).name) for k, v in written.items()}
+        if base is None:
+            with staged_folder(args.export) as stage:  # all three files, or none
+                written = bispectral.to_fabric_measurements(matrix, stage, fit)
+            exported = {k: str(Path(args.export) / Path(v).name) for k, v in written.items()}
+        else:
+            from catalog.optics.bispectral.preset import banded_preset  # noqa: PLC0415
+
+            carried = banded if args.residual != "none" else bispectral_bands.fit_banded(
+                matrix, base=fit, residual=False)
+            with staged_folder(args.export) as stage:  # the preset and its files, or none
+                name = f"{base.name}-{matrix.name.lower()}-banded"
+                made = banded_preset(base, carried, stage, name, copy_pattern=True,
+                                     files_folder=name)
+            exported = {"preset": str(Path(args.export) / Path(made.path).name)}
 
     fit_info = {"yield_absorptance": fit.yield_absorptance, "quantum_yield": fit.quantum_yield,
                 "peak_absorptance": fit.peak_absorptance,
