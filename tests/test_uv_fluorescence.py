@@ -167,7 +167,7 @@ def test_banded_preset_renders_the_sum_of_its_bands(tmp_path):
     """The renderer's per-light pre-integration of a banded preset: the emission it hands
     the shader for the key light equals the bands' summed emission (relative 1e-5: the
     preset's CSV files and 6-digit quantum yields)."""
-    from catalog.optics.bispectral.preset import banded_preset
+    from catalog.presets.banded import banded_preset
     from catalog.optics.bispectral.bands import fit_banded
     from catalog.optics.lights import get_light
     from catalog.presets import find_preset, load_preset
@@ -187,7 +187,7 @@ def test_banded_preset_renders_the_sum_of_its_bands(tmp_path):
 
 
 def test_bad_band_entry_is_refused_naming_the_field(tmp_path):
-    from catalog.optics.bispectral.preset import banded_preset
+    from catalog.presets.banded import banded_preset
     from catalog.optics.bispectral.bands import fit_banded
     from catalog.presets import find_preset, load_preset, preset_from_dict, preset_to_dict
     from catalog.render import scene

@@ -236,7 +236,7 @@ def test_bad_residual_file_is_refused_in_one_line(tmp_path, text, message):
 
 
 def test_bad_residual_field_in_a_preset_is_refused_naming_it(tmp_path):
-    from catalog.optics.bispectral.preset import banded_preset
+    from catalog.presets.banded import banded_preset
     from catalog.optics.bispectral.bands import fit_banded
     from catalog.presets import find_preset, load_preset, preset_from_dict, preset_to_dict
 
@@ -257,7 +257,7 @@ def test_renderer_carries_bands_plus_residual_under_the_key(tmp_path):
     normal incidence is the bands' emission plus the residual's spectrum (float64
     reference: the fit's own sum), relative 1e-4 (CSV files at 6-8 digits); the absorbed
     photons (what the shader multiplies) are those of the bands alone, relative 1e-5."""
-    from catalog.optics.bispectral.preset import banded_preset
+    from catalog.presets.banded import banded_preset
     from catalog.optics.bispectral.bands import fit_banded
     from catalog.presets import find_preset, load_preset
     from catalog.render import scene

@@ -505,7 +505,7 @@ def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> d
 
         fit = fit_banded(read_bfc(find_bfc("CIBA12")), residual=DEFAULT_RESIDUAL,
                          residual_rank=DEFAULT_RESIDUAL_RANK)
-        from catalog.optics.bispectral.preset import banded_preset  # noqa: PLC0415
+        from catalog.presets.banded import banded_preset  # noqa: PLC0415
 
         banded = banded_preset(single, fit, folder)
         what = (f"lace-fwa cloth with CIBA12's {len(fit.components)}-band fit"

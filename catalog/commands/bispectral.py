@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
                 written = bispectral.to_fabric_measurements(matrix, stage, fit)
             exported = {k: str(Path(args.export) / Path(v).name) for k, v in written.items()}
         else:
-            from catalog.optics.bispectral.preset import banded_preset  # noqa: PLC0415
+            from catalog.presets.banded import banded_preset  # noqa: PLC0415
 
             carried = banded if args.residual != "none" else bispectral_bands.fit_banded(
                 matrix, base=fit, residual=False)
