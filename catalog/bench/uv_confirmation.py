@@ -1,6 +1,6 @@
 """Issue 15: a confirmation of the chosen fluorescence model on lights nobody has scored.
 
-    .venv/bin/python -m catalog.bench.uv_confirmation [--quick] [--out benchmarks/bench_uv_confirmation.json]
+    .venv/bin/python -m catalog.bench.uv_confirmation [--quick] [--json-out benchmarks/bench_uv_confirmation.json]
 
 Why: the chosen representation (the 14 excitation bands plus the whole measured residual,
 :data:`catalog.optics.bispectral.bands.CHOSEN`) was picked on the selection lights, but its
@@ -199,21 +199,15 @@ def markdown_tables(result: dict) -> dict[str, str]:
 
 
 def main(argv=None) -> int:
-    import argparse  # noqa: PLC0415
-    import json  # noqa: PLC0415
-    from pathlib import Path  # noqa: PLC0415
+    import sys  # noqa: PLC0415
 
-    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+    from catalog.bench.results import study_main  # noqa: PLC0415
 
-    parser = argparse.ArgumentParser(description="issue 15: the chosen model on unscored lights")
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--out", default=RESULT_JSON)
-    args = parser.parse_args(argv)
-    result = run(quick=args.quick)
-    write_text_atomic(Path(args.out), json.dumps(result, indent=1) + "\n")
-    for name, table in markdown_tables(result).items():
-        print(f"<!-- generated:{name} -->\n{table}\n<!-- /generated:{name} -->")
-    return 0
+    def options(parser):
+        parser.add_argument("--quick", action="store_true", help="8 noise draws, not 30")
+
+    return study_main(sys.modules[__name__], argv, make_result=lambda args: run(quick=args.quick),
+                      add_arguments=options)
 
 
 if __name__ == "__main__":
