@@ -92,9 +92,7 @@ def run(args: argparse.Namespace) -> int:
             carried = banded if args.residual != "none" else bispectral_bands.fit_banded(
                 matrix, base=fit, residual=False)
             with staged_folder(args.export) as stage:  # the preset and its files, or none
-                name = f"{base.name}-{matrix.name.lower()}-banded"
-                made = banded_preset(base, carried, stage, name, copy_pattern=True,
-                                     files_folder=name)
+                made = banded_preset(base, carried, stage, copy_pattern=True, own_folder=True)
             exported = {"preset": str(Path(args.export) / Path(made.path).name)}
 
     fit_info = {"yield_absorptance": fit.yield_absorptance, "quantum_yield": fit.quantum_yield,

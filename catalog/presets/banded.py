@@ -17,25 +17,26 @@ from pathlib import Path
 
 
 def banded_preset(base_preset, fit, folder, name: str | None = None, *,
-                  copy_pattern: bool = False, files_folder: str | None = None):
+                  copy_pattern: bool = False, own_folder: bool = False):
     """A preset like ``base_preset`` whose physical-mode fluorescence is ``fit``'s bands
     (a :class:`catalog.optics.bispectral.bands.BandedFit`), written with its spectra into
     ``folder``; returns the loaded :class:`catalog.presets.Preset`.
 
     The base's pattern images are referred to where they lie (absolute paths), or with
     ``copy_pattern`` copied beside the spectra so the folder stands alone. The spectra go
-    into ``folder``, or into ``folder/files_folder`` (then two fabrics exported into one
-    folder never share, or overwrite, each other's files); the preset is ``folder/NAME.toml``.
+    into ``folder``, or with ``own_folder`` into ``folder/NAME/`` (then two fabrics exported
+    into one folder never share, or overwrite, each other's files); the preset is
+    ``folder/NAME.toml``, NAME by default ``BASE-MATRIX-banded``.
     """
     from catalog.optics.bispectral.bands import band_materials_table  # noqa: PLC0415
     from catalog.presets import preset_to_dict, save_preset_dict  # noqa: PLC0415
 
     folder = Path(folder)
-    files = folder / files_folder if files_folder else folder
-    prefix = f"{files_folder}/" if files_folder else ""
+    name = name or f"{base_preset.name}-{fit.matrix_name.lower()}-banded"
+    files = folder / name if own_folder else folder
+    prefix = f"{name}/" if own_folder else ""
     files.mkdir(parents=True, exist_ok=True)
     doc = preset_to_dict(base_preset)
-    name = name or f"{base_preset.name}-{fit.matrix_name.lower()}-banded"
     doc["name"] = name
     doc["display_name"] = f"{base_preset.display_name} ({fit.matrix_name}, {len(fit.components)} bands)"
     doc.pop("fit", None)
