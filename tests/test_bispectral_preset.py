@@ -87,3 +87,25 @@ def test_bad_preset_options_get_one_line_and_write_nothing(tmp_path, capsys, arg
     err = capsys.readouterr().err.strip()
     assert field in err and "\n" not in err
     assert not out.exists()
+
+
+@pytest.mark.data
+@pytest.mark.slow
+def test_json_describes_the_model_the_export_carries(tmp_path, capsys):
+    """With --residual none the report's model and its per-light XYZ are the bands alone,
+    the model the exported fabric carries, not the default one with the residual."""
+    import json
+
+    from catalog.optics.bispectral.bands import BANDS_CHOSEN, CHOSEN
+
+    models = {}
+    for choice in ("whole", "none"):
+        assert _export(tmp_path / choice, "--residual", choice, "--json",
+                       "--lights", "LED-405") == 0
+        models[choice] = json.loads(capsys.readouterr().out)
+    assert models["whole"]["model"]["name"] == CHOSEN
+    assert models["whole"]["model"]["measured_residual"] == "whole"
+    assert models["none"]["model"]["name"] == BANDS_CHOSEN
+    assert models["none"]["model"]["measured_residual"] is None
+    assert (models["none"]["lights"]["LED-405"]["xyz_model"]
+            != models["whole"]["lights"]["LED-405"]["xyz_model"])

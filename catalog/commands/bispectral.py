@@ -72,8 +72,10 @@ def run(args: argparse.Namespace) -> int:
     reference = [m for m in study.reference_models() if m.matrix.name != matrix.name]
     models = study.with_global_paper_scale(reference + [models])[-1]
     rows = study.study_material(models, lights)
-    banded = bispectral_bands.fit_banded(matrix, base=fit,
-                                         residual=bispectral_bands.DEFAULT_RESIDUAL,
+    # the model the renderer carries: the chosen one, or with --residual none its bands alone
+    with_residual = bispectral_bands.DEFAULT_RESIDUAL and args.residual != "none"
+    model_name = bispectral_bands.CHOSEN if with_residual else bispectral_bands.BANDS_CHOSEN
+    banded = bispectral_bands.fit_banded(matrix, base=fit, residual=with_residual,
                                          residual_rank=bispectral_bands.DEFAULT_RESIDUAL_RANK)
     per_light = banded_colours(matrix, banded, lights)
     exported = {}
@@ -89,10 +91,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             from catalog.presets.banded import banded_preset  # noqa: PLC0415
 
-            carried = banded if args.residual != "none" else bispectral_bands.fit_banded(
-                matrix, base=fit, residual=False)
             with staged_folder(args.export) as stage:  # the preset and its files, or none
-                made = banded_preset(base, carried, stage, copy_pattern=True, own_folder=True)
+                made = banded_preset(base, banded, stage, copy_pattern=True, own_folder=True)
             exported = {"preset": str(Path(args.export) / Path(made.path).name)}
 
     fit_info = {"yield_absorptance": fit.yield_absorptance, "quantum_yield": fit.quantum_yield,
@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
                     "paper_scale_global": models.paper_scale_global,
                     "delta_e_2000": rows, "methods": list(study.METHODS),
                     "lights": per_light, "model": {
-                        "name": bispectral_bands.CHOSEN,
+                        "name": model_name,
                         "excitation_band_edges_nm": list(banded.edges_nm),
                         "measured_residual": (None if banded.residual is None else
                                               "whole" if banded.residual_rank is None
@@ -136,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
     print("  " + f"{'light':<9}" + "".join(f"{c[:14]:>15}" for c in columns))
     for row in rows:
         print("  " + f"{row['light']:<9}" + "".join(f"{row[c]:>15.2f}" for c in columns))
-    print(f"\n  banded model ({bispectral_bands.CHOSEN}, what the renderer carries) "
+    print(f"\n  banded model ({model_name}, what the renderer carries) "
           "against the exact matrix result")
     for name, entry in per_light.items():
         print(f"  {name:<18} Delta E 2000 {entry['delta_e_2000']:6.2f}")
