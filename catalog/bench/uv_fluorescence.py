@@ -502,11 +502,10 @@ def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> d
     folder = tempfile.mkdtemp(prefix="bench-uv-")
     if (bispectral_dir() / "CIBA12.BFC").is_file():
         from catalog.optics.bispectral.bands import DEFAULT_RESIDUAL, DEFAULT_RESIDUAL_RANK  # noqa: PLC0415
+        from catalog.presets.banded import banded_preset  # noqa: PLC0415
 
         fit = fit_banded(read_bfc(find_bfc("CIBA12")), residual=DEFAULT_RESIDUAL,
                          residual_rank=DEFAULT_RESIDUAL_RANK)
-        from catalog.presets.banded import banded_preset  # noqa: PLC0415
-
         banded = banded_preset(single, fit, folder)
         what = (f"lace-fwa cloth with CIBA12's {len(fit.components)}-band fit"
                 + ("" if fit.residual is None else " and its measured residual"))
