@@ -1,0 +1,71 @@
+"""Self-contained presets (catalog.presets.bundle): what ``catalog fit`` and
+``catalog bispectral --export`` write names no path outside the preset's folder, and the
+folder still works after it is moved."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from catalog.commands.cli import main
+from catalog.core.resources import FABRIC_DIR
+from catalog.presets import load_preset
+from catalog.presets.bundle import bundle_files, is_contained, outside_paths
+
+
+def test_is_contained_refuses_climbing_and_absolute_paths():
+    assert is_contained("n/measurements/dye.csv")
+    for bad in ("../x.csv", "n/../../x.csv", "/etc/passwd", "~/x.csv", "..\\x.csv"):
+        assert not is_contained(bad), bad
+
+
+def test_two_files_of_one_name_get_two_copies_and_one_file_one(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    a.mkdir(), b.mkdir()
+    (a / "dye.csv").write_text("1")
+    (b / "dye.csv").write_text("2")
+    doc = {"dye": {"transmittance": str(a / "dye.csv")},
+           "fluorescence": {"excitation": str(b / "dye.csv"), "emission": str(a / "dye.csv")}}
+    out = tmp_path / "out" / "n.toml"
+    bundle_files(doc, out, lambda _k, v: tmp_path / v)
+    assert doc["dye"]["transmittance"] == "n/measurements/dye.csv"
+    assert doc["fluorescence"]["emission"] == "n/measurements/dye.csv"
+    assert doc["fluorescence"]["excitation"] == "n/measurements/dye-2.csv"
+    assert (out.parent / "n/measurements/dye-2.csv").read_text() == "2"
+    assert outside_paths(doc) == []
+
+
+def test_a_missing_file_is_refused_naming_the_key(tmp_path):
+    from catalog.core.errors import InputError
+
+    with pytest.raises(InputError, match=r"dye\.transmittance"):
+        bundle_files({"dye": {"transmittance": "nope.csv"}}, tmp_path / "n.toml",
+                     lambda _k, v: tmp_path / v)
+    assert not (tmp_path / "n").exists()
+
+
+@pytest.mark.slow
+def test_a_fitted_preset_moved_elsewhere_still_loads_and_renders(tmp_path, capsys):
+    """Fit from inputs outside the output folder, move the folder, load and render it."""
+    source = tmp_path / "inputs"
+    shutil.copytree(FABRIC_DIR / "measurements" / "sheer-teal", source)
+    out = tmp_path / "first" / "teal.toml"
+    assert main(["fit", "--gonio", str(source / "gonio.csv"), "--points", "79",
+                 "--name", "teal", "--out", str(out), "--json"]) == 0
+    capsys.readouterr()
+    written = load_preset(out)
+    assert outside_paths(written.raw) == []
+    assert written.raw["dye"]["transmittance"] == "teal/measurements/dye.csv"
+    shutil.rmtree(source)                                  # the inputs are gone
+    moved = tmp_path / "elsewhere"
+    (tmp_path / "first").rename(moved)                     # and the folder moved
+    preset = load_preset(moved / "teal.toml")
+    assert preset.resolve(preset.raw["dye"]["transmittance"]).is_file()
+    assert preset.resolve(preset.fit["source"]).is_relative_to(moved.resolve())
+    image = tmp_path / "teal.png"
+    assert main(["snapshot", "--fabric", str(moved / "teal.toml"), "--light", "D65",
+                 "--size", "96x54", "--out", str(image), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert image.is_file() and max(report["mean_srgb8"]) > 5
