@@ -29,6 +29,7 @@ PATH_KEYS: dict[tuple[str, str], str] = {
     ("fluorescence", "residual"): "measurements",
     ("pattern", "coverage"): "patterns",
     ("pattern", "height"): "patterns",
+    ("import", "source"): "source",      # what ``catalog import`` read (kept for provenance)
 }
 #: A file a preset names is copied whole; larger ones are refused (a preset's spectra and
 #: patterns are kilobytes to a few megabytes).
@@ -89,12 +90,12 @@ def bundle_files(doc: dict[str, Any], preset_path: str | Path,
         if not source.is_file():
             raise InputError(f"no such file: {source}", path=preset_path, field=dotted)
         resolved = source.resolve()
-        lexical = Path(os.path.abspath(source))
-        home = Path(os.path.abspath(published_folder or folder))
-        if lexical.is_relative_to(home):
+        homes = [Path(os.path.abspath(f)) for f in (folder, published_folder) if f is not None]
+        home = next((h for h in homes if source.is_relative_to(h)), None)
+        if home is not None:
             # already inside the preset's folder (its own N/, or the catalog's shared
             # measurements/ and patterns/ beside it): named as it lies, never climbing out
-            table[key] = lexical.relative_to(home).as_posix()
+            table[key] = source.relative_to(home).as_posix()
             continue
         if resolved in copied:
             table[key] = copied[resolved]
