@@ -1,7 +1,7 @@
 """Draw a lace as a backlit scanner would see it: the project's own test and docs image.
 
 A rosette lace on a hexagonal tulle (the geometry of tools/make_patterns.py's lace, with
-its own parameters: 2 mm cells, eight petals), seen against a white backlight: open = the
+its own parameters: 2 mm cells, a larger rosette), seen against a white backlight: open = the
 light (1), thread = what a dense yarn lets through (THREAD_TRANSMITTANCE), written as an
 8-bit sRGB RGB PNG with its resolution (dpi) in the header, as a flatbed scan is.
 
