@@ -42,6 +42,8 @@ class ImportedFabric:
     cloth: dict[str, Any] = field(default_factory=dict)
     import_table: dict[str, Any] = field(default_factory=dict)
     display_name: str | None = None
+    lobes: dict[str, Any] | None = None      # eq. 7 lobes the source carries (our own U3M)
+    lobes_source: str | None = None
 
 
 def open_area_of(coverage: np.ndarray) -> float:
@@ -59,8 +61,10 @@ def check_open_area_range(open_area: float, path, field: str) -> None:
                          "holes (between 0.1 % and 99.9 % open)", path=path, field=field)
 
 
-def btdf_and_cloth(direct: float, weight_kg_m2: float | None, gonio: str | Path | None):
-    """([btdf], [cloth], lobes report) for a fabric of open area ``direct``."""
+def btdf_and_cloth(direct: float, weight_kg_m2: float | None, gonio: str | Path | None,
+                   carried: dict[str, Any] | None = None, carried_from: str | None = None):
+    """([btdf], [cloth], lobes report, [fit]) for a fabric of open area ``direct``: the
+    lobes fitted to ``gonio``, else those the source carries, else the nearest fabric's."""
     from catalog.exchange.nearest import distance, lobes_from, nearest_fabric  # noqa: PLC0415
 
     if gonio is not None:
@@ -85,6 +89,12 @@ def btdf_and_cloth(direct: float, weight_kg_m2: float | None, gonio: str | Path 
         fit = {"rmse": _round(hg.rmse), "points": hg.points, "source": str(Path(gonio).absolute()),
                "weighting": hg.weighting, "direct_from": "the pattern's open area"}
         return btdf, cloth, report, fit
+    if carried is not None:
+        btdf = {k: float(carried[k]) for k in ("k_d", "k_s", "tau", "g_diff", "g_spec")}
+        btdf.update(direct=direct, rho=max(1.0 - direct, 1e-3))
+        if isinstance(carried.get("anisotropy"), (int, float)):
+            btdf["anisotropy"] = float(carried["anisotropy"])
+        return btdf, {}, {"lobes_from": carried_from or "the source"}, {}
     neighbour = nearest_fabric(direct, weight_kg_m2)
     btdf = lobes_from(neighbour, direct)
     cloth = dict(neighbour.table("cloth"))
@@ -106,7 +116,8 @@ def write_imported_preset(fabric: ImportedFabric, name: str, out_dir: str | Path
     out_dir = Path(out_dir)
     direct = _round(open_area_of(fabric.coverage))
     check_open_area_range(direct, fabric.source, "coverage")
-    btdf, cloth, lobes, fit = btdf_and_cloth(direct, fabric.weight_kg_m2, gonio)
+    btdf, cloth, lobes, fit = btdf_and_cloth(direct, fabric.weight_kg_m2, gonio,
+                                             fabric.lobes, fabric.lobes_source)
     cloth.update(fabric.cloth)
     doc: dict[str, Any] = {
         "schema": 1, "name": name, "display_name": fabric.display_name or name,

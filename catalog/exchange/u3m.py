@@ -18,6 +18,7 @@ What a preset takes from it (the front side; the back or the side when the front
   thread height, integrated from its slopes (Frankot-Chellappa, periodic);
 - the texture's physical size ``width`` x ``height`` (mm), or its pixels over ``dpi``:
   ``repeat_m``;
+- ``custom.catalog.btdf`` (a U3M this program wrote): the eq. 7 lobes, exactly;
 - ``physics`` (1.1): ``weight`` (g/m2) -> ``cloth.areal_density_kg_m2``; the fab file's
   bending and stretch are kept under ``[import]`` (their units are a vendor's; only our own
   ``custom.catalog`` block, written by :func:`write_u3m`, maps back exactly).
@@ -286,11 +287,17 @@ def dye_from_rgb(rgb_linear) -> tuple[np.ndarray, np.ndarray]:
 
 def rgb_of_spectrum(wavelength_nm: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Linear sRGB of a reflectance spectrum under D65 (white = a flat 1): the inverse of
-    :func:`dye_from_rgb` (colour-science's CIE 1931 observer)."""
+    :func:`dye_from_rgb` (colour-science's CIE 1931 observer, 380-780 nm at 5 nm)."""
     import colour  # noqa: PLC0415
 
-    sd = colour.SpectralDistribution(dict(zip(wavelength_nm, values)))
-    xyz = colour.sd_to_XYZ(sd, illuminant=colour.SDS_ILLUMINANTS["D65"]) / 100.0
+    from colour.recovery import SPECTRAL_SHAPE_sRGB_MALLETT2019 as shape  # noqa: PLC0415
+
+    # on the upsampling's own grid (380-780 nm, 5 nm), where it inverts to 1e-4
+    grid = np.asarray(shape.wavelengths, dtype=np.float64)
+    sd = colour.SpectralDistribution(np.interp(grid, wavelength_nm, values), grid)
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
+    illuminant = colour.SDS_ILLUMINANTS["D65"].copy().align(shape)
+    xyz = colour.sd_to_XYZ(sd, cmfs=cmfs, illuminant=illuminant) / 100.0
     return np.asarray(colour.XYZ_to_RGB(xyz, "sRGB", apply_cctf_encoding=False), dtype=np.float64)
 
 
@@ -436,12 +443,31 @@ def _fabric_from_document(source: _Source, doc: dict, repeat_m, ImportedFabric):
             cloth.update(cloth_fab)
             if kept:
                 imported["physics"] = kept
+    lobes = _carried_lobes(checker, doc.get("custom"))
     if isinstance(material.get("description"), str) and material["description"]:
         imported["description"] = material["description"]
     return ImportedFabric(coverage=coverage, height=height, repeat_m=repeat, source=source.path,
                           kind=f"u3m {version}", height_m=height_m, dye=dye, weight_kg_m2=weight,
                           cloth=cloth, import_table={**imported, "size_from": size_from},
-                          display_name=material["name"])
+                          display_name=material["name"], lobes=lobes,
+                          lobes_source=None if lobes is None else "u3m custom.catalog.btdf")
+
+
+def _carried_lobes(checker: _Checker, custom) -> dict | None:
+    """The eq. 7 lobes a U3M written by this program carries (``custom.catalog.btdf``)."""
+    if not isinstance(custom, dict) or not isinstance(custom.get("catalog"), dict):
+        return None
+    btdf = custom["catalog"].get("btdf")
+    if not isinstance(btdf, dict):
+        return None
+    where = "custom.catalog.btdf"
+    lobes = {key: checker.number(btdf.get(key), f"{where}.{key}", 0.0)
+             for key in ("k_d", "k_s", "tau")}
+    lobes.update({key: checker.number(btdf.get(key), f"{where}.{key}", -0.999999, 0.999999)
+                  for key in ("g_diff", "g_spec")})
+    if "anisotropy" in btdf:
+        lobes["anisotropy"] = checker.number(btdf["anisotropy"], f"{where}.anisotropy")
+    return lobes
 
 
 def _read_fab(source: _Source, relative: str) -> tuple[dict, dict]:
