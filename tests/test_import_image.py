@@ -117,3 +117,55 @@ def test_bad_images_are_refused_in_one_line_and_nothing_is_written(tmp_path, cap
     assert "\n" not in line and str(path) in line and field in line, line
     assert report["exit_code"] == 2
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_gonio_gives_the_lobes_and_travels_with_the_preset(scan, tmp_path, capsys):
+    """With --gonio the lobes are the fit's (eq. 7 a_diff, a_spec, g's), direct stays the
+    image's open area, and the gonio file is copied into the preset's folder."""
+    from catalog.core.resources import FABRIC_DIR
+    from catalog.fit.gonio import read_gonio
+    from catalog.fit.preset_build import fit_measurement
+    from catalog.presets import load_preset
+    from catalog.presets.bundle import outside_paths
+
+    gonio = FABRIC_DIR / "measurements" / "lace-fwa" / "gonio.csv"
+    status, report, err = _run(capsys, scan, "--name", "g", "--out", tmp_path, "--gonio", gonio)
+    assert status == 0, err
+    assert report["lobes_from"] == "gonio"
+    preset = load_preset(tmp_path / "g.toml")
+    fit = fit_measurement(read_gonio(gonio), "relative")["hg"].params
+    for key in ("a_diff", "a_spec", "g_diff", "g_spec"):
+        assert getattr(preset.btdf, key) == pytest.approx(fit[key], rel=1e-4), key
+    assert preset.btdf.direct == pytest.approx(_independent_open_area(scan), rel=0.01)
+    assert outside_paths(preset.raw) == []
+    assert preset.resolve(preset.fit["source"]).read_bytes() == gonio.read_bytes()
+
+
+@pytest.mark.slow
+def test_the_docs_figures_come_from_the_committed_scan_and_record():
+    """docs/exchange.md's source image is what tools/make_lace_scan.py draws (byte for byte)
+    and the numbers it quotes are those of docs/img/exchange.json."""
+    import io
+
+    from PIL import Image
+
+    record = json.loads((ROOT / "docs" / "img" / "exchange.json").read_text())
+    assert len(record["commit"]) >= 7
+    committed = np.asarray(Image.open(ROOT / "docs" / "img" / record["source"]).convert("RGB"))
+    drawn, dpi, _ = _scan_module().draw_scan(512)
+    assert np.array_equal(committed, drawn)
+    text = (ROOT / "docs" / "exchange.md").read_text()
+    assert f"{record['import']['open_area']:.4f}" in text
+    assert f"{dpi:.2f} dpi" in text and record["import"]["lobes_from"] in text
+
+
+def test_reimporting_a_presets_own_image_into_itself_is_refused(tmp_path, capsys):
+    folder = tmp_path / "x" / "patterns"
+    folder.mkdir(parents=True)
+    path = folder / "coverage.png"
+    _write_grey(path, np.tile((np.arange(64) % 8 < 4).astype(float), (64, 1)))
+    before = path.read_bytes()
+    status, report, err = _run(capsys, path, "--name", "x", "--out", tmp_path)
+    assert status == 2 and "--out" in err and "never overwritten" in err
+    assert path.read_bytes() == before and not (tmp_path / "x.toml").exists()

@@ -113,7 +113,15 @@ def write_imported_preset(fabric: ImportedFabric, name: str, out_dir: str | Path
     from catalog.presets.bundle import bundle_files  # noqa: PLC0415
     from catalog.presets.patterns import DEFAULT_HEIGHT_M, Pattern, write_pattern_images  # noqa: PLC0415
 
+    from catalog.core.errors import InputError  # noqa: PLC0415
+
     out_dir = Path(out_dir)
+    own = (out_dir / name).resolve()
+    for given in (fabric.source, gonio):
+        if given is not None and (Path(given).resolve().is_relative_to(own)
+                                  or Path(given).resolve() == own.with_suffix(".toml")):
+            raise InputError(f"{given} lies in the folder this import writes ({own}): an input "
+                             "is never overwritten; choose another --name or --out", field="--out")
     direct = _round(open_area_of(fabric.coverage))
     check_open_area_range(direct, fabric.source, "coverage")
     btdf, cloth, lobes, fit = btdf_and_cloth(direct, fabric.weight_kg_m2, gonio,
