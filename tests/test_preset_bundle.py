@@ -70,3 +70,30 @@ def test_a_fitted_preset_moved_elsewhere_still_loads_and_renders(tmp_path, capsy
                  "--size", "96x54", "--out", str(image), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert image.is_file() and max(report["mean_srgb8"]) > 5
+
+
+@pytest.mark.slow
+def test_a_banded_export_of_a_dyed_base_carries_its_dye_and_moves(tmp_path):
+    """banded_preset (catalog bispectral --export) on organza-ivory, whose dye and pattern
+    lie in the built-in catalog: both are copied, the folder moves and still loads."""
+    import numpy as np
+
+    from catalog.optics.bispectral.bands import fit_banded
+    from catalog.optics.bispectral.matrix import DonaldsonMatrix
+    from catalog.presets import find_preset
+    from catalog.presets.banded import banded_preset
+    from catalog.render import scene
+
+    lo, li = np.arange(380.0, 781.0, 10.0), np.arange(300.0, 781.0, 10.0)
+    v = np.where(li <= 380, 0.012 * np.exp(-0.5 * ((li - 350) / 20) ** 2), 0.0)
+    u = np.exp(-0.5 * ((lo - 430) / 20) ** 2)
+    values = np.outer(u, v) * li[None, :] / lo[:, None] * 10.0 + np.where(lo[:, None] == li[None, :], 0.8, 0.0)
+    fit = fit_banded(DonaldsonMatrix(lo, li, values, "SYN", "synthetic"))
+    made = banded_preset(load_preset(find_preset("organza-ivory")), fit, tmp_path / "a")
+    assert outside_paths(made.raw) == []
+    assert made.raw["dye"]["transmittance"].startswith(f"{made.name}/measurements/")
+    (tmp_path / "a").rename(tmp_path / "b")
+    moved = load_preset(tmp_path / "b" / f"{made.name}.toml")
+    assert np.array_equal(scene.dye_transmittance(moved),
+                          scene.dye_transmittance(load_preset(find_preset("organza-ivory"))))
+    assert scene.fluorescent_material(moved) is not None
