@@ -65,6 +65,9 @@ def test_glb_carries_the_fabric_under_extras(lace_glb):
     extras = doc["scenes"][0]["extras"]["catalog"]
     assert extras["light"] == "D65" and extras["frame"] == 0 and extras["room"] == "box"
     assert extras["preset"]["name"] == "lace-fwa"
+    from catalog.presets import find_preset, load_preset
+
+    assert extras["preset"] == json.loads(json.dumps(load_preset(find_preset("lace-fwa")).raw))
     assert extras["preset"]["btdf"]["direct"] == pytest.approx(0.383842)
     material = doc["materials"][0]
     assert material["alphaMode"] == "BLEND" and material["doubleSided"]

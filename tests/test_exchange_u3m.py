@@ -60,6 +60,12 @@ def test_u3m_round_trip_keeps_coverage_dye_and_repeat(teal_u3m, tmp_path, capsys
     assert np.max(np.abs(_dye_rgb(one) - want)) < 2e-3
     assert one.table("import")["dye_upsampling"].startswith("Mallett")
     assert one.table("cloth")["areal_density_kg_m2"] == original.table("cloth")["areal_density_kg_m2"]
+    # the height: normals out, slopes integrated back (Frankot-Chellappa): the same relief
+    a, b = load_pattern(original), load_pattern(one)
+    ha, hb = a.height * a.height_m, b.height * b.height_m
+    ha, hb = ha - ha.mean(), hb - hb.mean()
+    assert (ha * hb).sum() / np.sqrt((ha ** 2).sum() * (hb ** 2).sum()) > 0.95
+    assert b.height_m == pytest.approx(np.ptp(a.height) * a.height_m, rel=0.15)
     # our own U3M carries the lobes: the same eq. 7 fabric
     assert first["lobes_from"] == "u3m custom.catalog.btdf"
     for key in ("k_d", "k_s", "tau", "rho", "g_diff", "g_spec"):
