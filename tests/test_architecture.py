@@ -32,6 +32,7 @@ FORBIDDEN = [
     ("cloth", "viewer"), ("cloth", "render"),                       # cloth reaches GL via gl
     ("presets", "render"), ("presets", "viewer"),
     ("render", "pathtrace"), ("viewer", "pathtrace"),               # Mitsuba stays out of frames
+    ("render", "exchange"), ("viewer", "exchange"), ("presets", "exchange"),  # formats in/out sit above
 ]
 #: Module pairs allowed to import each other (none: image writing lives in render.imagefile,
 #: which both the snapshot and the environment tool use).
@@ -96,7 +97,7 @@ ROOMS = sorted({p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file
 
 def test_the_rooms_are_there():
     for room in ("core", "optics", "presets", "fit", "gl", "cloth", "render", "viewer",
-                 "commands", "bench"):
+                 "commands", "bench", "exchange"):
         assert room in ROOMS
     # the top level holds only the package's own entry points, no module of a room
     loose = sorted(p.name for p in PACKAGE.glob("*.py"))

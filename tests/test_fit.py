@@ -241,10 +241,14 @@ def test_catalog_fit_writes_the_preset_and_json(tmp_path, capsys):
     assert b.a_spec == pytest.approx(summary["identifiable"]["a_spec"], rel=1e-5)
     assert b.rho == pytest.approx(1 - b.direct, rel=1e-5)
     assert preset.fit["points"] == 4800
-    assert preset.resolve(preset.fit["source"]) == (folder / "gonio.csv").resolve()
+    # self-contained: the preset names copies in its own folder, byte-equal to the inputs
+    own = (tmp_path / "lace-fwa").resolve()
+    source = preset.resolve(preset.fit["source"])
+    assert source.is_relative_to(own) and source.read_bytes() == (folder / "gonio.csv").read_bytes()
     fl = preset.fluorescence
     assert fl is not None and fl.xyz[1] == pytest.approx(100.0)
-    assert fl.excitation == (folder / "excitation.csv").resolve()
+    assert fl.excitation.is_relative_to(own)
+    assert fl.excitation.read_bytes() == (folder / "excitation.csv").read_bytes()
     assert preset.table("cloth")["weave"] == "lace"
 
 

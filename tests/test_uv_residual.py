@@ -242,7 +242,8 @@ def test_bad_residual_field_in_a_preset_is_refused_naming_it(tmp_path):
 
     preset = banded_preset(load_preset(find_preset("lace-fwa")),
                            fit_banded(_noisy_matrix(), residual=True), tmp_path)
-    assert preset.fluorescence.extra["residual"] == "residual.csv"
+    # in the preset's own folder (catalog.presets.bundle)
+    assert preset.fluorescence.extra["residual"] == f"{preset.name}/residual.csv"
     doc = preset_to_dict(preset)
     for value, message in ((3, "must be a path string"), ("gone.csv", "cannot read the residual")):
         doc["fluorescence"]["residual"] = value

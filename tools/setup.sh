@@ -27,4 +27,9 @@ PY=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PY" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e ".[all,test,pathtrace,batch${EXTRAS:+,$EXTRAS}]"
+# Node tools the tests use (tools/node/package.json: the Khronos glTF-Validator, three.js)
+if command -v npm >/dev/null 2>&1 && [ ! -d tools/node/node_modules/gltf-validator ]; then
+  echo "setup: installing tools/node (npm)"
+  (cd tools/node && npm install --no-audit --no-fund --silent)
+fi
 echo "setup: ready (.venv)"

@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
             from catalog.presets.banded import banded_preset  # noqa: PLC0415
 
             with staged_folder(args.export) as stage:  # the preset and its files, or none
-                made = banded_preset(base, banded, stage, copy_pattern=True, own_folder=True)
+                made = banded_preset(base, banded, stage)
             exported = {"preset": str(Path(args.export) / Path(made.path).name)}
 
     fit_info = {"yield_absorptance": fit.yield_absorptance, "quantum_yield": fit.quantum_yield,

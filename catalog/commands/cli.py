@@ -45,6 +45,8 @@ COMMANDS: dict[str, str] = {
     "bench": "catalog.commands.bench",
     "web": "catalog.commands.web",
     "reference": "catalog.commands.reference",
+    "import": "catalog.commands.import_fabric",
+    "export": "catalog.commands.export",
 }
 
 

@@ -31,9 +31,11 @@ def fit_preset(args, started_s: float) -> dict:
     import time
     from pathlib import Path
 
+    from catalog.core.atomic import staged_folder
     from catalog.core.errors import InputError
     from catalog.fit.gonio import paper_subset_mask, read_gonio
     from catalog.presets import preset_from_dict, save_preset_dict
+    from catalog.presets.bundle import bundle_files
 
     out = Path(args.out)
     data = read_gonio(args.gonio)
@@ -53,10 +55,16 @@ def fit_preset(args, started_s: float) -> dict:
     rho = args.rho if args.rho is not None else max(MIN_RHO, 1.0 - hg.params["direct"])
 
     doc = preset_document(args, out, data, header, result, rho, tau, dye_path)
-    preset_from_dict(doc, out)          # refuse before anything is written
-    if args.plot:
-        plot_fit(data, hg, ct, Path(args.plot), title=doc["display_name"])
-    save_preset_dict(doc, out)
+    # the preset and copies of every file it names (gonio, spectra, dye) in out's own folder
+    # N/, staged: all of them appear together, or none (catalog.presets.bundle)
+    with staged_folder(out.parent) as stage:
+        staged = stage / out.name
+        bundle_files(doc, staged, lambda _key, value: out.parent / value,
+                     published_folder=out.parent)
+        preset_from_dict(doc, staged)          # refuse before the plot is drawn
+        if args.plot:
+            plot_fit(data, hg, ct, Path(args.plot), title=doc["display_name"])
+        save_preset_dict(doc, staged)
     elapsed = time.perf_counter() - started_s
 
     summary = json_summary(doc, result, out, elapsed)

@@ -12,61 +12,50 @@ BASE has one, the saturation (BASE need not fluoresce).
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 
-def banded_preset(base_preset, fit, folder, name: str | None = None, *,
-                  copy_pattern: bool = False, own_folder: bool = False):
+def banded_preset(base_preset, fit, folder, name: str | None = None):
     """A preset like ``base_preset`` whose physical-mode fluorescence is ``fit``'s bands
-    (a :class:`catalog.optics.bispectral.bands.BandedFit`), written with its spectra into
-    ``folder``; returns the loaded :class:`catalog.presets.Preset`.
+    (a :class:`catalog.optics.bispectral.bands.BandedFit`), written as ``folder/NAME.toml``
+    with its files in ``folder/NAME/`` (NAME by default ``BASE-MATRIX-banded``); returns the
+    loaded :class:`catalog.presets.Preset`.
 
-    The base's pattern images are referred to where they lie (absolute paths), or with
-    ``copy_pattern`` copied beside the spectra so the folder stands alone. The spectra go
-    into ``folder``, or with ``own_folder`` into ``folder/NAME/`` (then two fabrics exported
-    into one folder never share, or overwrite, each other's files); the preset is
-    ``folder/NAME.toml``, NAME by default ``BASE-MATRIX-banded``.
+    The preset is self-contained (:mod:`catalog.presets.bundle`): the bands' spectra are
+    written into ``folder/NAME/``, the base's pattern images and dye are copied
+    beside them, so two fabrics exported into one folder never share, or overwrite, each
+    other's files, and the folder can be moved.
     """
     from catalog.optics.bispectral.bands import band_materials_table  # noqa: PLC0415
     from catalog.presets import preset_to_dict, save_preset_dict  # noqa: PLC0415
+    from catalog.presets.bundle import bundle_files  # noqa: PLC0415
 
     folder = Path(folder)
     name = name or f"{base_preset.name}-{fit.matrix_name.lower()}-banded"
-    files = folder / name if own_folder else folder
-    prefix = f"{name}/" if own_folder else ""
+    files = folder / name
     files.mkdir(parents=True, exist_ok=True)
     doc = preset_to_dict(base_preset)
     doc["name"] = name
     doc["display_name"] = f"{base_preset.display_name} ({fit.matrix_name}, {len(fit.components)} bands)"
     doc.pop("fit", None)
-    source_folder = Path(base_preset.path).parent if base_preset.path is not None else None
-    pattern = dict(doc.get("pattern", {}))
-    for key in ("coverage", "height"):  # the base's pattern images
-        if isinstance(pattern.get(key), str) and source_folder is not None:
-            image = (source_folder / pattern[key]).resolve()
-            if copy_pattern:
-                (files / "patterns").mkdir(exist_ok=True)
-                shutil.copyfile(image, files / "patterns" / image.name)
-                pattern[key] = f"{prefix}patterns/{image.name}"
-            else:
-                pattern[key] = str(image)
-    if pattern:
-        doc["pattern"] = pattern
     fluorescence = {k: v for k, v in doc.get("fluorescence", {}).items()
                     if k == "saturation_photon_irradiance"}
     xyz, rgb = paper_colour_of(fit)
     fluorescence.update(xyz=[round(float(v), 4) for v in xyz],
                         rgb=[round(float(v), 4) for v in rgb])
     table = band_materials_table(fit, files)
-    for entry in [table] + table["bands"]:  # paths relative to the preset's folder
+    for entry in [table] + table["bands"]:  # the bands' files, where they were written
         for key in ("excitation", "emission"):
-            entry[key] = prefix + entry[key]
+            entry[key] = str(files / entry[key])
     if "residual" in table:
-        table["residual"] = prefix + table["residual"]
+        table["residual"] = str(files / table["residual"])
     fluorescence.update(table)
     doc["fluorescence"] = fluorescence
-    return save_preset_dict(doc, folder / f"{name}.toml")
+    # the base's files (pattern, dye) are named relative to the base's folder
+    base_folder = Path(base_preset.path).parent if base_preset.path is not None else folder
+    target = folder / f"{name}.toml"
+    bundle_files(doc, target, lambda _key, value: base_folder / value)
+    return save_preset_dict(doc, target)
 
 
 def paper_colour_of(fit):
