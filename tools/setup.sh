@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Set up a fresh machine: Debian packages the renderer and the window tests need (only
 # those missing), a virtual environment in .venv, and the project installed editable with
-# every dependency group (all) and the test tools.
+# its optional extras (the path tracer, Dask) and the test tools.
 # Idempotent: a second run installs nothing new.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,5 +26,5 @@ fi
 PY=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PY" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e ".[all,test,pathtrace,batch${EXTRAS:+,$EXTRAS}]"
+.venv/bin/python -m pip install -q -e ".[test,pathtrace,batch${EXTRAS:+,$EXTRAS}]"
 echo "setup: ready (.venv)"

@@ -13,7 +13,8 @@ echo "wheel_check: building the wheel"
 "$ROOT/.venv/bin/python" -m pip wheel -q --no-deps -w "$WORK/wheel" "$ROOT"
 "$PY" -m venv "$WORK/venv"
 WHEEL=$(ls "$WORK"/wheel/*.whl)
-"$WORK/venv/bin/python" -m pip install -q "$WHEEL[all]"
+# a plain install, no extras: every main command must run from it
+"$WORK/venv/bin/python" -m pip install -q "$WHEEL"
 CATALOG="$WORK/venv/bin/catalog"
 
 cd "$WORK/run"  # outside the checkout: only what the wheel carries is found

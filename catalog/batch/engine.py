@@ -23,7 +23,7 @@ from pathlib import Path
 
 from catalog.batch.manifest import Manifest
 from catalog.batch.spec import JobSpec
-from catalog.core.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, EnvironmentFailure, InputError
 
 #: Seconds between manifest rewrites during a run (the journal holds what comes between).
 MANIFEST_EVERY_S = 60.0
@@ -54,8 +54,9 @@ def check_engine(workers: int | None, scheduler: str | None) -> None:
                              field="--scheduler")
     if (workers is not None or scheduler is not None) and not dask_available():
         option = "--workers" if workers is not None else "--scheduler"
-        raise InputError("needs Dask distributed, which is not installed "
-                         "(pip install 'fabric-catalog[batch]')", field=option)
+        from catalog.core.extras import missing_message  # noqa: PLC0415
+
+        raise EnvironmentFailure(missing_message("distributed", option))
 
 
 def _run_process(tasks, retries, on_image, on_result) -> dict:

@@ -14,7 +14,8 @@ Command modules import nothing heavy at module level, so ``catalog --help`` stay
 Exit status: 0 done; 2 a refused input (:class:`catalog.core.errors.CatalogError`: one line
 on stderr naming the file, field or option); 3 an environment failure
 (:class:`catalog.core.errors.EnvironmentFailure`: no EGL device or display, a missing
-shader); 130 interrupted. With ``--json`` an error is also one JSON object on stdout,
+shader, an optional package not installed: one line naming the extra to install,
+:mod:`catalog.core.extras`); 130 interrupted. With ``--json`` an error is also one JSON object on stdout,
 ``{"error": MESSAGE, "exit_code": N}``.
 """
 
@@ -181,6 +182,11 @@ def main(argv: list[str] | None = None) -> int:
         return _report(args, exc)
     except BrokenPipeError:
         return _report(args, OutputError("stdout", "closed"))
+    except ModuleNotFoundError as exc:
+        # an optional package (or a broken installation): one line naming the extra, exit 3
+        from catalog.core.extras import failure_for  # noqa: PLC0415
+
+        return _report(args, failure_for(exc, f"catalog {args.command}"))
     except OSError as exc:
         # an OS error no writer turned into a message (the output layer does for its own
         # files): still one line, naming the path where the OS gave one
