@@ -35,6 +35,29 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip)
 
 
+#: Set (e.g. by .ci/run) to a number of seconds: an unmarked test whose call phase takes
+#: longer FAILS, so the fast loop (-m "not slow") stays fast. The rule marks a test slow at
+#: 0.5 s; CI fails it at twice that, the margin for run-to-run noise on a 2-core machine
+#: (medians of repeated fast-loop runs there vary by about 30 %). Fixture set-up (the one GL
+#: context, a module's shared render) is shared work and is not counted.
+SLOW_LIMIT_ENV = "CATALOG_UNMARKED_LIMIT_S"
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    limit = os.environ.get(SLOW_LIMIT_ENV)
+    if not limit or call.when != "call":
+        return
+    report = outcome.get_result()
+    if (report.passed and item.get_closest_marker("slow") is None
+            and report.duration > float(limit)):
+        report.outcome = "failed"
+        report.longrepr = (f"{item.nodeid} took {report.duration:.2f} s without "
+                           f"@pytest.mark.slow (limit {float(limit):g} s, ${SLOW_LIMIT_ENV}): "
+                           "mark it slow or make it faster")
+
+
 @pytest.fixture(scope="session")
 def shared_data() -> Path:
     """The validation data: real measurements by others (read in place, never copied).

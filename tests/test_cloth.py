@@ -177,6 +177,7 @@ def _energy_bound_j(p: ClothParams) -> float:
 
 @pytest.mark.parametrize("stiffness", [1e1, 1e3, 1e6])
 @pytest.mark.parametrize("dt", [1 / 60, 1 / 30, 1 / 15])
+@pytest.mark.slow
 def test_no_wind_energy_bounded_stretch_limited(stiffness, dt):
     p = ClothParams(grid_w=10, grid_h=12, opening=0.6, stretch_stiffness_n_m=stiffness)
     sim = ClothSimulation(p, "cpu")

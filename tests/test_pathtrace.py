@@ -520,6 +520,7 @@ def test_glow_reaches_the_room_alike_by_emitter_and_by_bsdf_sampling(mi):
     assert np.allclose(emitter, bsdf, rtol=0.06), (emitter, bsdf)
 
 
+@pytest.mark.slow
 def test_glow_shells_lie_on_the_cloth_finer_than_its_mesh():
     """The glow shells' mesh (issue 11, fourth round): the curtain's triangles split in four
     GLOW_SUBDIVISIONS times, so 16x the triangles at 2 levels; every new vertex lies on one of
@@ -1009,6 +1010,7 @@ def test_the_window_filter_gives_the_outside_the_keys_spectrum():
     assert np.all(grey[..., 0] == grey[..., 2])
 
 
+@pytest.mark.slow
 def test_the_bench_takes_the_spectral_reference_where_the_dye_of_the_secondary_light_differs():
     """image.reference_variant_for (issue 11, seventh round): the spectral variant for the
     safety-yellow under the UV lamp (its glow passes its dye at 0.99 in green, the key's leak

@@ -181,6 +181,7 @@ def test_recording_context_refuses_what_the_page_cannot_replay(gl):
 
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_split_commands_keeps_every_uniform_value_in_order(gl):
     from catalog.render.frame import FrameRenderer
     from catalog.web.export import split_commands
