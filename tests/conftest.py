@@ -12,6 +12,17 @@ from pathlib import Path
 # is imported; an explicit setting in the environment wins.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+# The settled drape's disk cache (catalog.cloth.drape_cache) in a folder of this session's
+# own, shared by the commands the tests start and removed after: tests neither read a
+# user's cache nor leave one behind.
+if "CATALOG_CACHE_DIR" not in os.environ:
+    import atexit
+    import tempfile
+
+    _CACHE = tempfile.mkdtemp(prefix="catalog-test-cache-")
+    os.environ["CATALOG_CACHE_DIR"] = _CACHE
+    atexit.register(shutil.rmtree, _CACHE, True)
+
 import pytest
 
 from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT, data_dir_candidate, data_missing_reason

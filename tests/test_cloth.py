@@ -190,6 +190,7 @@ def test_no_wind_energy_bounded_stretch_limited(stiffness, dt):
 
 
 @pytest.mark.parametrize("stiffness", [1e1, 1e6])
+@pytest.mark.slow
 def test_gusty_wind_stays_finite_and_limited(stiffness):
     p = ClothParams(grid_w=16, grid_h=20, opening=0.8, stretch_stiffness_n_m=stiffness,
                     wind_speed_m_s=1.0)

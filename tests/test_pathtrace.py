@@ -552,6 +552,7 @@ def test_glow_shells_lie_on_the_cloth_finer_than_its_mesh():
     assert inside.shape[0] >= side * (side + 1) // 2
 
 
+@pytest.mark.slow
 def test_the_key_reaches_the_glow_through_cloth_not_through_the_wall(mi):
     """key_visibility (issue 11, fourth round): 1 with nothing in the way, LD behind the cloth
     (through its gaps), 0 where the window wall stops the ray (it had passed LD as cloth does).

@@ -109,6 +109,7 @@ def _checked(parts: list[str], before: str, subpackages: set[str]) -> bool:
             or bool(re.search(r"(import|from|:mod:`|:func:`|:class:`)\s*$", before)))
 
 
+@pytest.mark.slow
 def test_every_dotted_catalog_name_resolves():
     subpackages = {p.stem for p in (PROJECT_ROOT / "catalog").iterdir()
                    if (p.is_dir() and (p / "__init__.py").is_file()) or p.suffix == ".py"}

@@ -325,6 +325,7 @@ def test_scene_values_are_compiled_in_on_cpu_rasterisers_only(gl):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_room_side_term_is_part_of_the_per_pixel_comparison(gl, make_preset):
     """The default frame (room lit, viewer inside) lights the cloth's room side by the room's
     solved light (curtain.frag ROOM_SIDE): its twin's share of the curtain's luminance is above

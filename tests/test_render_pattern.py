@@ -68,6 +68,7 @@ def _join(*meshes):
 # --- the mip chain's far limit ------------------------------------------------------------
 
 @pytest.mark.parametrize("path", list_presets(), ids=lambda p: p.stem)
+@pytest.mark.slow
 def test_mip_far_limit_is_the_fitted_open_area(gl, path):
     """The last mip level GL builds (what the far cloth samples) holds coverage 1 - LD
     within the 1 % of the pattern's own rule, and the averaged normal tilts less than 1 deg."""
@@ -86,6 +87,7 @@ def test_mip_far_limit_is_the_fitted_open_area(gl, path):
 # --- layers: weighted blended OIT against sorted compositing --------------------------------
 
 @pytest.mark.parametrize("antialiasing", ["auto", "msaa"])
+@pytest.mark.slow
 def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, antialiasing, record_figure):
     """Two overlapping layers of a flat cloth (coverage a = 1 - LD = 0.6 each), the back one
     tilted 35 deg so the layers' radiances C1, C2 differ. Sorted compositing gives

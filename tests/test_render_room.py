@@ -273,6 +273,7 @@ def test_room_lamp_lights_the_floor_by_inverse_square(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_light_map_is_the_float64_radiosity_of_its_direct_light(gl):
     """room_radiosity.frag and room_bounce.frag against float64 numpy: from the GPU's own
     direct light map and beam (read back), the coarse sources S (2^BOUNCE_LEVEL box means),
@@ -549,6 +550,7 @@ def _corner_factor(a, b, h):
                   + y / math.hypot(1, y) * math.atan(x / math.hypot(1, y)))
 
 
+@pytest.mark.slow
 def test_rectangle_factor_matches_the_closed_forms():
     """room_light.rectangle_irradiance_factor (Lambert's polygon formula, the twin of
     common.glsl's) against closed forms, 1e-9: a point over a rectangle's corner and over its
