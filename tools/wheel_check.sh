@@ -27,7 +27,7 @@ cp "$ROOT/fabrics/measurements/voile-white/gonio.csv" gonio.csv
 "$CATALOG" fit --gonio gonio.csv --name my-voile --out my-voile.toml --json > fit.json
 echo "wheel_check: sheet (the built-in catalog and the user's folder)"
 mkdir -p mine && cp my-voile.toml mine/
-"$CATALOG" sheet --lights D65 --fabrics lace-fwa,my-voile,mine --size 48x36 --out sheet --json > sheet.json
+"$CATALOG" sheet --lights D65 --fabric lace-fwa,my-voile --fabrics mine --size 48x36 --out sheet --json > sheet.json
 echo "wheel_check: view --frames under Xvfb"
 xvfb-run -a "$CATALOG" view --frames 2 --size 160x120 --grid 12x16 --cloth-backend numpy \
   --fabric voile-white --screenshot view.png

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from catalog import __version__
 from catalog.core.errors import CatalogError
-from catalog.core.resources import DATA_ENV, FABRICS_ENV, use_data, use_fabrics
+from catalog.core.resources import DATA_ENV, use_data, use_fabrics
 
 #: Subcommand name -> module. Order is the order shown by ``catalog --help``.
 COMMANDS: dict[str, str] = {
@@ -69,6 +69,29 @@ class CommandLineError(CatalogError):
         super().__init__(message)
 
 
+class DefaultsHelpFormatter(argparse.HelpFormatter):
+    """--help states every option's default: ``(default: X)`` after the help, unless the
+    help already says it or there is none to state (a flag, an option left out)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        default = action.default
+        if (not action.option_strings or default is None or default is False
+                or default is argparse.SUPPRESS or "default" in text.lower()
+                or isinstance(action, (argparse._HelpAction, argparse._VersionAction))):
+            return text
+        return f"{text} (default: {format_default(default)})"
+
+
+def format_default(value) -> str:
+    """An option's default as one would type it: (1280, 720) -> 1280x720, a Path as text."""
+    if isinstance(value, tuple) and len(value) == 2 and all(isinstance(v, int) for v in value):
+        return f"{value[0]}x{value[1]}"
+    if isinstance(value, (list, tuple)):
+        return ",".join(str(v) for v in value)
+    return str(value).replace("%", "%%")
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse, but a refused option is one line (no usage block) and, with ``--json``,
     one JSON object like every other refusal: :meth:`error` raises instead of exiting."""
@@ -86,14 +109,14 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True,
                                 parser_class=_Parser)
     for name, module in _available_commands().items():
-        command_parser = sub.add_parser(name, help=module.HELP, description=module.HELP)
+        command_parser = sub.add_parser(name, help=module.HELP, description=module.HELP,
+                                        formatter_class=DefaultsHelpFormatter)
         module.add_arguments(command_parser)
         resources = getattr(module, "RESOURCES", ())
         if "fabrics" in resources and "--fabrics" not in command_parser._option_string_actions:
-            command_parser.add_argument(
-                "--fabrics", metavar="DIR", action="append", type=Path,
-                help="a folder of your own fabric presets, searched before the built-in "
-                     f"catalog (repeatable; default ${FABRICS_ENV})")
+            from catalog.core.fabricargs import add_fabric_folders  # noqa: PLC0415
+
+            add_fabric_folders(command_parser)
         if "data" in resources:
             command_parser.add_argument(
                 "--data", metavar="DIR", type=Path,
@@ -164,7 +187,7 @@ def main(argv: list[str] | None = None) -> int:
     install_signal_handlers()
     try:
         if getattr(args, "fabrics", None) and isinstance(args.fabrics, list):
-            use_fabrics(args.fabrics)  # a command's own --fabrics (sheet's list) handles itself
+            use_fabrics(args.fabrics)  # --fabrics DIR, every command (catalog.core.fabricargs)
         if getattr(args, "data", None) is not None:
             use_data(args.data)
         check_outputs(args._module, args)

@@ -21,7 +21,7 @@ def _fabric_list(fabrics):
     paths = list_presets() if fabrics is None else [find_preset(f) for f in fabrics]
     if not paths:
         raise InputError("no fabric presets found (fabrics/*.toml); run `catalog fit` first",
-                         field="--fabrics")
+                         field="--fabric")
     return [load_preset(p) for p in paths]
 
 
