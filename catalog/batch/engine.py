@@ -78,24 +78,6 @@ def _run_process(tasks, retries, on_image, on_result) -> dict:
     return {"engine": "process", "workers": 1, "startup_s": 0.0}
 
 
-# ---------------------------------------------------------------------- progress
-def _progress_bar(enabled: bool):
-    from rich.console import Console  # noqa: PLC0415
-    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, ProgressColumn,  # noqa: PLC0415
-                               TextColumn, TimeElapsedColumn, TimeRemainingColumn)
-    from rich.text import Text  # noqa: PLC0415
-
-    class RateColumn(ProgressColumn):
-        def render(self, task):
-            speed = task.finished_speed or task.speed
-            return Text("  ?  img/s" if speed is None else f"{speed:5.1f} img/s")
-
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    RateColumn(), TimeElapsedColumn(), TextColumn("left"),
-                    TimeRemainingColumn(), console=Console(stderr=True),
-                    disable=not enabled, transient=False)
-
-
 # ---------------------------------------------------------------------- the job
 def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str | None = None,
                    retries: int = 2, lp_threads: int | None = None,
@@ -129,13 +111,15 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
         lock = threading.Lock()
         last_write = [time.perf_counter()]
         use_dask = workers is not None or scheduler is not None
-        with _progress_bar(progress) as bar:
-            bar_task = bar.add_task("render-catalog", total=left)
+        from catalog.core.progress import progress as progress_bar  # noqa: PLC0415
+
+        with progress_bar("catalog render-catalog", total=left, unit="images",
+                          enabled=progress) as bar:
 
             def on_image(event):
                 with lock:
                     seen[event["fabric"]] = seen.get(event["fabric"], 0) + 1
-                bar.advance(bar_task)
+                bar.advance()
                 if "sha256" in event and not use_dask:  # in process: journal every image
                     manifest.add([event])
 
@@ -157,7 +141,7 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
                     missing = len(task.images) - seen.get(task.fabric, 0)
                     seen[task.fabric] = len(task.images)
                 if missing > 0:
-                    bar.advance(bar_task, missing)
+                    bar.advance(missing)
                 if time.perf_counter() - last_write[0] > MANIFEST_EVERY_S:
                     manifest.write(spec.describe())
                     last_write[0] = time.perf_counter()

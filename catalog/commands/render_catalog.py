@@ -72,7 +72,7 @@ def run(args) -> int:
         pitch_deg=args.pitch, distance_m=args.distance, exposure=args.exposure)
     summary = render_catalog(spec, workers=args.workers, scheduler=args.scheduler,
                              retries=args.retries, lp_threads=args.lp_threads,
-                             progress=not (args.json or args.no_progress) and sys.stderr.isatty())
+                             progress=not (args.json or args.no_progress))
     if args.json:
         print_json(summary)
     else:

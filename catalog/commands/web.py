@@ -25,7 +25,7 @@ def run(args) -> int:
     from catalog.web.site import build_site  # noqa: PLC0415
 
     fabrics = None if args.fabric is None else ",".join(args.fabric)
-    report = build_site(args.out, fabrics=fabrics, lights=args.lights)
+    report = build_site(args.out, fabrics=fabrics, lights=args.lights, progress=not args.json)
     if args.json:
         print_json(report)
     else:

@@ -190,9 +190,12 @@ def _asset(name: str) -> bytes:
 
 
 def build_site(out: str | Path, fabrics: str | None = None, lights: str | None = None,
-               ctx=None) -> dict:
-    """Write the site into ``out``; returns a report (sizes, counts, seconds)."""
+               ctx=None, progress: bool = False) -> dict:
+    """Write the site into ``out``; returns a report (sizes, counts, seconds). ``progress``:
+    the bake's and the recording's progress on stderr (catalog.core.progress)."""
     import base64  # noqa: PLC0415
+
+    from catalog.core.progress import progress as progress_bar  # noqa: PLC0415
 
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
@@ -214,11 +217,15 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         t = time.perf_counter()
         animations = {}
         fabric_animation = {}
-        for preset in presets:
-            key = bake_lib.cloth_key(bake_lib.bake_params(preset))
-            if key not in animations:
-                animations[key] = bake_lib.bake(preset)
-            fabric_animation[preset.name] = animations[key]
+        keys = {preset.name: bake_lib.cloth_key(bake_lib.bake_params(preset)) for preset in presets}
+        with progress_bar("catalog web: bake", total=len(set(keys.values())), unit="cloths",
+                          enabled=progress) as bar:
+            for preset in presets:
+                key = keys[preset.name]
+                if key not in animations:
+                    animations[key] = bake_lib.bake(preset)
+                    bar.advance()
+                fabric_animation[preset.name] = animations[key]
         first = next(iter(animations.values()))
         for animation in animations.values():  # the page swaps the curtain's buffers only
             if not (np.array_equal(animation.indices, first.indices)
@@ -235,19 +242,26 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             exporter.use_drape(fabric_animation[presets[0].name])
             exporter.check_camera_uniforms(presets[0], choices[0])
             scenes = {}
-            for preset in presets:
-                exporter.use_drape(fabric_animation[preset.name])
-                for choice in choices:
-                    metered = exporter.record(preset, choice, "on")
-                    # the switches keep the exposure metered with fluorescence on, no glare,
-                    # no lamp: they show the brightener's, the glare's and the lamp's light
-                    for fluorescence, glare, lamp in itertools.product(
-                            export.FLUORESCENCE, export.GLARE, export.ROOM_LAMPS):
-                        key = export.scene_key(preset.name, choice.id, fluorescence, glare, lamp)
-                        scenes[key] = (metered if (fluorescence, glare, lamp) == ("on", "off", "none")
-                                       else exporter.record(preset, choice, fluorescence,
-                                                            ev100=metered["ev100"], glare=glare,
-                                                            lamp=lamp))
+            variants = list(itertools.product(export.FLUORESCENCE, export.GLARE,
+                                              export.ROOM_LAMPS))
+            with progress_bar("catalog web: record", total=len(presets) * len(choices)
+                              * len(variants), unit="scenes", enabled=progress) as bar:
+                for preset in presets:
+                    exporter.use_drape(fabric_animation[preset.name])
+                    for choice in choices:
+                        metered = exporter.record(preset, choice, "on")
+                        # the switches keep the exposure metered with fluorescence on, no
+                        # glare, no lamp: they show the brightener's, the glare's and the
+                        # lamp's light
+                        for fluorescence, glare, lamp in variants:
+                            key = export.scene_key(preset.name, choice.id, fluorescence, glare,
+                                                   lamp)
+                            scenes[key] = (
+                                metered if (fluorescence, glare, lamp) == ("on", "off", "none")
+                                else exporter.record(preset, choice, fluorescence,
+                                                     ev100=metered["ev100"], glare=glare,
+                                                     lamp=lamp))
+                            bar.advance()
             objects = exporter.objects()
             swatches = {p.name: base64.b64encode(export.swatch_png(exporter.ctx._ctx, p))
                         .decode("ascii") for p in presets}
