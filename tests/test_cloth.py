@@ -223,6 +223,7 @@ def test_grid_sizes(w, h, frames):
         assert sim.max_stretch <= p.max_stretch + STRAIN_SLACK
 
 
+@pytest.mark.slow
 def test_wall_and_floor_are_never_crossed():
     # wind blowing into the wall, and a curtain longer than the rod is high
     p = ClothParams(grid_w=12, grid_h=16, height_m=2.6, rod_height_m=2.2,

@@ -572,6 +572,7 @@ def test_the_key_reaches_the_glow_through_cloth_not_through_the_wall(mi):
     assert any(np.isclose(visible[1], desc.fabric["direct"] ** k) for k in (1, 2, 3, 4)), visible
 
 
+@pytest.mark.slow
 def test_the_key_reaches_the_glow_through_each_layer_of_cloth(mi):
     """key_visibility (issue 11, seventh round): two flat sheets 10 cm apart before the
     window: LD between them, LD^2 behind both (LD before, for any number of layers), as the
@@ -950,6 +951,7 @@ def test_a_spectral_render_leaves_a_pixels_nan_pass_out_of_its_mean():
     assert mi.calls == [(20, 1)]
 
 
+@pytest.mark.slow
 def test_the_spectral_key_and_backdrop_keep_their_luminance():
     """scene.in_gamut_same_luminance: in-gamut colours unchanged (1e-12), out-of-gamut ones
     with no negative channel and their luminance kept (1e-9), 0 where the luminance is <= 0;

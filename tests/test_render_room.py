@@ -932,6 +932,7 @@ def test_wall_light_per_vertex_matches_its_numpy_evaluation(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_the_cloth_sees_the_window_wall_as_the_viewer_does(gl):
     """room_light.wall_radiance_along (common.glsl's twin; what WALL_LIGHT gives the cloth's
     window side) against the frame's own room pass (room.frag: the light map on the window
