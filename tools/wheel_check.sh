@@ -31,6 +31,16 @@ mkdir -p mine && cp my-voile.toml mine/
 echo "wheel_check: view --frames under Xvfb"
 xvfb-run -a "$CATALOG" view --frames 2 --size 160x120 --grid 12x16 --cloth-backend numpy \
   --fabric voile-white --screenshot view.png
+echo "wheel_check: an optional extra that is not installed is one line naming it (exit 3)"
+set +e
+"$CATALOG" reference --fabric lace-fwa --size 16x12 --spp 1 --out ref.exr 2> ref.err
+status=$?
+set -e
+if [ "$status" -ne 3 ] || [ "$(wc -l < ref.err)" -ne 1 ] || [ -e ref.exr ]; then
+  echo "wheel_check: catalog reference without the pathtrace extra: exit $status" >&2
+  cat ref.err >&2; exit 1
+fi
+grep -q "fabric-catalog\[pathtrace\]\|libllvm19" ref.err || { cat ref.err >&2; exit 1; }
 for f in snap.png sheet.json view.png my-voile.toml; do
   [ -s "$f" ] || { echo "wheel_check: $f missing" >&2; exit 1; }
 done
