@@ -45,6 +45,16 @@ FORMAT_VERSION = 2  # 2: data.js packed (pack_data)
 BINARY_FIELDS = (("textures", "data"), ("buffers", "data"), ("blobs", None))
 
 
+def _json_length(value, depth: int = 2) -> int:
+    """len(json.dumps(value, separators=(",", ":"))) without the whole text at once: the
+    top ``depth`` levels of dicts part by part (the scenes one at a time)."""
+    if depth and isinstance(value, dict) and value:
+        return (2 + len(value) - 1
+                + sum(len(json.dumps(str(key))) + 1 + _json_length(item, depth - 1)
+                      for key, item in value.items()))
+    return len(json.dumps(value, separators=(",", ":")))
+
+
 def pack_data(data: dict) -> tuple[str, int]:
     """data.js's text, and the bytes a plain ``window.CATALOG_DATA = JSON`` would take.
 
@@ -56,19 +66,22 @@ def pack_data(data: dict) -> tuple[str, int]:
     the rest of the JSON (uniform values, frame structures, shaders) is deflated as text, each
     distinct uniform value once (``value_pool``; a scene's ``values`` index it)."""
     import base64  # noqa: PLC0415
-    import copy  # noqa: PLC0415
     import zlib  # noqa: PLC0415
 
-    plain = len(plain_data_js(data))
-    data = copy.deepcopy(data)
+    # The whole catalog's data is hundreds of MB as Python objects: no deep copy of it and no
+    # plain JSON text of it whole. The plain size is counted part by part (_json_length), and
+    # only what packing changes is copied (the scenes' value lists, the entries whose bytes
+    # move out).
+    plain = len(plain_data_js({})) - 2 + _json_length(data)
+    data = dict(data)
     binary: list[str] = []
     # every distinct uniform value once ("values": [0.5, ..] -> "values": [i, ..] into
     # "value_pool"): scenes of one fabric or light share most of theirs
     pool: dict[str, int] = {}
-    for scene in data.get("scenes", {}).values():
-        scene["values"] = [pool.setdefault(json.dumps(v, separators=(",", ":")), len(pool))
-                           for v in scene["values"]]
     if "scenes" in data:
+        data["scenes"] = {key: {**scene, "values": [
+            pool.setdefault(json.dumps(v, separators=(",", ":")), len(pool))
+            for v in scene["values"]]} for key, scene in data["scenes"].items()}
         data["value_pool"] = [json.loads(text) for text in pool]
 
     def move(text: str) -> dict:
@@ -79,9 +92,9 @@ def pack_data(data: dict) -> tuple[str, int]:
         if field is None:
             data[section] = [move(v) for v in data[section]]
             continue
-        for entry in data[section].values():
-            if isinstance(entry.get(field), str):
-                entry[field] = move(entry[field])
+        data[section] = {key: ({**entry, field: move(entry[field])}
+                               if isinstance(entry.get(field), str) else entry)
+                         for key, entry in data[section].items()}
     text = json.dumps(data, separators=(",", ":")).encode("utf-8")
     packed = {"format": FORMAT_VERSION,
               "json": base64.b64encode(zlib.compress(text, 9)).decode("ascii"),
