@@ -244,6 +244,7 @@ def test_wall_and_floor_are_never_crossed():
 
 # ---- sleep ----------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_sleeps_at_rest_and_wakes_on_change():
     p = ClothParams(grid_w=12, grid_h=12, opening=1.0, sleep_frames=10)
     sim = ClothSimulation(p, "cpu")

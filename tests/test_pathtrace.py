@@ -976,6 +976,7 @@ def test_the_spectral_key_and_backdrop_keep_their_luminance():
         np.testing.assert_allclose(film_luminance(wavelengths, values), desc.key_rgb @ luma, rtol=1e-9)
 
 
+@pytest.mark.slow
 def test_the_window_filter_gives_the_outside_the_keys_spectrum():
     """catalog.pathtrace.window_filter (issue 11, eighth round): T = S / (Y(S) D65), so a grey
     texel of luminance g times D65 leaves the sheet as g S / Y(S) and the key given as Y(S)
