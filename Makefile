@@ -1,7 +1,7 @@
 # Fabric presets from the measurement sets (issue 3). Python from the project's virtualenv.
 PYTHON ?= .venv/bin/python
 
-.PHONY: presets measurements fit-table
+.PHONY: presets measurements fit-table figures figures-age
 
 # Regenerate every fabrics/*.toml with `catalog fit` (deterministic output), then the preset
 # table of docs/fit.md made from them.
@@ -15,3 +15,17 @@ measurements:
 # The per-fabric HG vs Cook-Torrance error table of docs/fit.md.
 fit-table:
 	$(PYTHON) -m catalog.bench.fit_table && $(PYTHON) tools/docs_figures.py
+
+# Measure every published result again (each bench module's full run, its JSON recording the
+# commit and machine), then regenerate every table of the docs from the JSON. Hours on a
+# 2-core machine; a module that needs what this machine lacks (the pathtrace extra, the
+# validation data) stops the run with its one-line reason.
+figures:
+	for m in $$($(PYTHON) tools/figures_age.py --modules); do \
+	  echo "figures: catalog.bench.$$m"; $(PYTHON) -m catalog.bench.$$m >/dev/null || exit 1; \
+	done
+	$(PYTHON) tools/docs_figures.py
+
+# The published results older than the code they measure (a warning each; CI runs it).
+figures-age:
+	$(PYTHON) tools/figures_age.py

@@ -12,6 +12,17 @@ from pathlib import Path
 # is imported; an explicit setting in the environment wins.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+# The settled drape's disk cache (catalog.cloth.drape_cache) in a folder of this session's
+# own, shared by the commands the tests start and removed after: tests neither read a
+# user's cache nor leave one behind.
+if "CATALOG_CACHE_DIR" not in os.environ:
+    import atexit
+    import tempfile
+
+    _CACHE = tempfile.mkdtemp(prefix="catalog-test-cache-")
+    os.environ["CATALOG_CACHE_DIR"] = _CACHE
+    atexit.register(shutil.rmtree, _CACHE, True)
+
 import pytest
 
 from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT, data_dir_candidate, data_missing_reason
@@ -33,6 +44,29 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.get_closest_marker("data") is not None:
             item.add_marker(skip)
+
+
+#: Set (e.g. by .ci/run) to a number of seconds: an unmarked test whose call phase takes
+#: longer FAILS, so the fast loop (-m "not slow") stays fast. The rule marks a test slow at
+#: 0.5 s; CI fails it at twice that, the margin for run-to-run noise on a 2-core machine
+#: (medians of repeated fast-loop runs there vary by about 30 %). Fixture set-up (the one GL
+#: context, a module's shared render) is shared work and is not counted.
+SLOW_LIMIT_ENV = "CATALOG_UNMARKED_LIMIT_S"
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    limit = os.environ.get(SLOW_LIMIT_ENV)
+    if not limit or call.when != "call":
+        return
+    report = outcome.get_result()
+    if (report.passed and item.get_closest_marker("slow") is None
+            and report.duration > float(limit)):
+        report.outcome = "failed"
+        report.longrepr = (f"{item.nodeid} took {report.duration:.2f} s without "
+                           f"@pytest.mark.slow (limit {float(limit):g} s, ${SLOW_LIMIT_ENV}): "
+                           "mark it slow or make it faster")
 
 
 @pytest.fixture(scope="session")

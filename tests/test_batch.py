@@ -83,8 +83,8 @@ def test_yaw_list_and_range():
     (["--frames", "x"], "--frames"),
     (["--size", "0x32"], "--size"),
     (["--format", "jpg"], "--format"),
-    (["--fabrics", "no-such-fabric"], "--fabrics"),
-    (["--fabrics", "lace-fwa,lace-fwa"], "--fabrics"),
+    (["--fabric", "no-such-fabric"], "--fabric"),
+    (["--fabric", "lace-fwa,lace-fwa"], "--fabric"),
     (["--lights", "NOT-A-LIGHT"], "--lights"),
     (["--yaw", "0,a"], "--yaw"),
     (["--workers", "0"], "--workers"),
@@ -96,7 +96,7 @@ def test_yaw_list_and_range():
 ])
 def test_bad_options_refused_in_one_line_nothing_written(tmp_path, capsys, change, option):
     out = tmp_path / "out"
-    args = ["render-catalog", "--fabrics", "lace-fwa", "--lights", "D65", "--frames", "0:1",
+    args = ["render-catalog", "--fabric", "lace-fwa", "--lights", "D65", "--frames", "0:1",
             "--out", str(out), *SMALL]
     # a later option replaces an earlier one of the same name in argparse
     assert main(args + change) == 2
@@ -109,7 +109,7 @@ def test_bad_options_refused_in_one_line_nothing_written(tmp_path, capsys, chang
 def test_out_must_be_a_folder(tmp_path, capsys):
     out = tmp_path / "file.txt"
     out.write_text("keep me")
-    assert main(["render-catalog", "--fabrics", "lace-fwa", "--lights", "D65",
+    assert main(["render-catalog", "--fabric", "lace-fwa", "--lights", "D65",
                  "--out", str(out), *SMALL]) == 2
     assert "--out" in capsys.readouterr().err
     assert out.read_text() == "keep me"
@@ -195,7 +195,7 @@ def test_batch_images_equal_snapshot_images(gl, tmp_path):
 def test_failing_fabric_reported_rest_finish(tmp_path, make_preset):
     broken = make_preset("broken", rho=1.5)  # out of range: refused when the worker loads it
     out = tmp_path / "out"
-    run = _run(["render-catalog", "--fabrics", f"lace-fwa,{broken},linen-dense",
+    run = _run(["render-catalog", "--fabric", f"lace-fwa,{broken},linen-dense",
                 "--lights", "D65", "--frames", "0:3", "--out", str(out), "--json", *SMALL])
     assert run.returncode == 3, run.stderr
     summary = json.loads(run.stdout)
@@ -217,7 +217,7 @@ def test_failing_fabric_reported_rest_finish(tmp_path, make_preset):
 def test_failing_fabric_on_dask_workers(tmp_path, make_preset):
     broken = make_preset("broken", g_spec=3.0)
     out = tmp_path / "out"
-    run = _run(["render-catalog", "--fabrics", f"{broken},lace-fwa", "--lights", "D65,A",
+    run = _run(["render-catalog", "--fabric", f"{broken},lace-fwa", "--lights", "D65,A",
                 "--frames", "0:2", "--out", str(out), "--workers", "2", "--json", *SMALL])
     assert run.returncode == 3, run.stderr
     summary = json.loads(run.stdout)
@@ -231,7 +231,7 @@ def test_same_images_whatever_the_engine_and_workers(tmp_path):
     """One process, one and two Dask workers (LocalCluster) and an existing cluster reached
     with --scheduler write byte-identical files (PNG; EXR for one process against two
     workers), and the manifest's hashes are the files' hashes."""
-    job = ["render-catalog", "--fabrics", "lace-fwa,fluoro-pink", "--lights", "D65,LED-B4",
+    job = ["render-catalog", "--fabric", "lace-fwa,fluoro-pink", "--lights", "D65,LED-B4",
            "--frames", "0:3:2", "--yaw", "0,40", "--json", *SMALL]
     hashes = {}
     runs = [("process", "png", []), ("process", "exr", [])]
@@ -285,7 +285,7 @@ def test_resume_after_kill(tmp_path):
     mtime), renders only the rest, leaves no partial or temporary file, and the manifest
     lists every image with its file's hash."""
     out = tmp_path / "out"
-    job = ["render-catalog", "--fabrics", "lace-fwa,linen-dense", "--lights", "D65,A",
+    job = ["render-catalog", "--fabric", "lace-fwa,linen-dense", "--lights", "D65,A",
            "--frames", "0:3:2", "--yaw", "0:360:20", "--out", str(out), *SMALL]
     total = 2 * 2 * 2 * 18
     proc = subprocess.Popen(CATALOG + job, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)

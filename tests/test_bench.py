@@ -130,6 +130,7 @@ def test_colour_section_on_one_fabric_and_light(gl, tmp_path):
 
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_truth_switches_on_the_emission_as_the_renderer_does(gl):
     """The bench's truth forces the emission on with the scene's with_physical_emission;
     the renderer's own physical mode must build the same terms."""

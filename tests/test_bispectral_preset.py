@@ -56,6 +56,7 @@ def test_exported_fabric_renders_the_bands_and_the_residual(tmp_path, capsys):
 
 
 @pytest.mark.data
+@pytest.mark.slow
 def test_two_fabrics_exported_into_one_folder_keep_their_own_files(tmp_path, capsys):
     from catalog.presets import find_preset, load_preset
 

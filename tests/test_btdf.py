@@ -95,6 +95,7 @@ def test_hg_finite_positive_and_matches_decimal_reference(a, b, g):
 
 @settings(max_examples=200, deadline=None)
 @given(unit_vectors(), G, st.floats(min_value=-12, max_value=0))
+@pytest.mark.slow
 def test_hg_near_straight_through_matches_reference(a, g, log_angle):
     """theta -> 0: views a tiny angle away from the direction of travel."""
     a = _normalise(a)

@@ -121,6 +121,7 @@ def test_bispectral_refuses_bad_matrix_files(tmp_path, capsys, text):
                                         st.text(alphabet="xyz-", max_size=3)),
                               min_size=4, max_size=6).map(lambda r: ",".join(map(str, r))),
                      max_size=5))
+@pytest.mark.slow
 def test_fit_refuses_bad_gonio_files(tmp_path, capsys, columns, rows):
     bad = tmp_path / "gonio.csv"
     bad.write_text("\n".join([columns, *rows]) + "\n")

@@ -177,6 +177,7 @@ def _energy_bound_j(p: ClothParams) -> float:
 
 @pytest.mark.parametrize("stiffness", [1e1, 1e3, 1e6])
 @pytest.mark.parametrize("dt", [1 / 60, 1 / 30, 1 / 15])
+@pytest.mark.slow
 def test_no_wind_energy_bounded_stretch_limited(stiffness, dt):
     p = ClothParams(grid_w=10, grid_h=12, opening=0.6, stretch_stiffness_n_m=stiffness)
     sim = ClothSimulation(p, "cpu")
@@ -189,6 +190,7 @@ def test_no_wind_energy_bounded_stretch_limited(stiffness, dt):
 
 
 @pytest.mark.parametrize("stiffness", [1e1, 1e6])
+@pytest.mark.slow
 def test_gusty_wind_stays_finite_and_limited(stiffness):
     p = ClothParams(grid_w=16, grid_h=20, opening=0.8, stretch_stiffness_n_m=stiffness,
                     wind_speed_m_s=1.0)
@@ -221,6 +223,7 @@ def test_grid_sizes(w, h, frames):
         assert sim.max_stretch <= p.max_stretch + STRAIN_SLACK
 
 
+@pytest.mark.slow
 def test_wall_and_floor_are_never_crossed():
     # wind blowing into the wall, and a curtain longer than the rod is high
     p = ClothParams(grid_w=12, grid_h=16, height_m=2.6, rod_height_m=2.2,
@@ -241,6 +244,7 @@ def test_wall_and_floor_are_never_crossed():
 
 # ---- sleep ----------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_sleeps_at_rest_and_wakes_on_change():
     p = ClothParams(grid_w=12, grid_h=12, opening=1.0, sleep_frames=10)
     sim = ClothSimulation(p, "cpu")

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import ast
 
+import pytest
+
 from catalog.core.resources import PROJECT_ROOT
 
 CONSTANTS = PROJECT_ROOT / "catalog" / "core" / "constants.py"
@@ -28,6 +30,7 @@ def _literal_copies(tree: ast.AST) -> list[str]:
     return found
 
 
+@pytest.mark.slow
 def test_shared_constants_are_written_once():
     offenders = []
     for path in sorted((PROJECT_ROOT / "catalog").rglob("*.py")):

@@ -83,7 +83,7 @@ def test_exr_opens_in_ocio_with_a_standard_view(gl, tmp_path):
 @pytest.mark.slow
 def test_sheet_grid_is_labelled(tmp_path):
     out = tmp_path / "sheet"
-    result = _run("sheet", "--lights", "D65,UV-A", "--fabrics", "lace-fwa,net-grey",
+    result = _run("sheet", "--lights", "D65,UV-A", "--fabric", "lace-fwa,net-grey",
                   "--size", "40x30", "--out", str(out), "--json")
     assert result.returncode == 0, result.stderr
     import json
@@ -100,6 +100,6 @@ def test_sheet_grid_is_labelled(tmp_path):
     names = grid[dy:, :dx].astype(int)
     for i in range(2):  # each row's name beside it
         assert names[i * 30:(i + 1) * 30].max() > 150
-    unlabelled = _run("sheet", "--lights", "D65", "--fabrics", "net-grey", "--size", "40x30",
+    unlabelled = _run("sheet", "--lights", "D65", "--fabric", "net-grey", "--size", "40x30",
                       "--out", str(tmp_path / "bare"), "--no-labels", "--json")
     assert json.loads(unlabelled.stdout)["label_offset_px"] == [0, 0]

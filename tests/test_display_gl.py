@@ -166,6 +166,7 @@ def test_lace_and_safety_yellow_differ_at_sunset(gl, capsys, record_figure):
     assert delta >= 10.0
 
 
+@pytest.mark.slow
 def test_lace_under_a_displays_as_an_adapted_white(gl, capsys, record_figure):
     renderer, mask = _frame(gl, "lace-fwa", "A")
     lab = _lab(_displayed_mean_linear(renderer, mask))

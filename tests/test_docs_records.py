@@ -52,6 +52,7 @@ def test_tested_figures_make_every_block_the_docs_use():
             "render_led405_brief"} <= set(made)
 
 
+@pytest.mark.slow
 def test_record_figure_merges_into_the_named_json_only_when_asked(tmp_path):
     """The conftest hook: with CATALOG_RECORD_FIGURES set, a session's figures are merged
     into the file (earlier figures kept); without it nothing is written."""

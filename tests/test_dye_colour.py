@@ -126,6 +126,7 @@ def test_the_frame_passes_the_rooms_and_folds_light_by_the_secondary_dye(gl):
 
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_the_secondary_dye_brightens_the_safety_yellow_under_the_uv_lamp(gl):
     """set_secondary_dye: a folded safety-yellow curtain under the UV lamp, seen from the room.
     With the key's dye (0.048 in every channel) the folds' glow passing the cloth and the

@@ -79,6 +79,7 @@ GUESSES = [
 
 
 @pytest.mark.parametrize("measured", [False, True])
+@pytest.mark.slow
 def test_fit_does_not_depend_on_the_initial_guess(measured):
     """Far-off guesses, alone (no scan) or with the scan, end where the scan's starts do
     (to 1e-5: LM's stopping tolerance; the standard errors are ~1e-3)."""

@@ -141,6 +141,7 @@ def test_out_of_range_options_are_refused(capsys, option, value):
     assert len(err) == 1 and option in err[0]
 
 
+@pytest.mark.slow
 def test_console_script_prints_one_json_object():
     completed = subprocess.run(
         [sys.executable, "-m", "catalog", *ARGS, "--light", "sun:500", "--mode", "paper", "--json"],

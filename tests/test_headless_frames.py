@@ -18,6 +18,7 @@ def test_parse_case_reads_size_and_grid_and_refuses_bad_text():
 
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_a_small_run_times_the_cloth_and_the_frame(tmp_path):
     out = tmp_path / "frames.json"
     assert bench.main(["--cases", "64x48:6x8", "--backend", "numpy", "--frames", "2",

@@ -114,31 +114,25 @@ def test_help_texts_point_inside_the_repository():
     assert "../" not in result.stdout and "shared/spec" not in result.stdout
 
 
-def test_dependency_groups_keep_the_viewer_and_the_offline_tools_apart():
-    """The offline tools' group pulls no window or GL; the viewer's (with what it includes)
-    pulls no scipy, colour-science or pvlib; `all` is both; setup installs all and test."""
+def test_a_plain_install_brings_every_main_command_and_extras_only_the_optional():
+    """`pip install fabric-catalog` alone runs snapshot, sheet, view, fit, simulate,
+    fluorescence, sun and web: the design's packages are ordinary dependencies; the extras
+    are the path tracer, Dask, the bench's peers and the tests; setup installs them all."""
     import tomllib
 
     project = tomllib.loads((PROJECT_ROOT / "pyproject.toml").read_text())["project"]
-    groups = project["optional-dependencies"]
 
     def names(requirements: list[str]) -> set[str]:
-        out = set()
-        for req in requirements:
-            name = re.split(r"[<>=\[ ;]", req, maxsplit=1)[0].lower()
-            if name == project["name"]:  # fabric-catalog[render]: expand the named groups
-                for group in re.search(r"\[(.*)\]", req).group(1).split(","):
-                    out |= names(groups[group.strip()])
-            else:
-                out.add(name)
-        return out
+        return {re.split(r"[<>=\[ ;]", req, maxsplit=1)[0].lower() for req in requirements}
 
     base = names(project["dependencies"])
-    offline, viewer, everything = (names(groups[g]) | base for g in ("offline", "viewer", "all"))
-    window_and_gl = {"glfw", "imgui-bundle", "pyopengl", "moderngl"}
-    assert not offline & window_and_gl
-    assert not viewer & {"scipy", "colour-science", "pvlib", "matplotlib", "pandas"}
-    assert everything == offline | viewer
-    assert "scipy" not in base and "moderngl" not in base
+    assert {"moderngl", "glfw", "imgui-bundle", "pyopengl", "scipy", "colour-science", "pvlib",
+            "matplotlib", "openimageio", "trimesh", "numba", "platformdirs"} <= base
+    groups = project["optional-dependencies"]
+    assert set(groups) == {"pathtrace", "batch", "bench", "test"}
+    assert "mitsuba" in names(groups["pathtrace"]) and "dask" in names(groups["batch"])
+    from catalog.core.extras import EXTRA_OF
+
+    assert set(EXTRA_OF.values()) <= set(groups)
     setup = (PROJECT_ROOT / "tools" / "setup.sh").read_text()
-    assert '-e ".[all,test' in setup
+    assert '-e ".[test,pathtrace,batch' in setup

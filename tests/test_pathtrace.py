@@ -520,6 +520,7 @@ def test_glow_reaches_the_room_alike_by_emitter_and_by_bsdf_sampling(mi):
     assert np.allclose(emitter, bsdf, rtol=0.06), (emitter, bsdf)
 
 
+@pytest.mark.slow
 def test_glow_shells_lie_on_the_cloth_finer_than_its_mesh():
     """The glow shells' mesh (issue 11, fourth round): the curtain's triangles split in four
     GLOW_SUBDIVISIONS times, so 16x the triangles at 2 levels; every new vertex lies on one of
@@ -551,6 +552,7 @@ def test_glow_shells_lie_on_the_cloth_finer_than_its_mesh():
     assert inside.shape[0] >= side * (side + 1) // 2
 
 
+@pytest.mark.slow
 def test_the_key_reaches_the_glow_through_cloth_not_through_the_wall(mi):
     """key_visibility (issue 11, fourth round): 1 with nothing in the way, LD behind the cloth
     (through its gaps), 0 where the window wall stops the ray (it had passed LD as cloth does).
@@ -570,6 +572,7 @@ def test_the_key_reaches_the_glow_through_cloth_not_through_the_wall(mi):
     assert any(np.isclose(visible[1], desc.fabric["direct"] ** k) for k in (1, 2, 3, 4)), visible
 
 
+@pytest.mark.slow
 def test_the_key_reaches_the_glow_through_each_layer_of_cloth(mi):
     """key_visibility (issue 11, seventh round): two flat sheets 10 cm apart before the
     window: LD between them, LD^2 behind both (LD before, for any number of layers), as the
@@ -948,6 +951,7 @@ def test_a_spectral_render_leaves_a_pixels_nan_pass_out_of_its_mean():
     assert mi.calls == [(20, 1)]
 
 
+@pytest.mark.slow
 def test_the_spectral_key_and_backdrop_keep_their_luminance():
     """scene.in_gamut_same_luminance: in-gamut colours unchanged (1e-12), out-of-gamut ones
     with no negative channel and their luminance kept (1e-9), 0 where the luminance is <= 0;
@@ -972,6 +976,7 @@ def test_the_spectral_key_and_backdrop_keep_their_luminance():
         np.testing.assert_allclose(film_luminance(wavelengths, values), desc.key_rgb @ luma, rtol=1e-9)
 
 
+@pytest.mark.slow
 def test_the_window_filter_gives_the_outside_the_keys_spectrum():
     """catalog.pathtrace.window_filter (issue 11, eighth round): T = S / (Y(S) D65), so a grey
     texel of luminance g times D65 leaves the sheet as g S / Y(S) and the key given as Y(S)
@@ -1009,6 +1014,7 @@ def test_the_window_filter_gives_the_outside_the_keys_spectrum():
     assert np.all(grey[..., 0] == grey[..., 2])
 
 
+@pytest.mark.slow
 def test_the_bench_takes_the_spectral_reference_where_the_dye_of_the_secondary_light_differs():
     """image.reference_variant_for (issue 11, seventh round): the spectral variant for the
     safety-yellow under the UV lamp (its glow passes its dye at 0.99 in green, the key's leak

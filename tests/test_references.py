@@ -17,6 +17,8 @@ import importlib.util
 import re
 from pathlib import Path
 
+import pytest
+
 from catalog.core.resources import PROJECT_ROOT
 
 ROOTS = ("README.md", "BENCHMARKS.md", "docs", "catalog", "shaders", "tools", "tests")
@@ -107,6 +109,7 @@ def _checked(parts: list[str], before: str, subpackages: set[str]) -> bool:
             or bool(re.search(r"(import|from|:mod:`|:func:`|:class:`)\s*$", before)))
 
 
+@pytest.mark.slow
 def test_every_dotted_catalog_name_resolves():
     subpackages = {p.stem for p in (PROJECT_ROOT / "catalog").iterdir()
                    if (p.is_dir() and (p / "__init__.py").is_file()) or p.suffix == ".py"}
@@ -150,6 +153,7 @@ def _defined_anywhere() -> set[str]:
     return names
 
 
+@pytest.mark.slow
 def test_every_sphinx_role_in_a_docstring_names_something_defined():
     """``:func:`name```, ``:meth:``, ``:class:``, ``:data:``, ``:attr:`` in catalog/: the last
     part of the name is defined somewhere in catalog/ (a removed helper leaves no pointer)."""

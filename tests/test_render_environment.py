@@ -89,6 +89,7 @@ def test_cli_refuses_a_bad_environment_in_one_line(tmp_path):
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_the_flat_curtains_see_through_shows_the_environment(gl, tmp_path):
     """Curtain closed and flat (the paper's cloth, see-through LD), looking out: replacing a
     uniform reddish image by a uniform bluish one changes each curtain pixel whose ray leaves

@@ -57,6 +57,7 @@ CASES = [
 
 
 @pytest.mark.parametrize("light,mode,options", CASES)
+@pytest.mark.slow
 def test_rgb_radiance_matches_float64_reference_per_pixel(gl, make_preset, light, mode, options,
                                                           record_figure):
     extra = f"anisotropy = {options['anisotropy']}" if "anisotropy" in options else ""
@@ -71,6 +72,7 @@ def test_rgb_radiance_matches_float64_reference_per_pixel(gl, make_preset, light
     renderer.release()
 
 
+@pytest.mark.slow
 def test_band_counts_delta_e_against_spectral_reference(gl, make_preset, capsys):
     """Reported (run with -s) and bounded: RGB is exact for one light on one material; the
     interval bands approach it as N grows."""
@@ -91,6 +93,7 @@ def test_band_counts_delta_e_against_spectral_reference(gl, make_preset, capsys)
     renderer.release()
 
 
+@pytest.mark.slow
 def test_grey_fabric_same_in_every_band_count_under_a_lamp(gl, make_preset):
     """Invariant: with no dye, no emission and every spectrum a multiple of the lamp's, the
     bands only regroup the same integrals."""
@@ -106,6 +109,7 @@ def test_grey_fabric_same_in_every_band_count_under_a_lamp(gl, make_preset):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_two_sided_flipped_normals_and_tangents_render_the_same(gl, make_preset):
     renderer = _renderer(gl, make_preset(extra_btdf="anisotropy = 0.5"), "sun:100")
     renderer.render()
@@ -121,6 +125,7 @@ def test_two_sided_flipped_normals_and_tangents_render_the_same(gl, make_preset)
     renderer.release()
 
 
+@pytest.mark.slow
 def test_front_lit_curtain_is_not_black(gl, make_preset):
     """A light on the viewer's side: the thin layer scatters back (eq. 6 at theta > 90 deg)."""
     renderer = _renderer(gl, make_preset(direct=0.0, fluorescent=False), "D65")
@@ -135,6 +140,7 @@ def test_front_lit_curtain_is_not_black(gl, make_preset):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_see_through_pass_only_when_direct_is_positive(gl, make_preset):
     """The flat cloth (no pattern, issue 12's ``patterned = False``) compiles the see-through
     term only for a fabric with gaps; the patterned frame never does (its holes are the OIT
@@ -151,6 +157,7 @@ def test_see_through_pass_only_when_direct_is_positive(gl, make_preset):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_viewport_split_screen_and_mesh_updates(gl, make_preset):
     renderer = _renderer(gl, make_preset(), "D65")
     renderer.render()
@@ -205,6 +212,7 @@ def test_paper_mode_colour_is_eq_1_to_3_of_the_emission(gl, make_preset):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_cloth_interleaved_vertex_buffer_draws_like_set_mesh(gl, make_preset):
     """The cloth's dynamic layout (docs/cloth.md, 48 bytes a vertex) bound directly, moved by an
     offset in the vertex shader, gives the frame that uploading the same arrays gives."""
@@ -229,6 +237,7 @@ def test_cloth_interleaved_vertex_buffer_draws_like_set_mesh(gl, make_preset):
 
 
 @pytest.mark.parametrize("illuminance_lx", [0.0, 1e9])
+@pytest.mark.slow
 def test_zero_and_huge_light_stay_finite_and_match_the_reference(gl, make_preset, illuminance_lx,
                                                                  record_figure):
     from catalog.optics.lights import Light, get_light
@@ -253,6 +262,7 @@ def test_zero_and_huge_light_stay_finite_and_match_the_reference(gl, make_preset
 
 
 @pytest.mark.parametrize("n_bands", [6, 9, 16])
+@pytest.mark.slow
 def test_band_shader_arithmetic_matches_float64_bands(gl, make_preset, n_bands):
     """The N-band shader against the same bands taken in float64 from the 1 nm radiance:
     display = to_rgb . (W . L(l)). This isolates the shader's arithmetic (chunks, indices,
@@ -315,6 +325,7 @@ def test_scene_values_are_compiled_in_on_cpu_rasterisers_only(gl):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_room_side_term_is_part_of_the_per_pixel_comparison(gl, make_preset):
     """The default frame (room lit, viewer inside) lights the cloth's room side by the room's
     solved light (curtain.frag ROOM_SIDE): its twin's share of the curtain's luminance is above
@@ -337,6 +348,7 @@ def test_room_side_term_is_part_of_the_per_pixel_comparison(gl, make_preset):
 
 @pytest.mark.parametrize("switches", [{"sky_occlusion": False}, {"key_shadow": False},
                                       {"sky_occlusion": False, "key_shadow": False}])
+@pytest.mark.slow
 def test_room_side_with_the_cloth_shadows_off(gl, make_preset, switches):
     """ROOM_SIDE compiles and matches its twin per pixel (1e-3) with issue 11's shadow terms
     switched off (the image bench's options): without SKY_OCCLUSION the folds hide nothing."""

@@ -68,6 +68,7 @@ def _join(*meshes):
 # --- the mip chain's far limit ------------------------------------------------------------
 
 @pytest.mark.parametrize("path", list_presets(), ids=lambda p: p.stem)
+@pytest.mark.slow
 def test_mip_far_limit_is_the_fitted_open_area(gl, path):
     """The last mip level GL builds (what the far cloth samples) holds coverage 1 - LD
     within the 1 % of the pattern's own rule, and the averaged normal tilts less than 1 deg."""
@@ -86,6 +87,7 @@ def test_mip_far_limit_is_the_fitted_open_area(gl, path):
 # --- layers: weighted blended OIT against sorted compositing --------------------------------
 
 @pytest.mark.parametrize("antialiasing", ["auto", "msaa"])
+@pytest.mark.slow
 def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, antialiasing, record_figure):
     """Two overlapping layers of a flat cloth (coverage a = 1 - LD = 0.6 each), the back one
     tilted 35 deg so the layers' radiances C1, C2 differ. Sorted compositing gives
@@ -144,6 +146,7 @@ def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, ant
 
 # --- the pattern is where the uvs say -------------------------------------------------------
 
+@pytest.mark.slow
 def test_a_known_pattern_appears_where_the_texture_coordinates_put_it(gl, make_preset, tmp_path):
     """A repeat whose top-left quarter (u < 1/2, v < 1/2) is thread and the rest open, on a
     flat quad facing the camera that spans exactly one repeat with uv (0, 0) at its top
@@ -190,6 +193,7 @@ def test_a_known_pattern_appears_where_the_texture_coordinates_put_it(gl, make_p
 # --- far away the patterned cloth is the fitted cloth -------------------------------------
 
 @pytest.mark.parametrize("name", WHITES + ["net-grey", "linen-dense"])
+@pytest.mark.slow
 def test_far_limit_equals_the_unpatterned_cloth(gl, name, record_figure):
     """At 4.3 m on a 48x36 image a pixel spans 0.11 m of cloth, more than the largest repeat
     (the lace's 0.1 m): the curtain's mean displayed colour equals the flat cloth's (eq. 8
@@ -244,6 +248,7 @@ def test_white_fabrics_differ_pairwise_at_the_default_view(gl, record_figure):
 
 # --- a close-up resolves the lace's repeat ---------------------------------------------------
 
+@pytest.mark.slow
 def test_close_up_luminance_spectrum_peaks_at_the_lace_repeat(gl, record_figure):
     """The lace hung flat (fullness 1, so no pleat shading) seen from 0.3 m, 256x256 px,
     D65: the strongest frequency of the curtain's luminance off the axes is a fundamental
@@ -427,6 +432,7 @@ def test_auto_antialiasing_takes_msaa_on_a_gpu_and_fxaa_on_a_cpu_rasteriser(gl):
     renderer.release()
 
 
+@pytest.mark.slow
 def test_msaa_keeps_the_curtain_interior_and_the_layers(gl, record_figure):
     """MSAA changes edges only: over the curtain's interior (pixels whose 3x3 neighbourhood
     is curtain in the G-buffer mask) the resolved HDR radiance equals the one-sample frame's

@@ -58,6 +58,7 @@ def _beam_transmittance(inputs):
     return inputs.direct + inputs.a_spec * hg_hemisphere_factors(inputs.g_spec)[0]
 
 
+@pytest.mark.slow
 def test_open_window_beam_is_the_key_irradiance(gl):
     """Curtain open: the patch's excess over the floor away from it is the Lambertian floor
     under the key light, rho / pi * E * cos(theta) (E the key's illuminance as linear sRGB Y).
@@ -74,6 +75,7 @@ def test_open_window_beam_is_the_key_irradiance(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_closing_the_lace_dims_the_patch_by_its_transmittance(gl):
     """Closing lace-fwa with the key's directional lobe kept in the beam (set_room_lobe(False),
     issue 13's frame) leaves the beam's transmittance LD + a_spec fwd(g_spec) (0.65): the
@@ -239,6 +241,7 @@ def test_layers_multiply_in_the_shadow_map(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_room_lamp_lights_the_floor_by_inverse_square(gl):
     """A lamp 1.5 m above a floor texel's centre in the middle of the room adds its direct
     I / h^2 there (the light map, read back) plus the light bounced off the walls, which the
@@ -270,6 +273,7 @@ def test_room_lamp_lights_the_floor_by_inverse_square(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_light_map_is_the_float64_radiosity_of_its_direct_light(gl):
     """room_radiosity.frag and room_bounce.frag against float64 numpy: from the GPU's own
     direct light map and beam (read back), the coarse sources S (2^BOUNCE_LEVEL box means),
@@ -460,6 +464,7 @@ def test_room_shaders_compile_as_glsl_es_300(tmp_path, name, defines):
 
 
 @pytest.mark.parametrize("n_bands", [3, 16])
+@pytest.mark.slow
 def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
     """A lamp in the room (A, isotropic, 1.5 m above the floor's centre) adds to every curtain
     pixel seen from the room eq. 8 with the lamp as the light: the band values of
@@ -513,6 +518,7 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
     r.release()
 
 
+@pytest.mark.slow
 def test_shadow_map_size_is_a_frame_option(gl):
     """set_shadow_map_size (issue 11's Pareto): the maps are made again at the new side (read
     back at that size), the room's beam patch keeps its mean within 2 % (the map's resolution
@@ -544,6 +550,7 @@ def _corner_factor(a, b, h):
                   + y / math.hypot(1, y) * math.atan(x / math.hypot(1, y)))
 
 
+@pytest.mark.slow
 def test_rectangle_factor_matches_the_closed_forms():
     """room_light.rectangle_irradiance_factor (Lambert's polygon formula, the twin of
     common.glsl's) against closed forms, 1e-9: a point over a rectangle's corner and over its
@@ -582,6 +589,7 @@ def test_room_corners_are_not_occluded_by_the_room():
 
 
 @pytest.mark.parametrize("fabric, light", [("safety-yellow", "UV-A"), ("lace-fwa", "sun:60")])
+@pytest.mark.slow
 def test_window_light_is_the_float64_sum_over_both_sides(gl, fabric, light):
     """room_lightmap.frag's window term against room_light.window_irradiance (float64 numpy)
     from the GPU's own captures (read back at their patch levels): the room side's patches in
@@ -689,6 +697,7 @@ def test_the_lobe_lands_whole_in_the_room():
         assert flux == pytest.approx(expected, rel=0.03), front_z
 
 
+@pytest.mark.slow
 def test_capture_alpha_is_the_key_on_the_nearest_cloth(gl):
     """The room capture's alpha (curtain.frag ROOM_CAPTURE), by which the directional lobe
     leaves each window patch: one sheet across the window, |cos_i| (the key's irradiance per
@@ -741,6 +750,7 @@ def test_sample_bilinear_is_gl_linear_with_clamp():
 
 
 @pytest.mark.parametrize("light", ["sun:60", "UV-A"])
+@pytest.mark.slow
 def test_room_side_grid_matches_float64_gather(gl, light):
     """Pass R4b (issue 11, fourth round): the room's irradiance on the curtain's room side,
     gathered on the GPU from the coarse patches' total irradiance, against its float64 twin
@@ -758,6 +768,7 @@ def test_room_side_grid_matches_float64_gather(gl, light):
     r.release()
 
 
+@pytest.mark.slow
 def test_room_side_replaces_the_stand_ins(gl):
     """With the room lit and the viewer inside, the curtain program drops the stand-ins (no fill
     light, the ambient's outside share alone, neither exciting the glow: scene.with_room_solved)
@@ -789,6 +800,7 @@ def test_room_side_replaces_the_stand_ins(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_the_window_outside_the_wall_is_lit_by_the_outside_and_the_key(gl):
     """The window's reveals and the wall's outer face lie outside the wall's inner plane, on the
     light's side of the cloth (issue 11, fourth round). Under a key 5 deg high square to the
@@ -848,6 +860,7 @@ def test_the_window_outside_the_wall_is_lit_by_the_outside_and_the_key(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_room_side_light_per_vertex_matches_its_numpy_evaluation(gl):
     """curtain.vert ROOM_SIDE reads the room's grid and the two captures per vertex (the light
     varies over 16 cm patches; the curtain's vertices are 2-3 cm apart): at the G-buffer's
@@ -883,6 +896,7 @@ def test_room_side_light_per_vertex_matches_its_numpy_evaluation(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_wall_light_per_vertex_matches_its_numpy_evaluation(gl):
     """curtain.vert WALL_LIGHT (issue 11, fifth round): what the window wall and its reveals
     show the cloth's window side, per vertex (the walled hemisphere from the room update's
@@ -918,6 +932,7 @@ def test_wall_light_per_vertex_matches_its_numpy_evaluation(gl):
     r.release()
 
 
+@pytest.mark.slow
 def test_the_cloth_sees_the_window_wall_as_the_viewer_does(gl):
     """room_light.wall_radiance_along (common.glsl's twin; what WALL_LIGHT gives the cloth's
     window side) against the frame's own room pass (room.frag: the light map on the window
@@ -1075,6 +1090,7 @@ def test_capture_eye_weights_blend_the_three_eyes_by_angle():
     assert np.abs(near[0] - near[1]).max() < 1e-5
 
 
+@pytest.mark.slow
 def test_the_captures_see_the_folds_behind_through_the_holes(gl):
     """curtain.frag FOLDS_BEHIND (issue 11, sixth round): the room's captures show, through
     the cloth's holes (LD), the folds behind where the occlusion maps say a fold hides the
@@ -1111,6 +1127,7 @@ def test_the_captures_see_the_folds_behind_through_the_holes(gl):
 
 
 @pytest.mark.parametrize("elevation_deg, azimuth_deg", [(25.0, 15.0), (55.0, -30.0)])
+@pytest.mark.slow
 def test_the_beams_flux_into_the_room_is_the_sheets_shadow_integrated(gl, elevation_deg, azimuth_deg):
     """The beam the light map carries for the bounces (room_lightmap.frag, issue 11's sixth
     round: the mean over BEAM_SAMPLES^2 points of a texel, the shadow map read at their

@@ -149,6 +149,7 @@ def test_spectral_sky_agrees_with_the_rgb_sky_in_colour():
 
 
 @pytest.mark.parametrize("n_bands", [16])
+@pytest.mark.slow
 def test_band_frame_sky_is_the_band_integral_of_the_spectral_sky(gl, n_bands):
     """In 6/9/16 bands the sky behind the window follows the bands: every pixel through the
     opening equals the numpy reference -- the spectral sky L(l, d) of each pixel's ray on the

@@ -67,6 +67,7 @@ def test_brightened_lace_under_noon_sun_turns_blue(gl, make_preset, mode, capsys
     assert on8[2] - off8[2] > 3.0                 # visible on the display (8-bit levels)
 
 
+@pytest.mark.slow
 def test_fabric_without_brightener_renders_identically(gl, make_preset):
     plain = make_preset("plain", fluorescent=False)
     off, off8, _, _ = _lit_cloth_mean(gl, plain, "off", hour=12.0)

@@ -398,6 +398,7 @@ def test_bad_dates_and_places_are_refused(bad, pattern):
 # ------------------------------------------------------------------ CLI
 
 
+@pytest.mark.slow
 def test_cli_sun_plot_and_json(tmp_path, capsys):
     from catalog.commands.cli import main
 

@@ -270,6 +270,7 @@ def test_committed_benchmark_choice_is_the_model_the_renderer_carries():
 # ---------------------------------------------------------------------------- picture
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_violet_lamp_shows_the_brightened_lace_glow(gl, record_figure):
     """Under LED-405 the brightened lace is bluer than a plain white voile (mean B of the
     cloth at least 1.2x) and the plain voile is not clipped (mean B below 250 of 255)."""

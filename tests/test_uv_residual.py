@@ -282,6 +282,7 @@ def test_renderer_carries_bands_plus_residual_under_the_key(tmp_path):
 # ------------------------------------------------------------------ with the real data
 
 @needs_matrices
+@pytest.mark.slow
 def test_real_matrices_residual_model_meets_the_bounds_on_test_lights():
     """The chosen model on the 8 matrices x the issue's 8 test lights: mean Delta E 2000
     <= 1.5 (the issue's bound; bench 0.07) and every case below 1.0 (bench max 0.57); the

@@ -473,13 +473,17 @@ def test_broken_preset_shows_an_error_and_the_others_render(xdisplay, tmp_path):
     broken = broken.replace("g_spec = ", "g_spec = 1.5 # was ", 1)
     (fabrics / "aaa-broken.toml").write_text(broken)  # sorts first: the viewer must skip it
     out = tmp_path / "shot.png"
-    result = _catalog(["view", *QUICK, "--fabric-dir", str(fabrics), "--frames", "4",
+    result = _catalog(["view", *QUICK, "--fabrics", str(fabrics), "--frames", "4",
                        "--screenshot", str(out), "--stats", "--paused"], xdisplay, tmp_path)
     assert result.returncode == 0, result.stderr
     first = _stats_records(result.stdout)[0]
     errors = first["panel_errors"]
     assert len(errors) == 1 and "aaa-broken.toml" in errors[0] and "btdf.g_spec" in errors[0]
-    assert first["fabric"] == LACE  # the first usable preset, not the broken one
+    # the first usable preset of the search path (the folder's, then the built-in ones),
+    # not the broken one
+    usable = sorted({p.stem for p in fabrics.glob("*.toml")} - {"aaa-broken"}
+                    | {p.stem for p in FABRIC_DIR.glob("*.toml")})
+    assert first["fabric"] == usable[0]
     image = _read_image(out)
     panel = image[:, :200]
     # the error is written in the panel in its red (1.0, 0.42, 0.35)
@@ -494,7 +498,7 @@ def test_broken_preset_on_the_command_line_is_refused(xdisplay, tmp_path):
     fabrics = tmp_path / "fabrics"
     _copy_fabrics(fabrics, [VOILE])
     (fabrics / "bad.toml").write_text('schema = 1\nname = "bad"\n')
-    result = _catalog(["view", *QUICK, "--fabric-dir", str(fabrics), "--fabric", "bad",
+    result = _catalog(["view", *QUICK, "--fabrics", str(fabrics), "--fabric", "bad",
                        "--frames", "2", "--screenshot", str(tmp_path / "x.png")],
                       xdisplay, tmp_path, timeout=60)
     assert result.returncode == 2
@@ -512,7 +516,7 @@ def test_a_failed_frame_fails_a_frames_run(xdisplay, tmp_path):
     _copy_fabrics(fabrics, [VOILE])
     preset = fabrics / f"{VOILE}.toml"
     preset.write_text(preset.read_text() + '\n[dye]\ntransmittance = "no-such-dye.csv"\n')
-    result = _catalog(["view", *QUICK, "--fabric-dir", str(fabrics), "--fabric", VOILE,
+    result = _catalog(["view", *QUICK, "--fabrics", str(fabrics), "--fabric", VOILE,
                        "--frames", "2", "--screenshot", str(tmp_path / "x.png")],
                       xdisplay, tmp_path, timeout=120)
     assert result.returncode == 2, result.stderr
@@ -532,7 +536,7 @@ def test_preset_reloads_when_its_file_changes(xdisplay, tmp_path):
     _copy_fabrics(fabrics, [VOILE, LACE])
     path = fabrics / f"{VOILE}.toml"
     original = path.read_text()
-    viewer = Viewer(xdisplay, tmp_path, ["--fabric-dir", str(fabrics), "--fabric", VOILE,
+    viewer = Viewer(xdisplay, tmp_path, ["--fabrics", str(fabrics), "--fabric", VOILE,
                                          "--paused"])
     try:
         viewer.wait_title(VOILE)

@@ -181,6 +181,7 @@ def test_recording_context_refuses_what_the_page_cannot_replay(gl):
 
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_split_commands_keeps_every_uniform_value_in_order(gl):
     from catalog.render.frame import FrameRenderer
     from catalog.web.export import split_commands
@@ -221,16 +222,16 @@ def _run_web(*args, env=None):
 
 def test_unknown_fabric_one_line_exit_2_nothing_written(tmp_path):
     out = tmp_path / "site"
-    result = _run_web("--out", str(out), "--fabrics", "no-such-cloth")
+    result = _run_web("--out", str(out), "--fabric", "no-such-cloth")
     assert result.returncode == 2
     assert len(result.stderr.strip().splitlines()) == 1
-    assert "no-such-cloth" in result.stderr and "--fabrics" in result.stderr
+    assert "no-such-cloth" in result.stderr and "--fabric" in result.stderr
     assert list(tmp_path.iterdir()) == []
 
 
 def test_unknown_light_one_line_exit_2_nothing_written(tmp_path):
     out = tmp_path / "site"
-    result = _run_web("--out", str(out), "--fabrics", "voile-white", "--lights", "D65,D99")
+    result = _run_web("--out", str(out), "--fabric", "voile-white", "--lights", "D65,D99")
     assert result.returncode == 2
     assert len(result.stderr.strip().splitlines()) == 1
     assert "D99" in result.stderr and "--lights" in result.stderr
@@ -243,7 +244,7 @@ def test_unwritable_folder_one_line_exit_2(tmp_path):
     parent.mkdir()
     parent.chmod(stat.S_IRUSR | stat.S_IXUSR)
     try:
-        result = _run_web("--out", str(parent / "site"), "--fabrics", "voile-white")
+        result = _run_web("--out", str(parent / "site"), "--fabric", "voile-white")
     finally:
         parent.chmod(stat.S_IRWXU)
     assert result.returncode == 2
@@ -269,7 +270,7 @@ def test_foreign_folder_is_not_replaced(tmp_path):
     out = tmp_path / "photos"
     out.mkdir()
     (out / "holiday.jpg").write_bytes(b"x")
-    result = _run_web("--out", str(out), "--fabrics", "voile-white", "--lights", "D65")
+    result = _run_web("--out", str(out), "--fabric", "voile-white", "--lights", "D65")
     assert result.returncode == 2 and "not a catalog site" in result.stderr
     assert [p.name for p in out.iterdir()] == ["holiday.jpg"]
 

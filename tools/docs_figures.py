@@ -59,9 +59,51 @@ def module_tables(module, root: Path = ROOT) -> dict[str, str] | None:
             raise SystemExit(f"docs_figures: error: {source}: no such file (run the benchmark)")
         return json.loads(path.read_text(encoding="utf-8"))
 
-    made = make(load(one)) if one is not None else make({key: load(source)
-                                                         for key, source in several.items()})
-    return {name: text.rstrip("\n") for name, text in made.items()}
+    results = {source: load(source) for source in result_sources(module)}
+    made = make(results[one]) if one is not None else make({key: results[source]
+                                                           for key, source in several.items()})
+    note = provenance(results)
+    return {name: text.rstrip("\n") + (f"\n\n{note}" if _has_table(text) else "")
+            for name, text in made.items()}
+
+
+def _has_table(text: str) -> bool:
+    return any(line.lstrip().startswith("|") for line in text.splitlines())
+
+
+def _find(data, key: str):
+    """The first value of ``key`` anywhere in a JSON result (a run's machine may sit at the
+    top or inside each run)."""
+    if isinstance(data, dict):
+        if key in data:
+            return data[key]
+        for value in data.values():
+            found = _find(value, key)
+            if found is not None:
+                return found
+    elif isinstance(data, list):
+        for value in data:
+            found = _find(value, key)
+            if found is not None:
+                return found
+    return None
+
+
+def provenance(results: dict[str, dict]) -> str:
+    """One line under a table: the JSON it is made from, the commit and the machine it was
+    measured on (as the result recorded them: catalog.bench.results.machine_info)."""
+    parts = []
+    for source, result in results.items():
+        machine = _find(result, "machine")
+        machine = machine if isinstance(machine, dict) else {}
+        commit = machine.get("commit") or _find(result, "commit")
+        cores = machine.get("cpu_count") or machine.get("cpus")
+        renderer = machine.get("gl_renderer") or machine.get("renderer")
+        where = ", ".join(str(p) for p in (f"{cores} cores" if cores else None, renderer) if p)
+        parts.append(f"`{source}`: "
+                     + (f"commit `{commit}`" if commit else "commit not recorded")
+                     + (f", {where}" if where else ", machine not recorded"))
+    return "<sub>Measured: " + "; ".join(parts) + " (`make figures` measures again).</sub>"
 
 
 def tables(root: Path = ROOT) -> dict[str, str]:

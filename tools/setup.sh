@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Set up a fresh machine: Debian packages the renderer and the window tests need (only
 # those missing), a virtual environment in .venv, and the project installed editable with
-# every dependency group (all) and the test tools.
+# its optional extras (the path tracer, Dask) and the test tools.
 # Idempotent: a second run installs nothing new.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,7 +26,7 @@ fi
 PY=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PY" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e ".[all,test,pathtrace,batch${EXTRAS:+,$EXTRAS}]"
+.venv/bin/python -m pip install -q -e ".[test,pathtrace,batch${EXTRAS:+,$EXTRAS}]"
 # Node tools the tests use (tools/node/package.json: the Khronos glTF-Validator, three.js)
 if command -v npm >/dev/null 2>&1 && [ ! -d tools/node/node_modules/gltf-validator ]; then
   echo "setup: installing tools/node (npm)"

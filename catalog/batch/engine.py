@@ -23,7 +23,7 @@ from pathlib import Path
 
 from catalog.batch.manifest import Manifest
 from catalog.batch.spec import JobSpec
-from catalog.core.errors import CatalogError, InputError
+from catalog.core.errors import CatalogError, EnvironmentFailure, InputError
 
 #: Seconds between manifest rewrites during a run (the journal holds what comes between).
 MANIFEST_EVERY_S = 60.0
@@ -54,8 +54,9 @@ def check_engine(workers: int | None, scheduler: str | None) -> None:
                              field="--scheduler")
     if (workers is not None or scheduler is not None) and not dask_available():
         option = "--workers" if workers is not None else "--scheduler"
-        raise InputError("needs Dask distributed, which is not installed "
-                         "(pip install 'fabric-catalog[batch]')", field=option)
+        from catalog.core.extras import missing_message  # noqa: PLC0415
+
+        raise EnvironmentFailure(missing_message("distributed", option))
 
 
 def _run_process(tasks, retries, on_image, on_result) -> dict:
@@ -75,24 +76,6 @@ def _run_process(tasks, retries, on_image, on_result) -> dict:
                                        f"(after {retries} retries)"}
         on_result(task, result)
     return {"engine": "process", "workers": 1, "startup_s": 0.0}
-
-
-# ---------------------------------------------------------------------- progress
-def _progress_bar(enabled: bool):
-    from rich.console import Console  # noqa: PLC0415
-    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, ProgressColumn,  # noqa: PLC0415
-                               TextColumn, TimeElapsedColumn, TimeRemainingColumn)
-    from rich.text import Text  # noqa: PLC0415
-
-    class RateColumn(ProgressColumn):
-        def render(self, task):
-            speed = task.finished_speed or task.speed
-            return Text("  ?  img/s" if speed is None else f"{speed:5.1f} img/s")
-
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    RateColumn(), TimeElapsedColumn(), TextColumn("left"),
-                    TimeRemainingColumn(), console=Console(stderr=True),
-                    disable=not enabled, transient=False)
 
 
 # ---------------------------------------------------------------------- the job
@@ -128,13 +111,15 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
         lock = threading.Lock()
         last_write = [time.perf_counter()]
         use_dask = workers is not None or scheduler is not None
-        with _progress_bar(progress) as bar:
-            bar_task = bar.add_task("render-catalog", total=left)
+        from catalog.core.progress import progress as progress_bar  # noqa: PLC0415
+
+        with progress_bar("catalog render-catalog", total=left, unit="images",
+                          enabled=progress) as bar:
 
             def on_image(event):
                 with lock:
                     seen[event["fabric"]] = seen.get(event["fabric"], 0) + 1
-                bar.advance(bar_task)
+                bar.advance()
                 if "sha256" in event and not use_dask:  # in process: journal every image
                     manifest.add([event])
 
@@ -156,7 +141,7 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
                     missing = len(task.images) - seen.get(task.fabric, 0)
                     seen[task.fabric] = len(task.images)
                 if missing > 0:
-                    bar.advance(bar_task, missing)
+                    bar.advance(missing)
                 if time.perf_counter() - last_write[0] > MANIFEST_EVERY_S:
                     manifest.write(spec.describe())
                     last_write[0] = time.perf_counter()

@@ -161,7 +161,7 @@ class JobSpec:
         from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
         fabrics = split_list(fabrics if isinstance(fabrics, str) else ",".join(fabrics),
-                             "--fabrics")
+                             "--fabric")
         lights = split_list(lights if isinstance(lights, str) else ",".join(lights), "--lights")
         for light in lights:
             try:
@@ -208,10 +208,10 @@ class JobSpec:
             try:
                 path = find_preset(fabric)
             except InputError as exc:
-                raise InputError(exc.problem, path=exc.path, field="--fabrics") from None
+                raise InputError(exc.problem, path=exc.path, field="--fabric") from None
             if path.stem in stems:
                 raise InputError(f"{fabric!r} and {stems[path.stem]!r} are both called "
-                                 f"{path.stem!r}", field="--fabrics")
+                                 f"{path.stem!r}", field="--fabric")
             stems[path.stem] = fabric
             paths.append(str(path.resolve()))
             hashes.append(hashlib.sha256(path.read_bytes()).hexdigest())

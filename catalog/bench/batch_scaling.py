@@ -61,7 +61,7 @@ def _timed(cmd: list[str]) -> tuple[float, float, subprocess.CompletedProcess]:
 
 
 def _job_args(size: str, out: Path) -> list[str]:
-    return ["render-catalog", "--fabrics", ",".join(FABRICS), "--lights", ",".join(LIGHTS),
+    return ["render-catalog", "--fabric", ",".join(FABRICS), "--lights", ",".join(LIGHTS),
             "--frames", FRAMES, "--yaw", YAWS, "--size", size, "--out", str(out), "--json"]
 
 

@@ -166,12 +166,12 @@ def _option_cases() -> list[Case]:
           "--out", "{dir}/r.exr"), "--spp"),
         (("reference", "--fabric", "voile-white", "--variant", "cuda_rgb", "--size", "8x8",
           "--spp", "1", "--out", "{dir}/r.exr"), "--variant"),
-        (("render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--frames", "3:1",
+        (("render-catalog", "--fabric", "voile-white", "--lights", "D65", "--frames", "3:1",
           "--size", "8x8", "--format", "png", "--out", "{dir}/c"), "--frames"),
-        (("render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--frames", "0:1",
+        (("render-catalog", "--fabric", "voile-white", "--lights", "D65", "--frames", "0:1",
           "--size", "8x8", "--format", "tiff", "--out", "{dir}/c"), "--format"),
         (("web", "--lights", "D65,nope", "--out", "{dir}/site"), "nope"),
-        (("web", "--fabrics", "nope", "--out", "{dir}/site"), "nope"),
+        (("web", "--fabric", "nope", "--out", "{dir}/site"), "nope"),
     ]
     return [Case("options", " ".join(a for a in argv if not a.startswith("{dir}"))[:60], argv,
                  names=name) for argv, name in rows]

@@ -497,26 +497,6 @@ def table(rows: list[dict], columns: list[str], headers: list[str]) -> str:
     return "\n".join(lines)
 
 
-def ranges_sentence(before: dict, after: dict) -> str:
-    """README's summary of the after-run over its scenes, with the floor and walls before."""
-    from catalog.bench.results import fmt  # noqa: PLC0415
-
-    def span(run: dict, *keys: str) -> str:
-        values = [r[k] for r in run["rows"] for k in keys if r.get(k) is not None]
-        return f"{fmt(min(values))}-{fmt(max(values))}"
-
-    s = after["summary"]
-    speed = [r["speedup"] for r in after["rows"]]
-    return (f"Over {s['scenes']} scenes mean FLIP is {span(after, 'mean_flip')} and the curtain's "
-            f"mean Delta E 2000 {span(after, 'curtain_delta_e_mean')} (goal: <= "
-            f"{GOAL['mean_flip_at_most']} and <= {GOAL['curtain_mean_delta_e_at_most']} on every "
-            f"scene: met on {s['scenes_meeting_goal']}); the floor's and walls' mean error went from "
-            f"{span(before, 'floor_delta_e_mean', 'walls_delta_e_mean')} before the room lighting of "
-            f"issue 13 to {span(after, 'floor_delta_e_mean', 'walls_delta_e_mean')}. The frame is "
-            f"{min(speed):,.0f}-{max(speed):,.0f}x faster than the reference (goal >= "
-            f"{GOAL['speedup_at_least']:g}x: {'met' if min(speed) >= GOAL['speedup_at_least'] else 'NOT met'}).")
-
-
 def summary_line(result: dict) -> str:
     """One sentence of a run's ranges (for the README and BENCHMARKS.md)."""
     rows = result["rows"]
@@ -538,72 +518,61 @@ def _flip4(value) -> str:
     return "-" if value is None else f"{value:.4f}"
 
 
-def round_changes(before: dict, after: dict) -> str:
-    """Per scene: mean FLIP and curtain dE mean before -> after, and whether the goal is met
-    (where the after-run shows the reference through the frame's display step, also its FLIP
-    by the before-run's measure, the reference without the glare)."""
-    glare = any("mean_flip_no_glare" in r for r in after["rows"]) and not any(
-        "mean_flip_no_glare" in r for r in before["rows"])
-    extra = " after, reference without the glare |" if glare else ""
-    lines = ["| scene | mean FLIP before | after |" + extra
-             + " curtain dE before | after | goal met after |",
-             "|---|---|---|" + ("---|" if glare else "") + "---|---|---|"]
-    earlier = {r["scene"]: r for r in before["rows"]}
-    for row in after["rows"]:
-        old = earlier.get(row["scene"], {})
-        same = f" {_flip4(row.get('mean_flip_no_glare'))} |" if glare else ""
-        # FLIP to 4 places: the goal's bound is 0.10, and 3 significant digits round 0.1001 to it
-        lines.append(f"| {row['scene']} | {_flip4(old.get('mean_flip'))} | {_flip4(row['mean_flip'])} |{same} "
-                     f"{_cell(old.get('curtain_delta_e_mean'))} | {_cell(row['curtain_delta_e_mean'])} | "
-                     f"{_cell(row['meets_goal'])} |")
+#: The committed runs in the order they were measured, each with what changed before it (the
+#: history of each change is in git: docs/pathtrace.md as of the run's commit).
+RUNS = (
+    ("baseline", "the first frame: static drape, no pattern, no room light, no shadows"),
+    ("after_12_16", "patterns, the settled drape, the display step, the room lit through the "
+                    "curtain, the clear sky"),
+    ("after_11", "issue 11: the key's shadows, the room's bounces, the curtain's glow in the room"),
+    (ROUND_2, "the reference's glow, the room's bounces, the fold shadows' bias"),
+    (ROUND_3, "the curtain's window side, exact form factors, the lobe spread; 2048 spp"),
+    (ROUND_4, "the curtain's room side from the room's solved light"),
+    (ROUND_5, "the window wall and reveals light the cloth; the reference shown with the "
+              "frame's glare"),
+    (ROUND_6, "the room's window captured from three eyes, the folds behind through the holes"),
+    (ROUND_7, "a spectral reference; the room's light through the lit cloth's own dye; two "
+              "layers' key shadow"),
+    (ROUND_7B, "each scene's reference in the variant it needs"),
+    (ROUND_8, "the pattern's mip level by a pixel box's variance; the lamp's outside in its "
+              "own spectrum"),
+    (ROUND_9, "the room sees the curtain through a box around its folds"),
+)
+
+
+def rounds_table(runs: dict) -> str:
+    """One row per committed run: what changed, the worst scene's FLIP and curtain Delta E,
+    how many scenes meet the goal."""
+    lines = ["| run | what changed before it | reference spp | worst mean FLIP | worst curtain dE "
+             "mean | scenes meeting the goal |", "|---|---|---|---|---|---|"]
+    for name, change in RUNS:
+        if name not in runs:
+            continue
+        run = runs[name]
+        rows = run["rows"]
+        des = [r["curtain_delta_e_mean"] for r in rows if r["curtain_delta_e_mean"] is not None]
+        lines.append(f"| `{name}` | {change} | {run['settings']['spp']} | "
+                     f"{_flip4(max(r['mean_flip'] for r in rows))} | {_cell(max(des))} | "
+                     f"{run['summary']['scenes_meeting_goal']} of {run['summary']['scenes']} |")
     return "\n".join(lines)
 
 
-def _round_blocks(runs: dict, name: str, ordinal: str, previous: str) -> dict[str, str]:
-    """The blocks of one of issue 11's later rounds (``runs[name]``, named
-    ``image-after-11-round-N``): its table, options and images, its summary line, and its
-    changes against ``runs[previous]``."""
-    run = runs[name]
-    latest = markdown_tables(run)
-    prefix = "image-after-11-round-" + name.rsplit("_", 1)[-1]
-    return {
-        prefix: (latest["image"] + "\n\nReal-time options against the same references:\n\n"
-                 + latest["image-options"]
-                 + f"\n\n![six scenes after issue 11's {ordinal} round: real-time | reference | FLIP]"
-                 f"(img/pathtrace_scenes_{name}.png)\n\n"
-                 f"![real-time options against the reference](img/pathtrace_pareto_{name}.png)"),
-        prefix + "-summary": summary_line(run),
-        prefix + "-changes": round_changes(runs[previous], run),
-    }
-
-
 def markdown_tables(result: dict) -> dict[str, str]:
-    """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run; of the
-    committed JSON (``{"runs": {...}}``) the baseline's, and ``image-after`` the run after
-    issues 12-16 (its table, its options and its error maps)."""
+    """Generated blocks: ``image`` (per scene) and ``image-options`` of one bench run. Of the
+    committed JSON (``{"runs": {...}}``): those of the latest run, its ``image-summary``, and
+    ``image-rounds``, one row per run."""
     if "runs" in result:
-        blocks = markdown_tables(result["runs"]["baseline"])
-        after = markdown_tables(result["runs"]["after_12_16"])
-        blocks["image-after"] = (after["image"] + "\n\nReal-time options:\n\n" + after["image-options"]
-                                 + "\n\n![six scenes after issues 12-16: real-time | reference | FLIP]"
-                                 "(img/pathtrace_scenes_after_13.png)")
-        blocks["image-ranges"] = ranges_sentence(result["runs"]["baseline"], result["runs"]["after_12_16"])
-        if "after_11" in result["runs"]:
-            run = result["runs"]["after_11"]
-            latest = markdown_tables(run)
-            blocks["image-after-11"] = (
-                latest["image"] + "\n\nReal-time options (issue 11's terms switched off one at a time "
-                "against the same references):\n\n" + latest["image-options"]
-                + "\n\n![six scenes after issue 11's fixes: real-time | reference | FLIP]"
-                "(img/pathtrace_scenes_after_11.png)")
-            blocks["image-after-11-summary"] = summary_line(run)
-        for name, ordinal, previous in ((ROUND_2, "second", "after_11"), (ROUND_3, "third", ROUND_2),
-                                        (ROUND_4, "fourth", ROUND_3), (ROUND_5, "fifth", ROUND_4),
-                                        (ROUND_6, "sixth", ROUND_5), (ROUND_7, "seventh", ROUND_6),
-                                        (ROUND_7B, "seventh (each scene's variant)", ROUND_6),
-                                        (ROUND_8, "eighth", ROUND_7B), (ROUND_9, "ninth", ROUND_8)):
-            if name in result["runs"]:
-                blocks.update(_round_blocks(result["runs"], name, ordinal, previous))
+        runs = result["runs"]
+        order = [name for name, _ in RUNS if name in runs]
+        latest = order[-1]
+        blocks = markdown_tables(runs[latest])
+        blocks.pop("image-options-by-scene")  # in the JSON and catalog bench's report
+        blocks["image"] += (f"\n\n![six scenes, run `{latest}`: real-time | reference | FLIP]"
+                            f"(img/pathtrace_scenes_{latest}.png)")
+        blocks["image-options"] += (f"\n\n![real-time options against the reference]"
+                                    f"(img/pathtrace_pareto_{latest}.png)")
+        blocks["image-summary"] = f"Run `{latest}`: " + summary_line(runs[latest])
+        blocks["image-rounds"] = rounds_table(runs)
         return blocks
 
     s = result["summary"]
@@ -635,13 +604,13 @@ def markdown_tables(result: dict) -> dict[str, str]:
                                              "frame_ms", "pareto"],
                     ["real-time option", "mean FLIP (mean over scenes)",
                      "curtain dE mean (mean over scenes)", "frame ms (median)", "on the Pareto front"])
-    options += "\n\n" + table(option_rows, ["scene", "option", "mean_flip", "curtain_mean_delta_e",
-                                            "frame_ms"],
-                               ["scene", "real-time option", "mean FLIP", "curtain dE mean", "frame ms"])
+    by_scene = table(option_rows, ["scene", "option", "mean_flip", "curtain_mean_delta_e",
+                                   "frame_ms"],
+                     ["scene", "real-time option", "mean FLIP", "curtain dE mean", "frame ms"])
     if s.get("absent_options"):
         options += (f"\n\nNot yet in the frame (measured when they land): "
                     f"{', '.join(s['absent_options'])}.")
-    return {"image": per_scene, "image-options": options}
+    return {"image": per_scene, "image-options": options, "image-options-by-scene": by_scene}
 
 
 

@@ -73,7 +73,8 @@ def image_md(result: dict) -> str:
     from catalog.bench.image import markdown_tables  # noqa: PLC0415
 
     blocks = markdown_tables(result)
-    return blocks["image"] + "\n\nReal-time options (image-pareto.png):\n\n" + blocks["image-options"]
+    return (blocks["image"] + "\n\nReal-time options (image-pareto.png):\n\n"
+            + blocks["image-options"] + "\n\n" + blocks["image-options-by-scene"])
 
 
 def uv_md(section: dict) -> str:

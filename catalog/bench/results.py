@@ -38,12 +38,31 @@ def machine_info(ctx=None) -> dict:
 
     machine = {"cpu_count": os.cpu_count(), "platform": platform.platform(),
                "python": platform.python_version(),
-               "load_average_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
+               "load_average_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
+               "commit": source_commit()}
     if ctx is not None:
         from catalog.gl.context import describe  # noqa: PLC0415
 
         machine["gl_renderer"] = describe(ctx)["renderer"]
     return machine
+
+
+def source_commit() -> str | None:
+    """The checkout's commit the measurement runs on (``+dirty`` when files differ from it;
+    None outside a git checkout): the tables name it (tools/docs_figures.py)."""
+    import subprocess  # noqa: PLC0415
+
+    root = Path(__file__).resolve().parents[2]
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short=10", "HEAD"], cwd=root,
+                              capture_output=True, text=True, timeout=10)
+        if head.returncode != 0:
+            return None
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                               cwd=root, capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return head.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
 
 
 def section_main(name: str, argv: list[str] | None = None) -> int:

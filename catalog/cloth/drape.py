@@ -69,8 +69,9 @@ def rod_centre_x_m(params: ClothParams) -> float:
     return -0.5 * params.width_m + 0.5 * params.width_m * params.opening
 
 
-@functools.lru_cache(maxsize=16)
-def _settled(params: ClothParams, frames: int):
+def settle(params: ClothParams, frames: int):
+    """Hang ``params`` without wind for ``frames`` frames from the rest pose (the numpy
+    cloth; velocities zeroed): the computation the caches keep."""
     from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
 
     still = params.with_changes(wind_speed_m_s=0.0)
@@ -81,9 +82,22 @@ def _settled(params: ClothParams, frames: int):
     return state
 
 
+@functools.lru_cache(maxsize=16)
+def _settled(params: ClothParams, frames: int):
+    from catalog.cloth import drape_cache  # noqa: PLC0415
+
+    key = drape_cache.drape_key(params, frames, FRAME_DT_S)
+    state = drape_cache.load(key, params)
+    if state is None:
+        state = settle(params, frames)
+        drape_cache.store(key, state)
+    return state
+
+
 def settled_state(params: ClothParams, frames: int = SETTLE_FRAMES):
     """The cloth after hanging ``frames`` frames without wind from the rest pose (a copy;
-    computed once per parameter set in a process)."""
+    computed once per parameter set and solver, then read from the user's cache folder:
+    catalog.cloth.drape_cache)."""
     return _settled(params, int(frames)).copy()
 
 

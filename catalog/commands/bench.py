@@ -46,13 +46,10 @@ def parse_sections(text: str | None) -> list[str]:
 
 
 def run(args) -> int:
-    import importlib  # noqa: PLC0415
     import sys  # noqa: PLC0415
     import time  # noqa: PLC0415
-    import traceback  # noqa: PLC0415
     from pathlib import Path  # noqa: PLC0415
 
-    from catalog.bench import SECTIONS  # noqa: PLC0415
     from catalog.bench.report import write_report  # noqa: PLC0415
     from catalog.bench.results import GL_SECTIONS, machine_info  # noqa: PLC0415
     from catalog.core.errors import InputError  # noqa: PLC0415
@@ -83,22 +80,13 @@ def run(args) -> int:
               "sections": {}, "failed": {}}
     start_all = time.perf_counter()
     plotters = {}
-    for name in names:
-        module = importlib.import_module(SECTIONS[name])
-        say(f"{name} ...")
-        start = time.perf_counter()
-        try:
-            result = module.run(quick=bool(args.quick), ctx=ctx)
-        except Exception as exc:  # noqa: BLE001 - one broken section must not lose the others
-            report["failed"][name] = f"{type(exc).__name__}: {exc}"
-            say(f"{name} FAILED: {type(exc).__name__}: {exc}")
-            traceback.print_exc(file=sys.stderr)
-            continue
-        result["seconds"] = time.perf_counter() - start
-        report["sections"][name] = result
-        if hasattr(module, "plot"):
-            plotters[name] = module.plot
-        say(f"{name} done in {result['seconds']:.1f} s")
+    from catalog.core.progress import progress  # noqa: PLC0415
+
+    with progress("catalog bench", total=len(names), unit="sections",
+                  enabled=not args.json) as bar:
+        for name in names:
+            _run_section(name, args, ctx, report, plotters, say)
+            bar.advance()
     report["total_seconds"] = time.perf_counter() - start_all
     written = write_report(report, out, plotters)
     report["written"] = [str(p) for p in written]
@@ -110,3 +98,29 @@ def run(args) -> int:
     else:
         print((out / "bench.md").read_text(encoding="utf-8"))
     return 1 if report["failed"] else 0
+
+
+def _run_section(name, args, ctx, report, plotters, say) -> None:
+    """One section into ``report`` (a failure is recorded; the others still run)."""
+    import importlib  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+    import time  # noqa: PLC0415
+    import traceback  # noqa: PLC0415
+
+    from catalog.bench import SECTIONS  # noqa: PLC0415
+
+    module = importlib.import_module(SECTIONS[name])
+    say(f"{name} ...")
+    start = time.perf_counter()
+    try:
+        result = module.run(quick=bool(args.quick), ctx=ctx)
+    except Exception as exc:  # noqa: BLE001 - one broken section must not lose the others
+        report["failed"][name] = f"{type(exc).__name__}: {exc}"
+        say(f"{name} FAILED: {type(exc).__name__}: {exc}")
+        traceback.print_exc(file=sys.stderr)
+        return
+    result["seconds"] = time.perf_counter() - start
+    report["sections"][name] = result
+    if hasattr(module, "plot"):
+        plotters[name] = module.plot
+    say(f"{name} done in {result['seconds']:.1f} s")

@@ -14,7 +14,8 @@ Command modules import nothing heavy at module level, so ``catalog --help`` stay
 Exit status: 0 done; 2 a refused input (:class:`catalog.core.errors.CatalogError`: one line
 on stderr naming the file, field or option); 3 an environment failure
 (:class:`catalog.core.errors.EnvironmentFailure`: no EGL device or display, a missing
-shader); 130 interrupted. With ``--json`` an error is also one JSON object on stdout,
+shader, an optional package not installed: one line naming the extra to install,
+:mod:`catalog.core.extras`); 130 interrupted. With ``--json`` an error is also one JSON object on stdout,
 ``{"error": MESSAGE, "exit_code": N}``.
 """
 
@@ -28,7 +29,7 @@ from pathlib import Path
 
 from catalog import __version__
 from catalog.core.errors import CatalogError
-from catalog.core.resources import DATA_ENV, FABRICS_ENV, use_data, use_fabrics
+from catalog.core.resources import DATA_ENV, use_data, use_fabrics
 
 #: Subcommand name -> module. Order is the order shown by ``catalog --help``.
 COMMANDS: dict[str, str] = {
@@ -70,6 +71,29 @@ class CommandLineError(CatalogError):
         super().__init__(message)
 
 
+class DefaultsHelpFormatter(argparse.HelpFormatter):
+    """--help states every option's default: ``(default: X)`` after the help, unless the
+    help already says it or there is none to state (a flag, an option left out)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        default = action.default
+        if (not action.option_strings or default is None or default is False
+                or default is argparse.SUPPRESS or "default" in text.lower()
+                or isinstance(action, (argparse._HelpAction, argparse._VersionAction))):
+            return text
+        return f"{text} (default: {format_default(default)})"
+
+
+def format_default(value) -> str:
+    """An option's default as one would type it: (1280, 720) -> 1280x720, a Path as text."""
+    if isinstance(value, tuple) and len(value) == 2 and all(isinstance(v, int) for v in value):
+        return f"{value[0]}x{value[1]}"
+    if isinstance(value, (list, tuple)):
+        return ",".join(str(v) for v in value)
+    return str(value).replace("%", "%%")
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse, but a refused option is one line (no usage block) and, with ``--json``,
     one JSON object like every other refusal: :meth:`error` raises instead of exiting."""
@@ -87,14 +111,14 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True,
                                 parser_class=_Parser)
     for name, module in _available_commands().items():
-        command_parser = sub.add_parser(name, help=module.HELP, description=module.HELP)
+        command_parser = sub.add_parser(name, help=module.HELP, description=module.HELP,
+                                        formatter_class=DefaultsHelpFormatter)
         module.add_arguments(command_parser)
         resources = getattr(module, "RESOURCES", ())
         if "fabrics" in resources and "--fabrics" not in command_parser._option_string_actions:
-            command_parser.add_argument(
-                "--fabrics", metavar="DIR", action="append", type=Path,
-                help="a folder of your own fabric presets, searched before the built-in "
-                     f"catalog (repeatable; default ${FABRICS_ENV})")
+            from catalog.core.fabricargs import add_fabric_folders  # noqa: PLC0415
+
+            add_fabric_folders(command_parser)
         if "data" in resources:
             command_parser.add_argument(
                 "--data", metavar="DIR", type=Path,
@@ -165,7 +189,7 @@ def main(argv: list[str] | None = None) -> int:
     install_signal_handlers()
     try:
         if getattr(args, "fabrics", None) and isinstance(args.fabrics, list):
-            use_fabrics(args.fabrics)  # a command's own --fabrics (sheet's list) handles itself
+            use_fabrics(args.fabrics)  # --fabrics DIR, every command (catalog.core.fabricargs)
         if getattr(args, "data", None) is not None:
             use_data(args.data)
         check_outputs(args._module, args)
@@ -183,6 +207,11 @@ def main(argv: list[str] | None = None) -> int:
         return _report(args, exc)
     except BrokenPipeError:
         return _report(args, OutputError("stdout", "closed"))
+    except ModuleNotFoundError as exc:
+        # an optional package (or a broken installation): one line naming the extra, exit 3
+        from catalog.core.extras import failure_for  # noqa: PLC0415
+
+        return _report(args, failure_for(exc, f"catalog {args.command}"))
     except OSError as exc:
         # an OS error no writer turned into a message (the output layer does for its own
         # files): still one line, naming the path where the OS gave one

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from catalog.core.constants import FLUORESCENT_MODES
 
+RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 INPUT_FILES = ("fabric",)
 OUTPUT_FILES = ("out",)

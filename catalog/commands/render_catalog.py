@@ -18,13 +18,16 @@ EXIT_PARTIAL = 3
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("--fabrics", required=True, help="comma-separated preset names or .toml paths")
-    parser.add_argument("--lights", required=True, help="comma-separated light names (D65,A,LED-B4,sun:22,...)")
+    from catalog.core.fabricargs import CATALOG_LIGHTS, add_fabric_options  # noqa: PLC0415
+
+    add_fabric_options(parser, many=True, legacy_list=True)
+    parser.add_argument("--lights", default=CATALOG_LIGHTS, metavar="NAME[,NAME..]",
+                        help="comma-separated light names (`catalog lights`)")
     parser.add_argument("--frames", default="0:1",
                         help="START:STOP[:STEP] as a Python slice, STOP excluded (0: the settled "
-                             "drape, N: the cloth after N steps of 1/60 s); default 0:1")
+                             "drape, N: the cloth after N steps of 1/60 s)")
     parser.add_argument("--yaw", default=None,
-                        help="camera yaw angles in deg: 0,90,180 or START:STOP:STEP (default 0)")
+                        help="camera yaw angles in deg: 0,90,180 or START:STOP:STEP (default: 0)")
     parser.add_argument("--size", default="320x240", help="WIDTHxHEIGHT of each image")
     parser.add_argument("--format", default="png", help="png (display sRGB) or exr (linear)")
     parser.add_argument("--out", required=True, help="output folder (images, manifest.json)")
@@ -36,7 +39,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--lp-threads", type=int, default=None,
                         help="llvmpipe threads per Dask worker (default: cores / workers per host)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
-    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical")
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
+                        help="fluorescence model")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3, 6, 9, 16")
     parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
     parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")
@@ -55,14 +59,20 @@ def run(args) -> int:
     check_engine(args.workers, args.scheduler)
     if args.lp_threads is not None and args.lp_threads < 1:
         raise InputError(f"{args.lp_threads} must be >= 1", field="--lp-threads")
+    if args.fabric is None:  # left out: every fabric on the search path
+        from catalog.presets import list_presets  # noqa: PLC0415
+
+        fabrics = [str(path) for path in list_presets()]
+    else:
+        fabrics = args.fabric
     spec = JobSpec.create(
-        fabrics=args.fabrics, lights=args.lights, frames=args.frames, yaws=args.yaw,
+        fabrics=fabrics, lights=args.lights, frames=args.frames, yaws=args.yaw,
         size=args.size, image_format=args.format, out_dir=args.out,
         fluorescence="off" if args.no_fluorescence else args.mode, bands=args.bands,
         pitch_deg=args.pitch, distance_m=args.distance, exposure=args.exposure)
     summary = render_catalog(spec, workers=args.workers, scheduler=args.scheduler,
                              retries=args.retries, lp_threads=args.lp_threads,
-                             progress=not (args.json or args.no_progress) and sys.stderr.isatty())
+                             progress=not (args.json or args.no_progress))
     if args.json:
         print_json(summary)
     else:

@@ -5,23 +5,23 @@ from __future__ import annotations
 from catalog.commands.displayargs import add_display_arguments, display_choices
 from catalog.core.constants import FLUORESCENT_MODES
 
-RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
 HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("--lights", required=True, help="comma-separated light names, e.g. D65,A,LED-B4,sun:22")
+    from catalog.core.fabricargs import CATALOG_LIGHTS, add_fabric_options  # noqa: PLC0415
+
+    parser.add_argument("--lights", default=CATALOG_LIGHTS, metavar="NAME[,NAME..]",
+                        help="comma-separated light names (`catalog lights`)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--size", default="320x240", help="WIDTHxHEIGHT of each image")
-    parser.add_argument("--fabrics", default=None,
-                        help="comma-separated preset names, .toml paths or folders of your own "
-                             "presets (a folder is searched before the built-in catalog; default: "
-                             "every preset, $CATALOG_FABRICS first)")
+    add_fabric_options(parser, many=True, legacy_list=True)
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
-    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical")
-    parser.add_argument("--bands", type=int, default=3)
+    parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
+                        help="fluorescence model")
+    parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3, 6, 9, 16")
     add_display_arguments(parser)
     parser.add_argument("--no-labels", action="store_true",
                         help="grid without the fabric (row) and light (column) labels")
@@ -41,10 +41,7 @@ def run(args) -> int:
     if any(not name for name in names) and any(names):
         raise InputError(f"{args.lights!r}: an empty light name between commas", field="--lights")
     lights = [name for name in names if name]
-    from catalog.core.cliargs import fabric_list  # noqa: PLC0415
-
-    fabrics = fabric_list(args.fabrics)  # folders join the search path, names select
-    report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=fabrics,
+    report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=args.fabric,
                           fluorescence="off" if args.no_fluorescence else args.mode,
                           bands=args.bands, progress=not args.json, ev=ev,
                           white_balance=white_balance, labels=not args.no_labels)

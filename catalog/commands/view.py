@@ -91,8 +91,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --compare: the right half's fluorescence mode (default: "
                         "the left's); --compare NAME --fabric NAME shows one fabric on | off")
     add_display_arguments(parser)
-    parser.add_argument("--fabric-dir", type=Path, metavar="DIR",
-                        help="folder of presets (default: the catalog's fabrics/)")
+    from catalog.core.fabricargs import add_fabric_dir_alias, add_fabric_folders  # noqa: PLC0415
+
+    add_fabric_folders(parser)
+    add_fabric_dir_alias(parser)
 
 
 def _forbid_scipy() -> None:
@@ -132,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
         raise NoDisplayError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
                              + NO_DISPLAY_HINT)
     init_glfw()  # a named display that cannot be opened: the same one line, exit 2
-    fabric, fabric_dir = args.fabric, args.fabric_dir
+    fabric, fabric_dir = args.fabric, None  # --fabrics DIR: on the search path (cli)
     if fabric is not None and fabric.endswith(".toml"):  # a preset file: browse its folder
         path = Path(fabric)
         if not path.is_file():

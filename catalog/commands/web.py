@@ -11,9 +11,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", required=True,
                         help="folder of the site (DIR/index.html); built beside it and renamed "
                              "when complete; replaces only an earlier site or an empty folder")
-    parser.add_argument("--fabrics", default=None,
-                        help="comma-separated preset names (default: every preset in fabrics/)")
-    parser.add_argument("--lights", default=None,
+    from catalog.core.fabricargs import add_fabric_options  # noqa: PLC0415
+
+    add_fabric_options(parser, many=True, legacy_list=True)
+    parser.add_argument("--lights", default=None, metavar="NAME[,NAME..]",
                         help="comma-separated lamps of the light library, and 'sun-by-hour' for "
                              "the sun slider (default: D65,A,FL2,LED-B4,LED-warm,UV-A,sun-by-hour)")
     parser.add_argument("--json", action="store_true", help="print the report as one JSON object")
@@ -23,7 +24,8 @@ def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.web.site import build_site  # noqa: PLC0415
 
-    report = build_site(args.out, fabrics=args.fabrics, lights=args.lights)
+    fabrics = None if args.fabric is None else ",".join(args.fabric)
+    report = build_site(args.out, fabrics=fabrics, lights=args.lights, progress=not args.json)
     if args.json:
         print_json(report)
     else:

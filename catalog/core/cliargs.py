@@ -60,20 +60,3 @@ def number_type(low: float, high: float, *, unit: str = "", low_open: bool = Fal
         return value
     return parse
 
-
-def fabric_list(text: str | None) -> list[str] | None:
-    """``--fabrics A,B,DIR``: preset names or .toml paths, and folders of the user's own
-    presets. The folders go first on the fabric search path (before the built-in catalog,
-    :func:`catalog.core.resources.use_fabrics`); the names and paths are returned, or None
-    (every preset on the search path) when only folders, or nothing, were given."""
-    from pathlib import Path  # noqa: PLC0415
-
-    from catalog.core.resources import use_fabrics  # noqa: PLC0415
-
-    if text is None:
-        return None
-    items = [item.strip() for item in str(text).split(",") if item.strip()]
-    folders = [item for item in items if Path(item).is_dir()]
-    if folders:
-        use_fabrics(folders)
-    return [item for item in items if item not in folders] or None

@@ -65,11 +65,9 @@ def load_mitsuba(variant: str = DEFAULT_VARIANT):
             f"no LLVM >= {MIN_LLVM_MAJOR} library found for Mitsuba's JIT: install libllvm19 "
             "(tools/setup.sh) or set DRJIT_LIBLLVM_PATH to libLLVM-19.so")
     os.environ["DRJIT_LIBLLVM_PATH"] = library
-    try:
-        import mitsuba as mi  # noqa: PLC0415
-    except ImportError as exc:
-        raise EnvironmentFailure(f"Mitsuba 3 is not installed ({exc}); run tools/setup.sh "
-                                 "(it installs the 'pathtrace' extra)") from None
+    from catalog.core.extras import require  # noqa: PLC0415
+
+    mi = require("mitsuba", "the path-traced reference")
     try:
         mi.set_variant(variant)
     except (ImportError, AttributeError, RuntimeError) as exc:

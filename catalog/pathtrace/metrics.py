@@ -36,7 +36,9 @@ def display(linear: np.ndarray, exposure: float, white_balance=None) -> np.ndarr
 
 def flip_map(test_display: np.ndarray, reference_display: np.ndarray) -> np.ndarray:
     """Per-pixel LDR-FLIP (H, W) in [0, 1] of two display images in [0, 1]."""
-    import flip_evaluator  # noqa: PLC0415
+    from catalog.core.extras import require  # noqa: PLC0415
+
+    flip_evaluator = require("flip_evaluator", "FLIP")
 
     error, _mean, _params = flip_evaluator.evaluate(
         np.ascontiguousarray(reference_display, dtype=np.float32),

@@ -21,7 +21,7 @@ def _fabric_list(fabrics):
     paths = list_presets() if fabrics is None else [find_preset(f) for f in fabrics]
     if not paths:
         raise InputError("no fabric presets found (fabrics/*.toml); run `catalog fit` first",
-                         field="--fabrics")
+                         field="--fabric")
     return [load_preset(p) for p in paths]
 
 
@@ -145,15 +145,12 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
                            "ev100": info["ev100"]})
             advance()
 
-    try:
-        if progress:
-            from rich.progress import Progress  # noqa: PLC0415
+    from catalog.core.progress import progress as progress_bar  # noqa: PLC0415
 
-            with Progress(transient=True) as bar:
-                task = bar.add_task("rendering", total=len(pairs))
-                work(lambda: bar.advance(task))
-        else:
-            work(lambda: None)
+    try:
+        with progress_bar("catalog sheet", total=len(pairs), unit="images",
+                          enabled=progress) as bar:
+            work(bar.advance)
     finally:
         renderer.release()
     grid_path = out_dir / "grid.png"

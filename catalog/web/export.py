@@ -131,21 +131,20 @@ def room_lamps(lamp: str) -> list:
 
 
 def parse_fabrics(text: str | None) -> list[str]:
-    from catalog.core.resources import FABRIC_DIR  # noqa: PLC0415
     from catalog.presets import list_presets  # noqa: PLC0415
 
-    known = [p.stem for p in list_presets(FABRIC_DIR)]
+    known = [p.stem for p in list_presets()]  # the search path: --fabrics DIR, then built-in
     if not text:
         return known
     names = [n.strip() for n in text.split(",") if n.strip()]
     if not names:
-        raise InputError("no fabric named", field="--fabrics")
+        raise InputError("no fabric named", field="--fabric")
     for name in names:
         if name not in known:
             raise InputError(f"unknown fabric {name!r}; known: {', '.join(known)}",
-                             field="--fabrics")
+                             field="--fabric")
     if len(set(names)) != len(names):
-        raise InputError("a fabric is named twice", field="--fabrics")
+        raise InputError("a fabric is named twice", field="--fabric")
     return names
 
 

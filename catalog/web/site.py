@@ -45,6 +45,16 @@ FORMAT_VERSION = 2  # 2: data.js packed (pack_data)
 BINARY_FIELDS = (("textures", "data"), ("buffers", "data"), ("blobs", None))
 
 
+def _json_length(value, depth: int = 2) -> int:
+    """len(json.dumps(value, separators=(",", ":"))) without the whole text at once: the
+    top ``depth`` levels of dicts part by part (the scenes one at a time)."""
+    if depth and isinstance(value, dict) and value:
+        return (2 + len(value) - 1
+                + sum(len(json.dumps(str(key))) + 1 + _json_length(item, depth - 1)
+                      for key, item in value.items()))
+    return len(json.dumps(value, separators=(",", ":")))
+
+
 def pack_data(data: dict) -> tuple[str, int]:
     """data.js's text, and the bytes a plain ``window.CATALOG_DATA = JSON`` would take.
 
@@ -56,19 +66,22 @@ def pack_data(data: dict) -> tuple[str, int]:
     the rest of the JSON (uniform values, frame structures, shaders) is deflated as text, each
     distinct uniform value once (``value_pool``; a scene's ``values`` index it)."""
     import base64  # noqa: PLC0415
-    import copy  # noqa: PLC0415
     import zlib  # noqa: PLC0415
 
-    plain = len(plain_data_js(data))
-    data = copy.deepcopy(data)
+    # The whole catalog's data is hundreds of MB as Python objects: no deep copy of it and no
+    # plain JSON text of it whole. The plain size is counted part by part (_json_length), and
+    # only what packing changes is copied (the scenes' value lists, the entries whose bytes
+    # move out).
+    plain = len(plain_data_js({})) - 2 + _json_length(data)
+    data = dict(data)
     binary: list[str] = []
     # every distinct uniform value once ("values": [0.5, ..] -> "values": [i, ..] into
     # "value_pool"): scenes of one fabric or light share most of theirs
     pool: dict[str, int] = {}
-    for scene in data.get("scenes", {}).values():
-        scene["values"] = [pool.setdefault(json.dumps(v, separators=(",", ":")), len(pool))
-                           for v in scene["values"]]
     if "scenes" in data:
+        data["scenes"] = {key: {**scene, "values": [
+            pool.setdefault(json.dumps(v, separators=(",", ":")), len(pool))
+            for v in scene["values"]]} for key, scene in data["scenes"].items()}
         data["value_pool"] = [json.loads(text) for text in pool]
 
     def move(text: str) -> dict:
@@ -79,9 +92,9 @@ def pack_data(data: dict) -> tuple[str, int]:
         if field is None:
             data[section] = [move(v) for v in data[section]]
             continue
-        for entry in data[section].values():
-            if isinstance(entry.get(field), str):
-                entry[field] = move(entry[field])
+        data[section] = {key: ({**entry, field: move(entry[field])}
+                               if isinstance(entry.get(field), str) else entry)
+                         for key, entry in data[section].items()}
     text = json.dumps(data, separators=(",", ":")).encode("utf-8")
     packed = {"format": FORMAT_VERSION,
               "json": base64.b64encode(zlib.compress(text, 9)).decode("ascii"),
@@ -190,9 +203,12 @@ def _asset(name: str) -> bytes:
 
 
 def build_site(out: str | Path, fabrics: str | None = None, lights: str | None = None,
-               ctx=None) -> dict:
-    """Write the site into ``out``; returns a report (sizes, counts, seconds)."""
+               ctx=None, progress: bool = False) -> dict:
+    """Write the site into ``out``; returns a report (sizes, counts, seconds). ``progress``:
+    the bake's and the recording's progress on stderr (catalog.core.progress)."""
     import base64  # noqa: PLC0415
+
+    from catalog.core.progress import progress as progress_bar  # noqa: PLC0415
 
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
@@ -214,11 +230,15 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         t = time.perf_counter()
         animations = {}
         fabric_animation = {}
-        for preset in presets:
-            key = bake_lib.cloth_key(bake_lib.bake_params(preset))
-            if key not in animations:
-                animations[key] = bake_lib.bake(preset)
-            fabric_animation[preset.name] = animations[key]
+        keys = {preset.name: bake_lib.cloth_key(bake_lib.bake_params(preset)) for preset in presets}
+        with progress_bar("catalog web: bake", total=len(set(keys.values())), unit="cloths",
+                          enabled=progress) as bar:
+            for preset in presets:
+                key = keys[preset.name]
+                if key not in animations:
+                    animations[key] = bake_lib.bake(preset)
+                    bar.advance()
+                fabric_animation[preset.name] = animations[key]
         first = next(iter(animations.values()))
         for animation in animations.values():  # the page swaps the curtain's buffers only
             if not (np.array_equal(animation.indices, first.indices)
@@ -235,19 +255,26 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             exporter.use_drape(fabric_animation[presets[0].name])
             exporter.check_camera_uniforms(presets[0], choices[0])
             scenes = {}
-            for preset in presets:
-                exporter.use_drape(fabric_animation[preset.name])
-                for choice in choices:
-                    metered = exporter.record(preset, choice, "on")
-                    # the switches keep the exposure metered with fluorescence on, no glare,
-                    # no lamp: they show the brightener's, the glare's and the lamp's light
-                    for fluorescence, glare, lamp in itertools.product(
-                            export.FLUORESCENCE, export.GLARE, export.ROOM_LAMPS):
-                        key = export.scene_key(preset.name, choice.id, fluorescence, glare, lamp)
-                        scenes[key] = (metered if (fluorescence, glare, lamp) == ("on", "off", "none")
-                                       else exporter.record(preset, choice, fluorescence,
-                                                            ev100=metered["ev100"], glare=glare,
-                                                            lamp=lamp))
+            variants = list(itertools.product(export.FLUORESCENCE, export.GLARE,
+                                              export.ROOM_LAMPS))
+            with progress_bar("catalog web: record", total=len(presets) * len(choices)
+                              * len(variants), unit="scenes", enabled=progress) as bar:
+                for preset in presets:
+                    exporter.use_drape(fabric_animation[preset.name])
+                    for choice in choices:
+                        metered = exporter.record(preset, choice, "on")
+                        # the switches keep the exposure metered with fluorescence on, no
+                        # glare, no lamp: they show the brightener's, the glare's and the
+                        # lamp's light
+                        for fluorescence, glare, lamp in variants:
+                            key = export.scene_key(preset.name, choice.id, fluorescence, glare,
+                                                   lamp)
+                            scenes[key] = (
+                                metered if (fluorescence, glare, lamp) == ("on", "off", "none")
+                                else exporter.record(preset, choice, fluorescence,
+                                                     ev100=metered["ev100"], glare=glare,
+                                                     lamp=lamp))
+                            bar.advance()
             objects = exporter.objects()
             swatches = {p.name: base64.b64encode(export.swatch_png(exporter.ctx._ctx, p))
                         .decode("ascii") for p in presets}

@@ -1,0 +1,134 @@
+"""The settled drape on disk: computed once per cloth parameters, grid and solver.
+
+Settling a curtain (catalog.cloth.drape, SETTLE_FRAMES frames of the numpy cloth) costs
+seconds; every ``catalog snapshot`` process used to pay it again. The result is a pure
+function of the parameters, the frame count and step, and the solver's code, so it is kept
+in the user's cache folder (platformdirs' user cache dir, ``fabric-catalog/drape``) under
+the SHA-256 of all of these:
+
+- every field of :class:`~catalog.cloth.params.ClothParams` (the grid included), the frames
+  and the frame step;
+- the source text of the modules the numpy settle runs (a changed solver is a new key:
+  old entries are never read again);
+- numpy's version (its reductions may round differently).
+
+Writes are atomic (a temporary beside the target, fsync, rename: catalog.core.atomic), so
+two processes settling the same key at once both publish a whole file and a reader sees one
+or the other, never a torn one. A file that cannot be read back as the key's state (torn by
+a crash of the file system, edited, another key's) is ignored and written again. The cache
+never fails a command: a folder that cannot be written only costs the settle next time.
+
+``$CATALOG_CACHE_DIR`` names another folder; ``off`` (or empty) turns the cache off.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import io
+import json
+import os
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+#: Environment variable: the cache folder (``off`` or empty: no disk cache).
+CACHE_ENV = "CATALOG_CACHE_DIR"
+#: Bumped when the file's layout changes.
+FORMAT = 1
+#: The modules whose code decides the settled state (the numpy backend's whole path).
+SOLVER_MODULES = ("params", "state", "topology", "wind", "backend", "backend_numpy",
+                  "simulation", "drape")
+
+
+def cache_dir() -> Path | None:
+    """The drape cache folder, or None when the cache is off."""
+    value = os.environ.get(CACHE_ENV)
+    if value is not None:
+        return None if value.strip() in ("", "off") else Path(value) / "drape"
+    from platformdirs import user_cache_dir  # noqa: PLC0415
+
+    return Path(user_cache_dir("fabric-catalog", appauthor=False)) / "drape"
+
+
+_SOLVER_HASH: str | None = None
+
+
+def solver_hash() -> str:
+    """SHA-256 of the source of the modules that settle the cloth."""
+    global _SOLVER_HASH
+    if _SOLVER_HASH is None:
+        digest = hashlib.sha256()
+        here = Path(__file__).resolve().parent
+        for name in SOLVER_MODULES:
+            digest.update(name.encode())
+            digest.update((here / f"{name}.py").read_bytes())
+        _SOLVER_HASH = digest.hexdigest()
+    return _SOLVER_HASH
+
+
+def drape_key(params, frames: int, frame_dt_s: float) -> str:
+    """The content key of a settled drape (hex SHA-256)."""
+    fields = {f.name: getattr(params, f.name) for f in dataclasses.fields(params)
+              if f.compare}
+    text = json.dumps({"format": FORMAT, "params": fields, "frames": int(frames),
+                       "frame_dt_s": float(frame_dt_s), "solver": solver_hash(),
+                       "numpy": ".".join(np.__version__.split(".")[:2])},
+                      sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _path(key: str) -> Path | None:
+    folder = cache_dir()
+    return None if folder is None else folder / f"{key}.npz"
+
+
+def load(key: str, params):
+    """The cached :class:`~catalog.cloth.state.ClothState` of ``key``, or None."""
+    from catalog.cloth.state import ClothState  # noqa: PLC0415
+
+    path = _path(key)
+    if path is None or not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if str(data["key"]) != key:
+                return None
+            shape = (params.grid_h, params.grid_w, 3)
+            positions = np.array(data["positions_m"], dtype=np.float64)
+            velocities = np.array(data["velocities_m_s"], dtype=np.float64)
+            if positions.shape != shape or velocities.shape != shape \
+                    or not np.isfinite(positions).all():
+                return None
+            scalars = json.loads(str(data["scalars"]))
+            return ClothState(positions_m=positions, velocities_m_s=velocities,
+                              ring_positions_m=np.array(data["ring_positions_m"], np.float64),
+                              ring_targets_m=np.array(data["ring_targets_m"], np.float64),
+                              time_s=float(scalars["time_s"]), frames=int(scalars["frames"]),
+                              finite=bool(scalars["finite"]),
+                              max_stretch_seen=float(scalars["max_stretch_seen"]),
+                              quiet_frames=int(scalars["quiet_frames"]))
+    except (OSError, ValueError, KeyError, EOFError, TypeError, zipfile.BadZipFile):  # torn, edited, foreign
+        return None
+
+
+def store(key: str, state) -> Path | None:
+    """Publish ``state`` under ``key`` atomically; None (and nothing left) when it cannot."""
+    from catalog.core.atomic import write_bytes_atomic  # noqa: PLC0415
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+
+    path = _path(key)
+    if path is None:
+        return None
+    scalars = {"time_s": state.time_s, "frames": state.frames, "finite": state.finite,
+               "max_stretch_seen": state.max_stretch_seen, "quiet_frames": state.quiet_frames}
+    buffer = io.BytesIO()
+    np.savez(buffer, key=np.array(key), scalars=np.array(json.dumps(scalars)),
+             positions_m=state.positions_m, velocities_m_s=state.velocities_m_s,
+             ring_positions_m=state.ring_positions_m, ring_targets_m=state.ring_targets_m)
+    try:
+        write_bytes_atomic(path, buffer.getvalue())
+    except (CatalogError, OSError):
+        return None  # a read-only or full cache folder costs the settle next time, no more
+    return path
