@@ -125,7 +125,7 @@ def test_closed_room_returns_the_albedo_series():
     rays = NumpyRays(closed)
     hit, escaped = gather(rec, rays, len(closed), 64, np.random.default_rng(0))
     assert not escaped.any() and (hit >= 0).all()         # every ray lands on a front face
-    f = form_factors(hit, np.arange(rec.count), rec.count)
+    f = form_factors(hit, np.arange(rec.count), rec.count).toarray()
     assert np.allclose(f.sum(axis=1), 1.0)
     total = np.linalg.solve(np.eye(rec.count) - 0.7 * f, np.ones(rec.count))
     assert np.allclose(total, 1.0 / (1.0 - 0.7), rtol=1e-10)

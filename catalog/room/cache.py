@@ -22,7 +22,7 @@ from catalog.room.receivers import Receivers
 from catalog.room.transport import Transport, TransportParams, precompute
 
 TRANSPORT_VERSION = 1
-_ARRAYS = ("direct", "form_factors", "window_operator", "window_basis", "window_modes",
+_ARRAYS = ("direct", "window_operator", "window_basis", "window_modes",
            "bounce_left", "bounce_right", "frame")
 _RECEIVERS = ("corners", "normal", "area_m2", "albedo", "triangle", "divisions", "first", "triangles")
 
@@ -45,6 +45,8 @@ def save(transport: Transport, path: Path, key: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     arrays = {name: getattr(transport, name) for name in _ARRAYS if getattr(transport, name) is not None}
     arrays.update({f"receivers_{name}": getattr(transport.receivers, name) for name in _RECEIVERS})
+    f = transport.form_factors.tocsr()
+    arrays.update({"f_data": f.data, "f_indices": f.indices, "f_indptr": f.indptr})
     arrays["window_corners"] = transport.window.corners
     arrays["window_normal"] = transport.window.normal
     meta = {"key": key, "params": transport.params.key(), "timings_s": transport.timings_s}
@@ -71,6 +73,11 @@ def load(path: Path, key: str) -> Transport | None:
             receivers = Receivers(**{name: data[f"receivers_{name}"] for name in _RECEIVERS})
             window = Window(data["window_corners"], data["window_normal"])
             arrays = {name: (data[name] if name in data else None) for name in _ARRAYS}
+            import scipy.sparse  # noqa: PLC0415
+
+            count = receivers.corners.shape[0]
+            arrays["form_factors"] = scipy.sparse.csr_matrix(
+                (data["f_data"], data["f_indices"], data["f_indptr"]), shape=(count, count))
     except (OSError, ValueError, KeyError, json.JSONDecodeError):
         return None
     return Transport(params=TransportParams(**params), receivers=receivers, window=window,

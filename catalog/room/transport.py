@@ -69,7 +69,7 @@ class Transport:
     window: Window
     frame: np.ndarray                # (3, 3) the window's SH frame (rows x, y, z)
     direct: np.ndarray               # D (E, P K)
-    form_factors: np.ndarray         # F (E, E)
+    form_factors: object             # F (E, E), scipy.sparse CSR
     window_operator: np.ndarray      # (3, E, P K) irradiance per unit coefficient, all bounces
     window_basis: np.ndarray = None  # compressed: (3, E, r) and (r, P K)
     window_modes: np.ndarray = None
@@ -90,26 +90,19 @@ class Transport:
             return np.einsum("cer,rc->ec", self.window_basis, modes)
         return np.einsum("cek,kc->ec", self.window_operator, c)
 
-    def sparse_form_factors(self):
-        """F as a CSR matrix (at most gather_rays entries a row)."""
-        import scipy.sparse  # noqa: PLC0415
-
-        if getattr(self, "_sparse_f", None) is None:
-            self._sparse_f = scipy.sparse.csr_matrix(self.form_factors)
-        return self._sparse_f
-
     def bounced(self, direct: np.ndarray, compressed: bool = True) -> np.ndarray:
         """(E, 3) total irradiance from a direct irradiance (E, 3) at the receivers (the
         sun's beam): the direct plus every interreflection."""
         direct = np.asarray(direct, dtype=np.float64)
         if compressed and self.bounce_left is not None:
             rho = self.receivers.albedo
-            once = self.sparse_form_factors() @ (rho * direct)
+            once = self.form_factors @ (rho * direct)
             return direct + once + np.einsum("cer,cr->ec", self.bounce_left,
                                              np.einsum("cre,ec->cr", self.bounce_right, direct))
         out = np.empty_like(direct)
+        f = self.form_factors.toarray()
         for ch in range(3):
-            a = np.eye(self.receivers.count) - self.form_factors * self.receivers.albedo[None, :, ch]
+            a = np.eye(self.receivers.count) - f * self.receivers.albedo[None, :, ch]
             out[:, ch] = np.linalg.solve(a, direct[:, ch])
         return out
 
@@ -204,20 +197,47 @@ def gather(rec: Receivers, rays_room, window_tris_first: int, count: int, rng,
     return hit_rec, escaped
 
 
-def form_factors(hit: np.ndarray, new_index: np.ndarray, count: int) -> np.ndarray:
-    """F (E', E') from gathered hits (old receiver indices), over the kept receivers."""
+def form_factors(hit: np.ndarray, new_index: np.ndarray, count: int):
+    """F (E', E') as a CSR matrix (at most rays entries a row) from gathered hits (old
+    receiver indices), over the kept receivers."""
+    import scipy.sparse  # noqa: PLC0415
+
     e = hit.shape[0]
     rows = np.repeat(np.arange(e), hit.shape[1])
     cols = new_index[np.where(hit.ravel() >= 0, hit.ravel(), 0)]
     keep = (hit.ravel() >= 0) & (cols >= 0)
-    flat = np.bincount(rows[keep] * count + cols[keep], minlength=e * count)
-    return flat.reshape(e, count) / hit.shape[1]
+    f = scipy.sparse.csr_matrix((np.full(int(keep.sum()), 1.0 / hit.shape[1]), (rows[keep], cols[keep])),
+                                shape=(e, count))
+    f.sum_duplicates()
+    return f
+
+
+def _orthonormal(a: np.ndarray) -> np.ndarray:
+    """An orthonormal basis of a's columns by Cholesky-QR twice (eigh of the small Gram
+    matrix, then matrix products): LAPACK's QR of a tall thin matrix runs ~50x slower here
+    when its threads compete for the shared cores."""
+    for _ in range(2):
+        w, v = np.linalg.eigh(a.T @ a)
+        keep = w > w.max() * 1e-13
+        a = a @ (v[:, keep] / np.sqrt(w[keep]))
+    return a
+
+
+def _svd_wide(small: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The SVD of a (k, n) matrix with k << n through its (k, k) Gram matrix."""
+    w, u = np.linalg.eigh(small @ small.T)
+    order = np.argsort(w)[::-1]
+    w, u = np.maximum(w[order], 0.0), u[:, order]
+    s = np.sqrt(w)
+    keep = s > s[0] * 1e-7 if s.size and s[0] > 0 else np.zeros(s.size, dtype=bool)
+    return u[:, keep], s[keep], (u[:, keep].T @ small) / s[keep, None]
 
 
 def compress(matrix: np.ndarray, tolerance: float, max_rank: int) -> tuple[np.ndarray, np.ndarray, float]:
     """(left, right) with left @ right ~ matrix to relative Frobenius error <= tolerance (or
-    at max_rank), and the error reached."""
-    u, s, vt = np.linalg.svd(matrix, full_matrices=False)
+    at max_rank), and the error reached (the SVD from the narrow side's Gram matrix)."""
+    vt_u, s, u_t = _svd_wide(matrix.T)                # matrix^T = V S U^T
+    u, vt = u_t.T, vt_u.T
     total = float(np.sum(s * s))
     tail = np.sqrt(np.maximum(0.0, total - np.cumsum(s * s)) / max(total, 1e-300))
     rank = int(min(max_rank, np.searchsorted(-tail, -tolerance) + 1, s.size))
@@ -256,11 +276,13 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
 
     operator = np.empty((3, rec.count, d.shape[1]))
     lus = []
+    dense = f.toarray()
     for ch in range(3):
-        lu = scipy.linalg.lu_factor(np.eye(rec.count) - f * rec.albedo[None, :, ch])
+        lu = scipy.linalg.lu_factor(np.eye(rec.count) - dense * rec.albedo[None, :, ch], overwrite_a=True)
         lus.append(lu)
         operator[ch] = scipy.linalg.lu_solve(lu, d)
     timings["solve_s"] = time.perf_counter() - start
+    del dense
     transport = Transport(params, rec, window, frame, d, f, operator, timings_s=timings)
     if compress_operators:
         start = time.perf_counter()
@@ -300,10 +322,10 @@ def bounce_low_rank(lus, f: np.ndarray, albedo: np.ndarray, params: TransportPar
             return rho[:, None] * (f.T @ y)
 
         omega = rng.normal(size=(e, min(e, rank + 10)))
-        q, _ = np.linalg.qr(apply(omega))
-        q, _ = np.linalg.qr(apply(apply_t(q)))
+        q = _orthonormal(apply(omega))
+        q = _orthonormal(apply(apply_t(q)))
         small = apply_t(q).T                               # q^T B  (k, E)
-        u, s, vt = np.linalg.svd(small, full_matrices=False)
+        u, s, vt = _svd_wide(small)
         total = float(np.sum(s * s))
         tail = np.sqrt(np.maximum(0.0, total - np.cumsum(s * s)) / max(total, 1e-300))
         r = int(min(rank, np.searchsorted(-tail, -params.rank_tolerance) + 1, s.size))
