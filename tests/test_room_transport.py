@@ -27,17 +27,26 @@ def test_sh_is_orthonormal_under_quadrature():
     y = sh.real_sh(full, 4)
     gram = (y * np.concatenate([w, w])[:, None]).T @ y
     assert np.abs(gram - np.eye(16)).max() < 1e-10
+    h = sh.hemi_basis(dirs, 5)                   # the window's basis: orthonormal on the hemisphere
+    assert h.shape[1] == sh.basis_count(5) == 15
+    assert np.abs((h * w[:, None]).T @ h - np.eye(15)).max() < 1e-10
 
 
 def test_projection_of_clamped_cosine_matches_closed_form():
-    # max(cos theta, 0) has zonal coefficients sqrt(pi)/2, sqrt(pi/3), sqrt(5 pi)/8 (l = 0, 1, 2)
+    # cos theta on the hemisphere: the SH zonal integrals sqrt(pi)/2 (l = 0) and sqrt(5 pi)/8
+    # (l = 2) times sqrt(2); l = 1, m = 0 is odd in z, not in the basis
     dirs, w = sh.hemisphere_quadrature(8, 16)
-    c = sh.project(dirs, w, dirs[:, 2], 3)
-    assert c[0] == pytest.approx(math.sqrt(math.pi) / 2, rel=1e-12)
-    assert c[2] == pytest.approx(math.sqrt(math.pi / 3), rel=1e-12)
-    assert c[6] == pytest.approx(math.sqrt(5 * math.pi) / 8, rel=1e-12)
-    others = np.delete(c, [0, 2, 6])
-    assert np.abs(others).max() < 1e-12
+    c = sh.project(dirs, w, dirs[:, 2], 3)          # basis (0,0), (1,-1), (1,1), (2,-2), (2,0), (2,2)
+    assert c[0] == pytest.approx(math.sqrt(2) * math.sqrt(math.pi) / 2, rel=1e-12)
+    assert c[4] == pytest.approx(math.sqrt(2) * math.sqrt(5 * math.pi) / 8, rel=1e-12)
+    assert np.abs(np.delete(c, [0, 4])).max() < 1e-12
+
+
+def test_uniform_radiance_is_exact_at_order_one():
+    # the full SH would hold half of it at order 1 (the zero behind the window); the even basis all
+    dirs, w = sh.hemisphere_quadrature(6, 12)
+    c = sh.project(dirs, w, np.ones(dirs.shape[0]), 1)
+    assert np.allclose(c[0] * sh.hemi_basis(dirs, 1)[:, 0], 1.0, rtol=1e-12)
 
 
 @pytest.mark.slow
@@ -52,7 +61,7 @@ def test_projection_of_a_tilted_lobe_matches_dense_quadrature():
     d = rng.normal(size=(400_000, 3))
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     d[:, 2] = np.abs(d[:, 2])
-    mc = sh.real_sh(d, 3).T @ lobe(d) * (2 * math.pi / d.shape[0])
+    mc = sh.hemi_basis(d, 3).T @ lobe(d) * (2 * math.pi / d.shape[0])
     assert np.abs(coarse - mc).max() < 5e-3 * np.abs(mc).max() + 3e-3
 
 
@@ -110,7 +119,7 @@ def test_direct_light_matches_the_rectangle_view_factor():
     rec = t.receivers
     back = np.flatnonzero(np.abs(rec.centre[:, 2] - 1.0) < 1e-9)
     c = np.zeros((16, 1, 3))
-    c[:, 0, :] = 1.0 / sh.real_sh(np.array([[0, 0, 1.0]]), 1)[0, 0]     # L = 1 everywhere
+    c[:, 0, :] = 1.0 / sh.hemi_basis(np.array([[0, 0, 1.0]]), 1)[0, 0]     # L = 1 everywhere
     e = t.irradiance(c, compressed=False)[back, 0]
     expected = []
     for x, y, _ in rec.centre[back]:
@@ -180,14 +189,14 @@ def test_operator_matches_brute_force_path_tracing():
     def radiance(x, w):      # brighter towards +x across the window, more light travelling +x
         return (1.0 + 0.8 * (x[:, 0] - 0.3)) * (1.0 + 0.5 * w[:, 0])
 
-    # SH order 2 holds (1 + 0.5 w_x) exactly; the patch's x factor at its centre
-    y00 = sh.real_sh(np.array([[0, 0, 1.0]]), 1)[0, 0]
-    y11 = 0.5 * math.sqrt(3 / math.pi)
-    c = np.zeros((4, 4, 3))
+    # order 2 holds (1 + 0.5 w_x) exactly (H_0 = 1 / sqrt(2 pi), H_2 = sqrt(3 / (2 pi)) w_x);
+    # the patch's x factor at its centre
+    h0, h2 = 1 / math.sqrt(2 * math.pi), math.sqrt(3 / (2 * math.pi))
+    c = np.zeros((4, 3, 3))
     for p in range(4):
         xc = 0.3 + 0.4 * ((p % 2) + 0.5) / 2
-        c[p, 0] = (1.0 + 0.8 * (xc - 0.3)) / y00
-        c[p, 3] = (1.0 + 0.8 * (xc - 0.3)) * 0.5 / y11
+        c[p, 0] = (1.0 + 0.8 * (xc - 0.3)) / h0
+        c[p, 2] = (1.0 + 0.8 * (xc - 0.3)) * 0.5 / h2
     e = t.irradiance(c, compressed=False)[:, 0]
     rec = t.receivers
     rng = np.random.default_rng(5)

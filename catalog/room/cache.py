@@ -22,7 +22,7 @@ from catalog.room.receivers import Receivers
 from catalog.room.transport import Transport, TransportParams, precompute
 
 TRANSPORT_VERSION = 1
-_ARRAYS = ("direct", "window_operator", "window_basis", "window_modes",
+_ARRAYS = ("direct", "window_operator", "kept_index", "window_basis", "window_modes",
            "bounce_left", "bounce_right", "frame")
 _RECEIVERS = ("corners", "normal", "area_m2", "albedo", "triangle", "divisions", "first", "triangles")
 

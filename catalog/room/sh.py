@@ -1,11 +1,13 @@
-"""Real spherical harmonics, the window's directional basis (float64 numpy).
+"""The window's directional basis: hemispherical harmonics from the real SH (float64 numpy).
 
 The radiance a window patch sends into the room, L(w) for w in the hemisphere around the
-window's normal, is held as sum_k c_k Y_k(w) over the real, orthonormal SH of degree
-l < order (order**2 coefficients), in the window's frame (x = its u edge, z = its normal).
-:func:`project` takes the coefficients from radiance samples with quadrature weights
-(the captured views of the aperture); the back hemisphere is zero (no light leaves the
-window out of the room), so a truncated expansion rings there, which no receiver sees.
+window's normal (z, in the window's frame: x along its u edge), is held as
+sum_k c_k H_k(w) with H = sqrt(2) Y_lm over the real SH of degree l < order with l + m
+even: the SH even in z, orthonormal over the hemisphere, order (order + 1) / 2 of them.
+They expand L mirrored onto the back hemisphere, which is continuous at the horizon; the
+full SH would expand L with zero behind the window, whose jump at the horizon converges
+slowly (order 1 holds half of a uniform radiance). :func:`project` takes the coefficients
+from radiance samples with quadrature weights (the captured views of the aperture).
 """
 
 from __future__ import annotations
@@ -48,6 +50,22 @@ def real_sh(directions: np.ndarray, order: int) -> np.ndarray:
     return out
 
 
+def basis_count(order: int) -> int:
+    """Functions of the hemispherical basis of ``order``: order (order + 1) / 2."""
+    return order * (order + 1) // 2
+
+
+def even_indices(order: int) -> np.ndarray:
+    """Indices (into :func:`real_sh`) of the SH with l + m even, by l then m."""
+    return np.array([ell * ell + ell + m for ell in range(order) for m in range(-ell, ell + 1)
+                     if (ell + m) % 2 == 0])
+
+
+def hemi_basis(directions: np.ndarray, order: int) -> np.ndarray:
+    """(N, basis_count(order)) the hemispherical basis at unit local ``directions`` (z >= 0)."""
+    return math.sqrt(2.0) * real_sh(directions, order)[:, even_indices(order)]
+
+
 def hemisphere_quadrature(n_theta: int, n_phi: int) -> tuple[np.ndarray, np.ndarray]:
     """Directions (n_theta n_phi, 3) over z >= 0 and their weights (sr, summing to 2 pi):
     Gauss-Legendre in cos(theta) on [0, 1], uniform in phi (exact for SH products on the
@@ -63,9 +81,10 @@ def hemisphere_quadrature(n_theta: int, n_phi: int) -> tuple[np.ndarray, np.ndar
 
 
 def project(directions: np.ndarray, weights: np.ndarray, radiance: np.ndarray, order: int) -> np.ndarray:
-    """SH coefficients (order**2, ...) of radiance samples (N, ...) at ``directions`` (N, 3)
-    with quadrature ``weights`` (N,) (sr): c_k = sum_s w_s L_s Y_k(w_s)."""
-    y = real_sh(directions, order)
+    """Coefficients (basis_count(order), ...) of radiance samples (N, ...) at local
+    hemisphere ``directions`` (N, 3) with quadrature ``weights`` (N,) (sr):
+    c_k = sum_s w_s L_s H_k(w_s)."""
+    y = hemi_basis(directions, order)
     return np.einsum("nk,n,n...->k...", y, weights, radiance)
 
 

@@ -2,14 +2,14 @@
 catalog.room.rays).
 
 Light enters the room only through its window. Cut the window into a grid of patches and
-hold the radiance each patch sends into the room in real SH of ``order`` (catalog.room.sh,
-in the window's frame): L_p(w) = sum_k c_pk Y_k(w). The irradiance at the room's
+hold the radiance each patch sends into the room in the hemispherical harmonics of
+``order`` (catalog.room.sh, in the window's frame): L_p(w) = sum_k c_pk H_k(w). The irradiance at the room's
 receivers (catalog.room.receivers: elements of every surface) is linear in the c_pk:
 
     E = D c + F (rho E)    =>    E_ch = (I - F diag(rho_ch))^-1 D c_ch     per colour channel
 
 - D (E, P K), the window's direct light: the integral over each patch of
-  Y_k(w) V cos(theta_e) cos(theta_w) / r^2 (area samples of the patch, shadow rays);
+  H_k(w) V cos(theta_e) cos(theta_w) / r^2 (area samples of the patch, shadow rays);
 - F (E, E), the form factors: the share of an element's cosine-weighted rays that land on
   the front of each other element (a ray leaving through the window or meeting a back face
   carries nothing back: the window's light is all in D, counted once);
@@ -48,7 +48,7 @@ class TransportParams:
 
     element_m: float = 0.25          # receiver size
     patches: tuple = (6, 6)          # window patches along its u and v edges
-    order: int = 3                   # SH order (order**2 coefficients per patch)
+    order: int = 3                   # basis order (order (order + 1) / 2 coefficients per patch)
     gather_rays: int = 256           # form-factor rays per receiver
     window_samples: int = 4          # area samples per patch per receiver
     rank_tolerance: float = 1e-3     # relative Frobenius error of the compressed operators
@@ -76,10 +76,16 @@ class Transport:
     bounce_left: np.ndarray = None   # compressed bounce: (3, E, r), (3, r, E)
     bounce_right: np.ndarray = None
     timings_s: dict = field(default_factory=dict)
+    kept_index: np.ndarray = None    # (E_all,) receiver index of each element before the sort, -1: outside
+
+    def receiver_at(self, triangle: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """(N,) the receiver holding ``points`` on room triangles ``triangle`` (-1: a place no
+        ray from inside reaches)."""
+        return self.kept_index[self.receivers.element_at(triangle, points)]
 
     @property
     def coefficient_count(self) -> int:
-        return int(np.prod(self.params.patches)) * self.params.order ** 2
+        return int(np.prod(self.params.patches)) * sh.basis_count(self.params.order)
 
     def irradiance(self, coefficients: np.ndarray, compressed: bool = True) -> np.ndarray:
         """(E, 3) irradiance at the receivers from window coefficients (P, K, 3) (or
@@ -130,7 +136,7 @@ def direct_operator(rec: Receivers, window: Window, params: TransportParams, ray
     (visibility by shadow rays against the room)."""
     nu, nv = params.patches
     patches = nu * nv
-    k = params.order ** 2
+    k = sh.basis_count(params.order)
     s_count = params.window_samples
     out = np.zeros((rec.count, patches * k))
     per_receiver = patches * s_count
@@ -158,7 +164,7 @@ def direct_operator(rec: Receivers, window: Window, params: TransportParams, ray
         visible = np.zeros(ee.size, dtype=bool)
         visible[np.flatnonzero(ok)] = hit >= r[ok] * (1 - 1e-6) - eps
         g = np.where(visible, cos_e * cos_w / (r * r), 0.0) * jac / (patches * s_count)
-        y = sh.real_sh(-d @ frame.T, params.order)                 # light travels window -> receiver
+        y = sh.hemi_basis(-d @ frame.T, params.order)              # light travels window -> receiver
         contrib = (g[:, None] * y).reshape(e.size, patches, s_count, k).sum(axis=2)
         out[e] = contrib.reshape(e.size, patches * k)
     return out
@@ -283,7 +289,8 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
         operator[ch] = scipy.linalg.lu_solve(lu, d)
     timings["solve_s"] = time.perf_counter() - start
     del dense
-    transport = Transport(params, rec, window, frame, d, f, operator, timings_s=timings)
+    transport = Transport(params, rec, window, frame, d, f, operator, timings_s=timings,
+                          kept_index=new_index)
     if compress_operators:
         start = time.perf_counter()
         left, right, err = compress(operator.reshape(3 * rec.count, -1), params.rank_tolerance, params.max_rank)
