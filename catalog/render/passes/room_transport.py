@@ -2,9 +2,8 @@
 
 Input: a :class:`catalog.room.transport.Transport` and the receivers' irradiance (E, 3)
 (:meth:`Transport.irradiance` of the window's coefficients, plus :meth:`Transport.bounced`
-of the sun's beam); the pass welds each receiver corner's irradiance with the corners it
-shares on one plane (area-weighted), so the light map is continuous across receivers and
-linear inside each, and draws albedo x E / pi (room_transport.vert/.frag) into the bound
+of the sun's beam); the pass draws the light map of catalog.room.lightmap (corners welded
+on each plane, linear inside each receiver) as albedo x E / pi (room_transport.vert/.frag) into the bound
 framebuffer. Not yet wired into the frame (catalog/render/frame.py): the lead places it
 among the passes; until then the tests draw it alone.
 """
@@ -14,28 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from catalog.render.camera import gl_bytes
-
-#: Corner positions closer than this (m) on one plane are one vertex of the light map.
-WELD_M = 1e-5
-
-
-def welded_corner_irradiance(transport, irradiance: np.ndarray) -> np.ndarray:
-    """(E, 3, 3) the irradiance at each receiver corner: the area-weighted mean of the
-    receivers meeting there on the same plane (same normal and offset)."""
-    rec = transport.receivers
-    corners = rec.corners.reshape(-1, 3)
-    normal = np.repeat(rec.normal, 3, axis=0)
-    offset = np.einsum("ni,ni->n", corners, normal)
-    key = np.concatenate([np.round(corners / WELD_M), np.round(normal * 1e4),
-                          np.round(offset[:, None] / WELD_M)], axis=1).astype(np.int64)
-    _, vertex = np.unique(key, axis=0, return_inverse=True)
-    vertex = vertex.ravel()
-    weight = np.repeat(rec.area_m2, 3)
-    total = np.zeros((vertex.max() + 1, 3))
-    np.add.at(total, vertex, weight[:, None] * np.repeat(irradiance, 3, axis=0))
-    norm = np.bincount(vertex, weights=weight)
-    return (total / norm[:, None])[vertex].reshape(-1, 3, 3)
-
+from catalog.room.lightmap import corner_irradiance
 
 def look_at_view_projection(position, forward, up, fov_y_deg: float, aspect: float,
                             near_m: float = 0.05, far_m: float = 50.0) -> np.ndarray:
@@ -76,7 +54,7 @@ class RoomTransportPass:
 
     def update(self, irradiance: np.ndarray) -> None:
         """Upload the receivers' irradiance (E, 3)."""
-        corner = welded_corner_irradiance(self.transport, np.asarray(irradiance, dtype=np.float64))
+        corner = corner_irradiance(self.transport, np.asarray(irradiance, dtype=np.float64))
         data = np.concatenate([self._positions, corner.reshape(-1, 3).astype("f4"), self._albedo], axis=1)
         self._buffer.write(np.ascontiguousarray(data, dtype="f4").tobytes())
 
