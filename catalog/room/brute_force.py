@@ -16,12 +16,13 @@ from catalog.room.receivers import cosine_directions
 def probe_points(room, count: int, rng, backend: str = "mitsuba") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``count`` points on the room's inside surfaces (their normals and triangles): where rays from
     random points of the window land, half of them after one diffuse bounce (so shadowed
-    places are among them)."""
+    places are among them; a bounce that leaves through the window keeps its first point:
+    the window's reveals beyond it are outside the room)."""
     from catalog.room.rays import ray_caster  # noqa: PLC0415
 
     tris = room.triangles()
     normals = _normals(tris)
-    rays = ray_caster(tris, backend)
+    rays = ray_caster(np.concatenate([tris, room.window.triangles()]), backend)
     w = room.window
     s, t = rng.random((2, count))
     o = w.origin + s[:, None] * w.u_edge + t[:, None] * w.v_edge + 1e-4 * w.normal
@@ -32,7 +33,8 @@ def probe_points(room, count: int, rng, backend: str = "mitsuba") -> tuple[np.nd
     second = np.arange(count) % 2 == 1
     d2 = cosine_directions(n[second], rng)
     dist2, tri2 = rays.intersect(p[second] + 1e-5 * n[second], d2)
-    ok = np.isfinite(dist2) & (np.einsum("ni,ni->n", d2, normals[np.maximum(tri2, 0)]) < 0)
+    inside = (tri2 >= 0) & (tri2 < len(tris))
+    ok = inside & (np.einsum("ni,ni->n", d2, normals[np.clip(tri2, 0, len(tris) - 1)]) < 0)
     idx = np.flatnonzero(second)[ok]
     p[idx] = p[idx] + 1e-5 * n[idx] + dist2[ok, None] * d2[ok]
     n[idx] = normals[tri2[ok]]
