@@ -198,7 +198,10 @@ def plot(result: dict, path) -> None:
 
     plt = pyplot()
     sweeps_ = list(result["rooms"][0]["sweeps"])
-    fig, axes = plt.subplots(1, len(sweeps_), figsize=(3.2 * len(sweeps_), 3.0), squeeze=False)
+    from matplotlib.ticker import NullFormatter, ScalarFormatter  # noqa: PLC0415
+
+    fig, axes = plt.subplots(1, len(sweeps_), figsize=(3.2 * len(sweeps_), 3.0), squeeze=False,
+                             sharey=True)
     labels = {"element_m": "receiver size (m)", "patches": "window patches per side",
               "order": "basis order", "gather_rays": "form-factor rays per receiver"}
     for ax, sweep in zip(axes[0], sweeps_):
@@ -211,8 +214,13 @@ def plot(result: dict, path) -> None:
         ax.set_yscale("log")
         if sweep == "element_m":
             ax.invert_xaxis()
+        ax.set_xticks([r["value"] for r in result["rooms"][0]["sweeps"][sweep]])
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_formatter(ScalarFormatter())
+            axis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(labels.get(sweep, sweep))
         ax.grid(True, which="both", alpha=0.3)
+    axes[0][0].set_yticks([0.02, 0.05, 0.1, 0.2, 0.5])
     axes[0][0].set_ylabel("relative RMS error vs path tracer")
     axes[0][0].legend(fontsize=8)
     fig.suptitle(f"room transport convergence (dotted: reference noise), commit {result['commit']}",
