@@ -145,3 +145,17 @@ def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     assert third.timings_s["from_cache"] is False
     assert not np.allclose(third.receivers.centre, first.receivers.centre)   # the deeper room
     assert third.direct.sum() < first.direct.sum()         # its far wall sees less of the window
+
+
+@pytest.mark.slow
+def test_built_in_rooms_are_what_the_tool_makes(tmp_path):
+    import subprocess
+    import sys
+
+    from catalog.core.resources import PROJECT_ROOT
+    from catalog.room.load import DATA_DIR
+
+    subprocess.run([sys.executable, str(PROJECT_ROOT / "tools" / "make_rooms.py"), "--out", str(tmp_path)],
+                   check=True, capture_output=True, timeout=120)
+    for name in ("box", "living"):
+        assert (tmp_path / f"{name}.glb").read_bytes() == (DATA_DIR / f"{name}.glb").read_bytes(), name
