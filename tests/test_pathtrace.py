@@ -176,8 +176,13 @@ def test_export_reads_the_real_time_scene():
     assert np.allclose(desc.sky_rgb, bands.spectrum_to_display_rgb(desc.inputs.sky_radiance), rtol=1e-9)
     assert np.allclose(desc.key_to_light, scene_lib.key_direction(scene_lib.LAMP_ELEVATION_DEG))
     assert desc.key_radius_rad == scene_lib.SUN_RADIUS_RAD
-    room = scene_lib.room_props()[0].astype(np.float64)
-    assert np.array_equal(desc.room_positions[:room.shape[0]], room)  # then the rings
+    rod = scene_lib.rod_mesh()[0].astype(np.float64)
+    assert np.array_equal(desc.room_positions[:rod.shape[0]], rod)  # then the rings
+    # the room is the built-in box: today's shell (room_props less the rod), grey
+    shell = np.concatenate([s.triangles.reshape(-1, 3) for s in desc.room_surfaces])
+    theirs = scene_lib.room_props()[0][:-rod.shape[0]].astype(np.float64)
+    assert np.allclose(np.sort(shell, axis=0), np.sort(theirs, axis=0), atol=1e-6)
+    assert all(np.allclose(s.factor, scene_lib.ROOM_ALBEDO) for s in desc.room_surfaces)
 
 
 def test_environment_disc_integrates_to_the_key_irradiance():
@@ -706,7 +711,9 @@ def test_the_window_wall_beside_the_opening_gets_the_path_tracers_direct_light(g
     u1 = (np.arange(rays) + 0.5) / rays
     u2 = (np.arange(rays) * 0.6180339887) % 1.0
     local = np.stack([np.sqrt(u1) * np.cos(2 * np.pi * u2), np.sqrt(u1) * np.sin(2 * np.pi * u2), np.sqrt(1 - u1)], -1)
-    scene = build_mitsuba_scene(mi, dataclasses.replace(desc, room_albedo=0.0), max_depth=16)
+    black = tuple(dataclasses.replace(s, factor=np.zeros(3)) for s in desc.room_surfaces)
+    scene = build_mitsuba_scene(mi, dataclasses.replace(desc, room_albedo=0.0, room_surfaces=black),
+                                max_depth=16)
     sampler = mi.load_dict({"type": "independent"})
     sampler.seed(3, len(points) * rays)
     origins = np.repeat(points, rays, axis=0)

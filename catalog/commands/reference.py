@@ -6,7 +6,7 @@ from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
-INPUT_FILES = ("fabric",)
+INPUT_FILES = ("fabric", "room")
 OUTPUT_FILES = ("out",)
 HELP = "path-trace the snapshot scene (Mitsuba 3 on the CPU) to a linear EXR: the reference"
 
@@ -27,6 +27,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--no-fluorescence", action="store_true", help="without fluorescence")
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model (default physical)")
+    parser.add_argument("--room", default="box", help="room: a built-in name (box, living) or a .glb file")
     parser.add_argument("--out", required=True, help="FILE.exr (linear radiance)")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
@@ -42,7 +43,7 @@ def run(args) -> int:
         fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
         spp=args.spp, frame=args.frame, distance_m=args.distance, yaw_deg=args.yaw,
         pitch_deg=args.pitch, fluorescence="off" if args.no_fluorescence else args.mode,
-        variant=args.variant, seed=args.seed, max_depth=args.max_depth)
+        variant=args.variant, seed=args.seed, max_depth=args.max_depth, room=args.room)
     _, report = render_reference(request)
     if args.json:
         print_json(report)

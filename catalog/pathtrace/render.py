@@ -44,6 +44,7 @@ class ReferenceRequest:
     variant: str = "llvm_ad_rgb"
     seed: int = 0
     max_depth: int = MAX_DEPTH
+    room: str = "box"
 
 
 def check_out(path) -> Path:
@@ -94,6 +95,9 @@ def validate(request: ReferenceRequest):
     scene_lib.dye_transmittance(preset)
     scene_lib.fluorescent_material(preset)
     light = get_light(request.light)
+    from catalog.room.load import load_room  # noqa: PLC0415
+
+    load_room(request.room)          # a bad room is refused before Mitsuba loads
     return preset, light
 
 
@@ -103,7 +107,8 @@ def describe(request: ReferenceRequest):
     preset, light = validate(request)
     return describe_scene(preset, light, size=request.size, frame=request.frame,
                           yaw_deg=request.yaw_deg, pitch_deg=request.pitch_deg,
-                          distance_m=request.distance_m, fluorescence=request.fluorescence)
+                          distance_m=request.distance_m, fluorescence=request.fluorescence,
+                          room=request.room)
 
 
 #: A spectral variant renders in this many passes (or one a sample when spp is smaller):

@@ -10,7 +10,9 @@ the export follows because it holds no numbers of its own.
 What the reference keeps and what it replaces (the real-time frame's stand-ins for light
 it cannot trace are not light sources here; path tracing computes what they stand for):
 
-- kept: the room box with its window opening and the rod (grey Lambertian, ROOM_ALBEDO),
+- kept: the room (a catalog.room.model.Room, ``--room``: by default the built-in ``box``,
+  today's grey box with its window opening), each surface a Lambertian of its albedo
+  (factor x texture), the rod and rings (grey Lambertian, ROOM_ALBEDO),
   the curtain mesh, the camera (position, target, vertical field of view), the key light
   as a distant source with the disc of SUN_RADIUS_RAD and the key's normal irradiance, the
   sky above and the ground below the horizon with the real-time radiances (for a sun, the
@@ -69,8 +71,8 @@ class SceneDescription:
     near_m: float
     far_m: float
     curtain: tuple                       # positions, normals, uvs, tangents, indices
-    room_positions: np.ndarray           # (3T, 3) non-indexed triangles
-    room_albedo: float
+    room_positions: np.ndarray           # (3T, 3) non-indexed triangles: the rod and the rings
+    room_albedo: float                   # theirs
     fabric: dict                         # woven BSDF parameters + dye_rgb
     sky_rgb: np.ndarray
     ground_rgb: np.ndarray
@@ -86,6 +88,9 @@ class SceneDescription:
     fabric_size_m: tuple | None = None   # the rest fabric's (width, length) that uv 0..1 spans
     ring_xs_m: tuple = ()                # the curtain rings on the rod (x, m)
     sky: object = None                   # the frame's clear-sky model (a sun above the horizon)
+    room_surfaces: tuple = ()            # the room's catalog.room.model.Surface values
+    window_corners: np.ndarray | None = None   # (4, 3) the room's aperture
+    window_normal: np.ndarray | None = None    # (3,) into the room
 
 
 def rgb_weights(key_irradiance: np.ndarray) -> np.ndarray:
@@ -112,8 +117,9 @@ def key_light_for(light) -> tuple[np.ndarray, bool]:
 
 def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: float = 0.0,
                    pitch_deg: float = 0.0, distance_m: float = 2.6,
-                   fluorescence: str = "physical", curtain=None) -> SceneDescription:
-    """The snapshot scene for ``preset`` under ``light`` (a catalog.optics.lights.Light)."""
+                   fluorescence: str = "physical", curtain=None, room="box") -> SceneDescription:
+    """The snapshot scene for ``preset`` under ``light`` (a catalog.optics.lights.Light) in
+    ``room`` (a loaded catalog.room.model.Room, or a built-in name or .glb path)."""
     from catalog.render import scene as scene_lib  # noqa: PLC0415
     from catalog.render.camera import OrbitCamera  # noqa: PLC0415
 
@@ -135,7 +141,11 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         rings = tuple(ring_xs_m(preset))
     elif len(curtain) == 6:
         *curtain, fabric_size = curtain
-    room_positions, _ = scene_lib.room_props()
+    if isinstance(room, (str, bytes)) or hasattr(room, "__fspath__"):
+        from catalog.room.load import load_room  # noqa: PLC0415
+
+        room = load_room(room)
+    room_positions, _ = scene_lib.rod_mesh()
     if rings:
         ring_positions, _ = scene_lib.ring_mesh(list(rings))
         room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
@@ -189,8 +199,10 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         key_radius_rad=scene_lib.SUN_RADIUS_RAD, fill_rgb=w @ inputs.fill_irradiance,
         fill_to_light=np.asarray(inputs.fill_to_light, dtype=np.float64), fluorescence=fl,
         inputs=inputs, pattern=pattern, fabric_size_m=fabric_size, ring_xs_m=rings,
-        sky=clear_sky_for(inputs, is_sun),
-        info={"fabric": preset.name, "light": light.name, "fluorescence_requested": decision.requested,
+        sky=clear_sky_for(inputs, is_sun), room_surfaces=tuple(room.surfaces),
+        window_corners=np.asarray(room.window.corners, dtype=np.float64),
+        window_normal=np.asarray(room.window.normal, dtype=np.float64),
+        info={"room": room.name, "fabric": preset.name, "light": light.name, "fluorescence_requested": decision.requested,
               "fluorescence_variant": inputs.fluorescence_mode, "frame": int(frame),
               "camera": {"yaw_deg": camera.yaw_deg, "pitch_deg": camera.pitch_deg,
                          "distance_m": camera.distance_m}})
@@ -425,7 +437,7 @@ def key_visibility(desc: SceneDescription, scene, mi, positions) -> np.ndarray:
 
     p = np.asarray(positions, dtype=np.float64).reshape(-1, 3) + 1e-3 * desc.key_to_light
     d = np.repeat(desc.key_to_light[None, :], p.shape[0], axis=0)
-    wall_z = scene_lib.ROOM_BOX[2][0] + 1e-3
+    window_point, window_normal = _window_plane(desc)
     blocked = np.zeros(p.shape[0], dtype=bool)
     layers = np.zeros(p.shape[0])
     active = np.ones(p.shape[0], dtype=bool)
@@ -434,7 +446,7 @@ def key_visibility(desc: SceneDescription, scene, mi, positions) -> np.ndarray:
         si = scene.ray_intersect(ray)
         hit = np.asarray(si.is_valid(), dtype=bool) & active
         hit_p = np.asarray(si.p, dtype=np.float64).T
-        wall = hit & (hit_p[:, 2] < wall_z)
+        wall = hit & ((hit_p - window_point) @ window_normal < 1e-3)
         blocked |= wall
         cloth = hit & ~wall
         layers += cloth
@@ -444,6 +456,36 @@ def key_visibility(desc: SceneDescription, scene, mi, positions) -> np.ndarray:
         p = np.where(cloth[:, None], hit_p + 1e-4 * d, p)
     visible = float(desc.fabric["direct"]) ** layers
     return np.where(blocked, 0.0, visible)
+
+
+def _window_plane(desc: SceneDescription) -> tuple[np.ndarray, np.ndarray]:
+    """A point of the room's aperture and its normal (into the room); the box's without a room."""
+    if desc.window_corners is None:
+        from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+        return np.array([0.0, 0.0, scene_lib.WINDOW_Z]), np.array([0.0, 0.0, 1.0])
+    return np.asarray(desc.window_corners, dtype=np.float64)[0], np.asarray(desc.window_normal, dtype=np.float64)
+
+
+def _window_area_m2(desc: SceneDescription) -> float:
+    if desc.window_corners is None:
+        from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+        x0, x1, y0, y1 = scene_lib.WINDOW_RECT
+        return (x1 - x0) * (y1 - y0)
+    c = np.asarray(desc.window_corners, dtype=np.float64)
+    return 0.5 * float(np.linalg.norm(np.cross(c[2] - c[0], c[3] - c[1])))
+
+
+def room_surface_bsdf(mi, surface) -> object:
+    """A room surface's Lambertian BSDF: its factor, times its texture (linear) where it has one."""
+    if surface.texture is None:
+        return mi.load_dict({"type": "diffuse", "reflectance": {
+            "type": "rgb", "value": [float(v) for v in surface.factor]}})
+    albedo = np.ascontiguousarray(surface.texture * surface.factor[None, None, :], dtype=np.float32)
+    return mi.load_dict({"type": "diffuse", "reflectance": {
+        "type": "bitmap", "bitmap": mi.Bitmap(albedo), "raw": True, "filter_type": "bilinear",
+        "wrap_mode": "repeat"}})
 
 
 #: The least share of next-event samples an emitter gets (none is starved).
@@ -457,11 +499,8 @@ def emitter_sampling_weights(desc: SceneDescription, emission: np.ndarray) -> di
     room (the environment's through the window, a shell's pi L A), at least
     MIN_SAMPLING_SHARE each. Mitsuba's default, uniform over emitters, spends two thirds of
     the shadow rays on a faint glow under daylight and on a black sky under a UV lamp."""
-    from catalog.render import scene as scene_lib  # noqa: PLC0415
-
     luma = np.array([0.2126, 0.7152, 0.0722])
-    x0, x1, y0, y1 = scene_lib.WINDOW_RECT
-    window_m2 = (x1 - x0) * (y1 - y0)
+    window_m2 = _window_area_m2(desc)
     key = max(float(desc.key_rgb @ luma), 0.0) * window_m2
     backdrop = math.pi * 0.5 * max(float((desc.sky_rgb + desc.ground_rgb) @ luma), 0.0) * window_m2
     env = key + backdrop
@@ -515,6 +554,14 @@ def build_mitsuba_scene(mi, desc: SceneDescription, *, max_depth: int = 16,
             "type": "rgb", "value": [desc.room_albedo] * 3}})
         scene["room"] = _mesh(mi, "room", tris, np.arange(tris.shape[0]).reshape(-1, 3),
                               props=room_props)
+        for index, surface in enumerate(desc.room_surfaces):
+            corners = np.asarray(surface.triangles, dtype=np.float64).reshape(-1, 3)
+            surface_props = mi.Properties()
+            surface_props["bsdf"] = room_surface_bsdf(mi, surface)
+            uvs = None if surface.uvs is None else np.asarray(surface.uvs).reshape(-1, 2)
+            name = f"room_{index}"
+            scene[name] = _mesh(mi, name, corners, np.arange(corners.shape[0]).reshape(-1, 3),
+                                uvs=uvs, props=surface_props)
     # a spectral variant takes the key as its own spectrum (key_spectrum), a directional light
     # (the disc's 0.27 degree radius gives penumbrae under 1 mm at the folds' distances)
     spectral_key = bool(mi.is_spectral) and environment and not key_as_directional

@@ -204,6 +204,11 @@ def room_props() -> tuple[np.ndarray, np.ndarray]:
     return _flat_shaded(triangles)
 
 
+def rod_mesh() -> tuple[np.ndarray, np.ndarray]:
+    """The curtain rod alone (the last of the room's parts), flat-shaded like :func:`room_props`."""
+    return _flat_shaded(_room_parts()[-1])
+
+
 def _flat_shaded(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     normals = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)

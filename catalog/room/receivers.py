@@ -1,0 +1,153 @@
+"""The room's receivers: its triangles cut into small elements (a regular barycentric grid
+of n x n sub-triangles per triangle, n from the element size), each with a centre, a normal,
+an area and an albedo. A ray's hit (triangle, point) maps to its element in closed form
+(:meth:`Receivers.element_at`). Float64 numpy."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Receivers:
+    """``corners`` (E, 3, 3) m; ``normal`` (E, 3); ``area_m2`` (E,); ``albedo`` (E, 3) linear;
+    ``triangle`` (E,) the room triangle each lies in; ``divisions`` (T,) n per triangle and
+    ``first`` (T,) its first element."""
+
+    corners: np.ndarray
+    normal: np.ndarray
+    area_m2: np.ndarray
+    albedo: np.ndarray
+    triangle: np.ndarray
+    divisions: np.ndarray
+    first: np.ndarray
+    triangles: np.ndarray
+
+    @property
+    def count(self) -> int:
+        return int(self.corners.shape[0])
+
+    @property
+    def centre(self) -> np.ndarray:
+        return self.corners.mean(axis=1)
+
+    def sample_points(self, index: np.ndarray, rng) -> np.ndarray:
+        """(N, 3) uniform random points in elements ``index`` (N,)."""
+        r1, r2 = rng.random((2, index.shape[0]))
+        s = np.sqrt(r1)
+        b = np.stack([1 - s, s * (1 - r2), s * r2], axis=1)
+        return np.einsum("nk,nkj->nj", b, self.corners[index])
+
+    def element_at(self, triangle: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """(N,) element index of ``points`` lying on room triangles ``triangle`` (N,)."""
+        t = self.triangles[triangle]
+        e1, e2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+        p = points - t[:, 0]
+        d11, d12, d22 = (np.einsum("ni,ni->n", e1, e1), np.einsum("ni,ni->n", e1, e2),
+                         np.einsum("ni,ni->n", e2, e2))
+        p1, p2 = np.einsum("ni,ni->n", p, e1), np.einsum("ni,ni->n", p, e2)
+        det = d11 * d22 - d12 * d12
+        b1 = np.clip((d22 * p1 - d12 * p2) / det, 0.0, 1.0)
+        b2 = np.clip((d11 * p2 - d12 * p1) / det, 0.0, 1.0)
+        n = self.divisions[triangle]
+        return self.first[triangle] + grid_index(b1, b2, n)
+
+
+def grid_index(b1: np.ndarray, b2: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Local index of the sub-triangle holding barycentrics (b1, b2) in an n x n grid:
+    'up' triangles (i, j) first, row by row (j), then the 'down' ones."""
+    x, y = b1 * n, b2 * n
+    j = np.clip(np.floor(y).astype(np.int64), 0, n - 1)
+    i = np.clip(np.floor(x).astype(np.int64), 0, n - 1 - j)
+    up = ((x - i) + (y - j) <= 1.0) | (i + j >= n - 1)
+    up_index = j * n - j * (j - 1) // 2 + i
+    down_index = n * (n + 1) // 2 + j * (n - 1) - j * (j - 1) // 2 + i
+    return np.where(up, up_index, down_index)
+
+
+def _grid(n: int) -> np.ndarray:
+    """(n*n, 3, 2) barycentric (b1, b2) corners of the grid's sub-triangles, in grid_index order."""
+    cells = []
+    for j in range(n):
+        for i in range(n - j):
+            cells.append(((i, j), (i + 1, j), (i, j + 1)))
+    for j in range(n - 1):
+        for i in range(n - 1 - j):
+            cells.append(((i + 1, j), (i + 1, j + 1), (i, j + 1)))
+    return np.array(cells, dtype=np.float64) / n
+
+
+def divisions_for(triangles: np.ndarray, size_m: float) -> np.ndarray:
+    """n per triangle: elements of about size_m (their area ~ size_m^2 / 2, their longest
+    edge at most 3 size_m)."""
+    e = np.stack([triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 1],
+                  triangles[:, 0] - triangles[:, 2]], axis=1)
+    longest = np.linalg.norm(e, axis=2).max(axis=1)
+    area = 0.5 * np.linalg.norm(np.cross(e[:, 0], -e[:, 2]), axis=1)
+    return np.maximum(1, np.ceil(np.maximum(np.sqrt(2 * area) / size_m, longest / (3 * size_m)))).astype(np.int64)
+
+
+def build_receivers(triangles: np.ndarray, albedo_of, size_m: float) -> Receivers:
+    """Cut ``triangles`` (T, 3, 3) into elements of about ``size_m``; ``albedo_of(tri, bary)``
+    gives (N, 3) albedo at barycentrics (N, 3) of room triangles tri (N,) (the element's
+    albedo is its mean at four points)."""
+    triangles = np.asarray(triangles, dtype=np.float64)
+    n = divisions_for(triangles, size_m)
+    first = np.concatenate([[0], np.cumsum(n * n)[:-1]])
+    corners, tri_index, bary_corners = [], [], []
+    grids = {}
+    for t, k in enumerate(n):
+        g = grids.setdefault(int(k), _grid(int(k)))
+        b = np.concatenate([1 - g.sum(axis=2, keepdims=True), g], axis=2)    # (k*k, 3, 3)
+        corners.append(np.einsum("ecv,vj->ecj", b, triangles[t]))
+        bary_corners.append(b)
+        tri_index.append(np.full(g.shape[0], t))
+    corners = np.concatenate(corners)
+    bary_corners = np.concatenate(bary_corners)
+    tri_index = np.concatenate(tri_index)
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    normal = cross / np.maximum(2 * area, 1e-300)[:, None]
+    rule = np.array([[1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+    points = np.einsum("qc,ecv->eqv", rule, bary_corners)                      # (E, 4, 3) bary
+    albedo = albedo_of(np.repeat(tri_index, 4), points.reshape(-1, 3)).reshape(-1, 4, 3).mean(axis=1)
+    return Receivers(corners, normal, area, albedo, tri_index, n, first, triangles)
+
+
+def subset(r: Receivers, keep: np.ndarray) -> tuple[Receivers, np.ndarray]:
+    """The receivers ``keep`` (bool (E,)) and the map old index -> new (-1: dropped)."""
+    new = np.full(r.count, -1, dtype=np.int64)
+    new[keep] = np.arange(int(keep.sum()))
+    return Receivers(r.corners[keep], r.normal[keep], r.area_m2[keep], r.albedo[keep],
+                     r.triangle[keep], r.divisions, r.first, r.triangles), new
+
+
+def room_albedo_of(room):
+    """``albedo_of`` for :func:`build_receivers` over ``room.triangles()`` (texture x factor)."""
+    surface, local = room.surface_of_triangle()
+
+    def albedo_of(tri: np.ndarray, bary: np.ndarray) -> np.ndarray:
+        out = np.empty((tri.shape[0], 3))
+        for s_index, s in enumerate(room.surfaces):
+            mask = surface[tri] == s_index
+            if mask.any():
+                out[mask] = s.albedo_at(local[tri[mask]], bary[mask])
+        return out
+
+    return albedo_of
+
+
+def cosine_directions(normals: np.ndarray, rng) -> np.ndarray:
+    """(N, 3) cosine-distributed unit directions around unit ``normals`` (N, 3)."""
+    r1, r2 = rng.random((2, normals.shape[0]))
+    phi = 2 * math.pi * r1
+    s = np.sqrt(r2)
+    local = np.stack([s * np.cos(phi), s * np.sin(phi), np.sqrt(1 - r2)], axis=1)
+    helper = np.where(np.abs(normals[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]])
+    t = np.cross(normals, helper)
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    b = np.cross(normals, t)
+    return local[:, :1] * t + local[:, 1:2] * b + local[:, 2:] * normals
