@@ -295,7 +295,7 @@ class FrameRenderer:
         self._is_sun = False
         self.mode = "physical"
         self.n_bands = 3
-        self.camera = OrbitCamera()
+        self.camera = OrbitCamera(bounds=scene_lib.ROOM_BOX)
         self.exposure = 1.0              # a multiplier on top of the EV (compensation)
         self.ev100 = None                # None: metered per frame (auto exposure)
         self.white_balance = display_lib.DEFAULT_WHITE_BALANCE
@@ -724,9 +724,15 @@ class FrameRenderer:
     def set_bands(self, n_bands: int) -> None:
         self.n_bands = band_lib.check_band_count(n_bands)
 
-    def set_camera(self, yaw_deg: float, pitch_deg: float, distance_m: float) -> None:
+    def set_camera(self, yaw_deg: float, pitch_deg: float, distance_m: float,
+                   target=None, fov_y_deg: float | None = None) -> None:
+        """The orbit camera (catalog.render.camera), kept inside the room's box."""
+        extra = {} if fov_y_deg is None else {"fov_y_deg": float(fov_y_deg)}
+        if target is not None:
+            extra["target"] = tuple(float(v) for v in target)
         self.camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                                  distance_m=float(distance_m))
+                                  distance_m=float(distance_m), bounds=scene_lib.ROOM_BOX,
+                                  **extra)
 
     def set_exposure(self, multiplier: float) -> None:
         if not (math.isfinite(multiplier) and multiplier > 0):
