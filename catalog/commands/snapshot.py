@@ -29,7 +29,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model (default physical)")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3 (RGB), 6, 9, 16")
-    from catalog.render.camera import DEFAULT_VIEW, VIEWS  # noqa: PLC0415
+    from catalog.render.views import DEFAULT_VIEW, VIEWS  # noqa: PLC0415
 
     parser.add_argument("--view", choices=tuple(VIEWS), default=DEFAULT_VIEW,
                         help="the composition: " + "; ".join(
@@ -79,7 +79,7 @@ def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.snapshot import SnapshotRequest, parse_size, render_snapshot  # noqa: PLC0415
 
-    from catalog.render.camera import view_named  # noqa: PLC0415
+    from catalog.render.views import view_named  # noqa: PLC0415
 
     ev, white_balance = display_choices(args)
     view = view_named(args.view)

@@ -54,13 +54,46 @@ def fit_preset(args, started_s: float) -> dict:
 
     doc = preset_document(args, out, data, header, result, rho, tau, dye_path)
     preset_from_dict(doc, out)          # refuse before anything is written
+    pattern = _fitted_pattern(args, doc) if getattr(args, "pattern", None) else None
     if args.plot:
         plot_fit(data, hg, ct, Path(args.plot), title=doc["display_name"])
+    if pattern is not None:
+        from catalog.presets.patterns import write_pattern_images
+
+        write_pattern_images(pattern, out.parent / doc["pattern"]["coverage"], None)
     save_preset_dict(doc, out)
     elapsed = time.perf_counter() - started_s
 
     summary = json_summary(doc, result, out, elapsed)
     return summary
+
+
+def _fitted_pattern(args, doc):
+    """``--pattern IMAGE``: the image read as a coverage, remapped to the fitted open area
+    (catalog.presets.patterns.match_open_area) and named in ``doc``'s [pattern] table
+    (patterns/NAME.png beside the preset). Returns the pattern to write."""
+    from dataclasses import replace
+    from pathlib import Path
+
+    from catalog.core.errors import InputError
+    from catalog.presets.patterns import match_open_area, pattern_from_images
+
+    try:
+        repeat = [float(v) for v in str(args.pattern_repeat).split(",")]
+    except ValueError:
+        repeat = []
+    if len(repeat) not in (1, 2) or not all(math.isfinite(v) and 0 < v <= 10 for v in repeat):
+        raise InputError(f"{args.pattern_repeat!r}: one or two lengths in metres (0, 10]",
+                         field="--pattern-repeat")
+    pattern = pattern_from_images(args.pattern, repeat[0] if len(repeat) == 1 else repeat)
+    coverage = match_open_area(pattern.coverage, doc["btdf"]["direct"], where=args.pattern)
+    rel = f"patterns/{doc['name']}.png"
+    target = Path(args.out).parent / rel
+    if target.resolve() == Path(args.pattern).resolve():
+        raise InputError("would overwrite the input image; move it first", field="--pattern")
+    doc["pattern"] = {"coverage": rel, "repeat_m": [round(v, 8) for v in pattern.repeat_m],
+                      "kind": "image"}
+    return replace(pattern, coverage=coverage, height=None)
 
 
 def fit_measurement(data, weighting: str) -> dict:

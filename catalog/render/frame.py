@@ -428,7 +428,11 @@ class FrameRenderer:
         texture = self.ctx.texture((w, h), 4, np.ascontiguousarray(texels).tobytes(), dtype="f4")
         texture.repeat_x = texture.repeat_y = True
         texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
-        texture.build_mipmaps()
+        texture.build_mipmaps()   # allocates the levels; their texels are the prefiltered chain
+        from catalog.presets.patterns import mip_chain  # noqa: PLC0415
+
+        for level, image in enumerate(mip_chain(texels)[1:], start=1):
+            texture.write(np.ascontiguousarray(image, dtype="f4").tobytes(), level=level)
         max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
         texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
         self._pattern_texture = texture
