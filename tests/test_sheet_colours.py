@@ -62,3 +62,19 @@ def test_every_catalog_pair_differs_by_two_delta_e(cells):
     worst = min((float(delta_e_2000(cells[a], cells[b], WHITE_XYZ).mean()), a, b)
                 for a, b in itertools.combinations(sorted(cells), 2))
     assert worst[0] >= 2.0, worst
+
+
+def test_inset_keeps_the_swatch_brightness_and_frames_it():
+    """put_inset: the area-averaged swatch (in linear light) keeps a checkerboard's mean
+    linear level (0.5 -> sRGB 188), sits in the lower right corner inside a dark frame, and
+    leaves the rest of the cell untouched."""
+    from catalog.render.sheet import put_inset
+
+    cell = np.full((96, 128, 3), 100, np.uint8)
+    swatch = np.zeros((96, 128, 3), np.uint8)
+    swatch[::2, ::2] = swatch[1::2, 1::2] = 255
+    put_inset(cell, swatch, 0.5)
+    inner = cell[-2 - 48:-2, -2 - 64:-2]
+    assert abs(float(inner.mean()) - 188.0) <= 1.0
+    assert cell[-2 - 48 - 1, -30, 0] == 16 and cell[-1 - 1, -2 - 64 - 1, 0] == 16
+    assert np.all(cell[:40, :60] == 100)
