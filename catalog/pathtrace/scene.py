@@ -118,7 +118,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
     from catalog.render.camera import OrbitCamera  # noqa: PLC0415
 
     camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                         distance_m=float(distance_m), bounds=scene_lib.ROOM_BOX)
+                         distance_m=float(distance_m))
     to_light, is_sun = key_light_for(light)
     inside = bool(camera.position[2] > scene_lib.WINDOW_Z)
     # as the frame builds them (FrameRenderer.shading_inputs): a ``sun:PATH_KM`` light is the

@@ -295,7 +295,7 @@ class FrameRenderer:
         self._is_sun = False
         self.mode = "physical"
         self.n_bands = 3
-        self.camera = OrbitCamera(bounds=scene_lib.ROOM_BOX)
+        self.camera = OrbitCamera()
         self.exposure = 1.0              # a multiplier on top of the EV (compensation)
         self.ev100 = None                # None: metered per frame (auto exposure)
         self.white_balance = display_lib.DEFAULT_WHITE_BALANCE
@@ -351,6 +351,9 @@ class FrameRenderer:
         self.key_second_layer = True
         #: the pattern's LOD bias (set_pattern_lod_bias)
         self.pattern_lod_bias = PATTERN_LOD_BIAS
+        #: the pattern's mip levels from catalog.presets.patterns.mip_chain (True) or the
+        #: hardware's 2x2 box chain (False: the web page's, which replays whole-texture writes)
+        self.pattern_prefilter = True
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -429,10 +432,11 @@ class FrameRenderer:
         texture.repeat_x = texture.repeat_y = True
         texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
         texture.build_mipmaps()   # allocates the levels; their texels are the prefiltered chain
-        from catalog.presets.patterns import mip_chain  # noqa: PLC0415
+        if self.pattern_prefilter:
+            from catalog.presets.patterns import mip_chain  # noqa: PLC0415
 
-        for level, image in enumerate(mip_chain(texels)[1:], start=1):
-            texture.write(np.ascontiguousarray(image, dtype="f4").tobytes(), level=level)
+            for level, image in enumerate(mip_chain(texels)[1:], start=1):
+                texture.write(np.ascontiguousarray(image, dtype="f4").tobytes(), level=level)
         max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
         texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
         self._pattern_texture = texture
@@ -440,6 +444,13 @@ class FrameRenderer:
         self._pattern_repeat_m = tuple(float(v) for v in repeat)
         self._pattern_mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
         self._pattern_key = key
+
+    def set_pattern_prefilter(self, on: bool) -> None:
+        """The pattern's mip chain: prefiltered (True, default: a periodic Gaussian per level,
+        no moire) or the hardware's box chain (False). Takes effect at the next fabric load."""
+        if bool(on) != self.pattern_prefilter:
+            self.pattern_prefilter = bool(on)
+            self._pattern_key = None
 
     def set_pattern_filtering(self, filtered: bool) -> None:
         """True (default): trilinear mipmapped, anisotropic; False: nearest texel, no mips
@@ -729,14 +740,15 @@ class FrameRenderer:
         self.n_bands = band_lib.check_band_count(n_bands)
 
     def set_camera(self, yaw_deg: float, pitch_deg: float, distance_m: float,
-                   target=None, fov_y_deg: float | None = None) -> None:
-        """The orbit camera (catalog.render.camera), kept inside the room's box."""
+                   target=None, fov_y_deg: float | None = None, inside: bool = False) -> None:
+        """The orbit camera (catalog.render.camera); ``inside``: kept inside the room's box
+        (what every command asks for; the library also draws the room from outside)."""
         extra = {} if fov_y_deg is None else {"fov_y_deg": float(fov_y_deg)}
         if target is not None:
             extra["target"] = tuple(float(v) for v in target)
         self.camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                                  distance_m=float(distance_m), bounds=scene_lib.ROOM_BOX,
-                                  **extra)
+                                  distance_m=float(distance_m),
+                                  bounds=scene_lib.ROOM_BOX if inside else None, **extra)
 
     def set_exposure(self, multiplier: float) -> None:
         if not (math.isfinite(multiplier) and multiplier > 0):

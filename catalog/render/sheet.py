@@ -82,7 +82,7 @@ def close_up(renderer) -> np.ndarray:
     camera = renderer.camera
     view = VIEWS["close"]
     renderer.set_camera(view.yaw_deg, view.pitch_deg, view.distance_m, target=view.target,
-                        fov_y_deg=view.fov_y_deg)
+                        fov_y_deg=view.fov_y_deg, inside=True)
     try:
         renderer.render()
         return renderer.read_srgb8()

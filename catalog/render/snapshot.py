@@ -211,7 +211,7 @@ def configure_renderer(renderer, request: SnapshotRequest, preset, light):
     renderer.set_fluorescence(request.fluorescence)
     renderer.set_bands(request.bands)
     renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m,
-                        target=request.target, fov_y_deg=request.fov_y_deg)
+                        target=request.target, fov_y_deg=request.fov_y_deg, inside=True)
     renderer.set_exposure(request.exposure)
     renderer.set_ev(request.ev)
     renderer.set_white_balance(request.white_balance)

@@ -216,7 +216,7 @@ class ViewerApp:
                                                                 self._viewports())):
                     renderer.set_camera(self.camera.yaw_deg, self.camera.pitch_deg,
                                         self.camera.distance_m, target=self.camera.target,
-                                        fov_y_deg=self.camera.fov_y_deg)
+                                        fov_y_deg=self.camera.fov_y_deg, inside=True)
                     try:
                         self._set_exposure(slot, renderer)
                         if self._scaled_fbos:
