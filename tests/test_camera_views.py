@@ -83,3 +83,19 @@ def test_default_view_shows_lit_side_walls(tmp_path):
     curtain = np.sort(middle)[-w // 8:].mean()
     for side in (px[:, :w // 6], px[:, -w // 6:]):
         assert side.mean() >= curtain / 3.0, (side.mean(), curtain)
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_snapshot_keeps_the_camera_in_the_room(tmp_path, capsys):
+    """The issue's command, ``snapshot --distance 3.5 --yaw 40``: the report's camera lies
+    inside the room's box (it left it before: a sky wedge at the frame's edge)."""
+    import json
+
+    from catalog.commands.cli import main
+
+    assert main(["snapshot", "--fabric", "voile-white", "--light", "D65", "--size", "64x36",
+                 "--distance", "3.5", "--yaw", "40", "--out", str(tmp_path / "a.png"),
+                 "--json"]) == 0
+    camera = json.loads(capsys.readouterr().out)["camera"]
+    assert _inside(camera["position_m"], 0.0) and camera["distance_m"] < 3.5, camera
