@@ -69,3 +69,26 @@ def test_the_default_breeze_sways_the_lightest_curtain_and_a_gale_throws_it():
         rises[wind] = worst
     assert rises[DEFAULT_WIND_M_S] < 0.10
     assert rises[2.0] > 0.30
+
+
+def test_heading_folds_keep_the_fabric_at_rest_length():
+    """The rest pose's heading (catalog.cloth.state.top_row): neighbouring columns on a fold's
+    leg are one rest spacing apart (1e-9 m) for every catalog preset (only the chord across an
+    apex that falls between two columns, odd columns per span, is shorter; at most one per
+    fold), none is longer, and no fold reaches the wall. Before
+    issue 34 a V deeper than half the wall gap was flattened, its legs 30 % short for fullness
+    2: the squeezed heading pushed the fabric out below it (the hem flared)."""
+    from catalog.cloth.drape import drape_params
+    from catalog.cloth.state import ring_columns, top_row
+    from catalog.presets import list_presets, load_preset
+
+    for path in list_presets():
+        params = drape_params(load_preset(path))
+        row = top_row(params)
+        steps = np.linalg.norm(np.diff(row, axis=0), axis=1)
+        dx = params.spacing_x_m
+        assert np.all(steps <= dx + 1e-9), path.stem
+        short = np.sum(steps < dx - 1e-9)
+        spans = len(ring_columns(params)) - 1
+        assert short <= spans, (path.stem, short, spans)
+        assert row[:, 2].min() >= -params.wall_gap_m + params.thickness_m, path.stem

@@ -314,3 +314,46 @@ def test_catalog_fit_refuses_bad_options(tmp_path, capsys):
                                 "--out", tmp_path / "voile.toml", "--rho", "1.5")
     assert status == 2 and "--rho" in stderr
     assert not any(tmp_path.iterdir())
+
+
+# --- catalog fit --pattern IMAGE (issue 34) -------------------------------------------------
+
+def test_match_open_area_remaps_to_the_fitted_ld_and_keeps_holes():
+    """c^gamma hits LD to 1e-6, keeps c = 0 and c = 1 and every pixel's order; an image whose
+    holes alone exceed LD is refused naming --pattern."""
+    from catalog.core.errors import InputError
+    from catalog.presets.patterns import match_open_area
+
+    rng = np.random.default_rng(7)
+    c = rng.uniform(0.0, 1.0, (32, 32))
+    c[:4] = 0.0
+    c[-2:] = 1.0
+    out = match_open_area(c, 0.3)
+    assert abs(1.0 - out.mean(dtype=np.float64) - 0.3) < 1e-6
+    assert np.all(out[:4] == 0.0) and np.all(out[-2:] == 1.0)
+    order = np.argsort(c.ravel(), kind="stable")
+    assert np.all(np.diff(out.ravel()[order]) >= -1e-7)
+    with pytest.raises(InputError, match="--pattern"):
+        match_open_area(c, 0.05)     # 12.5 % of the image is holes
+
+
+def test_fit_with_a_pattern_writes_a_self_contained_preset(tmp_path):
+    """``catalog fit --pattern IMAGE --pattern-repeat W``: the preset gets a [pattern] whose
+    image lies beside it and whose open area is the fit's LD within formats' 1 %."""
+    from catalog.core.resources import FABRIC_DIR
+    from catalog.presets import load_preset
+    from catalog.presets.patterns import OPEN_AREA_TOLERANCE, load_pattern
+
+    out = tmp_path / "mine.toml"
+    assert catalog_main(["fit", "--gonio", str(FABRIC_DIR / "measurements/voile-white/gonio.csv"),
+                         "--name", "mine", "--out", str(out), "--pattern",
+                         str(FABRIC_DIR / "patterns/jacquard-white.png"),
+                         "--pattern-repeat", "0.1"]) == 0
+    preset = load_preset(out)
+    pattern = load_pattern(preset)
+    assert (tmp_path / "mine" / "patterns" / "mine.png").is_file()   # in its own folder
+    assert pattern.repeat_m == pytest.approx((0.1, 0.1))
+    assert abs(pattern.open_area - preset.btdf.direct) <= OPEN_AREA_TOLERANCE * preset.btdf.direct
+    assert catalog_main(["fit", "--gonio", str(FABRIC_DIR / "measurements/voile-white/gonio.csv"),
+                         "--name", "other", "--out", str(tmp_path / "other.toml"), "--pattern",
+                         str(FABRIC_DIR / "patterns/jacquard-white.png")]) == 2

@@ -151,3 +151,22 @@ def test_a_preset_whose_pattern_misses_its_direct_is_not_written(tmp_path):
     doc["btdf"]["direct"] = 1 - 128 / 255
     save_preset_dict(doc, target)
     assert load_pattern(load_preset(target)).open_area == pytest.approx(1 - 128 / 255, abs=1e-6)
+
+
+def test_three_distinct_laces_with_cords_and_a_half_drop():
+    """At least three laces (kind "lace"); each has a hexagonal net ground (holes over >= 20 %
+    of the repeat), cord relief (height 1 somewhere, the net's threads at most 0.3), dense
+    cloth-stitch (c >= 0.8 over >= 8 %), and no two laces share a repeat or a coverage."""
+    laces = [load_preset(p) for p in list_presets()
+             if load_preset(p).table("pattern").get("kind") == "lace"]
+    assert len(laces) >= 3
+    seen = []
+    for preset in laces:
+        pattern = load_pattern(preset)
+        c, h = pattern.coverage, pattern.height
+        assert np.mean(c == 0.0) > 0.2, preset.name
+        assert h.max() > 0.99 and np.mean(h > 0.9) > 0.003, preset.name
+        assert np.mean(c >= 0.8) > 0.08, preset.name
+        key = (tuple(round(r, 6) for r in pattern.repeat_m), c.shape)
+        assert key not in seen, preset.name
+        seen.append(key)

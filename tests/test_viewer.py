@@ -584,9 +584,11 @@ def test_orbit_camera_clamps_and_wraps():
     from catalog.viewer.input import room_limit_m
 
     assert camera.distance_m == min(camera.max_distance_m,
-                                    room_limit_m(camera.yaw_deg, camera.pitch_deg))
-    camera.reset()
-    assert (camera.yaw_deg, camera.pitch_deg, camera.distance_m) == (0.0, 0.0, 2.6)
+                                    room_limit_m(camera.yaw_deg, camera.pitch_deg, camera.target))
+    camera.reset()   # the home view: the default view's composition (catalog.render.camera)
+    view = camera.view
+    assert (camera.yaw_deg, camera.pitch_deg, camera.distance_m) == (
+        view.yaw_deg, view.pitch_deg, view.distance_m)
     camera.drag(float("nan"), 1.0)
     camera.zoom(float("inf"))
     assert np.isfinite([camera.yaw_deg, camera.pitch_deg, camera.distance_m]).all()

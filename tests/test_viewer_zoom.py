@@ -56,13 +56,15 @@ def test_the_zoom_slider_moves_the_camera_and_reset_brings_it_home(gui):
     y = 0.5 * (y0 + y1)
     _click(gui, panel, camera, x0 + 3.0, y)   # the slider's near end
     assert abs(math.log(camera.distance_m / camera.min_distance_m)) < 0.05
-    far = min(camera.max_distance_m, room_limit_m(camera.yaw_deg, camera.pitch_deg))
+    far = min(camera.max_distance_m, room_limit_m(camera.yaw_deg, camera.pitch_deg,
+                                                   camera.target))
     _click(gui, panel, camera, x1 - 3.0, y)   # the far end: kept inside the room
     assert camera.distance_m <= far + 1e-9
     assert abs(math.log(camera.distance_m / far)) < 0.05
     (x0, y0), (x1, y1) = panel.reset_rect_px
     _click(gui, panel, camera, 0.5 * (x0 + x1), 0.5 * (y0 + y1))
-    assert camera.distance_m == 2.6 and camera.yaw_deg == 0.0 and camera.pitch_deg == 0.0
+    assert camera.distance_m == 2.6 and camera.yaw_deg == camera.view.yaw_deg \
+        and camera.pitch_deg == camera.view.pitch_deg
 
 
 def test_set_distance_is_clamped_like_the_wheel():

@@ -123,6 +123,14 @@ DYES = {
     "grey": lambda wl: np.full_like(wl, 0.45),
     # ivory: a little blue absorbed
     "ivory": lambda wl: 0.97 - 0.22 * (1 - _sigmoid(wl, 450.0, 20.0)),
+    # cream: a warm yellowish white, the violet-blue absorbed up to about 490 nm (an
+    # unbleached or cream-dyed cotton's reflectance falls from ~0.85 in the red to ~0.6 at
+    # 420 nm); a slight green dip keeps it from reading lemon
+    "cream": lambda wl: 0.96 - 0.42 * (1 - _sigmoid(wl, 485.0, 22.0))
+                        - 0.03 * _gauss(wl, 540.0, 40.0),
+    # natural flax (unbleached linen): an ecru that absorbs across the blue and a little of
+    # the green (CIELAB a* ~ 1, b* ~ 8 on screen), less yellow than cream
+    "flax": lambda wl: 0.90 - 0.30 * (1 - _sigmoid(wl, 520.0, 45.0)),
 }
 
 CATALOG: tuple[YarnFabric, ...] = (
@@ -132,7 +140,7 @@ CATALOG: tuple[YarnFabric, ...] = (
                crossings=2.5, albedo=0.92, sigma_x_deg=7.5, sigma_y_deg=6.5, seed=102),
     YarnFabric("linen-dense", "Dense linen", "plain", 0.42, 0.46, 0.45, 0.48, 0.55,
                crossings=7.0, albedo=0.90, sigma_x_deg=11.0, sigma_y_deg=9.0, back_scale=3.0,
-               seed=103, cloth={"areal_density_kg_m2": 0.19}),
+               dye="flax", seed=103, cloth={"areal_density_kg_m2": 0.19}),
     YarnFabric("sheer-teal", "Teal sheer", "voile", 0.11, 0.25, 0.11, 0.24, 0.15,
                crossings=2.8, albedo=0.95, sigma_x_deg=7.5, sigma_y_deg=6.5, dye="teal",
                seed=104),
@@ -146,10 +154,17 @@ CATALOG: tuple[YarnFabric, ...] = (
                crossings=1.6, albedo=0.97, sigma_x_deg=7.0, sigma_y_deg=6.0, dye="ivory",
                seed=107, cloth={"areal_density_kg_m2": 0.03}),
     YarnFabric("batiste-cream", "Cream batiste", "plain", 0.14, 0.19, 0.14, 0.19, 0.18,
-               crossings=4.5, albedo=0.93, sigma_x_deg=8.5, sigma_y_deg=7.5, seed=108),
+               crossings=4.5, albedo=0.93, sigma_x_deg=8.5, sigma_y_deg=7.5, dye="cream",
+               seed=108),
     YarnFabric("net-grey", "Grey net", "lace", 0.10, 0.50, 0.10, 0.50, 0.14,
                crossings=3.0, albedo=0.95, sigma_x_deg=9.0, sigma_y_deg=9.0, dye="grey",
                seed=109, cloth={"areal_density_kg_m2": 0.035}),
+    YarnFabric("raschel-ivory", "Ivory Raschel lace", "lace", 0.18, 0.40, 0.16, 0.38, 0.24,
+               crossings=3.2, albedo=0.94, sigma_x_deg=8.0, sigma_y_deg=7.0, dye="ivory",
+               seed=111, cloth={"areal_density_kg_m2": 0.07}),
+    YarnFabric("tulle-embroidered", "White embroidered tulle", "lace", 0.10, 0.40, 0.10,
+               0.40, 0.14, crossings=2.5, albedo=0.95, sigma_x_deg=8.0, sigma_y_deg=8.0,
+               seed=112, cloth={"areal_density_kg_m2": 0.04}),
     YarnFabric("jacquard-white", "White jacquard", "satin", 0.30, 0.34, 0.28, 0.31, 0.45,
                crossings=6.0, albedo=0.93, sigma_x_deg=10.0, sigma_y_deg=7.0,
                back_scale=3.5, seed=110, cloth={"areal_density_kg_m2": 0.26}),

@@ -25,15 +25,22 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # lace_motifs beside this file
 FABRICS = ROOT / "fabrics"
 SQRT3 = math.sqrt(3.0)
 
 #: name -> the pattern's named parameters (lengths in mm). ``size`` = texture side in px.
 PATTERNS: dict[str, dict] = {
-    # lace: a six-petal rosette (cloth-stitch fill, a gimp cord around it) on a hexagonal
-    # tulle of 1 mm cells, repeat 0.1 m (100 cells across, 58 rows of cell pairs down)
-    "lace-fwa": {"kind": "lace", "cell_mm": 1.0, "cells_u": 100, "row_pairs_v": 58,
-                 "rosette_mm": 28.0, "petals": 6, "fill": 0.9, "cord_mm": 0.8, "size": 1024},
+    # laces (tools/lace_motifs.py): a hexagonal net ground of cell_mm holes, cord-outlined
+    # cloth-stitch motifs with open fillings, at several scales on a half-drop repeat
+    # (cells_u cells across, row_pairs_v pairs of hexagon rows down; even, so the filling's
+    # honeycomb of twice the cell tiles too)
+    "lace-fwa": {"kind": "lace", "layout": "leavers", "cell_mm": 1.0, "cells_u": 100,
+                 "row_pairs_v": 86, "cord_mm": 0.8, "size": 1024},
+    "raschel-ivory": {"kind": "lace", "layout": "raschel", "cell_mm": 1.25, "cells_u": 96,
+                      "row_pairs_v": 50, "cord_mm": 1.2, "size": 1024},
+    "tulle-embroidered": {"kind": "lace", "layout": "tulle", "cell_mm": 0.8, "cells_u": 100,
+                          "row_pairs_v": 56, "cord_mm": 0.6, "size": 1024},
     "net-grey": {"kind": "net", "cell_mm": 2.0, "cells_u": 8, "row_pairs_v": 5, "size": 256},
     "safety-yellow": {"kind": "net", "cell_mm": 1.5, "cells_u": 8, "row_pairs_v": 5, "size": 256},
     # woven sheers: pitch = thread spacing, the yarn width found from LD
@@ -112,59 +119,72 @@ def net_pattern(p, direct):
                                   "height_m": round(1.4 * half, 8)}
 
 
-def _rosette(x, y, centre, radius, petals):
-    """Signed distance-like field of a rosette: r / R(theta) - 1 (< 0 inside)."""
-    dx, dy = x - centre[0], y - centre[1]
-    r = np.hypot(dx, dy)
-    theta = np.arctan2(dy, dx)
-    shape = radius * (0.55 + 0.45 * np.abs(np.cos(0.5 * petals * theta)))
-    return r - shape, r
+def _leavers(lace, ru, rv):
+    """A Leavers floral all-over: per half-drop column a large six-petal flower with two
+    leaves, a smaller five-petal flower on a scrolling stem, buds and scattered spots."""
+    for u0, v0, flip in ((0.25 * ru, 0.25 * rv, 1.0), (0.75 * ru, 0.75 * rv, -1.0)):
+        lace.flower((u0, v0), 0.021, 6, rotation=0.3 * flip)
+        lace.leaf((u0 + flip * 0.026, v0 + 0.022), 0.024, 0.009, flip * 0.7)
+        lace.leaf((u0 - flip * 0.020, v0 + 0.030), 0.020, 0.008, -flip * 1.1)
+        small = (u0 + flip * 0.024, v0 - 0.042)
+        lace.flower(small, 0.010, 5, rotation=0.5, open_petals=False)
+        lace.scroll((u0 + flip * 0.012, v0 - 0.018), small, 0.006 * flip)
+        lace.scroll(small, (u0 - flip * 0.018, v0 - 0.060), -0.008 * flip)
+        for k, (du, dv) in enumerate(((-0.018, -0.062), (-0.030, -0.050), (0.040, -0.020))):
+            lace.spot((u0 + flip * du, v0 + dv), 0.0022 if k == 0 else 0.0016)
+        lace.leaf((u0 - flip * 0.032, v0 - 0.030), 0.014, 0.006, flip * 2.2)
+    for k in range(9):   # point d'esprit: small spots scattered on the ground (a fixed pattern)
+        lace.spot(((0.11 + 0.37 * k) % 1.0 * ru, (0.07 + 0.61 * k) % 1.0 * rv), 0.0009)
+
+
+def _raschel(lace, ru, rv):
+    """A Raschel lace with a heavy cord: double-ringed eight-petal flowers in a half-drop,
+    linked by an ogee trail of leaves; a four-petal flower between the trails."""
+    for u0, v0, flip in ((0.25 * ru, 0.25 * rv, 1.0), (0.75 * ru, 0.75 * rv, -1.0)):
+        lace.flower((u0, v0), 0.028, 8, rotation=0.2)
+        lace.flower((u0, v0), 0.013, 8, rotation=0.2 + math.pi / 8, open_petals=False)
+        top, bottom = (u0 + flip * 0.5 * 0.5 * ru, v0 - 0.25 * rv), (u0, v0 - 0.5 * rv)
+        lace.scroll((u0 + flip * 0.03, v0 - 0.02), top, 0.02 * flip)
+        lace.scroll(top, bottom, 0.02 * flip)
+        for t in (0.3, 0.7):
+            at = (u0 + flip * 0.03 + t * (top[0] - u0 - flip * 0.03), v0 - 0.02 + t * (top[1] - v0 + 0.02))
+            lace.leaf(at, 0.020, 0.008, flip * (0.9 + t))
+        lace.flower((u0 + flip * 0.25 * ru, v0 + 0.02), 0.009, 4, rotation=0.78, open_petals=False)
+        lace.leaf((u0 - flip * 0.034, v0 + 0.03), 0.026, 0.010, -flip * 0.5)
+
+
+def _tulle(lace, ru, rv):
+    """Embroidered tulle: sparse sprigs (a five-petal flower, two leaves on a short stem) on
+    a fine net, in a half-drop with small scattered dots; most of the cloth is open net."""
+    for u0, v0, flip in ((0.25 * ru, 0.3 * rv, 1.0), (0.75 * ru, 0.8 * rv, -1.0)):
+        lace.flower((u0, v0), 0.009, 5, rotation=0.3 * flip, open_petals=False)
+        end = (u0 - flip * 0.012, v0 + 0.026)
+        lace.scroll((u0, v0 + 0.007), end, 0.004 * flip)
+        lace.leaf((u0 - flip * 0.009, v0 + 0.016), 0.011, 0.0045, flip * 0.9)
+        lace.leaf((u0 + flip * 0.002, v0 + 0.022), 0.009, 0.004, -flip * 0.6)
+        lace.spot(end, 0.0018)
+    for k in range(6):
+        lace.spot(((0.55 + 0.41 * k) % 1.0 * ru, (0.12 + 0.29 * k) % 1.0 * rv), 0.0012)
+
+
+LACE_LAYOUTS = {"leavers": _leavers, "raschel": _raschel, "tulle": _tulle}
 
 
 def lace_pattern(p, direct):
+    """A lace (tools/lace_motifs.py) whose net thread width is found so that the mean open
+    area equals LD; the cord's relief is the height map's 1 (height_m the cord's radius)."""
+    from lace_motifs import Lace, lace_fields
+
     cell = p["cell_mm"] * 1e-3
     ru, rv = p["cells_u"] * cell, p["row_pairs_v"] * cell * SQRT3
     n = p["size"]
-    x, y = _grid(n, n, ru, rv)
-    px = ru / n
-    edge = _hex_edge_distance(x, y, cell)
-    radius = p["rosette_mm"] * 1e-3
+    lace = Lace(n, round(n * rv / ru), ru, rv)
+    LACE_LAYOUTS[p["layout"]](lace, ru, rv)
     cord = p["cord_mm"] * 1e-3
-    # a rosette at the centre and one at the corners (a centred lattice tiles the repeat)
-    inside = np.full(x.shape, np.inf)
-    boundary = np.full(x.shape, np.inf)
-    ring = np.full(x.shape, np.inf)
-    for cx in (0.0, ru / 2, ru):
-        for cy in (0.0, rv / 2, rv):
-            if (cx == ru / 2) != (cy == rv / 2):
-                continue
-            field, r = _rosette(x, y, (cx, cy), radius, p["petals"])
-            inside = np.minimum(inside, field)
-            boundary = np.minimum(boundary, np.abs(field))
-            ring = np.minimum(ring, np.abs(r - 0.18 * radius))
-            # the eye of the rosette: an open centre (net only) inside the ring
-            inside = np.where(r < 0.18 * radius, np.maximum(inside, 1.0), inside)
-    # small spots (point d'esprit) at the middles of the repeat's edges
-    spot = np.full(x.shape, np.inf)
-    for cx, cy in ((ru / 2, 0.0), (ru / 2, rv), (0.0, rv / 2), (ru, rv / 2)):
-        spot = np.minimum(spot, np.hypot(x - cx, y - cy))
-    fill = p["fill"] * np.maximum(_ramp(inside, 0.0, px), _ramp(spot, 2.5e-3, px))
-    cords = np.maximum(_ramp(boundary, cord / 2, px), _ramp(ring, cord / 2, px))
-
-    def coverage(half):
-        net = _ramp(edge, half, px)
-        return np.maximum(np.maximum(net, fill), cords)
-
+    coverage, height = lace_fields(lace, cell, cord, 2 * cell)
     half = _bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, cell / 2)
-    c = coverage(half)
-    net_h = 0.35 * np.clip(1.0 - (edge / max(half, 1e-9)) ** 2, 0.0, 1.0) ** 0.5
-    # cloth stitch: a fine woven texture inside the motif (threads at the net's cell / 3)
-    weave = 0.5 + 0.25 * (np.cos(2 * math.pi * x / (cell / 3)) + np.cos(2 * math.pi * y / (cell / 3)))
-    cord_h = np.maximum(np.clip(1.0 - (boundary / (cord / 2)) ** 2, 0, 1),
-                        np.clip(1.0 - (ring / (cord / 2)) ** 2, 0, 1)) ** 0.5
-    height = np.maximum(np.maximum(net_h * _ramp(edge, half, px), 0.6 * fill * weave), cord_h)
-    return c, np.clip(height, 0, 1), (ru, rv), {"net_thread_mm": round(2 * half * 1e3, 4),
-                                                  "height_m": round(0.5 * cord, 8)}
+    return coverage(half), height(half), (ru, rv), {"net_thread_mm": round(2 * half * 1e3, 4),
+                                                     "height_m": round(0.5 * cord, 8)}
 
 
 def weave_pattern(p, direct, basket=False):

@@ -28,8 +28,8 @@ def ring_columns(params: ClothParams) -> np.ndarray:
 
 
 def _max_pleat_depth(params: ClothParams) -> float:
-    """Pleats stay clear of the window wall: at most half the gap deep."""
-    return 0.5 * (params.wall_gap_m - params.thickness_m)
+    """A pleat's apex towards the window stays off the wall (z = -wall_gap + thickness)."""
+    return params.wall_gap_m - 2.0 * params.thickness_m
 
 
 def ring_positions(params: ClothParams, opening: float | None = None) -> np.ndarray:
@@ -51,8 +51,26 @@ def ring_positions(params: ClothParams, opening: float | None = None) -> np.ndar
     return rings
 
 
+def _folds_in_span(k: int, dx: float, span: float, max_depth: float) -> tuple[int, float]:
+    """(n, depth): the fewest V folds the ``k`` rest spacings between two rings make so
+    that each fold's apex stays within ``max_depth`` while its legs keep their rest length
+    (k dx / 2n each). A single V deeper than the wall allows would squeeze the heading
+    (legs shorter than the fabric), and the squeezed fabric spreads below it: the hem
+    flared wider than the rod. More, shallower folds hold the same fabric at rest length.
+    """
+    for n in range(1, max(1, k // 2) + 1):
+        if k % n:
+            continue
+        half_leg, half_span = 0.5 * k * dx / n, 0.5 * span / n
+        depth = math.sqrt(max(half_leg ** 2 - half_span ** 2, 0.0))
+        if depth <= max_depth:
+            return n, depth
+    return n, min(depth, max_depth)
+
+
 def top_row(params: ClothParams, opening: float | None = None) -> np.ndarray:
-    """(W, 3) heading: rings on the rod, V-shaped pleats of rest length between them."""
+    """(W, 3) heading: rings on the rod, V-shaped pleats of rest length between them
+    (split into several folds where one would reach the wall, :func:`_folds_in_span`)."""
     o = params.opening if opening is None else opening
     dx = params.spacing_x_m
     cols = ring_columns(params)
@@ -67,13 +85,14 @@ def top_row(params: ClothParams, opening: float | None = None) -> np.ndarray:
         if k == 1:
             continue
         span = rings[j + 1, 0] - rings[j, 0]
-        half_leg = 0.5 * k * dx
-        depth = min(math.sqrt(max(half_leg ** 2 - (0.5 * span) ** 2, 0.0)), max_depth)
+        folds, depth = _folds_in_span(k, dx, span, max_depth)
         sign = 1.0 if j % 2 == 0 else -1.0
         for c in range(c0, c1 + 1):
             s = (c - c0) / k  # 0..1 along the span
+            f = min(int(s * folds), folds - 1)   # which fold, and where along it
+            t = s * folds - f
             row[c, 0] = rings[j, 0] + s * span
-            row[c, 2] = sign * depth * (1.0 - abs(2.0 * s - 1.0))
+            row[c, 2] = sign * (-1.0) ** f * depth * (1.0 - abs(2.0 * t - 1.0))
     return row
 
 

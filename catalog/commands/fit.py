@@ -13,7 +13,7 @@ from __future__ import annotations
 from catalog.fit.preset_build import DEFAULT_TAU_UNDYED
 
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
-INPUT_FILES = ("gonio", "excitation", "emission")
+INPUT_FILES = ("gonio", "excitation", "emission", "pattern")
 OUTPUT_FILES = ("out", "plot")
 HELP = "fit the woven-cloth HG BTDF (eq. 7) to gonio data and write a fabric preset"
 
@@ -47,6 +47,13 @@ def add_arguments(parser) -> None:
                         help="physical-mode quantum yield of the fluorescence")
     parser.add_argument("--peak-absorptance", type=float,
                         help="physical-mode peak absorptance of the fluorescence")
+    parser.add_argument("--pattern", metavar="IMAGE",
+                        help="the fabric's pattern: a grey tileable coverage image (1 = thread), "
+                             "remapped to the fitted open area and written beside the preset as "
+                             "patterns/NAME.png with a [pattern] table (needs --pattern-repeat)")
+    parser.add_argument("--pattern-repeat", metavar="W[,H]",
+                        help="the pattern image's size on the cloth, m (one number: the width, "
+                             "the height by the pixel aspect)")
     parser.add_argument("--plot", metavar="FIG.png",
                         help="draw measured vs fitted HG and Cook-Torrance (paper Fig. 11)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -74,6 +81,9 @@ def run(args) -> int:
     if args.tau is not None and not args.tau >= 0:
         raise InputError(f"{args.tau:g} must be >= 0", field="--tau")
 
+    if (getattr(args, "pattern", None) is None) != (getattr(args, "pattern_repeat", None) is None):
+        raise InputError("--pattern and --pattern-repeat go together",
+                         field="--pattern-repeat" if args.pattern is not None else "--pattern")
     summary = fit_preset(args, t0)
     if args.json:
         from catalog.core.jsonout import print_json

@@ -29,9 +29,19 @@ def add_arguments(parser) -> None:
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model (default physical)")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3 (RGB), 6, 9, 16")
-    parser.add_argument("--yaw", type=number_type(-360.0, 360.0, unit="deg"), default=0.0, help="camera yaw, deg")
-    parser.add_argument("--pitch", type=number_type(-89.0, 89.0, unit="deg"), default=0.0, help="camera pitch, deg")
-    parser.add_argument("--distance", type=number_type(0.05, 50.0, unit="m", low_open=True), default=2.6, help="camera distance, m")
+    from catalog.render.views import DEFAULT_VIEW, VIEWS  # noqa: PLC0415
+
+    parser.add_argument("--view", choices=tuple(VIEWS), default=DEFAULT_VIEW,
+                        help="the composition: " + "; ".join(
+                            f"{name}: {view.about}" for name, view in VIEWS.items())
+                        + f" (default {DEFAULT_VIEW}; --yaw, --pitch, --distance change it)")
+    parser.add_argument("--yaw", type=number_type(-360.0, 360.0, unit="deg"), default=None,
+                        help="camera yaw, deg (default: the view's)")
+    parser.add_argument("--pitch", type=number_type(-89.0, 89.0, unit="deg"), default=None,
+                        help="camera pitch, deg (default: the view's)")
+    parser.add_argument("--distance", type=number_type(0.05, 50.0, unit="m", low_open=True),
+                        default=None, help="camera distance from the view's target, m, kept "
+                                           "inside the room (default: the view's)")
     parser.add_argument("--exposure", type=number_type(0.0, 1e9, low_open=True), default=1.0,
                         help="exposure multiplier on top of --ev or the automatic exposure")
     add_display_arguments(parser)
@@ -69,12 +79,18 @@ def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.snapshot import SnapshotRequest, parse_size, render_snapshot  # noqa: PLC0415
 
+    from catalog.render.views import view_named  # noqa: PLC0415
+
     ev, white_balance = display_choices(args)
+    view = view_named(args.view)
     request = SnapshotRequest(
         fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
         frame=args.frame, fluorescence="off" if args.no_fluorescence else args.mode,
-        bands=args.bands, hour=args.hour, yaw_deg=args.yaw, pitch_deg=args.pitch,
-        distance_m=args.distance, exposure=args.exposure, ev=ev,
+        bands=args.bands, hour=args.hour,
+        yaw_deg=view.yaw_deg if args.yaw is None else args.yaw,
+        pitch_deg=view.pitch_deg if args.pitch is None else args.pitch,
+        distance_m=view.distance_m if args.distance is None else args.distance,
+        target=view.target, fov_y_deg=view.fov_y_deg, exposure=args.exposure, ev=ev,
         white_balance=white_balance, environment=args.environment,
         curtain_open=args.curtain == "open", room_light=not args.no_room_light,
         bloom=not args.no_bloom, lamps=tuple(parse_lamp(text) for text in args.lamp))

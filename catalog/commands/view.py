@@ -72,9 +72,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--grid", type=_grid, default=(96, 56), metavar="WxH",
                         help="cloth particles across x down (default 96x56: the fabric is "
                              "fullness x the rod wide)")
-    parser.add_argument("--distance", type=float, default=2.6, metavar="M",
+    parser.add_argument("--distance", type=float, default=None, metavar="M",
                         help="camera distance from the curtain, m (0.2-4; the wheel zooms, "
-                             "R resets; default 2.6)")
+                             "R resets, V the next view; default: the view's)")
     parser.add_argument("--cloth-backend", choices=("auto", "numpy", "cpu", "gpu"),
                         default="auto",
                         help="cloth simulation backend: gpu (compute shaders writing the "
@@ -126,7 +126,8 @@ def run(args: argparse.Namespace) -> int:
                            "in interactive use)")
     if args.hour is not None and not 0.0 <= args.hour <= 24.0:
         raise CatalogError(f"--hour: {args.hour:g} is not an hour of the day (0-24)")
-    if not (math.isfinite(args.distance) and 0.2 <= args.distance <= 4.0):
+    if args.distance is not None and not (math.isfinite(args.distance)
+                                          and 0.2 <= args.distance <= 4.0):
         raise CatalogError(f"--distance: {args.distance:g} m is outside 0.2-4 m (the room)")
     if args.wind is not None and not 0.0 <= args.wind <= 50.0:
         raise CatalogError(f"--wind: {args.wind:g} m/s is outside 0-50 m/s")

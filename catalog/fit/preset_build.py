@@ -28,6 +28,7 @@ IDENTIFIABLE = ("direct", "a_diff", "a_spec", "g_diff", "g_spec")
 def fit_preset(args, started_s: float) -> dict:
     """Read ``args.gonio``, fit, write the preset ``args.out`` (and ``args.plot``); the JSON
     summary. ``args`` holds the options of ``catalog fit`` (already checked there)."""
+    import tempfile
     import time
     from pathlib import Path
 
@@ -55,9 +56,17 @@ def fit_preset(args, started_s: float) -> dict:
     rho = args.rho if args.rho is not None else max(MIN_RHO, 1.0 - hg.params["direct"])
 
     doc = preset_document(args, out, data, header, result, rho, tau, dye_path)
-    # the preset and copies of every file it names (gonio, spectra, dye) in out's own folder
-    # N/, staged: all of them appear together, or none (catalog.presets.bundle)
-    with staged_folder(out.parent) as stage:
+    # the preset and copies of every file it names (gonio, spectra, dye, the fitted pattern)
+    # in out's own folder N/, staged: all of them appear together, or none
+    # (catalog.presets.bundle)
+    pattern = _fitted_pattern(args, doc) if getattr(args, "pattern", None) else None
+    with staged_folder(out.parent) as stage, tempfile.TemporaryDirectory() as scratch:
+        if pattern is not None:  # drawn once, then bundled like every other file it names
+            from catalog.presets.patterns import write_pattern_images
+
+            drawn = Path(scratch) / Path(doc["pattern"]["coverage"]).name
+            write_pattern_images(pattern, drawn, None)
+            doc["pattern"]["coverage"] = str(drawn)
         staged = stage / out.name
         bundle_files(doc, staged, lambda _key, value: out.parent / value,
                      published_folder=out.parent)
@@ -69,6 +78,34 @@ def fit_preset(args, started_s: float) -> dict:
 
     summary = json_summary(doc, result, out, elapsed)
     return summary
+
+
+def _fitted_pattern(args, doc):
+    """``--pattern IMAGE``: the image read as a coverage, remapped to the fitted open area
+    (catalog.presets.patterns.match_open_area) and named in ``doc``'s [pattern] table
+    (patterns/NAME.png beside the preset). Returns the pattern to write."""
+    from dataclasses import replace
+    from pathlib import Path
+
+    from catalog.core.errors import InputError
+    from catalog.presets.patterns import match_open_area, pattern_from_images
+
+    try:
+        repeat = [float(v) for v in str(args.pattern_repeat).split(",")]
+    except ValueError:
+        repeat = []
+    if len(repeat) not in (1, 2) or not all(math.isfinite(v) and 0 < v <= 10 for v in repeat):
+        raise InputError(f"{args.pattern_repeat!r}: one or two lengths in metres (0, 10]",
+                         field="--pattern-repeat")
+    pattern = pattern_from_images(args.pattern, repeat[0] if len(repeat) == 1 else repeat)
+    coverage = match_open_area(pattern.coverage, doc["btdf"]["direct"], where=args.pattern)
+    rel = f"patterns/{doc['name']}.png"
+    target = Path(args.out).parent / rel
+    if target.resolve() == Path(args.pattern).resolve():
+        raise InputError("would overwrite the input image; move it first", field="--pattern")
+    doc["pattern"] = {"coverage": rel, "repeat_m": [round(v, 8) for v in pattern.repeat_m],
+                      "kind": "image"}
+    return replace(pattern, coverage=coverage, height=None)
 
 
 def fit_measurement(data, weighting: str) -> dict:

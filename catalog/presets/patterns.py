@@ -243,6 +243,29 @@ def load_pattern(preset, check_fit: bool = True) -> Pattern | None:
     return pattern
 
 
+def match_open_area(coverage: np.ndarray, direct: float, where=None) -> np.ndarray:
+    """``coverage`` remapped as c^gamma (holes stay holes, full thread stays thread, the order
+    of every pair of pixels kept) with gamma found by bisection so that 1 - mean = ``direct``
+    (the fit's LD) to 1e-6: how ``catalog fit --pattern`` makes a user's image agree with
+    the fit. Refused when no gamma can: the image's holes (c = 0) alone are more open than LD,
+    or its full-thread pixels (c = 1) alone cover more than 1 - LD."""
+    c = np.clip(np.asarray(coverage, dtype=np.float64), 0.0, 1.0)
+    holes, threads = float(np.mean(c == 0.0)), float(np.mean(c == 1.0))
+    if not holes <= direct <= 1.0 - threads or np.all((c == 0.0) | (c == 1.0)) and \
+            abs(1.0 - c.mean() - direct) > OPEN_AREA_TOLERANCE * direct + OPEN_AREA_FLOOR:
+        raise InputError(f"the image's holes cover {holes:.3f} and its full threads "
+                         f"{threads:.3f} of it: no remap gives the fit's open area "
+                         f"(btdf.direct {direct:.4f})", path=where, field="--pattern")
+    lo, hi = -12.0, 12.0                    # log2 gamma
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        if 1.0 - np.mean(c ** (2.0 ** mid)) < direct:
+            lo = mid
+        else:
+            hi = mid
+    return (c ** (2.0 ** (0.5 * (lo + hi)))).astype(np.float32)
+
+
 def write_pattern_images(pattern: Pattern, coverage_path: Path, height_path: Path | None) -> None:
     """16-bit grey PNGs (or EXR by suffix) of a pattern, written atomically."""
     _write_grey(coverage_path, pattern.coverage)
@@ -278,3 +301,51 @@ def _write_grey(path: Path, values: np.ndarray) -> None:
 def quantise16(values: np.ndarray) -> np.ndarray:
     """What a 16-bit PNG stores and reads back."""
     return (np.round(np.clip(values, 0, 1) * 65535.0) / 65535.0).astype(np.float32)
+
+
+#: The mip chain's prefilter (:func:`mip_chain`): a Gaussian of this standard deviation in
+#: texels of the level being made. Its response at that level's Nyquist frequency is
+#: exp(-2 pi^2 s^2 / 4) = 0.089 for s = 0.7 (a 2x2 box's chain passes 0.64 of a frequency
+#: just below Nyquist and folds what lies above it: a 1 mm net on ~1 mm texels became stripes).
+MIP_SIGMA_TEXELS = 0.7
+
+
+def _fourier_downsample(image: np.ndarray, size: tuple[int, int], sigma: float) -> np.ndarray:
+    """``image`` (h, w, C), periodic, low-passed by a Gaussian of ``sigma`` of its texels and
+    resampled to ``size`` (lh, lw) by keeping the frequencies the smaller image can hold."""
+    h, w = image.shape[:2]
+    lh, lw = size
+    spectrum = np.fft.fft2(image, axes=(0, 1))
+    ky_all, kx_all = np.round(np.fft.fftfreq(h) * h).astype(int), np.round(np.fft.fftfreq(w) * w).astype(int)
+    keep_y, keep_x = np.abs(ky_all) < lh / 2.0, np.abs(kx_all) < lw / 2.0
+    fy = (ky_all[keep_y] / h)[:, None, None]
+    fx = (kx_all[keep_x] / w)[None, :, None]
+    gain = np.exp(-2.0 * math.pi ** 2 * sigma ** 2 * (fx ** 2 + fy ** 2))
+    small = np.zeros((lh, lw) + image.shape[2:], dtype=complex)
+    small[np.ix_(ky_all[keep_y] % lh, kx_all[keep_x] % lw)] = spectrum[np.ix_(keep_y, keep_x)] * gain
+    return np.real(np.fft.ifft2(small, axes=(0, 1))) * (lh * lw) / (h * w)
+
+
+def mip_chain(texels: np.ndarray, levels: int | None = None) -> list[np.ndarray]:
+    """The mip levels of a periodic (tileable) image (H, W, C), level 0 first, each level's
+    size GL's (floor of half the last, at least 1). Level k is level 0 low-passed by a
+    periodic Gaussian of MIP_SIGMA_TEXELS of its own texel (2^k level-0 texels), made from
+    level k-1 by the Gaussian that adds the missing variance (sigma 1.4 texels for level 1,
+    sqrt(1.4^2 - 0.7^2) = 1.21 of level k-1's texels after), resampled by Fourier cropping:
+    exact for a repeat, so the mean (the far limit) is kept. Values are clipped to level 0's
+    range (the cropped Gaussian rings a little) and the mean the clipping moved is put back."""
+    texels = np.asarray(texels, dtype=np.float64)
+    h, w = texels.shape[:2]
+    top = int(math.floor(math.log2(max(h, w)))) if levels is None else int(levels)
+    low, high = texels.min(axis=(0, 1)), texels.max(axis=(0, 1))
+    mean = texels.mean(axis=(0, 1))
+    chain, current = [texels.astype(np.float32)], texels
+    s = MIP_SIGMA_TEXELS
+    for level in range(1, top + 1):
+        size = (max(1, h >> level), max(1, w >> level))
+        sigma = 2 * s if level == 1 else math.sqrt((2 * s) ** 2 - s ** 2)
+        current = _fourier_downsample(current, size, sigma)
+        for _ in range(4):   # clip the ringing, then put back the mean the clipping moved
+            current = np.clip(current + (mean - current.mean(axis=(0, 1))), low, high)
+        chain.append(current.astype(np.float32))
+    return chain

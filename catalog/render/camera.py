@@ -15,19 +15,47 @@ from catalog.core.errors import CatalogError
 
 #: Pitch is kept inside +-89 deg (the up vector degenerates at the poles).
 PITCH_LIMIT_DEG = 89.0
+#: A camera kept inside a room stays this far (m) from its walls, floor and ceiling.
+ROOM_MARGIN_M = 0.15
+
+from catalog.render.views import (CURTAIN_TARGET, DEFAULT_VIEW, VIEWS,  # noqa: E402,F401
+                                  CameraView, view_named)
+def room_limit_m(target, yaw_deg: float, pitch_deg: float, box,
+                 margin_m: float = ROOM_MARGIN_M) -> float:
+    """How far from ``target`` the orbit camera may be in this direction and stay inside
+    ``box`` ((x0, x1), (y0, y1), (z0, z1), m) less ``margin_m``: where the ray from the target
+    leaves the shrunk box (the slab method; the target itself may lie outside it, as the
+    curtain does, closer to the window wall than the margin). 0 when the ray misses it."""
+    yaw, pitch = math.radians(yaw_deg), math.radians(pitch_deg)
+    direction = (math.sin(yaw) * math.cos(pitch), math.sin(pitch), math.cos(yaw) * math.cos(pitch))
+    t_in, t_out = 0.0, math.inf
+    for axis in range(3):
+        lo, hi = box[axis][0] + margin_m, box[axis][1] - margin_m
+        o, d = target[axis], direction[axis]
+        if abs(d) < 1e-12:
+            if not lo <= o <= hi:
+                return 0.0
+            continue
+        a, b = (lo - o) / d, (hi - o) / d
+        t_in, t_out = max(t_in, min(a, b)), min(t_out, max(a, b))
+    return t_out if t_out >= t_in else 0.0
 
 
 @dataclass(frozen=True)
 class OrbitCamera:
-    """yaw 0 looks from +z towards -z (from the room at the window); pitch > 0 from above."""
+    """yaw 0 looks from +z towards -z (from the room at the window); pitch > 0 from above.
 
-    target: tuple[float, float, float] = (0.0, 0.15, -0.08)
+    With ``bounds`` (a room's box, see :func:`room_limit_m`) the distance is shortened so
+    that the camera stays inside the room whatever yaw, pitch and distance ask for."""
+
+    target: tuple[float, float, float] = CURTAIN_TARGET
     yaw_deg: float = 0.0
     pitch_deg: float = 0.0
     distance_m: float = 2.6
     fov_y_deg: float = 50.0
     near_m: float = 0.05
     far_m: float = 50.0
+    bounds: tuple | None = None
 
     def __post_init__(self) -> None:
         for name in ("yaw_deg", "pitch_deg", "distance_m", "fov_y_deg"):
@@ -40,6 +68,18 @@ class OrbitCamera:
             raise CatalogError(f"camera field of view {self.fov_y_deg:g} deg is outside 1..170")
         object.__setattr__(self, "pitch_deg",
                            max(-PITCH_LIMIT_DEG, min(PITCH_LIMIT_DEG, self.pitch_deg)))
+        if self.bounds is not None:
+            limit = room_limit_m(self.target, self.yaw_deg, self.pitch_deg, self.bounds)
+            object.__setattr__(self, "distance_m",
+                               max(2.0 * self.near_m, min(self.distance_m, limit)))
+
+    @classmethod
+    def from_view(cls, view: CameraView, bounds=None, **overrides) -> "OrbitCamera":
+        """The camera of a named view, any of yaw_deg, pitch_deg, distance_m overridden."""
+        values = {"target": view.target, "yaw_deg": view.yaw_deg, "pitch_deg": view.pitch_deg,
+                  "distance_m": view.distance_m, "fov_y_deg": view.fov_y_deg}
+        values.update({k: v for k, v in overrides.items() if v is not None})
+        return cls(bounds=bounds, **values)
 
     @property
     def position(self) -> np.ndarray:

@@ -351,6 +351,9 @@ class FrameRenderer:
         self.key_second_layer = True
         #: the pattern's LOD bias (set_pattern_lod_bias)
         self.pattern_lod_bias = PATTERN_LOD_BIAS
+        #: the pattern's mip levels from catalog.presets.patterns.mip_chain (True) or the
+        #: hardware's 2x2 box chain (False: the web page's, which replays whole-texture writes)
+        self.pattern_prefilter = True
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -428,7 +431,12 @@ class FrameRenderer:
         texture = self.ctx.texture((w, h), 4, np.ascontiguousarray(texels).tobytes(), dtype="f4")
         texture.repeat_x = texture.repeat_y = True
         texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
-        texture.build_mipmaps()
+        texture.build_mipmaps()   # allocates the levels; their texels are the prefiltered chain
+        if self.pattern_prefilter:
+            from catalog.presets.patterns import mip_chain  # noqa: PLC0415
+
+            for level, image in enumerate(mip_chain(texels)[1:], start=1):
+                texture.write(np.ascontiguousarray(image, dtype="f4").tobytes(), level=level)
         max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
         texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
         self._pattern_texture = texture
@@ -436,6 +444,13 @@ class FrameRenderer:
         self._pattern_repeat_m = tuple(float(v) for v in repeat)
         self._pattern_mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
         self._pattern_key = key
+
+    def set_pattern_prefilter(self, on: bool) -> None:
+        """The pattern's mip chain: prefiltered (True, default: a periodic Gaussian per level,
+        no moire) or the hardware's box chain (False). Takes effect at the next fabric load."""
+        if bool(on) != self.pattern_prefilter:
+            self.pattern_prefilter = bool(on)
+            self._pattern_key = None
 
     def set_pattern_filtering(self, filtered: bool) -> None:
         """True (default): trilinear mipmapped, anisotropic; False: nearest texel, no mips
@@ -724,9 +739,16 @@ class FrameRenderer:
     def set_bands(self, n_bands: int) -> None:
         self.n_bands = band_lib.check_band_count(n_bands)
 
-    def set_camera(self, yaw_deg: float, pitch_deg: float, distance_m: float) -> None:
+    def set_camera(self, yaw_deg: float, pitch_deg: float, distance_m: float,
+                   target=None, fov_y_deg: float | None = None, inside: bool = False) -> None:
+        """The orbit camera (catalog.render.camera); ``inside``: kept inside the room's box
+        (what every command asks for; the library also draws the room from outside)."""
+        extra = {} if fov_y_deg is None else {"fov_y_deg": float(fov_y_deg)}
+        if target is not None:
+            extra["target"] = tuple(float(v) for v in target)
         self.camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                                  distance_m=float(distance_m))
+                                  distance_m=float(distance_m),
+                                  bounds=scene_lib.ROOM_BOX if inside else None, **extra)
 
     def set_exposure(self, multiplier: float) -> None:
         if not (math.isfinite(multiplier) and multiplier > 0):
@@ -2662,7 +2684,8 @@ class FrameRenderer:
             "see_through": inputs.direct > 0,
             "key_to_light": [round(float(v), 6) for v in inputs.key_to_light],
             "camera": {"yaw_deg": self.camera.yaw_deg, "pitch_deg": self.camera.pitch_deg,
-                       "distance_m": self.camera.distance_m},
+                       "distance_m": self.camera.distance_m,
+                       "position_m": [round(float(v), 6) for v in self.camera.position]},
             "exposure": self.exposure_scale() if metered else None,
             "ev100": round(self.current_ev100(), 4) if metered else None,
             "auto_exposure": self.ev100 is None,

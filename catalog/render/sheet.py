@@ -25,6 +25,13 @@ def _fabric_list(fabrics):
     return [load_preset(p) for p in paths]
 
 
+#: The grid's inset swatch: the close-up view (catalog.render.views "close") of the same
+#: fabric and light, this fraction of the cell's side, in the cell's lower right corner, so
+#: that the weave or the lace's motif reads at catalog size (the whole curtain alone shows
+#: the white fabrics nearly alike). Cells smaller than INSET_MIN_CELL_PX get none.
+INSET_FRACTION = 0.45
+INSET_MIN_CELL_PX = 64
+
 #: Label strips of the grid (px): the fabric names' column and the lights' header row.
 LABEL_COLUMN_PX = 200
 LABEL_ROW_PX = 22
@@ -65,6 +72,38 @@ def _wrap(text: str, width_px: int, font_px: int) -> list[str]:
             line = f"{line} {word}".strip()
     lines.append(line)
     return lines if len(lines) <= 3 else [*lines[:2], " ".join(lines[2:])[:per_line]]
+
+
+def close_up(renderer) -> np.ndarray:
+    """The renderer's fabric and light seen from the close-up view (sRGB8), the camera put
+    back as it was."""
+    from catalog.render.views import VIEWS  # noqa: PLC0415
+
+    camera = renderer.camera
+    view = VIEWS["close"]
+    renderer.set_camera(view.yaw_deg, view.pitch_deg, view.distance_m, target=view.target,
+                        fov_y_deg=view.fov_y_deg, inside=True)
+    try:
+        renderer.render()
+        return renderer.read_srgb8()
+    finally:
+        renderer.camera = camera
+
+
+def put_inset(cell: np.ndarray, swatch: np.ndarray, fraction: float = INSET_FRACTION) -> None:
+    """``swatch`` (the cell's size) reduced by area averaging to ``fraction`` of the cell and
+    framed by a 1 px dark line, into the cell's lower right corner (in place)."""
+    h, w = cell.shape[:2]
+    k = max(1, int(round(1.0 / fraction)))
+    sh, sw = h // k, w // k
+    small = swatch[:sh * k, :sw * k].reshape(sh, k, sw, k, 3).astype(np.float64)
+    # average in linear light (sRGB decode, mean, encode) so the reduction keeps the brightness
+    lin = np.where(small / 255.0 <= 0.04045, small / 255.0 / 12.92,
+                   ((small / 255.0 + 0.055) / 1.055) ** 2.4).mean(axis=(1, 3))
+    enc = np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * lin ** (1 / 2.4) - 0.055)
+    y0, x0 = h - sh - 2, w - sw - 2
+    cell[y0 - 1:y0 + sh + 1, x0 - 1:x0 + sw + 1] = 16
+    cell[y0:y0 + sh, x0:x0 + sw] = np.round(np.clip(enc, 0, 1) * 255).astype(np.uint8)
 
 
 def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fabrics=None,
@@ -139,7 +178,10 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
                                        "catalog:fluorescence_variant": info["fluorescence_variant"],
                                        "catalog:ev100": f"{info['ev100']:.4f}",
                                        "catalog:white_balance": info["white_balance"]})
-            grid[i * height:(i + 1) * height, j * width:(j + 1) * width] = pixels
+            cell = pixels.copy()
+            if min(width, height) >= INSET_MIN_CELL_PX:
+                put_inset(cell, close_up(renderer))
+            grid[i * height:(i + 1) * height, j * width:(j + 1) * width] = cell
             images.append({"fabric": preset.name, "light": light.name, "path": str(path),
                            "fluorescence_variant": info["fluorescence_variant"],
                            "ev100": info["ev100"]})

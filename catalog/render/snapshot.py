@@ -52,6 +52,8 @@ class SnapshotRequest:
     yaw_deg: float = 0.0
     pitch_deg: float = 0.0
     distance_m: float = 2.6
+    target: tuple | None = None       # the orbit's target (m); None: the curtain's middle
+    fov_y_deg: float | None = None    # vertical field of view; None: the camera's default
     exposure: float = 1.0
     ev: float | None = None           # EV100; None: automatic exposure
     white_balance: str = "room"
@@ -208,7 +210,8 @@ def configure_renderer(renderer, request: SnapshotRequest, preset, light):
         renderer.set_light(light)
     renderer.set_fluorescence(request.fluorescence)
     renderer.set_bands(request.bands)
-    renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m)
+    renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m,
+                        target=request.target, fov_y_deg=request.fov_y_deg, inside=True)
     renderer.set_exposure(request.exposure)
     renderer.set_ev(request.ev)
     renderer.set_white_balance(request.white_balance)

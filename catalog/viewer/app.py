@@ -54,7 +54,7 @@ class ViewerOptions:
     hour: float | None = None
     wind_m_s: float | None = None
     grid: tuple[int, int] = (96, 56)
-    distance_m: float = 2.6  # the camera's home distance from the curtain (the R key returns)
+    distance_m: float | None = None  # the camera's home distance (R returns); None: the view's
     cloth_backend: str | None = None  # None: auto (see ViewerApp._choose_cloth_backend)
     panel: bool = True
     paused: bool = False
@@ -90,7 +90,7 @@ class ViewerApp:
         if options.wind_m_s is not None:
             self.settings.wind_m_s = options.wind_m_s
         self._choose_start(options)
-        self.camera = OrbitCamera(distance_m=options.distance_m, home_distance_m=options.distance_m)
+        self.camera = OrbitCamera(home_distance_m=options.distance_m)
         self.camera.reset()
         self.timer = FrameTimer()
         self._actions: list[Action] = []
@@ -215,7 +215,8 @@ class ViewerApp:
                 for slot, (renderer, viewport) in enumerate(zip(self._renderers,
                                                                 self._viewports())):
                     renderer.set_camera(self.camera.yaw_deg, self.camera.pitch_deg,
-                                        self.camera.distance_m)
+                                        self.camera.distance_m, target=self.camera.target,
+                                        fov_y_deg=self.camera.fov_y_deg, inside=True)
                     try:
                         self._set_exposure(slot, renderer)
                         if self._scaled_fbos:
@@ -358,6 +359,8 @@ class ViewerApp:
                 settings.curtain_open = not settings.curtain_open
             elif action is Action.RESET_VIEW:
                 self.camera.reset()
+            elif action is Action.NEXT_VIEW:
+                self.camera.next_view()
             elif action is Action.QUIT:
                 self._quit = True
 

@@ -3,7 +3,7 @@
 Keys (glfw key codes -> actions; :data:`KEY_HELP` is the text of the help overlay):
 Left/Right previous/next fabric, L next light, F fluorescence off/paper/physical,
 Space pause, S screenshot (EXR and PNG), H help, Tab panel, C curtain open/close,
-R reset the view, Escape quit. Mouse: drag with the left button to orbit, wheel to zoom.
+R reset the view, V next view (room, fabric, close-up), Escape quit. Mouse: drag with the left button to orbit, wheel to zoom.
 
 The glfw module is imported for its key constants only (no window is needed to import it).
 """
@@ -15,6 +15,10 @@ import math
 from dataclasses import dataclass
 
 import glfw
+
+from catalog.render.camera import (CURTAIN_TARGET, DEFAULT_VIEW, ROOM_MARGIN_M,  # noqa: F401
+                                   VIEWS)
+from catalog.render.camera import room_limit_m as render_room_limit_m
 
 
 class Action(enum.Enum):
@@ -28,6 +32,7 @@ class Action(enum.Enum):
     TOGGLE_PANEL = "show / hide the panel"
     TOGGLE_CURTAIN = "open / close the curtain"
     RESET_VIEW = "reset the view (the distance --distance gave)"
+    NEXT_VIEW = "next view: room / fabric / close-up"
     QUIT = "quit"
 
 
@@ -43,6 +48,7 @@ KEY_ACTIONS: dict[int, tuple[Action, str]] = {
     glfw.KEY_TAB: (Action.TOGGLE_PANEL, "Tab"),
     glfw.KEY_C: (Action.TOGGLE_CURTAIN, "C"),
     glfw.KEY_R: (Action.RESET_VIEW, "R"),
+    glfw.KEY_V: (Action.NEXT_VIEW, "V"),
     glfw.KEY_ESCAPE: (Action.QUIT, "Esc"),
 }
 
@@ -81,17 +87,37 @@ class OrbitCamera:
     max_pitch_deg: float = 80.0
     min_distance_m: float = 0.2
     max_distance_m: float = 12.0
-    home_distance_m: float = 2.6
+    home_distance_m: float | None = None   # None: the view's own distance
+    view_name: str = DEFAULT_VIEW           # catalog.render.camera.VIEWS
+
+    @property
+    def view(self):
+        return VIEWS[self.view_name]
+
+    @property
+    def target(self) -> tuple[float, float, float]:
+        return self.view.target
+
+    @property
+    def fov_y_deg(self) -> float:
+        return self.view.fov_y_deg
 
     def reset(self) -> None:
-        """Back to the home view."""
-        self.yaw_deg = 0.0
-        self.pitch_deg = 0.0
-        self.distance_m = self.home_distance_m
+        """Back to the home view: the view's yaw and pitch, at ``home_distance_m``."""
+        self.yaw_deg = self.view.yaw_deg
+        self.pitch_deg = self.view.pitch_deg
+        self.distance_m = self.home_distance_m or self.view.distance_m
         self._keep_inside()
 
+    def next_view(self) -> None:
+        """The next of the named views (room, fabric, close-up), at its own distance."""
+        names = list(VIEWS)
+        self.view_name = names[(names.index(self.view_name) + 1) % len(names)]
+        self.home_distance_m = None
+        self.reset()
+
     def _keep_inside(self) -> None:
-        limit = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg))
+        limit = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg, self.target))
         self.distance_m = min(limit, max(self.min_distance_m, self.distance_m))
 
     def drag(self, dx_px: float, dy_px: float) -> None:
@@ -105,7 +131,7 @@ class OrbitCamera:
 
     def distance_limits_m(self) -> tuple[float, float]:
         """The nearest and farthest distance (m) allowed in the current direction."""
-        far = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg))
+        far = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg, self.target))
         return self.min_distance_m, max(self.min_distance_m, far)
 
     def set_distance(self, distance_m: float) -> None:
@@ -123,28 +149,12 @@ class OrbitCamera:
         self._keep_inside()
 
 
-#: The camera keeps this far (m) from the room's walls, floor and ceiling.
-ROOM_MARGIN_M = 0.15
-
-
-def room_limit_m(yaw_deg: float, pitch_deg: float) -> float:
-    """How far the orbit camera may be from its target in this direction and stay inside the
-    room (less ROOM_MARGIN_M): where the ray from the target leaves the room's box."""
-    from catalog.render.camera import OrbitCamera as RenderCamera  # noqa: PLC0415
+def room_limit_m(yaw_deg: float, pitch_deg: float, target=CURTAIN_TARGET) -> float:
+    """How far the orbit camera may be from ``target`` in this direction and stay inside the
+    room's box less ROOM_MARGIN_M (catalog.render.camera.room_limit_m), at least 0.2 m."""
     from catalog.render.scene import ROOM_BOX  # noqa: PLC0415
 
-    yaw, pitch = math.radians(yaw_deg), math.radians(pitch_deg)
-    direction = (math.sin(yaw) * math.cos(pitch), math.sin(pitch), math.cos(yaw) * math.cos(pitch))
-    target = RenderCamera().target
-    limit = math.inf
-    for axis in range(3):
-        lo, hi = ROOM_BOX[axis]
-        d = direction[axis]
-        if d > 1e-9:
-            limit = min(limit, (hi - ROOM_MARGIN_M - target[axis]) / d)
-        elif d < -1e-9:
-            limit = min(limit, (lo + ROOM_MARGIN_M - target[axis]) / d)
-    return max(limit, 0.2)
+    return max(render_room_limit_m(target, yaw_deg, pitch_deg, ROOM_BOX), 0.2)
 
 
 class MouseOrbit:
