@@ -79,7 +79,8 @@ def test_artwork_with_threshold_and_polarity(scan, tmp_path, capsys):
                              "--polarity", "dark-open", "--repeat-m", "0.1")
     assert status == 0, err
     assert light["open_area"] + dark["open_area"] == pytest.approx(1.0, abs=1e-3)
-    assert light["repeat_m"] == [0.1, 0.1]
+    # --repeat-m is the width; the height follows the pixels' aspect (square pixels)
+    assert light["repeat_m"] == pytest.approx([0.1, 0.1 * grey.shape[0] / grey.shape[1]], abs=1e-6)
 
 
 def _write_grey(path: Path, values: np.ndarray, dpi: float | None = 300.0):

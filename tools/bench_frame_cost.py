@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Frame cost of a checkout against another, 1280x720 on this machine's GL (llvmpipe here).
 
-    .venv/bin/python tools/bench_frame_cost.py --base /work/main [--repeats 7] [--json OUT]
+    .venv/bin/python tools/bench_frame_cost.py --base OTHER_CHECKOUT [--repeats 7] [--json OUT]
 
 For each checkout (the base and this one) a child process renders the settled drape of each
 fabric under D65 with the same camera (yaw 0, pitch 0, 2.6 m: the composition both have) and,

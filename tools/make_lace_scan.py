@@ -1,7 +1,7 @@
 """Draw a lace as a backlit scanner would see it: the project's own test and docs image.
 
-A rosette lace on a hexagonal tulle (the geometry of tools/make_patterns.py's lace, with
-its own parameters: 2 mm cells, a larger rosette), seen against a white backlight: open = the
+An embroidered tulle (tools/make_patterns.py's "tulle" layout: sprigs on a hexagonal net) with
+its own parameters (2 mm cells, an 80 mm repeat), seen against a white backlight: open = the
 light (1), thread = what a dense yarn lets through (THREAD_TRANSMITTANCE), written as an
 8-bit sRGB RGB PNG with its resolution (dpi) in the header, as a flatbed scan is.
 
@@ -20,8 +20,8 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 #: The lace: cell, repeat and motif in mm (tools/make_patterns.py's parameters).
-LACE = {"kind": "lace", "cell_mm": 2.0, "cells_u": 40, "row_pairs_v": 23,
-        "rosette_mm": 22.0, "petals": 8, "fill": 0.85, "cord_mm": 1.0}
+LACE = {"kind": "lace", "layout": "tulle", "cell_mm": 2.0, "cells_u": 40, "row_pairs_v": 23,
+        "cord_mm": 1.0}
 #: The geometric open area the net is drawn to (bisection on the thread width).
 OPEN_AREA = 0.45
 #: Backlight through a thread (a dense cotton yarn, fraction of the open light).
@@ -48,7 +48,7 @@ def write_scan(path: Path, size: int = 512) -> float:
     from catalog.core.atomic import atomic_path
 
     rgb, dpi, _repeat = draw_scan(size)
-    spec = oiio.ImageSpec(size, size, 3, oiio.UINT8)
+    spec = oiio.ImageSpec(rgb.shape[1], rgb.shape[0], 3, oiio.UINT8)  # the repeat's aspect
     spec.attribute("XResolution", float(dpi))
     spec.attribute("YResolution", float(dpi))
     spec.attribute("ResolutionUnit", "in")
