@@ -9,7 +9,7 @@ import math
 import pytest
 
 from catalog.bench import alpha_to_coverage, pattern, viewer_frames
-from catalog.render.frame import choose_antialiasing
+from catalog.render.passes.targets import choose_antialiasing
 
 
 @pytest.mark.slow

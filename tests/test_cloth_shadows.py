@@ -326,7 +326,7 @@ def test_the_sill_is_lit_by_the_sun(gl, make_preset):
     assert sill.sum() >= 10
     open_ = margin > 0.02
     assert open_.sum() >= 10
-    key_y = float(np.asarray(r._display_colours(r.shading_inputs())["u_key_rgb"]) @ LUMA)
+    key_y = float(np.asarray(r.terms.display_colours(r.shading_inputs())["u_key_rgb"]) @ LUMA)
     expected = scene_lib.ROOM_ALBEDO / math.pi * key_y * to_light[1]
     assert (img[sill][open_] @ LUMA).min() > 0.9 * expected
     r.release()

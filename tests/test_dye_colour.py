@@ -113,12 +113,12 @@ def test_the_frame_passes_the_rooms_and_folds_light_by_the_secondary_dye(gl):
     secondary, key = dye_colour.secondary_dye_rgb(inputs), dye_colour.key_dye_rgb(inputs)
     back = (inputs.a_diff * hg_hemisphere_factors(inputs.g_diff)[1]
             + inputs.a_spec * hg_hemisphere_factors(inputs.g_spec)[1])
-    np.testing.assert_allclose(r.curtain_room_reflectance_rgb(inputs), np.clip(secondary * back, 0, 1), rtol=1e-9)
-    assert r.curtain_room_reflectance_rgb(inputs)[1] > 0.85 * back
-    diffuse, _directional = r.curtain_forward_rgb(inputs)
+    np.testing.assert_allclose(r.terms.curtain_room_reflectance_rgb(inputs), np.clip(secondary * back, 0, 1), rtol=1e-9)
+    assert r.terms.curtain_room_reflectance_rgb(inputs)[1] > 0.85 * back
+    diffuse, _directional = r.terms.curtain_forward_rgb(inputs)
     forward = inputs.a_diff * hg_hemisphere_factors(inputs.g_diff)[0]
     np.testing.assert_allclose(diffuse, np.clip(secondary * forward, 0, 1), rtol=1e-9)
-    thread = np.asarray(r._room_colours(inputs)["u_thread_beam_rgb"])
+    thread = np.asarray(r.terms.room_colours(inputs)["u_thread_beam_rgb"])
     undyed = inputs.a_spec * hg_hemisphere_factors(inputs.g_spec)[0] / (1.0 - inputs.direct)
     np.testing.assert_allclose(thread, np.clip(key * undyed, 0, 1), rtol=1e-6)
     assert thread[1] < 0.1 * undyed

@@ -73,8 +73,8 @@ def test_mip_far_limit_is_the_fitted_open_area(gl, path):
     within the 1 % of the pattern's own rule, and the averaged normal tilts less than 1 deg."""
     renderer = FrameRenderer(gl, (16, 16))
     renderer.set_fabric(path)
-    levels = int(math.log2(max(renderer._pattern_texture.size)))
-    top = renderer.pattern_mip_level(levels)
+    levels = int(math.log2(max(renderer.fabric_pattern.texture.size)))
+    top = renderer.fabric_pattern.pattern_mip_level(levels)
     direct = load_preset(path).btdf.direct
     assert top.shape[:2] == (1, 1)
     assert abs((1.0 - top[0, 0, 3]) - direct) <= OPEN_AREA_TOLERANCE * direct
@@ -119,7 +119,7 @@ def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, ant
     one_front = render(front)
     one_back = render(back)
     both = render(front, back)
-    revealage = np.frombuffer(renderer._oit_accum.read(), np.float32).reshape(72, 96, 4)[::-1, :, 3]
+    revealage = np.frombuffer(renderer.targets.oit_accum.read(), np.float32).reshape(72, 96, 4)[::-1, :, 3]
     a = 0.6
     c1 = (one_front - (1 - a) * behind) / a
     c2 = (one_back - (1 - a) * behind) / a
@@ -160,7 +160,7 @@ def test_a_known_pattern_appears_where_the_texture_coordinates_put_it(gl, make_p
     renderer.set_fabric(preset)
     renderer.set_light("D65")
     renderer.set_camera(0.0, 0.0, 1.2)
-    renderer.set_pattern_filtering(False)
+    renderer.fabric_pattern.set_pattern_filtering(False)
     target_y = renderer.camera.target[1]
     quad = _quad(-0.4, 0.4, target_y - 0.4, target_y + 0.4, lambda x, y: np.full_like(x, -0.08))
     renderer.set_mesh(*quad, fabric_size_m=(0.8, 0.8))
@@ -285,7 +285,7 @@ def dolly_change(renderer, mask_frames, filtered: bool, frames: int = 40) -> flo
     """Mean over a dolly (3 m -> 0.2 m, geometric steps) of the mean absolute change of the
     displayed luminance (8-bit levels) between consecutive frames, over pixels that are
     curtain in both."""
-    renderer.set_pattern_filtering(filtered)
+    renderer.fabric_pattern.set_pattern_filtering(filtered)
     previous = None
     changes = []
     for k, distance in enumerate(np.geomspace(3.0, 0.2, frames)):
@@ -383,7 +383,7 @@ def test_the_patterns_lod_bias_brings_a_pixel_closer_to_its_box(gl, record_figur
     (no fold silhouettes), the mean relative luminance error with the bias is at most 0.85
     times the error without (bound set before measuring; on the bench's lace close-up the
     curtain's Delta E against the path tracer went 2.26 -> 1.87)."""
-    from catalog.render.frame import PATTERN_LOD_BIAS
+    from catalog.render.passes.pattern import PATTERN_LOD_BIAS
 
     def frame(size, bias):
         renderer = FrameRenderer(gl, size)
@@ -416,7 +416,7 @@ def test_the_patterns_lod_bias_brings_a_pixel_closer_to_its_box(gl, record_figur
 def test_auto_antialiasing_takes_msaa_on_a_gpu_and_fxaa_on_a_cpu_rasteriser(gl):
     """The rule of choose_antialiasing: MSAA needs 4 samples and a GPU (multisampling on a
     CPU rasteriser shades and blends every sample: benchmarks/bench_pattern.json)."""
-    from catalog.render.frame import choose_antialiasing
+    from catalog.render.passes.targets import choose_antialiasing
 
     assert choose_antialiasing({"GL_RENDERER": "NVIDIA H200/PCIe/SSE2", "GL_MAX_SAMPLES": 32}) == "msaa"
     assert choose_antialiasing({"GL_RENDERER": "NVIDIA H200/PCIe/SSE2", "GL_MAX_SAMPLES": 2}) == "fxaa"

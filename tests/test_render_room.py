@@ -226,15 +226,15 @@ def test_layers_multiply_in_the_shadow_map(gl):
     uvs = np.tile([[0, 0], [1, 0], [1, 1], [0, 1]], (2, 1)).astype("f4")
     indices = np.array([0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7], dtype="i4")
     r.set_mesh(positions, normals, uvs, tangents, indices)
-    r.draw_room_shadow(r.shading_inputs())
-    shadow = r.read_room_shadow()
+    r.shadow.draw_room_shadow(r.shading_inputs())
+    shadow = r.lightmap.read_room_shadow()
     n = shadow.shape[0]
     centre = shadow[n // 2 - 4: n // 2 + 4, n // 2 - 4: n // 2 + 4].reshape(-1, 3)
     t = _beam_transmittance(r.shading_inputs())
     assert np.allclose(centre, t * t, atol=2e-3)
     r.set_room_lobe(True)
-    r.draw_room_shadow(r.shading_inputs())
-    centre = r.read_room_shadow()[n // 2 - 4: n // 2 + 4, n // 2 - 4: n // 2 + 4].reshape(-1, 3)
+    r.shadow.draw_room_shadow(r.shading_inputs())
+    centre = r.lightmap.read_room_shadow()[n // 2 - 4: n // 2 + 4, n // 2 - 4: n // 2 + 4].reshape(-1, 3)
     assert np.allclose(centre, r.shading_inputs().direct ** 2, atol=2e-3)
     r.release()
 
@@ -256,10 +256,10 @@ def test_room_lamp_lights_the_floor_by_inverse_square(gl):
     lamp = (float(centre[0]), float(centre[1] + height), float(centre[2]))
     r.set_curtain_open(False)
     r.render()
-    before = r.read_room_lightmap()[j, i]
+    before = r.lightmap.read_room_lightmap()[j, i]
     r.set_room_lamps([("A", lamp)])
     r.render()
-    after = r.read_room_lightmap()[j, i]
+    after = r.lightmap.read_room_lightmap()[j, i]
     intensity = _luma(spectrum_to_display_rgb(r.room_lamps[0][0].irradiance_w_m2_nm))
     added = _luma(after) - _luma(before)
     rho = scene_lib.ROOM_ALBEDO
@@ -280,8 +280,8 @@ def test_light_map_is_the_float64_radiosity_of_its_direct_light(gl):
     r = _renderer(gl)
     r.set_room_lamps([("A", (0.5, 1.0, 2.0))])
     r.render()
-    light_map = r.read_room_lightmap().astype(np.float64)
-    res = r._room_resources()
+    light_map = r.lightmap.read_room_lightmap().astype(np.float64)
+    res = r.room_targets.get()
     aw, ah = room_light.atlas_size()
     direct = np.frombuffer(res["direct"].read(level=0), dtype=np.float32).reshape(ah, aw, 4)[..., :3]
     beam = np.frombuffer(res["beam"].read(level=0), dtype=np.float32).reshape(ah, aw, 4)[..., :3]
@@ -293,7 +293,7 @@ def test_light_map_is_the_float64_radiosity_of_its_direct_light(gl):
     faces = patches["face"]
     order = [(faces[n] * rc + n % rc, (n // rc) % rc) for n in range(faces.size)]  # (column, row)
     s = np.array([source[row, col] for col, row in order])
-    window = np.array(r.window_albedo_rgb(r.shading_inputs()))
+    window = np.array(r.terms.window_albedo_rgb(r.shading_inputs()))
     assert np.all(window > 0.01)   # the closed lace sends part of the room's light back
     total = s + np.stack([room_light.radiosity_operator(scene_lib.ROOM_ALBEDO, round(float(w), 4)) @ s[:, c]
                           for c, w in enumerate(window)], axis=-1)
@@ -341,7 +341,7 @@ def test_room_light_is_stable_as_the_cloth_moves(gl):
         mesh = scene_lib.draped_curtain(fold_shift_m=0.02 * step)
         r.set_mesh(mesh.positions, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices)
         r.render()
-        light = _luma(r.read_room_lightmap())
+        light = _luma(r.lightmap.read_room_lightmap())
         if previous is not None:
             worst = max(worst, float((np.abs(light - previous) / previous).max()))
         previous = light
@@ -518,7 +518,7 @@ def test_shadow_map_size_is_a_frame_option(gl):
     back at that size), the room's beam patch keeps its mean within 2 % (the map's resolution
     moves its edges, not its light), and a size outside SHADOW_MAP_SIZES is one InputError."""
     from catalog.core.errors import InputError
-    from catalog.render.frame import SHADOW_MAP_SIZES
+    from catalog.render.passes.shadow import SHADOW_MAP_SIZES
 
     r = _renderer(gl)
     patch, _ = _floor_regions(r)
@@ -526,7 +526,7 @@ def test_shadow_map_size_is_a_frame_option(gl):
     for texels in (128, 512):
         r.set_shadow_map_size(texels)
         image = _frame(r, False)
-        assert r.read_room_shadow().shape == (texels, texels, 3)
+        assert r.lightmap.read_room_shadow().shape == (texels, texels, 3)
         means[texels] = _luma(image[patch]).mean()
     assert means[128] == pytest.approx(means[512], rel=0.02)
     assert r.info()["shadow_map_size"] == 512
@@ -602,7 +602,7 @@ def test_window_light_is_the_float64_sum_over_both_sides(gl, fabric, light):
     r = FrameRenderer(gl, (32, 18))
     r.set_fabric(fabric)
     r.set_light(light)
-    res = r._room_resources()
+    res = r.room_targets.get()
     aw, ah = room_light.atlas_size()
     rf = room_light.FACE_TEXELS
     cols = slice(room_light.FACE_NAMES.index("window_wall") * rf, None)
@@ -623,24 +623,24 @@ def test_window_light_is_the_float64_sum_over_both_sides(gl, fabric, light):
         front = captured[..., :3]
         back = level("luminaire_back", room_light.BACK_LUMINAIRE_LEVEL)[..., :3]
         inputs = r.shading_inputs()
-        lobe = None if curtain_open else {"lobe_rgb": r._room_colours(inputs)["u_lobe_rgb"],
+        lobe = None if curtain_open else {"lobe_rgb": r.terms.room_colours(inputs)["u_lobe_rgb"],
                                           "g_spec": float(inputs.g_spec), "to_light": inputs.key_to_light}
         sides = None
         if r.side_eyes:   # the side eyes' captures, left then right (the sky too when open)
-            sides = r.read_side_captures()
-        walls = r.read_wall_captures() if r.wall_eyes_active() else None
+            sides = r.capture.read_side_captures()
+        walls = r.capture.read_wall_captures() if r.capture.wall_eyes_active() else None
         expected = room_light.window_irradiance(front, back, lobe=lobe, radiance_sides=sides,
-                                                alpha=captured[..., 3], front_z=r.window_front_z(),
+                                                alpha=captured[..., 3], front_z=r.capture.window_front_z(),
                                                 radiance_walls=walls)
         scale = float(np.abs(expected[mask]).max())
         assert np.abs(direct[mask] - expected[mask]).max() <= 1e-3 * scale
-        assert r.window_near() == (not curtain_open)
-        if r.window_near():   # the window wall beside the opening's finer grid, the same sum
+        assert r.capture.window_near() == (not curtain_open)
+        if r.capture.window_near():   # the window wall beside the opening's finer grid, the same sum
             points = room_light.window_near_points().reshape(-1, 3)
             near = room_light.window_irradiance_at(points, np.tile([0.0, 0.0, 1.0], (len(points), 1)), front,
                                                    back, sides, lobe=lobe, alpha=captured[..., 3],
-                                                   front_z=r.window_front_z(), radiance_walls=walls)
-            got = r.read_window_near().reshape(-1, 3)
+                                                   front_z=r.capture.window_front_z(), radiance_walls=walls)
+            got = r.capture.read_window_near().reshape(-1, 3)
             assert np.abs(got - near).max() <= 1e-3 * float(np.abs(near).max())
         wall = _luma(direct[:, cols][beside])
         if curtain_open:   # in-plane round-off of the sky's patches aside
@@ -699,7 +699,7 @@ def test_capture_alpha_is_the_key_on_the_nearest_cloth(gl):
     r.set_patterned(False)
     cos_i = abs(float(r.shading_inputs().key_to_light[2]))
     t = _beam_transmittance(r.shading_inputs())
-    res = r._room_resources()
+    res = r.room_targets.get()
     lvl = room_light.LUMINAIRE_LEVEL
     w, h = (v >> lvl for v in room_light.luminaire_capture_size(lvl))
     for sheets, expected in (((0.05,), cos_i), ((-0.15, 0.05), cos_i * t)):
@@ -750,9 +750,9 @@ def test_room_side_grid_matches_float64_gather(gl, light):
     r.set_curtain_open(False)
     r.render()
     assert r.room_side_active()
-    side = r.read_room_side()
-    twin = room_light.curtain_side_irradiance(r.read_room_total(), scene_lib.ROOM_ALBEDO,
-                                              r.window_albedo_rgb(r.shading_inputs()))
+    side = r.lightmap.read_room_side()
+    twin = room_light.curtain_side_irradiance(r.lightmap.read_room_total(), scene_lib.ROOM_ALBEDO,
+                                              r.terms.window_albedo_rgb(r.shading_inputs()))
     assert np.all(_luma(twin) > 0.0)
     assert np.abs(side - twin).max() < 1e-3 * np.abs(twin).max()
     r.release()
@@ -768,18 +768,18 @@ def test_room_side_replaces_the_stand_ins(gl):
     r = _renderer(gl, fabric="safety-yellow", light="UV-A")
     r.set_curtain_open(False)
     inputs, solved = r.shading_inputs(), r.curtain_inputs()
-    assert r.variant_defines().get("ROOM_SIDE")
+    assert r.curtain.variant_defines().get("ROOM_SIDE")
     assert not np.any(solved.fill_irradiance) and inputs.fill_irradiance.max() > 0
     assert np.allclose(solved.ambient_radiance, inputs.ambient_outside_radiance)
     assert solved.absorbed_photons[1] == 0.0
     assert solved.absorbed_photons[2] == pytest.approx(inputs.absorbed_photons[2] - inputs.absorbed_room_photons)
     r.render()
-    side = r.read_room_side()
-    colours = r._display_colours(inputs)
+    side = r.lightmap.read_room_side()
+    colours = r.terms.display_colours(inputs)
     stand_in = math.pi * _luma(colours["u_room_rgb"]) + math.pi / scene_lib.ROOM_ALBEDO * _luma(colours["u_fill_rgb"])
     assert _luma(side).mean() > 10.0 * stand_in
     r.set_room_side(False)
-    assert not r.variant_defines().get("ROOM_SIDE") and r.curtain_inputs() is r.shading_inputs()
+    assert not r.curtain.variant_defines().get("ROOM_SIDE") and r.curtain_inputs() is r.shading_inputs()
     r.set_room_side(True)
     r.set_room_lighting(False)
     assert not r.room_side_active()
@@ -829,10 +829,10 @@ def test_the_window_outside_the_wall_is_lit_by_the_outside_and_the_key(gl):
     assert sill.sum() > 100 and outer.sum() > 100
     inputs = r.shading_inputs()
     to_light = np.asarray(inputs.key_to_light, dtype=np.float64)
-    colours = r._display_colours(inputs)
+    colours = r.terms.display_colours(inputs)
     key_rgb, sky, ground = (np.asarray(colours[k]) for k in ("u_key_rgb", "u_sky_rgb", "u_ground_rgb"))
     level = room_light.BACK_LUMINAIRE_LEVEL + 1
-    back = r.read_luminaire_back(level)
+    back = r.capture.read_luminaire_back(level)
     p = q[sill]
     f = np.clip((p[:, 0] - wx0) / (wx1 - wx0), 0.0, 0.999)
     back_at = back[0, (f * back.shape[1]).astype(int)]
@@ -868,7 +868,7 @@ def test_room_side_light_per_vertex_matches_its_numpy_evaluation(gl):
             r.set_mesh(mesh.positions, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices)
         g = r.render_gbuffer()
         mask = g["mask"]
-        room, window = r.room_side_light_at(g["position"][mask], g["room_occlusion"][mask])
+        room, window = r.twin.room_side_light_at(g["position"][mask], g["room_occlusion"][mask])
         got_room = g["room_side_light"][mask].astype(np.float64)
         got_window = g["window_side_light"][mask].astype(np.float64)
         rel_room = np.abs(_luma(got_room) / _luma(room) - 1)
@@ -902,7 +902,7 @@ def test_wall_light_per_vertex_matches_its_numpy_evaluation(gl):
     g = r.render_gbuffer()
     mask = g["mask"]
     got = g["wall_light"][mask].astype(np.float64)
-    want = r.wall_light_at(g["position"][mask], g["shadows"][mask][:, 3])
+    want = r.twin.wall_light_at(g["position"][mask], g["shadows"][mask][:, 3])
     scale = _luma(want).mean()
     assert scale > 0
     assert abs(_luma(got).mean() / scale - 1) < 0.03, (_luma(got).mean(), scale)
@@ -943,7 +943,7 @@ def test_the_cloth_sees_the_window_wall_as_the_viewer_does(gl):
     towards = d[..., 2] < -1e-3
     safe = np.where(towards[..., None], d, np.array([0.0, 0.0, -1.0]))
     points = np.broadcast_to(eye, safe.shape).reshape(-1, 3)
-    want, walled = room_light.wall_radiance_along(points, safe.reshape(-1, 3), r.wall_light_sources(),
+    want, walled = room_light.wall_radiance_along(points, safe.reshape(-1, 3), r.twin.wall_light_sources(),
                                                   with_walled=True)
     want = want.reshape(h, w, 3)
     walled = walled.reshape(h, w) & towards
@@ -1087,8 +1087,8 @@ def test_the_captures_see_the_folds_behind_through_the_holes(gl):
     def captures(r, on):
         r.set_capture_folds(on)
         r.render()
-        sides = r.read_side_captures()
-        return [sides[0], r.read_luminaire(room_light.LUMINAIRE_LEVEL), sides[1]]
+        sides = r.capture.read_side_captures()
+        return [sides[0], r.capture.read_luminaire(room_light.LUMINAIRE_LEVEL), sides[1]]
 
     r = FrameRenderer(gl, SIZE)
     r.set_fabric("safety-yellow")
@@ -1133,13 +1133,13 @@ def test_the_beams_flux_into_the_room_is_the_sheets_shadow_integrated(gl, elevat
                np.array([[0, 1], [1, 1], [1, 0], [0, 0]], dtype="f4"),
                np.tile([1.0, 0.0, 0.0], (4, 1)).astype("f4"), np.array([0, 1, 2, 0, 2, 3], dtype="i4"))
     r.render()
-    res = r._room_resources()
+    res = r.room_targets.get()
     aw, ah = room_light.atlas_size()
     beam = _luma(np.frombuffer(res["beam"].read(level=0), dtype=np.float32).reshape(ah, aw, 4)[..., :3]
                  .astype(np.float64))
     inputs = r.shading_inputs()
     to_light = np.asarray(inputs.key_to_light, dtype=np.float64)
-    key = float(_luma(r._room_colours(inputs)["u_key_rgb"]))
+    key = float(_luma(r.terms.room_colours(inputs)["u_key_rgb"]))
     rf, n = room_light.FACE_TEXELS, 512
     points, normals = room_light.texel_points(n)
     mask_fine = room_light.surface_mask(points.reshape(-1, 3)).reshape(points.shape[:2]) > 0.5

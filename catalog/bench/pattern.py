@@ -46,7 +46,8 @@ def _clock(ctx, draw, repeats: int) -> list[float]:
 def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = None) -> dict:
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
-    from catalog.render.frame import MSAA_SAMPLES, FrameRenderer, choose_antialiasing  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.passes.targets import MSAA_SAMPLES, choose_antialiasing  # noqa: PLC0415
     from catalog.render.scene import draped_curtain  # noqa: PLC0415
     from catalog.render.snapshot import simulated_curtain  # noqa: PLC0415
 
@@ -103,14 +104,14 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     msaa_colour = ctx.renderbuffer((w, h), 4, samples=4, dtype="f4")
     msaa_depth = ctx.depth_renderbuffer((w, h), samples=4)
     msaa_fbo = ctx.framebuffer([msaa_colour], msaa_depth)
-    single_fbo = renderer._hdr_fbo
+    single_fbo = renderer.targets.hdr_fbo
 
     def hdr_single():
-        renderer._hdr_fbo = single_fbo
+        renderer.targets.hdr_fbo = single_fbo
         renderer.render_hdr()
 
     def hdr_msaa():
-        renderer._hdr_fbo = msaa_fbo
+        renderer.targets.hdr_fbo = msaa_fbo
         renderer.render_hdr()
         ctx.copy_framebuffer(single_fbo, msaa_fbo)   # resolve
 
@@ -120,7 +121,7 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     for _ in range(repeats):
         msaa_samples["1x (flat HDR passes)"] += _clock(ctx, hdr_single, 1)
         msaa_samples["MSAA 4x (flat HDR passes + resolve)"] += _clock(ctx, hdr_msaa, 1)
-    renderer._hdr_fbo = single_fbo
+    renderer.targets.hdr_fbo = single_fbo
     single_fbo.use()   # never leave a released framebuffer bound (the context is the caller's)
     for obj in (msaa_fbo, msaa_colour, msaa_depth):
         obj.release()

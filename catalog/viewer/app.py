@@ -431,7 +431,7 @@ class ViewerApp:
         return {"room_light": True, "bloom": True, "room_update_every": 1}
 
     def _software_gl(self) -> bool:
-        from catalog.render.frame import software_rasteriser  # noqa: PLC0415
+        from catalog.render.passes.targets import software_rasteriser  # noqa: PLC0415
 
         return software_rasteriser(self.ctx.info)
 

@@ -409,7 +409,7 @@ class SiteExporter:
         return {"u_view_proj": matrix(view_proj),
                 "u_inverse_view_proj": matrix(np.linalg.inv(view_proj)),
                 "u_camera_position": [float(v) for v in r.camera.position],
-                "u_oit_depth_ref": float(r.oit_depth_reference_m())}
+                "u_oit_depth_ref": float(r.curtain.oit_depth_reference_m())}
 
     def check_camera_uniforms(self, preset, light: LightChoice) -> None:
         """Refuse a desktop frame whose other uniforms depend on the camera: the page would
