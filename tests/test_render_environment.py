@@ -104,8 +104,8 @@ def test_the_flat_curtains_see_through_shows_the_environment(gl, tmp_path):
     r.set_patterned(False)
     r.set_bloom(False)
     # the see-through alone: the room's light on the cloth's room side (ROOM_SIDE) changes with
-    # the outside too, through the room's captures, and is held to its twin elsewhere
-    r.set_room_side(False)
+    # the outside too, through the room's captures, and is held to its twin elsewhere: unlit
+    r.set_room_lighting(False)
     r.set_camera(0.0, 5.0, 1.0)
     red, blue = np.array([2.0, 1.0, 0.5]), np.array([0.5, 1.0, 2.0])
     out = []

@@ -335,16 +335,3 @@ def test_room_side_term_is_part_of_the_per_pixel_comparison(gl, make_preset):
     renderer.release()
 
 
-@pytest.mark.parametrize("switches", [{"sky_occlusion": False}, {"key_shadow": False},
-                                      {"sky_occlusion": False, "key_shadow": False}])
-def test_room_side_with_the_cloth_shadows_off(gl, make_preset, switches):
-    """ROOM_SIDE compiles and matches its twin per pixel (1e-3) with issue 11's shadow terms
-    switched off (the image bench's options): without SKY_OCCLUSION the folds hide nothing."""
-    renderer = _renderer(gl, make_preset(), "sun:60", "physical")
-    renderer.set_camera(yaw_deg=20.0, pitch_deg=-10.0, distance_m=2.2)
-    for name, on in switches.items():
-        getattr(renderer, f"set_{name}")(on)
-    assert renderer.room_side_active()
-    gl_rgb, reference = _compare(renderer)
-    assert _relative_error(gl_rgb, reference).max() < 1e-3
-    renderer.release()

@@ -374,45 +374,6 @@ def test_antialiasing_brings_edges_closer_to_a_supersampled_frame(gl, mode, reco
     assert error_fxaa <= 0.8 * error_plain
 
 
-@pytest.mark.slow
-def test_the_patterns_lod_bias_brings_a_pixel_closer_to_its_box(gl, record_figure):
-    """Issue 11's eighth round: the pattern sampled at PATTERN_LOD_BIAS (the mip level whose
-    filter has a pixel box's variance) against the hardware's level (bias 0). Reference: the
-    same lace close-up rendered at 4x4 the pixels with the hardware's level and box-averaged
-    in linear light (what the path tracer's box filter averages). Over the curtain's interior
-    (no fold silhouettes), the mean relative luminance error with the bias is at most 0.85
-    times the error without (bound set before measuring; on the bench's lace close-up the
-    curtain's Delta E against the path tracer went 2.26 -> 1.87)."""
-    from catalog.render.passes.pattern import PATTERN_LOD_BIAS
-
-    def frame(size, bias):
-        renderer = FrameRenderer(gl, size)
-        renderer.set_fabric("lace-fwa")
-        renderer.set_light("D65")
-        renderer.set_antialiasing("off")
-        renderer.set_bloom(False)
-        renderer.set_camera(0.0, 0.0, 0.8)
-        renderer.set_pattern_lod_bias(bias)
-        renderer.render()
-        image = renderer.read_linear().astype(np.float64) @ [0.2126, 0.7152, 0.0722]
-        mask = renderer.render_gbuffer()["mask"]
-        renderer.release()
-        return image, mask
-
-    big, big_mask = frame((384, 288), 0.0)
-    reference = big.reshape(72, 4, 96, 4).mean(axis=(1, 3))
-    interior = big_mask.reshape(72, 4, 96, 4).all(axis=(1, 3))
-    assert interior.sum() > 3000
-    errors = {}
-    for name, bias in (("hardware level", 0.0), ("box variance", PATTERN_LOD_BIAS)):
-        image, _mask = frame((96, 72), bias)
-        errors[name] = float((np.abs(image - reference)[interior] / reference[interior]).mean())
-    print(f"mean relative error against the 4x4 box over {int(interior.sum())} pixels: "
-          + ", ".join(f"{k} {v:.4f}" for k, v in errors.items()))
-    record_figure("pattern.lod_bias_box_error", errors)
-    assert errors["box variance"] <= 0.85 * errors["hardware level"]
-
-
 def test_auto_antialiasing_takes_msaa_on_a_gpu_and_fxaa_on_a_cpu_rasteriser(gl):
     """The rule of choose_antialiasing: MSAA needs 4 samples and a GPU (multisampling on a
     CPU rasteriser shades and blends every sample: benchmarks/bench_pattern.json)."""

@@ -57,7 +57,7 @@ from catalog.render.passes.display import DisplayPass
 from catalog.render.passes.gl_common import GLPrograms
 from catalog.render.passes.glare import GlarePass
 from catalog.render.passes.lightmap import LightmapPass
-from catalog.render.passes.pattern import PATTERN_LOD_BIAS, PatternTexture
+from catalog.render.passes.pattern import PatternTexture
 from catalog.render.passes.room import RoomPass
 from catalog.render.passes.scene_terms import SceneTerms
 from catalog.render.passes.shadow import SHADOW_MAP_SIZES, ShadowPass
@@ -95,51 +95,12 @@ class FrameRenderer:
         self.ev100 = None                # None: metered per frame (auto exposure)
         self.white_balance = display_lib.DEFAULT_WHITE_BALANCE
         self.metered_ev100 = None        # the auto exposure's current EV100 (adapted)
-        self.display_stages = 3          # tonemap.frag's DISPLAY_STAGES (benchmark variants)
         self._last = None  # (vw, vh, fbo, viewport)
         #: issue 13: the room lit through the curtain (False: the earlier constant room)
         self.room_lighting = True
-        #: issue 11: the key light on the cloth shaded by the window wall and by the folds
-        #: nearer the light (curtain.frag KEY_SHADOW; False: the key reaches every fragment)
-        self.key_shadow = True
-        #: issue 11: the cloth's own folds hide part of the outside from its ambient term
-        #: (curtain.frag SKY_OCCLUSION; False: every fragment sees the whole outside)
-        self.sky_occlusion = True
-        #: issue 11: the ambient term by view (False: the normal view's at every angle)
-        self.ambient_by_view = True
-        #: issue 11: the outside through the lobes by the view's height, the sky above the
-        #: view's line and the ground below (False: the outside averaged)
-        self.outside_by_view = True
-        #: issue 11: the room's bounces, "all" (radiosity, room_radiosity.frag) or "one"
-        self.room_bounces = "all"
-        #: issue 11: the key's directional lobe through the cloth reaches the room spread over
-        #: its HG lobe, from the window's patches (room_lightmap.frag); False: collimated in
-        #: the beam, a_spec forward(g_spec) per thread (issue 13's frame)
-        self.room_lobe = True
-        #: issue 11 (fourth round): the curtain's room side lit by the room's solved light
-        #: (curtain.frag ROOM_SIDE, with the room lighting and the viewer inside); False: by
-        #: the stand-ins, the fill light and the room's share of the ambient term
-        self.room_side_solved = True
-        self.wall_light = True     # the window wall and its reveals light the cloth (WALL_LIGHT)
-        #: issue 11 (sixth round): the room's capture of the window from three eyes, blended
-        #: per receiving point (room_lightmap.frag SIDE_EYES); False: from the middle alone
-        self.side_eyes = True
-        #: the room sees the closed curtain through a box around its folds (set_window_box)
-        self.window_box = True
-        #: the box's sides also captured from eyes by the window wall (set_wall_eyes)
-        self.wall_eyes = True
-        #: the window wall beside the opening takes the window's light per pixel (set_window_near)
-        self.window_near_field = True
-        #: issue 11 (sixth round): the room's captures see the folds behind through the holes
-        #: (curtain.frag FOLDS_BEHIND); False: the outside there
-        self.capture_folds = True
-        #: the room's and the folds' light passed by the dye of the lit cloth's own light
-        #: (set_secondary_dye)
-        self.secondary_dye = True
-        #: the key's shadow on the cloth through two layers, not one (set_key_second_layer)
+        #: the key's shadow on the cloth through two layers of its folds (False: the nearest
+        #: alone; the web page's frame, catalog.web.export.DESKTOP_MODES)
         self.key_second_layer = True
-        #: the pattern's LOD bias (set_pattern_lod_bias)
-        self.pattern_lod_bias = PATTERN_LOD_BIAS
         #: the side (texels) of the key light's maps: the room's transmittance map and the
         #: cloth's front-layer map (set_shadow_map_size)
         self.shadow_texels = room_light.SHADOW_TEXELS
@@ -153,7 +114,6 @@ class FrameRenderer:
         self.bloom = True          # glare before the tone map (bloom.frag)
         self.environment = None    # (path, texture, upper-hemisphere illuminance) or None
         self.antialiasing = "fxaa"
-        self.fxaa_shader = "fxaa.frag"   # the benchmark swaps in its earlier version
         self.room_targets = RoomTargets(ctx, self.shadow_texels)
         # the passes, in the order a frame runs them (render_hdr, render)
         self.gl = GLPrograms(ctx)
@@ -237,108 +197,17 @@ class FrameRenderer:
         keep the earlier constant room (a fraction of the key light plus the fill light)."""
         self.room_lighting = bool(on)
 
-    def set_key_shadow(self, on: bool) -> None:
-        """Shade the key light on the cloth by the window wall and the folds nearer the light
-        (issue 11; curtain.frag KEY_SHADOW), or let it reach every fragment (the earlier frame)."""
-        self.key_shadow = bool(on)
-
-    def set_ambient_by_view(self, on: bool) -> None:
-        """The cloth's ambient term by view (issue 11; the lobes integrated for the view's
-        angle to the normal), or the normal view's at every angle (the earlier frame)."""
-        self.ambient_by_view = bool(on)
-
-    def set_room_bounces(self, bounces: str) -> None:
-        """The room's diffuse bounces: "all" (the radiosity solve of
-        :func:`catalog.render.room_light.radiosity_operator`, issue 11) or "one" (issue 13's
-        single bounce, which left the walls and the floor too dark)."""
-        if bounces not in room_light.ROOM_BOUNCES:
-            raise InputError(f"{bounces!r}: choose one of {', '.join(room_light.ROOM_BOUNCES)}",
-                             field="room bounces")
-        self.room_bounces = bounces
-
-    def set_room_lobe(self, on: bool) -> None:
-        """The key's directional lobe in the room: spread over its HG lobe from the window's
-        patches (True, issue 11: the path-traced floor by a voile under a low key was 1.5x the
-        collimated beam's light) or kept in the collimated beam (False, issue 13's frame)."""
-        self.room_lobe = bool(on)
-
-    def set_room_side(self, solved: bool) -> None:
-        """Light the curtain's room side by the room's solved light (True, issue 11's fourth
-        round: the stand-ins were 1.6-3x the room's light under daylight and 1 % of it under
-        UV-A, where the room is lit by the glow) or by the stand-ins (False: the fill light
-        and the room's share of the ambient term, the earlier frame)."""
-        self.room_side_solved = bool(solved)
-
-    def set_wall_light(self, on: bool) -> None:
-        """Light the cloth's window side by the window wall and its reveals where they hide
-        the outside (True, issue 11's fifth round: the sunlit sill seen through the
-        directional lobe was 40-57 % of the path-traced lace noon room's curtain bottom) or
-        count those directions dark (False, before). Needs the room side's solved light and
-        the outside's occlusion."""
-        self.wall_light = bool(on)
-
-    def set_window_near(self, on: bool) -> None:
-        """The window wall within room_light.WINDOW_NEAR_M of the opening takes the window's
-        light per pixel (True: it falls tenfold within a light-map texel there) or from the
-        light map (False)."""
-        self.window_near_field = bool(on)
-
-    def set_wall_eyes(self, on: bool) -> None:
-        """Capture the box's sides also from eyes by the window wall (room_light.WALL_EYES) and
-        blend the two by the angle of the way to each receiving point (True); off: the side
-        eyes' edge columns alone."""
-        self.wall_eyes = bool(on)
-
-    def set_window_box(self, on: bool) -> None:
-        """The room sees the closed curtain through a box around its folds (the patches at the
-        folds' front, the box's sides at the opening's edges: a wall seeing the window edge-on
-        gets the flanks' light); off: through the opening's plane alone (before issue 11's
-        ninth round)."""
-        self.window_box = bool(on)
-
-    def set_side_eyes(self, on: bool) -> None:
-        """Capture the window for the room's direct light from the middle and two eyes towards
-        the side walls, blended by the angle to each receiving point (True, issue 11's sixth
-        round: under the UV lamp the folds' lit flanks, facing one way, glow about three times
-        the shadowed, and the path-traced left wall got 1.3x the right's direct light while the
-        one capture from the middle lit both alike) or from the middle alone (False, before)."""
-        self.side_eyes = bool(on)
-
-    def set_capture_folds(self, on: bool) -> None:
-        """Let the room's captures of the window see, through the cloth's holes, the folds
-        behind where they hide the outside (True, issue 11's sixth round: the frame's own
-        patterned curtain composites them, the captures draw the flat cloth and showed the
-        outside there, dark under the UV lamp) or the outside (False, before)."""
-        self.capture_folds = bool(on)
-
-    def set_secondary_dye(self, on: bool) -> None:
-        """Pass the room's light and the folds' light through the cloth by the dye of what the
-        key-lit cloth sends on, its forward share of the key and its glow (True, issue 11's
-        seventh round, catalog.optics.dye_colour) or by the key's dye (False, before)."""
-        self.secondary_dye = bool(on)
-
     def set_key_second_layer(self, on: bool) -> None:
         """Shade the cloth behind two layers of its folds with the key's beam through both (True,
-        issue 11's seventh round: the front-layer map peeled into a second map, each layer
-        passing the beam by its own coverage) or through the nearest alone (False, before: a
-        point of voile behind two folds was 1.15-1.55x the path tracer's)."""
+        the front-layer map peeled into a second map) or through the nearest alone (False: what
+        the web page shows, catalog.web.export.DESKTOP_MODES)."""
         self.key_second_layer = bool(on)
-
-    def set_pattern_lod_bias(self, bias: float | bool) -> None:
-        """The pattern's mip level bias (log2 of the filter's texel side): PATTERN_LOD_BIAS or
-        True, the level whose filter has the pixel's box's variance (issue 11's eighth round);
-        0 or False, the hardware's level (before: the lace's motifs blurred); any float in
-        [-4, 4]."""
-        bias = PATTERN_LOD_BIAS if bias is True else 0.0 if bias is False else float(bias)
-        if not -4.0 <= bias <= 4.0:
-            raise InputError(f"{bias}: a LOD bias in [-4, 4]", field="pattern LOD bias")
-        self.pattern_lod_bias = bias
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
-        room lighting, the option on and the viewer in the room (from outside, the room lies
-        behind the cloth and the stand-ins stay)."""
-        return bool(self.room_lighting and self.room_side_solved and self.viewer_inside)
+        room lighting on and the viewer in the room (from outside, the room lies behind the
+        cloth and the stand-ins stay)."""
+        return bool(self.room_lighting and self.viewer_inside)
 
     def set_shadow_map_size(self, texels: int) -> None:
         """The side of the key light's maps (the room's transmittance map and the cloth's
@@ -351,16 +220,6 @@ class FrameRenderer:
             self.shadow_texels = texels
             self.room_targets.release()
             self.room_targets.shadow_texels = texels
-
-    def set_outside_by_view(self, on: bool) -> None:
-        """The outside the lobes bring by the view's height (issue 11: the sky above the view's
-        line, the ground below; u_ambient_tilt), or the outside averaged (the earlier frame)."""
-        self.outside_by_view = bool(on)
-
-    def set_sky_occlusion(self, on: bool) -> None:
-        """Let the cloth's own folds hide part of the outside from its ambient term (issue 11;
-        curtain.frag SKY_OCCLUSION), or let every fragment see the whole outside."""
-        self.sky_occlusion = bool(on)
 
     def set_curtain_open(self, open_: bool) -> None:
         """Open: the curtain is drawn aside (not drawn, casts nothing, lights nothing)."""
@@ -470,7 +329,7 @@ class FrameRenderer:
         inputs = self.terms.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
-        if (self.room_lighting or self.key_shadow or self.sky_occlusion) and self.lightmap.stale():
+        if self.lightmap.stale():
             if self.room_lighting:   # the room's passes (the cloth's own shadow maps with them)
                 self._timed(profile, "room_shadow", lambda: self.shadow.draw_room_shadow(inputs))
                 self._timed(profile, "room_luminaire", lambda: self.capture.draw_room_luminaire(inputs))
@@ -606,13 +465,7 @@ class FrameRenderer:
             "white_balance": self.white_balance,
             "white_balance_adapted": not np.allclose(self.display.white_balance_matrix(), np.eye(3)),
             "size": list(self.size),
-            "room_lighting": self.room_lighting, "key_shadow": self.key_shadow,
-            "sky_occlusion": self.sky_occlusion, "ambient_by_view": self.ambient_by_view,
-            "outside_by_view": self.outside_by_view,
-            "room_bounces": self.room_bounces, "room_lobe": self.room_lobe,
-            "room_side_solved": self.room_side_solved, "side_eyes": self.side_eyes,
-            "capture_folds": self.capture_folds, "secondary_dye": self.secondary_dye,
-            "key_second_layer": self.key_second_layer,
+            "room_lighting": self.room_lighting, "key_second_layer": self.key_second_layer,
             "shadow_map_size": self.shadow_texels,
             "curtain_open": self.curtain_open,
             "sky_model": self.sky_model, "bloom": self.bloom,

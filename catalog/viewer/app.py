@@ -407,9 +407,6 @@ class ViewerApp:
             renderer = FrameRenderer(self.ctx, size)
             renderer.set_bloom(self.room_settings["bloom"])
             renderer.set_room_lighting(self.room_settings["room_light"])
-            # the cloth's own shadows (issue 11) are drawn with the room's light: off with it
-            renderer.set_key_shadow(self.room_settings["room_light"])
-            renderer.set_sky_occlusion(self.room_settings["room_light"])
             renderer.set_sky_model(self.room_settings["room_light"])
             renderer.room_update_every = self.room_settings["room_update_every"]
             self._renderers.append(renderer)

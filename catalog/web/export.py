@@ -92,10 +92,10 @@ DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa
 
 def configure_desktop_frame(renderer) -> None:
     """Put a FrameRenderer in the modes the page shows (:data:`DESKTOP_MODES`)."""
-    for name, value in DESKTOP_MODES.items():
-        setter = getattr(renderer, f"set_{name}", None)
-        if setter is not None:  # a mode this frame does not have is off anyway
-            setter(value)
+    renderer.set_patterned(DESKTOP_MODES["patterned"])
+    renderer.set_room_lighting(DESKTOP_MODES["room_lighting"])
+    renderer.set_antialiasing(DESKTOP_MODES["antialiasing"])
+    renderer.set_key_second_layer(DESKTOP_MODES["key_second_layer"])
 #: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
 #: the page shows each scene at the EV100 a desktop frame of this size meters at the default
 #: camera (fixed while orbiting, like a photograph's), recorded as an ordinary uniform. The

@@ -8,6 +8,7 @@ from catalog.gl.shaderlib import glsl_literal
 from catalog.render import bands as band_lib, room_light
 from catalog.render.camera import gl_bytes
 from catalog.render.passes.gl_common import ENVIRONMENT_UNIT, PATTERN_UNIT, Pass, set_uniform
+from catalog.render.passes.pattern import PATTERN_LOD_BIAS
 
 def shared_division_safe(g_diff: float, g_spec: float) -> bool:
     """Whether curtain.frag may divide once for the key, the fill and the fluorescence
@@ -43,24 +44,23 @@ class CurtainPass(Pass):
             defines["CURTAIN_ENVIRONMENT"] = True  # the see-through shows the image
         if self.frame.room_lamps:
             defines["N_ROOM_LAMPS"] = len(self.frame.room_lamps)   # the lamps light the cloth too
-        if self.frame.key_shadow and not self.frame.curtain_open:
+        if not self.frame.curtain_open:
             defines["KEY_SHADOW"] = True   # the wall's and the folds' shadow on the cloth
-        if self.frame.sky_occlusion and not self.frame.curtain_open:
             defines["SKY_OCCLUSION"] = True   # the folds hide part of the outside
             defines["N_OCCLUSION"] = room_light.OCCLUSION_DIRECTIONS
         if self.frame.room_side_active():
             defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
             if defines.get("SKY_OCCLUSION"):
                 defines["OCCLUSION_MAPS"] = True   # the folds' maps (the G-buffer's view continuation)
-                if self.frame.wall_light:   # the wall and its reveals where the outside is walled
-                    defines["WALL_LIGHT"] = True
-                    defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
+                # the wall and its reveals where the outside is walled
+                defines["WALL_LIGHT"] = True
+                defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
         if self.frame.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.frame.patterned and not gbuffer:
             # the holes are drawn by the OIT composite: no see-through term in the shader
             defines.update({"PATTERN": True, "OIT": True, "SEE_THROUGH": False,
-                            "PATTERN_LOD_BIAS": glsl_literal(self.frame.pattern_lod_bias)})
+                            "PATTERN_LOD_BIAS": glsl_literal(PATTERN_LOD_BIAS)})
         return defines
 
     def _curtain_program(self, gbuffer: bool, overrides: dict | None = None, folds_behind: bool = False):
@@ -213,7 +213,7 @@ class CurtainPass(Pass):
         w, h = self.frame.size
         if self.frame.room_side_active():   # the room's light on the cloth's room side (and its maps)
             self.frame.lightmap.draw_room_light(self.frame.terms.shading_inputs())
-        elif self.frame.key_shadow or self.frame.sky_occlusion:   # the cloth's shadow maps of this mesh
+        else:   # the cloth's shadow maps of this mesh
             self.frame.shadow.draw_cloth_shadow_maps(self.frame.terms.shading_inputs())
         if self.frame.targets.gbuffer is None:
             textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(8)]

@@ -65,9 +65,10 @@ class DisplayPass(Pass):
         rgb = data[:ch, :cw, :3].astype(np.float64) @ self.white_balance_matrix().T  # as shown
         return display_lib.meter_ev100(display_lib.luminance_histogram(display_lib.meter_signal(rgb)))
 
-    def display_pass(self, vw: int, vh: int, fbo=None, viewport=None, hdr=None) -> None:
+    def display_pass(self, vw: int, vh: int, fbo=None, viewport=None, hdr=None, stages: int = 3) -> None:
         """The display transform of the HDR target's (vw, vh) corner (the benchmark times it);
-        ``hdr``: the texture to show (default the HDR target; the glare's output when on)."""
+        ``hdr``: the texture to show (default the HDR target; the glare's output when on);
+        ``stages``: tonemap.frag's DISPLAY_STAGES (3, all; fewer for the benchmark's cost per stage)."""
         target = fbo if fbo is not None else self.frame.targets.ldr_fbo
         target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
                            else (0, 0, vw, vh))
@@ -79,7 +80,7 @@ class DisplayPass(Pass):
             target.use()
             self.ctx.viewport = target_viewport
         program = self.gl.program("fullscreen.vert", "tonemap.frag",
-                                {"DISPLAY_STAGES": self.frame.display_stages})
+                                {"DISPLAY_STAGES": int(stages)})
         (hdr if hdr is not None else self.frame.targets.hdr).use(location=0)
         set_uniform(program, "u_hdr", 0)
         set_uniform(program, "u_hdr_rect", (0.0, 0.0, vw / self.frame.size[0], vh / self.frame.size[1]))
@@ -89,7 +90,7 @@ class DisplayPass(Pass):
         if fxaa:
             target.use()
             self.ctx.viewport = target_viewport
-            program = self.gl.program("fullscreen.vert", self.frame.fxaa_shader)
+            program = self.gl.program("fullscreen.vert", "fxaa.frag")
             self.frame.targets.pre.use(location=0)
             set_uniform(program, "u_ldr", 0)
             set_uniform(program, "u_size_px", (float(vw), float(vh)))

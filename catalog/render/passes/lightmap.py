@@ -91,39 +91,34 @@ class LightmapPass(Pass):
         gl["direct"].build_mipmaps()
         gl["beam"].build_mipmaps()
         rc = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
-        all_bounces = self.frame.room_bounces == "all"
         window_albedo = self.frame.terms.window_albedo_rgb(inputs)
-        if all_bounces:   # the coarse patches' total irradiance (room_radiosity.frag)
-            self._radiosity_operator(window_albedo)
-            gl["total_fbo"].use()
-            self.ctx.viewport = (0, 0, len(room_light.FACE_NAMES) * rc, rc)
-            program = self.gl.program("fullscreen.vert", "room_radiosity.frag")
-            self._bind_bounce_sources(program)
-            gl["radiosity_operator"].use(location=4)
-            set_uniform(program, "u_operator", 4)
-            self.gl.fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
-            self.ctx.viewport = (0, 0, aw, ah)
+        # the coarse patches' total irradiance (room_radiosity.frag)
+        self._radiosity_operator(window_albedo)
+        gl["total_fbo"].use()
+        self.ctx.viewport = (0, 0, len(room_light.FACE_NAMES) * rc, rc)
+        program = self.gl.program("fullscreen.vert", "room_radiosity.frag")
+        self._bind_bounce_sources(program)
+        gl["radiosity_operator"].use(location=4)
+        set_uniform(program, "u_operator", 4)
+        self.gl.fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
+        self.ctx.viewport = (0, 0, aw, ah)
 
         gl["lightmap_fbo"].use()
-        program = self._bounce_gather_program(all_bounces, window_albedo)
+        program = self._bounce_gather_program(window_albedo)
         self.gl.fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
         if self.frame.room_side_active():
-            self._draw_room_side(all_bounces, window_albedo)
-            if self.frame.sky_occlusion and self.frame.wall_light and not self.frame.curtain_open:
+            self._draw_room_side(window_albedo)
+            if not self.frame.curtain_open:
                 self._draw_vertex_wall_light(inputs)
 
-    def _bounce_gather_program(self, all_bounces: bool, window_albedo, defines: dict | None = None):
+    def _bounce_gather_program(self, window_albedo, defines: dict | None = None):
         """room_bounce.frag (with ``defines``) and its inputs bound: the coarse patches' totals
-        (every bounce) or their direct light, the faces, the obscurance and wall fraction, the
-        albedos; for pass R4 and R4b."""
+        (every bounce), the faces, the obscurance and wall fraction, the albedos; for pass R4
+        and R4b."""
         gl = self.frame.room_targets.get()
-        defines = dict(defines or {})
-        if all_bounces:
-            defines["ALL_BOUNCES"] = True
-        program = self.gl.program("fullscreen.vert", "room_bounce.frag", defines or None)
-        if all_bounces:
-            gl["total"].use(location=4)
-            set_uniform(program, "u_total", 4)
+        program = self.gl.program("fullscreen.vert", "room_bounce.frag", defines)
+        gl["total"].use(location=4)
+        set_uniform(program, "u_total", 4)
         for name, value in room_light.face_uniforms().items():
             set_uniform(program, name, value)
         self._bind_bounce_sources(program)
@@ -133,13 +128,13 @@ class LightmapPass(Pass):
         set_uniform(program, "u_window_albedo", window_albedo)
         return program
 
-    def _draw_room_side(self, all_bounces: bool, window_albedo) -> None:
+    def _draw_room_side(self, window_albedo) -> None:
         """Pass R4b (issue 11, fourth round): the room's irradiance on the curtain's room side,
         room_bounce.frag's gather at CURTAIN_SIDE_TEXELS points over the opening."""
         mgl, gl = self.mgl, self.frame.room_targets.get()
         gl["room_side_fbo"].use()
         self.ctx.viewport = (0, 0, *room_light.CURTAIN_SIDE_TEXELS)
-        program = self._bounce_gather_program(all_bounces, window_albedo, {"CURTAIN_SIDE": True})
+        program = self._bounce_gather_program(window_albedo, {"CURTAIN_SIDE": True})
         set_uniform(program, "u_side_rect", room_light.curtain_side_rect())
         set_uniform(program, "u_side_z", scene_lib.ROOM_BOX[2][0])
         self.gl.fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
@@ -255,11 +250,8 @@ class LightmapPass(Pass):
 
     def stale(self) -> bool:
         """Whether the room's light must be redrawn this frame (see room_update_every)."""
-        key = (self.frame.terms.inputs_key, self.frame.curtain_open, self.frame.key_shadow, self.frame.sky_occlusion,
-               self.frame.room_bounces, self.frame.room_lobe, self.frame.room_side_active(), self.frame.wall_light,
-               self.frame.side_eyes, self.frame.window_box, self.frame.wall_eyes, self.frame.window_near_field,
-               self.frame.capture_folds, self.frame.secondary_dye, self.frame.key_second_layer,
-               self.frame.patterned,
+        key = (self.frame.terms.inputs_key, self.frame.curtain_open, self.frame.room_lighting,
+               self.frame.room_side_active(), self.frame.key_second_layer, self.frame.patterned,
                self.frame.fabric_pattern.key,
                tuple((light.name, position) for light, position in self.frame.room_lamps))
         self._room_frames += 1

@@ -76,11 +76,6 @@ class SceneTerms:
         }
         for name, value in self._band_uniforms().items():
             values[name] = tuple(float(v) for v in value) if isinstance(value, tuple) else value
-        if not self.frame.ambient_by_view:   # the normal view's ambient at every angle
-            for name in ("u_ambient_view_outside", "u_ambient_view_room"):
-                values[name] = np.ones_like(values[name])
-        if not self.frame.outside_by_view:   # the outside averaged, sky and ground alike
-            values["u_ambient_tilt"] = np.zeros_like(values["u_ambient_tilt"])
         return values
 
     def room_lamp_values(self) -> dict:
@@ -208,7 +203,7 @@ class SceneTerms:
         if self._dye_key != self.inputs_key:
             self._dyes = {"key": dye_colour.key_dye_rgb(inputs), "secondary": dye_colour.secondary_dye_rgb(inputs)}
             self._dye_key = self.inputs_key
-        return self._dyes[light if self.frame.secondary_dye else "key"]
+        return self._dyes[light]
 
     def room_colours(self, inputs) -> dict:
         """Linear sRGB of the key light (irradiance) and of the beam a thread passes: the

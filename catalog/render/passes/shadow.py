@@ -189,8 +189,7 @@ class ShadowPass(Pass):
                       gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
             set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
             set_uniform(program, "u_mean_coverage", colours["u_mean_coverage"])
-            set_uniform(program, "u_thread_beam_rgb", (0.0, 0.0, 0.0) if self.frame.room_lobe
-                      else colours["u_thread_beam_rgb"])
+            set_uniform(program, "u_thread_beam_rgb", (0.0, 0.0, 0.0))
             self.ctx.disable(mgl.DEPTH_TEST)
             self.ctx.disable(mgl.CULL_FACE)
             self.ctx.enable(mgl.BLEND)
@@ -209,11 +208,9 @@ class ShadowPass(Pass):
         pattern = self.frame.fabric_pattern.texture
         patterned = (pattern is not None and self.frame.patterned
                      and self.frame.mesh.format != "interleaved")
-        if self.frame.key_shadow:
-            self._draw_key_front(inputs, patterned, self.frame.terms.room_colours(inputs))
-        if self.frame.sky_occlusion:
-            self._draw_occlusion_maps()
-            self._draw_vertex_occlusion()
+        self._draw_key_front(inputs, patterned, self.frame.terms.room_colours(inputs))
+        self._draw_occlusion_maps()
+        self._draw_vertex_occlusion()
 
     def _draw_occlusion_maps(self) -> None:
         """SKY_OCCLUSION's maps: per direction of room_light.occlusion_directions, the depth
@@ -266,8 +263,8 @@ class ShadowPass(Pass):
         gl["key_second_fbo"].clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
         if self.frame.key_second_layer:
             program = self.gl.program("room_shadow.vert", "room_shadow.frag",
-                                    {"HAS_UV": True, "PATTERN": patterned, "SECOND_LAYER": True,
-                                     "PEEL_SPAN_TEXELS": glsl_literal(KEY_PEEL_SPAN_TEXELS)})
+                                      {"HAS_UV": True, "PATTERN": patterned, "SECOND_LAYER": True,
+                                       "PEEL_SPAN_TEXELS": glsl_literal(KEY_PEEL_SPAN_TEXELS)})
             self._front_layer_uniforms(program, inputs, patterned, colours)
             gl["key_front"].use(location=KEY_FRONT_UNIT)
             set_uniform(program, "u_first_layer", KEY_FRONT_UNIT)

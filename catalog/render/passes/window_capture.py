@@ -25,7 +25,7 @@ class WindowCapturePass(Pass):
         """The plane of the room side's window patches (m): the front of the box around the
         closed curtain's folds (room_light.WINDOW_FRONT_Z), or the opening's when the curtain
         is open or ``window_box`` is off (before issue 11's ninth round)."""
-        if self.frame.window_box and not self.frame.curtain_open:
+        if not self.frame.curtain_open:
             return room_light.WINDOW_FRONT_Z
         return scene_lib.ROOM_BOX[2][0]
 
@@ -37,11 +37,11 @@ class WindowCapturePass(Pass):
     def window_near(self) -> bool:
         """Whether room.frag takes the window's light per pixel on the window wall beside the
         opening (WINDOW_NEAR): with the box (its sides stand on that wall)."""
-        return self.frame.window_near_field and self.box_active()
+        return self.box_active()
 
     def wall_eyes_active(self) -> bool:
         """Whether the box's sides are captured from the wall eyes too (WALL_EYES)."""
-        return self.frame.wall_eyes and self.box_active()
+        return self.box_active()
 
     def read_luminaire_back(self, level: int) -> np.ndarray:
         """The window-side capture at mip ``level``, float32 (H, W, 3), row 0 = the opening's bottom."""
@@ -78,7 +78,7 @@ class WindowCapturePass(Pass):
     def draw_room_luminaire(self, inputs) -> None:
         """Pass R2: what the room sees in the window (the curtain's room-side radiance, or the
         outside where it is open), one texel per window patch, the sun's disc left out; from
-        the room's middle and (side_eyes) from two eyes towards the side walls. The window
+        the room's middle and from two eyes towards the side walls. The window
         side's capture R2b first: through the holes, the room's captures see it on the folds
         behind (curtain.frag FOLDS_BEHIND)."""
         mgl, gl = self.mgl, self.frame.room_targets.get()
@@ -95,10 +95,11 @@ class WindowCapturePass(Pass):
         gl["luminaire_back"].build_mipmaps()
         # alpha: the key's irradiance on the cloth (curtain.frag ROOM_CAPTURE), 0 where none
         overrides = self.frame.terms.capture_overrides()
+        # the side eyes' side by side, a tile a power of 2 wide at the patch level: the mipmaps
+        # keep them apart
         targets = [("luminaire", room_light.LUMINAIRE_EYE, 0, room_light.LUMINAIRE_LEVEL)]
-        if self.frame.side_eyes:   # side by side, a tile a power of 2 wide at the patch level: the
-            targets += [("luminaire_sides", eye, k, room_light.SIDE_LUMINAIRE_LEVEL)  # mipmaps
-                        for k, eye in enumerate(room_light.CAPTURE_SIDE_EYES)]   # keep them apart
+        targets += [("luminaire_sides", eye, k, room_light.SIDE_LUMINAIRE_LEVEL)
+                    for k, eye in enumerate(room_light.CAPTURE_SIDE_EYES)]
         for name, eye, tile, level in targets:
             lw, lh = room_light.luminaire_capture_size(level)
             if tile == 0:
@@ -107,7 +108,7 @@ class WindowCapturePass(Pass):
             self.ctx.viewport = (tile * lw, 0, lw, lh)
             view_proj = room_light.luminaire_view_projection(eye, self.window_front_z())
             if not self.frame.curtain_open:
-                self.frame.curtain.draw_flat(view_proj, eye, overrides, folds_behind=self.frame.capture_folds)
+                self.frame.curtain.draw_flat(view_proj, eye, overrides, folds_behind=True)
             self.frame.background.draw(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
         for name in {name for name, _eye, _tile, _level in targets}:
             gl[name].build_mipmaps()   # level LUMINAIRE_LEVEL: each patch's mean radiance
@@ -118,17 +119,16 @@ class WindowCapturePass(Pass):
             for k, eye in enumerate(room_light.WALL_EYES):
                 self.ctx.viewport = (k * ww, 0, ww, wh)
                 self.frame.curtain.draw_flat(room_light.wall_eye_view_projection(k == 1, self.window_front_z()), eye,
-                                        overrides, folds_behind=self.frame.capture_folds)
+                                        overrides, folds_behind=True)
             gl["luminaire_walls"].build_mipmaps()
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
 
     def window_light_defines(self) -> dict:
         """common.glsl WINDOW_LIGHT's defines (room_lightmap.frag and the lit room.frag define
-        WINDOW_LIGHT itself): the window from three eyes (SIDE_EYES), the box's sides also
-        from the wall's side (WALL_EYES, with the box)."""
-        return {**({"SIDE_EYES": True} if self.frame.side_eyes else {}),
-                **({"WALL_EYES": True} if self.wall_eyes_active() else {})}
+        WINDOW_LIGHT itself): the box's sides also captured from the wall's side (WALL_EYES,
+        with the box)."""
+        return {"WALL_EYES": True} if self.wall_eyes_active() else {}
 
     def window_light_uniforms(self, program, inputs) -> None:
         """common.glsl WINDOW_LIGHT's inputs (the room's captures on units 3-5, the box, the
@@ -137,12 +137,11 @@ class WindowCapturePass(Pass):
         gl = self.frame.room_targets.get()
         gl["luminaire"].use(location=5)
         set_uniform(program, "u_luminaire", 5)
-        if self.frame.side_eyes:
-            gl["luminaire_sides"].use(location=4)
-            set_uniform(program, "u_luminaire_sides", 4)
-            set_uniform(program, "u_luminaire_sides_level", room_light.SIDE_LUMINAIRE_LEVEL)
-            set_uniform(program, "u_side_eye", np.asarray(room_light.CAPTURE_SIDE_EYES, dtype="f4"))
-            set_uniform(program, "u_middle_eye", room_light.LUMINAIRE_EYE)
+        gl["luminaire_sides"].use(location=4)
+        set_uniform(program, "u_luminaire_sides", 4)
+        set_uniform(program, "u_luminaire_sides_level", room_light.SIDE_LUMINAIRE_LEVEL)
+        set_uniform(program, "u_side_eye", np.asarray(room_light.CAPTURE_SIDE_EYES, dtype="f4"))
+        set_uniform(program, "u_middle_eye", room_light.LUMINAIRE_EYE)
         set_uniform(program, "u_luminaire_size", room_light.LUMINAIRE_TEXELS)
         set_uniform(program, "u_luminaire_level", room_light.LUMINAIRE_LEVEL)
         gl["luminaire_back"].use(location=3)
@@ -156,7 +155,7 @@ class WindowCapturePass(Pass):
             set_uniform(program, "u_luminaire_walls_level", room_light.WALL_EYE_LEVEL)
             set_uniform(program, "u_wall_eye", np.asarray(room_light.WALL_EYES, dtype="f4"))
         colours = self.frame.terms.room_colours(inputs)
-        set_uniform(program, "u_lobe_rgb", colours["u_lobe_rgb"] if self.frame.room_lobe and not self.frame.curtain_open
+        set_uniform(program, "u_lobe_rgb", colours["u_lobe_rgb"] if not self.frame.curtain_open
                   else (0.0, 0.0, 0.0))
         set_uniform(program, "u_g_spec", float(inputs.g_spec))
         lamps = self.frame.room_lamps

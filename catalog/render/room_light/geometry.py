@@ -53,8 +53,6 @@ BACK_LUMINAIRE_LEVEL = 3
 #: room_lightmap.frag's beam (the bounces' source): the mean over BEAM_SAMPLES x BEAM_SAMPLES
 #: points of a light-map texel (issue 11, sixth round; frame.py passes it to the shader as a define).
 BEAM_SAMPLES = 8
-#: ``room_bounce.frag``'s bounces: "all" (the radiosity solve) or "one" (issue 13's first).
-ROOM_BOUNCES = ("all", "one")
 #: The transmittance shadow map's side (texels).
 SHADOW_TEXELS = 256
 #: Ambient occlusion: rays per texel and the distance within which geometry occludes.
