@@ -235,5 +235,7 @@ def test_a_dated_sun_stands_where_it_stands_then():
 
     name = "sun@2026-12-21T12:00,34.7,135.5"
     expected = 90.0 - sun_position("2026-12-21T12:00", 34.7, 135.5).zenith_deg
-    assert scene_lib.key_elevation_for(name) == pytest.approx(expected, abs=1e-9)
+    from catalog.optics.lights import get_light
+
+    assert scene_lib.key_elevation_for(get_light(name)) == pytest.approx(expected, abs=1e-9)
     assert abs(expected - scene_lib.LAMP_ELEVATION_DEG) > 5.0

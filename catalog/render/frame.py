@@ -165,12 +165,8 @@ class FrameRenderer:
         if isinstance(light, str):
             light = get_light(light)
         self.light = light
-        self._is_sun = light.name.startswith(("sun:", "sun-clear:", "sun@"))
-        try:
-            elevation = scene_lib.key_elevation_for(light.name)
-        except (ValueError, CatalogError):
-            elevation = scene_lib.LAMP_ELEVATION_DEG
-        self._key_to_light = scene_lib.key_direction(elevation)
+        self._is_sun = light.is_sun
+        self._key_to_light = scene_lib.key_direction(scene_lib.key_elevation_for(light))
 
     def set_sun_hour(self, hour: float) -> dict:
         """The sun at ``hour`` (local solar time, summer solstice, 34.7 N) behind the window."""

@@ -49,7 +49,7 @@ class SceneTerms:
             self._inputs, self.decision = scene_lib.build_shading_inputs(
                 self.frame.preset, self.frame.light.irradiance_w_m2_nm, self.frame._key_to_light,
                 is_sun=self.frame._is_sun, fluorescence=self.frame.mode, viewer_inside=self.frame.viewer_inside,
-                paper_beam=self.frame.light.name.startswith("sun:"))
+                paper_beam=self.frame.light.sun is not None and self.frame.light.sun.model == "paper")
             self.inputs_key = key
             self._uniforms_key = None
         return self._inputs
