@@ -104,11 +104,23 @@ def _patch_ratio_cv(gl, azimuth_deg, patterned):
 def test_folds_pattern_the_patch(gl):
     """The flat cloth (the fabric's pattern off): with the key 50 deg to the side its beam
     crosses the deepest folds twice (the fold's slope, up to 55 deg, is steeper than the ray's
-    in the x-z plane): those stripes pass T^2, the rest T, so the closed/open ratio varies
-    across the patch (coefficient of variation above 3 %); with the key 15 deg to the side (one
-    crossing everywhere) it is flat within 1 %."""
-    assert _patch_ratio_cv(gl, 50.0, patterned=False) > 0.03
-    assert _patch_ratio_cv(gl, 15.0, patterned=False) < 0.01
+    in the x-z plane): those stripes pass T^2, the rest T, so the room's transmittance map
+    varies where the cloth covers it (coefficient of variation above 3 %); with the key 15 deg
+    to the side (one crossing everywhere) it is flat within 1 %. The map, not the floor: the
+    key's directional lobe, spread from the window (issue 11), lays a smooth gradient over the
+    patch (its closed/open ratio varies by 2.9 % at 15 deg)."""
+    def map_cv(azimuth_deg):
+        r = _renderer(gl, azimuth_deg=azimuth_deg)
+        r.set_patterned(False)
+        r.render()
+        t = _luma(r.lightmap.read_room_shadow())
+        covered = t < 0.999 * t.max()   # the cloth's shadow (1 where the beam passes nothing)
+        r.release()
+        assert covered.sum() > 1000
+        return t[covered].std() / t[covered].mean()
+
+    assert map_cv(50.0) > 0.03
+    assert map_cv(15.0) < 0.01
 
 
 @pytest.mark.slow
