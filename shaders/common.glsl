@@ -201,7 +201,7 @@ vec2 front_layers_coverage(sampler2D first, sampler2D second, vec3 q, float bias
 #ifdef OCCLUSION_MAPS
 // The outside hidden from a point p of the cloth (normal `normal`; issue 11, model.md
 // section 9): of N_OCCLUSION directions (cosine-weighted about the window's normal,
-// catalog/render/room_light.py), the fraction in which a layer of cloth lies between p and
+// catalog/render/room_light/), the fraction in which a layer of cloth lies between p and
 // the outside (one depth map per direction, tiles of u_occlusion_maps: the layer nearest the
 // outside), and the fraction that does not leave through the window opening (the wall); and
 // (issue 11, fourth round) the room's side: of the opposite directions (cosine-weighted about
@@ -288,7 +288,7 @@ vec3 srgb_encode(vec3 linear) {
     return mix(hi, lo, lessThanEqual(c, vec3(0.0031308)));
 }
 
-// ---- The room (issue 13, model.md section 9): catalog/render/room_light.py has the layout.
+// ---- The room (issue 13, model.md section 9): catalog/render/room_light/ has the layout.
 // The room box's six inside faces, P(s, t) = origin + s axis_s + t axis_t, side by side in a
 // light-map atlas (face k covers u in [k / 6, (k + 1) / 6]). Face order: floor, ceiling, left,
 // right, back, window wall.
@@ -384,27 +384,25 @@ float rectangle_irradiance_factor(vec3 x, vec3 n, vec3 corner, vec3 s, vec3 t) {
 // opening, where it falls tenfold within a light-map texel.
 //
 // The room sees the curtain through a box around its folds: its front (the plane u_front_z,
-// the opening's rectangle in 12 x 9 patches) carries the room's captures (the middle eye's,
-// and with SIDE_EYES the three blended by angle); its sides (the opening's edges x = x0, x1,
+// the opening's rectangle in 12 x 9 patches) carries the room's captures (the middle eye's
+// and the two side eyes', blended by angle); its sides (the opening's edges x = x0, x1,
 // from the curtain's plane u_back_plane_z to the front, normal -x and +x) the edge column of
 // the eye towards that side; its top and bottom (y = y1, y0) the middle's edge row; between
 // the window wall and the curtain's plane, the sides' gaps show the cloth's window side
 // (its capture's edge column) to points in front of that plane, and points behind it see
 // the window side's patches (plane u_back_plane_z, normal -z). Light leaving the folds
 // sideways, which a rectangle in the opening's plane sends nowhere, reaches the walls that
-// see the window edge-on. With u_front_z at the opening's plane (no box) the front alone,
-// as before the ninth round.
+// see the window edge-on. With u_front_z at the opening's plane (no box: the curtain open)
+// the front alone.
 uniform sampler2D u_luminaire;       // mipmapped; level u_luminaire_level = one texel a patch
 uniform ivec2 u_luminaire_size;
 uniform int u_luminaire_level;
-#ifdef SIDE_EYES
 // The same capture from two eyes towards the side walls (left then right, side by side,
 // room_light.CAPTURE_SIDE_EYES): the folds' flanks face either way and glow unequally.
 uniform sampler2D u_luminaire_sides;
 uniform int u_luminaire_sides_level; // their level of one texel a patch
 uniform vec3 u_side_eye[2];
 uniform vec3 u_middle_eye;
-#endif
 uniform sampler2D u_luminaire_back;  // the closed curtain's window side (0 where no cloth)
 uniform int u_luminaire_back_level;  // its level of one texel a patch
 uniform float u_back_plane_z;        // its patches' plane (m), normal -z: the curtain's
@@ -415,14 +413,12 @@ uniform int u_lamp_count;
 uniform vec3 u_lamp_position[4];
 uniform vec3 u_lamp_rgb[4];          // intensity as linear sRGB (irradiance at 1 m)
 
-// The radiance window patch (i, j), centred at c, sends towards p: the middle capture's or,
-// SIDE_EYES, the three captures blended piecewise linearly in the horizontal angle of the way
+// The radiance window patch (i, j), centred at c, sends towards p: the three captures blended piecewise linearly in the horizontal angle of the way
 // from c to p between the angles at which c sees the eyes, clamped beyond the side eyes
 // (float64 twin: room_light.capture_eye_weights); alpha (the key's reach on the patch's
 // cloth) always the middle's.
 vec4 captured_towards(int i, int j, vec3 c, vec3 p) {
     vec4 middle = texelFetch(u_luminaire, ivec2(i, j), u_luminaire_level);
-#ifdef SIDE_EYES
     float a = atan(p.x - c.x, max(p.z - c.z, 1e-6));
     float a_left = atan(u_side_eye[0].x - c.x, max(u_side_eye[0].z - c.z, 1e-6));
     float a_mid = atan(u_middle_eye.x - c.x, max(u_middle_eye.z - c.z, 1e-6));
@@ -436,9 +432,6 @@ vec4 captured_towards(int i, int j, vec3 c, vec3 p) {
         rgb = mix(middle.rgb, right, clamp((a - a_mid) / (a_right - a_mid), 0.0, 1.0));
     }
     return vec4(rgb, middle.a);
-#else
-    return middle;
-#endif
 }
 
 #ifdef WALL_EYES
@@ -456,7 +449,7 @@ float box_side_angle(vec3 c, vec3 q, bool right) {
 }
 
 // What the box's left (or right) side, row j, centred at c, sends to p: the edge column of the
-// capture from the eye towards that side's wall (the middle's without SIDE_EYES); WALL_EYES,
+// capture from the eye towards that side's wall; WALL_EYES,
 // blended with the wall eye's capture linearly in box_side_angle from the wall eye's angle
 // (the wall eye's alone) to level (the room's eye's alone), clamped: a way level with the
 // side's centre or falling crosses the folds as the room's eyes see them, one rising from
@@ -466,12 +459,8 @@ float box_side_angle(vec3 c, vec3 q, bool right) {
 vec4 box_side_radiance(int j, bool right, vec3 c, vec3 p) {
     int column = right ? u_luminaire_size.x - 1 : 0;
     float alpha = texelFetch(u_luminaire, ivec2(column, j), u_luminaire_level).a;
-#ifdef SIDE_EYES
     vec3 rgb = texelFetch(u_luminaire_sides, ivec2(column + (right ? u_luminaire_size.x : 0), j),
                           u_luminaire_sides_level).rgb;
-#else
-    vec3 rgb = texelFetch(u_luminaire, ivec2(column, j), u_luminaire_level).rgb;
-#endif
 #ifdef WALL_EYES
     vec3 wall = texelFetch(u_luminaire_walls, ivec2(right ? 1 : 0, j), u_luminaire_walls_level).rgb;
     float a_wall = box_side_angle(c, u_wall_eye[right ? 1 : 0], right);

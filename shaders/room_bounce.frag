@@ -5,8 +5,7 @@
 // form factor of patch j (rectangle_irradiance_factor, common.glsl),
 // with rho_j = m_j rho + (1 - m_j) rho_curtain (m_j the patch's wall fraction, 0 in the window
 // opening, where the closed curtain reflects part of the room's light) and T_j the patch's
-// irradiance: with ALL_BOUNCES its total (room_radiosity.frag), else its direct light, the
-// coarse mip of the direct map plus the key's beam (one bounce, issue 13's frame). The room is a convex box, so
+// total irradiance, every bounce (room_radiosity.frag). The room is a convex box, so
 // every patch sees every other; the precomputed ambient occlusion (corners, the window's
 // reveals) scales the bounce.
 // CURTAIN_SIDE (issue 11, fourth round): the same gather at a grid of points over the window
@@ -69,12 +68,7 @@ void main() {
                 float geometry = rectangle_irradiance_factor(p, n, corner, u_face_s[f] / rc,
                                                              u_face_t[f] / rc);
                 float wall = texelFetch(u_ao_mask, texel, u_bounce_level).g;
-#ifdef ALL_BOUNCES
                 vec3 source = texelFetch(u_total, texel, 0).rgb;
-#else
-                vec3 source = texelFetch(u_direct, texel, u_bounce_level).rgb
-                            + texelFetch(u_beam, texel, u_bounce_level).rgb;
-#endif
                 bounce += source * ((wall * u_albedo + (1.0 - wall) * u_window_albedo) * geometry);
             }
         }

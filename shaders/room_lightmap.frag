@@ -1,6 +1,6 @@
 #version 430
 // The room's light map, direct part (issue 13, model.md section 9): per atlas texel (a point
-// of the room box's inside, catalog/render/room_light.py), the irradiance (linear sRGB) from
+// of the room box's inside, catalog/render/room_light/), the irradiance (linear sRGB) from
 //  - the window as an area light (common.glsl WINDOW_LIGHT, window_irradiance): the luminaire
 //    captures' texels are patches of a box around the curtain's folds with the radiance the
 //    curtain (or the sky through the opening) sends towards the room, E = sum L F (F pi times

@@ -155,3 +155,59 @@ def test_the_checker_sees_a_forbidden_import(tmp_path):
     edges = _edges(package)
     assert ("catalog/optics/probe.py", 2, "optics", "render") in edges
     assert ("catalog/render/probe.py", 1, "render", "bench") in edges
+
+
+#: The longest a module of catalog/ may be (docs/GUIDE: small modules with one job each).
+MAX_MODULE_LINES = 900
+#: The frame's setters: what a user chooses (light, fabric, camera, exposure, white balance,
+#: bands, fluorescence, anti-aliasing, room lighting, glare, shadow-map size, curtain,
+#: lamps, sky, environment) and the mesh it draws. Earlier variants of the method are in
+#: git history, not behind switches (issue 31): a setter outside this list fails.
+FRAME_SETTERS = {
+    "set_fabric", "set_light", "set_sun_hour", "set_key_direction", "set_fluorescence",
+    "set_bands", "set_camera", "set_exposure", "set_ev", "set_white_balance", "set_antialiasing",
+    "set_room_lighting", "set_bloom", "set_shadow_map_size", "set_curtain_open", "set_room_lamps",
+    "set_sky_model", "set_environment", "set_patterned", "set_key_second_layer",
+    "set_mesh", "set_fabric_size", "set_mesh_offset", "set_rings",
+}
+
+
+def test_no_module_is_over_the_size_limit():
+    long = {p.relative_to(PACKAGE.parent).as_posix(): n for p in PACKAGE.rglob("*.py")
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES}
+    assert long == {}
+
+
+def _frame_setters(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    classes = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "FrameRenderer"]
+    return {n.name for c in classes for n in c.body
+            if isinstance(n, ast.FunctionDef) and n.name.startswith("set_")}
+
+
+def _setters_by_name(tree) -> list[int]:
+    """Lines of ``getattr(x, f"set_...")``: a setter chosen by a string (an ablation switch)."""
+    return [node.lineno for node in ast.walk(tree)
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "getattr"
+            and len(node.args) >= 2 and isinstance(node.args[1], (ast.JoinedStr, ast.Constant))
+            and (ast.unparse(node.args[1]).lstrip("f").strip("'\"").startswith("set_"))]
+
+
+def test_the_frame_has_no_ablation_switches():
+    """Every setter of FrameRenderer is a user's choice (FRAME_SETTERS), and no module picks a
+    setter by its name (the image bench's ``getattr(renderer, f"set_{name}")`` of issue 11's
+    switches)."""
+    extra = _frame_setters(PACKAGE / "render" / "frame.py") - FRAME_SETTERS
+    assert extra == set()
+    by_name = {p.relative_to(PACKAGE.parent).as_posix(): lines for p in PACKAGE.rglob("*.py")
+               if (lines := _setters_by_name(ast.parse(p.read_text(encoding="utf-8"))))}
+    assert by_name == {}
+
+
+def test_the_size_and_switch_checks_can_fail(tmp_path):
+    """The checks see a setter outside the list and a setter picked by name."""
+    probe = tmp_path / "frame.py"
+    probe.write_text("class FrameRenderer:\n    def set_room_bounces(self, b):\n        pass\n")
+    assert _frame_setters(probe) - FRAME_SETTERS == {"set_room_bounces"}
+    tree = ast.parse('def f(r, name):\n    getattr(r, f"set_{name}")(True)\n')
+    assert _setters_by_name(tree) == [2]

@@ -44,6 +44,18 @@ def _renderer(gl, preset, light="D65", mesh=None, camera=(0.0, 0.0, 1.6)):
     return r
 
 
+def _without_key_shadow(r, g) -> np.ndarray:
+    """The luminance (cd m^-2) of the G-buffer's curtain pixels as the float64 twin shades
+    them with the key's shadow taken away (the window's mask 1, no layer in front of the key;
+    the outside's occlusion kept): the shadow-free frame the shaded one is compared with."""
+    unshaded = dict(g)
+    shadows = g["shadows"].copy()
+    shadows[..., 0], shadows[..., 1] = 1.0, 0.0
+    unshaded["shadows"] = shadows
+    unshaded["second_coverage"] = np.zeros_like(g["second_coverage"])
+    return r.twin_linear_srgb(unshaded, g["mask"]) @ LUMA
+
+
 def _through_opening(p, d):
     """(P,) whether rays p + s d (s > 0) cross the window opening in both wall planes, and
     the distance (m) of the crossing points from the opening's edges (+ inside, - outside)."""
@@ -62,7 +74,8 @@ def test_window_wall_shades_the_upper_curtain(gl, make_preset):
     """A flat curtain under a key 60 deg high: the G-buffer's window mask is 1 where the ray
     to the light leaves through the opening and 0 where the wall stops it, within 1e-3 at
     every pixel more than 1 cm from the shadow's edge (the penumbra there is < 1 mm), both
-    sides present; the shaded pixels are at most half as bright as with the shadow off."""
+    sides present; the shaded pixels are at most half as bright as without the shadow (the
+    float64 twin without it)."""
     mesh = scene_lib.draped_curtain(columns=40, rows=30, depth_m=0.0)
     r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh, camera=(0.0, 0.0, 2.6))
     r.set_key_direction(elevation_deg=60.0)
@@ -77,20 +90,19 @@ def test_window_wall_shades_the_upper_curtain(gl, make_preset):
     assert lit[sure].any() and (~lit[sure]).any()
     assert np.abs(beam[sure] - lit[sure]).max() < 1e-3
     shaded = g["radiance"][mask][sure & ~lit] @ LUMA
-    r.set_key_shadow(False)
-    unshaded = r.render_gbuffer()["radiance"][mask][sure & ~lit] @ LUMA
+    unshaded = _without_key_shadow(r, g)[sure & ~lit]
     assert shaded.mean() < 0.5 * unshaded.mean()
     r.release()
 
 
 def _key_across_the_folds(gl, make_preset, mesh):
     """A cloth with no holes on ``mesh`` under a key 20 deg high and 60 deg aside (across the
-    folds), the room's light on its room side off (the room's capture draws the cloth with the
+    folds), the room unlit so that its light is off the cloth's room side (the room's capture draws the cloth with the
     key's shadows, and these tests are about the key on the cloth alone): the renderer, its
     G-buffer, the curtain mask, the pixels' positions and the direction to the light."""
     r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh)
     r.set_key_direction(elevation_deg=20.0, azimuth_deg=60.0)
-    r.set_room_side(False)
+    r.set_room_lighting(False)
     g = r.render_gbuffer()
     mask = g["mask"]
     p = g["position"][mask].astype(np.float64)
@@ -108,7 +120,7 @@ def test_folds_shade_the_cloth_behind_them(gl, make_preset):
     slope-scaled one chosen on this drape (catalog/bench/key_shadow_bias.py: 100 % here, the
     2 cm bias 99.2 %; the bound 98 % was set with the choice). The shaded pixels' key light is
     dimmed to the layer's transmittance: their luminance falls by more than 20 % against the
-    shadow off, the rest changes by less than 1e-3."""
+    shadow taken away (the float64 twin without it), the rest changes by less than 1e-3."""
     mesh = scene_lib.draped_curtain(columns=60, rows=40)
     r, g, mask, p, to_light = _key_across_the_folds(gl, make_preset, mesh)
     expected, clear = key_shadow_bias.shadow_truth(p, to_light, mesh)
@@ -117,8 +129,7 @@ def test_folds_shade_the_cloth_behind_them(gl, make_preset):
     assert expected[clear].mean() > 0.05   # the light really crosses folds
     assert (behind[clear] == expected[clear]).mean() > 0.98
     on = g["radiance"][mask] @ LUMA
-    r.set_key_shadow(False)
-    off = r.render_gbuffer()["radiance"][mask] @ LUMA
+    off = _without_key_shadow(r, g)
     cover = g["shadows"][mask][:, 1]
     shaded = behind & (beam > 0.999)
     free = (cover == 0) & (beam > 0.999)
@@ -326,7 +337,7 @@ def test_the_sill_is_lit_by_the_sun(gl, make_preset):
     assert sill.sum() >= 10
     open_ = margin > 0.02
     assert open_.sum() >= 10
-    key_y = float(np.asarray(r._display_colours(r.shading_inputs())["u_key_rgb"]) @ LUMA)
+    key_y = float(np.asarray(r.terms.display_colours(r.shading_inputs())["u_key_rgb"]) @ LUMA)
     expected = scene_lib.ROOM_ALBEDO / math.pi * key_y * to_light[1]
     assert (img[sill][open_] @ LUMA).min() > 0.9 * expected
     r.release()

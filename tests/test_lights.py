@@ -221,3 +221,34 @@ def test_cli_lights_bad_name_is_one_line_exit_2(tmp_path, capsys):
 
 def test_errors_are_catalog_errors():
     assert issubclass(InputError, CatalogError)
+
+
+def test_every_light_knows_its_kind_when_the_library_makes_it():
+    """The light's kind and, for the sun, its model and elevation are resolved once by the
+    library (issue 31: nothing below reads them from the name): CIE tables are illuminants,
+    the blacklight and the 385 nm LED UV lamps, the 405 nm and white LEDs lamps; a sun by path
+    stands at 90 deg less the zenith its path implies (sun.model), one by date where
+    sun_position puts it; rescaling keeps both; a path with no zenith has no elevation."""
+    from catalog.optics.lights import SunSource, _make, get_light
+    from catalog.optics.sun.model import sun_position, zenith_deg_from_path
+
+    kinds = {name: get_light(name).kind for name in ("D65", "A", "FL2", "UV-A", "UV-385", "LED-405",
+                                                     "LED-warm", "LED-violet-white", "sun:60")}
+    assert kinds == {"D65": "illuminant", "A": "illuminant", "FL2": "illuminant", "UV-A": "uv",
+                     "UV-385": "uv", "LED-405": "lamp", "LED-warm": "lamp", "LED-violet-white": "lamp",
+                     "sun:60": "sun"}
+    assert get_light("D65").sun is None and not get_light("UV-A").is_sun
+    paper, clear = get_light("sun:60").sun, get_light("sun-clear:60").sun
+    assert paper.model == "paper" and clear.model == "clear"
+    assert paper.elevation_deg == pytest.approx(90.0 - zenith_deg_from_path(60.0), abs=1e-12)
+    assert clear.elevation_deg == paper.elevation_deg
+    dated = get_light("sun@2026-06-21T12:00,34.7,135.5").sun
+    assert dated.model == "date"
+    assert dated.elevation_deg == pytest.approx(90.0 - sun_position("2026-06-21T12:00", 34.7, 135.5).zenith_deg)
+    assert get_light("sun:10").sun.elevation_deg is None   # shorter than the 22 km layer
+    scaled = get_light("sun:60", illuminance_lx=500.0)
+    assert scaled.kind == "sun" and scaled.sun == paper
+    with pytest.raises(ValueError, match="SunSource"):
+        _make("x", "a sun without a position", np.zeros_like(GRID_NM), "sun")
+    with pytest.raises(ValueError, match="kind"):
+        _make("x", "a lamp with one", np.zeros_like(GRID_NM), "lamp", SunSource("paper", 30.0))

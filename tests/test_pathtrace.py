@@ -461,7 +461,7 @@ def test_the_reference_builds_the_frames_shading_inputs(gl, light):
         else:
             assert np.allclose(np.asarray(a, dtype=float), np.asarray(b, dtype=float), rtol=1e-12), f.name
     if desc.sky is not None:
-        assert np.allclose(r.sky_model_for(frame).scale_rgb, desc.sky.scale_rgb, rtol=1e-12)
+        assert np.allclose(r.background.sky_model_for(frame).scale_rgb, desc.sky.scale_rgb, rtol=1e-12)
     r.release()
 
 
@@ -687,14 +687,14 @@ def test_the_window_wall_beside_the_opening_gets_the_path_tracers_direct_light(g
     from catalog.render import scene as scene_lib
 
     r, desc = _safety_yellow_under_the_lamp(gl, depth_m=0.07)
-    captured = r.read_luminaire(room_light.LUMINAIRE_LEVEL)
-    res = r._room_resources()
+    captured = r.capture.read_luminaire(room_light.LUMINAIRE_LEVEL)
+    res = r.room_targets.get()
     w, h = room_light.LUMINAIRE_TEXELS
     alpha = np.frombuffer(res["luminaire"].read(level=room_light.LUMINAIRE_LEVEL), dtype=np.float32).reshape(h, w, 4)[..., 3]
-    back = r.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL)
-    sides, walls = r.read_side_captures(), r.read_wall_captures()
+    back = r.capture.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL)
+    sides, walls = r.capture.read_side_captures(), r.capture.read_wall_captures()
     inputs = r.shading_inputs()
-    lobe = {"lobe_rgb": r._room_colours(inputs)["u_lobe_rgb"], "g_spec": float(inputs.g_spec),
+    lobe = {"lobe_rgb": r.terms.room_colours(inputs)["u_lobe_rgb"], "g_spec": float(inputs.g_spec),
             "to_light": inputs.key_to_light}
     r.release()
     wall_z = scene_lib.ROOM_BOX[2][0]
@@ -757,9 +757,9 @@ def test_the_rooms_window_captures_match_traced_radiance_along_their_rays(gl, mi
 
     r, desc = _safety_yellow_under_the_lamp(gl, depth_m=0.12)
     nx, ny = room_light.LUMINAIRE_TEXELS
-    middle = r.read_luminaire(room_light.LUMINAIRE_LEVEL)
-    sides = r.read_side_captures()
-    front_z = r.window_front_z()   # the box's front (ninth round), where the captures' patches lie
+    middle = r.capture.read_luminaire(room_light.LUMINAIRE_LEVEL)
+    sides = r.capture.read_side_captures()
+    front_z = r.capture.window_front_z()   # the box's front (ninth round), where the captures' patches lie
     r.release()
     captures = {"left": sides[0], "middle": middle, "right": sides[1]}
     eyes = {"left": room_light.CAPTURE_SIDE_EYES[0], "middle": room_light.LUMINAIRE_EYE,

@@ -64,13 +64,13 @@ def test_the_procedural_sky_as_an_image_renders_as_the_sky(gl, tmp_path):
     r.set_bloom(False)
     r.set_camera(0.0, 5.0, 1.0)
     path = tmp_path / "sky.exr"
-    env.write_sky_environment(path, r.sky_model_for(r.shading_inputs()), height=256)
+    env.write_sky_environment(path, r.background.sky_model_for(r.shading_inputs()), height=256)
     r.render()
     analytic = r.read_linear()
     r.set_environment(path)
     r.render()
     image = r.read_linear()
-    assert r.environment_scale(r.shading_inputs()) == pytest.approx(1.0, rel=0.01)
+    assert r.background.environment_scale(r.shading_inputs()) == pytest.approx(1.0, rel=0.01)
     rel = np.abs(image - analytic) / np.maximum(np.abs(analytic), 1.0)
     assert np.median(rel) < 0.005 and np.percentile(rel, 95) < 0.02
     r.release()
@@ -105,15 +105,15 @@ def test_the_flat_curtains_see_through_shows_the_environment(gl, tmp_path):
     r.set_patterned(False)
     r.set_bloom(False)
     # the see-through alone: the room's light on the cloth's room side (ROOM_SIDE) changes with
-    # the outside too, through the room's captures, and is held to its twin elsewhere
-    r.set_room_side(False)
+    # the outside too, through the room's captures, and is held to its twin elsewhere: unlit
+    r.set_room_lighting(False)
     r.set_camera(0.0, 5.0, 1.0)
     red, blue = np.array([2.0, 1.0, 0.5]), np.array([0.5, 1.0, 2.0])
     out = []
     for name, colour in (("red", red), ("blue", blue)):
         r.set_environment(_write(tmp_path / f"{name}.exr", np.ones((32, 64, 3)) * colour))
         g = r.render_gbuffer()
-        out.append((g, r.environment_scale(r.shading_inputs()) * colour))
+        out.append((g, r.background.environment_scale(r.shading_inputs()) * colour))
     (g1, l1), (g2, l2) = out
     mask = g1["mask"] & g2["mask"]
     assert mask.sum() > 500

@@ -287,7 +287,7 @@ def test_band_shader_arithmetic_matches_float64_bands(gl, make_preset, n_bands):
 def test_specialised_and_uniform_programs_agree(gl, make_preset):
     """Scene values compiled in as constants (the default on a CPU rasteriser) or passed as uniforms: the same
     frame up to float32 constant folding; and old specialised programs are released."""
-    from catalog.render.frame import MAX_SPECIALISED
+    from catalog.render.passes.gl_common import MAX_SPECIALISED
 
     path = make_preset(dye=YELLOW_DYE, extra_btdf="anisotropy = 0.2")
     frames = []
@@ -313,7 +313,7 @@ def test_scene_values_are_compiled_in_on_cpu_rasterisers_only(gl):
     """choose_specialise: constants where every operation runs per fragment (CPU rasterisers),
     uniforms on a GPU (NVIDIA's constant folding of the see-through terms measured 1.1e-3 off
     the float64 reference, the uniform program 1.2e-6: docs/gpu.md)."""
-    from catalog.render.frame import choose_specialise, software_rasteriser
+    from catalog.render.passes.targets import choose_specialise, software_rasteriser
 
     assert choose_specialise({"GL_RENDERER": "llvmpipe (LLVM 15.0.6, 256 bits)"})
     assert choose_specialise({"GL_RENDERER": "ANGLE (Google, Vulkan 1.3.0 (SwiftShader Device))"})
@@ -346,17 +346,3 @@ def test_room_side_term_is_part_of_the_per_pixel_comparison(gl, make_preset):
     renderer.release()
 
 
-@pytest.mark.parametrize("switches", [{"sky_occlusion": False}, {"key_shadow": False},
-                                      {"sky_occlusion": False, "key_shadow": False}])
-@pytest.mark.slow
-def test_room_side_with_the_cloth_shadows_off(gl, make_preset, switches):
-    """ROOM_SIDE compiles and matches its twin per pixel (1e-3) with issue 11's shadow terms
-    switched off (the image bench's options): without SKY_OCCLUSION the folds hide nothing."""
-    renderer = _renderer(gl, make_preset(), "sun:60", "physical")
-    renderer.set_camera(yaw_deg=20.0, pitch_deg=-10.0, distance_m=2.2)
-    for name, on in switches.items():
-        getattr(renderer, f"set_{name}")(on)
-    assert renderer.room_side_active()
-    gl_rgb, reference = _compare(renderer)
-    assert _relative_error(gl_rgb, reference).max() < 1e-3
-    renderer.release()

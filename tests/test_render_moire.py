@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from catalog.presets.patterns import mip_chain
-from catalog.render.frame import PATTERN_LOD_BIAS, FrameRenderer
+from catalog.render.frame import FrameRenderer
+from catalog.render.passes.pattern import PATTERN_LOD_BIAS
 
 SUPERSAMPLE = 4
 
@@ -76,7 +77,8 @@ def test_no_energy_above_nyquist_at_any_distance(gl, fabric):
     renderer.set_light("D65")
     renderer.set_mesh(*_quad_mesh(), fabric_size_m=(1.8, 2.05))
     renderer.set_ev(12.0)
-    renderer.set_pattern_lod_bias(PATTERN_LOD_BIAS + math.log2(SUPERSAMPLE))
+    # filtered for the pixel the supersampled frame is measured at
+    renderer.fabric_pattern.lod_bias = PATTERN_LOD_BIAS + math.log2(SUPERSAMPLE)
     shares = []
     for distance in np.geomspace(0.3, 4.0, 8):
         renderer.set_camera(0.0, 0.0, float(distance))

@@ -74,8 +74,8 @@ def test_mip_far_limit_is_the_fitted_open_area(gl, path):
     within the 1 % of the pattern's own rule, and the averaged normal tilts less than 1 deg."""
     renderer = FrameRenderer(gl, (16, 16))
     renderer.set_fabric(path)
-    levels = int(math.log2(max(renderer._pattern_texture.size)))
-    top = renderer.pattern_mip_level(levels)
+    levels = int(math.log2(max(renderer.fabric_pattern.texture.size)))
+    top = renderer.fabric_pattern.pattern_mip_level(levels)
     direct = load_preset(path).btdf.direct
     assert top.shape[:2] == (1, 1)
     assert abs((1.0 - top[0, 0, 3]) - direct) <= OPEN_AREA_TOLERANCE * direct
@@ -121,7 +121,7 @@ def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, ant
     one_front = render(front)
     one_back = render(back)
     both = render(front, back)
-    revealage = np.frombuffer(renderer._oit_accum.read(), np.float32).reshape(72, 96, 4)[::-1, :, 3]
+    revealage = np.frombuffer(renderer.targets.oit_accum.read(), np.float32).reshape(72, 96, 4)[::-1, :, 3]
     a = 0.6
     c1 = (one_front - (1 - a) * behind) / a
     c2 = (one_back - (1 - a) * behind) / a
@@ -163,7 +163,7 @@ def test_a_known_pattern_appears_where_the_texture_coordinates_put_it(gl, make_p
     renderer.set_fabric(preset)
     renderer.set_light("D65")
     renderer.set_camera(0.0, 0.0, 1.2)
-    renderer.set_pattern_filtering(False)
+    renderer.fabric_pattern.set_pattern_filtering(False)
     target_y = renderer.camera.target[1]
     quad = _quad(-0.4, 0.4, target_y - 0.4, target_y + 0.4, lambda x, y: np.full_like(x, -0.08))
     renderer.set_mesh(*quad, fabric_size_m=(0.8, 0.8))
@@ -290,7 +290,7 @@ def dolly_change(renderer, mask_frames, filtered: bool, frames: int = 40) -> flo
     """Mean over a dolly (3 m -> 0.2 m, geometric steps) of the mean absolute change of the
     displayed luminance (8-bit levels) between consecutive frames, over pixels that are
     curtain in both."""
-    renderer.set_pattern_filtering(filtered)
+    renderer.fabric_pattern.set_pattern_filtering(filtered)
     previous = None
     changes = []
     for k, distance in enumerate(np.geomspace(3.0, 0.2, frames)):
@@ -379,49 +379,10 @@ def test_antialiasing_brings_edges_closer_to_a_supersampled_frame(gl, mode, reco
     assert error_fxaa <= 0.8 * error_plain
 
 
-@pytest.mark.slow
-def test_the_patterns_lod_bias_brings_a_pixel_closer_to_its_box(gl, record_figure):
-    """Issue 11's eighth round: the pattern sampled at PATTERN_LOD_BIAS (the mip level whose
-    filter has a pixel box's variance) against the hardware's level (bias 0). Reference: the
-    same lace close-up rendered at 4x4 the pixels with the hardware's level and box-averaged
-    in linear light (what the path tracer's box filter averages). Over the curtain's interior
-    (no fold silhouettes), the mean relative luminance error with the bias is at most 0.85
-    times the error without (bound set before measuring; on the bench's lace close-up the
-    curtain's Delta E against the path tracer went 2.26 -> 1.87)."""
-    from catalog.render.frame import PATTERN_LOD_BIAS
-
-    def frame(size, bias):
-        renderer = FrameRenderer(gl, size)
-        renderer.set_fabric("lace-fwa")
-        renderer.set_light("D65")
-        renderer.set_antialiasing("off")
-        renderer.set_bloom(False)
-        renderer.set_camera(0.0, 0.0, 0.8)
-        renderer.set_pattern_lod_bias(bias)
-        renderer.render()
-        image = renderer.read_linear().astype(np.float64) @ [0.2126, 0.7152, 0.0722]
-        mask = renderer.render_gbuffer()["mask"]
-        renderer.release()
-        return image, mask
-
-    big, big_mask = frame((384, 288), 0.0)
-    reference = big.reshape(72, 4, 96, 4).mean(axis=(1, 3))
-    interior = big_mask.reshape(72, 4, 96, 4).all(axis=(1, 3))
-    assert interior.sum() > 3000
-    errors = {}
-    for name, bias in (("hardware level", 0.0), ("box variance", PATTERN_LOD_BIAS)):
-        image, _mask = frame((96, 72), bias)
-        errors[name] = float((np.abs(image - reference)[interior] / reference[interior]).mean())
-    print(f"mean relative error against the 4x4 box over {int(interior.sum())} pixels: "
-          + ", ".join(f"{k} {v:.4f}" for k, v in errors.items()))
-    record_figure("pattern.lod_bias_box_error", errors)
-    assert errors["box variance"] <= 0.85 * errors["hardware level"]
-
-
 def test_auto_antialiasing_takes_msaa_on_a_gpu_and_fxaa_on_a_cpu_rasteriser(gl):
     """The rule of choose_antialiasing: MSAA needs 4 samples and a GPU (multisampling on a
     CPU rasteriser shades and blends every sample: benchmarks/bench_pattern.json)."""
-    from catalog.render.frame import choose_antialiasing
+    from catalog.render.passes.targets import choose_antialiasing
 
     assert choose_antialiasing({"GL_RENDERER": "NVIDIA H200/PCIe/SSE2", "GL_MAX_SAMPLES": 32}) == "msaa"
     assert choose_antialiasing({"GL_RENDERER": "NVIDIA H200/PCIe/SSE2", "GL_MAX_SAMPLES": 2}) == "fxaa"

@@ -88,14 +88,14 @@ def test_background_pixels_match_the_sky_model(gl):
     d, ok = _window_rays(r)
     assert ok.sum() > 0.3 * ok.size
     assert not any(v.get("SKY_BANDS") for k, v in _background_variants(r))
-    model = r.sky_model_for(r.shading_inputs())
+    model = r.background.sky_model_for(r.shading_inputs())
     expected = model.radiance(d[ok])
     assert np.allclose(img[ok], expected, rtol=3e-3, atol=1e-3 * np.abs(expected).max())
     r.release()
 
 
 def _background_variants(r):
-    return [(k, dict(k[2])) for k in r._programs if k[1] == "background.frag"]
+    return [(k, dict(k[2])) for k in r.gl.programs if k[1] == "background.frag"]
 
 
 def _window_rays(r):
@@ -168,10 +168,10 @@ def test_band_frame_sky_is_the_band_integral_of_the_spectral_sky(gl, n_bands):
     assert any(v.get("SKY_BANDS") for k, v in _background_variants(r))
     inputs = r.shading_inputs()
     weights, to_rgb = band_lib.band_weights(n_bands, inputs.key_irradiance)
-    spectral = r.spectral_sky_for(inputs).radiance(d[ok])          # (n, L) W m^-2 sr^-1 nm^-1
+    spectral = r.background.spectral_sky_for(inputs).radiance(d[ok])          # (n, L) W m^-2 sr^-1 nm^-1
     expected = (weights @ spectral.T).T @ to_rgb.T
     assert np.allclose(img[ok], expected, rtol=5e-3, atol=1e-3 * np.abs(expected).max())
-    rgb = r.sky_model_for(inputs).radiance(d[ok])
+    rgb = r.background.sky_model_for(inputs).radiance(d[ok])
     assert np.abs(img[ok] - rgb).max() > 5e-3 * np.abs(rgb).max()
     r.release()
 
@@ -190,7 +190,7 @@ def test_bloom_keeps_the_frames_energy_and_glows_around_the_sun(gl):
     r.render()
     sharp = r.read_linear()
     w, h = r.size
-    data = r._bloom_gl["out_fbo"].read(viewport=(0, 0, w, h), components=4, dtype="f4")
+    data = r.glare.objects["out_fbo"].read(viewport=(0, 0, w, h), components=4, dtype="f4")
     bloomed = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1, :, :3]
     assert bloomed.sum() == pytest.approx(sharp.sum(), rel=0.01)
     d = _rays(r)
@@ -236,5 +236,7 @@ def test_a_dated_sun_stands_where_it_stands_then():
 
     name = "sun@2026-12-21T12:00,34.7,135.5"
     expected = 90.0 - sun_position("2026-12-21T12:00", 34.7, 135.5).zenith_deg
-    assert scene_lib.key_elevation_for(name) == pytest.approx(expected, abs=1e-9)
+    from catalog.optics.lights import get_light
+
+    assert scene_lib.key_elevation_for(get_light(name)) == pytest.approx(expected, abs=1e-9)
     assert abs(expected - scene_lib.LAMP_ELEVATION_DEG) > 5.0

@@ -1,4 +1,4 @@
-"""Precompute the room's ambient occlusion (catalog/render/room_light.py) into
+"""Precompute the room's ambient occlusion (catalog/render/room_light/geometry.py) into
 catalog/render/data/room_ao.npz: the room is static, so the first frame need not pay for it.
 
     .venv/bin/python tools/make_room_ao.py

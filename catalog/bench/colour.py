@@ -140,9 +140,9 @@ def run(quick: bool = False, ctx=None, *, fabrics=None, lights=None, error_size=
 
     error_renderer = FrameRenderer(ctx, error_size)
     # the colours of the bands and the glow against their spectral truth: the room side's
-    # stand-ins kept (the room's solved light is an RGB term outside the bands, which
-    # tests/test_render_frame.py holds to its twin per pixel)
-    error_renderer.set_room_side(False)
+    # stand-ins kept, the room unlit (the room's solved light is an RGB term outside the
+    # bands, which tests/test_render_frame.py holds to its twin per pixel)
+    error_renderer.set_room_lighting(False)
     time_renderer = FrameRenderer(ctx, time_size)
     rows = []
     try:

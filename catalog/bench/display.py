@@ -37,19 +37,16 @@ def run(quick: bool = False, ctx=None, size=(640, 360)) -> dict:
             renderer.set_fabric(fabric)
             renderer.set_light(light)
             renderer.set_ev(None)
-            renderer.display_stages = 3
             renderer.render()
             w, h = renderer.size
             row = {"fabric": fabric, "light": light, "size": list(size)}
             stage_ms = []
             for stages in range(4):
-                renderer.display_stages = stages
-                stage_ms.append(1e3 * median_seconds(lambda: renderer.display_pass(w, h),
+                stage_ms.append(1e3 * median_seconds(lambda: renderer.display.display_pass(w, h, stages=stages),
                                                      repeats, finish=ctx.finish))
-            renderer.display_stages = 3
             row["pass_ms"] = stage_ms
             row["cost_ms"] = [stage_ms[0]] + [b - a for a, b in zip(stage_ms, stage_ms[1:])]
-            row["meter_ms"] = 1e3 * median_seconds(lambda: renderer.meter(w, h), repeats,
+            row["meter_ms"] = 1e3 * median_seconds(lambda: renderer.display.meter(w, h), repeats,
                                                    finish=ctx.finish)
             row["frame_ms"] = 1e3 * median_seconds(renderer.render, repeats, finish=ctx.finish)
             row["display_share"] = (stage_ms[3] + row["meter_ms"]) / row["frame_ms"]

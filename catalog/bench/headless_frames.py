@@ -53,7 +53,7 @@ def parse_case(text: str) -> tuple[tuple[int, int], tuple[int, int]]:
 def choose_backend(ctx, backend: str) -> str:
     if backend != "auto":
         return backend
-    from catalog.render.frame import software_rasteriser  # noqa: PLC0415
+    from catalog.render.passes.targets import software_rasteriser  # noqa: PLC0415
 
     return "numpy" if software_rasteriser(ctx.info) else "gpu"
 

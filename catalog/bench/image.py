@@ -16,12 +16,13 @@ description and curtain mesh. Measured:
 - both run times (frame: median of repeats with glFinish; reference: the two renders'
   wall time, scene building excluded) and their ratio, at equal resolution.
 
-Real-time options (the Pareto plot): spectral bands 3/6/16, paper vs physical
-fluorescence, anti-aliasing (FXAA, the default; none; 2x2 supersampling), the room lit
-through the curtain (issue 13, the default) or the earlier constant room, the room's
-bounces (all, by radiosity, the default; or one, as before), the key light's shadow maps
-at 128 and 512 texels a side (256 the default). The shadow map's size
-was a module constant until issue 11 made it a frame option (set_shadow_map_size).
+Real-time options (the Pareto plot), the ones a user chooses: spectral bands 3/6/16, paper
+vs physical fluorescence, anti-aliasing (FXAA, the default; none; 2x2 supersampling), the room
+lit through the curtain (issue 13, the default) or the constant room, the key light's shadow
+maps at 128 and 512 texels a side (256 the default). Earlier variants of the method (issue
+11's rounds: one bounce, the lobe in the beam, the room side by stand-ins, ...) are no
+longer in the frame: their figures are the runs recorded in RESULT_JSON, each measured at the
+commit it names; a change is compared against a tagged commit or such a recorded run.
 
 The goal of issue 11 (stated before measuring): on every scene mean FLIP <= 0.10, curtain
 Delta E 2000 mean <= 2, and the frame >= 1000x faster than the reference.
@@ -63,30 +64,8 @@ QUICK_SPP = 16
 OPTIONS = (
     ("default (physical, 3 bands, FXAA)", 3, "physical", 1, None),
     ("room lighting off", 3, "physical", 1, None, False),
-    ("one room bounce (before)", 3, "physical", 1, None, None, {"room_bounces": "one"}),
-    ("lobe in the beam (before round 3)", 3, "physical", 1, None, None, {"room_lobe": False}),
-    ("room side by stand-ins (before round 4)", 3, "physical", 1, None, None, {"room_side": False}),
-    ("wall and reveals dark to the cloth (before round 5)", 3, "physical", 1, None, None, {"wall_light": False}),
-    ("window captured from the middle, the outside through the holes (before round 6)", 3, "physical", 1,
-     None, None, {"side_eyes": False, "capture_folds": False}),
-    ("room's and folds' light by the key's dye (before round 7)", 3, "physical", 1, None, None,
-     {"secondary_dye": False}),
-    ("key's shadow through one layer (before round 7)", 3, "physical", 1, None, None,
-     {"key_second_layer": False}),
-    ("pattern at the hardware's mip level (before round 8)", 3, "physical", 1, None, None,
-     {"pattern_lod_bias": 0.0}),
-    ("window as the opening's plane (before round 9)", 3, "physical", 1, None, None, {"window_box": False}),
-    ("box's sides by the room's eyes alone (round 9)", 3, "physical", 1, None, None, {"wall_eyes": False}),
-    ("window wall beside the opening from the light map (round 9)", 3, "physical", 1, None, None,
-     {"window_near": False}),
-    ("shadow maps 128", 3, "physical", 1, None, None, {"shadow_map_size": 128}),
-    ("shadow maps 512", 3, "physical", 1, None, None, {"shadow_map_size": 512}),
-    ("key shadow off (issue 11)", 3, "physical", 1, None, None, {"key_shadow": False}),
-    ("sky occlusion off (issue 11)", 3, "physical", 1, None, None, {"sky_occlusion": False}),
-    ("ambient by view off (issue 11)", 3, "physical", 1, None, None, {"ambient_by_view": False}),
-    ("outside by view off (issue 11, round 2)", 3, "physical", 1, None, None, {"outside_by_view": False}),
-    ("issue 11's three off", 3, "physical", 1, None, None,
-     {"key_shadow": False, "sky_occlusion": False, "ambient_by_view": False}),
+    ("shadow maps 128", 3, "physical", 1, None, None, 128),
+    ("shadow maps 512", 3, "physical", 1, None, None, 512),
     ("FXAA off", 3, "physical", 1, "off"),
     ("6 bands", 6, "physical", 1, None),
     ("16 bands", 16, "physical", 1, None),
@@ -201,7 +180,7 @@ def _reference_in_child(fabric: str, light_key: str, view: str, size, spp: int, 
 
 def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
                  antialiasing: str | None = None, room_lighting: bool | None = None,
-                 repeats: int = 5, switches: dict | None = None, show: dict | None = None) -> dict:
+                 repeats: int = 5, shadow_map_size: int | None = None, show: dict | None = None) -> dict:
     """The real-time frame at desc.size: ``linear`` radiance (H, W, 3), ``display`` (the
     frame's own display image, sRGB in [0, 1]), the ``exposure`` and ``white_balance`` its
     display step used, and ``seconds``, the median wall time of render + glFinish.
@@ -224,8 +203,8 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
             renderer.set_antialiasing(antialiasing)
         if room_lighting is not None:
             renderer.set_room_lighting(room_lighting)
-        for name, on in (switches or {}).items():   # issue 11's terms: set_key_shadow, ...
-            getattr(renderer, f"set_{name}")(on)
+        if shadow_map_size is not None:
+            renderer.set_shadow_map_size(shadow_map_size)
         cam = desc.info["camera"]
         renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
         renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
@@ -333,7 +312,7 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
             frame = frame_images(ctx, desc, preset, light, bands, mode, supersample,
                                  antialiasing, extra[0] if extra else None,
                                  repeats=3 if quick else 7,
-                                 switches=extra[1] if len(extra) > 1 else None, show=show)
+                                 shadow_map_size=extra[1] if len(extra) > 1 else None, show=show)
             if default is None:  # the default frame's exposure and white balance show both
                 exposure, white_balance = frame["exposure"], frame["white_balance"]
             result = compare(frame, reference, masks, desc.inputs, exposure, white_balance)

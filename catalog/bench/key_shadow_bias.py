@@ -65,6 +65,7 @@ def run(ctx=None, size=(96, 72), fabric: str = "voile-white") -> dict:
     from catalog.bench.results import machine_info  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render import frame as frame_lib  # noqa: PLC0415
+    from catalog.render.passes import shadow as shadow_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
     if ctx is None:
@@ -73,14 +74,14 @@ def run(ctx=None, size=(96, 72), fabric: str = "voile-white") -> dict:
         ctx = create_headless_context()
     preset = load_preset(find_preset(fabric))
     meshes = [scene_lib.draped_curtain(columns=60, rows=40, folds=f, depth_m=d) for f, d in DRAPES]
-    saved = (frame_lib.KEY_SHADOW_BIAS_M, frame_lib.KEY_SHADOW_SLOPE_TEXELS, frame_lib.KEY_SHADOW_SLOPE_CAP,
-             frame_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS)
+    saved = (shadow_lib.KEY_SHADOW_BIAS_M, shadow_lib.KEY_SHADOW_SLOPE_TEXELS, shadow_lib.KEY_SHADOW_SLOPE_CAP,
+             shadow_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS)
     truth: dict = {}
     rows = []
     try:
         for candidate in CANDIDATES:
-            (frame_lib.KEY_SHADOW_BIAS_M, frame_lib.KEY_SHADOW_SLOPE_TEXELS,
-             frame_lib.KEY_SHADOW_SLOPE_CAP, frame_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS) = candidate
+            (shadow_lib.KEY_SHADOW_BIAS_M, shadow_lib.KEY_SHADOW_SLOPE_TEXELS,
+             shadow_lib.KEY_SHADOW_SLOPE_CAP, shadow_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS) = candidate
             scores, shaded = [], []
             for (elevation, azimuth), (m, mesh) in [(k, d) for d in enumerate(meshes) for k in KEYS]:
                 renderer = frame_lib.FrameRenderer(ctx, size)
@@ -108,8 +109,8 @@ def run(ctx=None, size=(96, 72), fabric: str = "voile-white") -> dict:
                          "agreement": scores, "mean_agreement": float(np.mean(scores)),
                          "truly_shaded_share": shaded})
     finally:
-        (frame_lib.KEY_SHADOW_BIAS_M, frame_lib.KEY_SHADOW_SLOPE_TEXELS,
-         frame_lib.KEY_SHADOW_SLOPE_CAP, frame_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS) = saved
+        (shadow_lib.KEY_SHADOW_BIAS_M, shadow_lib.KEY_SHADOW_SLOPE_TEXELS,
+         shadow_lib.KEY_SHADOW_SLOPE_CAP, shadow_lib.KEY_SHADOW_NORMAL_OFFSET_TEXELS) = saved
     best = max(rows, key=lambda r: r["mean_agreement"])   # the first of equals: CANDIDATES' order
     return {"machine": machine_info(), "fabric": fabric, "keys": [list(k) for k in KEYS],
             "drapes": [{"folds": f, "depth_m": d} for f, d in DRAPES],

@@ -15,10 +15,9 @@ before each clock read); issue 13's room light, sky model and glare are off on e
 - ``MSAA 4x (flat)`` against ``1x (flat)``: the HDR passes of the flat frame into a 4-sample
   float target and resolved, against one sample: what multisampling costs llvmpipe before
   any OIT target is multisampled;
-- ``FXAA pass``: the post-process alone (frame with FXAA minus frame without);
-- ``... with the first FXAA``: the settled frame with issue 12's first FXAA shader (six
-  bilinear reads, catalog/bench/shaders/fxaa_filtered.frag) instead of today's (five texel
-  fetches, the blend in the shader): what that rewrite saved, in the same run.
+- ``FXAA pass``: the post-process alone (frame with FXAA minus frame without). Issue 12's
+  first FXAA shader (six bilinear reads), once timed here against today's, is in git history
+  and in the recorded runs of benchmarks/bench_pattern.json.
 
 :func:`markdown_tables` renders the JSON as the tables of docs/pattern.md and BENCHMARKS.md.
 """
@@ -46,7 +45,8 @@ def _clock(ctx, draw, repeats: int) -> list[float]:
 def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = None) -> dict:
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
-    from catalog.render.frame import MSAA_SAMPLES, FrameRenderer, choose_antialiasing  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.passes.targets import MSAA_SAMPLES, choose_antialiasing  # noqa: PLC0415
     from catalog.render.scene import draped_curtain  # noqa: PLC0415
     from catalog.render.snapshot import simulated_curtain  # noqa: PLC0415
 
@@ -68,8 +68,7 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
 
     def configure(patterned, aa, mesh):
         renderer.set_patterned(patterned)
-        renderer.fxaa_shader = "fxaa_filtered.frag" if aa == "fxaa-filtered" else "fxaa.frag"
-        renderer.set_antialiasing("fxaa" if aa == "fxaa-filtered" else aa)
+        renderer.set_antialiasing(aa)
         if mesh == "static":
             renderer.set_mesh(static.positions, static.normals, static.uvs, static.tangents,
                               static.indices)
@@ -81,7 +80,6 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
         "patterned + OIT, no AA (static drape)": (True, "off", "static"),
         "patterned + OIT + FXAA (static drape)": (True, "fxaa", "static"),
         "patterned + OIT + FXAA (settled drape)": (True, "fxaa", "settled"),
-        "... with the first FXAA (6 filtered reads)": (True, "fxaa-filtered", "settled"),
     }
     msaa_case = "patterned + OIT + MSAA 4x (settled drape)"
     if int(ctx.info.get("GL_MAX_SAMPLES", 0) or 0) >= MSAA_SAMPLES:
@@ -103,14 +101,14 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     msaa_colour = ctx.renderbuffer((w, h), 4, samples=4, dtype="f4")
     msaa_depth = ctx.depth_renderbuffer((w, h), samples=4)
     msaa_fbo = ctx.framebuffer([msaa_colour], msaa_depth)
-    single_fbo = renderer._hdr_fbo
+    single_fbo = renderer.targets.hdr_fbo
 
     def hdr_single():
-        renderer._hdr_fbo = single_fbo
+        renderer.targets.hdr_fbo = single_fbo
         renderer.render_hdr()
 
     def hdr_msaa():
-        renderer._hdr_fbo = msaa_fbo
+        renderer.targets.hdr_fbo = msaa_fbo
         renderer.render_hdr()
         ctx.copy_framebuffer(single_fbo, msaa_fbo)   # resolve
 
@@ -120,7 +118,7 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     for _ in range(repeats):
         msaa_samples["1x (flat HDR passes)"] += _clock(ctx, hdr_single, 1)
         msaa_samples["MSAA 4x (flat HDR passes + resolve)"] += _clock(ctx, hdr_msaa, 1)
-    renderer._hdr_fbo = single_fbo
+    renderer.targets.hdr_fbo = single_fbo
     single_fbo.use()   # never leave a released framebuffer bound (the context is the caller's)
     for obj in (msaa_fbo, msaa_colour, msaa_depth):
         obj.release()

@@ -169,11 +169,11 @@ def curtain_timer(renderer, fragment: str | None):
     view_proj = renderer.camera.view_projection(renderer.size[0] / renderer.size[1])
 
     def draw():
-        renderer._hdr_fbo.use()
+        renderer.targets.hdr_fbo.use()
         ctx.viewport = (0, 0, *renderer.size)
-        renderer._hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        renderer.targets.hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
-        renderer.draw_curtain(view_proj, fragment=fragment)
+        renderer.curtain.draw_curtain(view_proj, fragment=fragment)
 
     return draw
 
@@ -261,7 +261,7 @@ def main(argv=None) -> int:
         variant_renderer.set_light("D65")
         variant_renderer.set_fluorescence(mode)
         variant_renderer.set_bands(n_bands)
-        defines_of[label] = {k: v for k, v in variant_renderer.variant_defines().items() if v}
+        defines_of[label] = {k: v for k, v in variant_renderer.curtain.variant_defines().items() if v}
         drawers[label] = curtain_timer(variant_renderer, None)
     renderer.set_fluorescence("physical")
     renderer.set_bands(3)

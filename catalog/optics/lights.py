@@ -56,13 +56,38 @@ SUN_MENU = ("sun:22", "sun:100", "sun:200", "sun:300", "sun:400", "sun:500",
 _STEP_NM = float(GRID_NM[1] - GRID_NM[0])
 
 
+#: What a light is, resolved once when the library makes it (never read from its name
+#: elsewhere): a CIE (or ISO) illuminant table, a visible lamp, a UV lamp, or the sun.
+LIGHT_KINDS = ("illuminant", "lamp", "uv", "sun")
+#: How a sun light was asked for: the paper's direct beam by path length (``sun:PATH_KM``),
+#: the clear sky by path length (``sun-clear:PATH_KM``) or by date and place (``sun@...``).
+SUN_MODELS = ("paper", "clear", "date")
+
+
+@dataclass(frozen=True)
+class SunSource:
+    """The sun a light is: its model (SUN_MODELS) and the elevation (deg above the horizon)
+    its path or date implies; None where the path has no solar zenith (shorter than the
+    paper's layer: the frame then places it as a lamp)."""
+
+    model: str
+    elevation_deg: float | None
+
+
 @dataclass(frozen=True, eq=False)
 class Light:
-    """A light: spectral irradiance on :data:`GRID_NM` (300-780 nm), W m^-2 nm^-1, absolute."""
+    """A light: spectral irradiance on :data:`GRID_NM` (300-780 nm), W m^-2 nm^-1, absolute;
+    its ``kind`` (LIGHT_KINDS) and, for the sun, where it stands (``sun``)."""
 
     name: str
     description: str
     irradiance_w_m2_nm: np.ndarray
+    kind: str = "illuminant"
+    sun: SunSource | None = None
+
+    @property
+    def is_sun(self) -> bool:
+        return self.kind == "sun"
 
     @property
     def illuminance_lx(self) -> float:
@@ -93,16 +118,31 @@ class Light:
         if not current > 0:
             raise InputError("has no visible light (0 lx): cannot scale it to "
                              f"{target:g} lx", field=f"light {self.name!r}")
-        return _make(self.name, self.description, self.irradiance_w_m2_nm * (target / current))
+        return _make(self.name, self.description, self.irradiance_w_m2_nm * (target / current),
+                     self.kind, self.sun)
 
 
-def _make(name: str, description: str, irradiance: np.ndarray) -> Light:
+def _make(name: str, description: str, irradiance: np.ndarray, kind: str = "illuminant",
+          sun: SunSource | None = None) -> Light:
     values = np.array(irradiance, dtype=np.float64)
     if values.shape != GRID_NM.shape:
         raise ValueError(f"light {name!r}: spectrum has {values.shape} samples, "
                          f"the grid {GRID_NM.shape}")
+    if kind not in LIGHT_KINDS or (kind == "sun") != (sun is not None):
+        raise ValueError(f"light {name!r}: kind {kind!r} (one of {', '.join(LIGHT_KINDS)}; "
+                         "the sun, and only the sun, has a SunSource)")
     values.setflags(write=False)
-    return Light(name, description, values)
+    return Light(name, description, values, kind, sun)
+
+
+def _elevation_from_path(path_km: float) -> float | None:
+    """The sun's elevation (deg) for a path through the paper's layer, None where no zenith has it."""
+    from catalog.optics.sun.model import zenith_deg_from_path  # noqa: PLC0415
+
+    try:
+        return 90.0 - zenith_deg_from_path(path_km)
+    except (ValueError, CatalogError):
+        return None
 
 
 def illuminance_lx(irradiance_w_m2_nm: np.ndarray, grid_nm: np.ndarray = GRID_NM) -> float:
@@ -213,7 +253,7 @@ def _uva_light() -> Light:
     description = ("365 nm UV-A blacklight (Gaussian, 10 nm FWHM) with 1.5% leak in the "
                    "mercury lines 404.7 and 435.8 nm (illustrative); "
                    f"{UVA_TOTAL_W_M2:g} W/m2 in all")
-    return _make("UV-A", description, uva_lamp_relative() * UVA_TOTAL_W_M2)
+    return _make("UV-A", description, uva_lamp_relative() * UVA_TOTAL_W_M2, "uv")
 
 
 def _warm_led_light() -> Light:
@@ -221,7 +261,7 @@ def _warm_led_light() -> Light:
     description = (f"warm-white LED, {WARM_LED_CCT_K:g} K: 450 nm blue pump + yellow-green "
                    "and red phosphors (Gaussians mixed to the Planckian white), nothing "
                    f"at or below 400 nm; scaled to {LAMP_LX:,.0f} lx")
-    return _make("LED-warm", description, relative * (LAMP_LX / illuminance_lx(relative)))
+    return _make("LED-warm", description, relative * (LAMP_LX / illuminance_lx(relative)), "lamp")
 
 
 #: Narrow-band lamps: name -> (centre nm, FWHM nm, description). One Gaussian band each,
@@ -239,7 +279,8 @@ def _narrow_lamp(name: str) -> Light:
     centre, fwhm, what = NARROW_LAMPS[name]
     relative = _gaussian(centre, fwhm)
     relative = relative / (np.sum(relative) * _STEP_NM)
-    return _make(name, f"{what}; {UVA_TOTAL_W_M2:g} W/m2 in all", relative * UVA_TOTAL_W_M2)
+    return _make(name, f"{what}; {UVA_TOTAL_W_M2:g} W/m2 in all", relative * UVA_TOTAL_W_M2,
+                 "uv" if centre < 400.0 else "lamp")
 
 
 def violet_white_relative() -> tuple[np.ndarray, str]:
@@ -262,7 +303,7 @@ def _violet_white_light() -> Light:
                    f"red phosphors, 4000 K; {source or 'see ' + VIOLET_WHITE_FILE}; scaled to "
                    f"{LAMP_LX:,.0f} lx")
     return _make("LED-violet-white", description,
-                 relative * (LAMP_LX / illuminance_lx(relative)))
+                 relative * (LAMP_LX / illuminance_lx(relative)), "lamp")
 
 
 # --------------------------------------------------------------------------------------
@@ -289,7 +330,8 @@ def _sun_direct_light(name: str, path_km: float) -> Light:
     description = (f"sun, direct beam after {path_km:g} km of Rayleigh scattering through the "
                    "paper's uniform 22 km layer (ASTM G173 extraterrestrial, no ozone, "
                    "aerosol or sky), absolute")
-    return _make(name, description, direct_beam_w_m2_nm(path_km))
+    return _make(name, description, direct_beam_w_m2_nm(path_km), "sun",
+                 SunSource("paper", _elevation_from_path(path_km)))
 
 
 def _sun_clear_light(name: str, path_km: float) -> Light:
@@ -305,7 +347,8 @@ def _sun_clear_light(name: str, path_km: float) -> Light:
                    f"through the 22 km shell): direct + skylight (delta-Eddington) + ground "
                    f"on a plane facing the sun; ozone {atmosphere.ozone_atm_cm:g} atm-cm, aerosol "
                    f"{atmosphere.aod_500nm:g} at 500 nm, absolute")
-    return _make(name, description, sky.sun_facing(atmosphere.ground_albedo))
+    return _make(name, description, sky.sun_facing(atmosphere.ground_albedo), "sun",
+                 SunSource("clear", _elevation_from_path(path_km)))
 
 
 def _sun_at_light(name: str, spec: str) -> Light:
@@ -336,7 +379,8 @@ def _sun_at_light(name: str, spec: str) -> Light:
     description = (f"clear sky at {position.when_utc} UTC, {lat:g} N {lon:g} E: zenith "
                    f"{position.zenith_deg:.1f} deg, path {position.path_km:.0f} km; direct + "
                    "skylight (delta-Eddington) + ground on a plane facing the sun, absolute")
-    return _make(name, description, sky.sun_facing(atmosphere.ground_albedo))
+    return _make(name, description, sky.sun_facing(atmosphere.ground_albedo), "sun",
+                 SunSource("date", 90.0 - position.zenith_deg))
 
 
 # --------------------------------------------------------------------------------------

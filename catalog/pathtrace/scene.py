@@ -104,15 +104,9 @@ def rgb_weights(key_irradiance: np.ndarray) -> np.ndarray:
 def key_light_for(light) -> tuple[np.ndarray, bool]:
     """The key light's direction (unit, to the light) and whether it is the sun, as the
     real-time frame places it (:meth:`catalog.render.frame.FrameRenderer.set_light`)."""
-    from catalog.core.errors import CatalogError  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
-    is_sun = light.name.startswith(("sun:", "sun-clear:", "sun@"))
-    try:
-        elevation = scene_lib.key_elevation_for(light.name)
-    except (ValueError, CatalogError):
-        elevation = scene_lib.LAMP_ELEVATION_DEG
-    return scene_lib.key_direction(elevation), is_sun
+    return scene_lib.key_direction(scene_lib.key_elevation_for(light)), light.is_sun
 
 
 def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: float = 0.0,
@@ -131,7 +125,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
     # paper's beam, whose sky and ground are that beam Rayleigh-scattered (paper_beam)
     inputs, decision = scene_lib.build_shading_inputs(
         preset, light.irradiance_w_m2_nm, to_light, is_sun=is_sun, fluorescence=fluorescence,
-        paper_beam=light.name.startswith("sun:"), viewer_inside=inside)
+        paper_beam=light.sun is not None and light.sun.model == "paper", viewer_inside=inside)
     fabric_size = None
     rings: tuple = ()
     if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth

@@ -276,22 +276,13 @@ def sun_at_hour(hour: float) -> SunAtHour:
     return SunAtHour(hour, zenith, azimuth, path, f"sun:{path:.1f}")
 
 
-def key_elevation_for(light_name: str) -> float:
-    """Elevation (deg) of the key light: the sun's from its path length (``sun:PATH``,
-    ``sun-clear:PATH``) or from its date, time and place (``sun@WHEN,LAT[,LON]``), so that the
-    sky behind the window (catalog/optics/sun/sky.py) is the one of that sun; a lamp's fixed."""
-    if light_name.startswith(("sun:", "sun-clear:")):
-        from catalog.optics.sun.model import zenith_deg_from_path  # noqa: PLC0415
-
-        path = float(light_name.split(":", 1)[1])
-        return 90.0 - zenith_deg_from_path(path)
-    if light_name.startswith("sun@"):
-        from catalog.optics.sun.model import sun_position  # noqa: PLC0415
-
-        parts = [p.strip() for p in light_name[4:].split(",")]
-        position = sun_position(parts[0], float(parts[1]),
-                                float(parts[2]) if len(parts) > 2 else 0.0)
-        return 90.0 - position.zenith_deg
+def key_elevation_for(light) -> float:
+    """Elevation (deg) of the key light (a catalog.optics.lights.Light): the sun's, from its
+    path length or its date, time and place (``light.sun``, resolved when the library made
+    it), so that the sky behind the window (catalog/optics/sun/sky.py) is the one of that sun;
+    a lamp's, or a sun whose path has no zenith, LAMP_ELEVATION_DEG."""
+    if light.sun is not None and light.sun.elevation_deg is not None:
+        return light.sun.elevation_deg
     return LAMP_ELEVATION_DEG
 
 

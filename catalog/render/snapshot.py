@@ -24,7 +24,7 @@ IMAGE_SUFFIXES = (".exr", ".png")
 def parse_size(text: str) -> tuple[int, int]:
     """``WxH`` -> (width, height), refused unless both are whole numbers in 1..MAX_SIDE_PX."""
     from catalog.core.cliargs import parse_wxh  # noqa: PLC0415
-    from catalog.render.frame import MAX_SIDE_PX  # noqa: PLC0415
+    from catalog.render.passes.targets import MAX_SIDE_PX  # noqa: PLC0415
 
     return parse_wxh(text, "--size", 1, MAX_SIDE_PX)
 

@@ -410,9 +410,6 @@ class ViewerApp:
             renderer = FrameRenderer(self.ctx, size)
             renderer.set_bloom(self.room_settings["bloom"])
             renderer.set_room_lighting(self.room_settings["room_light"])
-            # the cloth's own shadows (issue 11) are drawn with the room's light: off with it
-            renderer.set_key_shadow(self.room_settings["room_light"])
-            renderer.set_sky_occlusion(self.room_settings["room_light"])
             renderer.set_sky_model(self.room_settings["room_light"])
             renderer.room_update_every = self.room_settings["room_update_every"]
             self._renderers.append(renderer)
@@ -434,7 +431,7 @@ class ViewerApp:
         return {"room_light": True, "bloom": True, "room_update_every": 1}
 
     def _software_gl(self) -> bool:
-        from catalog.render.frame import software_rasteriser  # noqa: PLC0415
+        from catalog.render.passes.targets import software_rasteriser  # noqa: PLC0415
 
         return software_rasteriser(self.ctx.info)
 

@@ -94,10 +94,11 @@ DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa
 
 def configure_desktop_frame(renderer) -> None:
     """Put a FrameRenderer in the modes the page shows (:data:`DESKTOP_MODES`)."""
-    for name, value in DESKTOP_MODES.items():
-        setter = getattr(renderer, f"set_{name}", None)
-        if setter is not None:  # a mode this frame does not have is off anyway
-            setter(value)
+    renderer.set_patterned(DESKTOP_MODES["patterned"])
+    renderer.set_room_lighting(DESKTOP_MODES["room_lighting"])
+    renderer.set_antialiasing(DESKTOP_MODES["antialiasing"])
+    renderer.set_key_second_layer(DESKTOP_MODES["key_second_layer"])
+    renderer.fabric_pattern.set_prefilter(DESKTOP_MODES["pattern_prefilter"])
 #: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
 #: the page shows each scene at the EV100 a desktop frame of this size meters at the default
 #: camera (fixed while orbiting, like a photograph's), recorded as an ordinary uniform. The
@@ -410,7 +411,7 @@ class SiteExporter:
         return {"u_view_proj": matrix(view_proj),
                 "u_inverse_view_proj": matrix(np.linalg.inv(view_proj)),
                 "u_camera_position": [float(v) for v in r.camera.position],
-                "u_oit_depth_ref": float(r.oit_depth_reference_m())}
+                "u_oit_depth_ref": float(r.curtain.oit_depth_reference_m())}
 
     def check_camera_uniforms(self, preset, light: LightChoice) -> None:
         """Refuse a desktop frame whose other uniforms depend on the camera: the page would

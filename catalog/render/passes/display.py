@@ -1,0 +1,100 @@
+"""Pass 5 of the frame: exposure, white balance, tone curve and sRGB (tonemap.frag), then FXAA."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from catalog.core.errors import CatalogError
+from catalog.render import display as display_lib
+from catalog.render.passes.gl_common import Pass, set_uniform
+
+#: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
+METER_MAX_SIDE_PX = 96
+
+
+class DisplayPass(Pass):
+    """The display transform (fullscreen.vert + tonemap.frag; :mod:`catalog.render.display`):
+    exposure (EV100, fixed or metered from a luminance histogram of this frame), white balance
+    (CAT16), the tone curve, gamut compression, the sRGB curve; then FXAA (fxaa.frag).
+
+    In: the HDR target (or the glare's texture). Out: the caller's framebuffer or the frame's
+    display image."""
+
+    def __init__(self, frame):
+        super().__init__(frame)
+        self._wb_cache = None
+
+    def current_ev100(self) -> float:
+        """The EV100 the next display pass uses (fixed, or the auto exposure's)."""
+        if self.frame.ev100 is not None:
+            return self.frame.ev100
+        if self.frame.metered_ev100 is None:
+            raise CatalogError("auto exposure: nothing metered yet (render a frame first)")
+        return self.frame.metered_ev100
+
+    def exposure_scale(self) -> float:
+        """Linear radiance (cd m^-2) -> scene value the tone curve takes (EV and multiplier)."""
+        return self.frame.exposure * display_lib.exposure_scale(self.current_ev100())
+
+    def white_balance_matrix(self) -> np.ndarray:
+        """Linear sRGB -> linear sRGB: CAT16 from the key light's white to D65 (or identity)."""
+        inputs = self.frame.terms.shading_inputs()
+        key = (self.frame.terms.inputs_key, self.frame.white_balance)
+        if self._wb_cache is None or self._wb_cache[0] != key:
+            from catalog.optics.shading_reference import white_xyz  # noqa: PLC0415
+
+            self._wb_cache = (key, display_lib.white_balance_matrix(white_xyz(inputs),
+                                                                     self.frame.white_balance))
+        return self._wb_cache[1]
+
+    def display_uniforms(self) -> dict:
+        return display_lib.shader_uniforms(self.exposure_scale(), self.white_balance_matrix())
+
+    def meter(self, vw: int, vh: int) -> float:
+        """EV100 of the HDR target's (vw, vh) corner: a histogram of a mip level (at most
+        METER_MAX_SIDE_PX wide), white-balanced, of display.meter_signal (largest channel)."""
+        level = 0
+        while max(vw, vh) >> level > METER_MAX_SIDE_PX:
+            level += 1
+        if level:
+            self.frame.targets.hdr.build_mipmaps(0, level)
+            self.frame.targets.hdr.filter = (self.mgl.NEAREST, self.mgl.NEAREST)
+        w, h = max(1, self.frame.size[0] >> level), max(1, self.frame.size[1] >> level)
+        data = np.frombuffer(self.frame.targets.hdr.read(level=level), dtype=np.float32).reshape(h, w, 4)
+        cw, ch = max(1, -(-vw >> level)), max(1, -(-vh >> level))
+        rgb = data[:ch, :cw, :3].astype(np.float64) @ self.white_balance_matrix().T  # as shown
+        return display_lib.meter_ev100(display_lib.luminance_histogram(display_lib.meter_signal(rgb)))
+
+    def display_pass(self, vw: int, vh: int, fbo=None, viewport=None, hdr=None, stages: int = 3) -> None:
+        """The display transform of the HDR target's (vw, vh) corner (the benchmark times it);
+        ``hdr``: the texture to show (default the HDR target; the glare's output when on);
+        ``stages``: tonemap.frag's DISPLAY_STAGES (3, all; fewer for the benchmark's cost per stage)."""
+        target = fbo if fbo is not None else self.frame.targets.ldr_fbo
+        target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
+                           else (0, 0, vw, vh))
+        fxaa = self.frame.antialiasing == "fxaa"
+        if fxaa:   # display into our copy, FXAA from it into the target
+            self.frame.targets.pre_fbo.use()
+            self.ctx.viewport = (0, 0, vw, vh)
+        else:
+            target.use()
+            self.ctx.viewport = target_viewport
+        program = self.gl.program("fullscreen.vert", "tonemap.frag",
+                                {"DISPLAY_STAGES": int(stages)})
+        (hdr if hdr is not None else self.frame.targets.hdr).use(location=0)
+        set_uniform(program, "u_hdr", 0)
+        set_uniform(program, "u_hdr_rect", (0.0, 0.0, vw / self.frame.size[0], vh / self.frame.size[1]))
+        for name, value in self.display_uniforms().items():
+            set_uniform(program, name, value)
+        self.gl.fullscreen_vao(program).render(self.mgl.TRIANGLES, vertices=3)
+        if fxaa:
+            target.use()
+            self.ctx.viewport = target_viewport
+            program = self.gl.program("fullscreen.vert", "fxaa.frag")
+            self.frame.targets.pre.use(location=0)
+            set_uniform(program, "u_ldr", 0)
+            set_uniform(program, "u_size_px", (float(vw), float(vh)))
+            set_uniform(program, "u_rect", (0.0, 0.0, vw / self.frame.size[0], vh / self.frame.size[1]))
+            set_uniform(program, "u_texel", (1.0 / self.frame.size[0], 1.0 / self.frame.size[1]))
+            self.gl.fullscreen_vao(program).render(self.mgl.TRIANGLES, vertices=3)
+        self.frame._last = (vw, vh, fbo, viewport)

@@ -1,0 +1,117 @@
+"""The fabric's pattern as a texture (the curtain and shadow passes sample it)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from catalog.render.passes.gl_common import Pass
+
+PATTERN_ANISOTROPY = 4.0
+
+
+#: The pattern's LOD bias (common.glsl thread_texel; issue 11, eighth round): the reference
+#: averages a pixel's box (variance 1/12 px^2), the hardware's trilinear filter at its level
+#: (texel side T about a pixel) is the mip's box and the bilinear tent, T^2/12 + T^2/6 = T^2/4:
+#: three times too wide, which blurs the lace's motifs; the level with T = 1/sqrt(3) px matches
+#: the box's variance. 0: the hardware's level (before).
+PATTERN_LOD_BIAS = math.log2(1.0 / math.sqrt(3.0))
+
+
+class PatternTexture(Pass):
+    """The fabric's pattern (catalog/presets/patterns.py) as a mipmapped RGBA32F texture
+    (thread normal, coverage), anisotropically filtered; one texel of coverage 1 - LD without
+    a [pattern]. The curtain and shadow passes read it."""
+
+    def __init__(self, frame):
+        super().__init__(frame)
+        self.texture = None
+        self.key = None
+        self._pattern = None
+        self.repeat_m = None
+        self.mean_coverage = None
+        #: the mip levels from catalog.presets.patterns.mip_chain (True: a periodic Gaussian
+        #: per level, no moire) or the hardware's 2x2 box chain (False: the web page's, which
+        #: builds its levels with generateMipmap)
+        self.prefilter = True
+        #: the mip level's bias (log2 of the filter's texel side per pixel): PATTERN_LOD_BIAS for
+        #: a frame shown at its own size; a frame rendered k times larger to be box-filtered
+        #: down (a supersampled still) adds log2(k), so the pattern is filtered for the pixel
+        #: it will be shown in
+        self.lod_bias = PATTERN_LOD_BIAS
+
+    def set_fabric(self, preset) -> None:
+        """The preset's pattern as a mipmapped RGBA32F texture (thread normal, coverage);
+        without a [pattern] a uniform coverage 1 - LD (one texel)."""
+        from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+
+        table = preset.table("pattern")
+        key = (str(preset.path), repr(sorted(table.items())), preset.btdf.direct)
+        if key == self.key:
+            return
+        pattern = load_pattern(preset)
+        if pattern is None:
+            texels = np.array([[[0.0, 0.0, 1.0, 1.0 - preset.btdf.direct]]], dtype=np.float32)
+            repeat = self.frame.mesh.fabric_size_m
+        else:
+            texels = pattern.normal_map()
+            repeat = pattern.repeat_m
+        mgl = self.mgl
+        if self.texture is not None:
+            self.texture.release()
+        h, w = texels.shape[:2]
+        texture = self.ctx.texture((w, h), 4, np.ascontiguousarray(texels).tobytes(), dtype="f4")
+        texture.repeat_x = texture.repeat_y = True
+        texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+        texture.build_mipmaps()   # allocates the levels; their texels are the prefiltered chain
+        if self.prefilter:
+            from catalog.presets.patterns import mip_chain  # noqa: PLC0415
+
+            for level, image in enumerate(mip_chain(texels)[1:], start=1):
+                texture.write(np.ascontiguousarray(image, dtype="f4").tobytes(), level=level)
+        max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
+        texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
+        self.texture = texture
+        self._pattern = pattern
+        self.repeat_m = tuple(float(v) for v in repeat)
+        self.mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
+        self.key = key
+
+    def set_prefilter(self, on: bool) -> None:
+        """The mip chain: prefiltered (True, default) or the hardware's box chain (False, what
+        the web page builds). Takes effect at the next fabric load."""
+        if bool(on) != self.prefilter:
+            self.prefilter = bool(on)
+            self.key = None
+
+    def set_pattern_filtering(self, filtered: bool) -> None:
+        """True (default): trilinear mipmapped, anisotropic; False: nearest texel, no mips
+        (for measuring what the filtering buys: shimmer, the far limit)."""
+        mgl = self.mgl
+        texture = self.texture
+        if filtered:
+            texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
+            max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
+            texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
+        else:
+            texture.filter = (mgl.NEAREST, mgl.NEAREST)
+            texture.anisotropy = 1.0
+
+    @property
+    def pattern(self):
+        """The current fabric's :class:`catalog.presets.patterns.Pattern` (None: uniform coverage)."""
+        return self._pattern
+
+    def pattern_mip_level(self, level: int) -> np.ndarray:
+        """Level ``level`` of the pattern texture's mip chain as GL built it, (H, W, 4)."""
+        texture = self.texture
+        w = max(1, texture.width >> level)
+        h = max(1, texture.height >> level)
+        data = texture.read(level=level)
+        return np.frombuffer(data, dtype=np.float32).reshape(h, w, 4).copy()
+
+    def release(self) -> None:
+        if self.texture is not None:
+            self.texture.release()
+            self.texture = None
