@@ -39,7 +39,7 @@ def test_gpu_follows_the_reference_for_one_second(gl):
 @pytest.mark.slow
 def test_rings_and_sleep_on_the_gpu(gl):
     params = ClothParams(grid_w=10, grid_h=10, opening=1.0, ring_speed_m_s=2.0,
-                         sleep_frames=10, sleep_speed_m_s=0.02)
+                         sleep_hold_s=1 / 3, sleep_speed_m_s=0.02, sleep_rms_speed_m_s=0.01)
     sim = ClothSimulation(params, "gpu", ctx=gl, monitor_every=5)
     sim.set_opening(0.5)
     sim.run(30, 1 / 30)
@@ -48,6 +48,22 @@ def test_rings_and_sleep_on_the_gpu(gl):
     sim.set_opening(1.0)
     simulated = sim.run(240, 1 / 30)
     assert sim.sleeping and simulated < 240
+
+
+@pytest.mark.slow
+def test_the_windless_drape_sleeps_on_the_gpu_within_five_seconds(gl):
+    """The settled drape (float64) in float32 on the GPU is still at rest: asleep within 5 s
+    of simulated time at wind 0 (checked every 10 frames), and the wind wakes it."""
+    from catalog.cloth.drape import drape_params, settled_simulation, settled_state
+
+    params = drape_params({"weave": "voile"}, grid=(48, 28))
+    rest = settled_state(params).positions_m
+    sim = settled_simulation(params, backend="gpu", ctx=gl, monitor_every=10)
+    frames = sim.run(300, 1 / 60)
+    assert sim.sleeping and frames < 300, (sim.peak_speed_m_s, sim.rms_speed_m_s)
+    assert np.abs(sim.positions() - rest).max() < 2e-3
+    sim.set_wind(1.0)
+    assert sim.run(10, 1 / 60) == 10 and not sim.sleeping
 
 
 def test_vertex_buffer_holds_the_mesh(gl):
