@@ -218,7 +218,7 @@ def main_at_rest(args) -> int:
     return 0
 
 
-def at_rest_table(result: dict, commit: str | None = None) -> str:
+def at_rest_table(result: dict) -> str:
     """An ``--at-rest`` run: the windless viewer's frame beside its paused (static) frame."""
     lines = ["| window | cloth | mode | frame ms (median) | simulation | shading | UI | other "
              "| at rest / static |", "|---|---|---|---|---|---|---|---|---|"]
@@ -230,6 +230,7 @@ def at_rest_table(result: dict, commit: str | None = None) -> str:
                      f"{row['shading_ms']:.1f} | {row['ui_ms']:.1f} | {row['other_ms']:.1f} | "
                      f"{ratio} |")
     load = result["machine"].get("load_average_1min")
+    commit = result["machine"].get("commit")
     note = f"\n\n{result['rounds']} interleaved rounds of {result['frames']} frames after " \
            f"{result['warmup']} of warm-up, medians"
     if load is not None:
