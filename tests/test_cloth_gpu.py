@@ -127,3 +127,40 @@ def test_gpu_parameters_change_while_running(gl):
     assert gpu.finite and gpu.params.areal_density_kg_m2 == 0.3
     diff = np.linalg.norm(gpu.positions() - cpu.positions(), axis=-1)
     assert np.sqrt(np.mean(diff ** 2)) < 1e-2
+
+
+@pytest.mark.slow
+def test_a_sleeping_gpu_cloth_leaves_the_frame_static(gl):
+    """The viewer's scene with the compute cloth at wind 0: while the cloth moves, each fed
+    frame tells the renderer (cloth_moved: the room's light follows); once it sleeps, nothing
+    is fed, so the room's light is not redrawn and the frame is static; wind wakes it."""
+    from catalog.presets import find_preset, load_preset
+    from catalog.viewer.scene import CurtainScene
+
+    class Renderer:
+        def __init__(self):
+            self.moved = 0
+
+        def set_mesh(self, *args, **kwargs):
+            pass
+
+        def bind_cloth_vertex_buffer(self, *args, **kwargs):
+            pass
+
+        def cloth_moved(self):
+            self.moved += 1
+
+    scene = CurtainScene((16, 12), backend="gpu", wind_m_s=0.0, ctx=gl)
+    scene.set_fabric(load_preset(find_preset("voile-white")))
+    renderer = Renderer()
+    scene.feed(renderer)
+    stepped = 0
+    for _ in range(120):
+        stepped += scene.step(1 / 60)
+        scene.feed(renderer)
+    assert scene.simulation.sleeping and stepped < 120
+    assert renderer.moved == stepped
+    scene.set_wind(1.0)
+    assert scene.step(1 / 60)
+    scene.feed(renderer)
+    assert renderer.moved == stepped + 1

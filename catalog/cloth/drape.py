@@ -77,8 +77,12 @@ def _settled(params: ClothParams, frames: int):
     from catalog.cloth.simulation import ClothSimulation  # noqa: PLC0415
 
     still = params.with_changes(wind_speed_m_s=0.0)
-    # numba: float64 like the reference (the same to 1e-8 m a second), ~10x its speed
-    simulation = ClothSimulation(still, backend="cpu")
+    # numba: float64 like the reference (the same to 1e-8 m a second), ~10x its speed;
+    # the reference itself where numba is not installed
+    import importlib.util  # noqa: PLC0415
+
+    backend = "cpu" if importlib.util.find_spec("numba") is not None else "numpy"
+    simulation = ClothSimulation(still, backend=backend)
     simulation.settle(max_s=frames * FRAME_DT_S)
     state = simulation.state.copy()
     state.velocities_m_s[...] = 0.0

@@ -2219,8 +2219,8 @@ class FrameRenderer:
                getattr(self, "_pattern_key", None),
                tuple((light.name, position) for light, position in self.room_lamps))
         self._room_frames += 1
-        moved = self._mesh_version != getattr(self, "_room_mesh_version", None) or (
-            self._curtain_format != "3f")  # a cloth on the GPU moves unseen
+        # a cloth on the GPU moves unseen: its owner calls cloth_moved() after each step
+        moved = self._mesh_version != getattr(self, "_room_mesh_version", None)
         due = moved and self._room_frames >= self.room_update_every
         if key != self._room_key or due or self._room_gl is None:
             self._room_key = key
@@ -2228,6 +2228,11 @@ class FrameRenderer:
             self._room_frames = 0
             return True
         return False
+
+    def cloth_moved(self) -> None:
+        """The bound cloth buffers (bind_cloth_vertex_buffer) were rewritten on the GPU: the
+        room's light follows (at its room_update_every); a sleeping cloth calls nothing."""
+        self._mesh_version += 1
 
     def invalidate_room_light(self) -> None:
         """Redraw the room's light at the next frame (e.g. after the cloth moved on the GPU)."""
