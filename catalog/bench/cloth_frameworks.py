@@ -126,6 +126,10 @@ def markdown_tables(result: dict) -> dict[str, str]:
             f"row (each spring once) at every size: "
             f"{'holds' if worst >= GOAL_RATIO else 'NOT met'} ("
             + ", ".join(f"{r['ratio_to_fastest_peer']:.2f}x at n = {r['n']}" for r in ours) + ").")
+    if all("cpu_ratio_to_fastest_peer" in r for r in ours):
+        goal += (" Per CPU second (the work, whatever share of the shared cores each got): "
+                 + ", ".join(f"{r['cpu_ratio_to_fastest_peer']:.2f}x at n = {r['n']}"
+                             for r in ours) + ".")
     gpu = result.get("gpu_frame_llvmpipe") or []
     gpu_text = ("A frame of the production GPU solver on llvmpipe (the compute passes on the same "
                 "2 CPU cores, one run): " + ", ".join(
@@ -638,25 +642,36 @@ def bench_springs(sizes, repeats: int, seconds_per_repeat: float, ctx) -> list[d
             rate = trial / max(time.perf_counter() - start, 1e-6)
             steps[name] = max(trial, int(rate * seconds_per_repeat))
         samples = {name: [] for name in impls}
+        cpu_samples = {name: [] for name in impls}
         for _ in range(repeats):  # interleaved: every implementation sees the same noise
             for name, impl in impls.items():
                 if name == "numpy-f32" and len(samples[name]) >= 2:
                     continue  # the slow reference: two samples are enough
                 impl.reset()
-                start = time.perf_counter()
+                start, cpu_start = time.perf_counter(), time.process_time()
                 impl.run(steps[name])
                 samples[name].append(steps[name] / (time.perf_counter() - start))
+                # CPU seconds of all the process's threads: on a machine shared by more
+                # runnable threads than cores, a 2-thread peer gets twice the wall-clock share
+                # of a 1-thread one; per CPU second the work itself is compared
+                cpu_samples[name].append(steps[name] / max(time.process_time() - cpu_start,
+                                                           1e-9))
         peer_rates = [statistics.median(samples[p]) for p in PEERS if p in samples]
         fastest_peer = max(peer_rates) if peer_rates else float("nan")
         gather_rates = [statistics.median(samples[p]) for p in GATHER_PEERS if p in samples]
         fastest_gather = max(gather_rates) if gather_rates else float("nan")
+        cpu_peer = max((statistics.median(cpu_samples[p]) for p in PEERS if p in cpu_samples),
+                       default=float("nan"))
         for name in names:
             row = {"n": n, "impl": name, **info[name]}
             if name in samples:
                 rate = statistics.median(samples[name])
+                cpu_rate = statistics.median(cpu_samples[name])
                 row.update(steps_per_second=rate, samples=samples[name],
                            ratio_to_fastest_peer=rate / fastest_peer,
-                           ratio_to_fastest_gather_peer=rate / fastest_gather)
+                           ratio_to_fastest_gather_peer=rate / fastest_gather,
+                           steps_per_cpu_second=cpu_rate,
+                           cpu_ratio_to_fastest_peer=cpu_rate / cpu_peer)
             rows.append(row)
     return rows
 

@@ -297,9 +297,10 @@ RESULT_JSONS = {
     "gpu_cloth": "benchmarks/viewer_gpu_cloth.json",
     "pattern": "benchmarks/viewer_pattern.json",
     "room": "benchmarks/viewer_room.json",
+    "rest": "benchmarks/viewer_rest.json",
 }
 #: Keys of RESULT_JSONS that are not plain frame-time runs.
-SPECIAL_RUNS = ("pattern", "room")
+SPECIAL_RUNS = ("pattern", "room", "rest")
 BACKEND_NAMES = {"cpu": "cpu (numba)", "numpy": "numpy", "gpu": "gpu (compute)"}
 
 
@@ -395,11 +396,13 @@ def room_light_table(result: dict) -> str:
 
 def markdown_tables(results: dict[str, dict]) -> dict[str, str]:
     """``viewer_before_after`` (the ``pattern`` run), ``viewer_room_light`` (the ``room`` run),
+    ``viewer_at_rest`` (the ``rest`` run: ``--at-rest``),
     ``viewer_frames`` and ``viewer_findings`` (every other run, docs/viewer.md) and
     ``viewer_brief`` (the default run, BENCHMARKS.md)."""
     runs = {k: v for k, v in results.items() if k not in SPECIAL_RUNS}
     return {"viewer_before_after": before_after_table(results["pattern"]),
             "viewer_room_light": room_light_table(results["room"]),
+            "viewer_at_rest": at_rest_table(results["rest"]),
             "viewer_frames": frame_table(runs), "viewer_findings": findings(runs),
             "viewer_brief": frame_table({"defaults": results["defaults"]})}
 
