@@ -180,30 +180,50 @@ class ClothSimulation:
         p = self.params
         elapsed = calm_s = 0.0
         energy_before = 0.0
-        while elapsed < max_s:
-            self.sleeping = False
-            self.step(frame_dt_s)
-            elapsed += frame_dt_s
-            if self.state.frames % self.monitor_every != 0:
-                self._monitor()
-            if not self.state.finite:
-                break
-            if self.peak_speed_m_s < tolerance * p.sleep_speed_m_s \
-                    and self.rms_speed_m_s < tolerance * p.sleep_rms_speed_m_s:
-                calm_s += frame_dt_s
-                if calm_s >= p.sleep_hold_s:
+        monitor_every, self.monitor_every = self.monitor_every, 1 << 62  # speeds only, below
+        try:
+            while elapsed < max_s:
+                self.sleeping = False
+                self.step(frame_dt_s)
+                elapsed += frame_dt_s
+                if not self._measure_motion():
                     break
-            else:
-                calm_s = 0.0
-            if self.kinetic_energy < energy_before:
-                self._zero_velocities()
-                energy_before = 0.0
-            else:
-                energy_before = self.kinetic_energy
+                if self.peak_speed_m_s < tolerance * p.sleep_speed_m_s \
+                        and self.rms_speed_m_s < tolerance * p.sleep_rms_speed_m_s:
+                    calm_s += frame_dt_s
+                    if calm_s >= p.sleep_hold_s:
+                        break
+                else:
+                    calm_s = 0.0
+                if self.kinetic_energy < energy_before:
+                    self._zero_velocities()
+                    energy_before = 0.0
+                else:
+                    energy_before = self.kinetic_energy
+        finally:
+            self.monitor_every = monitor_every
+        self._unchecked_s = 0.0
+        self._monitor()  # the strain and the finite check of the result
         self._zero_velocities()
         self.sleeping = self.state.finite
         self.state.calm_s = 0.0
         return elapsed
+
+    def _measure_motion(self) -> bool:
+        """Kinetic energy, largest and RMS speed of the free particles (a download on the
+        GPU); False (and the state marked not finite) if a value is not finite."""
+        self.backend.sync(self.state)
+        x, v = self.state.positions_m, self.state.velocities_m_s
+        if not (np.isfinite(x).all() and np.isfinite(v).all()):
+            self.state.finite = False
+            self.max_stretch = self.kinetic_energy = math.inf
+            return False
+        p = self.params
+        speed2 = np.sum(v * v, axis=-1)[inverse_mass(p) > 0.0]
+        self.kinetic_energy = 0.5 * p.particle_mass_kg * float(np.sum(speed2))
+        self.peak_speed_m_s = float(np.sqrt(np.max(speed2))) if speed2.size else 0.0
+        self.rms_speed_m_s = float(np.sqrt(np.mean(speed2))) if speed2.size else 0.0
+        return True
 
     def _zero_velocities(self) -> None:
         self.backend.sync(self.state)
@@ -228,10 +248,7 @@ class ClothSimulation:
         self.max_stretch = max_spring_strain(x, self.params)
         self.state.max_stretch_seen = max(self.state.max_stretch_seen, self.max_stretch)
         p = self.params
-        self.kinetic_energy = kinetic_energy_j(v, p)
-        speed2 = np.sum(v * v, axis=-1)[inverse_mass(p) > 0.0]
-        self.peak_speed_m_s = float(np.sqrt(np.max(speed2))) if speed2.size else 0.0
-        self.rms_speed_m_s = float(np.sqrt(np.mean(speed2))) if speed2.size else 0.0
+        self._measure_motion()
         elapsed, self._unchecked_s = self._unchecked_s, 0.0
         # the GPU keeps the rings in float32: "arrived" within a micrometre
         rings_done = np.allclose(self.state.ring_positions_m, self.state.ring_targets_m,
