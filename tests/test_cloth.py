@@ -246,7 +246,7 @@ def test_wall_and_floor_are_never_crossed():
 
 @pytest.mark.slow
 def test_sleeps_at_rest_and_wakes_on_change():
-    p = ClothParams(grid_w=12, grid_h=12, opening=1.0, sleep_frames=10)
+    p = ClothParams(grid_w=12, grid_h=12, opening=1.0, sleep_hold_s=1 / 3)
     sim = ClothSimulation(p, "cpu")
     simulated = sim.run(600, 1 / 30)
     assert sim.sleeping and simulated < 600
@@ -260,6 +260,46 @@ def test_sleeps_at_rest_and_wakes_on_change():
     sim.set_wind(0.0)
     sim.set_opening(0.6)  # rings move: awake until they arrive and the cloth settles
     assert not sim.sleeping
+
+
+def test_sleep_hysteresis():
+    """A calm spell starts under both thresholds, survives a speed between the sleep and the
+    wake threshold, ends above the wake one, with wind or with moving rings; it counts
+    simulated time."""
+    from catalog.cloth.simulation import calm_spell_s
+
+    p = ClothParams(sleep_speed_m_s=5e-3, sleep_rms_speed_m_s=1e-3, wake_factor=2.0)
+    assert calm_spell_s(-1.0, 4e-3, 5e-4, True, 0.1, p) == 0.0          # starts
+    assert calm_spell_s(-1.0, 6e-3, 5e-4, True, 0.1, p) == -1.0         # not yet calm
+    assert calm_spell_s(-1.0, 4e-3, 1.5e-3, True, 0.1, p) == -1.0       # RMS (energy) too high
+    assert calm_spell_s(0.2, 9e-3, 1.9e-3, True, 0.1, p) == pytest.approx(0.3)  # between: lasts
+    assert calm_spell_s(0.2, 1.1e-2, 5e-4, True, 0.1, p) == -1.0        # above wake: ends
+    assert calm_spell_s(0.2, 4e-3, 2.1e-3, True, 0.1, p) == -1.0
+    assert calm_spell_s(0.2, 0.0, 0.0, False, 0.1, p) == -1.0           # wind or rings moving
+    for bad in (0.5, math.nan):
+        with pytest.raises(InputError, match="wake_factor"):
+            ClothParams(wake_factor=bad)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("backend", ["numpy", "cpu"])
+def test_the_windless_drape_sleeps_within_five_seconds_and_wind_wakes_it(backend):
+    """From the settled drape every catalog weave (lightest and heaviest) falls asleep within
+    5 s of simulated time at wind 0 (docs/cloth.md, "Sleep"; before the drape was settled
+    to rest it rang for 13 s), stays where it is, and the wind wakes and moves it."""
+    from catalog.cloth.drape import drape_params, settled_simulation, settled_state
+
+    for weave in ("voile", "twill"):
+        params = drape_params({"weave": weave}, grid=(48, 28))
+        rest = settled_state(params).positions_m
+        sim = settled_simulation(params, backend=backend)
+        frames = sim.run(300, 1 / 60)
+        assert sim.sleeping and frames < 300, (weave, sim.peak_speed_m_s, sim.rms_speed_m_s)
+        assert np.abs(sim.positions() - rest).max() < 2e-3  # it was at rest: barely moved
+        assert sim.step(1 / 60) is False
+        sim.set_wind(1.0)
+        assert sim.run(30, 1 / 60) == 30 and not sim.sleeping
+        assert np.abs(sim.positions() - rest).max() > 1e-2
 
 
 def test_grid_cannot_change_on_a_running_simulation():

@@ -39,7 +39,7 @@ def test_gpu_follows_the_reference_for_one_second(gl):
 @pytest.mark.slow
 def test_rings_and_sleep_on_the_gpu(gl):
     params = ClothParams(grid_w=10, grid_h=10, opening=1.0, ring_speed_m_s=2.0,
-                         sleep_frames=10, sleep_speed_m_s=0.02)
+                         sleep_hold_s=1 / 3, sleep_speed_m_s=0.02, sleep_rms_speed_m_s=0.01)
     sim = ClothSimulation(params, "gpu", ctx=gl, monitor_every=5)
     sim.set_opening(0.5)
     sim.run(30, 1 / 30)
@@ -48,6 +48,22 @@ def test_rings_and_sleep_on_the_gpu(gl):
     sim.set_opening(1.0)
     simulated = sim.run(240, 1 / 30)
     assert sim.sleeping and simulated < 240
+
+
+@pytest.mark.slow
+def test_the_windless_drape_sleeps_on_the_gpu_within_five_seconds(gl):
+    """The settled drape (float64) in float32 on the GPU is still at rest: asleep within 5 s
+    of simulated time at wind 0 (checked every 10 frames), and the wind wakes it."""
+    from catalog.cloth.drape import drape_params, settled_simulation, settled_state
+
+    params = drape_params({"weave": "voile"}, grid=(48, 28))
+    rest = settled_state(params).positions_m
+    sim = settled_simulation(params, backend="gpu", ctx=gl, monitor_every=10)
+    frames = sim.run(300, 1 / 60)
+    assert sim.sleeping and frames < 300, (sim.peak_speed_m_s, sim.rms_speed_m_s)
+    assert np.abs(sim.positions() - rest).max() < 2e-3
+    sim.set_wind(1.0)
+    assert sim.run(10, 1 / 60) == 10 and not sim.sleeping
 
 
 def test_vertex_buffer_holds_the_mesh(gl):
@@ -111,3 +127,40 @@ def test_gpu_parameters_change_while_running(gl):
     assert gpu.finite and gpu.params.areal_density_kg_m2 == 0.3
     diff = np.linalg.norm(gpu.positions() - cpu.positions(), axis=-1)
     assert np.sqrt(np.mean(diff ** 2)) < 1e-2
+
+
+@pytest.mark.slow
+def test_a_sleeping_gpu_cloth_leaves_the_frame_static(gl):
+    """The viewer's scene with the compute cloth at wind 0: while the cloth moves, each fed
+    frame tells the renderer (cloth_moved: the room's light follows); once it sleeps, nothing
+    is fed, so the room's light is not redrawn and the frame is static; wind wakes it."""
+    from catalog.presets import find_preset, load_preset
+    from catalog.viewer.scene import CurtainScene
+
+    class Renderer:
+        def __init__(self):
+            self.moved = 0
+
+        def set_mesh(self, *args, **kwargs):
+            pass
+
+        def bind_cloth_vertex_buffer(self, *args, **kwargs):
+            pass
+
+        def cloth_moved(self):
+            self.moved += 1
+
+    scene = CurtainScene((16, 12), backend="gpu", wind_m_s=0.0, ctx=gl)
+    scene.set_fabric(load_preset(find_preset("voile-white")))
+    renderer = Renderer()
+    scene.feed(renderer)
+    stepped = 0
+    for _ in range(120):
+        stepped += scene.step(1 / 60)
+        scene.feed(renderer)
+    assert scene.simulation.sleeping and stepped < 120
+    assert renderer.moved == stepped
+    scene.set_wind(1.0)
+    assert scene.step(1 / 60)
+    scene.feed(renderer)
+    assert renderer.moved == stepped + 1

@@ -78,3 +78,44 @@ def test_one_spring_oscillates_at_its_natural_frequency():
         s12.Springs12Problem.initial_positions = original
     expected = amplitude * math.cos(omega * steps * problem.dt_s)
     assert x[1, 0, 2] - x0[1, 0, 2] == pytest.approx(expected, abs=2e-5)
+
+
+def test_peer_colours_hold_every_spring_once_and_never_share_a_particle():
+    """The 12 colours of the peers' fair kernels (cloth_frameworks.COLOURS): every forward
+    spring of a 7x9 grid in exactly one colour; within a colour no particle twice."""
+    from catalog.bench.cloth_frameworks import COLOURS, FORWARD_OFFSETS
+    from catalog.cloth.topology import GATHER_OFFSETS
+
+    assert len(FORWARD_OFFSETS) == 6 and len(COLOURS) == 12
+    assert {(-a, -b) for a, b in FORWARD_OFFSETS} | set(FORWARD_OFFSETS) == set(GATHER_OFFSETS)
+    h, w = 7, 9
+    seen = set()
+    for k, axis, parity in COLOURS:
+        di, dj = FORWARD_OFFSETS[k]
+        span = max(abs(di), abs(dj))
+        used = []
+        for i in range(h - di):
+            for j in range(max(0, -dj), w - max(dj, 0)):
+                if ((j if axis == 1 else i) // span) % 2 == parity:
+                    seen.add((i, j, di, dj))
+                    used += [(i, j), (i + di, j + dj)]
+        assert len(used) == len(set(used)), (k, axis, parity)
+    expected = {(i, j, di, dj) for di, dj in FORWARD_OFFSETS for i in range(h) for j in range(w)
+                if 0 <= i + di < h and 0 <= j + dj < w}
+    assert seen == expected
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("impl", ["taichi", "warp", "taichi-colours", "warp-colours",
+                                  "taichi-gather", "warp-gather"])
+def test_peer_kernels_match_the_float64_reference(impl):
+    """Every peer of the cloth race (fair: atomic scatter and 12 colours; gather) follows the
+    float64 reference to 1e-4 m after 200 steps (the benchmark's own check, at n = 16)."""
+    pytest.importorskip("taichi" if impl.startswith("taichi") else "warp")
+    from catalog.bench.cloth_frameworks import make
+
+    problem = Springs12Problem(n=16)
+    reference, _ = reference_steps(problem, 200)
+    peer = make(impl, problem)
+    peer.run(200)
+    assert np.abs(peer.positions() - reference).max() < 1e-4

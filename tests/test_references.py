@@ -31,6 +31,7 @@ ALLOWED = {
     "catalog/_data": "the wheel's copy of shaders/ and fabrics/, made at build time (setup.py)",
     "fabrics/measurements/textyell": "docs/bispectral.md: an example --export output folder",
     "benchmarks/viewer_gpu.json": "docs/viewer.md: the output of a run on a GPU, not made yet",
+    "benchmarks/gpu_check.json": "docs/gpu.md, tools/gpu_check.sh: the GPU check's output, not made yet (no GPU lent)",
     "catalog/optics/probe.py": "tests/test_architecture.py: a fixture module it writes",
     "catalog/render/probe.py": "tests/test_architecture.py: a fixture module it writes",
     "fabrics/x.toml": "tests/test_cloth.py: a fake preset's path",

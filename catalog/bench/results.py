@@ -31,6 +31,25 @@ def fmt(value, digits: int = 3) -> str:
 GL_SECTIONS = ("colour", "stability", "display", "image")
 
 
+def source_commit() -> str | None:
+    """The checkout's commit (short hash, ``+changes`` when tracked files differ from it), or
+    None outside a git checkout: the code a figure was measured on."""
+    import subprocess  # noqa: PLC0415
+
+    from catalog.core.resources import PROJECT_ROOT  # noqa: PLC0415
+
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=PROJECT_ROOT,
+                              capture_output=True, text=True, timeout=10)
+        if head.returncode != 0:
+            return None
+        dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", "catalog", "shaders"],
+                               cwd=PROJECT_ROOT, capture_output=True, timeout=10).returncode
+        return head.stdout.strip() + ("+changes" if dirty else "")
+    except (OSError, subprocess.SubprocessError):
+        return None
+
+
 def machine_info(ctx=None) -> dict:
     """The machine a result was measured on: cores, platform, Python, the GL renderer."""
     import os  # noqa: PLC0415

@@ -246,13 +246,18 @@ class Springs12Numba:
 
     def run(self, steps: int) -> None:
         serial, threaded = numba_kernels()
-        kernel = threaded if self.threads > 1 else serial
         p = self.problem
         src, dst = (self.a, self.b) if self.current == 0 else (self.b, self.a)
+        if self.threads == 1:
+            # one band: in place. Row i is integrated right after its own (forward) springs,
+            # and no later row's springs read it, so the old row is dead by then: one set of
+            # arrays streamed through the cache instead of two
+            dst = src
+        kernel = threaded if self.threads > 1 else serial
         which = kernel(src, dst, self.scratch, steps, self.rest, self.ke, np.float32(p.k_damping_n_s_m),
                        np.float32(p.dt_s / p.mass_kg), np.float32(p.dt_s),
                        np.float32(p.gravity_m_s2 * p.dt_s))
-        if which == 1:
+        if which == 1 and dst is not src:
             self.current = 1 - self.current
 
     def positions(self) -> np.ndarray:

@@ -65,7 +65,7 @@ def checkout(rev: str, into: Path) -> Path:
 
 def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backend: str,
              fabric: str, light: str, render_scale: str, room_light: bool = True,
-             tree: Path = ROOT) -> dict:
+             tree: Path = ROOT, wind_m_s: float = 2.0, paused: bool = False) -> dict:
     env = dict(os.environ, DISPLAY=display)
     env.pop("WAYLAND_DISPLAY", None)
     if tree != ROOT:   # that tree's package before the editable install of this one
@@ -73,9 +73,11 @@ def run_case(display: str, size: str, grid: str, frames: int, warmup: int, backe
     grid_args = [] if grid == "default" else ["--grid", grid]
     cmd = [sys.executable, "-m", "catalog", "view", "--size", size, *grid_args,
            "--cloth-backend", backend, "--frames", str(frames + warmup), "--stats",
-           "--wind", "2.0", "--fabric", fabric, "--light", light, "--render-scale", render_scale]
+           "--wind", f"{wind_m_s:g}", "--fabric", fabric, "--light", light, "--render-scale", render_scale]
     if not room_light:
         cmd.append("--no-room-light")
+    if paused:
+        cmd.append("--paused")
     start = time.perf_counter()
     result = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=tree)
     wall = time.perf_counter() - start
@@ -134,9 +136,14 @@ def main(argv: list[str] | None = None) -> int:
                         help="also run every case on this commit's tree, interleaved")
     parser.add_argument("--rounds", type=int, default=1,
                         help="with --before: runs of each version per case (medians kept)")
+    parser.add_argument("--at-rest", action="store_true",
+                        help="each case at wind 0 (the cloth settles and sleeps) beside the "
+                             "same view paused (its static frame), interleaved --rounds times")
     args = parser.parse_args(argv)
     if args.before:
         return main_before_after(args)
+    if args.at_rest:
+        return main_at_rest(args)
 
     xvfb = None
     display = args.display
@@ -166,6 +173,71 @@ def main(argv: list[str] | None = None) -> int:
                          "light": args.light, "rows": rows})
     print(f"wrote {args.json_out}")
     return 0
+
+
+def main_at_rest(args) -> int:
+    """Each case at wind 0 (from the settled drape the cloth sleeps within its hold time,
+    docs/cloth.md "Sleep") and paused (the static frame), interleaved ``--rounds`` times;
+    the rows hold the medians and at rest / static."""
+    xvfb = None
+    display = args.display
+    if display is None:
+        xvfb, display = start_xvfb()
+    rows = []
+    try:
+        for case in args.cases.split(","):
+            size, grid = case.split(":")
+            runs: dict[str, list[dict]] = {"at rest": [], "static": []}
+            for _ in range(args.rounds):
+                for mode in runs:
+                    runs[mode].append(run_case(display, size, grid, args.frames, args.warmup,
+                                               args.backend, args.fabric, args.light,
+                                               args.render_scale, args.room_light != "off",
+                                               wind_m_s=0.0, paused=mode == "static"))
+            for mode, mode_runs in runs.items():
+                row = dict(mode_runs[0])
+                for part in PARTS:
+                    row[f"{part}_ms"] = round(statistics.median(r[f"{part}_ms"]
+                                                                for r in mode_runs), 2)
+                row["fps"] = round(1e3 / row["total_ms"], 1)
+                row.update(mode=mode, case=case)
+                rows.append(row)
+            rest, static = rows[-2], rows[-1]
+            rest["over_static"] = round(rest["total_ms"] / static["total_ms"], 3)
+            print(f"{size} grid {grid}: at rest {rest['total_ms']:.1f} ms (simulation "
+                  f"{rest['simulation_ms']:.1f}), static {static['total_ms']:.1f} ms: "
+                  f"{rest['over_static']:.2f}x", flush=True)
+    finally:
+        if xvfb is not None:
+            xvfb.terminate()
+            xvfb.wait()
+    _write_report(args, {"at_rest": True, "rounds": args.rounds, "frames": args.frames,
+                         "warmup": args.warmup, "fabric": args.fabric, "light": args.light,
+                         "rows": rows})
+    print(f"wrote {args.json_out}")
+    return 0
+
+
+def at_rest_table(result: dict) -> str:
+    """An ``--at-rest`` run: the windless viewer's frame beside its paused (static) frame."""
+    lines = ["| window | cloth | mode | frame ms (median) | simulation | shading | UI | other "
+             "| at rest / static |", "|---|---|---|---|---|---|---|---|---|"]
+    for row in result["rows"]:
+        ratio = f"**{row['over_static']:.2f}**" if "over_static" in row else ""
+        lines.append(f"| {row['size']} x{row['render_scale']:g} | "
+                     f"{BACKEND_NAMES.get(row['backend'], row['backend'])} {row['grid']} | "
+                     f"{row['mode']} | {row['total_ms']:.1f} | {row['simulation_ms']:.1f} | "
+                     f"{row['shading_ms']:.1f} | {row['ui_ms']:.1f} | {row['other_ms']:.1f} | "
+                     f"{ratio} |")
+    load = result["machine"].get("load_average_1min")
+    commit = result["machine"].get("commit")
+    note = f"\n\n{result['rounds']} interleaved rounds of {result['frames']} frames after " \
+           f"{result['warmup']} of warm-up, medians"
+    if load is not None:
+        note += f"; load average {load:.1f} on the shared machine"
+    if commit:
+        note += f"; measured on commit {commit}"
+    return "\n".join(lines) + note + "."
 
 
 def main_before_after(args) -> int:
@@ -225,9 +297,10 @@ RESULT_JSONS = {
     "gpu_cloth": "benchmarks/viewer_gpu_cloth.json",
     "pattern": "benchmarks/viewer_pattern.json",
     "room": "benchmarks/viewer_room.json",
+    "rest": "benchmarks/viewer_rest.json",
 }
 #: Keys of RESULT_JSONS that are not plain frame-time runs.
-SPECIAL_RUNS = ("pattern", "room")
+SPECIAL_RUNS = ("pattern", "room", "rest")
 BACKEND_NAMES = {"cpu": "cpu (numba)", "numpy": "numpy", "gpu": "gpu (compute)"}
 
 
@@ -323,11 +396,13 @@ def room_light_table(result: dict) -> str:
 
 def markdown_tables(results: dict[str, dict]) -> dict[str, str]:
     """``viewer_before_after`` (the ``pattern`` run), ``viewer_room_light`` (the ``room`` run),
+    ``viewer_at_rest`` (the ``rest`` run: ``--at-rest``),
     ``viewer_frames`` and ``viewer_findings`` (every other run, docs/viewer.md) and
     ``viewer_brief`` (the default run, BENCHMARKS.md)."""
     runs = {k: v for k, v in results.items() if k not in SPECIAL_RUNS}
     return {"viewer_before_after": before_after_table(results["pattern"]),
             "viewer_room_light": room_light_table(results["room"]),
+            "viewer_at_rest": at_rest_table(results["rest"]),
             "viewer_frames": frame_table(runs), "viewer_findings": findings(runs),
             "viewer_brief": frame_table({"defaults": results["defaults"]})}
 

@@ -108,7 +108,7 @@ def load(key: str, params):
                               time_s=float(scalars["time_s"]), frames=int(scalars["frames"]),
                               finite=bool(scalars["finite"]),
                               max_stretch_seen=float(scalars["max_stretch_seen"]),
-                              quiet_frames=int(scalars["quiet_frames"]))
+                              calm_s=float(scalars["calm_s"]))
     except (OSError, ValueError, KeyError, EOFError, TypeError, zipfile.BadZipFile):  # torn, edited, foreign
         return None
 
@@ -122,7 +122,7 @@ def store(key: str, state) -> Path | None:
     if path is None:
         return None
     scalars = {"time_s": state.time_s, "frames": state.frames, "finite": state.finite,
-               "max_stretch_seen": state.max_stretch_seen, "quiet_frames": state.quiet_frames}
+               "max_stretch_seen": state.max_stretch_seen, "calm_s": state.calm_s}
     buffer = io.BytesIO()
     np.savez(buffer, key=np.array(key), scalars=np.array(json.dumps(scalars)),
              positions_m=state.positions_m, velocities_m_s=state.velocities_m_s,

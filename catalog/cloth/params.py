@@ -108,8 +108,14 @@ class ClothParams:
     strain_passes: int = 1  # strain-limiting sweeps per substep (after the LRA)
     final_strain_passes: int = 64  # at most this many in a frame's last substep (adaptive)
     max_substep_s: float = 1.0 / 600.0  # substeps per frame = ceil(frame_dt / this)
-    sleep_speed_m_s: float = 5.0e-3  # below this everywhere, for sleep_frames, it sleeps
-    sleep_frames: int = 20
+    # sleep (simulation.py, "Sleep"): calm when the largest particle speed is under
+    # sleep_speed_m_s and the RMS speed under sleep_rms_speed_m_s (the kinetic energy,
+    # 1/2 M v_rms^2); asleep after sleep_hold_s of simulated time calm; the calm spell only
+    # ends above wake_factor times either threshold (hysteresis)
+    sleep_speed_m_s: float = 5.0e-3
+    sleep_rms_speed_m_s: float = 1.0e-3
+    wake_factor: float = 2.0
+    sleep_hold_s: float = 0.5
     extra: Mapping[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
@@ -123,11 +129,12 @@ class ClothParams:
                 raise InputError(f"at most 4096 particles a side, found {value}", field=name)
         for name in ("width_m", "height_m", "areal_density_kg_m2", "stretch_stiffness_n_m",
                      "gust_length_m", "gust_period_s", "max_stretch", "max_substep_s",
-                     "ring_speed_m_s", "ring_spacing_m", "thickness_m"):
+                     "ring_speed_m_s", "ring_spacing_m", "thickness_m", "sleep_hold_s"):
             _positive(name, getattr(self, name))
         for name in ("bend_stiffness_n_m", "damping_per_s", "drag_coefficient",
                      "air_density_kg_m3", "gravity_m_s2", "wind_speed_m_s", "gust_strength",
-                     "wall_gap_m", "sleep_speed_m_s", "contact_damping_per_s"):
+                     "wall_gap_m", "sleep_speed_m_s", "sleep_rms_speed_m_s",
+                     "contact_damping_per_s"):
             _non_negative(name, getattr(self, name))
         if self.shear_stiffness_n_m is not None:
             _non_negative("shear_stiffness_n_m", self.shear_stiffness_n_m)
@@ -145,10 +152,9 @@ class ClothParams:
                 or not 0 <= self.final_strain_passes <= 256:
             raise InputError(f"must be an integer in 0..256, found "
                              f"{self.final_strain_passes!r}", field="final_strain_passes")
-        if isinstance(self.sleep_frames, bool) or not isinstance(self.sleep_frames, int) \
-                or self.sleep_frames < 1:
-            raise InputError(f"must be an integer >= 1, found {self.sleep_frames!r}",
-                             field="sleep_frames")
+        if _finite("wake_factor", self.wake_factor) < 1.0:
+            raise InputError(f"must be >= 1 (wake above the sleep thresholds), found "
+                             f"{self.wake_factor:g}", field="wake_factor")
         direction = self.wind_direction
         if not isinstance(direction, (tuple, list)) or len(direction) != 3:
             raise InputError(f"must be 3 numbers, found {direction!r}", field="wind_direction")

@@ -71,6 +71,26 @@ def kinetic_energy_j(velocities_m_s: np.ndarray, params: ClothParams) -> float:
     return 0.5 * params.particle_mass_kg * float(np.sum(v * v))
 
 
+def calm_spell_s(calm_s: float, peak_speed_m_s: float, rms_speed_m_s: float, still: bool,
+                 elapsed_s: float, params: ClothParams) -> float:
+    """The sleep test with hysteresis: how long the cloth has been calm (simulated s; -1:
+    not calm) after a check ``elapsed_s`` after the last one.
+
+    A calm spell starts when the largest particle speed is under ``sleep_speed_m_s`` and the
+    RMS speed (the kinetic energy's, 1/2 M v_rms^2) under ``sleep_rms_speed_m_s``; it lasts
+    while neither exceeds ``wake_factor`` times its threshold and the cloth is ``still``
+    (no wind, rings arrived). Asleep once it has lasted ``sleep_hold_s``."""
+    p = params
+    calm = peak_speed_m_s < p.sleep_speed_m_s and rms_speed_m_s < p.sleep_rms_speed_m_s
+    loud = peak_speed_m_s > p.wake_factor * p.sleep_speed_m_s \
+        or rms_speed_m_s > p.wake_factor * p.sleep_rms_speed_m_s
+    if not still or loud or (calm_s < 0.0 and not calm):
+        return -1.0
+    if calm_s < 0.0:
+        return 0.0  # a calm spell starts now
+    return calm_s + elapsed_s
+
+
 class ClothSimulation:
     """A curtain on a rod: parameters, state, a backend, sleep and monitoring."""
 
@@ -90,12 +110,15 @@ class ClothSimulation:
         self.sleeping = False
         self.last_substeps = 0
         self.kinetic_energy = 0.0
+        self.peak_speed_m_s = 0.0  # largest particle speed at the last check
+        self.rms_speed_m_s = 0.0  # RMS speed of the free particles at the last check
+        self._unchecked_s = 0.0  # simulated time since the last check
         self.max_stretch = max_spring_strain(self.state.positions_m, params)
 
     # ---- controls ----------------------------------------------------------------
     def wake(self) -> None:
         self.sleeping = False
-        self.state.quiet_frames = 0
+        self.state.calm_s = -1.0
 
     def set_wind(self, speed_m_s: float, direction: tuple[float, float, float] | None = None,
                  gust_strength: float | None = None) -> None:
@@ -132,9 +155,82 @@ class ClothSimulation:
         self.backend.advance(self.state, n, h)
         self.last_substeps = n
         self.state.frames += 1
+        self._unchecked_s += frame_dt_s
         if self.state.frames % self.monitor_every == 0:
             self._monitor()
         return True
+
+    def settle(self, max_s: float = 15.0, frame_dt_s: float = FRAME_DT_S,
+               tolerance: float = 0.5) -> float:
+        """Relax to the rest shape of the current parameters by kinetic damping (dynamic
+        relaxation, Cundall 1976) and fall asleep; returns the simulated seconds it took.
+
+        Frames run as usual (the same substeps, damping and constraints as every later
+        frame, so the result is a rest state of this simulation, not of another solver);
+        whenever the kinetic energy falls from one frame to the next, a swing has passed the
+        bottom of its potential and every velocity is zeroed: its energy is taken out at
+        once, where the light physical damping (0.5 /s) would let the curtain ring for tens
+        of seconds. It stops when, after a frame, the largest and the RMS particle speeds are
+        both under ``tolerance`` times the sleep thresholds (a frame from zero velocity
+        reaches speed = residual force / mass x frame time, so this bounds the residual) for
+        ``sleep_hold_s`` (so that slow swings, whose speed grows slowly, show), or after
+        ``max_s``. Needs no wind (there is no rest in a gust)."""
+        if self.params.wind_speed_m_s != 0.0:
+            raise CatalogError("settle: the wind blows; a curtain settles only without wind")
+        p = self.params
+        elapsed = calm_s = 0.0
+        energy_before = 0.0
+        monitor_every, self.monitor_every = self.monitor_every, 1 << 62  # speeds only, below
+        try:
+            while elapsed < max_s:
+                self.sleeping = False
+                self.step(frame_dt_s)
+                elapsed += frame_dt_s
+                if not self._measure_motion():
+                    break
+                if self.peak_speed_m_s < tolerance * p.sleep_speed_m_s \
+                        and self.rms_speed_m_s < tolerance * p.sleep_rms_speed_m_s:
+                    calm_s += frame_dt_s
+                    if calm_s >= p.sleep_hold_s:
+                        break
+                else:
+                    calm_s = 0.0
+                if self.kinetic_energy < energy_before:
+                    self._zero_velocities()
+                    energy_before = 0.0
+                else:
+                    energy_before = self.kinetic_energy
+        finally:
+            self.monitor_every = monitor_every
+        self._unchecked_s = 0.0
+        self._monitor()  # the strain and the finite check of the result
+        self._zero_velocities()
+        self.sleeping = self.state.finite
+        self.state.calm_s = 0.0
+        return elapsed
+
+    def _measure_motion(self) -> bool:
+        """Kinetic energy, largest and RMS speed of the free particles (a download on the
+        GPU); False (and the state marked not finite) if a value is not finite."""
+        self.backend.sync(self.state)
+        x, v = self.state.positions_m, self.state.velocities_m_s
+        if not (np.isfinite(x).all() and np.isfinite(v).all()):
+            self.state.finite = False
+            self.max_stretch = self.kinetic_energy = math.inf
+            return False
+        p = self.params
+        speed2 = np.sum(v * v, axis=-1)[inverse_mass(p) > 0.0]
+        self.kinetic_energy = 0.5 * p.particle_mass_kg * float(np.sum(speed2))
+        self.peak_speed_m_s = float(np.sqrt(np.max(speed2))) if speed2.size else 0.0
+        self.rms_speed_m_s = float(np.sqrt(np.mean(speed2))) if speed2.size else 0.0
+        return True
+
+    def _zero_velocities(self) -> None:
+        self.backend.sync(self.state)
+        self.state.velocities_m_s[...] = 0.0
+        self.kinetic_energy = self.peak_speed_m_s = self.rms_speed_m_s = 0.0
+        if isinstance(self.backend, DeviceBackend):
+            self.backend.load(self.state)
 
     def run(self, frames: int, frame_dt_s: float) -> int:
         """Step ``frames`` frames; returns how many were actually simulated (not asleep)."""
@@ -151,18 +247,17 @@ class ClothSimulation:
             return
         self.max_stretch = max_spring_strain(x, self.params)
         self.state.max_stretch_seen = max(self.state.max_stretch_seen, self.max_stretch)
-        self.kinetic_energy = kinetic_energy_j(v, self.params)
+        p = self.params
+        self._measure_motion()
+        elapsed, self._unchecked_s = self._unchecked_s, 0.0
         # the GPU keeps the rings in float32: "arrived" within a micrometre
         rings_done = np.allclose(self.state.ring_positions_m, self.state.ring_targets_m,
                                  rtol=0.0, atol=1e-6)
-        speed = float(np.sqrt(np.max(np.sum(v * v, axis=-1))))
-        if self.params.wind_speed_m_s == 0.0 and rings_done \
-                and speed < self.params.sleep_speed_m_s:
-            self.state.quiet_frames += self.monitor_every
-            if self.state.quiet_frames >= self.params.sleep_frames:
-                self.sleeping = True
-        else:
-            self.state.quiet_frames = 0
+        still = p.wind_speed_m_s == 0.0 and rings_done
+        self.state.calm_s = calm_spell_s(self.state.calm_s, self.peak_speed_m_s,
+                                         self.rms_speed_m_s, still, elapsed, p)
+        if self.state.calm_s >= p.sleep_hold_s:
+            self.sleeping = True
 
     # ---- reading -----------------------------------------------------------------
     def positions(self) -> np.ndarray:

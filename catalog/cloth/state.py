@@ -138,7 +138,7 @@ class ClothState:
     frames: int = 0
     finite: bool = True
     max_stretch_seen: float = 0.0
-    quiet_frames: int = 0
+    calm_s: float = -1.0  # simulated seconds calm (below the sleep thresholds); -1: not calm
     extra: dict = field(default_factory=dict)
 
     @classmethod
@@ -152,7 +152,7 @@ class ClothState:
         return ClothState(self.positions_m.copy(), self.velocities_m_s.copy(),
                           self.ring_positions_m.copy(), self.ring_targets_m.copy(),
                           self.time_s, self.frames, self.finite, self.max_stretch_seen,
-                          self.quiet_frames, dict(self.extra))
+                          self.calm_s, dict(self.extra))
 
 
 @dataclass(frozen=True)

@@ -311,6 +311,11 @@ class FrameRenderer:
                                f"{self.size[0]}x{self.size[1]} HDR target")
         return vw, vh
 
+    def cloth_moved(self) -> None:
+        """The bound cloth buffers (bind_cloth_vertex_buffer) were rewritten on the GPU: the
+        room's light follows (at its room_update_every); a sleeping cloth calls nothing."""
+        self.mesh.version += 1
+
     def _timed(self, profile, name, work) -> None:
         """Run ``work()``; with a ``profile`` dict, finish the GL queue and add its wall time (s)."""
         if profile is None:

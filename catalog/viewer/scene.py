@@ -94,8 +94,13 @@ class CurtainScene:
         if self.simulation is None:
             return
         have = self._uploaded.get(id(renderer))
-        if have == self.mesh_version or (have is not None and self.backend == "gpu"):
-            return  # up to date; or the compute shader writes the buffer the renderer draws
+        if have == self.mesh_version:
+            return  # up to date (a sleeping cloth stays so: the frame is static)
+        if have is not None and self.backend == "gpu":
+            # the compute shader rewrote the buffer the renderer draws: no copy, only a note
+            renderer.cloth_moved()
+            self._uploaded[id(renderer)] = self.mesh_version
+            return
         from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
 
         mesh = CurtainMesh.from_grid(self.simulation.positions(), self.simulation.params)

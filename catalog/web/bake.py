@@ -146,7 +146,7 @@ def simulate_loop(params, fps: float = BAKE_FPS, loop_s: float = LOOP_S,
     frames = np.stack(history[settle:])
     before = np.stack(history[settle - crossfade:settle])
     for j in range(crossfade):
-        w = (j + 1) / (crossfade + 1)
+        w = (j + 1) / crossfade  # the last frame is the one before the start: the seam is a step
         frames[loop - crossfade + j] = (1 - w) * frames[loop - crossfade + j] + w * before[j]
     return frames, params
 

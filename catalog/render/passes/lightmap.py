@@ -255,8 +255,8 @@ class LightmapPass(Pass):
                self.frame.fabric_pattern.key,
                tuple((light.name, position) for light, position in self.frame.room_lamps))
         self._room_frames += 1
-        moved = self.frame.mesh.version != self._room_mesh_version or (
-            self.frame.mesh.format != "3f")  # a cloth on the GPU moves unseen
+        # a cloth on the GPU moves unseen: its owner calls frame.cloth_moved() after each step
+        moved = self.frame.mesh.version != self._room_mesh_version
         due = moved and self._room_frames >= self.frame.room_update_every
         if key != self._room_key or due or self.frame.room_targets.objects is None:
             self._room_key = key
