@@ -36,7 +36,7 @@ def _same(a, b) -> bool:
     return (np.array_equal(a.positions_m, b.positions_m)
             and np.array_equal(a.velocities_m_s, b.velocities_m_s)
             and np.array_equal(a.ring_positions_m, b.ring_positions_m)
-            and (a.time_s, a.frames, a.quiet_frames) == (b.time_s, b.frames, b.quiet_frames))
+            and (a.time_s, a.frames, a.calm_s) == (b.time_s, b.frames, b.calm_s))
 
 
 def test_the_key_follows_every_parameter_the_grid_the_frames_and_the_solver(monkeypatch):
