@@ -112,10 +112,20 @@ def check_outputs(module, args) -> None:
     names one of the inputs is refused in one line naming the option
     (:func:`catalog.core.atomic.check_target`).
     """
-    from catalog.core.atomic import OutputError, check_target  # noqa: PLC0415
+    from catalog.core.atomic import OutputError, check_target, register_input  # noqa: PLC0415
+    from catalog.core.inputs import register_preset_inputs  # noqa: PLC0415
 
     inputs = [value for name in getattr(module, "INPUT_FILES", ())
               for value in _values(getattr(args, name, None))]
+    for value in inputs:
+        register_input(value)
+    if "fabric" in getattr(module, "INPUT_FILES", ()) and getattr(args, "fabric", None):
+        from catalog.presets import find_preset  # noqa: PLC0415
+
+        try:
+            register_preset_inputs(find_preset(args.fabric))  # the preset and its files
+        except (CatalogError, OSError, ValueError):
+            pass  # the command refuses it with its own line
     for names, folder in ((getattr(module, "OUTPUT_FILES", ()), False),
                           (getattr(module, "OUTPUT_FOLDERS", ()), True)):
         for name in names:
@@ -151,7 +161,29 @@ def _report(args, exc: CatalogError) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from catalog.core.atomic import OutputError, install_signal_handlers, os_cause  # noqa: PLC0415
+    status = _main(argv)
+    if argv is None and status in (130, 143):
+        # interrupted (the temporaries gone, old outputs untouched): end without the
+        # interpreter's teardown, where an EGL context torn down after a signal has crashed
+        from catalog.core.atomic import hard_exit  # noqa: PLC0415
+
+        hard_exit(status)
+    return status
+
+
+def _main(argv: list[str] | None) -> int:
+    from catalog.core.atomic import track_inputs  # noqa: PLC0415
+
+    track_inputs(True)
+    try:
+        return _run_command(argv)
+    finally:
+        track_inputs(False)
+
+
+def _run_command(argv: list[str] | None) -> int:
+    from catalog.core.atomic import (OutputError, Terminated,  # noqa: PLC0415
+                                     install_signal_handlers, os_cause)
 
     parser = build_parser()
     try:
@@ -187,6 +219,10 @@ def main(argv: list[str] | None = None) -> int:
         return _report(args, CatalogError(f"{exc.filename or 'a file'}: {os_cause(exc)}"))
     except KeyboardInterrupt:
         return 130
+    except Terminated as exc:
+        return int(exc.code)
+    except RecursionError:
+        return _report(args, CatalogError("the input is nested too deeply to read"))
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -13,7 +13,7 @@ from __future__ import annotations
 from catalog.fit.preset_build import DEFAULT_TAU_UNDYED
 
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
-INPUT_FILES = ("gonio", "excitation", "emission")
+INPUT_FILES = ("gonio", "excitation", "emission", "dye")
 OUTPUT_FILES = ("out", "plot")
 HELP = "fit the woven-cloth HG BTDF (eq. 7) to gonio data and write a fabric preset"
 

@@ -7,7 +7,7 @@ from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
-INPUT_FILES = ("fabric",)
+INPUT_FILES = ("fabric", "environment")
 OUTPUT_FILES = ("out",)
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
 

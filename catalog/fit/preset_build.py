@@ -54,9 +54,12 @@ def fit_preset(args, started_s: float) -> dict:
 
     doc = preset_document(args, out, data, header, result, rho, tau, dye_path)
     preset_from_dict(doc, out)          # refuse before anything is written
-    if args.plot:
-        plot_fit(data, hg, ct, Path(args.plot), title=doc["display_name"])
-    save_preset_dict(doc, out)
+    from catalog.core.atomic import commit_together  # noqa: PLC0415
+
+    with commit_together():  # the plot and the preset are published together, or neither
+        if args.plot:
+            plot_fit(data, hg, ct, Path(args.plot), title=doc["display_name"])
+        save_preset_dict(doc, out)
     elapsed = time.perf_counter() - started_s
 
     summary = json_summary(doc, result, out, elapsed)
