@@ -461,6 +461,7 @@ def staged_folder(destination: str | Path, *, inputs: Iterable[str | Path] = (),
         # the stage sits on the destination's own file system: inside it when it exists (a
         # mount point's parent is another file system), else beside it
         beside = destination if destination.is_dir() else destination.parent
+        made = [folder for folder in (beside, *beside.parents) if not folder.exists()]
         beside.mkdir(parents=True, exist_ok=True)
         remove_stale_temporaries(beside)
         with signals_deferred():
@@ -500,8 +501,12 @@ def staged_folder(destination: str | Path, *, inputs: Iterable[str | Path] = (),
                     if source.is_file():
                         os.replace(source, destination / source.relative_to(stage))
             _fsync_folder(destination)
+        made = []
     finally:
         _remove(stage)
+        for folder in made:  # the folders made above the destination, on a failure
+            with contextlib.suppress(OSError):
+                folder.rmdir()
 
 
 # --------------------------------------------------------------------------- signals
