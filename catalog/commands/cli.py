@@ -130,6 +130,10 @@ def check_outputs(module, args) -> None:
                           (getattr(module, "OUTPUT_FOLDERS", ()), True)):
         for name in names:
             for value in _values(getattr(args, name, None)):
+                if name == "plot":  # every command's --plot: an image the plotter writes
+                    from catalog.core.validate import check_plot_path  # noqa: PLC0415
+
+                    check_plot_path(value, "--plot")
                 try:
                     check_target(value, inputs=inputs, folder=folder)
                 except OutputError as exc:

@@ -18,6 +18,9 @@ EXIT_PARTIAL = 3
 
 
 def add_arguments(parser) -> None:
+    from catalog.core import validate  # noqa: PLC0415
+    from catalog.core.cliargs import number_type  # noqa: PLC0415
+
     parser.add_argument("--fabrics", required=True, help="comma-separated preset names or .toml paths")
     parser.add_argument("--lights", required=True, help="comma-separated light names (D65,A,LED-B4,sun:22,...)")
     parser.add_argument("--frames", default="0:1",
@@ -38,9 +41,12 @@ def add_arguments(parser) -> None:
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3, 6, 9, 16")
-    parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
-    parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")
-    parser.add_argument("--exposure", type=float, default=1.0, help="exposure multiplier")
+    parser.add_argument("--pitch", type=number_type(*validate.PITCH_DEG, unit="deg"), default=0.0,
+                        help="camera pitch, deg")
+    parser.add_argument("--distance", type=number_type(*validate.DISTANCE_M, unit="m", low_open=True),
+                        default=2.6, help="camera distance, m")
+    parser.add_argument("--exposure", type=number_type(*validate.EXPOSURE), default=1.0,
+                        help="exposure multiplier")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
 

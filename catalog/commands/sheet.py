@@ -37,10 +37,9 @@ def run(args) -> int:
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
     ev, white_balance = display_choices(args)
-    names = [name.strip() for name in args.lights.split(",")]
-    if any(not name for name in names) and any(names):
-        raise InputError(f"{args.lights!r}: an empty light name between commas", field="--lights")
-    lights = [name for name in names if name]
+    from catalog.core.validate import parse_light_list  # noqa: PLC0415
+
+    lights = parse_light_list(args.lights, "--lights")  # sun@DATE,LAT,LON keeps its commas
     from catalog.core.cliargs import fabric_list  # noqa: PLC0415
 
     fabrics = fabric_list(args.fabrics)  # folders join the search path, names select

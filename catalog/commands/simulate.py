@@ -111,6 +111,9 @@ def run(args: argparse.Namespace) -> int:
 
             from catalog.core.atomic import staged_folder
 
+            from catalog.core.validate import check_frame_template
+
+            check_frame_template(args.out, "--out")
             try:
                 names = [Path(args.out.format(frame=f)) for f in (0, 1)]
             except (ValueError, KeyError, IndexError) as exc:

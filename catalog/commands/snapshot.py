@@ -13,6 +13,7 @@ HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or 
 
 
 def add_arguments(parser) -> None:
+    from catalog.core import validate  # noqa: PLC0415
     from catalog.core.cliargs import number_type  # noqa: PLC0415
 
     parser.add_argument("--fabric", required=True, help="preset name (fabrics/NAME.toml) or a .toml path")
@@ -22,17 +23,17 @@ def add_arguments(parser) -> None:
                         help="instead of --light: the sun at this hour (local solar time, "
                              "summer solstice, 34.7 N) behind the window")
     parser.add_argument("--size", default="1280x720", help="WIDTHxHEIGHT in pixels")
-    parser.add_argument("--frame", type=int, default=0,
+    parser.add_argument("--frame", type=number_type(0, validate.MAX_FRAME, whole=True), default=0,
                         help="cloth simulation frame (0: the settled drape every simulation starts from)")
     parser.add_argument("--out", required=True, help="FILE.exr (linear) or FILE.png (sRGB)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model (default physical)")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3 (RGB), 6, 9, 16")
-    parser.add_argument("--yaw", type=number_type(-360.0, 360.0, unit="deg"), default=0.0, help="camera yaw, deg")
-    parser.add_argument("--pitch", type=number_type(-89.0, 89.0, unit="deg"), default=0.0, help="camera pitch, deg")
-    parser.add_argument("--distance", type=number_type(0.05, 50.0, unit="m", low_open=True), default=2.6, help="camera distance, m")
-    parser.add_argument("--exposure", type=number_type(0.0, 1e9, low_open=True), default=1.0,
+    parser.add_argument("--yaw", type=number_type(*validate.YAW_DEG, unit="deg"), default=0.0, help="camera yaw, deg")
+    parser.add_argument("--pitch", type=number_type(*validate.PITCH_DEG, unit="deg"), default=0.0, help="camera pitch, deg")
+    parser.add_argument("--distance", type=number_type(*validate.DISTANCE_M, unit="m", low_open=True), default=2.6, help="camera distance, m")
+    parser.add_argument("--exposure", type=number_type(*validate.EXPOSURE), default=1.0,
                         help="exposure multiplier on top of --ev or the automatic exposure")
     add_display_arguments(parser)
     parser.add_argument("--environment", metavar="FILE.exr", default=None,

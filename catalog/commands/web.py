@@ -21,8 +21,11 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.core.validate import parse_light_list  # noqa: PLC0415
     from catalog.web.site import build_site  # noqa: PLC0415
 
+    if args.lights is not None:
+        parse_light_list(args.lights, "--lights")  # '' and a repeated light are refused
     report = build_site(args.out, fabrics=args.fabrics, lights=args.lights)
     if args.json:
         print_json(report)

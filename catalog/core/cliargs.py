@@ -46,7 +46,10 @@ def number_type(low: float, high: float, *, unit: str = "", low_open: bool = Fal
 
     lo, hi = ("(" if low_open else "["), (")" if high_open else "]")
     kind = "whole number" if whole else "finite number"
-    wanted = f"must be a {kind} in {lo}{low:g}, {high:g}{hi}" + (f" {unit}" if unit else "")
+    def show(bound: float) -> str:
+        return str(int(bound)) if whole else f"{bound:g}"
+
+    wanted = f"must be a {kind} in {lo}{show(low)}, {show(high)}{hi}" + (f" {unit}" if unit else "")
 
     from catalog.core.validate import _DECIMAL, _WHOLE  # noqa: PLC0415
 

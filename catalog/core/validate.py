@@ -134,6 +134,18 @@ def parse_light_list(text: str | None, option: str = "--lights") -> list[str]:
     return names
 
 
+_FRAME_FIELD = re.compile(r"\{frame(:0?([1-9]\d?)?d)?\}")
+
+
+def check_frame_template(text: str, option: str = "--out") -> None:
+    """A file-name pattern with one ``{frame}`` field (``{frame:04d}``: up to 99 digits);
+    any other field, a second one or a huge width is refused before it is formatted."""
+    fields = re.findall(r"\{[^{}]*\}", text.replace("{{", "").replace("}}", ""))
+    if len(fields) != 1 or not _FRAME_FIELD.fullmatch(fields[0]):
+        raise InputError(f"{text[:60]!r} must hold exactly one {{frame}} field, e.g. "
+                         "f{frame:04d}.obj (a width of at most 99 digits)", field=option)
+
+
 def check_plot_path(path, option: str = "--plot", suffixes=PLOT_SUFFIXES) -> Path:
     """A plot's file name must end in an image suffix the writer makes."""
     path = Path(path)

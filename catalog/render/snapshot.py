@@ -132,8 +132,11 @@ def validate(request: SnapshotRequest):
     check_output(request.out)
     width, height = request.size
     parse_size(f"{width}x{height}")
-    if request.frame < 0:
-        raise InputError(f"{request.frame} must be >= 0", field="--frame")
+    from catalog.core import validate as checks  # noqa: PLC0415
+
+    checks.check_frame(request.frame, "--frame")
+    checks.check_camera({"--distance": request.distance_m, "--exposure": request.exposure,
+                         "--yaw": request.yaw_deg, "--pitch": request.pitch_deg})
     band_lib.check_band_count(request.bands)
     check_display_choices(request.ev, request.white_balance, request.exposure)
     preset = load_preset(find_preset(request.fabric))
