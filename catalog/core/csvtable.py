@@ -20,6 +20,8 @@ from catalog.core.validate import _DECIMAL
 _NON_FINITE = ("nan", "+nan", "-nan", "inf", "+inf", "-inf", "infinity", "+infinity", "-infinity")
 #: No value of a spectrum, gonio file or dye comes near this; beyond it sums overflow.
 MAX_MAGNITUDE = 1e12
+#: The largest measurement file read (a spectrum, gonio set or matrix is kilobytes).
+MAX_TEXT_BYTES = 64 << 20
 
 
 @dataclass(frozen=True)
@@ -112,6 +114,10 @@ def read_text(path: str | Path, encoding: str = "utf-8") -> str:
 
     register_input(path)
     try:
+        size = path.stat().st_size if path.is_file() else 0
+        if size > MAX_TEXT_BYTES:
+            raise InputError(f"{size} bytes: a measurement file here is at most "
+                             f"{MAX_TEXT_BYTES >> 20} MiB", path=path)
         return path.read_text(encoding=encoding)
     except FileNotFoundError:
         raise InputError("no such file", path=path) from None

@@ -232,12 +232,8 @@ def check_preset_tables(doc: dict, where, weaves) -> None:
     for key, (low, high) in PATTERN_NUMBERS.items():
         if key in pattern:
             _field_in(where, f"pattern.{key}", pattern[key], low, high)
-    if "repeat_m" in pattern:
-        repeat = pattern["repeat_m"]
-        if not (isinstance(repeat, list) and len(repeat) == 2 and all(map(_is_number, repeat))
-                and all(0 < v <= 10 for v in repeat)):
-            raise InputError(f"must be two lengths in (0, 10] m, found {str(repeat)[:30]!r}",
-                             path=where, field="pattern.repeat_m")
+    # repeat_m (a length or two) is checked where the pattern is built
+    # (catalog.presets.patterns._repeat), with the image it repeats
 
 
 def _field_in(where, key, value, low, high) -> None:

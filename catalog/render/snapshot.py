@@ -29,6 +29,33 @@ def parse_size(text: str) -> tuple[int, int]:
     return parse_wxh(text, "--size", 1, MAX_SIDE_PX)
 
 
+#: The largest single GL resource a software rasteriser allocates, bytes (Mesa llvmpipe's
+#: LP_MAX_TEXTURE_SIZE, 1 GiB; its GL_MAX_TEXTURE_SIZE of 16384 px a side does not say it).
+SOFTWARE_MAX_RESOURCE_BYTES = 1 << 30
+#: Bytes a pixel of the frame's largest target takes (RGBA32F: the HDR target).
+HDR_TARGET_BYTES_PER_PIXEL = 16
+
+
+def check_gl_size(ctx, size) -> None:
+    """Refuse, before a target is allocated, a size the context cannot hold: a side beyond
+    its queried limits (catalog.render.frame.gl_size_limit) or, on a software rasteriser, an
+    HDR target above its per-resource cap."""
+    from catalog.render.frame import gl_size_limit, software_rasteriser  # noqa: PLC0415
+
+    width, height = size
+    limit = gl_size_limit(ctx)
+    if width > limit or height > limit:
+        raise InputError(f"{width}x{height}: each side must be at most {limit} px (this GL "
+                         "context's limit)", field="--size")
+    need = width * height * HDR_TARGET_BYTES_PER_PIXEL
+    if software_rasteriser(ctx.info) and need > SOFTWARE_MAX_RESOURCE_BYTES:
+        side = int((SOFTWARE_MAX_RESOURCE_BYTES / HDR_TARGET_BYTES_PER_PIXEL) ** 0.5)
+        raise InputError(f"{width}x{height}: the HDR target would take {need >> 20} MiB, more "
+                         f"than the {SOFTWARE_MAX_RESOURCE_BYTES >> 20} MiB a software "
+                         f"rasteriser allocates at once (about {side}x{side} px at most)",
+                         field="--size")
+
+
 def check_output(path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in IMAGE_SUFFIXES:
@@ -170,7 +197,15 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
 
     preset, light = validate(request)
     ctx = ctx or create_headless_context()
-    renderer = FrameRenderer(ctx, request.size)
+    check_gl_size(ctx, request.size)
+    try:
+        renderer = FrameRenderer(ctx, request.size)
+    except Exception as exc:  # noqa: BLE001 - moderngl.Error is the GL driver's refusal
+        if "framebuffer" not in str(exc).lower():
+            raise
+        width, height = request.size
+        raise InputError(f"{width}x{height}: this GL context cannot make a framebuffer that "
+                         f"large ({' '.join(str(exc).split())[:80]})", field="--size") from None
     try:
         sun = configure_renderer(renderer, request, preset, light)
         *mesh, fabric_size = simulated_curtain(preset, request.frame)
