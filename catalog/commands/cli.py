@@ -185,10 +185,30 @@ def _main(argv: list[str] | None) -> int:
         track_inputs(False)
 
 
+def _guard_standard_descriptors() -> None:
+    """A process started with stdin, stdout or stderr closed (``cmd >&-``) would hand that
+    descriptor number to the next file it opens, and anything printed (by Python or a
+    native library) would land inside an output or over an input: park /dev/null there."""
+    import os  # noqa: PLC0415
+
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            try:
+                devnull = os.open(os.devnull, os.O_RDWR)
+            except OSError:
+                continue
+            if devnull != fd:
+                os.dup2(devnull, fd)
+                os.close(devnull)
+
+
 def _run_command(argv: list[str] | None) -> int:
     from catalog.core.atomic import (OutputError, Terminated,  # noqa: PLC0415
                                      install_signal_handlers, os_cause)
 
+    _guard_standard_descriptors()
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -204,7 +224,9 @@ def _run_command(argv: list[str] | None) -> int:
             use_data(args.data)
         check_outputs(args._module, args)
         if sys.stdout is None and getattr(args, "json", False):
-            raise OutputError("stdout", "closed")
+            # refused before any work: --json prints the result there
+            raise OutputError("stdout", "closed (--json prints its result on stdout; "
+                                        "nothing was done)")
         status = int(args._run(args) or 0)
         try:
             if sys.stdout is not None:
