@@ -26,7 +26,7 @@ from catalog.core.errors import CatalogError, InputError
 FORMATS = ("png", "exr")
 #: The most images one job may ask for (a guard against a typo such as 0:4800000).
 MAX_IMAGES = 50_000_000
-_SLICE = re.compile(r"\s*(-?\d+)\s*:\s*(-?\d+)\s*(?::\s*(-?\d+)\s*)?")
+_SLICE = re.compile(r"\s*(-?\d+)\s*:\s*(-?\d+)\s*(?::\s*(-?\d+)\s*)?", re.ASCII)
 
 
 def parse_frames(text: str) -> range:

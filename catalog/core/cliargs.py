@@ -7,7 +7,7 @@ import re
 
 from catalog.core.errors import InputError
 
-_WXH = re.compile(r"\s*(\d+)\s*[xX]\s*(\d+)\s*")
+_WXH = re.compile(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", re.ASCII)
 
 
 def parse_wxh(text: str, option: str, low: int, high: int | None = None,

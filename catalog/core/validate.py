@@ -16,9 +16,9 @@ from pathlib import Path
 from catalog.core.errors import InputError
 
 #: A decimal number as a person writes it: no '_' digit separators (Python's float() takes
-#: ``0_029`` as 29), no words (nan, inf, infinity), no hexadecimal.
-_DECIMAL = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?")
-_WHOLE = re.compile(r"[+-]?\d+")
+#: ``0_029`` as 29), no words (nan, inf, infinity), no hexadecimal, ASCII digits only.
+_DECIMAL = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?", re.ASCII)
+_WHOLE = re.compile(r"[+-]?\d+", re.ASCII)  # ASCII: int() also reads '１' (fullwidth)
 
 #: The last cloth frame any command simulates (one hour of cloth at 60 frames a second;
 #: a frame costs milliseconds to seconds, so a larger number is a typo or an attack).
