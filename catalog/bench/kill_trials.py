@@ -152,6 +152,7 @@ def classify(command: Command, folder: Path, base: dict[str, bytes], status: int
 
 def run_trials(trials: int, seed: int, budget_s: float, only: list[str] | None = None) -> dict:
     rng = random.Random(seed)
+    commit = _commit()  # the code measured: the checkout as it is when the run starts
     chosen = [c for c in commands() if only is None or c.name in only]
     work = Path(tempfile.mkdtemp(prefix="kill-trials-"))
     started = time.monotonic()
@@ -223,7 +224,7 @@ def run_trials(trials: int, seed: int, budget_s: float, only: list[str] | None =
     total = {k: sum(r[k] for r in results.values()) for k in ("trials", *OUTCOMES)}
     return {"commands": results, "total": total, "trials_asked": trials, "seed": seed,
             "wall_s": round(time.monotonic() - started, 1), "failures": failures,
-            "commit": _commit(), "machine": _machine()}
+            "commit": commit, "machine": _machine()}
 
 
 def _commit() -> str | None:
