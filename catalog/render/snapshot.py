@@ -56,6 +56,22 @@ def check_gl_size(ctx, size) -> None:
                          field="--size")
 
 
+def new_renderer(ctx, size, **options):
+    """A FrameRenderer of ``size`` on ``ctx``, the size checked first (:func:`check_gl_size`);
+    a framebuffer the driver still refuses is the same one line naming --size."""
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    check_gl_size(ctx, size)
+    try:
+        return FrameRenderer(ctx, size, **options)
+    except Exception as exc:  # noqa: BLE001 - moderngl.Error is the GL driver's refusal
+        if "framebuffer" not in str(exc).lower():
+            raise
+        width, height = size
+        raise InputError(f"{width}x{height}: this GL context cannot make a framebuffer that "
+                         f"large ({' '.join(str(exc).split())[:80]})", field="--size") from None
+
+
 def check_output(path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in IMAGE_SUFFIXES:
@@ -193,19 +209,10 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
     import time  # noqa: PLC0415
 
     from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
-    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
     preset, light = validate(request)
     ctx = ctx or create_headless_context()
-    check_gl_size(ctx, request.size)
-    try:
-        renderer = FrameRenderer(ctx, request.size)
-    except Exception as exc:  # noqa: BLE001 - moderngl.Error is the GL driver's refusal
-        if "framebuffer" not in str(exc).lower():
-            raise
-        width, height = request.size
-        raise InputError(f"{width}x{height}: this GL context cannot make a framebuffer that "
-                         f"large ({' '.join(str(exc).split())[:80]})", field="--size") from None
+    renderer = new_renderer(ctx, request.size)
     try:
         sun = configure_renderer(renderer, request, preset, light)
         *mesh, fabric_size = simulated_curtain(preset, request.frame)
