@@ -350,7 +350,10 @@ def run_suite(cases: list[Case] | None = None) -> dict:
         if outcome != "refused cleanly":
             failures.append({"category": case.category, "case": case.label, "outcome": outcome})
     total = {k: sum(r[k] for r in rows.values()) for k in OUTCOMES}
-    return {"categories": rows, "total": total, "cases": len(cases), "failures": failures}
+    from catalog.bench.kill_trials import _commit  # noqa: PLC0415
+
+    return {"categories": rows, "total": total, "cases": len(cases), "failures": failures,
+            "commit": _commit()}
 
 
 #: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
@@ -363,6 +366,8 @@ def markdown_tables(result: dict) -> dict[str, str]:
         n = sum(counts.values())
         label = f"**{name}**" if name == "all" else name
         lines.append(f"| {label} | {n} | " + " | ".join(str(counts[k]) for k in OUTCOMES) + " |")
+    if result.get("commit"):
+        lines += ["", f"Measured on commit {result['commit']}."]
     return {"hostile": "\n".join(lines)}
 
 
