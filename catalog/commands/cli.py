@@ -165,6 +165,9 @@ def _report(args, exc: CatalogError) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from catalog.core.atomic import install_signal_handlers  # noqa: PLC0415
+
+    install_signal_handlers()  # first: building the parser imports every command module
     status = _main(argv)
     if argv is None and status in (130, 143):
         # interrupted (the temporaries gone, old outputs untouched): end without the
