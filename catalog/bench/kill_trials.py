@@ -41,8 +41,10 @@ from pathlib import Path
 
 from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
 
-#: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
-RESULT_JSON = "benchmarks/kill_trials.json"
+#: The committed results the docs' generated block is made from (tools/docs_figures.py):
+#: every command, and a later run of one command after a fix (``--commands fit``).
+RESULT_JSONS = {"all commands": "benchmarks/kill_trials.json",
+                "fit, after the fix": "benchmarks/kill_trials_fit.json"}
 HANG_S = 5.0
 PROMISE_S = 1.0
 GONIO = FABRIC_DIR / "measurements" / "voile-white" / "gonio.csv"
@@ -241,7 +243,13 @@ def _machine() -> dict:
     return machine_info()
 
 
-def markdown_tables(result: dict) -> dict[str, str]:
+def markdown_tables(results: dict) -> dict[str, str]:
+    """One table per run (``results``: label -> result), in the order of RESULT_JSONS."""
+    return {"kill_trials": "\n\n".join(f"**{label}**\n\n" + _table(result)
+                                         for label, result in results.items())}
+
+
+def _table(result: dict) -> str:
     head = ("| command | trials | " + " | ".join(OUTCOMES) + " | exit after signal, median / max s |\n"
             "|---|---|" + "---|" * len(OUTCOMES) + "---|")
     lines = [head]
@@ -253,8 +261,10 @@ def markdown_tables(result: dict) -> dict[str, str]:
                      + " | ".join(str(counts[k]) for k in OUTCOMES) + f" | {latency} |")
     lines.append("")
     lines.append(f"{result['total']['trials']} of {result['trials_asked']} trials asked ran "
-                 f"(seed {result['seed']}, {result['wall_s']:.0f} s, commit {result['commit']}).")
-    return {"kill_trials": "\n".join(lines)}
+                 f"(seed {result['seed']}, {result['wall_s']:.0f} s, commit {result['commit']}, "
+                 f"load average {result['machine'].get('load_average_1min') or 0:.1f} on "
+                 f"{result['machine'].get('cpu_count')} cores at the end).")
+    return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -264,11 +274,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--budget-s", type=float, default=1500.0,
                         help="stop starting trials after this many seconds")
     parser.add_argument("--commands", default=None, help="comma-separated subset")
-    parser.add_argument("--json", type=Path, default=PROJECT_ROOT / RESULT_JSON)
+    parser.add_argument("--json", type=Path, default=PROJECT_ROOT / RESULT_JSONS["all commands"])
     args = parser.parse_args(argv)
     only = args.commands.split(",") if args.commands else None
     result = run_trials(args.trials, args.seed, args.budget_s, only)
-    print(markdown_tables(result)["kill_trials"])
+    print(_table(result))
     for failure in result["failures"]:
         print(f"  {failure['command']}: signal {failure['signal']} at {failure['delay_s']} s "
               f"-> {failure['outcome']} (status {failure['status']})")
