@@ -304,8 +304,8 @@ def test_resume_after_kill(tmp_path):
     for name in before:  # every file under a final name is a whole image
         buf = oiio.ImageBuf(str(out / name))
         assert buf.get_pixels(oiio.UINT8).shape == (32, 48, 3), name
-    from catalog.core.atomic import TEMP_MARK
-    torn = f".lace-fwa__A__f0002__yaw0.png{TEMP_MARK}-{proc.pid}-x1y2.png"  # the killed run's
+    from catalog.core.atomic import TEMP_MARK, temporary_name
+    torn = temporary_name("lace-fwa__A__f0002__yaw0.png", proc.pid, ".png")  # the killed run's
     (out / "lace-fwa" / torn).write_bytes(b"\x89PNG torn")
     with open(out / "manifest.journal.jsonl", "a") as journal:
         journal.write('{"path": "lace-fwa/torn')  # a line cut by the kill

@@ -12,6 +12,8 @@ are in test_output_layer.py.
 from __future__ import annotations
 
 import math
+import os
+import re
 import string
 from pathlib import Path
 
@@ -270,3 +272,453 @@ def test_the_fixed_hostile_corpus_is_refused_cleanly():
     result = run_suite()
     assert result["failures"] == [], result["failures"]
     assert result["cases"] >= 90
+
+
+# --------------------------------------------------------------------------- round two (issue 37)
+# Each class of the red team's second round: inputs never overwritten, work bounded before
+# it starts, typed preset fields, one validation per option; then a fuzz of preset TOML and
+# of every command's numeric options, and the signals (subprocesses, slow).
+
+def _inputs_digest(paths) -> dict[str, bytes]:
+    return {str(p): Path(p).read_bytes() for p in paths}
+
+
+def _lace_copy(tmp_path: Path, project_root: Path) -> Path:
+    """lace-fwa's preset with its spectra and pattern images beside it, in tmp_path."""
+    import shutil
+
+    fabrics = project_root / "fabrics"
+    for folder in ("patterns", "measurements/lace-fwa"):
+        (tmp_path / folder).mkdir(parents=True, exist_ok=True)
+    for name in ("lace-fwa.png", "lace-fwa-height.png"):
+        shutil.copyfile(fabrics / "patterns" / name, tmp_path / "patterns" / name)
+    for name in ("excitation.csv", "emission.csv"):
+        shutil.copyfile(fabrics / "measurements" / "lace-fwa" / name,
+                        tmp_path / "measurements" / "lace-fwa" / name)
+    shutil.copyfile(fabrics / "lace-fwa.toml", tmp_path / "lace-fwa.toml")
+    return tmp_path / "lace-fwa.toml"
+
+
+@pytest.mark.parametrize("how", ["coverage", "height", "spectrum", "through a symlinked folder",
+                                 "through a hard link"])
+def test_no_output_replaces_a_file_the_preset_names(tmp_path, capsys, project_root, how):
+    preset = _lace_copy(tmp_path, project_root)
+    inputs = [preset, *(tmp_path / "patterns").iterdir(),
+              *(tmp_path / "measurements" / "lace-fwa").iterdir()]
+    (tmp_path / "link").symlink_to(tmp_path, target_is_directory=True)
+    out = {"coverage": tmp_path / "patterns" / "lace-fwa.png",
+           "height": tmp_path / "patterns" / "lace-fwa-height.png",
+           "spectrum": tmp_path / "measurements" / "lace-fwa" / "emission.csv",
+           "through a symlinked folder": tmp_path / "link" / "patterns" / "lace-fwa.png",
+           "through a hard link": tmp_path / "hard.png"}[how]
+    if how == "through a hard link":
+        os.link(tmp_path / "patterns" / "lace-fwa.png", out)
+    before = _inputs_digest(inputs)
+    line = _refused(["snapshot", "--fabric", str(preset), "--size", "8x8", "--out", str(out)],
+                    capsys, tmp_path, [])
+    assert "own input" in line and "--out" in line, line
+    assert _inputs_digest(inputs) == before
+
+
+def test_no_output_replaces_an_environment_or_a_dye(tmp_path, capsys, project_root):
+    env = tmp_path / "env.exr"
+    env.write_bytes(b"an environment (never read: refused first)")
+    line = _refused(["snapshot", "--fabric", "voile-white", "--size", "8x8", "--environment",
+                     str(env), "--out", str(env)], capsys, tmp_path, [])
+    assert "own input" in line
+    dye = tmp_path / "d.png"
+    dye.write_text("wavelength_nm,transmittance\n400,0.5\n700,0.5\n")
+    gonio = project_root / "fabrics" / "measurements" / "voile-white" / "gonio.csv"
+    line = _refused(["fit", "--gonio", str(gonio), "--dye", str(dye), "--name", "p", "--out",
+                     str(tmp_path / "p.toml"), "--plot", str(dye)], capsys, tmp_path,
+                    [tmp_path / "p.toml"])
+    assert "--plot" in line and "own input" in line
+
+
+def test_an_output_never_replaces_a_device_or_a_pipe(tmp_path, capsys):
+    from catalog.core.atomic import OutputError, check_target, write_bytes_atomic
+
+    fifo = tmp_path / "pipe.png"
+    os.mkfifo(fifo)
+    line = _refused(["snapshot", "--fabric", "voile-white", "--size", "8x8", "--out", str(fifo)],
+                    capsys, tmp_path, [])
+    assert "not a regular file" in line
+    with pytest.raises(OutputError, match="not a regular file"):
+        check_target("/dev/null")
+    link = tmp_path / "null.png"
+    link.symlink_to("/dev/null")
+    with pytest.raises(OutputError, match="not a regular file"):
+        write_bytes_atomic(link, b"x")
+    assert link.is_symlink() and Path("/dev/null").is_char_device()
+
+
+@pytest.mark.slow
+def test_fit_publishes_its_plot_and_preset_together_or_neither(tmp_path, capsys, project_root,
+                                                               monkeypatch):
+    """--plot and --out: when the preset cannot be written the new plot does not appear."""
+    from catalog.core.errors import CatalogError
+    import catalog.presets as presets
+
+    gonio = project_root / "fabrics" / "measurements" / "voile-white" / "gonio.csv"
+    plot, out = tmp_path / "p.png", tmp_path / "p.toml"
+    plot.write_bytes(b"the old plot")
+
+    def refuse(*args, **kw):
+        raise CatalogError("the preset cannot be written (simulated)")
+
+    monkeypatch.setattr(presets, "write_text_atomic", refuse, raising=False)
+    import catalog.core.atomic as atomic
+    real = atomic.write_text_atomic
+    monkeypatch.setattr(atomic, "write_text_atomic",
+                        lambda target, *a, **k: refuse() if str(target).endswith(".toml")
+                        else real(target, *a, **k))
+    status = main(["fit", "--gonio", str(gonio), "--name", "p", "--out", str(out),
+                   "--plot", str(plot)])
+    assert status == 2
+    assert plot.read_bytes() == b"the old plot" and not out.exists()
+    from catalog.core.atomic import TEMP_MARK
+    assert not [p for p in tmp_path.iterdir() if TEMP_MARK in p.name]
+    monkeypatch.undo()
+    assert main(["fit", "--gonio", str(gonio), "--name", "p", "--out", str(out),
+                 "--plot", str(plot)]) == 0
+    assert plot.read_bytes()[:4] == b"\x89PNG" and out.is_file()
+
+
+def test_staging_lives_on_the_destinations_file_system(tmp_path):
+    """An existing destination (a mount point) gets its stage inside itself: the renames
+    never cross a file system; a missing one gets it beside, where it will be made."""
+    from catalog.core.atomic import STAGE_MARKER, staged_folder
+
+    dest = tmp_path / "mounted"
+    dest.mkdir()
+    with staged_folder(dest) as stage:
+        assert stage.parent == dest and (stage / STAGE_MARKER).is_file()
+        assert os.stat(stage).st_dev == os.stat(dest).st_dev
+        (stage / "a.png").write_text("a")
+    assert sorted(p.name for p in dest.iterdir()) == ["a.png"]
+    with staged_folder(tmp_path / "new" / "deep") as stage:
+        assert stage.parent == tmp_path / "new"
+        (stage / "b.png").write_text("b")
+    assert (tmp_path / "new" / "deep" / "b.png").read_text() == "b"
+    with pytest.raises(RuntimeError):
+        with staged_folder(tmp_path / "made" / "for" / "it") as stage:
+            raise RuntimeError("failed")
+    assert not (tmp_path / "made").exists()  # folders made above it are removed again
+
+
+def test_weaves_the_validator_knows_are_the_cloth_models():
+    from catalog.cloth.params import WEAVE_DEFAULTS
+    from catalog.core.validate import WEAVES
+
+    assert tuple(WEAVE_DEFAULTS) == WEAVES
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["snapshot", "--fabric", "voile-white", "--frame", "1000000000000"], "--frame"),
+    (["snapshot", "--fabric", "voile-white", "--frame", "216001"], "216000"),
+    (["reference", "--fabric", "voile-white", "--frame", "1e12"], "--frame"),
+    (["render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--frames", "0:50000000"],
+     "216000"),
+    (["reference", "--fabric", "voile-white", "--size", "16384x16384"], "MiB"),
+    (["simulate", "--grid", "8x8", "--steps", "2", "--out", "{tmp}/f{frame:0999999999999d}.obj"],
+     "--out"),
+    (["simulate", "--grid", "8x8", "--steps", "2", "--out", "{tmp}/f{frame}{other}.obj"], "--out"),
+    (["render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--distance", "1e308"],
+     "--distance"),
+    (["render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--exposure", "1e308"],
+     "--exposure"),
+    (["render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--pitch", "90"], "--pitch"),
+    (["reference", "--fabric", "voile-white", "--pitch", "90"], "--pitch"),
+    (["reference", "--fabric", "voile-white", "--pitch", "1e308"], "--pitch"),
+    (["reference", "--fabric", "voile-white", "--seed", "-1"], "--seed"),
+    (["reference", "--fabric", "voile-white", "--seed", str(1 << 64)], "4294967295"),
+    (["reference", "--fabric", "voile-white", "--distance", "0.01"], "0.05"),
+    (["snapshot", "--fabric", "voile-white", "--exposure", "1e-300"], "--exposure"),
+    (["snapshot", "--fabric", "voile-white", "--distance", "0.01"], "(0.05, 50]"),
+    (["snapshot", "--fabric", "voile-white", "--yaw", "1_0"], "--yaw"),
+    (["fit", "--gonio", "{gonio}", "--name", "p", "--tau", "inf"], "--tau"),
+    (["fit", "--gonio", "{gonio}", "--name", "p", "--rho", "0_5"], "--rho"),
+    (["fit", "--gonio", "{gonio}", "--name", "p", "--plot", "{tmp}/fig"], "--plot"),
+    (["fit", "--gonio", "{gonio}", "--name", "p", "--plot", "{tmp}/fig.txt"], "--plot"),
+    (["lights", "--plot", "{tmp}/fig.svgz"], "--plot"),
+    (["fluorescence", "--excitation", "{spectra}/excitation.csv", "--emission",
+      "{spectra}/emission.csv", "--light", "D65", "--illuminance", "1e308"], "--illuminance"),
+    (["sheet", "--lights", "D65,D65", "--size", "8x8"], "twice"),
+    (["render-catalog", "--fabrics", "voile-white", "--lights", "A,A"], "twice"),
+    (["web", "--lights", ""], "--lights"),
+    (["web", "--lights", "D65,D65"], "twice"),
+    (["sheet", "--lights", "sun@2026-13-21T12:00,34.7,-120", "--size", "8x8"],
+     "sun@2026-13-21T12:00,34.7,-120"),
+])
+def test_round_two_options_are_refused_naming_the_bound(tmp_path, capsys, project_root, argv,
+                                                        named):
+    outputs = {"snapshot": ["--out", "{tmp}/o.png"], "reference": ["--out", "{tmp}/r.exr"],
+               "render-catalog": ["--out", "{tmp}/c"], "fit": ["--out", "{tmp}/p.toml"],
+               "sheet": ["--out", "{tmp}/s"], "web": ["--out", "{tmp}/site"]}
+    if "--out" not in argv:
+        argv = argv + outputs.get(argv[0], [])
+    fills = {"{tmp}": str(tmp_path), "{spectra}": str(project_root / "fabrics" / "measurements"
+                                                       / "lace-fwa"),
+             "{gonio}": str(project_root / "fabrics" / "measurements" / "voile-white" / "gonio.csv")}
+    for key, value in fills.items():
+        argv = [a.replace(key, value) for a in argv]
+    line = _refused(argv, capsys, tmp_path, [])
+    assert named in line, line
+
+
+def test_light_lists_keep_a_dated_sun_whole():
+    from catalog.core.errors import InputError
+    from catalog.core.validate import parse_light_list
+
+    assert parse_light_list("D65,sun@2026-06-21T12:00,34.7,-120,A") == [
+        "D65", "sun@2026-06-21T12:00,34.7,-120", "A"]
+    for bad in ("", " ", "D65,,A", "D65,D65", ","):
+        with pytest.raises(InputError):
+            parse_light_list(bad)
+
+
+@pytest.mark.parametrize("label, edit", [
+    ("cloth.weave a list", lambda t: t + '[cloth]\nweave = ["lace"]\n'),
+    ("cloth.weave unknown", lambda t: t + '[cloth]\nweave = "tulle"\n'),
+    ("cloth a number", lambda t: t.replace("[btdf]", "cloth = 5\n[btdf]")),
+    ("pattern a string", lambda t: t.replace("[btdf]", 'pattern = "x"\n[btdf]')),
+    ("pattern.coverage a number", lambda t: t + "[pattern]\ncoverage = 3\nrepeat_m = 0.01\n"),
+    ("cloth.fullness text", lambda t: t + '[cloth]\nfullness = "full"\n'),
+    ("cloth.areal_density huge", lambda t: t + "[cloth]\nareal_density_kg_m2 = 1e300\n"),
+    ("nested 5000 deep", lambda t: t + "[deep]\nx = " + "[" * 5000 + "]" * 5000 + "\n"),
+    ("nested tables", lambda t: t + "x = " + "{a = " * 3000 + "1" + "}" * 3000 + "\n"),
+])
+def test_preset_fields_of_the_wrong_type_are_refused(tmp_path, capsys, make_preset, label, edit):
+    path = make_preset("typed", fluorescent=False)
+    path.write_text(edit(path.read_text()))
+    out = tmp_path / "o.png"
+    line = _refused(["snapshot", "--fabric", str(path), "--size", "8x8", "--out", str(out)],
+                    capsys, tmp_path, [out])
+    assert str(path) in line, line
+
+
+def _gonio_text(project_root: Path, transform) -> str:
+    lines = (project_root / "fabrics" / "measurements" / "voile-white" / "gonio.csv") \
+        .read_text().splitlines()
+    head = [i for i, ln in enumerate(lines) if ln.startswith("light_elevation_deg")][0]
+    return "\n".join(lines[:head + 1] + [transform(ln) for ln in lines[head + 1:]]) + "\n"
+
+
+@pytest.mark.parametrize("label, transform, named", [
+    ("underscore digits", lambda ln: ln.rsplit(",", 1)[0] + ",0_029", "0_029"),
+    ("values x1e300", lambda ln: ln.rsplit(",", 1)[0] + ","
+     + repr(float(ln.rsplit(",", 1)[1]) * 1e300), "1e+12"),
+])
+def test_gonio_values_are_plain_decimals_within_reach(tmp_path, capsys, project_root, label,
+                                                      transform, named):
+    bad = tmp_path / "gonio.csv"
+    bad.write_text(_gonio_text(project_root, transform))
+    line = _refused(["fit", "--gonio", str(bad), "--name", "p", "--out", str(tmp_path / "p.toml")],
+                    capsys, tmp_path, [tmp_path / "p.toml"])
+    assert str(bad) in line and named in line, line
+
+
+def test_sizes_are_read_from_headers_before_the_data(tmp_path, capsys, make_preset):
+    """A BFC whose dimension line claims 1e9 rows and a PNG whose header claims 40000x40000
+    are refused from their headers (the process stays small: nothing is allocated)."""
+    import resource
+    import struct
+    import zlib
+
+    bfc = tmp_path / "BIG.BFC"
+    bfc.write_text("x\nBFC-450\n" + "\n".join(["; c"] * 8) + "\n380 1000000380 1 49 300 10\n"
+                   "r:c: 300\n" + "x" * 20000)
+    line = _refused(["bispectral", str(bfc), "--export", str(tmp_path / "x")], capsys,
+                    tmp_path, [tmp_path / "x"])
+    assert "1e+09" in line
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 40000, 40000, 8, 0, 0, 0, 0))
+           + chunk(b"IDAT", zlib.compress(b"\x00" * 1000)) + chunk(b"IEND", b""))
+    from catalog.core.errors import InputError
+    from catalog.presets.patterns import read_image
+
+    (tmp_path / "big.png").write_bytes(png)
+    rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(InputError, match="big.png"):
+        read_image(tmp_path / "big.png")
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss_before < 200_000  # KiB
+    from catalog.core.validate import check_image_header
+
+    with pytest.raises(InputError, match="40000x40000"):
+        check_image_header("big.png", 40000, 40000, 1)
+    check_image_header("ok.png", 4096, 4096, 4)
+
+
+def test_snapshot_size_is_checked_against_the_gl_limits_before_allocating():
+    from types import SimpleNamespace
+
+    from catalog.core.errors import InputError
+    from catalog.render.snapshot import check_gl_size
+
+    llvmpipe = SimpleNamespace(info={"GL_RENDERER": "llvmpipe (LLVM 19.1.7, 256 bits)",
+                                     "GL_MAX_TEXTURE_SIZE": 16384,
+                                     "GL_MAX_RENDERBUFFER_SIZE": 16384,
+                                     "GL_MAX_VIEWPORT_DIMS": (16384, 16384)})
+    with pytest.raises(InputError, match="--size.*12000x12000.*1024 MiB"):
+        check_gl_size(llvmpipe, (12000, 12000))
+    check_gl_size(llvmpipe, (8000, 8000))  # 977 MiB: rendered (checked by hand here)
+    small = SimpleNamespace(info={"GL_RENDERER": "NVIDIA H200", "GL_MAX_TEXTURE_SIZE": 8192})
+    with pytest.raises(InputError, match="8192"):
+        check_gl_size(small, (9000, 10))
+    check_gl_size(small, (8192, 8192))  # a GPU has no software per-resource cap
+
+
+def test_an_output_name_that_is_not_text_is_refused(tmp_path, capsys):
+    name = os.fsdecode(bytes(tmp_path) + b"/bad\xff.png")
+    line = _refused(["snapshot", "--fabric", "voile-white", "--size", "8x8", "--out", name],
+                    capsys, tmp_path, [])
+    assert "UTF-8" in line
+
+
+# ---- the fuzz: generated garbage, never a traceback, never exit 0, no input changed ----
+
+#: Typed garbage for a preset's fields: each value is wrong for every field it is put in.
+_WRONG_NUMBER = st.one_of(st.text(max_size=6).map(repr), st.booleans().map(str).map(str.lower),
+                          st.just("[1.0, 2.0]"), st.just("{ a = 1 }"), st.just("nan"),
+                          st.just("-inf"), st.just("1e308"), st.just("-1e-9"))
+_NUMBER_FIELDS = [("btdf", k) for k in ("direct", "k_d", "tau", "rho", "g_diff", "g_spec")] + [
+    ("cloth", "areal_density_kg_m2"), ("cloth", "fullness"), ("cloth", "stretch_stiffness_n_m"),
+    ("pattern", "height_m")]
+_TEXT_FIELDS = [("cloth", "weave"), ("pattern", "coverage"), ("dye", "transmittance")]
+_WRONG_TEXT = st.one_of(st.integers().map(str), st.just("[\"lace\"]"), st.just("true"),
+                        st.just("{ x = 1 }"), st.just('""'), st.just('"no-such-weave"'))
+
+
+@pytest.mark.slow
+@settings(max_examples=40, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@given(field=st.sampled_from(_NUMBER_FIELDS + _TEXT_FIELDS), data=st.data())
+def test_fuzz_preset_toml_garbage_is_refused(tmp_path, capsys, make_preset, field, data):
+    table, key = field
+    wrong = data.draw(_WRONG_TEXT if field in _TEXT_FIELDS else _WRONG_NUMBER)
+    if wrong == "1e308" and key in ("k_d", "tau", "stretch_stiffness_n_m"):
+        wrong = "nan"  # no upper bound there (or one above 1e308's reach): not garbage
+    if wrong == "-1e-9" and key in ("g_diff", "g_spec"):
+        wrong = "-1.0"  # (-1, 1): -1e-9 is a valid shape
+    path = make_preset("fuzzed", fluorescent=False)
+    text = path.read_text()
+    if table == "btdf":
+        text = re.sub(rf"(?m)^{key} = .*$", lambda _: f"{key} = {wrong}", text)
+    else:
+        text += f"\n[{table}]\n{key} = {wrong}\n"
+        if table == "pattern" and key != "coverage":
+            text += 'coverage = "none.png"\n'
+    path.write_text(text)
+    inputs = _inputs_digest([path])
+    out = tmp_path / "o.png"
+    out.unlink(missing_ok=True)  # hypothesis reuses the folder between examples
+    _refused(["snapshot", "--fabric", str(path), "--size", "8x8", "--out", str(out)],
+             capsys, tmp_path, [out])
+    assert _inputs_digest([path]) == inputs
+
+
+#: Every command's numeric options: (command argv without the option, option, low, high,
+#: whole). Values are drawn outside the bounds, or malformed.
+_NUMERIC_OPTIONS = [
+    (["snapshot", "--fabric", "voile-white", "--out", "{tmp}/o.png"], opt, lo, hi, whole)
+    for opt, lo, hi, whole in [("--frame", 0, 216000, True), ("--distance", 0.05, 50, False),
+                               ("--exposure", 2 ** -20, 2 ** 20, False), ("--yaw", -360, 360, False),
+                               ("--pitch", -89, 89, False)]
+] + [
+    (["reference", "--fabric", "voile-white", "--out", "{tmp}/r.exr"], opt, lo, hi, whole)
+    for opt, lo, hi, whole in [("--frame", 0, 216000, True), ("--distance", 0.05, 50, False),
+                               ("--spp", 1, 65536, True), ("--seed", 0, 2 ** 32 - 1, True),
+                               ("--max-depth", 1, 256, True), ("--pitch", -89, 89, False)]
+] + [
+    (["render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--out", "{tmp}/c"],
+     opt, lo, hi, whole)
+    for opt, lo, hi, whole in [("--distance", 0.05, 50, False), ("--exposure", 2 ** -20, 2 ** 20, False),
+                               ("--pitch", -89, 89, False)]
+] + [
+    (["fit", "--gonio", "{gonio}", "--name", "p", "--out", "{tmp}/p.toml"], opt, lo, hi, whole)
+    for opt, lo, hi, whole in [("--tau", 0, 50, False), ("--rho", 0, 1, False),
+                               ("--quantum-yield", 0, 1, False)]
+] + [
+    (["fluorescence", "--excitation", "{spectra}/excitation.csv", "--emission",
+      "{spectra}/emission.csv", "--light", "D65"], "--illuminance", 0, 1e6, False),
+    (["simulate", "--grid", "8x8", "--out", "{tmp}/c.obj", "--steps", "2"], "--wind", 0, 50, False),
+    (["simulate", "--grid", "8x8", "--out", "{tmp}/c.obj"], "--steps", 1, 10_000_000, True),
+]
+
+
+def _outside(low, high, whole):
+    below = (st.integers(max_value=int(math.ceil(low)) - 1) if whole
+             else st.floats(max_value=low, allow_nan=False, allow_infinity=False)
+             .filter(lambda v: v < low))
+    above = (st.integers(min_value=int(high) + 1) if whole
+             else st.floats(min_value=high, allow_nan=False).filter(lambda v: v > high))
+    malformed = st.sampled_from(["nan", "inf", "-inf", "1_0", "0x10", "", " ", "1e", "--1",
+                                 "１", "1,5", "1e999", "NaN", "Infinity"])
+    if whole:
+        malformed = st.one_of(malformed, st.sampled_from(["1.5", "1e3", "2.0"]))
+    return st.one_of(below.map(repr), above.map(repr), malformed)
+
+
+@settings(max_examples=10, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@given(case=st.sampled_from(_NUMERIC_OPTIONS), data=st.data())
+def test_fuzz_numeric_options_garbage_is_refused(tmp_path, capsys, project_root, case, data):
+    argv, option, low, high, whole = case
+    value = data.draw(_outside(low, high, whole))
+    if option == "--rho" and value in ("0", "0.0"):
+        value = "-0.5"
+    fills = {"{tmp}": str(tmp_path), "{spectra}": str(project_root / "fabrics" / "measurements"
+                                                       / "lace-fwa"),
+             "{gonio}": str(project_root / "fabrics" / "measurements" / "voile-white" / "gonio.csv")}
+    args = [a for a in argv]
+    for key, fill in fills.items():
+        args = [a.replace(key, fill) for a in args]
+    line = _refused(args + [f"{option}={value}"], capsys, tmp_path, [])
+    assert option in line, line
+
+
+@pytest.mark.slow
+@settings(max_examples=120, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@given(case=st.sampled_from(_NUMERIC_OPTIONS), data=st.data())
+def test_fuzz_numeric_options_garbage_is_refused_long(tmp_path, capsys, project_root, case, data):
+    test_fuzz_numeric_options_garbage_is_refused.hypothesis.inner_test(
+        tmp_path, capsys, project_root, case, data)
+
+
+# ---- signals (subprocesses) ----
+
+def _signal_run(argv: list[str], delay_s: float, signum: int, tmp_path: Path):
+    import signal as signal_lib  # noqa: F401
+    import subprocess
+    import sys
+    import time
+
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parent.parent))
+    proc = subprocess.Popen([sys.executable, "-m", "catalog", *argv], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    time.sleep(delay_s)
+    sent = time.monotonic()
+    proc.send_signal(signum)
+    _, err = proc.communicate(timeout=30)
+    return proc.returncode, time.monotonic() - sent, err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("signum", [15, 2])
+def test_reference_honours_signals_inside_the_mitsuba_render(tmp_path, signum):
+    """SIGTERM/SIGINT while Mitsuba renders (native code, the main thread never returns to
+    Python): exit 143/130 within a second, the old EXR untouched, no temporary left."""
+    from catalog.core.atomic import TEMP_MARK
+
+    out = tmp_path / "r.exr"
+    out.write_bytes(b"the old reference")
+    status, latency, err = _signal_run(["reference", "--fabric", "voile-white", "--size", "64x48",
+                                        "--spp", "4096", "--out", str(out)], 7.0, signum, tmp_path)
+    assert status == 128 + signum, err
+    assert latency < 1.0 and "Traceback" not in err
+    assert out.read_bytes() == b"the old reference"
+    assert not [p for p in tmp_path.iterdir() if TEMP_MARK in p.name]

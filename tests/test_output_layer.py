@@ -116,19 +116,28 @@ def test_os_errors_become_one_output_error(tmp_path, monkeypatch):
 def test_stale_temporaries_of_dead_processes_are_removed_and_live_ones_kept(tmp_path):
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
                           capture_output=True, text=True).stdout.strip()
-    stale = tmp_path / f".x.png{TEMP_MARK}-{dead}-abc.png"
-    stale_stage = tmp_path / f".out{TEMP_MARK}-{dead}-stage"
-    live = tmp_path / f".y.png{TEMP_MARK}-{os.getpid()}-def.png"
+    from catalog.core.atomic import STAGE_MARKER, temporary_name
+
+    stale = tmp_path / temporary_name("x.png", int(dead), ".png")
+    stale_stage = tmp_path / temporary_name("out", int(dead))
+    live = tmp_path / temporary_name("y.png", os.getpid(), ".png")
     other = tmp_path / ".hidden"
-    for path in (stale, live, other):
+    # a user's file and folder that merely look like temporaries (no valid token, no marker)
+    look_alike = tmp_path / f".x.png{TEMP_MARK}-{dead}-abc.png"
+    users_folder = tmp_path / f".out{TEMP_MARK}-{dead}-0123456789abcdef"
+    unmarked_stage = tmp_path / temporary_name("old", int(dead))
+    for path in (stale, live, other, look_alike):
         path.write_text("x")
-    stale_stage.mkdir()
-    (stale_stage / "a.png").write_text("x")
+    for folder in (stale_stage, users_folder, unmarked_stage):
+        folder.mkdir()
+        (folder / "a.png").write_text("x")
+    (stale_stage / STAGE_MARKER).write_text(f"{dead}\n")
     assert temporary_owner(stale.name) == int(dead)
-    assert temporary_owner(other.name) is None
+    assert temporary_owner(other.name) is None and temporary_owner(look_alike.name) is None
     write_bytes_atomic(tmp_path / "x.png", b"new")
     assert not stale.exists() and not stale_stage.exists()
-    assert live.exists() and other.exists()
+    assert live.exists() and other.exists() and look_alike.exists()
+    assert (users_folder / "a.png").exists() and (unmarked_stage / "a.png").exists()
     assert remove_stale_temporaries(tmp_path) == []
 
 

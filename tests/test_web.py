@@ -295,16 +295,26 @@ def test_failure_midway_leaves_no_site_and_no_stage(tmp_path, monkeypatch):
 
 @pytest.mark.gl
 @pytest.mark.slow
-def test_a_second_build_replaces_an_earlier_site_whole(tmp_path):
+def test_a_second_build_replaces_only_what_the_first_wrote(tmp_path):
+    """The second build replaces the first's files and removes those its manifest lists and
+    the new site lacks; a file the user added (CNAME) survives."""
     from catalog.web import site
 
     out = tmp_path / "site"
     site.build_site(out, fabrics="voile-white", lights="D65")
-    (out / "stale.txt").write_text("from the first build")
+    manifest = json.loads((out / site.MARKER).read_text())
+    assert set(manifest["files"]) == {p.relative_to(out).as_posix() for p in out.rglob("*")
+                                      if p.is_file()}
+    (out / "anim" / "old-cloth.js").write_text("from the first build")  # listed: ours
+    manifest["files"].append("anim/old-cloth.js")
+    (out / site.MARKER).write_text(json.dumps(manifest))
+    (out / "CNAME").write_text("fabrics.example.org\n")  # the user's
     report = site.build_site(out, fabrics="voile-white", lights="A")
-    assert not (out / "stale.txt").exists()
+    assert not (out / "anim" / "old-cloth.js").exists()
+    assert (out / "CNAME").read_text() == "fabrics.example.org\n"
     assert json.loads((out / site.MARKER).read_text())["lights"] == ["A"] == report["lights"]
     assert [p.name for p in tmp_path.iterdir()] == ["site"]  # no stage or old copy left
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []
 
 
 @pytest.mark.gl

@@ -99,6 +99,12 @@ def run_dask(tasks, workers, scheduler, retries, lp_threads, on_image, on_result
             except (OSError, TimeoutError) as exc:
                 raise CatalogError(f"--scheduler: cannot reach {scheduler} ({exc})") from None
         else:
+            import os  # noqa: PLC0415
+
+            # the workers' semaphores outlive a Ctrl-C (the workers are terminated at once,
+            # catalog.core.atomic.hard_exit); multiprocessing's tracker, a process of its
+            # own, cleans them up and need not warn about it on the user's terminal
+            os.environ.setdefault("PYTHONWARNINGS", "ignore:resource_tracker:UserWarning")
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    host="127.0.0.1", dashboard_address=None,
                                    silence_logs=logging.ERROR)

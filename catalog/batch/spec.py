@@ -26,7 +26,7 @@ from catalog.core.errors import CatalogError, InputError
 FORMATS = ("png", "exr")
 #: The most images one job may ask for (a guard against a typo such as 0:4800000).
 MAX_IMAGES = 50_000_000
-_SLICE = re.compile(r"\s*(-?\d+)\s*:\s*(-?\d+)\s*(?::\s*(-?\d+)\s*)?")
+_SLICE = re.compile(r"\s*(-?\d+)\s*:\s*(-?\d+)\s*(?::\s*(-?\d+)\s*)?", re.ASCII)
 
 
 def parse_frames(text: str) -> range:
@@ -44,6 +44,11 @@ def parse_frames(text: str) -> range:
                          field="--frames")
     if step <= 0:
         raise InputError(f"{text!r}: STEP must be a positive whole number", field="--frames")
+    from catalog.core.validate import MAX_FRAME  # noqa: PLC0415
+
+    if stop > MAX_FRAME + 1:
+        raise InputError(f"{text!r}: the last frame must be at most {MAX_FRAME} (one hour "
+                         "of cloth at 60 frames a second)", field="--frames")
     frames = range(start, stop, step)
     if len(frames) == 0:
         raise InputError(f"{text!r} selects no frame (STOP is excluded, as in Python)",
@@ -162,7 +167,10 @@ class JobSpec:
 
         fabrics = split_list(fabrics if isinstance(fabrics, str) else ",".join(fabrics),
                              "--fabric")
-        lights = split_list(lights if isinstance(lights, str) else ",".join(lights), "--lights")
+        from catalog.core.validate import parse_light_list  # noqa: PLC0415
+
+        lights = tuple(parse_light_list(lights if isinstance(lights, str) else ",".join(lights),
+                                        "--lights"))
         for light in lights:
             try:
                 get_light(light)
@@ -191,11 +199,9 @@ class JobSpec:
             band_lib.check_band_count(bands)
         except CatalogError as exc:
             raise InputError(getattr(exc, "problem", str(exc)), field="--bands") from None
-        for value, option in ((distance_m, "--distance"), (exposure, "--exposure")):
-            if not (math.isfinite(value) and value > 0):
-                raise InputError(f"{value!r} must be a positive number", field=option)
-        if not (math.isfinite(pitch_deg) and -89.0 <= pitch_deg <= 89.0):
-            raise InputError(f"{pitch_deg!r} must lie in -89..89 deg", field="--pitch")
+        from catalog.core.validate import check_camera  # noqa: PLC0415
+
+        check_camera({"--distance": distance_m, "--exposure": exposure, "--pitch": pitch_deg})
         out_dir = Path(out_dir)
         if out_dir.exists() and not out_dir.is_dir():
             raise InputError(f"{str(out_dir)!r} exists and is not a folder", field="--out")

@@ -52,8 +52,7 @@ class RendererPool:
 
     def renderer_for(self, size: tuple[int, int]):
         from catalog.gl.context import create_headless_context  # noqa: PLC0415
-        from catalog.render.frame import FrameRenderer  # noqa: PLC0415
-
+    
         if self.ctx is None:
             self.ctx = create_headless_context(self.device_index)  # current in this thread
             self._thread = threading.get_ident()
@@ -63,7 +62,9 @@ class RendererPool:
             if self.renderer is not None:
                 self.renderer.release()
                 self.renderer = None
-            self.renderer = FrameRenderer(self.ctx, tuple(size))
+            from catalog.render.snapshot import new_renderer  # noqa: PLC0415
+
+            self.renderer = new_renderer(self.ctx, tuple(size))  # size checked first
         return self.renderer
 
     def make_current(self) -> None:

@@ -197,9 +197,89 @@ def _output_cases() -> list[Case]:
     return cases
 
 
+def _round_two_cases() -> list[Case]:
+    """The red team's second round (issue 37), one case per class member."""
+    header = ("light_elevation_deg,light_azimuth_deg,camera_elevation_deg,camera_azimuth_deg,"
+              "transmittance")
+    gonio = str(FABRIC_DIR / "measurements" / "voile-white" / "gonio.csv")
+    good = GOOD_PRESET.format(name="bad")
+    cases = [
+        # an input overwritten by an output
+        Case("inputs overwritten", "snapshot --environment X --out X",
+             ("snapshot", "--fabric", "voile-white", "--size", "8x8", "--environment", "{bad}",
+              "--out", "{bad}"), "not read: refused first", bad_name="env.exr", names="own input"),
+        Case("inputs overwritten", "fit --dye D --plot D",
+             ("fit", "--gonio", gonio, "--dye", "{bad}", "--name", "p", "--out", "{dir}/p.toml",
+              "--plot", "{bad}"), "wavelength_nm,transmittance\n400,0.5\n700,0.5\n",
+             bad_name="d.png", names="own input"),
+        Case("inputs overwritten", "fit --out onto --gonio",
+             ("fit", "--gonio", "{bad}", "--name", "bad", "--out", "{bad}"), "x",
+             bad_name="bad.toml", names="own input"),
+        Case("inputs overwritten", "snapshot --out onto its own preset",
+             ("snapshot", "--fabric", "{bad}", "--size", "8x8", "--out", "{bad}"), good,
+             bad_name="bad.toml", names="own input"),
+    ]
+    bounds = [
+        (("snapshot", "--fabric", "voile-white", "--frame", "1000000000000", "--out", "{dir}/o.png"), "--frame"),
+        (("reference", "--fabric", "voile-white", "--frame", "216001", "--out", "{dir}/r.exr"), "--frame"),
+        (("render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--frames", "0:50000000",
+          "--out", "{dir}/c"), "--frames"),
+        (("reference", "--fabric", "voile-white", "--size", "16384x16384", "--out", "{dir}/r.exr"), "--size"),
+        (("simulate", "--grid", "8x8", "--steps", "2", "--out", "{dir}/f{frame:0999999999999d}.obj"), "--out"),
+    ]
+    cases += [Case("bounds", " ".join(a for a in argv if "{dir}" not in a)[:60], argv, names=name)
+              for argv, name in bounds]
+    garbage = [
+        (("render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--distance", "1e308",
+          "--out", "{dir}/c"), "--distance"),
+        (("render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--exposure", "1e308",
+          "--out", "{dir}/c"), "--exposure"),
+        (("reference", "--fabric", "voile-white", "--pitch", "90", "--out", "{dir}/r.exr"), "--pitch"),
+        (("reference", "--fabric", "voile-white", "--pitch", "1e308", "--out", "{dir}/r.exr"), "--pitch"),
+        (("reference", "--fabric", "voile-white", "--seed", "-1", "--out", "{dir}/r.exr"), "--seed"),
+        (("reference", "--fabric", "voile-white", "--seed", str(1 << 64), "--out", "{dir}/r.exr"), "--seed"),
+        (("snapshot", "--fabric", "voile-white", "--exposure", "1e-300", "--out", "{dir}/o.png"), "--exposure"),
+        (("snapshot", "--fabric", "voile-white", "--distance", "0.01", "--out", "{dir}/o.png"), "(0.05"),
+        (("snapshot", "--fabric", "voile-white", "--yaw", "1_0", "--out", "{dir}/o.png"), "--yaw"),
+        (("fit", "--gonio", gonio, "--name", "p", "--out", "{dir}/p.toml", "--tau", "inf"), "--tau"),
+        (("fit", "--gonio", gonio, "--name", "p", "--out", "{dir}/p.toml", "--plot", "{dir}/p.txt"), "--plot"),
+        (("fit", "--gonio", gonio, "--name", "p", "--out", "{dir}/p.toml", "--plot", "{dir}/p"), "--plot"),
+        (("fluorescence", "--excitation", str(GOOD_SPECTRA / "excitation.csv"), "--emission",
+          str(GOOD_SPECTRA / "emission.csv"), "--light", "D65", "--illuminance", "1e308"), "--illuminance"),
+        (("sheet", "--lights", "D65,D65", "--size", "8x8", "--out", "{dir}/s"), "--lights"),
+        (("render-catalog", "--fabrics", "voile-white", "--lights", "A,A", "--out", "{dir}/c"), "--lights"),
+        (("web", "--lights", "", "--out", "{dir}/site"), "--lights"),
+        (("sheet", "--lights", "sun@2026-13-21T12:00,34.7,-120", "--size", "8x8", "--out", "{dir}/s"),
+         "sun@2026-13-21T12:00,34.7,-120"),
+    ]
+    cases += [Case("options, round two", " ".join(a for a in argv if "{dir}" not in a)[:60], argv,
+                   names=name) for argv, name in garbage]
+    presets = {
+        "cloth.weave a list": good + '[cloth]\nweave = ["lace"]\n',
+        "pattern a string": good.replace("[btdf]", 'pattern = "x"\n[btdf]'),
+        "cloth a number": good.replace("[btdf]", "cloth = 5\n[btdf]"),
+        "nested 5000 deep": good + "[deep]\nx = " + "[" * 5000 + "]" * 5000 + "\n",
+        "cloth.fullness text": good + '[cloth]\nfullness = "full"\n',
+    }
+    cases += [Case("preset types", label, ("snapshot", "--fabric", "{bad}", "--size", "8x8",
+                                           "--out", "{dir}/o.png"), text, bad_name="bad.toml",
+                   names="{bad}") for label, text in presets.items()]
+    rows = "\n".join(["180,0,90,0,0_029", "180,0,80,0,0.5", "180,0,70,0,0.4"])
+    huge = "\n".join(["180,0,90,0,1e300", "180,0,80,0,5e299", "180,0,70,0,4e299"])
+    cases += [Case("gonio CSV", label, ("fit", "--gonio", "{bad}", "--name", "p", "--out",
+                                        "{dir}/p.toml"), f"{header}\n{text}\n", names="{bad}")
+              for label, text in (("underscore digits 0_029", rows), ("values x1e300", huge))]
+    head = "x\nBFC-450\n" + "\n".join(["; c"] * 8)
+    cases.append(Case("bispectral BFC", "dimension line claims 1e9 rows",
+                      ("bispectral", "{bad}", "--export", "{dir}/x"),
+                      head + "\n380 1000000380 1 49 300 10\nr:c: 300\n" + "x" * 20000,
+                      bad_name="BAD.BFC", names="{bad}"))
+    return cases
+
+
 def corpus() -> list[Case]:
     return (_spectrum_cases() + _gonio_cases() + _bfc_cases() + _preset_cases()
-            + _option_cases() + _output_cases())
+            + _option_cases() + _output_cases() + _round_two_cases())
 
 
 def _tree(folder: Path) -> dict[str, tuple[int, int]]:
@@ -270,7 +350,10 @@ def run_suite(cases: list[Case] | None = None) -> dict:
         if outcome != "refused cleanly":
             failures.append({"category": case.category, "case": case.label, "outcome": outcome})
     total = {k: sum(r[k] for r in rows.values()) for k in OUTCOMES}
-    return {"categories": rows, "total": total, "cases": len(cases), "failures": failures}
+    from catalog.bench.kill_trials import _commit  # noqa: PLC0415
+
+    return {"categories": rows, "total": total, "cases": len(cases), "failures": failures,
+            "commit": _commit()}
 
 
 #: The committed result the docs' generated blocks are made from (tools/docs_figures.py).
@@ -283,6 +366,8 @@ def markdown_tables(result: dict) -> dict[str, str]:
         n = sum(counts.values())
         label = f"**{name}**" if name == "all" else name
         lines.append(f"| {label} | {n} | " + " | ".join(str(counts[k]) for k in OUTCOMES) + " |")
+    if result.get("commit"):
+        lines += ["", f"Measured on commit {result['commit']}."]
     return {"hostile": "\n".join(lines)}
 
 

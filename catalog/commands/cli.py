@@ -138,14 +138,28 @@ def check_outputs(module, args) -> None:
     names one of the inputs is refused in one line naming the option
     (:func:`catalog.core.atomic.check_target`).
     """
-    from catalog.core.atomic import OutputError, check_target  # noqa: PLC0415
+    from catalog.core.atomic import OutputError, check_target, register_input  # noqa: PLC0415
+    from catalog.core.inputs import register_preset_inputs  # noqa: PLC0415
 
     inputs = [value for name in getattr(module, "INPUT_FILES", ())
               for value in _values(getattr(args, name, None))]
+    for value in inputs:
+        register_input(value)
+    if "fabric" in getattr(module, "INPUT_FILES", ()) and getattr(args, "fabric", None):
+        from catalog.presets import find_preset  # noqa: PLC0415
+
+        try:
+            register_preset_inputs(find_preset(args.fabric))  # the preset and its files
+        except (CatalogError, OSError, ValueError):
+            pass  # the command refuses it with its own line
     for names, folder in ((getattr(module, "OUTPUT_FILES", ()), False),
                           (getattr(module, "OUTPUT_FOLDERS", ()), True)):
         for name in names:
             for value in _values(getattr(args, name, None)):
+                if name == "plot":  # every command's --plot: an image the plotter writes
+                    from catalog.core.validate import check_plot_path  # noqa: PLC0415
+
+                    check_plot_path(value, "--plot")
                 try:
                     check_target(value, inputs=inputs, folder=folder)
                 except OutputError as exc:
@@ -177,8 +191,65 @@ def _report(args, exc: CatalogError) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from catalog.core.atomic import OutputError, install_signal_handlers, os_cause  # noqa: PLC0415
+    from catalog.core.atomic import install_signal_handlers  # noqa: PLC0415
 
+    install_signal_handlers()  # first: building the parser imports every command module
+    status = _main(argv)
+    if argv is None:
+        # the command line (not a caller in process): end without the interpreter's
+        # teardown. It resets the signal handlers to the default action first, so a SIGTERM
+        # during a long teardown (scipy, matplotlib, llvmpipe loaded) killed the process
+        # with status -15 after its work was done (6 of 40 fit kill trials); an EGL context
+        # torn down after a signal has crashed. Every output is committed by now.
+        import contextlib  # noqa: PLC0415
+        import os  # noqa: PLC0415
+
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                if stream is not None:
+                    stream.flush()
+        if status in (130, 143):
+            from catalog.core.atomic import hard_exit  # noqa: PLC0415
+
+            hard_exit(status)
+        os._exit(status)
+    return status
+
+
+def _main(argv: list[str] | None) -> int:
+    from catalog.core.atomic import track_inputs  # noqa: PLC0415
+
+    track_inputs(True)
+    try:
+        return _run_command(argv)
+    finally:
+        track_inputs(False)
+
+
+def _guard_standard_descriptors() -> None:
+    """A process started with stdin, stdout or stderr closed (``cmd >&-``) would hand that
+    descriptor number to the next file it opens, and anything printed (by Python or a
+    native library) would land inside an output or over an input: park /dev/null there."""
+    import os  # noqa: PLC0415
+
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            try:
+                devnull = os.open(os.devnull, os.O_RDWR)
+            except OSError:
+                continue
+            if devnull != fd:
+                os.dup2(devnull, fd)
+                os.close(devnull)
+
+
+def _run_command(argv: list[str] | None) -> int:
+    from catalog.core.atomic import (OutputError, Terminated,  # noqa: PLC0415
+                                     install_signal_handlers, os_cause)
+
+    _guard_standard_descriptors()
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -194,7 +265,9 @@ def main(argv: list[str] | None = None) -> int:
             use_data(args.data)
         check_outputs(args._module, args)
         if sys.stdout is None and getattr(args, "json", False):
-            raise OutputError("stdout", "closed")
+            # refused before any work: --json prints the result there
+            raise OutputError("stdout", "closed (--json prints its result on stdout; "
+                                        "nothing was done)")
         status = int(args._run(args) or 0)
         try:
             if sys.stdout is not None:
@@ -218,6 +291,10 @@ def main(argv: list[str] | None = None) -> int:
         return _report(args, CatalogError(f"{exc.filename or 'a file'}: {os_cause(exc)}"))
     except KeyboardInterrupt:
         return 130
+    except Terminated as exc:
+        return int(exc.code)
+    except RecursionError:
+        return _report(args, CatalogError("the input is nested too deeply to read"))
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -13,12 +13,15 @@ from __future__ import annotations
 from catalog.fit.preset_build import DEFAULT_TAU_UNDYED
 
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
-INPUT_FILES = ("gonio", "excitation", "emission", "pattern")
+INPUT_FILES = ("gonio", "excitation", "emission", "dye", "pattern")
 OUTPUT_FILES = ("out", "plot")
 HELP = "fit the woven-cloth HG BTDF (eq. 7) to gonio data and write a fabric preset"
 
 
 def add_arguments(parser) -> None:
+    from catalog.core import validate  # noqa: PLC0415
+    from catalog.core.cliargs import number_type  # noqa: PLC0415
+
     parser.add_argument("--gonio", required=True, metavar="G.csv",
                         help="gonio transmittance CSV (formats.md)")
     parser.add_argument("--excitation", metavar="E.csv",
@@ -39,13 +42,13 @@ def add_arguments(parser) -> None:
     parser.add_argument("--weighting", choices=("relative", "none"), default="relative",
                         help="relative: each point weighted by 1/value (default); "
                              "none: the paper's plain least squares")
-    parser.add_argument("--rho", type=float,
+    parser.add_argument("--rho", type=number_type(0.0, 1.0, low_open=True),
                         help="thread density (0, 1] (default: 1 - fitted direct)")
-    parser.add_argument("--tau", type=float, help="absorption optical depth >= 0 "
+    parser.add_argument("--tau", type=number_type(*validate.TAU), help="absorption optical depth >= 0 "
                         "(default: from the dye, else %g)" % DEFAULT_TAU_UNDYED)
-    parser.add_argument("--quantum-yield", type=float,
+    parser.add_argument("--quantum-yield", type=number_type(0.0, 1.0),
                         help="physical-mode quantum yield of the fluorescence")
-    parser.add_argument("--peak-absorptance", type=float,
+    parser.add_argument("--peak-absorptance", type=number_type(0.0, 1.0, low_open=True),
                         help="physical-mode peak absorptance of the fluorescence")
     parser.add_argument("--pattern", metavar="IMAGE",
                         help="the fabric's pattern: a grey tileable coverage image (1 = thread), "

@@ -18,31 +18,48 @@ OUTPUT_FILES = ("plot",)
 HELP = "fluorescence colour (eq. 1-3) and intensity (eq. 4 or physical) of a material under a light"
 
 
+def _number(text: str) -> float:
+    from catalog.core.validate import _DECIMAL  # noqa: PLC0415
+
+    if not _DECIMAL.fullmatch(str(text).strip()):
+        raise argparse.ArgumentTypeError(f"must be a plain decimal number, not {str(text)[:20]!r}")
+    return float(text)
+
+
 def _fraction(text: str) -> float:
-    value = float(text)
+    value = _number(text)
     if not 0.0 <= value <= 1.0:
         raise argparse.ArgumentTypeError(f"must lie in [0, 1], not {text}")
     return value
 
 
 def _absorptance(text: str) -> float:
-    value = float(text)
+    value = _number(text)
     if not 0.0 < value <= 1.0:
         raise argparse.ArgumentTypeError(f"must lie in (0, 1], not {text}")
     return value
 
 
 def _saturation(text: str) -> float:
-    value = float(text)  # "inf" is accepted: no saturation
+    value = float("inf") if str(text).strip() == "inf" else _number(text)  # inf: no saturation
     if not value > 0:
         raise argparse.ArgumentTypeError(f"must be > 0 (photons m^-2 s^-1, or inf), not {text}")
     return value
 
 
 def _positive(text: str) -> float:
-    value = float(text)
+    value = _number(text)
     if not 0 < value < float("inf"):
         raise argparse.ArgumentTypeError(f"must be a positive number, not {text}")
+    return value
+
+
+def _illuminance(text: str) -> float:
+    from catalog.core.validate import ILLUMINANCE_LX  # noqa: PLC0415
+
+    value = _positive(text)
+    if value > ILLUMINANCE_LX[1]:
+        raise argparse.ArgumentTypeError(f"must lie in (0, {ILLUMINANCE_LX[1]:g}] lx, not {text}")
     return value
 
 
@@ -57,7 +74,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(see `catalog lights`)")
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="paper: eq. 1-4 exactly; physical (default): photons over 300-780 nm")
-    parser.add_argument("--illuminance", type=_positive, metavar="LX",
+    parser.add_argument("--illuminance", type=_illuminance, metavar="LX",
                         help="rescale the light to this illuminance (default: the library level)")
     parser.add_argument("--quantum-yield", type=_fraction, metavar="PHI",
                         help="emitted photons per absorbed photon, 0..1 (physical; default 0.6)")

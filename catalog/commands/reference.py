@@ -12,16 +12,25 @@ HELP = "path-trace the snapshot scene (Mitsuba 3 on the CPU) to a linear EXR: th
 
 
 def add_arguments(parser) -> None:
+    from catalog.core import validate  # noqa: PLC0415
+    from catalog.core.cliargs import number_type  # noqa: PLC0415
+
     parser.add_argument("--fabric", required=True, help="preset name (fabrics/NAME.toml) or a .toml path")
     parser.add_argument("--light", default="D65", help="light name (`catalog lights`)")
-    parser.add_argument("--frame", type=int, default=0, help="cloth simulation frame (0: the static drape)")
+    parser.add_argument("--frame", type=number_type(0, validate.MAX_FRAME, whole=True), default=0, help="cloth simulation frame (0: the static drape)")
     parser.add_argument("--size", default="320x240", help="WIDTHxHEIGHT in pixels")
-    parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")
-    parser.add_argument("--yaw", type=float, default=0.0, help="camera yaw, deg")
-    parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
-    parser.add_argument("--spp", type=int, default=64, help="samples per pixel (>= 1)")
-    parser.add_argument("--seed", type=int, default=0, help="sampler seed (independent renders: differ)")
-    parser.add_argument("--max-depth", type=int, default=16, help="path length limit (bounces)")
+    parser.add_argument("--distance", type=number_type(*validate.DISTANCE_M, unit="m", low_open=True),
+                        default=2.6, help="camera distance, m")
+    parser.add_argument("--yaw", type=number_type(*validate.YAW_DEG, unit="deg"), default=0.0,
+                        help="camera yaw, deg")
+    parser.add_argument("--pitch", type=number_type(*validate.PITCH_DEG, unit="deg"), default=0.0,
+                        help="camera pitch, deg")
+    parser.add_argument("--spp", type=number_type(1, 1 << 16, whole=True), default=64,
+                        help="samples per pixel (>= 1)")
+    parser.add_argument("--seed", type=number_type(0, validate.SEED_MAX, whole=True), default=0,
+                        help="sampler seed (independent renders: differ)")
+    parser.add_argument("--max-depth", type=number_type(1, 256, whole=True), default=16,
+                        help="path length limit (bounces)")
     parser.add_argument("--variant", default="llvm_ad_rgb",
                         help="Mitsuba variant: llvm_ad_rgb (default) or llvm_ad_spectral")
     parser.add_argument("--no-fluorescence", action="store_true", help="without fluorescence")

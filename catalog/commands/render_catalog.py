@@ -18,6 +18,8 @@ EXIT_PARTIAL = 3
 
 
 def add_arguments(parser) -> None:
+    from catalog.core import validate  # noqa: PLC0415
+    from catalog.core.cliargs import number_type  # noqa: PLC0415
     from catalog.core.fabricargs import CATALOG_LIGHTS, add_fabric_options  # noqa: PLC0415
 
     add_fabric_options(parser, many=True, legacy_list=True)
@@ -42,9 +44,12 @@ def add_arguments(parser) -> None:
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model")
     parser.add_argument("--bands", type=int, default=3, help="spectral bands: 3, 6, 9, 16")
-    parser.add_argument("--pitch", type=float, default=0.0, help="camera pitch, deg")
-    parser.add_argument("--distance", type=float, default=2.6, help="camera distance, m")
-    parser.add_argument("--exposure", type=float, default=1.0, help="exposure multiplier")
+    parser.add_argument("--pitch", type=number_type(*validate.PITCH_DEG, unit="deg"), default=0.0,
+                        help="camera pitch, deg")
+    parser.add_argument("--distance", type=number_type(*validate.DISTANCE_M, unit="m", low_open=True),
+                        default=2.6, help="camera distance, m")
+    parser.add_argument("--exposure", type=number_type(*validate.EXPOSURE), default=1.0,
+                        help="exposure multiplier")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
 

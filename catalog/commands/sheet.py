@@ -37,10 +37,9 @@ def run(args) -> int:
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
     ev, white_balance = display_choices(args)
-    names = [name.strip() for name in args.lights.split(",")]
-    if any(not name for name in names) and any(names):
-        raise InputError(f"{args.lights!r}: an empty light name between commas", field="--lights")
-    lights = [name for name in names if name]
+    from catalog.core.validate import parse_light_list  # noqa: PLC0415
+
+    lights = parse_light_list(args.lights, "--lights")  # sun@DATE,LAT,LON keeps its commas
     report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=args.fabric,
                           fluorescence="off" if args.no_fluorescence else args.mode,
                           bands=args.bands, progress=not args.json, ev=ev,

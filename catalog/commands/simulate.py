@@ -67,6 +67,10 @@ def run(args: argparse.Namespace) -> int:
     from catalog.core.errors import CatalogError, InputError
 
     w, h = _parse_grid(args.grid)
+    if args.out is not None and "{" in args.out:
+        from catalog.core.validate import check_frame_template
+
+        check_frame_template(args.out, "--out")  # before the simulation is built
     if args.steps < 1:
         raise CatalogError(f"--steps: must be >= 1, found {args.steps}")
     if not math.isfinite(args.dt) or not 0.0 < args.dt <= 1.0:

@@ -7,12 +7,13 @@ from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
-INPUT_FILES = ("fabric",)
+INPUT_FILES = ("fabric", "environment")
 OUTPUT_FILES = ("out",)
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
 
 
 def add_arguments(parser) -> None:
+    from catalog.core import validate  # noqa: PLC0415
     from catalog.core.cliargs import number_type  # noqa: PLC0415
 
     parser.add_argument("--fabric", required=True, help="preset name (fabrics/NAME.toml) or a .toml path")
@@ -22,7 +23,7 @@ def add_arguments(parser) -> None:
                         help="instead of --light: the sun at this hour (local solar time, "
                              "summer solstice, 34.7 N) behind the window")
     parser.add_argument("--size", default="1280x720", help="WIDTHxHEIGHT in pixels")
-    parser.add_argument("--frame", type=int, default=0,
+    parser.add_argument("--frame", type=number_type(0, validate.MAX_FRAME, whole=True), default=0,
                         help="cloth simulation frame (0: the settled drape every simulation starts from)")
     parser.add_argument("--out", required=True, help="FILE.exr (linear) or FILE.png (sRGB)")
     parser.add_argument("--no-fluorescence", action="store_true", help="render without fluorescence")
@@ -35,14 +36,14 @@ def add_arguments(parser) -> None:
                         help="the composition: " + "; ".join(
                             f"{name}: {view.about}" for name, view in VIEWS.items())
                         + f" (default {DEFAULT_VIEW}; --yaw, --pitch, --distance change it)")
-    parser.add_argument("--yaw", type=number_type(-360.0, 360.0, unit="deg"), default=None,
+    parser.add_argument("--yaw", type=number_type(*validate.YAW_DEG, unit="deg"), default=None,
                         help="camera yaw, deg (default: the view's)")
-    parser.add_argument("--pitch", type=number_type(-89.0, 89.0, unit="deg"), default=None,
+    parser.add_argument("--pitch", type=number_type(*validate.PITCH_DEG, unit="deg"), default=None,
                         help="camera pitch, deg (default: the view's)")
-    parser.add_argument("--distance", type=number_type(0.05, 50.0, unit="m", low_open=True),
+    parser.add_argument("--distance", type=number_type(*validate.DISTANCE_M, unit="m", low_open=True),
                         default=None, help="camera distance from the view's target, m, kept "
                                            "inside the room (default: the view's)")
-    parser.add_argument("--exposure", type=number_type(0.0, 1e9, low_open=True), default=1.0,
+    parser.add_argument("--exposure", type=number_type(*validate.EXPOSURE), default=1.0,
                         help="exposure multiplier on top of --ev or the automatic exposure")
     add_display_arguments(parser)
     parser.add_argument("--environment", metavar="FILE.exr", default=None,

@@ -128,7 +128,8 @@ def run(args: argparse.Namespace) -> int:
         raise CatalogError(f"--hour: {args.hour:g} is not an hour of the day (0-24)")
     if args.distance is not None and not (math.isfinite(args.distance)
                                           and 0.2 <= args.distance <= 4.0):
-        raise CatalogError(f"--distance: {args.distance:g} m is outside 0.2-4 m (the room)")
+        raise CatalogError(f"--distance: {args.distance:g} m is outside [0.2, 4] m (the viewer's "
+                           "room; snapshot and reference allow (0.05, 50])")
     if args.wind is not None and not 0.0 <= args.wind <= 50.0:
         raise CatalogError(f"--wind: {args.wind:g} m/s is outside 0-50 m/s")
     if not display_available():  # say so before any heavy import or preset read

@@ -22,8 +22,11 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.core.validate import parse_light_list  # noqa: PLC0415
     from catalog.web.site import build_site  # noqa: PLC0415
 
+    if args.lights is not None:
+        parse_light_list(args.lights, "--lights")  # '' and a repeated light are refused
     fabrics = None if args.fabric is None else ",".join(args.fabric)
     report = build_site(args.out, fabrics=fabrics, lights=args.lights, progress=not args.json)
     if args.json:

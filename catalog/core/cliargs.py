@@ -7,7 +7,7 @@ import re
 
 from catalog.core.errors import InputError
 
-_WXH = re.compile(r"\s*(\d+)\s*[xX]\s*(\d+)\s*")
+_WXH = re.compile(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", re.ASCII)
 
 
 def parse_wxh(text: str, option: str, low: int, high: int | None = None,
@@ -46,13 +46,19 @@ def number_type(low: float, high: float, *, unit: str = "", low_open: bool = Fal
 
     lo, hi = ("(" if low_open else "["), (")" if high_open else "]")
     kind = "whole number" if whole else "finite number"
-    wanted = f"must be a {kind} in {lo}{low:g}, {high:g}{hi}" + (f" {unit}" if unit else "")
+    def show(bound: float) -> str:
+        return str(int(bound)) if whole else f"{bound:g}"
+
+    wanted = f"must be a {kind} in {lo}{show(low)}, {show(high)}{hi}" + (f" {unit}" if unit else "")
+
+    from catalog.core.validate import _DECIMAL, _WHOLE  # noqa: PLC0415
 
     def parse(text: str):
-        try:
-            value = int(text) if whole else float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{wanted}, found {text[:20]!r}") from None
+        raw = str(text).strip()
+        # plain digits only: Python's int()/float() also take '1_000' and 'nan'
+        if not (_WHOLE if whole else _DECIMAL).fullmatch(raw) or len(raw) > 40:
+            raise argparse.ArgumentTypeError(f"{wanted}, found {text[:20]!r}")
+        value = int(raw) if whole else float(raw)
         ok = math.isfinite(value) and (value > low if low_open else value >= low) \
             and (value < high if high_open else value <= high)
         if not ok:

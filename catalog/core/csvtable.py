@@ -14,6 +14,14 @@ from pathlib import Path
 import numpy as np
 
 from catalog.core.errors import InputError
+from catalog.core.validate import _DECIMAL
+
+#: Words float() reads that are refused with their own message (NaN, infinite).
+_NON_FINITE = ("nan", "+nan", "-nan", "inf", "+inf", "-inf", "infinity", "+infinity", "-infinity")
+#: No value of a spectrum, gonio file or dye comes near this; beyond it sums overflow.
+MAX_MAGNITUDE = 1e12
+#: The largest measurement file read (a spectrum, gonio set or matrix is kilobytes).
+MAX_TEXT_BYTES = 64 << 20
 
 
 @dataclass(frozen=True)
@@ -65,6 +73,8 @@ def read_numeric_csv(path: str | Path, required: tuple[str, ...],
         values = []
         for name, field in zip(header, fields):
             try:
+                if not _DECIMAL.fullmatch(field) and field.lower() not in _NON_FINITE:
+                    raise ValueError(field)  # '0_029' is not 0.029 (float() reads 29)
                 value = float(field)
             except ValueError:
                 # the header matched, so this is a measurement file: a short quote helps find the typo
@@ -74,6 +84,9 @@ def read_numeric_csv(path: str | Path, required: tuple[str, ...],
                 raise InputError(f"{name} is NaN", path=path, line=line_no)
             if math.isinf(value):
                 raise InputError(f"{name} is infinite", path=path, line=line_no)
+            if abs(value) > MAX_MAGNITUDE:
+                raise InputError(f"{name} = {field[:20]} is beyond the {MAX_MAGNITUDE:g} any "
+                                 "measurement here reaches", path=path, line=line_no)
             if value < 0 and name not in allow_negative:
                 raise InputError(f"{name} is negative ({field[:20]})", path=path, line=line_no)
             values.append(value)
@@ -97,7 +110,14 @@ def read_text(path: str | Path, encoding: str = "utf-8") -> str:
     """The whole text of a measurement file; a missing, unreadable or undecodable file is an
     InputError naming it."""
     path = Path(path)
+    from catalog.core.atomic import register_input  # noqa: PLC0415
+
+    register_input(path)
     try:
+        size = path.stat().st_size if path.is_file() else 0
+        if size > MAX_TEXT_BYTES:
+            raise InputError(f"{size} bytes: a measurement file here is at most "
+                             f"{MAX_TEXT_BYTES >> 20} MiB", path=path)
         return path.read_text(encoding=encoding)
     except FileNotFoundError:
         raise InputError("no such file", path=path) from None

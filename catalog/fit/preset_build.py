@@ -57,23 +57,26 @@ def fit_preset(args, started_s: float) -> dict:
 
     doc = preset_document(args, out, data, header, result, rho, tau, dye_path)
     # the preset and copies of every file it names (gonio, spectra, dye, the fitted pattern)
-    # in out's own folder N/, staged: all of them appear together, or none
-    # (catalog.presets.bundle)
+    # in out's own folder N/, staged, and the plot: all of them appear together, or none
+    # (catalog.presets.bundle, catalog.core.atomic.commit_together)
+    from catalog.core.atomic import commit_together  # noqa: PLC0415
+
     pattern = _fitted_pattern(args, doc) if getattr(args, "pattern", None) else None
-    with staged_folder(out.parent) as stage, tempfile.TemporaryDirectory() as scratch:
+    with tempfile.TemporaryDirectory() as scratch:
         if pattern is not None:  # drawn once, then bundled like every other file it names
             from catalog.presets.patterns import write_pattern_images
 
             drawn = Path(scratch) / Path(doc["pattern"]["coverage"]).name
             write_pattern_images(pattern, drawn, None)
             doc["pattern"]["coverage"] = str(drawn)
-        staged = stage / out.name
-        bundle_files(doc, staged, lambda _key, value: out.parent / value,
-                     published_folder=out.parent)
-        preset_from_dict(doc, staged)          # refuse before the plot is drawn
-        if args.plot:
-            plot_fit(data, hg, ct, Path(args.plot), title=doc["display_name"])
-        save_preset_dict(doc, staged)
+        with commit_together(), staged_folder(out.parent) as stage:
+            staged = stage / out.name
+            bundle_files(doc, staged, lambda _key, value: out.parent / value,
+                         published_folder=out.parent)
+            preset_from_dict(doc, staged)          # refuse before the plot is drawn
+            if args.plot:
+                plot_fit(data, hg, ct, Path(args.plot), title=doc["display_name"])
+            save_preset_dict(doc, staged)
     elapsed = time.perf_counter() - started_s
 
     summary = json_summary(doc, result, out, elapsed)

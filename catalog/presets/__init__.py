@@ -17,6 +17,8 @@ from catalog.core.resources import FABRIC_DIR, fabric_dirs
 from catalog.core.errors import InputError
 
 SCHEMA = 1
+#: A preset is a page of text; a larger file is refused before it is read.
+MAX_PRESET_BYTES = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -133,6 +135,9 @@ def contained_path(where, key: str, base: Path, relative: Any) -> Path:
     if not isinstance(relative, str) or not relative or "\x00" in relative:
         raise InputError("must be a non-empty path string", path=where, field=key)
     resolved = (base / relative).resolve()
+    from catalog.core.atomic import register_input  # noqa: PLC0415
+
+    register_input(resolved)  # an input: no output may replace it
     roots = [base.resolve()] + [Path(p).resolve() for p in fabric_dirs()]
     roots += [Path(p).resolve() for p in
               os.environ.get(ALLOWED_PATHS_ENV, "").split(os.pathsep) if p]
@@ -193,6 +198,9 @@ def preset_from_dict(doc: dict[str, Any], path: Path | None = None) -> Preset:
     if not isinstance(display_name, str):
         raise InputError("must be a string", path=where, field="display_name")
 
+    from catalog.core.validate import WEAVES, check_preset_tables  # noqa: PLC0415
+
+    check_preset_tables(doc, where, WEAVES)
     bad = _non_finite_key(doc)
     if bad is not None:
         raise InputError("must be a finite number (NaN and inf are refused)", path=where, field=bad)
@@ -249,7 +257,13 @@ def preset_from_dict(doc: dict[str, Any], path: Path | None = None) -> Preset:
 def load_preset(path: str | Path) -> Preset:
     """Read and validate one preset file."""
     path = Path(path)
+    from catalog.core.atomic import register_input  # noqa: PLC0415
+
+    register_input(path)
     try:
+        if path.is_file() and path.stat().st_size > MAX_PRESET_BYTES:
+            raise InputError(f"{path.stat().st_size} bytes: a preset is at most "
+                             f"{MAX_PRESET_BYTES >> 10} KiB", path=path)
         data = path.read_bytes()
     except FileNotFoundError:
         raise InputError("no such preset file", path=path) from None
@@ -261,7 +275,12 @@ def load_preset(path: str | Path) -> Preset:
         doc = tomllib.loads(data.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"not valid TOML: {exc}", path=path) from None
-    return preset_from_dict(doc, path)
+    except RecursionError:
+        raise InputError("not valid TOML: nested too deeply", path=path) from None
+    try:
+        return preset_from_dict(doc, path)
+    except RecursionError:
+        raise InputError("nested too deeply", path=path) from None
 
 
 def _folders(fabric_dir: Path | None) -> list[Path]:

@@ -106,6 +106,10 @@ def read_image(path: str | Path) -> np.ndarray:
         raise InputError("no such pattern image", path=path)
     if path.stat().st_size == 0:
         raise InputError("the image file is empty (zero size)", path=path)
+    from catalog.core.atomic import register_input  # noqa: PLC0415
+    from catalog.core.validate import check_image_header  # noqa: PLC0415
+
+    register_input(path)
     image = oiio.ImageInput.open(str(path))
     if image is None:
         raise InputError(f"cannot read the image: {oiio.geterror().strip() or 'unknown format'}",
@@ -115,6 +119,7 @@ def read_image(path: str | Path) -> np.ndarray:
         if spec.width <= 0 or spec.height <= 0 or spec.nchannels <= 0:
             raise InputError(f"the image has zero size ({spec.width}x{spec.height}, "
                              f"{spec.nchannels} channels)", path=path)
+        check_image_header(path, spec.width, spec.height, spec.nchannels)  # before the pixels
         pixels = image.read_image(format=oiio.FLOAT)
         if pixels is None:
             raise InputError(f"cannot read the pixels: {image.geterror().strip()}", path=path)

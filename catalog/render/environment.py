@@ -35,12 +35,17 @@ def load_environment(path: str | Path) -> np.ndarray:
     path = Path(path)
     if not path.is_file():
         raise InputError("environment image not found", path=path, field="--environment")
+    from catalog.core.atomic import register_input  # noqa: PLC0415
+    from catalog.core.validate import check_image_header  # noqa: PLC0415
+
+    register_input(path)
     image = oiio.ImageInput.open(str(path))
     if image is None:
         raise InputError(f"cannot read the image: {oiio.geterror().strip() or 'unknown format'}",
                          path=path, field="--environment")
     try:
         spec = image.spec()
+        check_image_header(path, spec.width, spec.height, spec.nchannels, "--environment")
         pixels = image.read_image(0, 0, 0, min(spec.nchannels, 3), oiio.FLOAT)
         error = image.geterror()
     finally:

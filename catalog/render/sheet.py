@@ -140,11 +140,12 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
 def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluorescence,
                  bands, progress, ctx, ev, white_balance, labels) -> dict:
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
-    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.render.imagefile import write_image  # noqa: PLC0415
 
+    from catalog.render.snapshot import new_renderer  # noqa: PLC0415
+
     ctx = ctx or create_headless_context()
-    renderer = FrameRenderer(ctx, size)
+    renderer = new_renderer(ctx, size)  # the size checked against the context first
     renderer.set_fluorescence(fluorescence)
     renderer.set_bands(bands)
     renderer.set_ev(ev)

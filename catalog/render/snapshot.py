@@ -29,6 +29,49 @@ def parse_size(text: str) -> tuple[int, int]:
     return parse_wxh(text, "--size", 1, MAX_SIDE_PX)
 
 
+#: The largest single GL resource a software rasteriser allocates, bytes (Mesa llvmpipe's
+#: LP_MAX_TEXTURE_SIZE, 1 GiB; its GL_MAX_TEXTURE_SIZE of 16384 px a side does not say it).
+SOFTWARE_MAX_RESOURCE_BYTES = 1 << 30
+#: Bytes a pixel of the frame's largest target takes (RGBA32F: the HDR target).
+HDR_TARGET_BYTES_PER_PIXEL = 16
+
+
+def check_gl_size(ctx, size) -> None:
+    """Refuse, before a target is allocated, a size the context cannot hold: a side beyond
+    its queried limits (catalog.render.passes.targets.gl_size_limit) or, on a software rasteriser, an
+    HDR target above its per-resource cap."""
+    from catalog.render.passes.targets import gl_size_limit, software_rasteriser  # noqa: PLC0415
+
+    width, height = size
+    limit = gl_size_limit(ctx)
+    if width > limit or height > limit:
+        raise InputError(f"{width}x{height}: each side must be at most {limit} px (this GL "
+                         "context's limit)", field="--size")
+    need = width * height * HDR_TARGET_BYTES_PER_PIXEL
+    if software_rasteriser(ctx.info) and need > SOFTWARE_MAX_RESOURCE_BYTES:
+        side = int((SOFTWARE_MAX_RESOURCE_BYTES / HDR_TARGET_BYTES_PER_PIXEL) ** 0.5)
+        raise InputError(f"{width}x{height}: the HDR target would take {need >> 20} MiB, more "
+                         f"than the {SOFTWARE_MAX_RESOURCE_BYTES >> 20} MiB a software "
+                         f"rasteriser allocates at once (about {side}x{side} px at most)",
+                         field="--size")
+
+
+def new_renderer(ctx, size, **options):
+    """A FrameRenderer of ``size`` on ``ctx``, the size checked first (:func:`check_gl_size`);
+    a framebuffer the driver still refuses is the same one line naming --size."""
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    check_gl_size(ctx, size)
+    try:
+        return FrameRenderer(ctx, size, **options)
+    except Exception as exc:  # noqa: BLE001 - moderngl.Error is the GL driver's refusal
+        if "framebuffer" not in str(exc).lower():
+            raise
+        width, height = size
+        raise InputError(f"{width}x{height}: this GL context cannot make a framebuffer that "
+                         f"large ({' '.join(str(exc).split())[:80]})", field="--size") from None
+
+
 def check_output(path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in IMAGE_SUFFIXES:
@@ -134,8 +177,11 @@ def validate(request: SnapshotRequest):
     check_output(request.out)
     width, height = request.size
     parse_size(f"{width}x{height}")
-    if request.frame < 0:
-        raise InputError(f"{request.frame} must be >= 0", field="--frame")
+    from catalog.core import validate as checks  # noqa: PLC0415
+
+    checks.check_frame(request.frame, "--frame")
+    checks.check_camera({"--distance": request.distance_m, "--exposure": request.exposure,
+                         "--yaw": request.yaw_deg, "--pitch": request.pitch_deg})
     band_lib.check_band_count(request.bands)
     check_display_choices(request.ev, request.white_balance, request.exposure)
     preset = load_preset(find_preset(request.fabric))
@@ -165,11 +211,10 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
     import time  # noqa: PLC0415
 
     from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
-    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
     preset, light = validate(request)
     ctx = ctx or create_headless_context()
-    renderer = FrameRenderer(ctx, request.size)
+    renderer = new_renderer(ctx, request.size)
     try:
         sun = configure_renderer(renderer, request, preset, light)
         *mesh, fabric_size = simulated_curtain(preset, request.frame)

@@ -20,7 +20,8 @@ NO_DISPLAY_HINT = ("render without a window with `catalog snapshot --fabric NAME
 
 
 class NoDisplayError(EnvironmentFailure):
-    """No display to open a window on (the CLI prints the one line and exits 3)."""
+    """No display to open a window on (the CLI prints the one line and exits 3: the
+    machine lacks something, the input is fine; option values are checked first, exit 2)."""
 
 
 def display_available() -> bool:

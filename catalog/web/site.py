@@ -13,8 +13,11 @@ The site (docs/web.md)::
 
 Everything is a plain file read with <script>/<link> tags: it works from ``file://`` (no
 fetch of local files) and from any static host, with no network access at run time.
-It is built in a temporary folder beside ``DIR`` and renamed onto it when complete; an
-existing ``DIR`` is replaced only if it is an earlier catalog site or empty.
+It is staged in a marked temporary folder on ``DIR``'s file system (catalog.core.atomic)
+and moved in when complete; an existing ``DIR`` is written into only if it is an earlier
+catalog site or empty, and of an earlier site only the files its manifest
+(``catalog-web-site.json``, ``files``) lists are replaced or removed: a file the user
+added (``CNAME``) survives.
 """
 
 from __future__ import annotations
@@ -23,8 +26,6 @@ import contextlib
 import itertools
 import json
 import os
-import shutil
-import tempfile
 import time
 from importlib import resources
 from pathlib import Path
@@ -153,43 +154,34 @@ def _check_out(out: Path) -> Path:
     return out
 
 
-@contextlib.contextmanager
-def staged_folder(out: Path):
-    """A temporary folder beside ``out``, renamed onto ``out`` when the block succeeds."""
-    parent = out.resolve().parent
-    made = []
-    folder = parent
-    while not folder.exists():
-        made.append(folder)
-        folder = folder.parent
+def site_files(out: Path) -> list[str]:
+    """The files an earlier site in ``out`` wrote (its manifest's ``files``; a site written
+    before the manifest listed them: the page's fixed names and anim/*.js)."""
     try:
-        for folder in reversed(made):
-            folder.mkdir()
-        stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
-    except OSError as exc:
-        _remove_empty(made)
-        raise InputError(f"cannot write in {str(parent)!r}: {exc.strerror}", field="--out") from None
-    try:
-        yield stage
-        os.chmod(stage, 0o755 & ~_umask())
-        old = None
-        if out.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=parent))
-            os.replace(out, old / "site")
-        os.replace(stage, out)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
-        _remove_empty(made)
-        raise
+        manifest = json.loads((out / MARKER).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return []
+    files = manifest.get("files") if isinstance(manifest, dict) else None
+    if isinstance(files, list) and all(isinstance(f, str) for f in files):
+        return files
+    return [*ASSET_FILES, "data.js", MARKER,
+            *(f"anim/{p.name}" for p in sorted((out / "anim").glob("*.js")))]
 
 
-def _remove_empty(folders) -> None:
-    """Remove the folders we made above DIR (deepest first) when nothing was written."""
-    for folder in folders:
-        with contextlib.suppress(OSError):
-            folder.rmdir()
+def _replace_listed(new_files: list[str]):
+    """Before the new site's files are moved in: remove the earlier site's files that the
+    new one does not write. Only files the manifest lists, inside the site, are touched:
+    a file the user added (a CNAME) survives."""
+    def remove(out: Path) -> None:
+        root = out.resolve()
+        for name in site_files(out):
+            target = (out / name)
+            if name in new_files or not target.resolve().is_relative_to(root):
+                continue
+            with contextlib.suppress(OSError):
+                if target.is_file() and not target.is_symlink():
+                    target.unlink()
+    return remove
 
 
 def _umask() -> int:
@@ -225,7 +217,10 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         scene_lib.dye_transmittance(preset)
         scene_lib.fluorescent_material(preset)
 
-    with staged_folder(out) as stage:
+    from catalog.core.atomic import STAGE_MARKER, staged_folder  # noqa: PLC0415
+
+    new_files: list[str] = []
+    with staged_folder(out, replace_listed=_replace_listed(new_files)) as stage:
         timings = {}
         t = time.perf_counter()
         animations = {}
@@ -313,7 +308,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         for name in ASSET_FILES:
             (stage / name).write_bytes(_asset(name))
         sizes = {p.relative_to(stage).as_posix(): p.stat().st_size
-                 for p in sorted(stage.rglob("*")) if p.is_file()}
+                 for p in sorted(stage.rglob("*")) if p.is_file() and p.name != STAGE_MARKER}
         report = {"out": str(out), "fabrics": names, "lights": [c.id for c in choices],
                   "scenes": len(scenes), "structures": len(exporter.structures),
                   "shader_programs": len(objects["shaders"]),
@@ -323,8 +318,10 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                   + max(a.stat().st_size for a in (stage / "anim").iterdir()),
                   "data_js_plain_bytes": plain_bytes,
                   **{k: round(v, 3) for k, v in timings.items()}}
+        new_files.extend([*sizes, MARKER])
         (stage / MARKER).write_text(json.dumps({"format": FORMAT_VERSION, "fabrics": names,
-                                                "lights": report["lights"]}, indent=1) + "\n",
+                                                "lights": report["lights"],
+                                                "files": sorted(new_files)}, indent=1) + "\n",
                                     encoding="utf-8")
     report["build_s"] = round(time.perf_counter() - start, 3)
     if not (out / "index.html").is_file():

@@ -128,11 +128,19 @@ def _numbers(path: Path, line_no: int, fields: list[str], what: str) -> list[flo
     return out
 
 
+#: The most wavelengths one axis of a matrix file may list (1 nm steps over 200-2000 nm);
+#: a dimension line claiming more is refused before any row is read.
+MAX_AXIS_COUNT = 1801
+
+
 def _axis(path: Path, line_no: int, start: float, stop: float, step: float, count: float,
           what: str) -> np.ndarray:
-    if not (step > 0 and count == int(count) and count >= 2):
+    if not (step > 0 and math.isfinite(count) and count == int(count) and count >= 2):
         raise InputError(f"{what} axis: need a step > 0 and a whole count >= 2, got step "
                          f"{step:g}, count {count:g}", path=path, line=line_no)
+    if count > MAX_AXIS_COUNT:
+        raise InputError(f"{what} axis: the dimension line claims {count:g} wavelengths, more "
+                         f"than the {MAX_AXIS_COUNT} a matrix file holds", path=path, line=line_no)
     axis = start + step * np.arange(int(count))
     if abs(axis[-1] - stop) > 1e-6 * step:
         raise InputError(f"{what} axis: {start:g} + {step:g} x ({int(count)} - 1) is "
