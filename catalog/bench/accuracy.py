@@ -52,7 +52,7 @@ ROOMS = ("box",)
 SIZE = (160, 90)
 QUICK_SIZE = (64, 36)
 #: The references' samples per pixel (two halves of SPP / 2).
-SPP = 1024
+SPP = 512
 QUICK_SPP = 16
 DEFAULT_SCENES = 48
 QUICK_SCENES = 2
@@ -75,6 +75,17 @@ LIGHT_FAMILIES = {
     "UV and violet lamp": ("UV-A", "UV-385", "LED-405", "LED-violet-white"),
 }
 SUN_HOURS = (6.0, 20.0)
+#: The sun is drawn only where the product has it above the horizon (zenith below this).
+SUN_ZENITH_LIMIT_DEG = 89.0
+
+
+def sun_hours() -> tuple[float, float]:
+    """SUN_HOURS cut to where the product's sun is up (zenith < SUN_ZENITH_LIMIT_DEG), 0.01 h steps."""
+    from catalog.render.scene import solar_zenith_deg  # noqa: PLC0415
+
+    up = [h for h in np.arange(SUN_HOURS[0], SUN_HOURS[1] + 1e-9, 0.01)
+          if solar_zenith_deg(float(h)) < SUN_ZENITH_LIMIT_DEG]
+    return float(up[0]), float(up[-1])
 #: The issue's goals (issue 33), on at least 48 report scenes.
 GOAL = {"median_mean_flip_at_most": 0.06, "p90_mean_flip_at_most": 0.09, "max_mean_flip_at_most": 0.12,
         "median_curtain_delta_e_at_most": 1.5, "speedup_at_least": 1000.0}
@@ -107,12 +118,13 @@ def draw_scenes(count: int, seed: int, room: str | None = None) -> list[dict]:
     rng = np.random.default_rng(seed)
     fabrics = catalog_fabrics()
     families = list(LIGHT_FAMILIES)
+    hours = sun_hours()
     scenes = []
     for index in range(count):
         fabric = fabrics[rng.integers(len(fabrics))]
         family = families[rng.integers(len(families))]
         if LIGHT_FAMILIES[family] is None:
-            hour = float(rng.uniform(*SUN_HOURS))
+            hour = float(rng.uniform(*hours))
             light, light_label = sun_at_hour(hour).light_name, f"sun at {hour:.1f} h"
         else:
             names = LIGHT_FAMILIES[family]
@@ -258,6 +270,8 @@ def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5)
         "curtain_pixels": int(halves["masks"]["curtain"].sum()),
         "reference_flip_noise": noise,
         "noise_below_fifth": bool(noise < mean_flip / 5.0),
+        # the spp at which the noise would be a fifth of this FLIP (noise ~ 1 / sqrt(spp))
+        "spp_for_noise_rule": float(spp * (5.0 * noise / mean_flip) ** 2) if mean_flip > 0 else None,
         "frame_ms": 1e3 * frame_s, "reference_s": float(halves["seconds"]),
         "speedup": float(halves["seconds"]) / frame_s if frame_s > 0 else math.inf,
         "display_scale": scale,
@@ -298,8 +312,10 @@ def summarise(rows: list[dict]) -> dict:
 
 def run(quick: bool = False, ctx=None, scenes: int | None = None, seed: int | None = None,
         room: str | None = None, size=None, spp: int | None = None, cases: list[dict] | None = None,
-        progress=None) -> dict:
-    """The section: ``scenes`` drawn with ``seed`` (REPORT_SEED by default), or ``cases``."""
+        progress=None, rows_out: Path | None = None) -> dict:
+    """The section: ``scenes`` drawn with ``seed`` (REPORT_SEED by default), or ``cases``.
+    ``rows_out``: each row appended there as one JSON line as soon as it is measured (a long
+    run's finished scenes survive it)."""
     if ctx is None:
         from catalog.gl.context import create_headless_context  # noqa: PLC0415
 
@@ -318,6 +334,12 @@ def run(quick: bool = False, ctx=None, scenes: int | None = None, seed: int | No
         row, pictures = measure_scene(ctx, dict(scene), size, spp, own, repeats=3 if quick else 5)
         rows.append(row)
         images[row["label"]] = pictures
+        if rows_out is not None:
+            import json  # noqa: PLC0415
+
+            with open(rows_out, "a", encoding="utf-8") as handle:
+                handle.write(json.dumps(row) + "\n")
+            np.savez_compressed(Path(rows_out).with_suffix(f".{number:02d}.npz"), **pictures)
         if progress is not None:
             progress(f"accuracy {number}/{len(chosen)}: {row['label']}: FLIP {row['mean_flip']:.3f}, "
                      f"noise {row['reference_flip_noise']:.3f}, reference {row['reference_s']:.0f} s, "
@@ -403,3 +425,69 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"(goal >= {GOAL['speedup_at_least']:g}x: {yes('speedup')}). Worst: {'; '.join(s['worst'])}.",
     ])
     return {"accuracy": "\n".join(lines), "accuracy-summary": summary}
+
+
+def git_commit() -> str:
+    import subprocess  # noqa: PLC0415
+
+    return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                          check=False).stdout.strip() or "unknown"
+
+
+def record(scenes: int = DEFAULT_SCENES, rows_out: Path = Path("bench-out/accuracy-rows.jsonl")) -> dict:
+    """The report run: ``scenes`` of REPORT_SEED at SIZE and SPP, its rows streamed to
+    ``rows_out``; then :func:`publish` from them."""
+    import sys  # noqa: PLC0415
+
+    rows_out.parent.mkdir(parents=True, exist_ok=True)
+    commit = git_commit()
+    run(scenes=scenes, seed=REPORT_SEED, rows_out=rows_out,
+        progress=lambda text: print(text, file=sys.stderr, flush=True))
+    return publish(rows_out, commit, planned=scenes)
+
+
+def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RESULT_JSON),
+            image_folder: Path = Path("docs/img"), doc: Path = Path("docs/accuracy.md")) -> dict:
+    """The committed figures from a run's streamed rows: RESULT_JSON, the worst scenes' error
+    maps in ``image_folder`` and the generated block of ``doc`` (between its markers)."""
+    import json  # noqa: PLC0415
+
+    from catalog.bench.image import triptych  # noqa: PLC0415
+    from catalog.bench.plots import pyplot  # noqa: PLC0415
+    from catalog.core.atomic import atomic_path, write_text_atomic  # noqa: PLC0415
+
+    lines = Path(rows_out).read_text(encoding="utf-8").splitlines()
+    rows = [json.loads(line) for line in lines if line.strip()]
+    summary = summarise(rows)
+    first = rows[0]
+    result = {"commit": commit, "planned_scenes": planned, "rows": rows, "summary": summary,
+              "settings": {"size": first["size"], "spp": first["spp"], "seed": REPORT_SEED,
+                           "report_seed": REPORT_SEED, "tune_seed": TUNE_SEED, "room": None,
+                           "display": {"exposure": f"reference luminance p99 -> {P99_TARGET}",
+                                       "tone": f"x (1 + x / {TONE_WHITE:g}^2) / (1 + x)",
+                                       "white_balance": "none (sRGB white)", "glare": "none"}}}
+    for rank, label in enumerate(summary["worst"], 1):
+        number = next(i for i, r in enumerate(rows, 1) if r["label"] == label)
+        with np.load(Path(rows_out).with_suffix(f".{number:02d}.npz")) as data:
+            pictures = {k: data[k] for k in data.files}
+        with atomic_path(Path(image_folder) / f"accuracy_worst_{rank}.png") as tmp:
+            pyplot().imsave(tmp, triptych(pictures), format="png")
+    write_text_atomic(Path(json_path), json.dumps(result, indent=1) + "\n")
+    blocks = markdown_tables(result)
+    text = Path(doc).read_text(encoding="utf-8")
+    for name, block in blocks.items():
+        begin, end = f"<!-- begin {name} -->", f"<!-- end {name} -->"
+        head, _, rest = text.partition(begin)
+        _, _, tail = rest.partition(end)
+        text = f"{head}{begin}\n{block}\n{end}{tail}"
+    write_text_atomic(Path(doc), text)
+    return result
+
+
+if __name__ == "__main__":
+    import sys
+
+    if sys.argv[1:2] == ["record"]:
+        record(int(sys.argv[2]) if len(sys.argv) > 2 else DEFAULT_SCENES)
+    elif sys.argv[1:2] == ["publish"]:   # publish ROWS.jsonl COMMIT PLANNED
+        publish(Path(sys.argv[2]), sys.argv[3], int(sys.argv[4]))
