@@ -38,6 +38,7 @@ published figures (``python -m catalog.bench.accuracy record`` regenerates them)
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from pathlib import Path
@@ -53,7 +54,7 @@ SIZE = (160, 90)
 QUICK_SIZE = (64, 36)
 #: The references' samples per pixel (two halves of SPP / 2).
 SPP = 512
-QUICK_SPP = 16
+QUICK_SPP = 64
 DEFAULT_SCENES = 48
 QUICK_SCENES = 2
 #: The neutral display: the reference's luminance 99th percentile -> P99_TARGET, then the tone
@@ -79,6 +80,7 @@ SUN_HOURS = (6.0, 20.0)
 SUN_ZENITH_LIMIT_DEG = 89.0
 
 
+@functools.lru_cache(maxsize=1)
 def sun_hours() -> tuple[float, float]:
     """SUN_HOURS cut to where the product's sun is up (zenith < SUN_ZENITH_LIMIT_DEG), 0.01 h steps."""
     from catalog.render.scene import solar_zenith_deg  # noqa: PLC0415
@@ -91,6 +93,12 @@ GOAL = {"median_mean_flip_at_most": 0.06, "p90_mean_flip_at_most": 0.09, "max_me
         "median_curtain_delta_e_at_most": 1.5, "speedup_at_least": 1000.0}
 #: The image bench's six scenes as named cases (``--seed`` none: ``named_cases()``).
 RESULT_JSON = "benchmarks/bench_accuracy.json"
+#: The CI sample (tests/test_bench_accuracy.py): ``catalog bench --quick --sections accuracy
+#: --scenes CI_SCENES --seed CI_SEED`` (QUICK_SIZE, QUICK_SPP), its recorded rows in CI_JSON
+#: (``python -m catalog.bench.accuracy ci``). The tune seed's first scenes.
+CI_SEED = TUNE_SEED
+CI_SCENES = 3
+CI_JSON = "benchmarks/bench_accuracy_ci.json"
 WORST_SHOWN = 3
 
 
@@ -484,10 +492,28 @@ def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RE
     return result
 
 
+def record_ci(json_path: Path = Path(CI_JSON)) -> dict:
+    """Run the CI sample and keep its per-scene FLIP and the reference's noise in ``json_path``."""
+    import json  # noqa: PLC0415
+
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    result = run(quick=True, scenes=CI_SCENES, seed=CI_SEED)
+    result.pop("_images")
+    kept = {"commit": git_commit(), "seed": CI_SEED, "scenes": CI_SCENES,
+            "size": list(QUICK_SIZE), "spp": QUICK_SPP,
+            "rows": [{k: r[k] for k in ("label", "mean_flip", "reference_flip_noise",
+                                        "curtain_delta_e_mean")} for r in result["rows"]]}
+    write_text_atomic(json_path, json.dumps(kept, indent=1) + "\n")
+    return kept
+
+
 if __name__ == "__main__":
     import sys
 
     if sys.argv[1:2] == ["record"]:
         record(int(sys.argv[2]) if len(sys.argv) > 2 else DEFAULT_SCENES)
+    elif sys.argv[1:2] == ["ci"]:
+        record_ci()
     elif sys.argv[1:2] == ["publish"]:   # publish ROWS.jsonl COMMIT PLANNED
         publish(Path(sys.argv[2]), sys.argv[3], int(sys.argv[4]))
