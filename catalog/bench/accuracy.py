@@ -432,7 +432,13 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"the frame {s['speedup']['min']:,.0f}x (least) to {s['speedup']['median']:,.0f}x (median) faster "
         f"(goal >= {GOAL['speedup_at_least']:g}x: {yes('speedup')}). Worst: {'; '.join(s['worst'])}.",
     ])
-    return {"accuracy": "\n".join(lines), "accuracy-summary": summary}
+    readme = (f"Over {s['scenes']} scenes drawn at random from the whole scene space (report seed "
+              f"{cfg['seed']}, {cfg['size'][0]}x{cfg['size'][1]} px, docs/accuracy.md; measured on "
+              f"{result.get('commit', '?')}): mean FLIP median {_cell(f['median'])}, p90 {_cell(f['p90'])}, "
+              f"max {_cell(f['max'])} (goals 0.06 / 0.09 / 0.12); curtain Delta E 2000 median "
+              f"{_cell(d['median'])} (goal 1.5); the frame {s['speedup']['min']:,.0f}x to "
+              f"{s['speedup']['median']:,.0f}x (median) faster than the reference.")
+    return {"accuracy": "\n".join(lines), "accuracy-summary": summary, "accuracy-readme": readme}
 
 
 def git_commit() -> str:
@@ -455,9 +461,9 @@ def record(scenes: int = DEFAULT_SCENES, rows_out: Path = Path("bench-out/accura
 
 
 def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RESULT_JSON),
-            image_folder: Path = Path("docs/img"), doc: Path = Path("docs/accuracy.md")) -> dict:
-    """The committed figures from a run's streamed rows: RESULT_JSON, the worst scenes' error
-    maps in ``image_folder`` and the generated block of ``doc`` (between its markers)."""
+            image_folder: Path = Path("docs/img")) -> dict:
+    """The committed figures from a run's streamed rows: RESULT_JSON and the worst scenes'
+    error maps in ``image_folder`` (then tools/docs_figures.py fills the docs' blocks)."""
     import json  # noqa: PLC0415
 
     from catalog.bench.image import triptych  # noqa: PLC0415
@@ -481,14 +487,7 @@ def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RE
         with atomic_path(Path(image_folder) / f"accuracy_worst_{rank}.png") as tmp:
             pyplot().imsave(tmp, triptych(pictures), format="png")
     write_text_atomic(Path(json_path), json.dumps(result, indent=1) + "\n")
-    blocks = markdown_tables(result)
-    text = Path(doc).read_text(encoding="utf-8")
-    for name, block in blocks.items():
-        begin, end = f"<!-- begin {name} -->", f"<!-- end {name} -->"
-        head, _, rest = text.partition(begin)
-        _, _, tail = rest.partition(end)
-        text = f"{head}{begin}\n{block}\n{end}{tail}"
-    write_text_atomic(Path(doc), text)
+    # the docs' blocks (docs/accuracy.md, README.md) from the JSON: tools/docs_figures.py
     return result
 
 
