@@ -289,6 +289,46 @@ def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5)
     return row, {"frame": shown_frame, "reference": shown_reference, "flip": flip}
 
 
+#: The regions the FLIP is split by (catalog.pathtrace.render.region_masks): the curtain, the
+#: room (floor, walls, rod) and the outside seen through the window.
+SPLIT_REGIONS = {"curtain": ("curtain",), "room": ("floor", "walls", "other"), "outside": ("outside",)}
+
+
+def region_flip(flip: np.ndarray, masks: dict) -> dict:
+    """Per region of SPLIT_REGIONS: its share of the image's summed FLIP and its pixels' share."""
+    total = float(flip.sum()) or 1.0
+    out = {}
+    for name, parts in SPLIT_REGIONS.items():
+        mask = np.zeros(flip.shape, dtype=bool)
+        for part in parts:
+            mask |= masks[part]
+        out[name] = {"flip_share": float(flip[mask].sum()) / total, "pixel_share": float(mask.mean()),
+                     "mean_flip": float(flip[mask].mean()) if mask.any() else None}
+    return out
+
+
+def add_region_split(rows: list[dict], rows_out: Path) -> None:
+    """Each row's FLIP split by region (``flip_by_region``), from its streamed FLIP map and the
+    region masks of its scene (a ray per pixel centre through the reference's geometry)."""
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
+    from catalog.pathtrace.render import MAX_DEPTH, region_masks  # noqa: PLC0415
+    from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+
+    mi = load_mitsuba("llvm_ad_rgb")
+    for number, row in enumerate(rows, 1):
+        if "flip_by_region" in row:
+            continue
+        cam = row["camera"]
+        desc = describe_scene(load_preset(find_preset(row["fabric"])), get_light(row["light"]),
+                              size=tuple(row["size"]), yaw_deg=cam["yaw_deg"], pitch_deg=cam["pitch_deg"],
+                              distance_m=cam["distance_m"])
+        masks = region_masks(mi, build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH), desc)
+        with np.load(Path(rows_out).with_suffix(f".{number:02d}.npz")) as data:
+            row["flip_by_region"] = region_flip(data["flip"], masks)
+
+
 def stats(values: list[float]) -> dict:
     v = np.asarray([x for x in values if x is not None], dtype=np.float64)
     if not len(v):
@@ -309,7 +349,18 @@ def summarise(rows: list[dict]) -> dict:
         "scenes": len(rows) >= DEFAULT_SCENES,
     }
     worst = sorted(rows, key=lambda r: -r["mean_flip"])[:WORST_SHOWN]
+    split = {}
+    if all("flip_by_region" in r for r in rows):
+        split = {name: float(np.mean([r["flip_by_region"][name]["flip_share"] for r in rows]))
+                 for name in SPLIT_REGIONS}
+    by_family, by_fabric = {}, {}
+    for r in rows:
+        by_family.setdefault(r["light_family"], []).append(r["mean_flip"])
+        by_fabric.setdefault(r["fabric"], []).append(r["mean_flip"])
     return {"scenes": len(rows), "mean_flip": flip, "curtain_delta_e_mean": de,
+            "flip_share_by_region": split,
+            "median_flip_by_light_family": {k: float(np.median(v)) for k, v in by_family.items()},
+            "median_flip_by_fabric": {k: float(np.median(v)) for k, v in sorted(by_fabric.items())},
             "speedup": {"min": float(min(speed)), "median": float(np.median(speed))},
             "frame_ms_median": float(np.median([r["frame_ms"] for r in rows])),
             "reference_s_median": float(np.median([r["reference_s"] for r in rows])),
@@ -432,6 +483,13 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"the frame {s['speedup']['min']:,.0f}x (least) to {s['speedup']['median']:,.0f}x (median) faster "
         f"(goal >= {GOAL['speedup_at_least']:g}x: {yes('speedup')}). Worst: {'; '.join(s['worst'])}.",
     ])
+    if s.get("flip_share_by_region"):
+        share = s["flip_share_by_region"]
+        summary += ("\n\nWhere the FLIP is (mean over the scenes of each region's share of the image's "
+                    "summed FLIP): " + ", ".join(f"{k} {v:.0%}" for k, v in share.items()) + ".")
+    summary += ("\n\nMedian mean FLIP by light family: " + ", ".join(
+        f"{k} {v:.3f}" for k, v in s["median_flip_by_light_family"].items())
+        + "; by fabric: " + ", ".join(f"{k} {v:.3f}" for k, v in s.get("median_flip_by_fabric", {}).items()) + ".")
     readme = (f"Over {s['scenes']} scenes drawn at random from the whole scene space (report seed "
               f"{cfg['seed']}, {cfg['size'][0]}x{cfg['size'][1]} px, docs/accuracy.md; measured on "
               f"{result.get('commit', '?')}): mean FLIP median {_cell(f['median'])}, p90 {_cell(f['p90'])}, "
@@ -472,6 +530,7 @@ def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RE
 
     lines = Path(rows_out).read_text(encoding="utf-8").splitlines()
     rows = [json.loads(line) for line in lines if line.strip()]
+    add_region_split(rows, rows_out)
     summary = summarise(rows)
     first = rows[0]
     result = {"commit": commit, "planned_scenes": planned, "rows": rows, "summary": summary,
