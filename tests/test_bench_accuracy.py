@@ -39,6 +39,14 @@ def test_draw_is_seeded_and_covers_the_space():
         assert scene["room"] in accuracy.ROOMS
 
 
+def test_the_image_benchs_scenes_are_named_cases():
+    from catalog.bench import image
+
+    cases = accuracy.named_cases()
+    assert [c["label"] for c in cases] == [label for label, *_ in image.SCENES]
+    assert all(c["fabric"] in accuracy.catalog_fabrics() for c in cases)
+
+
 def test_sun_hours_are_above_the_horizon():
     from catalog.render.scene import solar_zenith_deg
 
