@@ -366,6 +366,10 @@ def summarise(rows: list[dict]) -> dict:
             "reference_s_median": float(np.median([r["reference_s"] for r in rows])),
             "reference_flip_noise": stats([r["reference_flip_noise"] for r in rows]),
             "scenes_noise_not_below_fifth": sum(not r["noise_below_fifth"] for r in rows),
+            # the spp the noise rule needs (noise ~ 1 / sqrt(spp)) and the reference time it projects
+            "spp_for_noise_rule_median": float(np.median([r.get("spp_for_noise_rule") or 0.0 for r in rows])),
+            "reference_s_for_noise_rule_total": float(sum(r["reference_s"] * max(1.0, (r.get("spp_for_noise_rule") or 0.0) / r["spp"])
+                                                       for r in rows)),
             "goal": GOAL, "goal_met": met, "worst": [r["label"] for r in worst]}
 
 
@@ -476,6 +480,10 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"median <= {GOAL['median_curtain_delta_e_at_most']}: {yes('median_curtain_delta_e')} |",
         f"| reference noise (FLIP of its halves) | {_cell(n['median'])} | {_cell(n['p90'])} | {_cell(n['max'])} | "
         f"< 1/5 of the FLIP judged: {s['scenes'] - s['scenes_noise_not_below_fifth']} of {s['scenes']} scenes |",
+        "",
+        f"The noise rule (the reference's noise below a fifth of the FLIP it judges) would need "
+        f"{s.get('spp_for_noise_rule_median', 0):,.0f} spp at the median scene; these references at that "
+        f"spp would take {s.get('reference_s_for_noise_rule_total', 0) / 3600:.1f} h on this machine.",
         "",
         f"{s['scenes']} scenes (seed {cfg['seed']}; report seed {cfg['report_seed']}), "
         f"{cfg['size'][0]}x{cfg['size'][1]} px, reference {cfg['spp']} spp (2 x {cfg['spp'] // 2}). "
