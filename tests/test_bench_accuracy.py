@@ -103,7 +103,7 @@ def test_curtain_delta_e_against_the_projects_ciede2000():
 def test_summary_statistics():
     rows = [{"mean_flip": f, "curtain_delta_e_mean": 1.0 + f, "speedup": 2000.0, "frame_ms": 1.0,
              "reference_s": 2.0, "reference_flip_noise": 0.01, "noise_below_fifth": True,
-             "label": str(f), "light_family": "LED", "fabric": "voile-white"} for f in np.linspace(0.01, 0.1, 10)]
+             "label": str(f), "light_family": "LED", "fabric": "voile-white", "spp": 512, "spp_for_noise_rule": 1024.0} for f in np.linspace(0.01, 0.1, 10)]
     s = accuracy.summarise(rows)
     assert s["mean_flip"]["median"] == pytest.approx(0.055)
     assert s["mean_flip"]["p90"] == pytest.approx(np.percentile(np.linspace(0.01, 0.1, 10), 90))
@@ -111,6 +111,8 @@ def test_summary_statistics():
     assert s["worst"][0] == str(0.1)
     assert s["goal_met"]["median_mean_flip"] and s["goal_met"]["max_mean_flip"]
     assert not s["goal_met"]["scenes"]
+    assert s["spp_for_noise_rule_median"] == 1024.0
+    assert s["reference_s_for_noise_rule_total"] == pytest.approx(10 * 2.0 * 2)
 
 
 @pytest.mark.slow
