@@ -142,15 +142,15 @@ def test_voile_near_neutral_every_daylight_hour(curtain_lab):
 
 @pytest.mark.slow
 def test_lace_bluer_than_voile_in_the_day(curtain_lab):
-    """The brightener's blue survives: lace b* at least 1.5 below the voile's, 7-17 h
-    (measured 3.8-5.1 below)."""
-    for hour in HOURS[:-2]:
+    """The brightener's blue survives: lace b* at least 1.5 below the voile's, 7-18 h
+    (measured 2.7-5.1 below)."""
+    for hour in HOURS[:-1]:
         assert curtain_lab("lace-fwa", hour)[0][2] <= curtain_lab("voile-white", hour)[0][2] - 1.5, hour
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="issue 33 goal not met at 18-19 h and sunset: the low sun "
-                                      "excites little brightener behind the room's warm white")
+@pytest.mark.xfail(strict=True, reason="issue 33 goal not met at 19 h (0.6 b* below the voile): "
+                                      "the low sun excites little brightener")
 def test_lace_bluer_than_voile_under_every_daylight(curtain_lab):
     for hour in HOURS:
         assert curtain_lab("lace-fwa", hour)[0][2] <= curtain_lab("voile-white", hour)[0][2] - 1.5, hour

@@ -83,6 +83,22 @@ def run(fabric: str = "linen-dense", spp: int = 256, hours=HOURS) -> dict:
     return {"rows": rows, "settings": {"size": list(SIZE), "sigma_px": SIGMA_PX, "view": "default"}}
 
 
+def markdown_tables(result: dict) -> dict[str, str]:
+    """``see-through``: per hour, the curtain's high-pass energy of frame and reference, ratio."""
+    lines = ["| fabric | hour | light | H frame | H reference (noise removed) | H reference with noise | "
+             "frame / reference | within 1.5x |", "|---|---|---|---|---|---|---|---|"]
+    for r in result["rows"]:
+        ratio = r["ratio"]
+        within = ratio is not None and 1 / 1.5 <= ratio <= 1.5
+        lines.append(f"| {r['fabric']} | {r['hour']:g} | {r['light']} | {r['h_frame']:.2e} | "
+                     f"{r['h_reference']:.2e} | {r['h_reference_with_noise']:.2e} | "
+                     f"{'-' if ratio is None else f'{ratio:.2f}'} | {'yes' if within else 'no'} |")
+    cfg = result["settings"]
+    lines += ["", f"Default view, {cfg['size'][0]}x{cfg['size'][1]} px, Gaussian sigma {cfg['sigma_px']} px, "
+                  f"reference {result['rows'][0]['spp']} spp; measured on {result.get('commit', '?')}."]
+    return {"see-through": "\n".join(lines)}
+
+
 if __name__ == "__main__":
     from catalog.bench.accuracy import git_commit
 
