@@ -6,18 +6,18 @@ a high sun a south window lets in little of the beam and much of the blue sky, s
 light is bluer than the sun. The room's surfaces are neutral (ROOM_ALBEDO is one number), so
 the chromaticity of the room's mean irradiance is that of the light entering it:
 
-    E_in(l) = T(l) [K(l) max(0, -d_z) + (pi / 2) (L_sky(l) + L_ground(l))]
+    E_in(l) = K(l) max(0, -d_z) + (pi / 2) (L_sky(l) + L_ground(l))
 
 - K: the key's normal irradiance, d its direction to the light (the window's plane is z =
   WINDOW_Z, the room on +z, so the beam falls on the window's outer face with cosine -d_z);
 - the outside's half-space as the frame's stand-in has it: the sky's mean radiance above the
   horizon and the ground's below, each over a quarter sphere, which a vertical plane sees with
-  weight pi / 2 each;
-- T: the closed curtain's transmission of that light, its open area plus its forward lobes
-  through the dye, ``direct + dye(l) (a_diff f_d + a_spec f_s)`` (f: the HG lobes' forward
-  hemisphere shares, catalog.optics.shading_reference.hg_hemisphere_factors); 1 when open.
-  The curtain's fluorescence is left out on purpose: the eye adapts to the light, and the
-  brightener's blue-white must survive the adaptation.
+  weight pi / 2 each.
+
+The curtain's own filtering is left out on purpose, its dye as well as its fluorescence: the
+adapting white is the window's light, the same for every fabric, so that fabrics compare under
+one adaptation (a pink curtain is not discounted as a pink illuminant, and the brightener's
+blue-white survives: the eye adapts to the light, not to the cloth).
 
 Adaptation is CAT16 (Li et al. 2017) with its degree of adaptation D (eq. of CIECAM02 / CAM16):
 D = F (1 - (1 / 3.6) exp((-L_A - 42) / 92)), for the viewer of the display image: the sRGB
@@ -60,33 +60,21 @@ def cat16_matrix(source_white_xyz, target_white_xyz, degree: float, cat16: np.nd
     return np.linalg.inv(m) @ np.diag(gains) @ m
 
 
-def curtain_transmission(inputs) -> np.ndarray:
-    """The closed curtain's transmission of diffuse and beam light into the room, per
-    wavelength, fluorescence excluded: direct + dye (a_diff f_d + a_spec f_s)."""
-    from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
-
-    fwd_d, _ = hg_hemisphere_factors(inputs.g_diff)
-    fwd_s, _ = hg_hemisphere_factors(inputs.g_spec)
-    dye = np.asarray(inputs.dye_transmittance, dtype=np.float64)
-    return inputs.direct + dye * (inputs.a_diff * fwd_d + inputs.a_spec * fwd_s)
-
-
-def entering_irradiance(inputs, curtain_open: bool = False) -> np.ndarray:
+def entering_irradiance(inputs) -> np.ndarray:
     """E_in(l) (module docstring), W m^-2 nm^-1 on the window's plane, into the room."""
     key = np.asarray(inputs.key_irradiance, dtype=np.float64)
     to_light = np.asarray(inputs.key_to_light, dtype=np.float64)
     beam = key * max(0.0, -float(to_light[2]) / float(np.linalg.norm(to_light)))
     outside = 0.5 * math.pi * (np.asarray(inputs.sky_radiance) + np.asarray(inputs.ground_radiance))
-    light = beam + outside
-    return light if curtain_open else light * curtain_transmission(inputs)
+    return beam + outside
 
 
-def adapting_white_xyz(inputs, curtain_open: bool = False) -> np.ndarray:
+def adapting_white_xyz(inputs) -> np.ndarray:
     """XYZ (a white diffuser's radiance, cd m^-2) under the light entering the room; falls
-    back to the key's own white where no light enters (a curtain that passes nothing)."""
+    back to the key's own white where none is defined."""
     from catalog.optics.shading_reference import spectral_to_xyz, white_xyz  # noqa: PLC0415
 
-    xyz = spectral_to_xyz(entering_irradiance(inputs, curtain_open) / math.pi)
+    xyz = spectral_to_xyz(entering_irradiance(inputs) / math.pi)
     if not (np.all(np.isfinite(xyz)) and xyz[1] > 0):
         return white_xyz(inputs)
     return np.asarray(xyz, dtype=np.float64)

@@ -1134,12 +1134,12 @@ class FrameRenderer:
         """Linear sRGB -> linear sRGB: CAT16 from the white of the light reaching the viewer to
         D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity."""
         inputs = self.shading_inputs()
-        key = (self._inputs_key, self.white_balance, self.curtain_open)
+        key = (self._inputs_key, self.white_balance)
         if self._wb_cache is None or self._wb_cache[0] != key:
             from catalog.render import adaptation  # noqa: PLC0415
 
             self._wb_cache = (key, display_lib.white_balance_matrix(
-                adaptation.adapting_white_xyz(inputs, self.curtain_open), self.white_balance,
+                adaptation.adapting_white_xyz(inputs), self.white_balance,
                 adaptation.degree_of_adaptation()))
         return self._wb_cache[1]
 
