@@ -491,6 +491,14 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"the frame {s['speedup']['min']:,.0f}x (least) to {s['speedup']['median']:,.0f}x (median) faster "
         f"(goal >= {GOAL['speedup_at_least']:g}x: {yes('speedup')}). Worst: {'; '.join(s['worst'])}.",
     ])
+    planned = result.get("planned_scenes")
+    if planned and planned > s["scenes"]:
+        per_scene = float(np.mean([r["reference_s"] for r in result["rows"]]))
+        summary += (f"\n\nThe run measured {s['scenes']} of the {planned} planned scenes (the report seed's "
+                    f"first {s['scenes']}: the draw is seeded, so they are the start of the same list) in the "
+                    f"time the shared machine allowed; the {planned} scenes project to "
+                    f"{planned * per_scene / 3600:.1f} h of reference time at {cfg['spp']} spp "
+                    f"(mean {per_scene:.0f} s a scene).")
     if s.get("flip_share_by_region"):
         share = s["flip_share_by_region"]
         summary += ("\n\nWhere the FLIP is (mean over the scenes of each region's share of the image's "
