@@ -273,8 +273,9 @@ def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5)
     row.update({
         "size": list(size), "spp": spp, "reference_variant": halves["variant"],
         "mean_flip": mean_flip,
-        "curtain_delta_e_mean": None if de is None else float(de.mean()),
-        "curtain_delta_e_p95": None if de is None else float(np.percentile(de, 95)),
+        "curtain_delta_e_mean": None if de is None else float(np.nanmean(de)),
+        "curtain_delta_e_p95": None if de is None else float(np.nanpercentile(de, 95)),
+        "curtain_delta_e_nan_pixels": 0 if de is None else int(np.isnan(de).sum()),
         "curtain_pixels": int(halves["masks"]["curtain"].sum()),
         "reference_flip_noise": noise,
         "noise_below_fifth": bool(noise < mean_flip / 5.0),
@@ -330,7 +331,9 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
 
 
 def stats(values: list[float]) -> dict:
-    v = np.asarray([x for x in values if x is not None], dtype=np.float64)
+    """Median, p90 and max of the finite values (a scene's NaN, e.g. a Delta E of a pixel
+    colour-science could not convert, is left out and counted in the row's table)."""
+    v = np.asarray([x for x in values if x is not None and math.isfinite(x)], dtype=np.float64)
     if not len(v):
         return {"median": None, "p90": None, "max": None}
     return {"median": float(np.median(v)), "p90": float(np.percentile(v, 90)), "max": float(v.max())}
@@ -547,6 +550,10 @@ def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RE
     lines = Path(rows_out).read_text(encoding="utf-8").splitlines()
     rows = [json.loads(line) for line in lines if line.strip()]
     add_region_split(rows, rows_out)
+    for row in rows:   # a NaN (a scene's Delta E over a pixel colour-science could not convert) -> null
+        for key, value in row.items():
+            if isinstance(value, float) and not math.isfinite(value):
+                row[key] = None
     summary = summarise(rows)
     first = rows[0]
     result = {"commit": commit, "planned_scenes": planned, "rows": rows, "summary": summary,
