@@ -51,7 +51,9 @@ def test_camera_white_balance_leaves_a_lamp_warm(gl, tmp_path):
                              ctx=gl)
     r_room, _, b_room = room["mean_srgb8"]
     r_cam, _, b_cam = camera["mean_srgb8"]
-    assert abs(r_room - b_room) < 10 < r_cam - b_cam  # adapted: neutral; camera: orange
+    # adapted (CAT16 with its degree of adaptation, D = 0.852): a warm residue, far less
+    # orange than the camera's fixed D65 balance
+    assert 0 < r_room - b_room < 0.4 * (r_cam - b_cam) and r_cam - b_cam > 30
 
 
 @pytest.mark.slow

@@ -196,7 +196,10 @@ def test_table_2_direction_in_the_display_image(gl, capsys, record_figure):
               f"{np.round(on8, 1)}, change R {change[0]:+.1f} G {change[1]:+.1f} B {change[2]:+.1f}")
     assert change[2] > 3.0
     assert change[2] > 5 * abs(change[1]) and change[2] > 5 * abs(change[0])
-    assert abs(change[0]) <= abs(change[1])
+    # R and G: the change is blue alone to the display's resolution (one 8-bit level); which
+    # of the two sub-level changes is larger follows the white balance (with issue 33's adapting
+    # white: R +0.3, G -0.3, B +8.7 levels)
+    assert max(abs(change[0]), abs(change[1])) <= 1.0
 
 
 @pytest.mark.slow

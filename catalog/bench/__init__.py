@@ -24,7 +24,9 @@ optionally, ``plot(result, folder) -> list[Path]``:
   against the frame without, each pass's share (:mod:`catalog.bench.room`);
 - ``image``: the real-time frame against the path-traced reference of the same scene, FLIP
   and Delta E per region, both run times (:mod:`catalog.bench.image`; needs the
-  ``pathtrace`` extra and LLVM 19, docs/pathtrace.md).
+  ``pathtrace`` extra and LLVM 19, docs/pathtrace.md);
+- ``accuracy``: the frame against the reference on scenes drawn at random from the whole
+  scene space, both through one neutral display (:mod:`catalog.bench.accuracy`).
 
 docs/bench.md has the figures and how to reproduce them.
 """
@@ -51,4 +53,5 @@ SECTIONS: dict[str, str] = {
     "display": "catalog.bench.display",
     "room": "catalog.bench.room",
     "image": "catalog.bench.image",
+    "accuracy": "catalog.bench.accuracy",
 }

@@ -89,6 +89,13 @@ def display_md(result: dict) -> str:
     return markdown_tables(result)["display_cost"]
 
 
+def accuracy_md(result: dict) -> str:
+    from catalog.bench.accuracy import markdown_tables  # noqa: PLC0415
+
+    blocks = markdown_tables(result)
+    return blocks["accuracy-summary"] + "\n\n" + blocks["accuracy"]
+
+
 SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "fluorescence": ("Fluorescence in an RGB engine (measured Donaldson matrices)", fluorescence_md),
               "uv": ("Fluorescence under UV and violet light: noise floor and banded model", uv_md),
@@ -98,7 +105,9 @@ SECTION_MD = {"colour": ("Colour accuracy against frame time", colour_md),
               "startup": ("Start-up", startup_md),
               "room": ("The room lit through the curtain: frame with and without", room_md),
               "display": ("The display step's cost in the frame", display_md),
-              "image": ("The real-time frame against the path-traced reference", image_md)}
+              "image": ("The real-time frame against the path-traced reference", image_md),
+              "accuracy": ("Accuracy over the scene space: frame against reference, neutral display",
+                           accuracy_md)}
 
 
 def markdown(report: dict) -> str:

@@ -28,7 +28,7 @@ def fmt(value, digits: int = 3) -> str:
 
 
 #: Sections that draw, and so need an OpenGL context (catalog bench makes one for them).
-GL_SECTIONS = ("colour", "stability", "display", "image")
+GL_SECTIONS = ("colour", "stability", "display", "image", "accuracy")
 
 
 def source_commit() -> str | None:

@@ -28,7 +28,13 @@ def add_arguments(parser) -> None:
                         help=f"folder for bench.md, bench.json and the plots (default {DEFAULT_OUT})")
     parser.add_argument("--sections", metavar="NAME,NAME",
                         help="run only these sections (default: all): colour, fluorescence, uv, "
-                             "fit, cloth, stability, startup, display, image")
+                             "fit, cloth, stability, startup, display, image, accuracy")
+    parser.add_argument("--scenes", type=int, default=None, metavar="N",
+                        help="accuracy: scenes drawn at random (default 48; --quick 2)")
+    parser.add_argument("--seed", type=int, default=None, metavar="S",
+                        help="accuracy: the draw's seed (default the report seed)")
+    parser.add_argument("--room", default=None, metavar="NAME",
+                        help="accuracy: only this built-in room (default: all drawn)")
 
 
 def parse_sections(text: str | None) -> list[str]:
@@ -56,6 +62,12 @@ def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
 
     names = parse_sections(args.sections)
+    if args.scenes is not None and not 1 <= args.scenes <= 1000:
+        raise InputError(f"{args.scenes}: give 1 to 1000 scenes", field="--scenes")
+    if args.room is not None:
+        from catalog.bench.accuracy import check_room  # noqa: PLC0415
+
+        check_room(args.room)
     if "fluorescence" in names:  # the measured matrices are not shipped: say so, run nothing
         from catalog.core.resources import data_missing_reason  # noqa: PLC0415
 
@@ -113,7 +125,10 @@ def _run_section(name, args, ctx, report, plotters, say) -> None:
     say(f"{name} ...")
     start = time.perf_counter()
     try:
-        result = module.run(quick=bool(args.quick), ctx=ctx)
+        options = module.section_options(args) if hasattr(module, "section_options") else {}
+        if hasattr(module, "section_options"):
+            options["progress"] = say
+        result = module.run(quick=bool(args.quick), ctx=ctx, **options)
     except Exception as exc:  # noqa: BLE001 - one broken section must not lose the others
         report["failed"][name] = f"{type(exc).__name__}: {exc}"
         say(f"{name} FAILED: {type(exc).__name__}: {exc}")

@@ -8,8 +8,9 @@ numpy twin (tests compare the two per pixel). The steps, on linear sRGB radiance
    of ISO 12232 as renderers use it: EV100 = log2(L_avg * 100 / 12.5) puts the metered
    average at 0.104), times a compensation ``2^EXPOSURE_COMPENSATION_EV``;
    ``--ev`` fixes EV100, otherwise :func:`meter_ev100` picks it from a luminance histogram.
-2. white balance: a 3x3 in linear sRGB, CAT16 (Li et al. 2017) von Kries from the light's
-   white to D65 (:func:`white_balance_matrix`), the identity for the "camera" setting.
+2. white balance: a 3x3 in linear sRGB, CAT16 (Li et al. 2017) von Kries from the white of
+   the light reaching the viewer to D65 with CAT16's degree of adaptation
+   (:func:`white_balance_matrix`, catalog.render.adaptation), the identity for "camera".
 3. tone curve on luminance Y only (chromaticity kept): a Michaelis-Menten curve with a power,
    as in ACES 2.0's tonescale, ``y = (x / (x + S0))^G``: mid grey 0.18 -> 0.18, y -> 1
    only as x -> infinity (no hard clip of highlights).
@@ -39,8 +40,8 @@ from catalog.core.errors import CatalogError
 
 TABLE_PATH = Path(__file__).resolve().parent / "data" / "display_tables.npz"
 
-#: White balance settings: "room" adapts to the light's white (what a person in the room
-#: sees after a minute), "camera" keeps a fixed D65 balance (what a daylight camera records).
+#: White balance settings: "room" adapts to the light reaching the viewer (what a person in
+#: the room sees after a minute; catalog.render.adaptation), "camera" keeps a fixed D65 balance (what a daylight camera records).
 WHITE_BALANCES = ("room", "camera")
 DEFAULT_WHITE_BALANCE = "room"
 #: Lights whose white lies further than this from the Planckian locus (CIE 1960 uv) are not
@@ -147,10 +148,9 @@ def d65_white_xyz() -> np.ndarray:
 def cat16_xyz_matrix(source_white_xyz, target_white_xyz) -> np.ndarray:
     """Full (D = 1) CAT16 von Kries adaptation, XYZ -> XYZ (both whites on any common scale:
     only their ratios in CAT16's cone space enter)."""
-    m = tables()["cat16"]
-    source = m @ (np.asarray(source_white_xyz, dtype=np.float64) / source_white_xyz[1])
-    target = m @ (np.asarray(target_white_xyz, dtype=np.float64) / target_white_xyz[1])
-    return np.linalg.inv(m) @ np.diag(target / source) @ m
+    from catalog.render.adaptation import cat16_matrix  # noqa: PLC0415
+
+    return cat16_matrix(source_white_xyz, target_white_xyz, 1.0, tables()["cat16"])
 
 
 @functools.lru_cache(maxsize=1)
@@ -184,13 +184,18 @@ def adapts_to(white_xyz, white_balance: str) -> bool:
             and planckian_distance(white) <= MAX_WHITE_DUV)
 
 
-def white_balance_matrix(white_xyz, white_balance: str = DEFAULT_WHITE_BALANCE) -> np.ndarray:
-    """Linear sRGB -> linear sRGB: CAT16 from ``white_xyz`` (the light's) to D65, or the
-    identity when the setting or the light does not adapt (:func:`adapts_to`)."""
+def white_balance_matrix(white_xyz, white_balance: str = DEFAULT_WHITE_BALANCE,
+                         degree: float = 1.0) -> np.ndarray:
+    """Linear sRGB -> linear sRGB: CAT16 from ``white_xyz`` (the adapting white: the frame
+    gives the light reaching the viewer, catalog.render.adaptation) to D65 with degree of
+    adaptation ``degree``, or the identity when the setting or the light does not adapt
+    (:func:`adapts_to`)."""
+    from catalog.render.adaptation import cat16_matrix  # noqa: PLC0415
+
     if not adapts_to(white_xyz, white_balance):
         return np.eye(3)
     m = matrices()
-    return m.xyz_to_rgb @ cat16_xyz_matrix(white_xyz, d65_white_xyz()) @ m.rgb_to_xyz
+    return m.xyz_to_rgb @ cat16_matrix(white_xyz, d65_white_xyz(), degree, tables()["cat16"]) @ m.rgb_to_xyz
 
 
 # ---------------------------------------------------------------------------------- exposure

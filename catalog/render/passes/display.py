@@ -37,14 +37,16 @@ class DisplayPass(Pass):
         return self.frame.exposure * display_lib.exposure_scale(self.current_ev100())
 
     def white_balance_matrix(self) -> np.ndarray:
-        """Linear sRGB -> linear sRGB: CAT16 from the key light's white to D65 (or identity)."""
+        """Linear sRGB -> linear sRGB: CAT16 from the white of the light reaching the viewer to
+        D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity."""
         inputs = self.frame.terms.shading_inputs()
         key = (self.frame.terms.inputs_key, self.frame.white_balance)
         if self._wb_cache is None or self._wb_cache[0] != key:
-            from catalog.optics.shading_reference import white_xyz  # noqa: PLC0415
+            from catalog.render import adaptation  # noqa: PLC0415
 
-            self._wb_cache = (key, display_lib.white_balance_matrix(white_xyz(inputs),
-                                                                     self.frame.white_balance))
+            self._wb_cache = (key, display_lib.white_balance_matrix(
+                adaptation.adapting_white_xyz(inputs), self.frame.white_balance,
+                adaptation.degree_of_adaptation()))
         return self._wb_cache[1]
 
     def display_uniforms(self) -> dict:
