@@ -6,7 +6,7 @@ PYTHON ?= .venv/bin/python
 # Regenerate every fabrics/*.toml with `catalog fit` (deterministic output), then the preset
 # table of docs/fit.md made from them.
 presets:
-	$(PYTHON) tools/make_presets.py && $(PYTHON) -m catalog.bench.preset_table && $(PYTHON) tools/docs_figures.py
+	$(PYTHON) tools/make_presets.py && $(PYTHON) -m benchmarks.preset_table && $(PYTHON) tools/docs_figures.py
 
 # Regenerate the gonio measurement sets (and dye spectra) from the yarn-level model.
 measurements:
@@ -14,7 +14,7 @@ measurements:
 
 # The per-fabric HG vs Cook-Torrance error table of docs/fit.md.
 fit-table:
-	$(PYTHON) -m catalog.bench.fit_table && $(PYTHON) tools/docs_figures.py
+	$(PYTHON) -m benchmarks.fit_table && $(PYTHON) tools/docs_figures.py
 
 # Measure every published result again (each bench module's full run, its JSON recording the
 # commit and machine), then regenerate every table of the docs from the JSON. Hours on a
@@ -22,7 +22,7 @@ fit-table:
 # validation data) stops the run with its one-line reason.
 figures:
 	for m in $$($(PYTHON) tools/figures_age.py --modules); do \
-	  echo "figures: catalog.bench.$$m"; $(PYTHON) -m catalog.bench.$$m >/dev/null || exit 1; \
+	  echo "figures: benchmarks.$$m"; $(PYTHON) -m benchmarks.$$m >/dev/null || exit 1; \
 	done
 	$(PYTHON) tools/docs_figures.py
 

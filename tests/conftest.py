@@ -162,7 +162,7 @@ def web_site(tmp_path_factory):
 
 
 # ---- figures the docs quote from test runs ------------------------------------------------
-#: NAME -> value measured by a test in this session (catalog/bench/tested_figures.py).
+#: NAME -> value measured by a test in this session (benchmarks/tested_figures.py).
 _FIGURES: dict[str, object] = {}
 
 
@@ -171,7 +171,7 @@ def record_figure():
     """``record_figure(NAME, value)``: keep a figure a test measured (a number, list or dict of
     them). With CATALOG_RECORD_FIGURES=FILE.json set, the session merges every recorded figure
     into that file at its end (benchmarks/tested_figures.json is where the docs' tables come
-    from: catalog/bench/tested_figures.py); otherwise nothing is written."""
+    from: benchmarks/tested_figures.py); otherwise nothing is written."""
     def record(name: str, value) -> None:
         _FIGURES[name] = value
     return record

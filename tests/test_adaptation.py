@@ -164,6 +164,6 @@ def test_lace_bluer_than_voile_under_every_daylight(curtain_lab):
 @pytest.mark.xfail(strict=True, reason="issue 33 goal not met: at sunset the voile reads b* -3.5 "
                                       "against the beam-dominated room white (docs/accuracy.md)")
 def test_voile_stays_warm_at_sunset(curtain_lab):
-    from catalog.bench.accuracy import sun_hours
+    from benchmarks.accuracy import sun_hours
 
     assert curtain_lab("voile-white", sun_hours()[1])[0][2] > 5.0

@@ -37,8 +37,9 @@ FORBIDDEN = [
 #: Module pairs allowed to import each other (none: image writing lives in render.imagefile,
 #: which both the snapshot and the environment tool use).
 KNOWN_CYCLES: set[tuple[str, str]] = set()
-#: Only these rooms may import the benchmarks (and bench itself).
-BENCH_IMPORTERS = {"bench", "commands"}
+#: The one module of the package that may import the benchmarks (top-level ``benchmarks/``,
+#: not in the wheel): ``catalog bench`` runs them when a checkout has them.
+BENCH_IMPORTERS = {"catalog/commands/bench.py"}
 
 
 def _module_name(path: Path, package: Path = PACKAGE) -> str:
@@ -97,7 +98,7 @@ ROOMS = sorted({p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file
 
 def test_the_rooms_are_there():
     for room in ("core", "optics", "presets", "fit", "gl", "cloth", "render", "viewer",
-                 "commands", "bench", "exchange"):
+                 "commands", "exchange", "room"):
         assert room in ROOMS
     # the top level holds only the package's own entry points, no module of a room
     loose = sorted(p.name for p in PACKAGE.glob("*.py"))
@@ -118,10 +119,13 @@ def test_no_forbidden_arrow():
     assert bad == []
 
 
-def test_only_commands_import_the_benchmarks():
-    bad = [f"{f}:{line} {src} -> bench" for f, line, src, dst in EDGES
-           if dst == "bench" and src not in BENCH_IMPORTERS]
+def test_only_the_bench_command_imports_the_benchmarks():
+    """The benchmarks live outside the package (``benchmarks/``); the product imports them
+    only in ``catalog bench``, which says in one line when they are not there."""
+    bad = [f"{f}:{line} {src} -> benchmarks" for f, line, src, dst in EDGES
+           if dst == "benchmarks" and f not in BENCH_IMPORTERS]
     assert bad == []
+    assert not (PACKAGE / "bench").exists()
 
 
 @pytest.mark.slow
@@ -151,10 +155,10 @@ def test_the_checker_sees_a_forbidden_import(tmp_path):
     for init in (package, package / "optics", package / "render"):
         (init / "__init__.py").write_text("")
     (package / "optics" / "probe.py").write_text("def f():\n    from catalog.render import frame\n")
-    (package / "render" / "probe.py").write_text("from ..bench import colour\n")
+    (package / "render" / "probe.py").write_text("from benchmarks import colour\n")
     edges = _edges(package)
     assert ("catalog/optics/probe.py", 2, "optics", "render") in edges
-    assert ("catalog/render/probe.py", 1, "render", "bench") in edges
+    assert ("catalog/render/probe.py", 1, "render", "benchmarks") in edges
 
 
 #: The longest a module of catalog/ may be (docs/GUIDE: small modules with one job each).

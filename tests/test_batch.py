@@ -335,7 +335,7 @@ def test_cost_model_by_hand():
     """The paper model against a hand count: 16 fabrics, 1 light, frames 0..2, 8 workers per
     node; a fabric costs 2 simulated frames (0.1 s each) + 3 images (0.01 s each) = 0.23 s,
     a process per image pays 1 s start + 0.01 s + 0.1 s per frame simulated: 3.33 s a fabric."""
-    from catalog.bench.batch_scaling import cost_model, markdown_tables
+    from benchmarks.batch_scaling import cost_model, markdown_tables
 
     model = cost_model(0.01, 0.1, 1.0, 5.0, fabrics=16, lights=1, frames=3, nodes=(1, 2),
                        workers_per_node=8)

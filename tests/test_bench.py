@@ -13,8 +13,8 @@ import pytest
 
 from catalog.core.resources import data_missing_reason
 
-from catalog.bench import SECTIONS
-from catalog.bench import reduction as red
+from benchmarks import SECTIONS
+from benchmarks import reduction as red
 from catalog.optics.spectra import GRID_NM
 
 LM_PER_W = 683.0
@@ -109,7 +109,7 @@ def test_every_section_module_has_run():
 @pytest.mark.gl
 @pytest.mark.slow
 def test_colour_section_on_one_fabric_and_light(gl, tmp_path):
-    from catalog.bench import colour
+    from benchmarks import colour
 
     result = colour.run(ctx=gl, fabrics=["lace-fwa"], lights=["D65"], error_size=(40, 24),
                         time_size=(64, 36), repeats=1)
@@ -155,7 +155,7 @@ def test_truth_switches_on_the_emission_as_the_renderer_does(gl):
 
 
 def test_pareto_front_and_default_choice():
-    from catalog.bench import colour
+    from benchmarks import colour
 
     points = [(1.0, 0.1, "a"), (0.9, 0.5, "b"), (1.2, 0.05, "c"), (1.3, 0.2, "d")]
     assert colour.pareto_front(points) == ["a", "b", "c"]  # d is beaten by a on both
@@ -172,7 +172,7 @@ def test_pareto_front_and_default_choice():
 
 
 def test_fit_errors_are_zero_for_the_true_parameters():
-    from catalog.bench import fit
+    from benchmarks import fit
     from catalog.optics.btdf import eq7_transmittance
 
     data = fit.synthetic_gonio()
@@ -188,7 +188,7 @@ def test_fit_errors_are_zero_for_the_true_parameters():
 
 @pytest.mark.slow
 def test_cloth_runs_are_deterministic_and_deviation_is_a_distance():
-    from catalog.bench import cloth
+    from benchmarks import cloth
 
     backend = cloth.fastest_backend()
     a, _, finite, used = cloth.trajectory((5, 6), 4, backend, 3)
@@ -203,7 +203,7 @@ def test_cloth_runs_are_deterministic_and_deviation_is_a_distance():
 
 @pytest.mark.slow
 def test_startup_section_without_first_frames():
-    from catalog.bench import startup
+    from benchmarks import startup
 
     result = startup.run(quick=True, first_frames=False, repeats=1)
     assert not _numbers_all_finite(result["rows"])
@@ -290,7 +290,7 @@ def test_n_bands_are_exact_for_a_grey_non_fluorescent_material(n_bands):
     own, so the N-band colour equals the spectral one (closed form: 683 r sum cmf E)."""
     from types import SimpleNamespace
 
-    from catalog.bench.fluorescence_rgb import bands_xyz
+    from benchmarks.fluorescence_rgb import bands_xyz
     from catalog.optics.fluorescence import FluorescentMaterial
 
     dark = FluorescentMaterial(absorptance=np.full(GRID_NM.size, 0.5),  # absorbs, emits nothing
@@ -305,9 +305,9 @@ def test_n_bands_are_exact_for_a_grey_non_fluorescent_material(n_bands):
 
 
 def test_a_section_run_alone_without_its_data_says_so_in_one_line(tmp_path, monkeypatch, capsys):
-    """python -m catalog.bench.fluorescence_rgb without the measured matrices: exit 2, one line
+    """python -m benchmarks.fluorescence_rgb without the measured matrices: exit 2, one line
     naming --data, no JSON written (the committed one is never half-replaced)."""
-    from catalog.bench.results import section_main
+    from benchmarks.results import section_main
     from catalog.core import resources
 
     monkeypatch.setattr(resources, "_user_data", None)
@@ -324,7 +324,7 @@ def test_a_section_run_alone_without_its_data_says_so_in_one_line(tmp_path, monk
 def test_render_shaders_bench_runs_every_variant(tmp_path):
     """The shader benchmark end to end at a small size: it broke twice unseen (a constant
     moved to core.constants without its import; a variant that changed LD under a pattern)."""
-    from catalog.bench import render_shaders
+    from benchmarks import render_shaders
 
     out = tmp_path / "render.json"
     assert render_shaders.main(["--quick", "--size", "96x64", "--repeats", "1", "--draws", "1",

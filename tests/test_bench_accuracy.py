@@ -1,4 +1,4 @@
-"""The accuracy bench (catalog.bench.accuracy, issue 33): the scene draw, the neutral display
+"""The accuracy bench (benchmarks.accuracy, issue 33): the scene draw, the neutral display
 against closed forms and colour-science, the option checks, and the CI sample against its
 recorded figures (fails when a scene's FLIP exceeds its record by more than the reference's noise).
 
@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from catalog.bench import accuracy
+from benchmarks import accuracy
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -40,7 +40,7 @@ def test_draw_is_seeded_and_covers_the_space():
 
 
 def test_the_image_benchs_scenes_are_named_cases():
-    from catalog.bench import image
+    from benchmarks import image
 
     cases = accuracy.named_cases()
     assert [c["label"] for c in cases] == [label for label, *_ in image.SCENES]

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from catalog.bench import alpha_to_coverage, pattern, viewer_frames
+from benchmarks import alpha_to_coverage, pattern, viewer_frames
 from catalog.render.passes.targets import choose_antialiasing
 
 

@@ -265,9 +265,9 @@ def test_unwritable_outputs_are_refused_before_the_work(tmp_path, capsys, argv):
 
 @pytest.mark.slow
 def test_the_fixed_hostile_corpus_is_refused_cleanly():
-    """The benchmark's fixed corpus (catalog.bench.hostile, ~90 cases in six categories):
+    """The benchmark's fixed corpus (benchmarks.hostile, ~90 cases in six categories):
     every case exits 2 with one line naming what was given, and leaves nothing behind."""
-    from catalog.bench.hostile import run_suite
+    from benchmarks.hostile import run_suite
 
     result = run_suite()
     assert result["failures"] == [], result["failures"]

@@ -25,7 +25,7 @@ def test_gpu_follows_the_reference_for_one_second(gl):
     gpu.run(60, 1 / 60)
     assert np.abs(cpu.positions() - gpu.positions()).max() < 1e-3
     # gusts and pleats: buckling amplifies float32 rounding (a 1e-7 m nudge of the float64
-    # run grows over the second: docs/cloth.md's generated table, catalog.bench.cloth_studies),
+    # run grows over the second: docs/cloth.md's generated table, benchmarks.cloth_studies),
     # so RMS is held to a centimetre, a bound with room for a longer or gustier run
     cpu, gpu = _pair(gl, opening=0.7, wind_speed_m_s=1.5)
     cpu.run(60, 1 / 60)
@@ -105,8 +105,8 @@ def test_bind_to_vertex_array_draws_the_curtain(gl):
 
 
 def test_springs12_on_the_gpu_matches_the_reference(gl):
-    from catalog.bench.springs12 import Springs12Gpu
-    from catalog.bench.springs12 import Springs12Problem, reference_steps
+    from benchmarks.springs12 import Springs12Gpu
+    from benchmarks.springs12 import Springs12Problem, reference_steps
 
     problem = Springs12Problem(n=20)
     reference, _ = reference_steps(problem, 120)

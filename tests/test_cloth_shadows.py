@@ -24,7 +24,7 @@ from catalog.optics import shading_reference as ref
 from catalog.render import room_light
 from catalog.render import scene as scene_lib
 from catalog.render.frame import FrameRenderer
-from catalog.bench import key_shadow_bias
+from benchmarks import key_shadow_bias
 from catalog.render.raycast import first_hit, mesh_triangles
 
 pytestmark = [pytest.mark.gl, pytest.mark.slow]   # each takes 0.5 s or more
@@ -117,7 +117,7 @@ def test_folds_shade_the_cloth_behind_them(gl, make_preset):
     mesh more than 3 mm away, on at least 98 % of the pixels more than 1.5 map texels from a
     shadow's edge (the map is looked up at its nearest texels). Issue 11 replaced the constant
     2 cm depth bias, which this test had to exclude (occluders within 1-3 cm), by a
-    slope-scaled one chosen on this drape (catalog/bench/key_shadow_bias.py: 100 % here, the
+    slope-scaled one chosen on this drape (benchmarks/key_shadow_bias.py: 100 % here, the
     2 cm bias 99.2 %; the bound 98 % was set with the choice). The shaded pixels' key light is
     dimmed to the layer's transmittance: their luminance falls by more than 20 % against the
     shadow taken away (the float64 twin without it), the rest changes by less than 1e-3."""

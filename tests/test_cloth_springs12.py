@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from catalog.bench.springs12 import Springs12Numba, Springs12Problem, reference_steps
+from benchmarks.springs12 import Springs12Numba, Springs12Problem, reference_steps
 
 
 @pytest.mark.parametrize("n", [2, 3, 7, 33])
@@ -62,7 +62,7 @@ def test_one_spring_oscillates_at_its_natural_frequency():
 
     # run the reference from a displaced start (the function starts at rest pose,
     # so reproduce its loop on a copy with the displaced free row)
-    import catalog.bench.springs12 as s12
+    import benchmarks.springs12 as s12
 
     original = s12.Springs12Problem.initial_positions
 
@@ -83,7 +83,7 @@ def test_one_spring_oscillates_at_its_natural_frequency():
 def test_peer_colours_hold_every_spring_once_and_never_share_a_particle():
     """The 12 colours of the peers' fair kernels (cloth_frameworks.COLOURS): every forward
     spring of a 7x9 grid in exactly one colour; within a colour no particle twice."""
-    from catalog.bench.cloth_frameworks import COLOURS, FORWARD_OFFSETS
+    from benchmarks.cloth_frameworks import COLOURS, FORWARD_OFFSETS
     from catalog.cloth.topology import GATHER_OFFSETS
 
     assert len(FORWARD_OFFSETS) == 6 and len(COLOURS) == 12
@@ -112,7 +112,7 @@ def test_peer_kernels_match_the_float64_reference(impl):
     """Every peer of the cloth race (fair: atomic scatter and 12 colours; gather) follows the
     float64 reference to 1e-4 m after 200 steps (the benchmark's own check, at n = 16)."""
     pytest.importorskip("taichi" if impl.startswith("taichi") else "warp")
-    from catalog.bench.cloth_frameworks import make
+    from benchmarks.cloth_frameworks import make
 
     problem = Springs12Problem(n=16)
     reference, _ = reference_steps(problem, 200)

@@ -205,7 +205,7 @@ def test_table_2_direction_in_the_display_image(gl, capsys, record_figure):
 @pytest.mark.slow
 def test_display_benchmark_section_reports_every_step(gl):
     """The benchmark's shape (not its speed): four pass variants, meter and frame per scene."""
-    from catalog.bench.display import SCENES, STAGES, markdown_tables, run
+    from benchmarks.display import SCENES, STAGES, markdown_tables, run
 
     result = run(quick=True, ctx=gl, size=(32, 24))
     assert len(result["rows"]) == len(SCENES) and result["stages"] == list(STAGES)

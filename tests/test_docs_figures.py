@@ -32,7 +32,7 @@ def test_committed_docs_equal_the_regenerated_blocks(docs_figures):
 
 
 def test_a_changed_figure_changes_the_block_and_unknown_names_are_refused(docs_figures):
-    from catalog.bench import bispectral_figures
+    from benchmarks import bispectral_figures
 
     result = json.loads((PROJECT_ROOT / bispectral_figures.RESULT_JSON).read_text())
     result["summary_goal_lights"]["physical"]["mean"] = 0.77
@@ -71,7 +71,7 @@ def test_a_module_may_make_its_tables_from_several_runs(docs_figures, tmp_path):
 
 def test_the_viewer_tables_take_one_more_run_as_one_more_row_set():
     """The viewer's frame table spans its runs: a run added (e.g. on a GPU) adds its rows."""
-    from catalog.bench import viewer_frames
+    from benchmarks import viewer_frames
 
     runs = {key: json.loads((PROJECT_ROOT / path).read_text())
             for key, path in viewer_frames.RESULT_JSONS.items()}
@@ -91,11 +91,11 @@ def test_no_two_bench_modules_claim_the_same_json(docs_figures):
     import importlib
     import pkgutil
 
-    import catalog.bench as bench
+    import benchmarks as bench
 
     owners: dict[str, list[str]] = {}
     for info in pkgutil.iter_modules(bench.__path__):
-        module = importlib.import_module(f"catalog.bench.{info.name}")
+        module = importlib.import_module(f"benchmarks.{info.name}")
         for source in docs_figures.result_sources(module):
             owners.setdefault(source, []).append(info.name)
     shared = {k: v for k, v in owners.items() if len(v) > 1}
@@ -105,7 +105,7 @@ def test_no_two_bench_modules_claim_the_same_json(docs_figures):
 def test_fit_table_margins_count_the_combinations_hg_loses():
     """The generated sentence counts, it does not assume: a combination where CT is better
     is reported as such."""
-    from catalog.bench import fit_table
+    from benchmarks import fit_table
 
     def row(fabric, points, weighting, hg, ct):
         return {"fabric": fabric, "points": points, "weighting": weighting, "hg_rmse": hg,

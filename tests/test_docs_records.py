@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from catalog.bench import records, sun_spectrl2, tested_figures
+from benchmarks import records, sun_spectrl2, tested_figures
 from catalog.core.resources import PROJECT_ROOT
 
 
@@ -79,7 +79,7 @@ def test_record_figure_merges_into_the_named_json_only_when_asked(tmp_path):
 def test_the_refinement_study_folds_hold_every_training_light_once():
     """The cross-validation of docs/bispectral.md holds out every training light exactly
     once, and never a goal light."""
-    from catalog.bench import bispectral_refinement as br
+    from benchmarks import bispectral_refinement as br
     from catalog.optics.bispectral.matrix import COLOUR_TRAINING_LIGHTS
     from catalog.optics.bispectral.study import GOAL_LIGHTS
 
@@ -89,7 +89,7 @@ def test_the_refinement_study_folds_hold_every_training_light_once():
 
 
 def test_the_refinement_tables_mark_the_default_and_the_lowest():
-    from catalog.bench import bispectral_refinement as br
+    from benchmarks import bispectral_refinement as br
 
     result = _load(br.RESULT_JSON)
     made = br.markdown_tables(result)
@@ -105,7 +105,7 @@ def test_the_refinement_tables_mark_the_default_and_the_lowest():
 @pytest.mark.slow
 def test_the_refinement_study_reproduces_its_committed_json(shared_data):
     """About 20 s: the study re-run gives the committed figures (the same code and data)."""
-    from catalog.bench import bispectral_refinement as br
+    from benchmarks import bispectral_refinement as br
 
     committed = _load(br.RESULT_JSON)
     fresh = json.loads(json.dumps(br.run()))

@@ -36,7 +36,7 @@ def test_the_provenance_line_names_commit_and_machine_or_says_they_are_unknown()
 
 
 def test_a_measurement_records_the_commit_it_ran_on():
-    from catalog.bench.results import machine_info
+    from benchmarks.results import machine_info
 
     head = subprocess.run(["git", "rev-parse", "--short=10", "HEAD"], cwd=PROJECT_ROOT,
                           capture_output=True, text=True).stdout.strip()
@@ -44,10 +44,10 @@ def test_a_measurement_records_the_commit_it_ran_on():
 
 
 def test_the_measured_code_is_the_module_its_imports_and_the_shaders(age):
-    import catalog.bench.render_shaders as module
+    import benchmarks.render_shaders as module
 
     code = age.measured_code(module)
-    assert "catalog/bench/render_shaders.py" in code and "shaders" in code
+    assert "benchmarks/render_shaders.py" in code and "shaders" in code
     assert any(p.startswith("catalog/render") or p.startswith("catalog/gl") for p in code)
     assert not any(p.endswith("atomic.py") for p in code)
 

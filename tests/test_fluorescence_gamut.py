@@ -8,7 +8,7 @@ import pytest
 
 @pytest.fixture(scope="module")
 def tables(shared_data):  # the measured brightener is one of the emissions studied
-    from catalog.bench import fluorescence_tables
+    from benchmarks import fluorescence_tables
 
     return fluorescence_tables
 

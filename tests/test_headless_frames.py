@@ -1,4 +1,4 @@
-"""catalog.bench.headless_frames: the viewer's frame without its window (EGL), and its tables."""
+"""benchmarks.headless_frames: the viewer's frame without its window (EGL), and its tables."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from catalog.bench import headless_frames as bench
+from benchmarks import headless_frames as bench
 from catalog.core.resources import PROJECT_ROOT
 
 

@@ -20,7 +20,6 @@ SHIPPED = ["catalog/_data/shaders/common.glsl", "catalog/_data/shaders/curtain.f
            "catalog/_data/fabrics/measurements/lace-fwa/excitation.csv",
            "catalog/_data/fabrics/measurements/lace-fwa/gonio.csv",
            "catalog/optics/data/reference_tables.npz",
-           "catalog/bench/shaders/trivial.frag",
            "catalog/room/data/box.glb", "catalog/room/data/living.glb"]
 
 
@@ -47,6 +46,7 @@ def test_wheel_carries_shaders_fabrics_tables_and_licence(wheel):
     assert presets == {p.name for p in (PROJECT_ROOT / "fabrics").glob("*.toml")}
     assert any(n.endswith(".dist-info/LICENSE") or "licenses/LICENSE" in n for n in names)
     assert not any("test" in Path(n).parts[0] for n in names)  # tests stay out
+    assert not any(Path(n).parts[0] == "benchmarks" or "/bench/" in n for n in names)  # so do the benchmarks
 
 
 @pytest.mark.slow

@@ -375,7 +375,7 @@ def test_coverage_pattern_hook_makes_holes_null_transmission(mi):
 
 
 def test_image_section_tables_and_pareto_front_from_a_result():
-    from catalog.bench import image
+    from benchmarks import image
 
     def option(label, flip, ms):
         return {"option": label, "mean_flip": flip, "curtain_mean_delta_e": 1.0, "frame_s": ms / 1e3}
@@ -401,7 +401,7 @@ def test_the_pareto_plot_numbers_its_points(tmp_path):
     overlapped when a dozen options sat within a few ms."""
     from matplotlib import image as mpimg
 
-    from catalog.bench import image
+    from benchmarks import image
 
     def option(label, flip, ms):
         return {"option": label, "mean_flip": flip, "curtain_mean_delta_e": 1.0, "frame_s": ms / 1e3}
@@ -630,10 +630,10 @@ def scene_lib_draped():
 
 @pytest.mark.slow
 def test_two_layer_study_reproduces_eq7_alone_and_tabulates(mi, monkeypatch):
-    """catalog.bench.two_layers on one angle pair at 256 spp: the seen layer alone, path-traced,
+    """benchmarks.two_layers on one angle pair at 256 spp: the seen layer alone, path-traced,
     is its eq. 7 within 3 % (the set-up's own check, as in the committed run), the layer in
     front only takes light away from the collimated key here, and the table renders."""
-    from catalog.bench import two_layers
+    from benchmarks import two_layers
 
     monkeypatch.setattr(two_layers, "ANGLES", ((40, 30),))
     result = two_layers.run(spp=256)
@@ -1027,7 +1027,7 @@ def test_the_bench_takes_the_spectral_reference_where_the_dye_of_the_secondary_l
     safety-yellow under the UV lamp (its glow passes its dye at 0.99 in green, the key's leak
     at 0.048), the RGB one for the bench's other five scenes (white cloth, or a dye the key's
     spectrum already describes within SPECTRAL_DYE_DIFFERENCE)."""
-    from catalog.bench import image
+    from benchmarks import image
 
     chosen = {label: image.reference_variant_for(image.describe_bench_scene(fabric, light, view, (8, 6)).inputs)
               for label, fabric, light, view in image.SCENES}
@@ -1042,7 +1042,7 @@ def test_a_scenes_reference_in_a_child_process_is_the_scene_described_here(mi):
     here through the same description (the camera, room and curtain; the render itself is not
     repeated here, since a second render in the test process crashed Mitsuba's JIT), and its
     two halves are finite, differ (their seeds) and have the noise's share of a mean."""
-    from catalog.bench import image
+    from benchmarks import image
     from catalog.pathtrace.render import MAX_DEPTH, region_masks
     from catalog.pathtrace.scene import build_mitsuba_scene
 

@@ -1,10 +1,10 @@
-"""catalog.bench.preset_table: docs/fit.md's preset table comes from the presets themselves."""
+"""benchmarks.preset_table: docs/fit.md's preset table comes from the presets themselves."""
 
 from __future__ import annotations
 
 import json
 
-from catalog.bench import preset_table
+from benchmarks import preset_table
 from catalog.core.resources import PROJECT_ROOT
 
 

@@ -132,7 +132,7 @@ def test_the_checks_catch_a_stale_name():
     assert not _resolves(["benchsuite", "colour"]) and not _resolves(["reference"])
     assert _checked(["reference"], "from ", set()) and not _checked(["entries"], "x = ", set())
     assert _resolves(["core", "constants", "FRAME_DT_S"])
-    assert PATH.search("see catalog/bench/report.py.").group(1).rstrip(".") == "catalog/bench/report.py"
+    assert PATH.search("see benchmarks/report.py.").group(1).rstrip(".") == "benchmarks/report.py"
     assert _placeholder("fabrics/NAME.toml") and not _placeholder("fabrics/lace-fwa.toml")
 
 

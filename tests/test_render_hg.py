@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-import catalog.bench  # noqa: F401  (registers catalog/bench/shaders, where probe_hg.comp is)
+import benchmarks  # noqa: F401  (registers benchmarks/shaders, where probe_hg.comp is)
 from catalog.optics.btdf import hg_phase_one_minus_cos, hg_phase_printed
 from catalog.gl.shaderlib import create_compute
 

@@ -382,7 +382,7 @@ def test_stored_ambient_occlusion_is_the_computed_one():
 def test_room_benchmark_quick_runs_and_tabulates(gl):
     """The benchmark's quick run: every configuration timed, finite ratios, each pass's
     share summing to 1, and both generated tables."""
-    from catalog.bench import room as bench
+    from benchmarks import room as bench
 
     result = bench.run(quick=True, ctx=gl, repeats=1)
     assert [row["config"] for row in result["rows"]] == [name for name, _ in bench.CONFIGS]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from catalog.bench import uv_confirmation as conf
+from benchmarks import uv_confirmation as conf
 from catalog.optics.spectra import GRID_NM
 
 
@@ -39,7 +39,7 @@ def test_blend_gives_the_second_light_its_share_of_the_power(fraction):
 @pytest.mark.data
 @pytest.mark.slow
 def test_chosen_model_meets_the_preregistered_bounds_on_the_confirmation_lights():
-    """The bounds were fixed in catalog.bench.uv_confirmation (commit 87cc5dd) before the
+    """The bounds were fixed in benchmarks.uv_confirmation (commit 87cc5dd) before the
     first score: the chosen model's mean Delta E 2000 against the raw matrices <= 1.5 with
     no case above its noise floor; the bands alone against the cleaned matrices <= 1.0.
     Also: the chosen model follows the raw matrix better than the bands alone in the mean

@@ -257,7 +257,7 @@ def test_command_reports_exact_and_model_xyz_per_light(capsys):
 @needs_matrices
 def test_committed_benchmark_choice_is_the_model_the_renderer_carries():
     from catalog.optics.bispectral.bands import CHOSEN
-    from catalog.bench.uv_fluorescence import SELECTION_LIGHTS, TEST_LIGHTS
+    from benchmarks.uv_fluorescence import SELECTION_LIGHTS, TEST_LIGHTS
 
     result = json.loads((PROJECT_ROOT / "benchmarks" / "bench_uv.json").read_text())
     assert result["summary"]["choice"] == CHOSEN

@@ -288,7 +288,7 @@ def test_real_matrices_residual_model_meets_the_bounds_on_test_lights():
     <= 1.5 (the issue's bound; bench 0.07) and every case below 1.0 (bench max 0.57); the
     bands stay physical (quantum yield <= 1, non-negative) and the reflectance line loses
     at most 0.002 to its clip at 0."""
-    from catalog.bench.uv_fluorescence import TEST_LIGHTS, light_spectrum
+    from benchmarks.uv_fluorescence import TEST_LIGHTS, light_spectrum
     from catalog.optics.bispectral import study as st
     from catalog.optics.bispectral.bands import (DEFAULT_RESIDUAL, DEFAULT_RESIDUAL_RANK,
                                                  fit_banded)
@@ -321,7 +321,7 @@ def test_near_diagonal_study_sees_a_bandpass_smear_and_collapse_keeps_row_sums()
     """A matrix whose neighbours are a 10 nm triangular smear (0.25 of the diagonal on both
     sides) reads as +25% at +-10 nm and 0 beyond; collapsing the neighbours onto the diagonal
     keeps every row's sum (to 1e-15) and leaves the far entries untouched."""
-    from catalog.bench.uv_fluorescence import collapsed_band, near_diagonal_case
+    from benchmarks.uv_fluorescence import collapsed_band, near_diagonal_case
     from catalog.optics.bispectral.matrix import DonaldsonMatrix
 
     lo = np.arange(380.0, 781.0, 10.0)

@@ -6,7 +6,7 @@ committed JSON, so that no figure in the docs is typed by hand.
     .venv/bin/python tools/docs_figures.py --check   # exit 1 naming the stale blocks
 
 A block is the text between ``<!-- generated:NAME -->`` and ``<!-- /generated:NAME -->``.
-Its content comes from a module of catalog.bench that has ``markdown_tables`` and either
+Its content comes from a module of benchmarks that has ``markdown_tables`` and either
 ``RESULT_JSON`` (one committed JSON, relative to the repository; ``markdown_tables(result)
 -> {NAME: markdown}``) or ``RESULT_JSONS`` (several: ``{KEY: path}``; ``markdown_tables``
 then receives ``{KEY: result}``, so a table may span runs, and one more run is one more
@@ -91,7 +91,7 @@ def _find(data, key: str):
 
 def provenance(results: dict[str, dict]) -> str:
     """One line under a table: the JSON it is made from, the commit and the machine it was
-    measured on (as the result recorded them: catalog.bench.results.machine_info)."""
+    measured on (as the result recorded them: benchmarks.results.machine_info)."""
     parts = []
     for source, result in results.items():
         machine = _find(result, "machine")
@@ -108,12 +108,12 @@ def provenance(results: dict[str, dict]) -> str:
 
 def tables(root: Path = ROOT) -> dict[str, str]:
     """Every NAME -> markdown the bench modules make from their committed JSON."""
-    import catalog.bench as bench
+    import benchmarks as bench
 
     out: dict[str, str] = {}
     owner: dict[str, str] = {}  # JSON path -> the module that writes it
     for info in pkgutil.iter_modules(bench.__path__):
-        module = importlib.import_module(f"catalog.bench.{info.name}")
+        module = importlib.import_module(f"benchmarks.{info.name}")
         for source in result_sources(module):
             if owner.setdefault(source, module.__name__) != module.__name__:
                 raise SystemExit(f"docs_figures: error: {source} is the result of both "

@@ -5,7 +5,7 @@
     .venv/bin/python tools/figures_age.py --strict   # exit 1 when one is stale
 
 A result (a bench module's committed JSON, tools/docs_figures.py) was measured at the commit
-it records (``machine.commit``, catalog.bench.results.machine_info), else at the last commit
+it records (``machine.commit``, benchmarks.results.machine_info), else at the last commit
 that changed the JSON file. The code it measures is the module's ``MEASURES`` (paths in the
 repository) if it declares them, else the module itself, the catalog modules it imports and,
 when it imports the renderer or GL, shaders/ (catalog.core apart from its constants, the
@@ -52,7 +52,7 @@ def measured_code(module) -> list[str]:
         elif isinstance(node, ast.Import):
             names = [alias.name for alias in node.names]
         for name in names:
-            if not name.startswith("catalog.") or name.startswith("catalog.bench") or \
+            if not name.startswith("catalog.") or name.startswith("benchmarks") or \
                     (name.startswith("catalog.core") and name != "catalog.core.constants"):
                 continue  # the bench's own helpers, the output layer: no figure changes
             parts = name.split(".")
@@ -86,11 +86,11 @@ def measured_at(source: str) -> tuple[str | None, str]:
 
 def runnable_modules() -> list[str]:
     """Bench modules with a committed result and a ``python -m`` entry that measures it."""
-    import catalog.bench as bench
+    import benchmarks as bench
 
     names = []
     for info in pkgutil.iter_modules(bench.__path__):
-        module = importlib.import_module(f"catalog.bench.{info.name}")
+        module = importlib.import_module(f"benchmarks.{info.name}")
         text = Path(module.__file__).read_text(encoding="utf-8")
         if result_sources(module) and 'if __name__ == "__main__"' in text:
             names.append(info.name)
@@ -98,11 +98,11 @@ def runnable_modules() -> list[str]:
 
 
 def stale_results() -> list[dict]:
-    import catalog.bench as bench
+    import benchmarks as bench
 
     out = []
     for info in pkgutil.iter_modules(bench.__path__):
-        module = importlib.import_module(f"catalog.bench.{info.name}")
+        module = importlib.import_module(f"benchmarks.{info.name}")
         sources = result_sources(module)
         if not sources or getattr(module, "markdown_tables", None) is None:
             continue

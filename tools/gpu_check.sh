@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The GPU check (docs/gpu.md, "The GPU check"): on a machine with an NVIDIA GPU and no
 # network, install the few packages it lacks from wheels carried with the checkout, then run
-# the frame bench (catalog.bench.gpu_check: 720p, 1080p, 4K; gpu and cpu cloth 128x128;
+# the frame bench (benchmarks.gpu_check: 720p, 1080p, 4K; gpu and cpu cloth 128x128;
 # moving and static) in under 5 minutes, writing one JSON.
 #
 #   tools/gpu_check.sh [OUT_JSON]                    # default benchmarks/gpu_check.json
@@ -49,6 +49,6 @@ nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader 2>
   | sed 's/^/gpu_check: /' || echo "gpu_check: nvidia-smi not found (no NVIDIA GPU?)"
 cd "$ROOT"
 # 240 s for starting cases, 290 s at most for the run: the 5 minutes include the set-up
-timeout 290 "$RUN_PY" -m catalog.bench.gpu_check --budget-s 240 --json-out "$OUT" \
+timeout 290 "$RUN_PY" -m benchmarks.gpu_check --budget-s 240 --json-out "$OUT" \
   ${GPU_CHECK_ARGS:-}
 echo "gpu_check: done in $(( $(date +%s) - START )) s: $OUT"

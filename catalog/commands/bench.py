@@ -2,7 +2,7 @@
 
     catalog bench [--quick] [--json] [--out DIR] [--sections colour,fluorescence,...]
 
-Runs the sections of :mod:`catalog.bench` (colour accuracy against frame time,
+Runs the sections of :mod:`benchmarks` (colour accuracy against frame time,
 fluorescence representations on measured matrices, fit, cloth, numerical stability,
 start-up) and writes ``bench.md`` (tables), ``bench.json`` and PNG plots into DIR
 (default ``bench-out``). ``--json`` prints the same report as one JSON object on stdout;
@@ -12,12 +12,38 @@ docs/bench.md has the latest figures.
 
 from __future__ import annotations
 
+import sys
+
 RESOURCES = ("data",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
 HELP = "benchmarks: colour error against frame time, fluorescence, fit, cloth, stability, start-up"
 
 DEFAULT_OUT = "bench-out"
+
+
+def load_benchmarks():
+    """The benchmark suite (top-level ``benchmarks/`` of a checkout; not in the wheel).
+
+    The installed product carries no benchmarks: outside a checkout this is one line and
+    the environment exit code."""
+    import importlib  # noqa: PLC0415
+
+    from catalog.core.errors import EnvironmentFailure  # noqa: PLC0415
+    from catalog.core.resources import IN_CHECKOUT, PROJECT_ROOT  # noqa: PLC0415
+
+    if IN_CHECKOUT and (PROJECT_ROOT / "benchmarks" / "__init__.py").is_file():
+        root = str(PROJECT_ROOT)
+        if root not in sys.path:
+            sys.path.insert(0, root)
+    try:
+        return importlib.import_module("benchmarks")
+    except ModuleNotFoundError as exc:
+        if exc.name != "benchmarks":
+            raise
+        raise EnvironmentFailure("the benchmarks are not part of the installed product: run "
+                                 "`catalog bench` (or `python -m benchmarks`) in a checkout of "
+                                 "the repository") from None
 
 
 def add_arguments(parser) -> None:
@@ -38,8 +64,9 @@ def add_arguments(parser) -> None:
 
 
 def parse_sections(text: str | None) -> list[str]:
-    from catalog.bench import SECTIONS  # noqa: PLC0415
     from catalog.core.errors import InputError  # noqa: PLC0415
+
+    SECTIONS = load_benchmarks().SECTIONS
 
     if text is None:
         return list(SECTIONS)
@@ -56,8 +83,9 @@ def run(args) -> int:
     import time  # noqa: PLC0415
     from pathlib import Path  # noqa: PLC0415
 
-    from catalog.bench.report import write_report  # noqa: PLC0415
-    from catalog.bench.results import GL_SECTIONS, machine_info  # noqa: PLC0415
+    load_benchmarks()   # the suite (a checkout's benchmarks/), or one line saying it is absent
+    from benchmarks.report import write_report  # noqa: PLC0415
+    from benchmarks.results import GL_SECTIONS, machine_info  # noqa: PLC0415
     from catalog.core.errors import InputError  # noqa: PLC0415
     from catalog.core.jsonout import print_json  # noqa: PLC0415
 
@@ -65,7 +93,7 @@ def run(args) -> int:
     if args.scenes is not None and not 1 <= args.scenes <= 1000:
         raise InputError(f"{args.scenes}: give 1 to 1000 scenes", field="--scenes")
     if args.room is not None:
-        from catalog.bench.accuracy import check_room  # noqa: PLC0415
+        from benchmarks.accuracy import check_room  # noqa: PLC0415
 
         check_room(args.room)
     if "fluorescence" in names:  # the measured matrices are not shipped: say so, run nothing
@@ -119,7 +147,7 @@ def _run_section(name, args, ctx, report, plotters, say) -> None:
     import time  # noqa: PLC0415
     import traceback  # noqa: PLC0415
 
-    from catalog.bench import SECTIONS  # noqa: PLC0415
+    from benchmarks import SECTIONS  # noqa: PLC0415
 
     module = importlib.import_module(SECTIONS[name])
     say(f"{name} ...")

@@ -1,6 +1,6 @@
 """Rays against a triangle mesh in float64 numpy, for the checks and studies that hold the GPU's
 shadow maps to an independent answer (tests/test_cloth_shadows.py,
-catalog/bench/key_shadow_bias.py). No GL here."""
+benchmarks/key_shadow_bias.py). No GL here."""
 
 from __future__ import annotations
 

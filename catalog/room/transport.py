@@ -44,7 +44,7 @@ CHUNK_RAYS = 1 << 20
 
 @dataclass(frozen=True)
 class TransportParams:
-    """The resolutions (each error falls as it rises; catalog/bench/room_transport.py)."""
+    """The resolutions (each error falls as it rises; benchmarks/room_transport.py)."""
 
     element_m: float = 0.25          # receiver size
     patches: tuple = (6, 6)          # window patches along its u and v edges

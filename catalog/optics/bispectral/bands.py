@@ -57,7 +57,7 @@ CANDIDATE_EDGES = {
 }
 
 #: The model the renderer carries: the candidate chosen on the selection lights by
-#: catalog/bench/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
+#: benchmarks/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
 BANDS_CHOSEN = "14 bands: every 10 nm below 430"
 DEFAULT_EDGES_NM = CANDIDATE_EDGES[BANDS_CHOSEN]
 
@@ -74,7 +74,7 @@ RESIDUAL_CANDIDATES = {
 }
 
 #: The model the renderer carries: the candidate chosen on the selection lights by
-#: catalog/bench/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
+#: benchmarks/uv_fluorescence.py (benchmarks/bench_uv.json records the choice).
 CHOSEN = f"{BANDS_CHOSEN} + whole residual"
 #: The chosen model's residual rank (None: whole) and whether it has one at all.
 DEFAULT_RESIDUAL = True

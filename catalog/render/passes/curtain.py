@@ -96,7 +96,7 @@ class CurtainPass(Pass):
 
         ``fragment``: draw the same mesh (same vertex shader and uniforms of the mesh and
         camera) with this fragment shader file instead of the curtain's: how a benchmark
-        measures the rasteriser's floor with shaders of its own (catalog/bench/shaders/).
+        measures the rasteriser's floor with shaders of its own (benchmarks/shaders/).
         ``camera_position``: the eye for the view-dependent terms (default the camera's; the
         room's passes draw the curtain as seen from the key light or the room);
         ``overrides``: scene values replaced for this draw; ``folds_behind``: with ``overrides``, the room capture's variant that

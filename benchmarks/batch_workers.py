@@ -1,0 +1,115 @@
+"""Does a second Dask worker pay? 48 images on one worker and on two, where the time goes.
+
+The job: 4 fabrics x 2 lights x frames 0:3 x yaws 0,90 = 48 PNG images (96x64), through the
+command line (`catalog render-catalog --workers N`, cluster start included), fresh folder
+each run, the two engines interleaved for ``--rounds`` rounds (medians), so both see the same
+load on the shared machine. Tasks are whole fabrics (4: two per worker, an even deal).
+Each worker sets LP_NUM_THREADS to the cores / the workers (catalog.batch.dask_engine).
+
+The split comes from the job's summary: per phase, the seconds summed over the tasks
+(settle = hanging the drape; simulate = the simulation including that settle; render =
+draw + read-back; write = encode + write) and the workers' start; ``busy`` = the tasks' seconds / (workers x
+wall), how much of the workers' time went into tasks.
+
+    .venv/bin/python -m benchmarks.batch_workers [--rounds 2] [--out F.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import tempfile
+from pathlib import Path
+
+from benchmarks.batch_scaling import _timed
+from catalog.core.resources import PROJECT_ROOT
+
+FABRICS = ("lace-fwa", "linen-dense", "net-grey", "voile-white")
+LIGHTS = ("D65", "A")
+FRAMES = "0:3"
+YAWS = "0,90"
+IMAGES = len(FABRICS) * len(LIGHTS) * 3 * 2
+PHASES = ("load_s", "settle_s", "simulate_s", "render_s", "write_s")
+#: The phases that add up to a task's time (the summary's simulate_s includes settle_s).
+TASK_PHASES = ("load_s", "simulate_s", "render_s", "write_s")
+GOAL = 1.7
+RESULT_JSON = "benchmarks/bench_batch_workers.json"
+
+
+def run_once(workers: int, size: str) -> dict:
+    with tempfile.TemporaryDirectory(prefix="bench-batch-workers-") as tmp:
+        cmd = [sys.executable, "-m", "catalog", "render-catalog", "--fabrics", ",".join(FABRICS),
+               "--lights", ",".join(LIGHTS), "--frames", FRAMES, "--yaw", YAWS, "--size", size,
+               "--out", str(Path(tmp) / "out"), "--json", "--workers", str(workers)]
+        wall, cpu, result = _timed(cmd)
+    summary = json.loads(result.stdout)
+    tasks_s = sum(summary.get(k, 0.0) for k in TASK_PHASES)
+    return {"wall_s": round(wall, 3), "cpu_s": round(cpu, 3), "rendered": summary["rendered"],
+            "startup_s": summary.get("startup_s", 0.0), "tasks_s": round(tasks_s, 3),
+            "busy": round(tasks_s / (workers * wall), 3),
+            **{k: summary.get(k, 0.0) for k in PHASES}}
+
+
+def run(rounds: int, size: str) -> dict:
+    from benchmarks.results import machine_info  # noqa: PLC0415
+
+    runs: dict[int, list[dict]] = {1: [], 2: []}
+    for _ in range(rounds):
+        for workers in runs:
+            runs[workers].append(run_once(workers, size))
+    rows = []
+    for workers, worker_runs in runs.items():
+        row = {"workers": workers, "runs": worker_runs}
+        for key in ("wall_s", "cpu_s", "startup_s", "tasks_s", "busy", *PHASES):
+            row[key] = round(statistics.median(r[key] for r in worker_runs), 3)
+        row["images_per_s"] = round(IMAGES / row["wall_s"], 3)
+        rows.append(row)
+    speedup = rows[0]["wall_s"] / rows[1]["wall_s"]
+    return {"job": {"fabrics": list(FABRICS), "lights": list(LIGHTS), "frames": FRAMES,
+                    "yaw_deg": YAWS, "size": size, "images": IMAGES},
+            "machine": machine_info(), "rounds": rounds, "rows": rows,
+            "speedup_2_over_1": round(speedup, 3), "goal": GOAL,
+            "goal_met": speedup >= GOAL}
+
+
+def markdown_tables(result: dict) -> dict[str, str]:
+    job, m = result["job"], result["machine"]
+    lines = [f"{job['images']} images ({len(job['fabrics'])} fabrics x {len(job['lights'])} lights "
+             f"x frames {job['frames']} x yaws {job['yaw_deg']}, {job['size']} PNG), "
+             f"{result['rounds']} interleaved rounds, medians:", "",
+             "| workers | wall s | images/s | start s | settle s | simulate s | render s | "
+             "write s | tasks s | busy | CPU s |", "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in result["rows"]:
+        lines.append(f"| {r['workers']} | {r['wall_s']:.1f} | {r['images_per_s']:.2f} | "
+                     f"{r['startup_s']:.1f} | {r['settle_s']:.1f} | {r['simulate_s']:.1f} | "
+                     f"{r['render_s']:.1f} | {r['write_s']:.1f} | {r['tasks_s']:.1f} | "
+                     f"{r['busy']:.2f} | {r['cpu_s']:.1f} |")
+    lines += ["", f"Two workers against one: **{result['speedup_2_over_1']:.2f}x** (goal "
+              f">= {result['goal']:g}x: {'met' if result['goal_met'] else 'NOT met'}); "
+              f"{m['cpu_count']} cores shared with other engineers' jobs, load average "
+              f"{m['load_average_1min']:.1f}; measured on commit {m.get('commit') or 'unknown'}."]
+    return {"batch_workers": "\n".join(lines)}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=2)
+    parser.add_argument("--size", default="96x64")
+    parser.add_argument("--out", default=str(PROJECT_ROOT / RESULT_JSON))
+    args = parser.parse_args(argv)
+    if args.rounds < 1:
+        parser.error(f"--rounds: must be at least 1, found {args.rounds}")
+    result = run(args.rounds, args.size)
+    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
+
+    write_text_atomic(args.out, json.dumps(result, indent=1) + "\n")
+    print(markdown_tables(result)["batch_workers"])
+    return 0
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+    sys.exit(main())

@@ -1,0 +1,59 @@
+"""One scene's path-traced reference for the image section, in a process of its own.
+
+``benchmarks.image`` renders a scene's reference in the Mitsuba variant the scene needs
+(:func:`benchmarks.image.reference_variant_for`). Mitsuba's JIT crashed (a segfault) when
+the variant was switched after renders in the same process, so a scene whose variant is not
+the bench process's own is rendered here, in a child process, and handed back as an .npz:
+the two half renders ``a`` and ``b``, the region masks ``mask_*``, the render time
+``seconds`` (the two halves, scene building excluded) and ``nan_pixel_passes``.
+
+    python -m benchmarks.image_reference FABRIC LIGHT YAW PITCH DISTANCE WIDTH HEIGHT SPP VARIANT OUT.npz
+
+(LIGHT a light's name; YAW, PITCH in degrees and DISTANCE in metres: the view's camera.)
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+
+def render_halves(mi, desc, spp: int) -> dict:
+    """The scene ``desc``'s two half renders (spp / 2 each, seeds 0 and 1), its region masks,
+    the halves' wall time and the pixel-passes left out as NaN."""
+    from catalog.pathtrace.render import MAX_DEPTH, region_masks, render_radiance  # noqa: PLC0415
+    from catalog.pathtrace.scene import build_mitsuba_scene  # noqa: PLC0415
+
+    scene = build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH)
+    start = time.perf_counter()
+    report_a, report_b = {}, {}
+    a = render_radiance(mi, scene, spp // 2, seed=0, report=report_a)
+    b = render_radiance(mi, scene, spp // 2, seed=1, report=report_b)
+    seconds = time.perf_counter() - start
+    return {"a": a, "b": b, "masks": region_masks(mi, scene, desc), "seconds": seconds,
+            "nan_pixel_passes": report_a["nan_pixel_passes"] + report_b["nan_pixel_passes"]}
+
+
+def main(argv=None) -> int:
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
+    from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+
+    fabric, light, yaw, pitch, distance, width, height, spp, variant, out = (argv or sys.argv[1:])
+    desc = describe_scene(load_preset(find_preset(fabric)), get_light(light), size=(int(width), int(height)),
+                          yaw_deg=float(yaw), pitch_deg=float(pitch), distance_m=float(distance))
+    result = render_halves(load_mitsuba(variant), desc, int(spp))
+    with atomic_path(out) as tmp:
+        with open(tmp, "wb") as handle:
+            np.savez(handle, a=result["a"], b=result["b"], seconds=result["seconds"],
+                     nan_pixel_passes=result["nan_pixel_passes"],
+                     **{f"mask_{name}": mask for name, mask in result["masks"].items()})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
