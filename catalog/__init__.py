@@ -13,7 +13,7 @@ imported here, so ``catalog --help`` answers at once. One sub-package per room
 - :mod:`catalog.gl`: the GL context and shader loading (used by cloth and render);
 - :mod:`catalog.cloth`, :mod:`catalog.render`, :mod:`catalog.viewer`;
 - :mod:`catalog.commands`: the ``catalog`` command (parse, call, print);
-- :mod:`benchmarks`: every benchmark and study.
+- ``benchmarks`` (top level, outside the package and the wheel): every benchmark and study.
 """
 
 __version__ = "0.1.0"

@@ -2,7 +2,7 @@
 
     catalog bench [--quick] [--json] [--out DIR] [--sections colour,fluorescence,...]
 
-Runs the sections of :mod:`benchmarks` (colour accuracy against frame time,
+Runs the sections of the ``benchmarks`` suite (top level, in a checkout) (colour accuracy against frame time,
 fluorescence representations on measured matrices, fit, cloth, numerical stability,
 start-up) and writes ``bench.md`` (tables), ``bench.json`` and PNG plots into DIR
 (default ``bench-out``). ``--json`` prints the same report as one JSON object on stdout;
