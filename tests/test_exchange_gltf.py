@@ -163,3 +163,21 @@ def test_glb_renders_in_chromium_through_threejs(lace_glb, tmp_path):
     grey = pixels.mean(axis=2)
     row = grey[grey.shape[0] // 2]
     assert np.abs(np.diff(row)).mean() > 3           # the lace's holes: not one flat colour
+
+
+@pytest.mark.slow
+def test_the_export_records_the_room_it_was_asked_for(tmp_path, capsys):
+    """``--room living`` (a built-in) and a room file are read and checked like every command's
+    room (catalog.room.load), and the file's extras name the room."""
+    import shutil
+
+    from catalog.room.load import room_path
+
+    own = tmp_path / "client-room.glb"
+    shutil.copyfile(room_path("living"), own)
+    for room, recorded in (("living", "living"), (str(own), "client-room.glb")):
+        out = tmp_path / f"{recorded}.glb"
+        assert main(["export", "--fabric", "voile-white", "--room", room, "--out", str(out)]) == 0
+        capsys.readouterr()
+        doc, _binary = _chunks(out)
+        assert doc["scenes"][0]["extras"]["catalog"]["room"] == recorded

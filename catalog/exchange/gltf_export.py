@@ -37,7 +37,6 @@ REPEAT, LINEAR, LINEAR_MIPMAP_LINEAR = 10497, 9729, 9987
 #: Sheen of a matte yarn (KHR_materials_sheen): roughness, and the colour's share of the yarn's.
 SHEEN_ROUGHNESS = 0.5
 SHEEN_SHARE = 0.5
-ROOMS = ("box",)
 
 
 def _pad(data: bytes, fill: bytes = b"\x00") -> bytes:
