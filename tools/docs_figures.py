@@ -28,6 +28,7 @@ from pathlib import Path
 from catalog.core.atomic import write_text_atomic
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))  # the benchmarks suite (top-level benchmarks/) beside catalog
 BLOCK = re.compile(r"(<!-- generated:(?P<name>[\w.-]+) -->\n)(?P<body>.*?)(\n?<!-- /generated:(?P=name) -->)",
                    re.S)
 

@@ -28,6 +28,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))  # the benchmarks suite (top-level benchmarks/) beside catalog
 sys.path.insert(0, str(ROOT))
 
 MEASUREMENTS = ROOT / "fabrics" / "measurements"

@@ -46,7 +46,7 @@ def run(args) -> int:
     from catalog.exchange.gltf_export import write_glb
     from catalog.room.load import BUILTIN_ROOMS, load_room
 
-    # a built-in name or a room .glb (shared/spec/formats.md, "Rooms"): one that breaks a rule
+    # a built-in name or a room .glb (docs/formats.md, "Rooms"): one that breaks a rule
     # is refused in one line naming the node and the rule, before the simulation. The curtain
     # hangs in the window as in every room; the file records the room's name
     load_room(args.room)
