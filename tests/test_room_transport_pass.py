@@ -44,6 +44,7 @@ def test_pass_draws_albedo_times_interpolated_irradiance(gl, cube_transport):
     room_pass.draw(vp)
     pixels = np.frombuffer(fbo.read(components=4, dtype="f4"), dtype="f4").reshape(height, width, 4)[..., :3]
     room_pass.release()
+    (gl.screen or gl.detect_framebuffer(0)).use()   # never leave a deleted framebuffer bound
     fbo.release(), colour.release(), depth.release()
     # the expected image: rays through pixel centres (read-back row 0 is the bottom)
     inv = np.linalg.inv(vp)

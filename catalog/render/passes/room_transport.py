@@ -65,6 +65,7 @@ class RoomTransportPass:
         self.ctx.enable(moderngl.DEPTH_TEST)
         self.ctx.disable(moderngl.CULL_FACE)
         self._vao.render(moderngl.TRIANGLES)
+        self.ctx.disable(moderngl.DEPTH_TEST)   # the state the other passes start from
 
     def release(self) -> None:
         for obj in (self._vao, self._buffer, self.program):
