@@ -43,7 +43,7 @@ from catalog.core.resources import FABRIC_DIR, PROJECT_ROOT
 
 #: The committed results the docs' generated block is made from (tools/docs_figures.py):
 #: every command, and a later run of one command after a fix (``--commands fit``).
-RESULT_JSONS = {"all commands, before the start-up and teardown fixes": "benchmarks/kill_trials.json",
+RESULT_JSONS = {"all commands, on the final code (200 trials)": "benchmarks/kill_trials.json",
                 "fit, after them": "benchmarks/kill_trials_fit.json",
                 "all commands, after them": "benchmarks/kill_trials_after.json"}
 HANG_S = 5.0
