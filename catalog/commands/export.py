@@ -19,9 +19,11 @@ MAX_FRAME = 10000
 
 
 def add_arguments(parser) -> None:
+    from catalog.core.cliargs import number_type  # noqa: PLC0415
+
     parser.add_argument("--fabric", required=True, help="a fabric name or a preset .toml")
     parser.add_argument("--light", default="D65", help="the light the file records (default D65)")
-    parser.add_argument("--frame", type=int, default=0,
+    parser.add_argument("--frame", type=number_type(0, MAX_FRAME, whole=True), default=0,
                         help="the cloth frame (0: the settled drape; default 0)")
     parser.add_argument("--room", default="box", metavar="NAME|FILE.glb",
                         help="the room the curtain hangs in: box, living or a room .glb (default box)")
@@ -41,8 +43,6 @@ def run(args) -> int:
     if suffix not in (".glb", ".u3m"):
         raise InputError(f"{out.suffix or '(no suffix)'!r}: write a .glb (glTF 2.0) or a .u3m",
                          field="--out")
-    if not 0 <= args.frame <= MAX_FRAME:
-        raise InputError(f"{args.frame} must lie in 0..{MAX_FRAME}", field="--frame")
     from catalog.exchange.gltf_export import write_glb
     from catalog.room.load import BUILTIN_ROOMS, load_room
 

@@ -22,14 +22,16 @@ IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".exr")
 
 
 def add_arguments(parser) -> None:
+    from catalog.core.cliargs import number_type  # noqa: PLC0415
+
     parser.add_argument("file", metavar="FILE", help="a .u3m / .u3ma material or a pattern image")
     parser.add_argument("--name", required=True, help="the preset's name (its file stem)")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="folder to write DIR/NAME.toml and DIR/NAME/ into")
-    parser.add_argument("--repeat-m", type=float, metavar="M",
+    parser.add_argument("--repeat-m", type=number_type(0.0, 1e6, unit="m", low_open=True), metavar="M",
                         help="the image's width in metres (one repeat); overrides the "
                              "image's or the U3M's own size")
-    parser.add_argument("--threshold", type=float, metavar="T",
+    parser.add_argument("--threshold", type=number_type(-1e6, 1e6), metavar="T",
                         help="an image is artwork: open where its linear luminance is above "
                              "T (light-open) or below it (dark-open); default: a backlit "
                              "scan, luminance = open fraction")
