@@ -67,12 +67,12 @@ def test_page_loads_without_errors_and_renders(page, web_site):
     assert page.console_errors() == []
 
 
-#: Found at this round's merge (issue 34's drape with longer heading pleats): the page and the
+#: Since the drape's heading pleats keep their rest length (longer folds): the page and the
 #: desktop frame differ on a few more edge pixels than the 1 % the rule allows (196 and 164 of
 #: 19 200, one off-edge pixel 11/255 apart) in these scenes; the cause is not yet isolated
 #: (SwiftShader's and llvmpipe's rasterisation of the new folds, or a term the page lacks).
 _EDGE_MISMATCH = pytest.mark.xfail(reason="page vs desktop: edge pixels just over the 1 % rule "
-                                          "since the new drape (issue 34); not yet isolated",
+                                          "since the longer heading pleats; not yet isolated",
                                    strict=False)
 
 

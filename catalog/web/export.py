@@ -86,7 +86,7 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: pixels of 19 200 in the fluoro-pink D65 scene (182 with one layer), over the 1 % the
 #: browser test allows (web/browser.py); the peel's slope taken from the normal instead of
 #: depth derivatives gave 194 too. Not yet understood; the page keeps the one-layer shadow.
-#: ``pattern_prefilter``: off (issue 34): the page builds the pattern's mips with
+#: ``pattern_prefilter``: off: the page builds the pattern's mips with
 #: generateMipmap (the box chain), not yet the desktop's prefiltered levels (level writes).
 DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa",
                  "key_second_layer": False, "pattern_prefilter": False}
