@@ -126,6 +126,14 @@ def markdown_tables(result: dict) -> dict[str, str]:
                      f"{r['frame_ms']['cpu']:.0f} | {r['glare_ms']['cpu']:.1f} | "
                      f"{r['display_ms']['cpu']:.1f} | {r['meter_ms']['cpu']:.1f} | "
                      f"{100 * r['share_cpu']:.0f} % | {100 * r['share_wall']:.0f} % |")
+    before = result.get("before")
+    if before:   # the same module on the tree before the change, for the change's figure
+        for r in before["rows"]:
+            lines.append(f"| *before ({before['commit']}):* {r['fabric']} under {r['light']} | "
+                         f"{r['size'][0]}x{r['size'][1]} | {r['frame_ms']['cpu']:.0f} | "
+                         f"{r['glare_ms']['cpu']:.1f} | {r['display_ms']['cpu']:.1f} | "
+                         f"{r['meter_ms']['cpu']:.1f} | {100 * r['share_cpu']:.0f} % | "
+                         f"{100 * r['share_wall']:.0f} % |")
     m = result["machine"]
     foot = (f"\n\nCommit {m.get('commit')}, {m.get('gl_renderer')}, {m.get('cpu_count')} cores, "
             f"load average {m.get('load_average_1min_before', 0):.1f} before the run; "
