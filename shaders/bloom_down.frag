@@ -1,7 +1,7 @@
 #version 430
-// Glare, step 1: the HDR frame averaged over 2 x 2 pixels into a half-size target (exactly
-// the box filter of a mip level, so the image's integral is kept), whose mip chain
-// bloom.frag then reads.
+// Glare, step 1: the HDR frame averaged over 4 x 4 pixels into a quarter-size target (the
+// box filter of the frame's mip level 2, so the image's integral is kept), whose mip chain
+// bloom_glow.frag then reads. Pixels past the drawn part repeat its last row and column.
 #include "common.glsl"
 
 in vec2 v_ndc;
@@ -13,11 +13,13 @@ uniform ivec2 u_hdr_size;            // the part of the HDR target drawn (pixels
 layout(location = 0) out vec4 out_radiance;
 
 void main() {
-    ivec2 p = 2 * ivec2(gl_FragCoord.xy);
+    ivec2 p = 4 * ivec2(gl_FragCoord.xy);
     ivec2 last = u_hdr_size - 1;
-    vec3 sum = texelFetch(u_hdr, min(p, last), 0).rgb
-             + texelFetch(u_hdr, min(p + ivec2(1, 0), last), 0).rgb
-             + texelFetch(u_hdr, min(p + ivec2(0, 1), last), 0).rgb
-             + texelFetch(u_hdr, min(p + ivec2(1, 1), last), 0).rgb;
-    out_radiance = vec4(0.25 * sum, 1.0);
+    vec3 sum = vec3(0.0);
+    for (int j = 0; j < 4; ++j) {
+        for (int i = 0; i < 4; ++i) {
+            sum += texelFetch(u_hdr, min(p + ivec2(i, j), last), 0).rgb;
+        }
+    }
+    out_radiance = vec4(0.0625 * sum, 1.0);
 }

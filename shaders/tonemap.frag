@@ -15,10 +15,15 @@ uniform vec3 u_luminance;         // Y row of linear sRGB -> XYZ
 uniform mat3 u_rgb_to_lms;        // OKLab M1 after sRGB -> XYZ
 uniform mat3 u_lms_to_rgb;
 uniform mat3 u_lms_to_lab;        // OKLab M2
-uniform mat3 u_lab_to_lms;
 uniform vec2 u_tone;              // (S0, G): y = (x / (x + S0))^G
 uniform float u_lightness_ceiling; // the largest OKLab L kept (display.lightness_ceiling)
 uniform vec3 u_gamut;             // (R_KNEE, R_LIMIT, CUBE_TOP): chroma ratios kept / approached, cube
+#ifdef GLARE
+// the glare mixed in first (glare.py; energy-preserving): (1 - s) sharp + s glow
+uniform sampler2D u_glow;         // bloom_glow.frag's quarter-size glow (bilinear)
+uniform vec4 u_glow_rect;         // (u0, v0, du, dv) of the part drawn, in u_glow
+uniform float u_glare_strength;
+#endif
 
 layout(location = 0) out vec4 out_colour;
 
@@ -34,36 +39,34 @@ vec3 signed_cbrt(vec3 v) {
     return sign(v) * pow(abs(v), vec3(1.0 / 3.0));
 }
 
-vec3 rgb_to_oklab(vec3 rgb) {
-    return u_lms_to_lab * signed_cbrt(u_rgb_to_lms * rgb);
-}
-
-vec3 oklab_to_rgb(vec3 lab) {
-    vec3 lms = u_lab_to_lms * lab;
+// OKLab's M2 maps LMS' = (L, L, L) to (L, 0, 0) (its first row sums to 1, the others to 0),
+// so the colour at lightness L and chroma scale t on this colour's hue is
+// LMS' = L + t (lms' - L_own): no trip through Lab. rgb at chroma scale t:
+vec3 rgb_at(vec3 lms_prime, float own_l, float l, float t) {
+    vec3 lms = vec3(l) + t * (lms_prime - vec3(own_l));
     return u_lms_to_rgb * (lms * lms * lms);
 }
 
-bool in_gamut(vec3 lab) {
-    vec3 rgb = oklab_to_rgb(lab);
+bool in_cube(vec3 rgb) {
     return all(greaterThanEqual(rgb, vec3(0.0))) && all(lessThanEqual(rgb, vec3(u_gamut.z)));
 }
 
 // Chroma ratio r = C / C_boundary at this L and hue: identity below the knee, then rolled off
 // toward the limit (< 1) so no channel lands on the cube's faces.
 vec3 gamut_compress(vec3 rgb) {
-    vec3 lab = rgb_to_oklab(rgb);
-    float lightness = clamp(lab.x, 0.0, u_lightness_ceiling);
-    bool clamped = lightness != lab.x;
-    lab.x = lightness;
+    vec3 lms_prime = signed_cbrt(u_rgb_to_lms * rgb);
+    float own_l = (u_lms_to_lab * lms_prime).x;
+    float lightness = clamp(own_l, 0.0, u_lightness_ceiling);
+    bool clamped = lightness != own_l;
     float t_hi = 1.0 / u_gamut.x;
-    if (!clamped && in_gamut(vec3(lab.x, lab.yz * t_hi))) {
+    if (!clamped && in_cube(rgb_at(lms_prime, own_l, lightness, t_hi))) {
         return rgb;
     }
     float lo = 0.0;
     float hi = t_hi;
     for (int i = 0; i < GAMUT_STEPS; ++i) {
         float mid = 0.5 * (lo + hi);
-        if (in_gamut(vec3(lab.x, lab.yz * mid))) {
+        if (in_cube(rgb_at(lms_prime, own_l, lightness, mid))) {
             lo = mid;
         } else {
             hi = mid;
@@ -73,7 +76,7 @@ vec3 gamut_compress(vec3 rgb) {
     float span = u_gamut.y - u_gamut.x;
     float u = max(r - u_gamut.x, 0.0) / span;
     float compressed = (r <= u_gamut.x) ? r : u_gamut.x + span * u / (1.0 + u);
-    return oklab_to_rgb(vec3(lab.x, lab.yz * (compressed / r)));
+    return rgb_at(lms_prime, own_l, lightness, compressed / r);
 }
 
 vec3 display_linear(vec3 hdr) {
@@ -97,5 +100,9 @@ vec3 display_linear(vec3 hdr) {
 
 void main() {
     vec3 hdr = texture(u_hdr, u_hdr_rect.xy + v_uv * u_hdr_rect.zw).rgb;
+#ifdef GLARE
+    vec3 glow = texture(u_glow, u_glow_rect.xy + v_uv * u_glow_rect.zw).rgb;
+    hdr = (1.0 - u_glare_strength) * hdr + u_glare_strength * glow;
+#endif
     out_colour = vec4(srgb_encode(display_linear(hdr)), 1.0);
 }

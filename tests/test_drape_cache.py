@@ -52,6 +52,21 @@ def test_the_key_follows_every_parameter_the_grid_the_frames_and_the_solver(monk
     assert key not in others and len(others) == 5
 
 
+@pytest.mark.slow
+def test_the_wind_is_no_part_of_the_key_because_the_settle_is_in_still_air(cache):
+    """A curtain at wind 0 and one at 2 m/s with other gusts share one settled rest: the
+    settle of the windy parameters is the windless settle bit for bit (so sharing is right),
+    and one file serves both."""
+    still, windy = _params(), _params(wind_speed_m_s=2.0, gust_strength=0.2,
+                                      wind_direction=(0.3, 0.0, 1.0), gust_period_s=1.0)
+    assert drape_cache.drape_key(windy, FRAMES, 1 / 60) == drape_cache.drape_key(still, FRAMES, 1 / 60)
+    assert _same(settle(windy, FRAMES), settle(still, FRAMES))
+    drape.settled_state(windy, FRAMES)
+    drape.settled_state(still, FRAMES)
+    assert len(list(cache.glob("*.npz"))) == 1
+    assert drape_cache.windless(windy) == drape_cache.windless(still)
+
+
 def test_the_cached_state_is_the_settles_and_a_second_read_does_not_settle(cache, monkeypatch):
     params = _params()
     fresh = settle(params, FRAMES)

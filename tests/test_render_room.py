@@ -429,7 +429,7 @@ ES_VARIANTS = [
     ("background.frag", {"SKY_MODEL": True}),
     ("background.frag", {"SKY_MODEL": True, "SKY_BANDS": True}), ("background.frag", {"ENVIRONMENT": True}),
     ("background.frag", {}),
-    ("bloom_down.frag", {}), ("bloom_glow.frag", {"BLOOM_LEVELS": 6}), ("bloom.frag", {}),
+    ("bloom_down.frag", {}), ("bloom_glow.frag", {"BLOOM_LEVELS": 5}), ("tonemap.frag", {"GLARE": True}),
     ("curtain.vert", {"N_ROOM_LAMPS": 2}),
     ("curtain.frag", {"N_BANDS": 16, "NV4": 4, "FLUORESCENCE_PHYSICAL": True, "SEE_THROUGH": True,
                       "ANISOTROPIC": True, "N_ROOM_LAMPS": 2}),

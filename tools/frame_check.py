@@ -8,7 +8,8 @@ with the tree on PYTHONPATH (e.g. ``git archive before-31 | tar -x -C /tmp/base`
 each frame's linear radiance and its sRGB8 display image; the cloth's settled meshes are
 written to MESHES.npz on the first run and read on the next, so both trees draw the same
 vertices. ``compare`` prints per case the largest and mean relative difference of the linear
-frames (|a - b| / max(|a|, 1e-3 max |a|)) and the largest sRGB8 step, then the worst.
+frames (|a - b| / max(|a|, 1e-3 max |a|)), the largest sRGB8 step and the mean FLIP of the
+display images (catalog.pathtrace.metrics.flip_map), then the worst of each.
 """
 
 from __future__ import annotations
@@ -99,17 +100,21 @@ def render(out: Path, meshes_path: Path) -> None:
 
 
 def compare(before: Path, after: Path) -> float:
+    from catalog.pathtrace.metrics import flip_map
+
     a, b = np.load(before), np.load(after)
-    worst = 0.0
+    worst = worst_flip = 0.0
     for k in a.files:
         if not k.startswith("lin:"): continue
         x, y = a[k].astype(np.float64), b[k].astype(np.float64)
         scale = np.maximum(np.abs(x), 1e-3 * max(np.abs(x).max(), 1e-30))
         rel = np.abs(x - y) / scale
         d8 = np.abs(a["srgb:" + k[4:]].astype(int) - b["srgb:" + k[4:]].astype(int)).max()
-        worst = max(worst, rel.max())
-        print(f"{k[4:]:34s} max rel {rel.max():.2e}  mean rel {rel.mean():.2e}  srgb8 max diff {d8}")
-    print("worst", worst)
+        flip = float(flip_map(b["srgb:" + k[4:]] / 255.0, a["srgb:" + k[4:]] / 255.0).mean())
+        worst, worst_flip = max(worst, rel.max()), max(worst_flip, flip)
+        print(f"{k[4:]:34s} max rel {rel.max():.2e}  mean rel {rel.mean():.2e}  srgb8 max diff {d8}"
+              f"  mean FLIP {flip:.5f}")
+    print("worst", worst, "worst mean FLIP", worst_flip)
     return worst
 
 

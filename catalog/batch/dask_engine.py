@@ -21,7 +21,8 @@ PROGRESS_TOPIC = "catalog-render-catalog"
 
 
 class RendererPlugin(WorkerPlugin):
-    """Per worker process: ``LP_NUM_THREADS`` (unless already set), the EGL device, and one
+    """Per worker process: ``LP_NUM_THREADS`` (unless already set) and ``NUMBA_NUM_THREADS``
+    (the cores / the host's workers), the EGL device, and one
     GL context and renderer kept for every task the worker runs (released at teardown).
 
     ``host_workers``: worker address -> (its rank among the workers of its host, how many
@@ -41,11 +42,13 @@ class RendererPlugin(WorkerPlugin):
 
         rank, peers = self.host_workers.get(worker.address, (0, 1))
         # read by llvmpipe when the context is made (the first task): set before that
-        if self.lp_threads:
-            os.environ["LP_NUM_THREADS"] = str(self.lp_threads)
-        elif "LP_NUM_THREADS" not in os.environ:
-            cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-            os.environ["LP_NUM_THREADS"] = str(max(1, (cpus or 1) // peers))
+        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+        share = str(self.lp_threads or max(1, (cpus or 1) // peers))
+        if self.lp_threads or "LP_NUM_THREADS" not in os.environ:
+            os.environ["LP_NUM_THREADS"] = share
+        # the settle's numba threads (read when numba is first imported, in the first task
+        # that settles): the worker's share of the cores too, not all of them per worker
+        os.environ.setdefault("NUMBA_NUM_THREADS", share)
         device = os.environ.get("CATALOG_EGL_DEVICE")
         if device is not None:
             device_index = int(device)

@@ -239,8 +239,12 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
                                       yaw_deg=image.yaw_deg, pitch_deg=task.pitch_deg,
                                       distance_m=task.distance_m, exposure=task.exposure)
             configure_renderer(renderer, request, preset, lights[image.light])
-            renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
-            renderer.set_rings(rings)
+            if image is by_frame[frame][0]:
+                # once a frame: a new mesh makes the room's light be drawn again, which the
+                # frame's other lights and yaws need not pay (its key holds the light; the
+                # camera is no part of it)
+                renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
+                renderer.set_rings(rings)
             renderer.render()
             pixels = renderer.read_linear() if linear else renderer.read_srgb8()
             render_s = time.perf_counter() - t0

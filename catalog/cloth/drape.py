@@ -106,8 +106,10 @@ def _settled(params: ClothParams, frames: int):
 def settled_state(params: ClothParams, frames: int = SETTLE_FRAMES):
     """The cloth at rest without wind, settled from the rest pose in at most ``frames``
     frames (a copy; computed once per parameter set and solver, then read from the user's
-    cache folder: catalog.cloth.drape_cache)."""
-    return _settled(params, int(frames)).copy()
+    cache folder: catalog.cloth.drape_cache; one for every wind)."""
+    from catalog.cloth import drape_cache  # noqa: PLC0415
+
+    return _settled(drape_cache.windless(params), int(frames)).copy()
 
 
 def settled_simulation(params: ClothParams, backend: str = "numpy", **options):

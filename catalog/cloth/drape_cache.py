@@ -6,8 +6,9 @@ function of the parameters, the frame count and step, and the solver's code, so 
 in the user's cache folder (platformdirs' user cache dir, ``fabric-catalog/drape``) under
 the SHA-256 of all of these:
 
-- every field of :class:`~catalog.cloth.params.ClothParams` (the grid included), the frames
-  and the frame step;
+- every field of :class:`~catalog.cloth.params.ClothParams` (the grid included) but the
+  wind's (WIND_FIELDS: the settle hangs the cloth in still air, so a curtain at wind 0 and
+  at wind 2 m/s share one settled rest: :func:`windless`), the frames and the frame step;
 - the source text of the modules the numpy settle runs (a changed solver is a new key:
   old entries are never read again);
 - numpy's version (its reductions may round differently).
@@ -42,6 +43,19 @@ SOLVER_MODULES = ("params", "state", "topology", "wind", "backend", "backend_num
                   "simulation", "drape")
 
 
+#: The fields that shape only the wind (catalog.cloth.wind): without wind (speed 0) the air
+#: is still whatever the gusts or the direction, so they change no settled drape.
+WIND_FIELDS = ("wind_speed_m_s", "wind_direction", "gust_strength", "gust_length_m",
+               "gust_period_s")
+
+
+def windless(params):
+    """``params`` in still air: the wind's fields (WIND_FIELDS) at their defaults, speed 0 (the
+    parameters the settle runs with, and so the ones its key and cache hold)."""
+    defaults = {f.name: f.default for f in dataclasses.fields(params) if f.name in WIND_FIELDS}
+    return params.with_changes(**{**defaults, "wind_speed_m_s": 0.0})
+
+
 def cache_dir() -> Path | None:
     """The drape cache folder, or None when the cache is off."""
     value = os.environ.get(CACHE_ENV)
@@ -69,8 +83,9 @@ def solver_hash() -> str:
 
 
 def drape_key(params, frames: int, frame_dt_s: float) -> str:
-    """The content key of a settled drape (hex SHA-256)."""
-    fields = {f.name: getattr(params, f.name) for f in dataclasses.fields(params)
+    """The content key of a settled drape (hex SHA-256): of :func:`windless` ``params``."""
+    still = windless(params)
+    fields = {f.name: getattr(still, f.name) for f in dataclasses.fields(still)
               if f.compare}
     text = json.dumps({"format": FORMAT, "params": fields, "frames": int(frames),
                        "frame_dt_s": float(frame_dt_s), "solver": solver_hash(),

@@ -360,7 +360,7 @@ def shader_uniforms(exposure: float, white_balance: np.ndarray) -> dict:
 
     return {"u_exposure": float(exposure), "u_white_balance": mat3(white_balance),
             "u_rgb_to_lms": mat3(m.rgb_to_lms), "u_lms_to_rgb": mat3(m.lms_to_rgb),
-            "u_lms_to_lab": mat3(m.lms_to_lab), "u_lab_to_lms": mat3(m.lab_to_lms),
+            "u_lms_to_lab": mat3(m.lms_to_lab),
             "u_luminance": tuple(float(v) for v in m.luminance),
             "u_tone": (float(TONE_S0), float(TONE_G)),
             "u_gamut": (float(R_KNEE), float(R_LIMIT), float(CUBE_TOP)),

@@ -24,7 +24,7 @@ Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
    what is really behind, undimmed, and overlapping folds multiply their open fractions;
    ``patterned = False`` draws the paper's flat cloth instead (opaque, LD times the
    background by ray direction: the frame before issue 12, kept for comparison);
-3b. glare (bloom_down/glow/bloom.frag), energy-preserving, when on;
+3b. glare (bloom_down/glow.frag at quarter size, mixed in by tonemap.frag), when on;
 4. display (fullscreen.vert + tonemap.frag) into the caller's framebuffer (or our RGBA8
    target): exposure (EV100, fixed or metered from a luminance histogram of this frame),
    white balance (CAT16), tone curve, gamut compression in OKLab, the sRGB curve
@@ -111,7 +111,7 @@ class FrameRenderer:
         #: cloth moves (a cloth drawn from GPU buffers is taken as moving); 1: every frame
         self.room_update_every = 1
         self.sky_model = True      # the clear sky of catalog/optics/sun/sky.py behind the window (a sun)
-        self.bloom = True          # glare before the tone map (bloom.frag)
+        self.bloom = True          # glare before the tone map (glare.py)
         self.environment = None    # (path, texture, upper-hemisphere illuminance) or None
         self.antialiasing = "fxaa"
         self.room_targets = RoomTargets(ctx, self.shadow_texels)
@@ -259,7 +259,7 @@ class FrameRenderer:
         self.lightmap.invalidate()
 
     def set_bloom(self, on: bool) -> None:
-        """Glare before the tone map (energy-preserving, bloom.frag) on or off."""
+        """Glare before the tone map (energy-preserving, glare.py) on or off."""
         self.bloom = bool(on)
 
     def set_bands(self, n_bands: int) -> None:
@@ -399,11 +399,11 @@ class FrameRenderer:
             self._timed(profile, "meter", lambda: setattr(
                 self, "metered_ev100",
                 display_lib.adapt_ev(self.metered_ev100, self.display.meter(vw, vh), dt_s)))
-        source = {"texture": self.targets.hdr}
+        source = {"glare": None}
         if self.bloom:
-            self._timed(profile, "bloom", lambda: source.update(texture=self.glare.draw_bloom(vw, vh)))
+            self._timed(profile, "bloom", lambda: source.update(glare=self.glare.draw_bloom(vw, vh)))
         self._timed(profile, "display",
-                    lambda: self.display.display_pass(vw, vh, fbo, viewport, source["texture"]))
+                    lambda: self.display.display_pass(vw, vh, fbo, viewport, source["glare"]))
 
     def read_linear(self) -> np.ndarray:
         """The last frame's HDR radiance: float32 (H, W, 3), linear sRGB, cd m^-2 scale, row 0 = top."""
@@ -429,11 +429,11 @@ class FrameRenderer:
             raise CatalogError("display_of: render a frame first (its exposure shows the image)")
         rgba = np.concatenate([image[::-1], np.ones((h, w, 1), dtype=np.float32)], axis=-1)
         self.targets.hdr.write(np.ascontiguousarray(rgba).tobytes())
-        texture = self.glare.draw_bloom(w, h) if self.bloom else self.targets.hdr
+        glare = self.glare.draw_bloom(w, h) if self.bloom else None
         mode = self.antialiasing
         self.antialiasing = "off"
         try:
-            self.display.display_pass(w, h, hdr=texture)
+            self.display.display_pass(w, h, glare=glare)
         finally:
             self.antialiasing = mode
         return self.read_srgb8()

@@ -1,4 +1,5 @@
-"""Pass 5 of the frame: exposure, white balance, tone curve and sRGB (tonemap.frag), then FXAA."""
+"""Pass 5 of the frame: the glare's mix, exposure, white balance, tone curve and sRGB
+(tonemap.frag), then FXAA."""
 
 from __future__ import annotations
 
@@ -17,8 +18,8 @@ class DisplayPass(Pass):
     exposure (EV100, fixed or metered from a luminance histogram of this frame), white balance
     (CAT16), the tone curve, gamut compression, the sRGB curve; then FXAA (fxaa.frag).
 
-    In: the HDR target (or the glare's texture). Out: the caller's framebuffer or the frame's
-    display image."""
+    In: the HDR target and the glare's glow (mixed in here, when on). Out: the caller's
+    framebuffer or the frame's display image."""
 
     def __init__(self, frame):
         super().__init__(frame)
@@ -67,9 +68,10 @@ class DisplayPass(Pass):
         rgb = data[:ch, :cw, :3].astype(np.float64) @ self.white_balance_matrix().T  # as shown
         return display_lib.meter_ev100(display_lib.luminance_histogram(display_lib.meter_signal(rgb)))
 
-    def display_pass(self, vw: int, vh: int, fbo=None, viewport=None, hdr=None, stages: int = 3) -> None:
+    def display_pass(self, vw: int, vh: int, fbo=None, viewport=None, glare=None, stages: int = 3) -> None:
         """The display transform of the HDR target's (vw, vh) corner (the benchmark times it);
-        ``hdr``: the texture to show (default the HDR target; the glare's output when on);
+        ``glare``: the glare pass's :class:`~catalog.render.passes.glare.Glare` to mix in first
+        (None: the HDR target as it is);
         ``stages``: tonemap.frag's DISPLAY_STAGES (3, all; fewer for the benchmark's cost per stage)."""
         target = fbo if fbo is not None else self.frame.targets.ldr_fbo
         target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
@@ -81,10 +83,15 @@ class DisplayPass(Pass):
         else:
             target.use()
             self.ctx.viewport = target_viewport
-        program = self.gl.program("fullscreen.vert", "tonemap.frag",
-                                {"DISPLAY_STAGES": int(stages)})
-        (hdr if hdr is not None else self.frame.targets.hdr).use(location=0)
+        defines = {"DISPLAY_STAGES": int(stages), **({"GLARE": True} if glare is not None else {})}
+        program = self.gl.program("fullscreen.vert", "tonemap.frag", defines)
+        self.frame.targets.hdr.use(location=0)
         set_uniform(program, "u_hdr", 0)
+        if glare is not None:
+            glare.glow.use(location=1)
+            set_uniform(program, "u_glow", 1)
+            set_uniform(program, "u_glow_rect", glare.rect)
+            set_uniform(program, "u_glare_strength", glare.strength)
         set_uniform(program, "u_hdr_rect", (0.0, 0.0, vw / self.frame.size[0], vh / self.frame.size[1]))
         for name, value in self.display_uniforms().items():
             set_uniform(program, name, value)
