@@ -41,6 +41,24 @@ def test_living_has_a_textured_floor_and_furniture():
     assert 0.1 < albedo.mean() < 0.5 and albedo.std() > 0
 
 
+@pytest.mark.slow
+def test_bedroom_is_another_furnished_room():
+    room = load_room("bedroom")
+    names = {s.name for s in room.surfaces}
+    assert {"floor", "bed_mattress", "desk_top", "chair_post", "rug", "wall_shelf_0", "window_sill"} <= names
+    for textured in ("floor", "rug"):
+        s = next(s for s in room.surfaces if s.name == textured)
+        assert s.texture is not None and s.uvs is not None
+    # its window is not the box's: wider, lower, off-centre
+    box = load_room("box")
+    assert room.window.area_m2 == pytest.approx(2.1 * 1.45, rel=1e-6)
+    assert not np.allclose(room.window.centre, box.window.centre, atol=0.1)
+    assert np.allclose(room.window.normal, [0, 0, 1])
+    lo, hi = room.bounds()
+    assert hi[1] - lo[1] < box.bounds()[1][1] - box.bounds()[0][1]     # a lower ceiling
+    assert room.camera is not None
+
+
 def test_unknown_name_is_refused():
     with pytest.raises(InputError, match="--room.*unknown room 'attic'"):
         room_path("attic")
@@ -157,5 +175,5 @@ def test_built_in_rooms_are_what_the_tool_makes(tmp_path):
 
     subprocess.run([sys.executable, str(PROJECT_ROOT / "tools" / "make_rooms.py"), "--out", str(tmp_path)],
                    check=True, capture_output=True, timeout=120)
-    for name in ("box", "living"):
+    for name in ("box", "living", "bedroom"):
         assert (tmp_path / f"{name}.glb").read_bytes() == (DATA_DIR / f"{name}.glb").read_bytes(), name
