@@ -140,7 +140,8 @@ def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     from catalog.room.transport import TransportParams
 
     monkeypatch.setenv("CATALOG_CACHE", str(tmp_path / "cache"))
-    params = TransportParams(element_m=0.3, patches=(1, 1), order=1, gather_rays=16, window_samples=2)
+    params = TransportParams(element_m=0.3, max_receivers=500, patches=(1, 1), order=1, gather_rays=16,
+                             window_samples=2)
     parts, window = _cube_room()
     path = _write(tmp_path, parts, window)
     room = load_room(path)
@@ -149,6 +150,14 @@ def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     again = room_transport(load_room(path), params, backend="numpy")
     assert again.timings_s["from_cache"] is True
     assert np.array_equal(again.window_operator, first.window_operator)
+    # the refined receivers' tree comes back: a point maps to the same receiver
+    assert again.receivers.children is not None and np.array_equal(again.receivers.leaf, first.receivers.leaf)
+    rng = np.random.default_rng(0)
+    pick = rng.integers(0, first.receivers.count, 64)
+    pts = first.receivers.sample_points(pick, rng)
+    tri = first.receivers.triangle[pick]
+    assert np.array_equal(again.receiver_at(tri, pts), first.receiver_at(tri, pts))
+    assert np.array_equal(first.receiver_at(tri, pts), pick)
     # the same room with a deeper back wall: another file, another entry, recomputed
     parts[4] = scene_lib.box_triangles(0, 1, 0, 1, 1, 1.05)
     parts[4][:, :, 2] += 0.2
@@ -162,7 +171,12 @@ def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     third = room_transport(changed, params, backend="numpy")
     assert third.timings_s["from_cache"] is False
     assert not np.allclose(third.receivers.centre, first.receivers.centre)   # the deeper room
-    assert third.direct.sum() < first.direct.sum()         # its far wall sees less of the window
+    def back_wall_mean(t):                                 # the far wall's mean direct light (unit DC patch)
+        rec = t.receivers
+        back = (rec.normal[:, 2] < -0.99) & (rec.centre[:, 2] > 0.5)      # the only inside face towards -z
+        return np.average(t.direct[back, 0], weights=rec.area_m2[back])
+
+    assert back_wall_mean(third) < 0.8 * back_wall_mean(first)      # its far wall sees less of the window
 
 
 @pytest.mark.slow

@@ -58,7 +58,7 @@ class TransportParams:
     element_m: float = 0.4           # receiver size before refinement
     refine_tolerance: float = 0.15   # split while the window's direct light spans more (of the mean)
     refine_levels: int = 3           # at most this many halvings
-    max_receivers: int = 6500        # refinement's bound (the dense solve grows as E^3)
+    max_receivers: int = 5000        # refinement's bound (the dense solve grows as E^3)
     patches: tuple = (6, 6)          # window patches along its u and v edges
     order: int = 3                   # basis order (order (order + 1) / 2 coefficients per patch)
     gather_rays: int = 256           # form-factor rays per receiver
