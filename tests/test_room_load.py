@@ -134,6 +134,24 @@ def test_too_many_triangles_are_refused_before_decoding(tmp_path, monkeypatch):
         load_room(path)
 
 
+def test_an_oversized_texture_is_refused_before_decoding(tmp_path, monkeypatch):
+    import catalog.room.load as load_mod
+    from PIL import Image
+
+    parts, window = _cube_room()
+    path = _write(tmp_path, parts, window)
+    scene = trimesh.load(path, force="scene", process=False)
+    floor = scene.geometry["part0"]
+    floor.visual = trimesh.visual.TextureVisuals(
+        uv=np.zeros((len(floor.vertices), 2)),
+        material=trimesh.visual.material.PBRMaterial(baseColorTexture=Image.new("RGB", (4097, 4))))
+    path.write_bytes(scene.export(file_type="glb"))
+    monkeypatch.setattr(load_mod, "_decoded", lambda *a: pytest.fail("decoded a room over the bound"))
+    with pytest.raises(InputError, match="a 4097x4 texture: at most 4096 texels a side") as info:
+        load_room(path)
+    assert "\n" not in str(info.value) and "r.glb" in str(info.value)
+
+
 @pytest.mark.slow
 def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     from catalog.room.cache import cache_path, room_transport
