@@ -98,7 +98,7 @@ def sweeps(quick: bool) -> dict:
     }
 
 
-def run_room(name: str, quick: bool, probes: int, paths: int, only=None) -> dict:
+def run_room(name: str, quick: bool, probes: int, paths: int, only=None, commit: str = "unknown") -> dict:
     from catalog.room import brute_force, lightmap  # noqa: PLC0415
     from catalog.room.load import load_room  # noqa: PLC0415
     from catalog.room.transport import precompute  # noqa: PLC0415
@@ -139,7 +139,6 @@ def run_room(name: str, quick: bool, probes: int, paths: int, only=None) -> dict
                                 "refinement": t.timings_s.get("refinement")})
             print(f"{name:7s} {sweep:11s} {value!s:6s} error {err:.4f} (flat {err_flat:.4f})  receivers {t.receivers.count:5d}"
                   f"  {seconds:6.1f} s", flush=True)
-    commit = _commit()
     return {"room": name, "probes": probes, "paths_per_probe": paths, "reference_noise": noise,
             "reference_s": reference_s, "sweeps": rows, "sweep_commits": {k: commit for k in rows}}
 
@@ -195,7 +194,8 @@ def run(quick: bool = False, rooms=("box", "living", "bedroom"), only=None, prev
     result = {"commit": _commit(), "rooms": [], "timing": []}
     old = {r["room"]: r for r in (previous or {}).get("rooms", [])}
     for name in rooms:
-        room = run_room(name, quick, probes=48 if quick else 96, paths=2048 if quick else 16384, only=only)
+        room = run_room(name, quick, probes=48 if quick else 96, paths=2048 if quick else 16384, only=only,
+                        commit=result["commit"])
         if only is not None and name in old:
             before = old[name]
             for key in ("probes", "paths_per_probe", "reference_noise", "reference_s"):

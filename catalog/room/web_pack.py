@@ -99,7 +99,7 @@ def _truncate_product(left: np.ndarray, right: np.ndarray, tolerance: float):
     return ql @ u[:, :rank], s[:rank], vt[:rank] @ qr_.T
 
 
-def pack(transport, window_tolerance: float = 1e-2, bounce_tolerance: float = 1e-2,
+def pack(transport, window_tolerance: float = 3e-2, bounce_tolerance: float = 3e-2,
          seed: int = 0) -> WebPack:
     """The :class:`WebPack` of a compressed transport (see the module doc); ``errors``: the
     Frobenius bounds and the relative RMS over receivers on random inputs (window
