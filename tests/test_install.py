@@ -20,7 +20,8 @@ SHIPPED = ["catalog/_data/shaders/common.glsl", "catalog/_data/shaders/curtain.f
            "catalog/_data/fabrics/measurements/lace-fwa/excitation.csv",
            "catalog/_data/fabrics/measurements/lace-fwa/gonio.csv",
            "catalog/optics/data/reference_tables.npz",
-           "catalog/room/data/box.glb", "catalog/room/data/living.glb"]
+           "catalog/room/data/box.glb", "catalog/room/data/living.glb",
+           "catalog/room/data/bedroom.glb"]
 
 
 @pytest.fixture(scope="module")

@@ -41,6 +41,24 @@ def test_living_has_a_textured_floor_and_furniture():
     assert 0.1 < albedo.mean() < 0.5 and albedo.std() > 0
 
 
+@pytest.mark.slow
+def test_bedroom_is_another_furnished_room():
+    room = load_room("bedroom")
+    names = {s.name for s in room.surfaces}
+    assert {"floor", "bed_mattress", "desk_top", "chair_post", "rug", "wall_shelf_0", "window_sill"} <= names
+    for textured in ("floor", "rug"):
+        s = next(s for s in room.surfaces if s.name == textured)
+        assert s.texture is not None and s.uvs is not None
+    # its window is not the box's: wider, lower, off-centre
+    box = load_room("box")
+    assert room.window.area_m2 == pytest.approx(2.1 * 1.45, rel=1e-6)
+    assert not np.allclose(room.window.centre, box.window.centre, atol=0.1)
+    assert np.allclose(room.window.normal, [0, 0, 1])
+    lo, hi = room.bounds()
+    assert hi[1] - lo[1] < box.bounds()[1][1] - box.bounds()[0][1]     # a lower ceiling
+    assert room.camera is not None
+
+
 def test_unknown_name_is_refused():
     with pytest.raises(InputError, match="--room.*unknown room 'attic'"):
         room_path("attic")
@@ -116,13 +134,32 @@ def test_too_many_triangles_are_refused_before_decoding(tmp_path, monkeypatch):
         load_room(path)
 
 
+def test_an_oversized_texture_is_refused_before_decoding(tmp_path, monkeypatch):
+    import catalog.room.load as load_mod
+    from PIL import Image
+
+    parts, window = _cube_room()
+    path = _write(tmp_path, parts, window)
+    scene = trimesh.load(path, force="scene", process=False)
+    floor = scene.geometry["part0"]
+    floor.visual = trimesh.visual.TextureVisuals(
+        uv=np.zeros((len(floor.vertices), 2)),
+        material=trimesh.visual.material.PBRMaterial(baseColorTexture=Image.new("RGB", (4097, 4))))
+    path.write_bytes(scene.export(file_type="glb"))
+    monkeypatch.setattr(load_mod, "_decoded", lambda *a: pytest.fail("decoded a room over the bound"))
+    with pytest.raises(InputError, match="a 4097x4 texture: at most 4096 texels a side") as info:
+        load_room(path)
+    assert "\n" not in str(info.value) and "r.glb" in str(info.value)
+
+
 @pytest.mark.slow
 def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     from catalog.room.cache import cache_path, room_transport
     from catalog.room.transport import TransportParams
 
     monkeypatch.setenv("CATALOG_CACHE", str(tmp_path / "cache"))
-    params = TransportParams(element_m=0.3, patches=(1, 1), order=1, gather_rays=16, window_samples=2)
+    params = TransportParams(element_m=0.3, max_receivers=500, patches=(1, 1), order=1, gather_rays=16,
+                             window_samples=2)
     parts, window = _cube_room()
     path = _write(tmp_path, parts, window)
     room = load_room(path)
@@ -131,6 +168,14 @@ def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     again = room_transport(load_room(path), params, backend="numpy")
     assert again.timings_s["from_cache"] is True
     assert np.array_equal(again.window_operator, first.window_operator)
+    # the refined receivers' tree comes back: a point maps to the same receiver
+    assert again.receivers.children is not None and np.array_equal(again.receivers.leaf, first.receivers.leaf)
+    rng = np.random.default_rng(0)
+    pick = rng.integers(0, first.receivers.count, 64)
+    pts = first.receivers.sample_points(pick, rng)
+    tri = first.receivers.triangle[pick]
+    assert np.array_equal(again.receiver_at(tri, pts), first.receiver_at(tri, pts))
+    assert np.array_equal(first.receiver_at(tri, pts), pick)
     # the same room with a deeper back wall: another file, another entry, recomputed
     parts[4] = scene_lib.box_triangles(0, 1, 0, 1, 1, 1.05)
     parts[4][:, :, 2] += 0.2
@@ -144,7 +189,12 @@ def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     third = room_transport(changed, params, backend="numpy")
     assert third.timings_s["from_cache"] is False
     assert not np.allclose(third.receivers.centre, first.receivers.centre)   # the deeper room
-    assert third.direct.sum() < first.direct.sum()         # its far wall sees less of the window
+    def back_wall_mean(t):                                 # the far wall's mean direct light (unit DC patch)
+        rec = t.receivers
+        back = (rec.normal[:, 2] < -0.99) & (rec.centre[:, 2] > 0.5)      # the only inside face towards -z
+        return np.average(t.direct[back, 0], weights=rec.area_m2[back])
+
+    assert back_wall_mean(third) < 0.8 * back_wall_mean(first)      # its far wall sees less of the window
 
 
 @pytest.mark.slow
@@ -157,5 +207,5 @@ def test_built_in_rooms_are_what_the_tool_makes(tmp_path):
 
     subprocess.run([sys.executable, str(PROJECT_ROOT / "tools" / "make_rooms.py"), "--out", str(tmp_path)],
                    check=True, capture_output=True, timeout=120)
-    for name in ("box", "living"):
+    for name in ("box", "living", "bedroom"):
         assert (tmp_path / f"{name}.glb").read_bytes() == (DATA_DIR / f"{name}.glb").read_bytes(), name

@@ -15,7 +15,7 @@ from catalog.render.scene import box_triangles
 from catalog.room import sh
 from catalog.room.model import Window
 from catalog.room.rays import NumpyRays
-from catalog.room.receivers import _grid, build_receivers, grid_index
+from catalog.room.receivers import _grid, build_receivers, grid_index, refine
 from catalog.room.transport import TransportParams, form_factors, gather, precompute_geometry
 
 
@@ -77,6 +77,26 @@ def test_grid_index_finds_each_sub_triangle():
                               np.arange(cells.shape[0]))
 
 
+def test_refined_receivers_tile_their_parents_and_are_found_by_element_at():
+    tris = box_triangles(0, 1, 0, 0.5, 0, 2)
+    albedo_of = lambda tri, bary: np.stack([bary[:, 0], bary[:, 1], 0.5 + 0 * tri], axis=1)   # noqa: E731
+    rec = build_receivers(tris, albedo_of, 0.4)
+    rng = np.random.default_rng(2)
+    for _ in range(3):                       # three levels, a random third split each time
+        rec, parent = refine(rec, rng.random(rec.count) < 0.33, albedo_of)
+    assert rec.children is not None and (rec.leaf >= 0).sum() == rec.count
+    assert rec.area_m2.sum() == pytest.approx(build_receivers(tris, albedo_of, 0.4).area_m2.sum(), rel=1e-12)
+    assert np.allclose(rec.area_m2, 0.5 * np.linalg.norm(np.cross(rec.corners[:, 1] - rec.corners[:, 0],
+                                                                  rec.corners[:, 2] - rec.corners[:, 0]), axis=1))
+    assert rec.area_m2.max() / rec.area_m2.min() > 60           # sizes over three levels (4^3 = 64)
+    index = np.repeat(np.arange(rec.count), 5)
+    points = rec.sample_points(index, rng)
+    assert np.array_equal(rec.element_at(rec.triangle[index], points), index)
+    # each child's albedo is its own (the texture's gradient), not its parent's
+    centre_bary = np.full((rec.count, 3), 1 / 3)
+    assert not np.allclose(rec.albedo[:, 0], albedo_of(rec.triangle, centre_bary)[:, 0][0])
+
+
 # --------------------------------------------------------------------------- small rooms
 
 def inward(tris):
@@ -113,7 +133,8 @@ def rect_view_factor(a, b):
 @pytest.mark.slow
 def test_direct_light_matches_the_rectangle_view_factor():
     tris, window = open_cube((0.0, 1.0, 0.0, 1.0))
-    params = TransportParams(element_m=0.12, patches=(4, 4), order=1, gather_rays=8, window_samples=16)
+    params = TransportParams(element_m=0.12, refine_levels=0, patches=(4, 4), order=1, gather_rays=8,
+                             window_samples=16)
     t = precompute_geometry(tris, constant_albedo(0.0), window, params, backend="numpy",
                             compress_operators=False)
     rec = t.receivers
@@ -177,12 +198,32 @@ def brute_force_irradiance(tris, albedo, window, radiance, points, normals, path
 
 
 @pytest.mark.slow
-def test_operator_matches_brute_force_path_tracing():
+def test_refinement_puts_the_small_receivers_where_the_light_changes():
+    tris, window = open_cube((0.3, 0.7, 0.35, 0.75))
+    params = TransportParams(element_m=0.25, refine_levels=3, max_receivers=900, patches=(1, 1), order=1,
+                             gather_rays=8, window_samples=2)
+    t = precompute_geometry(tris, constant_albedo(0.5), window, params, backend="numpy", compress_operators=False)
+    rec = t.receivers
+    summary = t.timings_s["refinement"]
+    assert summary["receivers"] == rec.count <= 900 and sum(summary["splits"]) > 0
+    near = np.abs(rec.centre[:, 2]) < 0.2                   # within 0.2 m of the window's wall
+    size = np.sqrt(rec.area_m2)
+    assert np.median(size[near]) < 0.6 * np.median(size[~near])
+    # the far wall (z = 1) sees a smooth light: none of it at the finest level
+    far = np.abs(rec.centre[:, 2] - 1) < 1e-9
+    assert size[far].min() > size.min() * 1.9
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("receivers", [dict(element_m=0.08, refine_levels=0),
+                                       dict(element_m=0.16, refine_levels=2, max_receivers=1500)],
+                         ids=["uniform", "refined"])
+def test_operator_matches_brute_force_path_tracing(receivers):
     tris, window = open_cube((0.3, 0.7, 0.35, 0.75))
     block = box_triangles(0.35, 0.65, 0.0, 0.25, 0.45, 0.7)
     tris = np.concatenate([tris, block])
     albedo = 0.6
-    params = TransportParams(element_m=0.08, patches=(2, 2), order=2, gather_rays=512, window_samples=16)
+    params = TransportParams(patches=(2, 2), order=2, gather_rays=512, window_samples=16, **receivers)
     t = precompute_geometry(tris, constant_albedo(albedo), window, params, backend="numpy",
                             compress_operators=False)
 
@@ -214,3 +255,33 @@ def test_operator_matches_brute_force_path_tracing():
     # averages out over the patch for these receivers to well under the tolerance
     print("operator / brute force - 1:", e[picks] / np.array(means) - 1)
     assert np.abs(e[picks] / np.array(means) - 1).max() < 0.05
+
+
+# --------------------------------------------------------------------------- web pack
+
+@pytest.mark.slow
+def test_web_pack_is_small_and_within_its_bound_of_the_full_operator():
+    from catalog.room import web_pack
+
+    tris, window = open_cube((0.3, 0.7, 0.35, 0.75))
+    params = TransportParams(element_m=0.2, refine_levels=1, max_receivers=500, patches=(2, 2), order=2,
+                             gather_rays=64, window_samples=4, rank_tolerance=1e-4, bounce_rank=32)
+    t = precompute_geometry(tris, constant_albedo(0.6), window, params, backend="numpy")
+    loose = web_pack.pack(t, window_tolerance=3e-2, bounce_tolerance=3e-2)
+    tight = web_pack.pack(t, window_tolerance=1e-3, bounce_tolerance=1e-3)
+    # F is kept exactly (ray counts)
+    assert np.array_equal(loose.form_factors().toarray(), t.form_factors.toarray())
+    for web, tol in ((loose, 3e-2), (tight, 1e-3)):
+        # the Frobenius bound holds on typical inputs (plus float16's ~5e-4 and the transport's own 1e-4)
+        assert web.errors["window_rank_bound"] <= tol
+        assert web.errors["window_rel_rms"] < tol + 2e-3
+        assert web.errors["bounce_rel_rms"] < tol + web.errors["bounce_rel_rms_transport"] + 2e-3
+    assert loose.errors["window_rank"] < tight.errors["window_rank"]
+    full = t.window_basis.nbytes + t.window_modes.nbytes + t.bounce_left.nbytes + t.bounce_right.nbytes \
+        + t.form_factors.data.nbytes + t.form_factors.indices.nbytes
+    assert loose.nbytes()["total"] < 0.3 * full
+    # the pack answers like the transport on a window light
+    c = np.zeros((4, 3, 3))
+    c[:, 0] = 1.0
+    exact = t.irradiance(c, compressed=False)
+    assert np.abs(tight.irradiance(c) - exact).max() < 5e-3 * np.abs(exact).max()

@@ -16,7 +16,8 @@ def cube_transport():
     from tests.test_room_transport import constant_albedo, open_cube
 
     tris, window = open_cube((0.25, 0.75, 0.3, 0.8))
-    params = TransportParams(element_m=0.2, patches=(2, 2), order=2, gather_rays=64, window_samples=4)
+    params = TransportParams(element_m=0.2, max_receivers=600, patches=(2, 2), order=2, gather_rays=64,
+                             window_samples=4)
     t = precompute_geometry(tris, constant_albedo(0.5), window, params, backend="numpy",
                             compress_operators=False)
     return tris, t

@@ -1,4 +1,4 @@
-"""Build the built-in rooms (catalog/room/data/box.glb, living.glb) from primitives.
+"""Build the built-in rooms (catalog/room/data/box.glb, living.glb, bedroom.glb) from primitives.
 
     python tools/make_rooms.py [--out catalog/room/data]
 
@@ -9,8 +9,10 @@ catalog/render/scene.py (ROOM_BOX with the WINDOW_RECT opening through a WALL_TH
 wall, ROOM_ALBEDO grey); its window quad lies in the wall's room-side plane z = WINDOW_Z,
 where the curtain is placed today. ``living`` keeps that window (so the curtain hangs as
 in the box) in a furnished room: a textured wood floor, painted walls, a window frame in a
-wider opening and a sill, a sofa, a low table, a rug and a shelf. The output is
-deterministic (the floor's texture from a seeded generator).
+wider opening and a sill, a sofa, a low table, a rug and a shelf. ``bedroom`` is another room: smaller and lower, its window
+wider, lower and off-centre in the same wall plane, a pale plank floor, a bed, a desk
+with a chair, a bedside table, a striped rug and wall shelves. The output is deterministic
+(the textures from seeded generators).
 """
 
 from __future__ import annotations
@@ -84,18 +86,20 @@ def wood_texture(size: int = 512, planks: int = 8, seed: int = 7):
     return Image.fromarray(np.round(srgb * 255).astype(np.uint8), "RGB")
 
 
-def window_quad(z: float):
-    """The aperture: the WINDOW_RECT quad at z, wound so its normal is +z (into the room)."""
+def window_quad(z: float, rect=scene_lib.WINDOW_RECT):
+    """The aperture: the ``rect`` (x0, x1, y0, y1) quad at z, wound so its normal is +z
+    (into the room)."""
     import trimesh  # noqa: PLC0415
 
-    x0, x1, y0, y1 = scene_lib.WINDOW_RECT
+    x0, x1, y0, y1 = rect
     v = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]])
     return trimesh.Trimesh(vertices=v, faces=[[0, 1, 2], [0, 2, 3]], process=False)
 
 
-def shell_parts(hole, wall_rgb, floor, ceiling_rgb):
-    """Floor, ceiling, four walls and the window wall around ``hole`` (x0, x1, y0, y1)."""
-    (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
+def shell_parts(hole, wall_rgb, floor, ceiling_rgb, box=scene_lib.ROOM_BOX):
+    """Floor, ceiling, four walls and the window wall around ``hole`` (x0, x1, y0, y1) of
+    the room ``box`` ((x0, x1), (y0, y1), (z0, z1), its inside; the window wall at z0)."""
+    (x0, x1), (y0, y1), (z0, z1) = box
     wx0, wx1, wy0, wy1 = hole
     t = scene_lib.WALL_THICKNESS_M
     floor_mesh, floor_material = floor
@@ -112,7 +116,7 @@ def shell_parts(hole, wall_rgb, floor, ceiling_rgb):
     }, floor_material
 
 
-def scene_bytes(parts: dict, window) -> bytes:
+def scene_bytes(parts: dict, window, camera=(CAMERA_POSITION, CAMERA_TARGET)) -> bytes:
     import trimesh  # noqa: PLC0415
 
     scene = trimesh.Scene()
@@ -120,7 +124,7 @@ def scene_bytes(parts: dict, window) -> bytes:
         scene.add_geometry(mesh, node_name=name, geom_name=name)
     scene.add_geometry(window, node_name="window", geom_name="window")
     data = scene.export(file_type="glb")
-    return with_camera(data, CAMERA_POSITION, CAMERA_TARGET, CAMERA_FOV_Y_DEG)
+    return with_camera(data, camera[0], camera[1], CAMERA_FOV_Y_DEG)
 
 
 def build_box() -> bytes:
@@ -195,7 +199,95 @@ def build_living() -> bytes:
     return scene_bytes(parts, window_quad(scene_lib.WINDOW_Z))
 
 
-BUILDERS = {"box": build_box, "living": build_living}
+#: bedroom: its inside (m), the window wall at z = WINDOW_Z as in the others.
+BEDROOM_BOX = ((-1.8, 2.3), (-1.3, 1.25), (scene_lib.WINDOW_Z, 3.6))
+#: Its window: wider, lower and left of the wall's centre (x0, x1, y0, y1).
+BEDROOM_WINDOW = (-1.25, 0.85, -0.45, 1.0)
+BEDROOM_WALL = (0.55, 0.62, 0.66)
+BEDROOM_CAMERA = ((-0.2, 0.3, 2.9), (-0.2, 0.25, -0.2))
+
+
+def stripe_texture(size: int = 256, stripes: int = 9, seed: int = 3):
+    """An sRGB woven-stripe rug image (PIL): bands of three colours with a fine weave."""
+    from PIL import Image  # noqa: PLC0415
+
+    rng = np.random.default_rng(seed)
+    v, u = np.mgrid[0:size, 0:size] / size
+    palette = np.array([[0.60, 0.52, 0.38], [0.20, 0.28, 0.42], [0.70, 0.66, 0.58]])
+    band = palette[np.floor(u * stripes).astype(int) % 3]
+    weave = 1.0 + 0.06 * np.sign(np.sin(2 * np.pi * u * 64) * np.sin(2 * np.pi * v * 64))
+    noise = 1.0 + 0.05 * rng.standard_normal((size, size))
+    linear = np.clip(band * (weave * noise)[..., None], 0.0, 1.0)
+    srgb = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055)
+    return Image.fromarray(np.round(srgb * 255).astype(np.uint8), "RGB")
+
+
+def textured(mesh, texture):
+    import trimesh  # noqa: PLC0415
+
+    mesh.visual = trimesh.visual.TextureVisuals(uv=mesh.visual.uv, material=material((1, 1, 1), texture))
+    return mesh
+
+
+def build_bedroom() -> bytes:
+    """A bedroom (see the module doc): the window off-centre, a bed against the right wall,
+    a desk and chair under the window's right side, a bedside table, a rug, two wall shelves."""
+    import trimesh  # noqa: PLC0415
+
+    planks = wood_texture(size=512, planks=6, seed=11)
+    (x0, x1), (y0, y1), (z0, z1) = BEDROOM_BOX
+    wx0, wx1, wy0, wy1 = BEDROOM_WINDOW
+    f, t = FRAME_WIDTH_M, scene_lib.WALL_THICKNESS_M
+
+    def floor(*extent):
+        return textured(box_part(*extent, uv_per_m=1.0 / 1.5), planks)
+
+    parts, _ = shell_parts((wx0 - f, wx1 + f, wy0 - f, wy1 + f), BEDROOM_WALL, (floor, None),
+                           CEILING_PAINT, box=BEDROOM_BOX)
+    parts["window_frame_left"] = painted(box_part(wx0 - f, wx0, wy0 - f, wy1 + f, z0 - t, z0), FRAME_PAINT)
+    parts["window_frame_right"] = painted(box_part(wx1, wx1 + f, wy0 - f, wy1 + f, z0 - t, z0), FRAME_PAINT)
+    parts["window_frame_bottom"] = painted(box_part(wx0, wx1, wy0 - f, wy0, z0 - t, z0), FRAME_PAINT)
+    parts["window_frame_top"] = painted(box_part(wx0, wx1, wy1, wy1 + f, z0 - t, z0), FRAME_PAINT)
+    parts["window_sill"] = painted(box_part(wx0 - 0.1, wx1 + 0.1, wy0 - f - 0.03, wy0 - f, z0, z0 + 0.05),
+                                   FRAME_PAINT)
+    fy = y0
+    # the bed, its head against the right wall: a frame, a mattress, a headboard, a cover
+    bed_wood, linen = (0.36, 0.24, 0.15), (0.78, 0.76, 0.72)
+    bz0, bz1 = 1.5, 3.1
+    parts["bed_frame"] = painted(box_part(x1 - 2.05, x1, fy, fy + 0.30, bz0, bz1), bed_wood)
+    parts["bed_mattress"] = painted(box_part(x1 - 2.0, x1 - 0.05, fy + 0.30, fy + 0.52, bz0 + 0.05, bz1 - 0.05),
+                                    linen)
+    parts["bed_cover"] = painted(box_part(x1 - 1.45, x1 - 0.05, fy + 0.52, fy + 0.55, bz0 + 0.02, bz1 - 0.02),
+                                 (0.45, 0.20, 0.22))
+    parts["bed_headboard"] = painted(box_part(x1 - 0.06, x1, fy + 0.30, fy + 1.05, bz0, bz1), bed_wood)
+    parts["bedside_table"] = painted(box_part(x1 - 0.45, x1, fy, fy + 0.50, bz1 + 0.05, bz1 + 0.45), bed_wood)
+    # a desk under the window's right side, its back 0.05 m from the window wall
+    desk = (0.66, 0.55, 0.40)
+    dx0, dx1, dz0, dz1, top = 0.35, 1.55, z0 + 0.05, z0 + 0.65, fy + 0.74
+    parts["desk_top"] = painted(box_part(dx0, dx1, top - 0.03, top, dz0, dz1), desk)
+    for i, (lx, lz) in enumerate(((dx0, dz0), (dx1 - 0.04, dz0), (dx0, dz1 - 0.04), (dx1 - 0.04, dz1 - 0.04))):
+        parts[f"desk_leg_{i}"] = painted(box_part(lx, lx + 0.04, fy, top - 0.03, lz, lz + 0.04), desk)
+    # a chair pulled back from the desk: a seat on a cylinder, a back
+    chair = (0.25, 0.25, 0.27)
+    cx, cz = 0.95, z0 + 0.95
+    parts["chair_seat"] = painted(box_part(cx - 0.22, cx + 0.22, fy + 0.44, fy + 0.48, cz - 0.22, cz + 0.22), chair)
+    parts["chair_back"] = painted(box_part(cx - 0.22, cx + 0.22, fy + 0.48, fy + 0.90, cz + 0.18, cz + 0.22), chair)
+    post = trimesh.creation.cylinder(radius=0.03, height=0.44, sections=12)
+    post.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0)))
+    post.apply_translation((cx, fy + 0.22, cz))
+    parts["chair_post"] = painted(post, chair)
+    # a striped rug beside the bed
+    rug = box_part(-0.9, 0.2, fy, fy + 0.012, 1.4, 3.0, uv_per_m=1.0 / 1.1)
+    parts["rug"] = textured(rug, stripe_texture())
+    # two shelves on the left wall, over a low chest
+    shelf = (0.70, 0.68, 0.62)
+    for i, level in enumerate((1.05, 1.45)):
+        parts[f"wall_shelf_{i}"] = painted(box_part(x0, x0 + 0.25, fy + level, fy + level + 0.025, 1.0, 2.2), shelf)
+    parts["chest"] = painted(box_part(x0, x0 + 0.45, fy, fy + 0.70, 1.1, 2.1), (0.52, 0.44, 0.34))
+    return scene_bytes(parts, window_quad(scene_lib.WINDOW_Z, BEDROOM_WINDOW), camera=BEDROOM_CAMERA)
+
+
+BUILDERS = {"box": build_box, "living": build_living, "bedroom": build_bedroom}
 
 
 def main(argv=None) -> int:

@@ -21,10 +21,11 @@ from catalog.room.model import Window
 from catalog.room.receivers import Receivers
 from catalog.room.transport import Transport, TransportParams, precompute
 
-TRANSPORT_VERSION = 1
+TRANSPORT_VERSION = 2
 _ARRAYS = ("direct", "window_operator", "kept_index", "window_basis", "window_modes",
            "bounce_left", "bounce_right", "frame")
 _RECEIVERS = ("corners", "normal", "area_m2", "albedo", "triangle", "divisions", "first", "triangles")
+_RECEIVER_TREE = ("node_corners", "children", "leaf")      # present when refined
 
 
 def cache_dir() -> Path:
@@ -44,7 +45,8 @@ def cache_path(room, params: TransportParams) -> Path:
 def save(transport: Transport, path: Path, key: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     arrays = {name: getattr(transport, name) for name in _ARRAYS if getattr(transport, name) is not None}
-    arrays.update({f"receivers_{name}": getattr(transport.receivers, name) for name in _RECEIVERS})
+    arrays.update({f"receivers_{name}": getattr(transport.receivers, name) for name in _RECEIVERS + _RECEIVER_TREE
+                   if getattr(transport.receivers, name) is not None})
     f = transport.form_factors.tocsr()
     arrays.update({"f_data": f.data, "f_indices": f.indices, "f_indptr": f.indptr})
     arrays["window_corners"] = transport.window.corners
@@ -70,7 +72,9 @@ def load(path: Path, key: str) -> Transport | None:
                 return None
             params = meta["params"]
             params["patches"] = tuple(params["patches"])
-            receivers = Receivers(**{name: data[f"receivers_{name}"] for name in _RECEIVERS})
+            receivers = Receivers(**{name: data[f"receivers_{name}"] for name in _RECEIVERS},
+                                  **{name: (data[f"receivers_{name}"] if f"receivers_{name}" in data else None)
+                                     for name in _RECEIVER_TREE})
             window = Window(data["window_corners"], data["window_normal"])
             arrays = {name: (data[name] if name in data else None) for name in _ARRAYS}
             import scipy.sparse  # noqa: PLC0415

@@ -26,7 +26,7 @@ from catalog.core.errors import InputError
 from catalog.room import glb
 from catalog.room.model import Camera, Room, Surface, Window
 
-BUILTIN_ROOMS = ("box", "living")
+BUILTIN_ROOMS = ("box", "living", "bedroom")
 DATA_DIR = Path(__file__).resolve().parent / "data"
 MAX_FILE_BYTES = 64 << 20
 MAX_TRIANGLES = 200_000

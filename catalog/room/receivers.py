@@ -1,7 +1,9 @@
 """The room's receivers: its triangles cut into small elements (a regular barycentric grid
 of n x n sub-triangles per triangle, n from the element size), each with a centre, a normal,
-an area and an albedo. A ray's hit (triangle, point) maps to its element in closed form
-(:meth:`Receivers.element_at`). Float64 numpy."""
+an area and an albedo, then refined where the light changes fast (:func:`refine`: an
+element split into its four midpoint sub-triangles, recursively: a quadtree on each base
+element). A ray's hit (triangle, point) maps to its element in closed form on the base grid
+and a descent of the tree (:meth:`Receivers.element_at`). Float64 numpy."""
 
 from __future__ import annotations
 
@@ -15,7 +17,10 @@ import numpy as np
 class Receivers:
     """``corners`` (E, 3, 3) m; ``normal`` (E, 3); ``area_m2`` (E,); ``albedo`` (E, 3) linear;
     ``triangle`` (E,) the room triangle each lies in; ``divisions`` (T,) n per triangle and
-    ``first`` (T,) its first element."""
+    ``first`` (T,) its first base element. After :func:`refine`, the tree: ``node_corners``
+    (N, 3, 3) every node's corners (the base elements are nodes 0..B-1), ``children`` (N,)
+    a node's first of four children (-1: a leaf) and ``leaf`` (N,) a leaf's receiver index
+    (-1: split); None when nothing is refined (the base elements are the receivers)."""
 
     corners: np.ndarray
     normal: np.ndarray
@@ -25,6 +30,9 @@ class Receivers:
     divisions: np.ndarray
     first: np.ndarray
     triangles: np.ndarray
+    node_corners: np.ndarray | None = None
+    children: np.ndarray | None = None
+    leaf: np.ndarray | None = None
 
     @property
     def count(self) -> int:
@@ -53,7 +61,41 @@ class Receivers:
         b1 = np.clip((d22 * p1 - d12 * p2) / det, 0.0, 1.0)
         b2 = np.clip((d11 * p2 - d12 * p1) / det, 0.0, 1.0)
         n = self.divisions[triangle]
-        return self.first[triangle] + grid_index(b1, b2, n)
+        node = self.first[triangle] + grid_index(b1, b2, n)
+        if self.children is None:
+            return node
+        inner = np.flatnonzero(self.children[node] >= 0)
+        while inner.size:
+            c = self.node_corners[node[inner]]
+            bary = barycentric(c, points[inner])
+            # midpoint children: 0, 1, 2 at the corners (barycentric >= 1/2), 3 the middle one
+            k = np.where(bary[:, 0] >= 0.5, 0, np.where(bary[:, 1] >= 0.5, 1, np.where(bary[:, 2] >= 0.5, 2, 3)))
+            node[inner] = self.children[node[inner]] + k
+            inner = inner[self.children[node[inner]] >= 0]
+        return self.leaf[node]
+
+
+def barycentric(corners: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(N, 3) barycentrics of ``points`` (N, 3) projected onto triangles ``corners`` (N, 3, 3)."""
+    e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    p = points - corners[:, 0]
+    d11, d12, d22 = (np.einsum("ni,ni->n", e1, e1), np.einsum("ni,ni->n", e1, e2),
+                     np.einsum("ni,ni->n", e2, e2))
+    p1, p2 = np.einsum("ni,ni->n", p, e1), np.einsum("ni,ni->n", p, e2)
+    det = d11 * d22 - d12 * d12
+    b1 = (d22 * p1 - d12 * p2) / det
+    b2 = (d11 * p2 - d12 * p1) / det
+    return np.stack([1 - b1 - b2, b1, b2], axis=1)
+
+
+def midpoint_children(corners: np.ndarray) -> np.ndarray:
+    """(N, 4, 3, 3) the four midpoint sub-triangles of triangles (N, 3, 3), in the order
+    :meth:`Receivers.element_at` descends: the three at corners 0, 1, 2, then the middle
+    one (same winding as the parent)."""
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+    return np.stack([np.stack([a, ab, ca], 1), np.stack([ab, b, bc], 1), np.stack([ca, bc, c], 1),
+                     np.stack([ab, bc, ca], 1)], axis=1)
 
 
 def grid_index(b1: np.ndarray, b2: np.ndarray, n: np.ndarray) -> np.ndarray:
@@ -118,11 +160,55 @@ def build_receivers(triangles: np.ndarray, albedo_of, size_m: float) -> Receiver
 
 
 def subset(r: Receivers, keep: np.ndarray) -> tuple[Receivers, np.ndarray]:
-    """The receivers ``keep`` (bool (E,)) and the map old index -> new (-1: dropped)."""
+    """The receivers ``keep`` (bool (E,)) and the map old index -> new (-1: dropped); the
+    result's :meth:`Receivers.element_at` still answers old indices (map them with it)."""
     new = np.full(r.count, -1, dtype=np.int64)
     new[keep] = np.arange(int(keep.sum()))
     return Receivers(r.corners[keep], r.normal[keep], r.area_m2[keep], r.albedo[keep],
-                     r.triangle[keep], r.divisions, r.first, r.triangles), new
+                     r.triangle[keep], r.divisions, r.first, r.triangles,
+                     r.node_corners, r.children, r.leaf), new
+
+
+def _element_albedo(albedo_of, triangles: np.ndarray, tri_index: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """(E, 3) the mean albedo at four points of each element (corners (E, 3, 3) on room
+    triangles tri_index (E,))."""
+    rule = np.array([[1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+    points = np.einsum("qc,ecj->eqj", rule, corners).reshape(-1, 3)
+    tri = np.repeat(tri_index, 4)
+    bary = barycentric(triangles[tri], points)
+    return albedo_of(tri, bary).reshape(-1, 4, 3).mean(axis=1)
+
+
+def refine(r: Receivers, split: np.ndarray, albedo_of) -> tuple[Receivers, np.ndarray]:
+    """Split receivers ``split`` (bool (E,)) into their four midpoint sub-triangles. Returns
+    the refined receivers (leaves in node order) and, per new receiver, the old receiver it
+    came from (its parent, or itself)."""
+    if r.children is None:
+        base = r.count
+        node_corners, children, leaf = r.corners, np.full(base, -1, dtype=np.int64), np.arange(base)
+    else:
+        node_corners, children, leaf = r.node_corners, r.children.copy(), r.leaf
+    split_nodes = np.flatnonzero((leaf >= 0) & np.isin(leaf, np.flatnonzero(split)))
+    split_nodes = split_nodes[np.argsort(leaf[split_nodes])]
+    n0 = node_corners.shape[0]
+    kids = midpoint_children(node_corners[split_nodes]).reshape(-1, 3, 3)
+    children[split_nodes] = n0 + 4 * np.arange(split_nodes.size)
+    children = np.concatenate([children, np.full(kids.shape[0], -1, dtype=np.int64)])
+    node_corners = np.concatenate([node_corners, kids])
+    # the receiver each node's leaf came from: a kept leaf itself, a child its parent's
+    origin = np.concatenate([leaf, np.repeat(leaf[split_nodes], 4)])
+    is_leaf = children < 0
+    new_leaf = np.full(children.size, -1, dtype=np.int64)
+    new_leaf[is_leaf] = np.arange(int(is_leaf.sum()))
+    parent = origin[is_leaf]
+    corners = node_corners[is_leaf]
+    fresh = np.arange(children.size)[is_leaf] >= n0
+    area = r.area_m2[parent] * np.where(fresh, 0.25, 1.0)
+    albedo = r.albedo[parent].copy()
+    if fresh.any():
+        albedo[fresh] = _element_albedo(albedo_of, r.triangles, r.triangle[parent[fresh]], corners[fresh])
+    return Receivers(corners, r.normal[parent], area, albedo, r.triangle[parent], r.divisions, r.first,
+                     r.triangles, node_corners, children, new_leaf), parent
 
 
 def room_albedo_of(room):

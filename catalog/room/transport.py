@@ -22,6 +22,15 @@ Both operators are compressed for the page: the window operator by its SVD (the 
 SVD; :class:`Transport` keeps the compressed forms and the exact ones for checks. Receivers
 no ray from inside reaches (the walls' outer faces) are dropped first: a receiver most of
 whose rays meet nothing faces the outside.
+
+Receivers are refined where the window's light changes fastest (:func:`refine_receivers`,
+one rule for every room): starting from elements of ``element_m``, an element is split in
+four while the direct irradiance of a uniform window, sampled at its corners, edge
+midpoints and centre (shadow rays to a fixed grid of window points), spans more than
+``refine_tolerance`` of the room's mean, for at most ``refine_levels`` levels and
+``max_receivers`` receivers (the worst split first). Near the window and at the edges of
+its light patches (the sill's shadow, furniture) this halves the element size per level;
+where the light is smooth the elements stay large.
 """
 
 from __future__ import annotations
@@ -34,7 +43,7 @@ import numpy as np
 
 from catalog.room import sh
 from catalog.room.model import Window
-from catalog.room.receivers import Receivers, build_receivers, cosine_directions, subset
+from catalog.room.receivers import Receivers, build_receivers, cosine_directions, refine, subset
 
 #: Rays per receiver of the first pass that sorts receivers inside from outside.
 SORT_RAYS = 16
@@ -46,7 +55,10 @@ CHUNK_RAYS = 1 << 20
 class TransportParams:
     """The resolutions (each error falls as it rises; benchmarks/room_transport.py)."""
 
-    element_m: float = 0.25          # receiver size
+    element_m: float = 0.4           # receiver size before refinement
+    refine_tolerance: float = 0.15   # split while the window's direct light spans more (of the mean)
+    refine_levels: int = 3           # at most this many halvings
+    max_receivers: int = 5000        # refinement's bound (the dense solve grows as E^3)
     patches: tuple = (6, 6)          # window patches along its u and v edges
     order: int = 3                   # basis order (order (order + 1) / 2 coefficients per patch)
     gather_rays: int = 256           # form-factor rays per receiver
@@ -170,6 +182,94 @@ def direct_operator(rec: Receivers, window: Window, params: TransportParams, ray
     return out
 
 
+# --------------------------------------------------------------------------- refinement
+
+#: Window points (per side) of the refinement's direct-light estimate, and the element's
+#: sample points (barycentric): corners pulled 10 % in, edge midpoints, centre.
+REFINE_WINDOW_SIDE = 8
+_REFINE_POINTS = np.array([[0.9, 0.05, 0.05], [0.05, 0.9, 0.05], [0.05, 0.05, 0.9],
+                           [0.475, 0.475, 0.05], [0.05, 0.475, 0.475], [0.475, 0.05, 0.475],
+                           [1 / 3, 1 / 3, 1 / 3]])
+
+
+def uniform_window_irradiance(points: np.ndarray, normals: np.ndarray, window: Window, rays) -> np.ndarray:
+    """(N,) irradiance at ``points`` (N, 3) with ``normals`` from the window sending unit
+    radiance everywhere, by a fixed midpoint grid of window points and shadow rays (the
+    same quadrature at every point: a smooth function of position away from shadows)."""
+    side = REFINE_WINDOW_SIDE
+    g = (np.arange(side) + 0.5) / side
+    ss, tt = [a.ravel() for a in np.meshgrid(g, g)]
+    xw, jac = patch_points(window, (1, 1), ss, tt, np.zeros(ss.size, dtype=np.int64))
+    weight = jac / ss.size
+    out = np.zeros(points.shape[0])
+    size = float(np.linalg.norm(np.ptp(points, axis=0))) + 1.0
+    eps = 1e-5 * size
+    step = max(1, CHUNK_RAYS // ss.size)
+    for start in range(0, points.shape[0], step):
+        i = np.arange(start, min(points.shape[0], start + step))
+        xe = np.repeat(points[i] + eps * normals[i], ss.size, axis=0)
+        ne = np.repeat(normals[i], ss.size, axis=0)
+        d = np.tile(xw, (i.size, 1)) - xe
+        r = np.linalg.norm(d, axis=1)
+        d /= r[:, None]
+        cos_e, cos_w = np.einsum("ni,ni->n", d, ne), -(d @ window.normal)
+        ok = (cos_e > 0) & (cos_w > 0)
+        visible = np.zeros(xe.shape[0], dtype=bool)
+        if ok.any():
+            hit, _ = rays.intersect(xe[ok], d[ok])
+            visible[np.flatnonzero(ok)] = hit >= r[ok] * (1 - 1e-6) - eps
+        g_ = np.where(visible, cos_e * cos_w / (r * r), 0.0) * np.tile(weight, i.size)
+        out[i] = g_.reshape(i.size, ss.size).sum(axis=1)
+    return out
+
+
+def refine_receivers(rec: Receivers, inside: np.ndarray, albedo_of, window: Window, params: TransportParams,
+                     rays) -> tuple[Receivers, np.ndarray, dict]:
+    """The receivers refined by the rule of the module doc, the inside mask carried to
+    them, and a summary (receivers, splits per round).
+
+    Greedy in rounds: each round splits the elements whose error estimate is within a
+    factor 2 of the largest (the span times sqrt(area / base area): an element's share of
+    the light map's L2 error) among those whose span exceeds the tolerance and whose
+    level is below ``refine_levels``, as many as ``max_receivers`` leaves room for."""
+    def spans(r: Receivers, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        pts = np.einsum("qc,ecj->eqj", _REFINE_POINTS, r.corners[which]).reshape(-1, 3)
+        e = uniform_window_irradiance(pts, np.repeat(r.normal[which], len(_REFINE_POINTS), axis=0), window, rays)
+        e = e.reshape(which.size, len(_REFINE_POINTS))
+        return e.max(axis=1) - e.min(axis=1), e.mean(axis=1)
+
+    summary = {"base_receivers": int(inside.sum()), "splits": []}
+    span = np.full(rec.count, np.nan)
+    level = np.zeros(rec.count, dtype=np.int64)
+    todo = np.flatnonzero(inside)
+    span[todo], mean = spans(rec, todo)
+    area = rec.area_m2[todo]
+    scale = max(float(np.sum(area * mean) / np.sum(area)), 1e-300)
+    base_area = float(np.mean(area))
+    for _ in range(4 * params.refine_levels):
+        todo = np.flatnonzero(inside & np.isnan(span))
+        if todo.size:
+            span[todo] = spans(rec, todo)[0]
+        relative = np.where(inside, np.nan_to_num(span) / scale, 0.0)
+        eligible = (relative > params.refine_tolerance) & (level < params.refine_levels)
+        room_for = max(0, (params.max_receivers - int(inside.sum())) // 3)
+        if not eligible.any() or room_for == 0:
+            break
+        priority = np.where(eligible, relative * np.sqrt(rec.area_m2 / base_area), 0.0)
+        chosen = np.flatnonzero(priority >= 0.5 * priority.max())
+        chosen = chosen[np.argsort(-priority[chosen])][:room_for]
+        summary["splits"].append(int(chosen.size))
+        split = np.zeros(rec.count, dtype=bool)
+        split[chosen] = True
+        rec, parent = refine(rec, split, albedo_of)
+        fresh = split[parent]
+        inside, level = inside[parent], level[parent] + fresh
+        span = np.where(fresh, np.nan, span[parent])
+    summary["receivers"] = int(inside.sum())
+    summary["levels"] = np.bincount(level[inside], minlength=params.refine_levels + 1).tolist()
+    return rec, inside, summary
+
+
 # --------------------------------------------------------------------------- room
 
 def gather(rec: Receivers, rays_room, window_tris_first: int, count: int, rng,
@@ -266,6 +366,9 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
     rays_room = ray_caster(triangles, backend)
     _, escaped = gather(rec_all, rays_gather, len(triangles), SORT_RAYS, rng)
     inside = escaped.mean(axis=1) < 0.5
+    if params.refine_levels > 0:
+        rec_all, inside, refinement = refine_receivers(rec_all, inside, albedo_of, window, params, rays_room)
+        timings["refinement"] = refinement
     rec, new_index = subset(rec_all, inside)
     timings["receivers_s"] = time.perf_counter() - start
     start = time.perf_counter()
