@@ -103,3 +103,28 @@ def test_the_frame_cuts_the_scallops_where_the_band_puts_them(gl):
     top = size[1] - band_top_row            # read_linear's rows run from the top
     assert np.abs(frames[0][:top - 2] - frames[1][:top - 2]).max() \
         <= 1e-3 * frames[1][:top - 2].max()
+
+
+def test_a_bad_border_is_refused_naming_the_field(tmp_path):
+    """A border without its depth, or a band narrower than the coverage, is refused with the
+    preset's file and the field (the preset's own writer refuses to write either)."""
+    import re
+    import shutil
+
+    from catalog.core.errors import InputError
+
+    (tmp_path / "patterns").mkdir()
+    for suffix in ("", "-height", "-border", "-border-height"):
+        shutil.copy(f"fabrics/patterns/tulle-embroidered{suffix}.png", tmp_path / "patterns")
+    text = open("fabrics/tulle-embroidered.toml").read()
+    for name, edit, message in (
+            ("no-depth", lambda t: re.sub(r"\nborder_m = [^\n]*", "", t), "border_m"),
+            ("mismatch", lambda t: t.replace('border = "patterns/tulle-embroidered-border.png"',
+                                             'border = "patterns/tulle-embroidered.png"'),
+             "as wide as the coverage")):
+        path = tmp_path / f"{name}.toml"
+        edited = edit(text).replace('name = "tulle-embroidered"', f'name = "{name}"')
+        assert edited != text
+        path.write_text(edited)
+        with pytest.raises(InputError, match=message):
+            load_pattern(load_preset(path))
