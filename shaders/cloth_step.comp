@@ -117,9 +117,12 @@ void main() {
 struct Selector {
     ivec4 offset_first;   // di, dj, first row, first col
     ivec4 step_count;     // row step, col step, rows, cols
-    vec4 rest_k_limit;    // rest (m), k (N/m), (1 + max_stretch) rest (m), strain-limited
+    vec4 rest_k_limit;    // flat rest (m), k (N/m), (1 + max_stretch) flat rest (m), strain-limited
+    ivec4 family;         // the family (topology.FAMILIES), unused x3
 };
 layout(std430, binding = 10) readonly buffer Selectors { Selector selector[]; };
+// per family and first particle: the spring's rest length (m), family * W * H + particle
+layout(std430, binding = 11) readonly buffer SpringRest { float spring_rest[]; };
 uniform int u_selector;
 uniform bool u_limit_only;  // the strain-limit sweep: only what exceeds the limit
 void main() {
@@ -138,6 +141,9 @@ void main() {
     if (wsum <= 0.0 || len <= 0.0) return;
     float rest = s.rest_k_limit.x;
     float limit = s.rest_k_limit.z;
+    // the elastic rest: the spring's length in the pleated pose (catalog/cloth/state.py
+    // spring_rest_lengths_m); the strain limit stays at the fabric's own (flat) length
+    rest = spring_rest[s.family.x * u_grid.x * u_grid.y + a];
     float shorten;
     if (u_limit_only) {
         shorten = max(len - limit, 0.0);

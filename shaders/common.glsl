@@ -149,15 +149,36 @@ uniform sampler2D u_pattern;
 // about three times the pixel's box in variance (T^2/12 + T^2/6 at texel side T). The frame
 // passes PATTERN_LOD_BIAS = log2(1/sqrt(3)), the level whose filter has the box's variance
 // (frame.py PATTERN_LOD_BIAS, issue 11's eighth round); a vertex stage #undefs it.
+// HEM_BORDER: the band along the hem (a lace's scallops; patterns.py HemBorder), its rows
+// from the hem (v = 0) up to u_border_repeats pattern repeats, across as the pattern; below
+// that height it replaces the all-over pattern (where a scallop's edge cuts the cloth away its
+// coverage is 0). Both are sampled on every fragment, so the derivatives stay defined.
+#ifdef HEM_BORDER
+uniform sampler2D u_border;
+uniform float u_border_repeats;
+vec2 border_uv(vec2 uv_repeats) {
+    return vec2(uv_repeats.x, uv_repeats.y * (1.0 / u_border_repeats));
+}
+#endif
 #ifdef PATTERN_LOD_BIAS
 vec4 thread_texel(vec2 uv_repeats) {
-    return texture(u_pattern, uv_repeats, PATTERN_LOD_BIAS);
+    vec4 texel = texture(u_pattern, uv_repeats, PATTERN_LOD_BIAS);
+#ifdef HEM_BORDER
+    vec4 band = texture(u_border, border_uv(uv_repeats), PATTERN_LOD_BIAS);
+    texel = uv_repeats.y < u_border_repeats ? band : texel;
+#endif
+    return texel;
 }
 #endif
 
 // Thread coverage at uv (in pattern repeats), mip-filtered by the hardware's footprint.
 float thread_coverage(vec2 uv_repeats) {
-    return texture(u_pattern, uv_repeats).a;
+    float c = texture(u_pattern, uv_repeats).a;
+#ifdef HEM_BORDER
+    float band = texture(u_border, border_uv(uv_repeats)).a;
+    c = uv_repeats.y < u_border_repeats ? band : c;
+#endif
+    return c;
 }
 
 // The shading normal: the cloth normal n tilted by the pattern's mip-averaged normal m in

@@ -13,7 +13,11 @@ What the structure follows (Leavers and Raschel machine laces, embroidered tulle
   standing proud of the net (the height map's 1);
 - motifs come at **several scales** (a large flower, smaller flowers and buds, leaves,
   scattered spots) on a **half-drop** repeat (the second column of motifs shifted half a repeat
-  down), so the layout never reads as a square grid of identical spots.
+  down), so the layout never reads as a square grid of identical spots;
+- the **border** along the hem (:func:`scalloped_border`): the lace ends in scallops, arcs
+  cut along a heavy cord (the gimp that a Leavers edging carries round each scallop) with
+  picots (small corded loops) outside it, a band of cloth-stitch rays inside each scallop
+  between the edge cord and an inner cord that follows it, and the all-over lace above.
 
 Everything is a field on the repeat's pixel grid, periodic in both directions (the minimum
 image of each displacement), so the repeat tiles without a seam. Lengths in metres.
@@ -77,11 +81,14 @@ class Lace:
     """Accumulates a lace's regions on one repeat: the cloth-stitch, the open filling, the
     cords (as distances to their centre lines) and the motif outline."""
 
-    def __init__(self, size_u: int, size_v: int, repeat_u: float, repeat_v: float):
+    def __init__(self, size_u: int, size_v: int, repeat_u: float, repeat_v: float,
+                 rows: int | None = None):
+        """A repeat of size_u x size_v px; ``rows``: only its first rows (the hem's band, on
+        the repeat's own pixel grid), the motifs still wrapping by the whole repeat."""
         self.ru, self.rv = repeat_u, repeat_v
         self.px = repeat_u / size_u
         xs = (np.arange(size_u) + 0.5) * (repeat_u / size_u)
-        ys = (np.arange(size_v) + 0.5) * (repeat_v / size_v)
+        ys = (np.arange(size_v if rows is None else rows) + 0.5) * (repeat_v / size_v)
         self.x, self.y = np.meshgrid(xs, ys)
         self.solid = np.full(self.x.shape, np.inf)     # signed distance of the motifs' union
         self.opening = np.full(self.x.shape, np.inf)   # the open fillings inside motifs
@@ -189,4 +196,85 @@ def lace_fields(lace: Lace, cell: float, cord: float, filling_cell: float,
         h = (1 - in_motif) * net_h + in_motif * body_h
         return np.clip(np.maximum(h, cord_h), 0.0, 1.0)
 
+    return coverage, height
+
+
+def scallop_distances(x, y, pitch: float, rise: float, bottom: float):
+    """The hem's scallops: arcs of circles ``pitch`` wide (m) whose lowest points lie
+    ``bottom`` above the hem line (y = 0, y up the cloth) and whose cusps lie ``rise`` higher.
+    Returns (signed distance to the edge arc, > 0 on the lace side; the scallop's circle
+    centre (cx, cy) per point; its radius)."""
+    radius = ((0.5 * pitch) ** 2 + rise ** 2) / (2.0 * rise)
+    cx = (np.floor(x / pitch) + 0.5) * pitch
+    cy = bottom + radius
+    return lower_arc(x - cx, y - cy, radius), (cx, cy), radius
+
+
+def lower_arc(dx, dy, radius):
+    """Signed distance to the lower half of a circle of ``radius`` about displacement 0,
+    > 0 above the arc (inside the circle below its centre, anywhere above the centre)."""
+    return np.where(dy < 0.0, radius - np.hypot(dx, dy), radius - np.abs(dx) + dy)
+
+
+def scalloped_border(p: dict, lace_of_rows, half: float, cell: float, cord: float):
+    """The band along the hem (rows from the hem up, on the all-over's pixel grid):
+    ``lace_of_rows(rows)`` gives the all-over's Lace on the band's rows (its motifs, the
+    same pixels as the repeat's first rows), ``half`` the net thread's half-width of the
+    all-over. Returns (coverage, height) of the band, rows = p["border_rows"]; the top rows
+    equal the all-over's, so the band joins it without a seam.
+
+    p: ``scallops`` per repeat across, ``scallop_rise`` (the cusp's height over the arc's
+    lowest point) and ``band`` (the ornament's width between the edge cord and the inner cord),
+    both as fractions of the scallop's pitch."""
+    rows = p["border_rows"]
+    lace = lace_of_rows(rows)
+    x, y = lace.x, lace.y
+    px = lace.px
+    pitch = lace.ru / p["scallops"]
+    rise, band = p["scallop_rise"] * pitch, p["band"] * pitch
+    bottom = 3.0 * cord
+    edge, (cx, cy), radius = scallop_distances(x, y, pitch, rise, bottom)
+    inner = lower_arc(x - cx, y - cy - band, radius)    # > 0 above the inner cord (the arc raised by band)
+    if bottom + rise + band + 2 * cord >= rows * px:
+        raise ValueError("the scallops and their band do not fit in the border's rows")
+    # the ornament between the cords: cloth-stitch rays (leaves) fanning out from the
+    # scallop's centre, outlined and veined by the cord, a spot between neighbours
+    ornament = Lace(x.shape[1], round(lace.rv / px), lace.ru, lace.rv, rows=rows)
+    rays = p.get("rays", 7)
+    half_angle = math.asin(min(1.0, 0.5 * pitch / radius))
+    mid_y = bottom + radius + 0.5 * band                 # the centre of the arc midway between the cords
+    for k in range(p["scallops"]):
+        centre_x = (k + 0.5) * pitch
+        for j in range(rays):
+            a = -half_angle + (j + 0.5) * 2 * half_angle / rays
+            at = (centre_x + radius * math.sin(a), mid_y - radius * math.cos(a))
+            ornament.leaf(at, 0.75 * band, 0.3 * band, 0.5 * math.pi + a)
+            if j:
+                b = a - half_angle / rays
+                ornament.spot((centre_x + radius * math.sin(b), mid_y - radius * math.cos(b)),
+                              0.07 * band)
+    coverage_all, height_all = lace_fields(lace, cell, cord, 2 * cell)
+    coverage_orn, height_orn = lace_fields(ornament, cell, cord, 2 * cell)
+    above = ramp(-inner, 0.0, px)                       # 1 above the inner cord
+    on_lace = ramp(-edge, 0.0, px)                      # 1 on the lace side of the edge
+    picot_pitch = pitch / p.get("picots", 12)
+    picot_r = 0.9 * cord
+    # picots: small loops standing outside the edge cord, along the arc
+    along = radius * np.arctan2(x - cx, cy - y)          # arc length from the scallop's bottom
+    nearest = np.round(along / picot_pitch) * picot_pitch
+    px_, py_ = cx + (radius + picot_r) * np.sin(nearest / radius), cy - (radius + picot_r) * np.cos(nearest / radius)
+    picot = np.abs(np.hypot(x - px_, y - py_) - picot_r)
+    heavy = 1.6 * cord                                   # the gimp round the scallop
+    edge_cord = np.abs(edge)
+    inner_cord = np.abs(inner)
+    cords = np.maximum.reduce([ramp(edge_cord, 0.5 * heavy, px), ramp(inner_cord, 0.5 * cord, px),
+                               ramp(picot, 0.25 * cord, px) * (edge < 0)])
+    cord_h = np.maximum.reduce([
+        np.sqrt(np.clip(1.0 - (edge_cord / (0.5 * heavy)) ** 2, 0.0, 1.0)),
+        np.sqrt(np.clip(1.0 - (inner_cord / (0.5 * cord)) ** 2, 0.0, 1.0)),
+        0.6 * np.sqrt(np.clip(1.0 - (picot / (0.25 * cord)) ** 2, 0.0, 1.0)) * (edge < 0)])
+    body_c = above * coverage_all(half) + (1 - above) * coverage_orn(half)
+    body_h = above * height_all(half) + (1 - above) * height_orn(half)
+    coverage = np.maximum(on_lace * body_c, cords)
+    height = np.clip(np.maximum(on_lace * body_h, cord_h), 0.0, 1.0)
     return coverage, height

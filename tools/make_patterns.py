@@ -35,12 +35,21 @@ PATTERNS: dict[str, dict] = {
     # cloth-stitch motifs with open fillings, at several scales on a half-drop repeat
     # (cells_u cells across, row_pairs_v pairs of hexagon rows down; even, so the filling's
     # honeycomb of twice the cell tiles too)
+    # and a scalloped border along the hem (lace_motifs.scalloped_border): ``scallops`` per
+    # repeat across, the cusp's rise and the ornament's band as fractions of the scallop's
+    # pitch, the band's depth in rows of the repeat's pixels (a power of two: exact mips)
     "lace-fwa": {"kind": "lace", "layout": "leavers", "cell_mm": 1.0, "cells_u": 100,
-                 "row_pairs_v": 86, "cord_mm": 0.8, "size": 1024},
+                 "row_pairs_v": 86, "cord_mm": 0.8, "size": 1024,
+                 "border": {"scallops": 2, "scallop_rise": 0.28, "band": 0.3, "rays": 7,
+                            "picots": 14, "border_rows": 512}},
     "raschel-ivory": {"kind": "lace", "layout": "raschel", "cell_mm": 1.25, "cells_u": 96,
-                      "row_pairs_v": 50, "cord_mm": 1.2, "size": 1024},
+                      "row_pairs_v": 50, "cord_mm": 1.2, "size": 1024,
+                      "border": {"scallops": 2, "scallop_rise": 0.35, "band": 0.25, "rays": 9,
+                                 "picots": 12, "border_rows": 512}},
     "tulle-embroidered": {"kind": "lace", "layout": "tulle", "cell_mm": 0.8, "cells_u": 100,
-                          "row_pairs_v": 56, "cord_mm": 0.6, "size": 1024},
+                          "row_pairs_v": 56, "cord_mm": 0.6, "size": 1024,
+                          "border": {"scallops": 4, "scallop_rise": 0.22, "band": 0.28,
+                                     "rays": 5, "picots": 8, "border_rows": 256}},
     "net-grey": {"kind": "net", "cell_mm": 2.0, "cells_u": 8, "row_pairs_v": 5, "size": 256},
     "safety-yellow": {"kind": "net", "cell_mm": 1.5, "cells_u": 8, "row_pairs_v": 5, "size": 256},
     # woven sheers: pitch = thread spacing, the yarn width found from LD
@@ -172,19 +181,29 @@ LACE_LAYOUTS = {"leavers": _leavers, "raschel": _raschel, "tulle": _tulle}
 
 def lace_pattern(p, direct):
     """A lace (tools/lace_motifs.py) whose net thread width is found so that the mean open
-    area equals LD; the cord's relief is the height map's 1 (height_m the cord's radius)."""
-    from lace_motifs import Lace, lace_fields
+    area equals LD; the cord's relief is the height map's 1 (height_m the cord's radius).
+    With a ``border``: the scalloped band along the hem as well (info's ``border``: its
+    coverage and height, (rows, W), row 0 at the hem)."""
+    from lace_motifs import Lace, lace_fields, scalloped_border
 
     cell = p["cell_mm"] * 1e-3
     ru, rv = p["cells_u"] * cell, p["row_pairs_v"] * cell * SQRT3
     n = p["size"]
-    lace = Lace(n, round(n * rv / ru), ru, rv)
-    LACE_LAYOUTS[p["layout"]](lace, ru, rv)
+    rows_v = round(n * rv / ru)
+
+    def lace_of_rows(rows=None):
+        lace = Lace(n, rows_v, ru, rv, rows=rows)
+        LACE_LAYOUTS[p["layout"]](lace, ru, rv)
+        return lace
+
     cord = p["cord_mm"] * 1e-3
-    coverage, height = lace_fields(lace, cell, cord, 2 * cell)
+    coverage, height = lace_fields(lace_of_rows(), cell, cord, 2 * cell)
     half = _bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, cell / 2)
-    return coverage(half), height(half), (ru, rv), {"net_thread_mm": round(2 * half * 1e3, 4),
-                                                     "height_m": round(0.5 * cord, 8)}
+    info = {"net_thread_mm": round(2 * half * 1e3, 4), "height_m": round(0.5 * cord, 8)}
+    if "border" in p:
+        info["border"] = scalloped_border(p["border"], lace_of_rows, half, cell, cord)
+        info["border_m"] = round(p["border"]["border_rows"] * rv / rows_v, 8)
+    return coverage(half), height(half), (ru, rv), info
 
 
 def weave_pattern(p, direct, basket=False):
@@ -297,13 +316,21 @@ def regenerate(name: str, fabrics: Path = FABRICS, write: bool = True) -> dict:
     c, h, repeat, info = make_pattern(name, preset.btdf.direct)
     c, h = quantise16(c), quantise16(h)
     table = pattern_table(name, repeat)
+    border = info.pop("border", None)
     table.update(info)
-    result = {"name": name, "coverage": c, "height": h, "table": table,
+    if border is not None:
+        border = tuple(quantise16(b) for b in border)
+        table.update({"border": f"patterns/{name}-border.png",
+                      "border_height": f"patterns/{name}-border-height.png"})
+    result = {"name": name, "coverage": c, "height": h, "table": table, "border": border,
               "open_area": 1.0 - float(c.mean(dtype=np.float64)), "direct": preset.btdf.direct}
     if write:
         (fabrics / "patterns").mkdir(exist_ok=True)
         pattern = Pattern(c, h, tuple(repeat), 0.0, name)
         write_pattern_images(pattern, fabrics / table["coverage"], fabrics / table["height"])
+        if border is not None:
+            band = Pattern(border[0], border[1], (repeat[0], table["border_m"]), 0.0, name)
+            write_pattern_images(band, fabrics / table["border"], fabrics / table["border_height"])
         doc = preset_to_dict(preset)
         doc["pattern"] = table
         save_preset_dict(doc, preset_path)    # refuses when the open area misses LD by > 1 %

@@ -73,11 +73,12 @@ class GpuBackend:
         particle[:, 0] = c.inv_mass_per_kg.ravel()
         particle[:, 1] = c.lra_limit_m.ravel()
         particle[:, 2] = c.lra_ring.ravel()
-        for name in ("_static", "_ring_cols", "_selector_buffer"):  # a change of parameters
+        for name in ("_static", "_ring_cols", "_selector_buffer", "_spring_rest"):  # a change of parameters
             old = getattr(self, name, None)
             if old is not None:
                 old.release()
         self._static = self.ctx.buffer(particle.tobytes())
+        self._spring_rest = self.ctx.buffer(np.ascontiguousarray(c.spring_rest_m, dtype=np.float32).tobytes())
         self._ring_cols = self.ctx.buffer(c.ring_cols.astype(np.int32).tobytes())
         self.ring_count = int(c.ring_cols.size)
         if not hasattr(self, "_rings"):
@@ -121,7 +122,8 @@ class GpuBackend:
         w, h = p.grid_w, p.grid_h
         table = np.zeros(len(SELECTORS), dtype=[("offset_first", "i4", 4),
                                                 ("step_count", "i4", 4),
-                                                ("rest_k_limit", "f4", 4)])
+                                                ("rest_k_limit", "f4", 4),
+                                                ("family", "i4", 4)])
         self._selectors = []  # (index, selector, groups x, groups y)
         for index, sel in enumerate(SELECTORS):
             rows, cols = sel.ranges(w, h)
@@ -129,7 +131,8 @@ class GpuBackend:
             table[index] = ((sel.di, sel.dj, rows.start, cols.start),
                             (rows.step, cols.step, len(rows), len(cols)),
                             (rest, float(c.stiffness_n_m[sel.family]),
-                             (1.0 + p.max_stretch) * rest, float(c.strain_limited[sel.family])))
+                             (1.0 + p.max_stretch) * rest, float(c.strain_limited[sel.family])),
+                            (sel.family, 0, 0, 0))
             if len(rows) and len(cols):
                 self._selectors.append((index, sel, _groups(len(cols)), len(rows)))
         self._selector_buffer = self.ctx.buffer(table.tobytes())
@@ -156,6 +159,7 @@ class GpuBackend:
         b["normal"].bind_to_storage_buffer(3)
         b["wind"].bind_to_storage_buffer(4)
         self._static.bind_to_storage_buffer(5)
+        self._spring_rest.bind_to_storage_buffer(11)
         self._rings.bind_to_storage_buffer(6)
         self._targets.bind_to_storage_buffer(7)
         self._ring_cols.bind_to_storage_buffer(8)

@@ -53,7 +53,8 @@ class NumbaBackend:
         self.params = params
         self.constants = SolverConstants.from_params(params)
         self._fp = pack_params(params, self.constants)
-        self._rest = np.ascontiguousarray(self.constants.rest_m, dtype=np.float64)
+        self._rest = np.ascontiguousarray(self.constants.spring_rest_m, dtype=np.float64)
+        self._flat = np.ascontiguousarray(self.constants.rest_m, dtype=np.float64)
         self._stiff = np.ascontiguousarray(self.constants.stiffness_n_m, dtype=np.float64)
         self._limited = np.ascontiguousarray(self.constants.strain_limited, dtype=np.bool_)
         self._inv_mass = np.ascontiguousarray(self.constants.inv_mass_per_kg, dtype=np.float64)
@@ -74,7 +75,8 @@ class NumbaBackend:
         state.time_s = self._kernels.advance(
             x, v, self._work("x_prev", x), self._work("normals", x), self._work("wind", x),
             self._inv_mass, state.ring_positions_m, state.ring_targets_m, self._ring_cols,
-            self._lra_ring, self._lra_limit, self._selectors, self._rest, self._stiff,
+            self._lra_ring, self._lra_limit, self._selectors, self._rest, self._flat,
+            self._stiff,
             self._limited, self._gust, self._fp, int(substeps), float(h),
             float(state.time_s), int(self.params.final_strain_passes))
 

@@ -166,11 +166,14 @@ class NumpyBackend:
         wsum = wa + wb
         d = b - a
         length = np.sqrt(np.sum(d * d, axis=-1, keepdims=True))
-        rest = c.rest_m[family]
+        # the elastic rest: the spring's length in the pleated pose; the strain limit: the
+        # fabric's own length between the two particles (flat), never stretched beyond it
+        rest = c.spring_rest_m[family][sa][..., None]
+        flat = c.rest_m[family]
         kh2 = c.stiffness_n_m[family] * h * h
         # XPBD with lambda = 0 (one iteration): dlambda = -C / (wa + wb + alpha/h^2);
         # written with k h^2 = h^2/alpha so that k = 0 gives no pull and k -> inf a hard one
-        limit = (1.0 + self.params.max_stretch) * rest
+        limit = (1.0 + self.params.max_stretch) * flat
         if limit_only:  # only pull back what is beyond the strain limit
             shorten = np.maximum(length - limit, 0.0)
         else:
@@ -181,5 +184,5 @@ class NumpyBackend:
         scale = np.where(safe, shorten / np.where(safe, wsum * length, 1.0), 0.0)
         x[sa] = a + (wa * scale) * d
         x[sb] = b - (wb * scale) * d
-        excess = np.where(safe, (length - limit) / rest, -1.0)
+        excess = np.where(safe, (length - limit) / flat, -1.0)
         return float(excess.max()) if excess.size else -1.0

@@ -23,8 +23,10 @@ FP_SIZE = 16
 
 
 @njit(cache=True, inline="always")
-def _project(x, ra, ca, rb, cb, wa, wb, rest, kh2, limited, max_stretch, limit_only):
-    """One XPBD distance constraint; returns its strain beyond the limit before it."""
+def _project(x, ra, ca, rb, cb, wa, wb, rest, flat, kh2, limited, max_stretch, limit_only):
+    """One XPBD distance constraint resting at ``rest`` (the pose's), strain-limited at
+    (1 + max_stretch) ``flat`` (the fabric's length); returns its strain beyond the limit
+    before it."""
     wsum = wa + wb
     if wsum <= 0.0:
         return 0.0
@@ -34,7 +36,7 @@ def _project(x, ra, ca, rb, cb, wa, wb, rest, kh2, limited, max_stretch, limit_o
     length = math.sqrt(dx * dx + dy * dy + dz * dz)
     if length <= 0.0:
         return 0.0
-    limit = (1.0 + max_stretch) * rest
+    limit = (1.0 + max_stretch) * flat
     if limit_only:
         shorten = max(length - limit, 0.0)
     else:
@@ -50,11 +52,11 @@ def _project(x, ra, ca, rb, cb, wa, wb, rest, kh2, limited, max_stretch, limit_o
     x[rb, cb, 0] -= sb * dx
     x[rb, cb, 1] -= sb * dy
     x[rb, cb, 2] -= sb * dz
-    return (length - limit) / rest
+    return (length - limit) / flat
 
 
 @njit(cache=True)
-def _selector_pass(x, w, sel, rest, stiff, limited, fp, h, limit_only):
+def _selector_pass(x, w, sel, rest, flat, stiff, limited, fp, h, limit_only):
     height, width = x.shape[0], x.shape[1]
     family, di, dj, row0, row_step, col0, col_step = (sel[0], sel[1], sel[2], sel[3],
                                                       sel[4], sel[5], sel[6])
@@ -70,14 +72,14 @@ def _selector_pass(x, w, sel, rest, stiff, limited, fp, h, limit_only):
         r = row0 + k * row_step
         for c in range(col0, col_stop, col_step):
             excess = _project(x, r, c, r + di, c + dj, w[r, c], w[r + di, c + dj],
-                              rest[family], kh2,
+                              rest[family, r, c], flat[family], kh2,
                               limited[family], max_stretch, limit_only)
             worst = max(worst, excess)
     return worst
 
 
 @njit(cache=True)
-def _strain_sweep(x, w, sel, rest, stiff, limited, fp, h, backward):
+def _strain_sweep(x, w, sel, rest, flat, stiff, limited, fp, h, backward):
     """Hard strain limiting over the stretch and shear selectors; returns the worst
     excess strain met (before its correction)."""
     worst = -1.0
@@ -85,7 +87,8 @@ def _strain_sweep(x, w, sel, rest, stiff, limited, fp, h, backward):
     for i in range(count):
         s_i = count - 1 - i if backward else i
         if limited[sel[s_i, 0]]:
-            worst = max(worst, _selector_pass(x, w, sel[s_i], rest, stiff, limited, fp, h, True))
+            worst = max(worst, _selector_pass(x, w, sel[s_i], rest, flat, stiff, limited, fp, h,
+                                                   True))
     return worst
 
 
@@ -230,7 +233,7 @@ def _collide_update(x, v, xp, fp, h):
 
 @njit(cache=True)
 def advance(x, v, xp, n, wind, w, rings, targets, ring_cols, lra_ring, lra_limit, sel, rest,
-            stiff, limited, gust, fp, substeps, h, t, final_passes):
+            flat, stiff, limited, gust, fp, substeps, h, t, final_passes):
     """One frame: ``substeps`` substeps of length h from time t; returns the new time.
 
     The last substep repeats the strain sweep (forward, backward, ...) until no spring
@@ -264,7 +267,7 @@ def advance(x, v, xp, n, wind, w, rings, targets, ring_cols, lra_ring, lra_limit
                 x[0, ring_cols[j], k] = rings[j, k]
         # 4. XPBD colour by colour
         for s_i in range(sel.shape[0]):
-            _selector_pass(x, w, sel[s_i], rest, stiff, limited, fp, h, False)
+            _selector_pass(x, w, sel[s_i], rest, flat, stiff, limited, fp, h, False)
         # 5. long-range attachments, 6. collisions, 6b. strain-limit sweeps
         _attach(x, w, rings, lra_ring, lra_limit)
         _collide(x, fp)
@@ -272,7 +275,7 @@ def advance(x, v, xp, n, wind, w, rings, targets, ring_cols, lra_ring, lra_limit
         if step == substeps - 1:
             passes = max(passes, final_passes)
         for k in range(passes):
-            worst = _strain_sweep(x, w, sel, rest, stiff, limited, fp, h, k % 2 == 1)
+            worst = _strain_sweep(x, w, sel, rest, flat, stiff, limited, fp, h, k % 2 == 1)
             if step == substeps - 1 and k + 1 >= int(fp[STRAIN_PASSES]) \
                     and worst <= STRAIN_TOLERANCE:
                 break

@@ -105,6 +105,33 @@ def rest_pose(params: ClothParams, opening: float | None = None) -> np.ndarray:
     return x
 
 
+def spring_rest_lengths_m(params: ClothParams) -> np.ndarray:
+    """(6, H, W) the rest length of each spring, by family (topology.FAMILIES) and first
+    particle (r, c): its length in the rest pose, the pleated heading hanging straight down
+    (where a family has no spring from (r, c), its flat rest length).
+
+    Springs resting flat pushed every pleat open where the pose's chord is shorter than the
+    flat length: the bend springs across each fold (2 dx flat), the stretch and shear
+    springs across an apex that falls between two columns. Below the rings nothing held the
+    pleats in, so they opened towards the hem and the hem flared wider than the heading (the
+    voile's hem 2.04 m under a 1.70 m heading). Resting at the pleated shape, the fabric
+    keeps its folds as a heading tape and pressing set them: the rest pose is free of
+    stress but for gravity, and the pleats hang down to the hem."""
+    from catalog.cloth.topology import FAMILIES, rest_lengths_m  # noqa: PLC0415
+
+    x = rest_pose(params)
+    h, w = params.grid_h, params.grid_w
+    flat = rest_lengths_m(params.spacing_x_m, params.spacing_y_m)
+    rest = np.empty((len(FAMILIES), h, w))
+    for family, (_, di, dj, _, _) in enumerate(FAMILIES):
+        rest[family] = flat[family]
+        c0, c1 = max(0, -dj), w - max(dj, 0)
+        a = x[0:h - di, c0:c1]
+        b = x[di:h, c0 + dj:c1 + dj]
+        rest[family, 0:h - di, c0:c1] = np.linalg.norm(b - a, axis=-1)
+    return rest
+
+
 def inverse_mass(params: ClothParams) -> np.ndarray:
     """(H, W) 1/m per particle (1/kg); 0 for the particles held by rings."""
     w = np.full((params.grid_h, params.grid_w), 1.0 / params.particle_mass_kg)
@@ -162,6 +189,7 @@ class SolverConstants:
     inv_mass_per_kg: np.ndarray  # (H, W) 1/m; 0 where a ring holds the particle
     ring_cols: np.ndarray  # (R,) columns of row 0 held by rings
     rest_m: np.ndarray  # (6,) rest length per family
+    spring_rest_m: np.ndarray  # (6, H, W) rest length per family and first particle (the pose's)
     stiffness_n_m: np.ndarray  # (6,) k per family; the XPBD compliance is alpha = 1/k
     strain_limited: np.ndarray  # (6,) bool
     aero_per_m: float  # 1/2 rho C_d A / m = 1/2 rho C_d / areal density, 1/m
@@ -178,6 +206,7 @@ class SolverConstants:
             inv_mass_per_kg=inverse_mass(params),
             ring_cols=ring_columns(params),
             rest_m=rest_lengths_m(params.spacing_x_m, params.spacing_y_m),
+            spring_rest_m=spring_rest_lengths_m(params),
             stiffness_n_m=np.array([k[fam[3]] for fam in FAMILIES]),
             strain_limited=np.array([fam[4] for fam in FAMILIES]),
             aero_per_m=0.5 * params.air_density_kg_m3 * params.drag_coefficient

@@ -200,8 +200,8 @@ CLOTH_FIELDS = {
     "bend_stiffness_n_m": (0.0, 1e6), "fullness": (1.0, 3.0),
 }
 #: [pattern] number keys and their bounds.
-PATTERN_NUMBERS = {"height_m": (0.0, 0.1), "net_thread_mm": (0.0, 100.0)}
-PATTERN_PATHS = ("coverage", "height")
+PATTERN_NUMBERS = {"height_m": (0.0, 0.1), "net_thread_mm": (0.0, 100.0), "border_m": (1e-4, 1.0)}
+PATTERN_PATHS = ("coverage", "height", "border", "border_height")
 
 
 def _is_number(value) -> bool:

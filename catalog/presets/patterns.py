@@ -11,6 +11,15 @@ separate ``height`` image). The table::
     height = "patterns/lace-fwa-height.png"  # optional: thread height, 0..1 of height_m
     repeat_m = [0.1, 0.1005]             # or one number: the width, the height by the pixel aspect
     height_m = 2.0e-4                    # optional: the height that a value of 1 means (m)
+    border = "patterns/lace-fwa-border.png"  # optional: the band along the hem (a lace's scallops)
+    border_height = "patterns/lace-fwa-border-height.png"   # optional: its thread height
+    border_m = 0.05                      # with border: the band's depth up from the hem (m)
+
+The border is a band as wide as the repeat (the coverage's width in pixels, the same u
+repeat), its row 0 at the hem, ``border_m`` deep; it replaces the all-over pattern below
+``border_m`` from the hem (where the cloth is cut away, below a scallop, its coverage is 0),
+so it tiles along u only. The open area of the fit is the all-over's (the band is a strip of
+the curtain, not of the cloth the fit measured).
 
 The pattern and the fit agree: the mean open area 1 - mean(c) equals the fitted
 ``btdf.direct`` (LD) within :data:`OPEN_AREA_TOLERANCE` (relative), checked when a preset
@@ -21,6 +30,7 @@ chain averages c) the patterned cloth is the fitted cloth.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -43,6 +53,16 @@ MAX_SIDE_PX = 8192
 
 
 @dataclass(frozen=True)
+class HemBorder:
+    """The band along the hem: coverage and height (rows, W) float32 in [0, 1], row 0 at the
+    hem, ``depth_m`` deep (the pattern's u repeat across)."""
+
+    coverage: np.ndarray
+    height: np.ndarray | None
+    depth_m: float
+
+
+@dataclass(frozen=True)
 class Pattern:
     """One repeat: coverage (H, W) float32 in [0, 1], row 0 = the top of the image (v = 0
     at the image's bottom row is *not* assumed: texture v runs with image rows, as the
@@ -53,6 +73,7 @@ class Pattern:
     repeat_m: tuple[float, float]
     height_m: float
     source: str
+    border: HemBorder | None = None
 
     @property
     def mean_coverage(self) -> float:
@@ -87,6 +108,19 @@ class Pattern:
         n = np.concatenate([-s, np.ones(s.shape[:2] + (1,))], axis=-1)
         n /= np.linalg.norm(n, axis=-1, keepdims=True)
         return np.concatenate([n, self.coverage[..., None]], axis=-1).astype(np.float32)
+
+    def border_normal_map(self) -> np.ndarray | None:
+        """The hem band's RGBA as :meth:`normal_map` (None without a border). The band does
+        not repeat along v: its slopes are taken on the band mirrored about its top row
+        (what a clamped edge continues as), so no slope wraps from the hem to the top."""
+        b = self.border
+        if b is None:
+            return None
+        rows = b.coverage.shape[0]
+        mirrored = Pattern(np.concatenate([b.coverage, b.coverage[::-1]]),
+                           None if b.height is None else np.concatenate([b.height, b.height[::-1]]),
+                           (self.repeat_m[0], 2.0 * b.depth_m), self.height_m, self.source)
+        return mirrored.normal_map()[:rows]
 
 
 def check_open_area(open_area: float, direct: float, *, path=None, field="pattern.coverage") -> None:
@@ -144,14 +178,14 @@ def _check_values(values: np.ndarray, path, what: str) -> None:
                          path=path)
 
 
-def check_tileable(values: np.ndarray, path, what: str = "coverage") -> None:
+def check_tileable(values: np.ndarray, path, what: str = "coverage", axes=(1, 0)) -> None:
     """Refuse a repeat whose opposite edges do not meet: the seam where the repeat wraps
     (last column to first, last row to first) may be no stronger than the strongest edge
     inside it (the mean absolute jump along a column or row), plus TILE_FLOOR. A ramp, a
     vignette or a crop through the motif makes the seam the strongest jump of all."""
     v = values.astype(np.float64)
     for axis, edges in ((1, "left and right"), (0, "top and bottom")):
-        if v.shape[axis] < 2:
+        if v.shape[axis] < 2 or axis not in axes:
             continue
         jumps = np.abs(np.diff(v, axis=axis)).mean(axis=1 - axis)   # per interior seam
         first = np.take(v, 0, axis=axis)
@@ -245,7 +279,43 @@ def load_pattern(preset, check_fit: bool = True) -> Pattern | None:
                                   table.get("height_m", DEFAULT_HEIGHT_M), where=where)
     if check_fit:
         check_open_area(pattern.open_area, preset.btdf.direct, path=where)
+    if table.get("border") is not None:
+        pattern = dataclasses.replace(pattern, border=_load_border(preset, table, pattern))
     return pattern
+
+
+def _load_border(preset, table: dict, pattern: Pattern) -> HemBorder:
+    """The [pattern] border band: grey images as wide as the coverage, border_m deep."""
+    where = preset.path
+    if "border_m" not in table:
+        raise InputError("missing required key (the border's depth from the hem in metres)",
+                         path=where, field="pattern.border_m")
+    depth = table["border_m"]
+    if isinstance(depth, bool) or not isinstance(depth, (int, float)) or not math.isfinite(depth) \
+            or not 1e-4 <= depth <= 1.0:
+        raise InputError(f"must be a depth in metres in [0.0001, 1], found {depth!r}",
+                         path=where, field="pattern.border_m")
+    width = pattern.coverage.shape[1]
+    images = []
+    for key in ("border", "border_height"):
+        rel = table.get(key)
+        if rel is None:
+            images.append(None)
+            continue
+        path = preset.resolve(rel)
+        pixels = read_image(path)
+        if pixels.shape[2] != 1:
+            raise InputError(f"a border image has 1 channel (grey), found {pixels.shape[2]}",
+                             path=path)
+        if pixels.shape[1] != width or (images and images[0] is not None
+                                        and pixels.shape[:2] != images[0].shape):
+            raise InputError(f"the border image is {pixels.shape[1]}x{pixels.shape[0]}: it must be "
+                             f"as wide as the coverage ({width} px), the height image as the border",
+                             path=path)
+        _check_values(pixels[..., 0], path, "the border")
+        check_tileable(pixels[..., 0], path, "the border", axes=(1,))
+        images.append(np.clip(pixels[..., 0], 0.0, 1.0).astype(np.float32))
+    return HemBorder(images[0], images[1], float(depth))
 
 
 def match_open_area(coverage: np.ndarray, direct: float, where=None) -> np.ndarray:

@@ -60,6 +60,7 @@ class CurtainPass(Pass):
             # the holes are drawn by the OIT composite: no see-through term in the shader
             defines.update({"PATTERN": True, "OIT": True, "SEE_THROUGH": False,
                             "PATTERN_LOD_BIAS": glsl_literal(self.frame.fabric_pattern.lod_bias)})
+            defines.update(self.frame.fabric_pattern.defines())
         return defines
 
     def _curtain_program(self, gbuffer: bool, overrides: dict | None = None, folds_behind: bool = False):
@@ -114,10 +115,7 @@ class CurtainPass(Pass):
             set_uniform(program, "u_camera_position", eye)
             set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
             if "u_pattern" in program:
-                self.frame.fabric_pattern.texture.use(location=PATTERN_UNIT)
-                set_uniform(program, "u_pattern", PATTERN_UNIT)
-                set_uniform(program, "u_uv_to_repeats",
-                          tuple(f / r for f, r in zip(self.frame.mesh.fabric_size_m, self.frame.fabric_pattern.repeat_m)))
+                self.frame.fabric_pattern.bind(program, PATTERN_UNIT, self.frame.mesh.fabric_size_m)
                 set_uniform(program, "u_inv_mean_coverage", 1.0 / max(self.frame.fabric_pattern.mean_coverage, 1e-6))
                 set_uniform(program, "u_oit_depth_ref", self.oit_depth_reference_m())
             if not self.frame.specialise:

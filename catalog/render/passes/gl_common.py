@@ -32,6 +32,10 @@ KEY_FRONT_UNIT = 6
 KEY_SECOND_UNIT = 14
 
 
+#: Texture unit of the pattern's band along the hem (a lace's scallops; common.glsl HEM_BORDER).
+BORDER_UNIT = 15
+
+
 #: Texture unit of the occlusion maps (the curtain's SKY_OCCLUSION).
 OCCLUSION_UNIT = 7
 

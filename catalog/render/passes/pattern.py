@@ -27,6 +27,10 @@ class PatternTexture(Pass):
     def __init__(self, frame):
         super().__init__(frame)
         self.texture = None
+        #: the hem's band (a lace's scallops: [pattern] border), RGBA32F as the pattern,
+        #: repeating across, clamped up and down; None without one
+        self.border = None
+        self.border_repeats = None   # the band's depth in pattern repeats along v
         self.key = None
         self._pattern = None
         self.repeat_m = None
@@ -57,26 +61,60 @@ class PatternTexture(Pass):
         else:
             texels = pattern.normal_map()
             repeat = pattern.repeat_m
+        self.release()
+        self.texture = self._mipmapped(texels, periodic_v=True)
+        band = None if pattern is None else pattern.border_normal_map()
+        if band is not None:
+            self.border = self._mipmapped(band, periodic_v=False)
+            self.border_repeats = pattern.border.depth_m / float(repeat[1])
+        self._pattern = pattern
+        self.repeat_m = tuple(float(v) for v in repeat)
+        self.mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
+        self.key = key
+
+    def _mipmapped(self, texels: np.ndarray, periodic_v: bool):
+        """A trilinear, anisotropic RGBA32F texture of ``texels``, repeating across and, when
+        ``periodic_v``, down (else clamped: the hem's band). Its levels: the prefiltered chain
+        (mip_chain; a band is mirrored about its top row first, what the clamped edge continues
+        as, and each level keeps its first half) or the hardware's box chain."""
         mgl = self.mgl
-        if self.texture is not None:
-            self.texture.release()
         h, w = texels.shape[:2]
         texture = self.ctx.texture((w, h), 4, np.ascontiguousarray(texels).tobytes(), dtype="f4")
-        texture.repeat_x = texture.repeat_y = True
+        texture.repeat_x = True
+        texture.repeat_y = periodic_v
         texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
         texture.build_mipmaps()   # allocates the levels; their texels are the prefiltered chain
         if self.prefilter:
             from catalog.presets.patterns import mip_chain  # noqa: PLC0415
 
-            for level, image in enumerate(mip_chain(texels)[1:], start=1):
+            source = texels if periodic_v else np.concatenate([texels, texels[::-1]])
+            for level, image in enumerate(mip_chain(source)[1:], start=1):
+                rows = max(1, h >> level)
+                image = image if periodic_v else image[:rows]
+                if image.shape[:2] != (rows, max(1, w >> level)):
+                    break   # the mirrored chain ran out of rows (a band under 2^level rows)
                 texture.write(np.ascontiguousarray(image, dtype="f4").tobytes(), level=level)
         max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
         texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
-        self.texture = texture
-        self._pattern = pattern
-        self.repeat_m = tuple(float(v) for v in repeat)
-        self.mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
-        self.key = key
+        return texture
+
+    def defines(self) -> dict:
+        """The shaders' defines that this pattern needs beside PATTERN (HEM_BORDER)."""
+        return {"HEM_BORDER": True} if self.border is not None else {}
+
+    def bind(self, program, unit: int, fabric_size_m) -> None:
+        """The pattern (and the hem's band) on texture ``unit`` (the band on BORDER_UNIT) and
+        the scale from the cloth's uv (0..1 over ``fabric_size_m``) to pattern repeats."""
+        from catalog.render.passes.gl_common import BORDER_UNIT, set_uniform  # noqa: PLC0415
+
+        self.texture.use(location=unit)
+        set_uniform(program, "u_pattern", unit)
+        set_uniform(program, "u_uv_to_repeats",
+                    tuple(f / r for f, r in zip(fabric_size_m, self.repeat_m)))
+        if self.border is not None and "u_border" in program:
+            self.border.use(location=BORDER_UNIT)
+            set_uniform(program, "u_border", BORDER_UNIT)
+            set_uniform(program, "u_border_repeats", float(self.border_repeats))
 
     def set_prefilter(self, on: bool) -> None:
         """The mip chain: prefiltered (True, default) or the hardware's box chain (False, what
@@ -112,6 +150,7 @@ class PatternTexture(Pass):
         return np.frombuffer(data, dtype=np.float32).reshape(h, w, 4).copy()
 
     def release(self) -> None:
-        if self.texture is not None:
-            self.texture.release()
-            self.texture = None
+        for texture in (self.texture, self.border):
+            if texture is not None:
+                texture.release()
+        self.texture = self.border = self.border_repeats = None

@@ -164,6 +164,10 @@ class ShadowPass(Pass):
         s(program, "u_occlusion_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
 
 
+    def _border(self, patterned: bool) -> dict:
+        """The hem band's define (the scallops' holes cast their shadow) when patterned."""
+        return self.frame.fabric_pattern.defines() if patterned else {}
+
     def draw_room_shadow(self, inputs) -> None:
         """Pass R1: the key light's transmittance through the curtain (room_shadow.frag)."""
         mgl, gl = self.mgl, self.frame.room_targets.get()
@@ -178,12 +182,9 @@ class ShadowPass(Pass):
             patterned = (pattern is not None and self.frame.patterned
                          and self.frame.mesh.format != "interleaved")
             program = self.gl.program("room_shadow.vert", "room_shadow.frag",
-                                    {"HAS_UV": True, "PATTERN": patterned})
+                                    {"HAS_UV": True, "PATTERN": patterned, **self._border(patterned)})
             if patterned:
-                pattern.use(location=3)
-                set_uniform(program, "u_pattern", 3)
-                set_uniform(program, "u_uv_to_repeats", tuple(
-                    f / r for f, r in zip(self.frame.mesh.fabric_size_m, self.frame.fabric_pattern.repeat_m)))
+                self.frame.fabric_pattern.bind(program, 3, self.frame.mesh.fabric_size_m)
             colours = self.frame.terms.room_colours(inputs)
             set_uniform(program, "u_light_view_proj",
                       gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
@@ -252,7 +253,8 @@ class ShadowPass(Pass):
         self.ctx.viewport = (0, 0, n, n)
         gl["key_front_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
         program = self.gl.program("room_shadow.vert", "room_shadow.frag",
-                                {"HAS_UV": True, "PATTERN": patterned, "FRONT_LAYER": True})
+                                {"HAS_UV": True, "PATTERN": patterned, "FRONT_LAYER": True,
+                                 **self._border(patterned)})
         self._front_layer_uniforms(program, inputs, patterned, colours)
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.depth_func = "<"
@@ -264,6 +266,7 @@ class ShadowPass(Pass):
         if self.frame.key_second_layer:
             program = self.gl.program("room_shadow.vert", "room_shadow.frag",
                                       {"HAS_UV": True, "PATTERN": patterned, "SECOND_LAYER": True,
+                                       **self._border(patterned),
                                        "PEEL_SPAN_TEXELS": glsl_literal(KEY_PEEL_SPAN_TEXELS)})
             self._front_layer_uniforms(program, inputs, patterned, colours)
             gl["key_front"].use(location=KEY_FRONT_UNIT)
@@ -276,10 +279,7 @@ class ShadowPass(Pass):
         """room_shadow.frag's FRONT_LAYER and SECOND_LAYER inputs: the light's frame, the
         pattern's coverage."""
         if patterned:
-            self.frame.fabric_pattern.texture.use(location=3)
-            set_uniform(program, "u_pattern", 3)
-            set_uniform(program, "u_uv_to_repeats", tuple(
-                f / r for f, r in zip(self.frame.mesh.fabric_size_m, self.frame.fabric_pattern.repeat_m)))
+            self.frame.fabric_pattern.bind(program, 3, self.frame.mesh.fabric_size_m)
         set_uniform(program, "u_light_view_proj",
                   gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
         set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
