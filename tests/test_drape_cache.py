@@ -151,3 +151,17 @@ def test_two_processes_writing_one_key_leave_one_whole_file(cache):
     assert seen > 0
     assert _same(drape_cache.load(key, params), expected)
     assert [p.name for p in cache.iterdir()] == [f"{key}.npz"]
+
+
+def test_every_cloth_module_is_keyed_or_excluded_for_a_reason():
+    """A solver module left out of the key would let a changed kernel reuse a stale drape."""
+    from pathlib import Path
+
+    from catalog.cloth import drape_cache
+
+    here = Path(drape_cache.__file__).parent
+    modules = {p.stem for p in here.glob("*.py")} - {"__init__"}
+    # Not on the settle's path: the cache itself, the GPU backend (settle runs numba or
+    # numpy), the mesh export.
+    excluded = {"drape_cache", "backend_gpu", "mesh"}
+    assert modules - excluded == set(drape_cache.SOLVER_MODULES)

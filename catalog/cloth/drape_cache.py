@@ -38,9 +38,10 @@ import numpy as np
 CACHE_ENV = "CATALOG_CACHE_DIR"
 #: Bumped when the file's layout changes.
 FORMAT = 1
-#: The modules whose code decides the settled state (the numpy backend's whole path).
+#: The modules whose code decides the settled state: the numpy backend's whole path and
+#: the numba one's (drape.settled_rest settles with numba when it is installed).
 SOLVER_MODULES = ("params", "state", "topology", "wind", "backend", "backend_numpy",
-                  "simulation", "drape")
+                  "backend_numba", "numba_kernels", "simulation", "drape")
 
 
 #: The fields that shape only the wind (catalog.cloth.wind): without wind (speed 0) the air
