@@ -105,6 +105,7 @@ class SnapshotRequest:
     room_light: bool = True
     bloom: bool = True
     lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
+    room: str | None = None           # a built-in room or FILE.glb (its transport); None: the box's special-case light
 
 
 def simulated_curtain(preset, frames: int):
@@ -262,6 +263,8 @@ def configure_renderer(renderer, request: SnapshotRequest, preset, light):
     renderer.set_white_balance(request.white_balance)
     renderer.set_curtain_open(request.curtain_open)
     renderer.set_room_lighting(request.room_light)
+    if request.room != renderer.room_spec:
+        renderer.set_room(request.room)
     renderer.set_bloom(request.bloom)
     if request.environment is not None:
         renderer.set_environment(request.environment)

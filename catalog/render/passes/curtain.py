@@ -51,6 +51,7 @@ class CurtainPass(Pass):
             defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
             if defines.get("SKY_OCCLUSION"):
                 defines["OCCLUSION_MAPS"] = True   # the folds' maps (the G-buffer's view continuation)
+            if defines.get("SKY_OCCLUSION") and self.frame.room_transport is None:
                 # the wall and its reveals where the outside is walled
                 defines["WALL_LIGHT"] = True
                 defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES

@@ -1,11 +1,12 @@
-"""A standalone GL pass: a room drawn with its light map from the precomputed transport.
+"""The room drawn with its light map from the precomputed transport (room_transport.vert/.frag).
 
-Input: a :class:`catalog.room.transport.Transport` and the receivers' irradiance (E, 3)
-(:meth:`Transport.irradiance` of the window's coefficients, plus :meth:`Transport.bounced`
-of the sun's beam); the pass draws the light map of catalog.room.lightmap (corners welded
-on each plane, linear inside each receiver) as albedo x E / pi (room_transport.vert/.frag) into the bound
-framebuffer. Not yet wired into the frame (catalog/render/frame.py): the lead places it
-among the passes; until then the tests draw it alone.
+Input: a :class:`catalog.room.model.Room`, its :class:`catalog.room.transport.Transport`
+and the receivers' irradiance (E, 3). The pass draws each receiver's triangle with the
+light map of catalog.room.lightmap (corners welded on each plane, linear inside each
+receiver) times the surface's albedo (base colour x texture, at the texture coordinates the
+receiver's corners take in their triangle) / pi; with ``key`` uniforms, the key's beam per
+pixel (KEY_BEAM: the curtain's transmittance map, the room's depth map from the key). The
+frame's room light (catalog/render/passes/room_transport_light.py) drives it.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import numpy as np
 
 from catalog.render.camera import gl_bytes
 from catalog.room.lightmap import corner_irradiance
+
 
 def look_at_view_projection(position, forward, up, fov_y_deg: float, aspect: float,
                             near_m: float = 0.05, far_m: float = 50.0) -> np.ndarray:
@@ -34,39 +36,151 @@ def look_at_view_projection(position, forward, up, fov_y_deg: float, aspect: flo
     return proj @ view
 
 
-class RoomTransportPass:
-    """Owns its program and vertex buffer; :meth:`update` uploads a new light map (the
-    curtain moved, the sun moved), :meth:`draw` draws it depth-tested."""
+def receiver_uvs(room, transport) -> tuple[np.ndarray, np.ndarray]:
+    """(E,) the surface of each receiver and (E, 3, 2) its corners' texture coordinates
+    (zeros where the surface has none), by the corners' barycentrics in their triangle."""
+    rec = transport.receivers
+    surface_of, local_of = room.surface_of_triangle()
+    surface = surface_of[rec.triangle]
+    uvs = np.zeros((rec.count, 3, 2))
+    tri = rec.triangles[rec.triangle]                       # (E, 3, 3)
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    d11, d12, d22 = (np.einsum("ni,ni->n", e1, e1), np.einsum("ni,ni->n", e1, e2),
+                     np.einsum("ni,ni->n", e2, e2))
+    det = d11 * d22 - d12 * d12
+    for k in range(3):
+        p = rec.corners[:, k] - tri[:, 0]
+        p1, p2 = np.einsum("ni,ni->n", p, e1), np.einsum("ni,ni->n", p, e2)
+        b1 = (d22 * p1 - d12 * p2) / det
+        b2 = (d11 * p2 - d12 * p1) / det
+        bary = np.stack([1 - b1 - b2, b1, b2], axis=1)
+        for s_index, s in enumerate(room.surfaces):
+            if s.uvs is None:
+                continue
+            sel = np.flatnonzero(surface == s_index)
+            uvs[sel, k] = np.einsum("nk,nkj->nj", bary[sel], s.uvs[local_of[rec.triangle[sel]]])
+    return surface, uvs
 
-    def __init__(self, ctx, transport):
+
+class RoomTransportPass:
+    """Owns its programs, vertex buffer and the surfaces' textures; :meth:`update` uploads a
+    new light map (the curtain moved, the sun moved), :meth:`draw` draws it depth-tested,
+    :meth:`draw_depth` the room's geometry alone (the key's depth map)."""
+
+    def __init__(self, ctx, transport, room=None):
+        import moderngl  # noqa: PLC0415
+
         from catalog.gl.shaderlib import create_program  # noqa: PLC0415
 
         self.ctx = ctx
         self.transport = transport
-        self.program = create_program(ctx, "room_transport.vert", "room_transport.frag")
+        self.room = room
+        self._programs = {}
+        self._create_program = create_program
         rec = transport.receivers
-        self._positions = rec.corners.reshape(-1, 3).astype("f4")
-        self._albedo = np.repeat(rec.albedo, 3, axis=0).astype("f4")
-        self._buffer = ctx.buffer(reserve=self._positions.shape[0] * 9 * 4)
-        self._vao = ctx.vertex_array(self.program, [(self._buffer, "3f 3f 3f", "in_position",
-                                                     "in_irradiance", "in_albedo")])
+        if room is not None:
+            surface, uvs = receiver_uvs(room, transport)
+        else:   # flat: each receiver's mean albedo as its factor (no texture)
+            surface, uvs = np.zeros(rec.count, dtype=np.int64), np.zeros((rec.count, 3, 2))
+        order = np.argsort(surface, kind="stable")
+        self._order = order
+        self._ranges = []   # (surface index, first vertex, count)
+        for s_index in np.unique(surface):
+            sel = np.flatnonzero(surface[order] == s_index)
+            self._ranges.append((int(s_index), 3 * int(sel[0]), 3 * int(sel.size)))
+        self._positions = rec.corners[order].reshape(-1, 3).astype("f4")
+        self._normals = np.repeat(rec.normal[order], 3, axis=0).astype("f4")
+        self._uvs = uvs[order].reshape(-1, 2).astype("f4")
+        self._flat_albedo = None if room is not None else rec.albedo[order]
+        self._buffer = ctx.buffer(reserve=self._positions.shape[0] * 11 * 4)
+        self._depth_buffer = ctx.buffer(self._positions.tobytes())
+        self._vaos = {}
+        self._textures = {}
+        white = ctx.texture((1, 1), 3, data=np.ones(3, dtype="f4").tobytes(), dtype="f4")
+        for s_index, _first, _count in self._ranges:
+            texture = None if room is None else room.surfaces[s_index].texture
+            if texture is None:
+                self._textures[s_index] = white
+                continue
+            h, w = texture.shape[:2]
+            t = ctx.texture((w, h), 3, data=np.ascontiguousarray(texture[::-1], dtype="f4").tobytes(),
+                            dtype="f4")
+            t.build_mipmaps()
+            t.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            self._textures[s_index] = t
+        self._white = white
         self.update(np.zeros((rec.count, 3)))
+
+    def program(self, defines: dict):
+        key = tuple(sorted(defines.items()))
+        if key not in self._programs:
+            self._programs[key] = self._create_program(self.ctx, "room_transport.vert",
+                                                       "room_transport.frag", defines)
+        return self._programs[key]
+
+    def _vao(self, program, depth: bool = False):
+        key = (id(program), depth)
+        if key not in self._vaos:
+            if depth:
+                self._vaos[key] = self.ctx.vertex_array(program, [(self._depth_buffer, "3f", "in_position")])
+            else:
+                # attributes a variant optimised away are skipped in the interleaved buffer
+                fields = [("in_position", "3f", "12x"), ("in_irradiance", "3f", "12x"),
+                          ("in_normal", "3f", "12x"), ("in_uv", "2f", "8x")]
+                layout = " ".join(fmt if name in program else skip for name, fmt, skip in fields)
+                names = [name for name, _f, _s in fields if name in program]
+                self._vaos[key] = self.ctx.vertex_array(program, [(self._buffer, layout, *names)])
+        return self._vaos[key]
 
     def update(self, irradiance: np.ndarray) -> None:
         """Upload the receivers' irradiance (E, 3)."""
-        corner = corner_irradiance(self.transport, np.asarray(irradiance, dtype=np.float64))
-        data = np.concatenate([self._positions, corner.reshape(-1, 3).astype("f4"), self._albedo], axis=1)
+        corner = corner_irradiance(self.transport, np.asarray(irradiance, dtype=np.float64))[self._order]
+        if self._flat_albedo is not None:   # no room: each receiver's mean albedo, factor 1
+            corner = corner * self._flat_albedo[:, None, :]
+        data = np.concatenate([self._positions, corner.reshape(-1, 3).astype("f4"), self._normals,
+                               self._uvs], axis=1)
         self._buffer.write(np.ascontiguousarray(data, dtype="f4").tobytes())
 
-    def draw(self, view_projection: np.ndarray) -> None:
+    def draw(self, view_proj: np.ndarray, beam_uniforms=None) -> None:
+        """Draw into the bound framebuffer, depth-tested. ``beam_uniforms``: a callable that
+        sets KEY_BEAM's inputs on the program (None: the light map alone)."""
         import moderngl  # noqa: PLC0415
 
-        self.program["u_view_proj"].write(gl_bytes(view_projection))
+        program = self.program({"KEY_BEAM": beam_uniforms is not None})
+        program["u_view_proj"].write(gl_bytes(view_proj))
+        if beam_uniforms is not None:
+            beam_uniforms(program)
         self.ctx.enable(moderngl.DEPTH_TEST)
         self.ctx.disable(moderngl.CULL_FACE)
-        self._vao.render(moderngl.TRIANGLES)
-        self.ctx.disable(moderngl.DEPTH_TEST)   # the state the other passes start from
+        vao = self._vao(program)
+        for s_index, first, count in self._ranges:
+            if self.room is not None:
+                factor = self.room.surfaces[s_index].factor
+            else:
+                factor = (1.0, 1.0, 1.0)
+            program["u_albedo_factor"].value = tuple(float(v) for v in factor)
+            self._textures[s_index].use(location=0)
+            program["u_albedo_texture"].value = 0
+            vao.render(moderngl.TRIANGLES, vertices=count, first=first)
+
+    def draw_depth(self, view_proj: np.ndarray) -> None:
+        """The room's triangles' depth alone into the bound framebuffer (no culling)."""
+        import moderngl  # noqa: PLC0415
+
+        program = self.program({"DEPTH_ONLY": True})
+        program["u_view_proj"].write(gl_bytes(view_proj))
+        self.ctx.enable(moderngl.DEPTH_TEST)
+        self.ctx.disable(moderngl.CULL_FACE)
+        self._vao(program, depth=True).render(moderngl.TRIANGLES)
 
     def release(self) -> None:
-        for obj in (self._vao, self._buffer, self.program):
-            obj.release()
+        for vao in self._vaos.values():
+            vao.release()
+        for t in {id(t): t for t in self._textures.values()}.values():
+            t.release()
+        if self._white not in self._textures.values():
+            self._white.release()
+        for program in self._programs.values():
+            program.release()
+        self._buffer.release()
+        self._depth_buffer.release()
