@@ -115,10 +115,9 @@ class FrameRenderer:
         self.environment = None    # (path, texture, upper-hemisphere illuminance) or None
         self.antialiasing = "fxaa"
         self.room_targets = RoomTargets(ctx, self.shadow_texels)
-        #: the room drawn and lit by its precomputed transport (set_room; None: the box's
-        #: special-case room light of catalog/render/room_light)
-        self.room_model = None
-        self.room_spec = None   # what set_room was given (a name or path; None: none)
+        #: the room drawn and lit by its precomputed transport (set_room: what it was given, a
+        #: name or a path; None: the box's special-case room light of catalog/render/room_light)
+        self.room_spec = None
         self.room_transport = None
         # the passes, in the order a frame runs them (render_hdr, render)
         self.gl = GLPrograms(ctx)
@@ -205,21 +204,18 @@ class FrameRenderer:
         self.key_second_layer = bool(on)
 
     def set_room(self, room) -> None:
-        """The room (a built-in name, a .glb path or a catalog.room.model.Room), drawn and lit
-        by its precomputed transport (catalog/render/passes/room_transport_light.py); None: the
-        box's special-case light."""
+        """The room (a built-in name or a .glb path), drawn and lit by its precomputed
+        transport (catalog/render/passes/room_transport_light.py; its bundle from the cache,
+        built on first use); None: the box's special-case light."""
         from catalog.render.passes.room_transport_light import RoomTransportLight  # noqa: PLC0415
-        from catalog.room.load import load_room  # noqa: PLC0415
 
+        light = None if room is None else RoomTransportLight(self, str(room))   # refused before any change
         if self.room_transport is not None:
             if self.ctx.fbo in self.room_transport.framebuffers():
                 (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
             self.room_transport.release()
-            self.room_transport = None
-        self.room_model = None if room is None else (room if hasattr(room, "surfaces") else load_room(room))
-        self.room_spec = None if room is None else (room.name if hasattr(room, "surfaces") else str(room))
-        if self.room_model is not None:
-            self.room_transport = RoomTransportLight(self, self.room_model)
+        self.room_transport = light
+        self.room_spec = None if room is None else str(room)
         self.lightmap.invalidate()
 
     def room_side_active(self) -> bool:

@@ -193,6 +193,10 @@ def validate(request: SnapshotRequest):
         from catalog.render.environment import load_environment  # noqa: PLC0415
 
         load_environment(request.environment)  # refused now, before a context exists
+    if request.room is not None:
+        from catalog.room.load import room_path  # noqa: PLC0415
+
+        room_path(request.room)   # a name or a file; its rules are checked as it loads (set_room)
     from catalog.render import room_light  # noqa: PLC0415
 
     if len(request.lamps) > room_light.MAX_ROOM_LAMPS:

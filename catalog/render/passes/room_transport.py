@@ -1,7 +1,7 @@
 """The room drawn with its light map from the precomputed transport (room_transport.vert/.frag).
 
-Input: a :class:`catalog.room.model.Room`, its :class:`catalog.room.transport.Transport`
-and the receivers' irradiance (E, 3). The pass draws each receiver's triangle with the
+Input: a room's runtime bundle (:class:`catalog.render.room_operators.RoomOperators`) and
+the receivers' irradiance (E, 3). The pass draws each receiver's triangle with the
 light map of catalog.room.lightmap (corners welded on each plane, linear inside each
 receiver) times the surface's albedo (base colour x texture, at the texture coordinates the
 receiver's corners take in their triangle) / pi; with ``key`` uniforms, the key's beam per
@@ -62,43 +62,64 @@ def receiver_uvs(room, transport) -> tuple[np.ndarray, np.ndarray]:
     return surface, uvs
 
 
+class FlatTransportRoom:
+    """A bare transport (no room file) as :class:`RoomTransportPass` draws it: each
+    receiver's mean albedo, no textures."""
+
+    def __init__(self, transport):
+        from catalog.render.room_operators import SurfaceData  # noqa: PLC0415
+
+        rec = transport.receivers
+        self.transport = transport
+        self.corners, self.normal, self.count = rec.corners, rec.normal, rec.count
+        self.surface = np.zeros(rec.count, dtype=np.int64)
+        self.uvs = np.zeros((rec.count, 3, 2))
+        self.surfaces = (SurfaceData("flat", np.ones(3), None),)
+        self.flat_albedo = rec.albedo
+        self.triangles = rec.triangles
+
+    def corner_irradiance(self, irradiance):
+        return corner_irradiance(self.transport, irradiance)
+
+
 class RoomTransportPass:
     """Owns its programs, vertex buffer and the surfaces' textures; :meth:`update` uploads a
     new light map (the curtain moved, the sun moved), :meth:`draw` draws it depth-tested,
-    :meth:`draw_depth` the room's geometry alone (the key's depth map)."""
+    :meth:`draw_depth` the room's geometry alone (the key's depth map). ``room``: a
+    :class:`catalog.render.room_operators.RoomOperators`, or a bare
+    :class:`catalog.room.transport.Transport` (each receiver's mean albedo)."""
 
-    def __init__(self, ctx, transport, room=None):
+    def __init__(self, ctx, room):
         import moderngl  # noqa: PLC0415
 
         from catalog.gl.shaderlib import create_program  # noqa: PLC0415
 
+        if not hasattr(room, "corner_irradiance"):
+            room = FlatTransportRoom(room)
         self.ctx = ctx
-        self.transport = transport
         self.room = room
         self._programs = {}
         self._create_program = create_program
-        rec = transport.receivers
-        if room is not None:
-            surface, uvs = receiver_uvs(room, transport)
-        else:   # flat: each receiver's mean albedo as its factor (no texture)
-            surface, uvs = np.zeros(rec.count, dtype=np.int64), np.zeros((rec.count, 3, 2))
+        surface = room.surface
         order = np.argsort(surface, kind="stable")
         self._order = order
         self._ranges = []   # (surface index, first vertex, count)
         for s_index in np.unique(surface):
             sel = np.flatnonzero(surface[order] == s_index)
             self._ranges.append((int(s_index), 3 * int(sel[0]), 3 * int(sel.size)))
-        self._positions = rec.corners[order].reshape(-1, 3).astype("f4")
-        self._normals = np.repeat(rec.normal[order], 3, axis=0).astype("f4")
-        self._uvs = uvs[order].reshape(-1, 2).astype("f4")
-        self._flat_albedo = None if room is not None else rec.albedo[order]
+        self._positions = room.corners[order].reshape(-1, 3).astype("f4")
+        self._normals = np.repeat(room.normal[order], 3, axis=0).astype("f4")
+        self._uvs = room.uvs[order].reshape(-1, 2).astype("f4")
+        flat = getattr(room, "flat_albedo", None)
+        self._flat_albedo = None if flat is None else flat[order]
         self._buffer = ctx.buffer(reserve=self._positions.shape[0] * 11 * 4)
-        self._depth_buffer = ctx.buffer(self._positions.tobytes())
+        # the key's depth map: the room's own triangles (not the receivers': fewer)
+        self._depth_buffer = ctx.buffer(np.asarray(room.triangles, dtype="f4").reshape(-1, 3).tobytes())
         self._vaos = {}
         self._textures = {}
         white = ctx.texture((1, 1), 3, data=np.ones(3, dtype="f4").tobytes(), dtype="f4")
         for s_index, _first, _count in self._ranges:
-            texture = None if room is None else room.surfaces[s_index].texture
+            texture = room.surfaces[s_index].texture
             if texture is None:
                 self._textures[s_index] = white
                 continue
@@ -109,7 +130,7 @@ class RoomTransportPass:
             t.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             self._textures[s_index] = t
         self._white = white
-        self.update(np.zeros((rec.count, 3)))
+        self.update(np.zeros((room.count, 3)))
 
     def program(self, defines: dict):
         key = tuple(sorted(defines.items()))
@@ -134,7 +155,7 @@ class RoomTransportPass:
 
     def update(self, irradiance: np.ndarray) -> None:
         """Upload the receivers' irradiance (E, 3)."""
-        corner = corner_irradiance(self.transport, np.asarray(irradiance, dtype=np.float64))[self._order]
+        corner = self.room.corner_irradiance(np.asarray(irradiance, dtype=np.float64))[self._order]
         if self._flat_albedo is not None:   # no room: each receiver's mean albedo, factor 1
             corner = corner * self._flat_albedo[:, None, :]
         data = np.concatenate([self._positions, corner.reshape(-1, 3).astype("f4"), self._normals,
@@ -154,10 +175,7 @@ class RoomTransportPass:
         self.ctx.disable(moderngl.CULL_FACE)
         vao = self._vao(program)
         for s_index, first, count in self._ranges:
-            if self.room is not None:
-                factor = self.room.surfaces[s_index].factor
-            else:
-                factor = (1.0, 1.0, 1.0)
+            factor = self.room.surfaces[s_index].factor
             program["u_albedo_factor"].value = tuple(float(v) for v in factor)
             self._textures[s_index].use(location=0)
             program["u_albedo_texture"].value = 0

@@ -47,14 +47,19 @@ GATHER_RAYS = 512
 REFLECTION_ITERATIONS = 4
 #: The room's depth map from the key (texels a side).
 ROOM_DEPTH_TEXELS = 1024
+#: Points of each receiver where the key's visibility is read (the beam's bounces).
+VISIBILITY_SAMPLES = 4
+#: The depth map's offset along the receiver's normal (m) against self-shadowing.
+DEPTH_OFFSET_M = 0.01
 
 
-def aperture_view_projection(window, direction, near_m: float = 1.5, far_m: float = 30.0) -> np.ndarray:
+def aperture_view_projection(corners, normal, direction, near_m: float = 1.5, far_m: float = 30.0) -> np.ndarray:
     """The oblique parallel projection of the window seen along -``direction`` (a unit
     direction into the room): a point maps to the aperture point it projects onto along the
     direction (NDC x, y = 2 (s, t) - 1 over the window's u and v edges), its depth its
     distance into the room along the normal, from ``near_m`` (near) to -``far_m`` (far)."""
-    o, u, v, n = window.origin, window.u_edge, window.v_edge, window.normal
+    corners = np.asarray(corners, dtype=np.float64)
+    o, u, v, n = corners[0], corners[1] - corners[0], corners[3] - corners[0], np.asarray(normal, dtype=np.float64)
     w = np.asarray(direction, dtype=np.float64)
     m = np.eye(4)
     # p - o = s u + t v + d (w / (w.n)); solve for (s, t, d) with the plane's dual basis
@@ -71,30 +76,6 @@ def aperture_view_projection(window, direction, near_m: float = 1.5, far_m: floa
     return ndc @ m
 
 
-def gather_operator(transport, points: np.ndarray, normal: np.ndarray, rays_per_point: int,
-                    rng, caster=None) -> "object":
-    """G (N, E), sparse: the share of cosine-weighted rays from ``points`` about ``normal``
-    that land on the front of each receiver (rays that leave through the window or meet a
-    back face carry nothing): the irradiance there is pi x G (rho E / pi) = G rho E."""
-    import scipy.sparse  # noqa: PLC0415
-
-    from catalog.room.receivers import cosine_directions  # noqa: PLC0415
-
-    rec = transport.receivers
-    n = np.broadcast_to(np.asarray(normal, dtype=np.float64), (len(points) * rays_per_point, 3))
-    o = np.repeat(points, rays_per_point, axis=0) + 1e-4 * n
-    d = cosine_directions(np.ascontiguousarray(n), rng)
-    dist, tri = caster.intersect(o, d)
-    hit = tri >= 0
-    rows = np.repeat(np.arange(len(points)), rays_per_point)
-    p = o[hit] + dist[hit, None] * d[hit]
-    receiver = transport.receiver_at(tri[hit], p)
-    front = np.einsum("ni,ni->n", d[hit], rec.normal[np.maximum(receiver, 0)]) < 0
-    ok = (receiver >= 0) & front
-    return scipy.sparse.csr_matrix((np.full(int(ok.sum()), 1.0 / rays_per_point),
-                                    (rows[hit][ok], receiver[ok])), shape=(len(points), rec.count))
-
-
 class RoomTransportLight(Pass):
     """The room's light by the precomputed transport, for the frame's room (a built-in name
     or a .glb): the captures, the operator, the cloth's reflection, the beam's bounces, the
@@ -105,50 +86,34 @@ class RoomTransportLight(Pass):
     grid ``room_side`` of frame.room_targets, the room into the HDR target."""
 
     def __init__(self, frame, room):
+        """``room``: a built-in name or a .glb path (its bundle from the cache, built when absent)."""
         super().__init__(frame)
         from catalog.render.passes.room_transport import RoomTransportPass  # noqa: PLC0415
-        from catalog.room.cache import room_transport  # noqa: PLC0415
-        from catalog.room.rays import ray_caster  # noqa: PLC0415
+        from catalog.render.room_operators import room_operators  # noqa: PLC0415
 
-        self.room = room
-        self.transport = room_transport(room)
-        self.window = room.window
-        self.draw_pass = RoomTransportPass(self.ctx, self.transport, room)
-        tris = room.triangles()
-        self._caster = ray_caster(tris)
+        self.ops = room_operators(room)
+        ops = self.ops
+        self.draw_pass = RoomTransportPass(self.ctx, ops)
         dirs, weights = sh.hemisphere_quadrature(CAPTURE_THETA, CAPTURE_PHI)
-        self._local_dirs, self._weights = dirs, weights
-        self._world_dirs = dirs @ self.transport.frame        # rows x, y, z: local -> world
-        self._basis = sh.hemi_basis(dirs, self.transport.params.order)   # (J, K)
-        nu, nv = self.transport.params.patches
+        self._weights = weights
+        self._world_dirs = dirs @ ops.frame        # rows x, y, z: local -> world
+        self._basis = sh.hemi_basis(dirs, ops.order)   # (J, K)
+        nu, nv = ops.patches
         self._patches = (nu, nv)
-        rng = np.random.default_rng(1)
-        # the window's patch centres and the cloth's room-side grid: the gathers
-        su, tv = np.meshgrid((np.arange(nu) + 0.5) / nu, (np.arange(nv) + 0.5) / nv)
-        self._g_patch = gather_operator(self.transport, self._aperture_points(su.ravel(), tv.ravel()),
-                                        self.window.normal, GATHER_RAYS, rng, self._caster)
-        from catalog.render import room_light  # noqa: PLC0415  (the cloth's room-side grid)
-
-        tw, th = room_light.CURTAIN_SIDE_TEXELS
-        x0, y0, w, h = room_light.curtain_side_rect()
-        gx, gy = np.meshgrid(x0 + (np.arange(tw) + 0.5) / tw * w, y0 + (np.arange(th) + 0.5) / th * h)
-        plane_z = float(self.window.centre @ self.window.normal) / float(self.window.normal[2])
-        side = np.stack([gx.ravel(), gy.ravel(), np.full(gx.size, plane_z)], axis=1)
-        self._side_size = (tw, th)
-        self._g_side = gather_operator(self.transport, side, self.window.normal, GATHER_RAYS // 4,
-                                       rng, self._caster)
+        self._side_size = (int(ops.side_grid[0]), int(ops.side_grid[1]))
         # the basis' uniform radiance: c_0 of L = 1 (H_0 is constant)
         self._uniform_c0 = float(2 * math.pi * self._basis[0, 0])
+        # points of each receiver where the key's visibility is read from the depth map
+        rng = np.random.default_rng(2)
+        r1, r2 = rng.random((2, ops.count, VISIBILITY_SAMPLES))
+        root = np.sqrt(r1)
+        bary = np.stack([1 - root, root * (1 - r2), root * r2], axis=-1)    # (E, S, 3)
+        self._visibility_points = np.einsum("esk,ekj->esj", bary, ops.corners)
         self._capture = None
         self._room_depth = None
-        self._visibility_key = None
-        self.irradiance = np.zeros((self.transport.receivers.count, 3))
+        self._lamp_key = None
+        self.irradiance = np.zeros((ops.count, 3))
         self.coefficients = np.zeros((nu * nv, self._basis.shape[1], 3))
-
-    def _aperture_points(self, s, t) -> np.ndarray:
-        c = self.window.corners
-        return (((1 - s) * (1 - t))[:, None] * c[0] + (s * (1 - t))[:, None] * c[1]
-                + (s * t)[:, None] * c[2] + ((1 - s) * t)[:, None] * c[3])
 
     # ------------------------------------------------------------------ GL targets
     def _targets(self):
@@ -205,10 +170,10 @@ class RoomTransportLight(Pass):
         self.ctx.disable(mgl.BLEND)
         self.ctx.depth_func = "<="
         overrides = self.capture_overrides()
-        centre = self.window.centre
+        centre = self.ops.window_centre
         for j, w in enumerate(self._world_dirs):
             self.ctx.viewport = (j * nu * k, 0, nu * k, nv * k)
-            view_proj = aperture_view_projection(self.window, w)
+            view_proj = aperture_view_projection(self.ops.window_corners, self.ops.window_normal, w)
             eye = tuple(float(v) for v in centre + 1e3 * w)   # the view's rays all ~ -w
             if not self.frame.curtain_open:
                 self.frame.curtain.draw_flat(view_proj, eye, overrides)
@@ -239,8 +204,8 @@ class RoomTransportLight(Pass):
 
         m = room_light.light_view_projection(to_light).copy()
         to_light = np.asarray(to_light, dtype=np.float64) / np.linalg.norm(to_light)
-        corners = np.array([[x, y, z] for x in self.room.bounds()[:, 0] for y in self.room.bounds()[:, 1]
-                            for z in self.room.bounds()[:, 2]])
+        b = self.ops.bounds
+        corners = np.array([[x, y, z] for x in b[:, 0] for y in b[:, 1] for z in b[:, 2]])
         depth = corners @ to_light                  # view z (towards the light)
         near, far = -(depth.max() + 0.1), -(depth.min() - 0.1)
         # view space looks down -z with z = to_light . p: map -near..-far to -1..1
@@ -260,27 +225,21 @@ class RoomTransportLight(Pass):
         self.ctx.disable(self.mgl.DEPTH_TEST)
 
     def _key_visibility(self, to_light) -> np.ndarray:
-        """(E,) each receiver's share of 4 points that see the key through the window (rays)."""
-        key = tuple(round(float(v), 6) for v in to_light)
-        if key != self._visibility_key:
-            rec = self.transport.receivers
-            rng = np.random.default_rng(2)
-            samples = 4
-            idx = np.repeat(np.arange(rec.count), samples)
-            d = np.broadcast_to(np.asarray(to_light, dtype=np.float64), (idx.size, 3))
-            o = rec.sample_points(idx, rng) + 1e-4 * rec.normal[idx]
-            from catalog.room.rays import ray_caster  # noqa: PLC0415
-
-            if not hasattr(self, "_window_caster"):
-                self._window_caster = ray_caster(self.window.triangles())
-            _, tri_room = self._caster.intersect(o, np.ascontiguousarray(d))
-            dist_w, tri_w = self._window_caster.intersect(o, np.ascontiguousarray(d))
-            through = (tri_w >= 0) & (tri_room < 0)
-            cos = np.clip(rec.normal @ np.asarray(to_light, dtype=np.float64), 0.0, None)
-            self._visibility = cos * through.reshape(rec.count, samples).mean(axis=1)
-            self._visibility_points = (o.reshape(rec.count, samples, 3)[:, 0])
-            self._visibility_key = key
-        return self._visibility
+        """(E,) cos x each receiver's share of its points that see the key, read from the room's
+        depth map as the room's pass reads it per pixel (the same normal offset, the same test)."""
+        ops = self.ops
+        texture = self._room_depth[0]
+        n = ROOM_DEPTH_TEXELS
+        depth = np.frombuffer(texture.read(), dtype="f4").reshape(n, n)
+        m = self.room_depth_view_projection(to_light)
+        p = (self._visibility_points + DEPTH_OFFSET_M * ops.normal[:, None, :]).reshape(-1, 3)
+        clip = np.c_[p, np.ones(len(p))] @ m.T
+        duv = clip[:, :3] * 0.5 + 0.5
+        inside = np.all((duv[:, :2] >= 0.0) & (duv[:, :2] <= 1.0), axis=1)
+        ij = np.clip((duv[:, :2] * n).astype(int), 0, n - 1)
+        lit = inside & (duv[:, 2] <= depth[ij[:, 1], ij[:, 0]])
+        cos = np.clip(ops.normal @ np.asarray(to_light, dtype=np.float64), 0.0, None)
+        return cos * lit.reshape(ops.count, -1).mean(axis=1)
 
     def beam_irradiance(self, inputs) -> np.ndarray:
         """(E, 3) the key's beam at the receivers: key x cos x visibility x the curtain's
@@ -297,7 +256,7 @@ class RoomTransportLight(Pass):
         side = max(n >> level, 1)
         t = np.frombuffer(shadow.read(level=level), dtype=np.float16).reshape(side, side, 4)[..., :3]
         m = room_light.light_view_projection(inputs.key_to_light)
-        centre = self.transport.receivers.centre
+        centre = self.ops.centre
         clip = np.c_[centre, np.ones(len(centre))] @ m.T
         uv = np.clip(clip[:, :2] * 0.5 + 0.5, 0.0, 1.0 - 1e-6)
         trans = t[(uv[:, 1] * side).astype(int), (uv[:, 0] * side).astype(int)].astype(np.float64)
@@ -305,30 +264,58 @@ class RoomTransportLight(Pass):
         trans[before] = 1.0
         return vis[:, None] * key_rgb[None, :] * trans
 
+    def lamp_irradiance(self) -> np.ndarray:
+        """(E, 3) the room's lamps at the receivers' centres: rgb x cos / r^2 x visibility
+        (a ray to each lamp), the isotropic points of FrameRenderer.set_room_lamps."""
+        from catalog.render import bands as band_lib  # noqa: PLC0415
+
+        from catalog.room.rays import NumpyRays  # noqa: PLC0415  (numpy: no Mitsuba in a frame)
+
+        ops = self.ops
+        out = np.zeros((ops.count, 3))
+        key = tuple((light.name, tuple(position)) for light, position in self.frame.room_lamps)
+        if self._lamp_key == key:
+            return self._lamp_e
+        caster = NumpyRays(ops.triangles)
+        centre = ops.centre + 1e-4 * ops.normal
+        for light, position in self.frame.room_lamps:
+            to = np.asarray(position, dtype=np.float64)[None, :] - centre
+            r = np.linalg.norm(to, axis=1)
+            d = to / r[:, None]
+            dist, tri = caster.intersect(centre, np.ascontiguousarray(d))
+            visible = (tri < 0) | (dist >= r - 1e-4)
+            cos = np.clip(np.einsum("ni,ni->n", ops.normal, d), 0.0, None)
+            rgb = band_lib.spectrum_to_display_rgb(light.irradiance_w_m2_nm)
+            out += (visible * cos / np.maximum(r * r, 1e-4))[:, None] * np.asarray(rgb)[None, :]
+        self._lamp_key, self._lamp_e = key, out
+        return out
+
     # ------------------------------------------------------------------ the whole update
     def update(self, inputs) -> None:
         """Steps 1-4 (the shadow pass has drawn the transmittance map)."""
         self.draw_captures(inputs)
         self.draw_room_depth(inputs)
         c_window = self.project(self.read_captures())
-        t = self.transport
-        rho = t.receivers.albedo
+        t = self.ops
+        rho = t.albedo
         beam = self.beam_irradiance(inputs)
         beam_bounces = t.bounced(beam) - beam if np.any(beam) else np.zeros_like(beam)
+        if self.frame.room_lamps:   # the lamps' light and its bounces, in the light map
+            beam_bounces = beam_bounces + t.bounced(self.lamp_irradiance())
         e_window = t.irradiance(c_window)
         reflectance = np.asarray(self.frame.terms.window_albedo_rgb(inputs), dtype=np.float64)
         c = c_window
         e = e_window
         if np.any(reflectance > 0):
             for _ in range(REFLECTION_ITERATIONS):
-                side = self._g_patch @ (rho * (e + beam_bounces + beam))     # (P, 3) irradiance
+                side = t.gather_patch.dot(rho * (e + beam_bounces + beam))   # (P, 3) irradiance
                 c = c_window.copy()
                 c[:, 0, :] += self._uniform_c0 * reflectance[None, :] * side / math.pi
                 e = t.irradiance(c)
         self.coefficients = c
         self.irradiance = e + beam_bounces
         self.draw_pass.update(self.irradiance)
-        room_side = self._g_side @ (rho * (self.irradiance + beam))
+        room_side = t.gather_side.dot(rho * (self.irradiance + beam))
         tw, th = self._side_size
         rgba = np.concatenate([room_side.reshape(th, tw, 3), np.ones((th, tw, 1))], axis=-1)
         self.frame.room_targets.get()["room_side"].write(np.ascontiguousarray(rgba, dtype="f4").tobytes())
@@ -350,7 +337,7 @@ class RoomTransportLight(Pass):
         self._room_depth[0].use(location=4)
         s(program, "u_room_depth", 4)
         s(program, "u_room_depth_view_proj", gl_bytes(self.room_depth_view_projection(inputs.key_to_light)))
-        s(program, "u_room_depth_offset_m", 0.01)
+        s(program, "u_room_depth_offset_m", DEPTH_OFFSET_M)
 
     def draw(self, view_proj, inputs) -> None:
         """The room into the bound framebuffer (depth-tested)."""

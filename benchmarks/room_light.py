@@ -1,0 +1,177 @@
+"""The room light by the precomputed transport against the box's special-case light, on the
+path tracer (the accuracy bench's scenes, neutral display and FLIP: benchmarks/accuracy.py),
+and what a room update and a static frame cost (llvmpipe, 1280x720).
+
+``python -m benchmarks.room_light accuracy --scenes N --seed S --rooms box,living --size 160x90 --spp 128``
+``python -m benchmarks.room_light cost``
+Each writes benchmarks/bench_room_light_{accuracy,cost}.json (with the commit measured).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+
+
+def git_commit() -> str:
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                              cwd=HERE, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def frame_linear(ctx, desc, preset, light, room: str | None, repeats: int = 3) -> tuple[np.ndarray, float]:
+    """The frame's linear radiance as benchmarks.image.frame_images draws it, in ``room``
+    (None: the box's special-case light), and its median render time (s)."""
+    from benchmarks.timing import median_wall_and_cpu  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    renderer = FrameRenderer(ctx, desc.size)
+    try:
+        renderer.set_fabric(preset)
+        renderer.set_light(light)
+        renderer.set_fluorescence("physical")
+        renderer.set_bands(3)
+        if room is not None:
+            renderer.set_room(room)
+        cam = desc.info["camera"]
+        renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
+        renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
+        renderer.set_rings(list(desc.ring_xs_m))
+        wall, _cpu = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)
+        return renderer.read_linear(), wall
+    finally:
+        renderer.release()
+
+
+def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int) -> dict:
+    from benchmarks import accuracy as acc  # noqa: PLC0415
+    from catalog.gl.context import create_headless_context  # noqa: PLC0415
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+    from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+
+    ctx = create_headless_context()
+    own: dict = {}
+    rows = []
+    for room in rooms:
+        for scene in acc.draw_scenes(scenes, seed, room):
+            preset = load_preset(find_preset(scene["fabric"]))
+            light = get_light(scene["light"])
+            cam = scene["camera"]
+            desc = describe_scene(preset, light, size=tuple(size), yaw_deg=cam["yaw_deg"],
+                                  pitch_deg=cam["pitch_deg"], distance_m=cam["distance_m"], room=room)
+            scene["_desc"] = desc
+            halves = acc.reference_halves(scene, size, spp, own)
+            scene.pop("_desc")
+            reference = 0.5 * (halves["a"] + halves["b"])
+            scale = acc.exposure_from_reference(reference)
+            shown_reference = acc.neutral_display(reference, scale)
+            noise = float(metrics.flip_map(acc.neutral_display(halves["a"], scale),
+                                           acc.neutral_display(halves["b"], scale)).mean())
+            row = {k: v for k, v in scene.items() if not k.startswith("_")}
+            row.update({"size": list(size), "spp": spp, "reference_flip_noise": noise,
+                        "reference_s": float(halves["seconds"])})
+            masks = halves["masks"]
+            lights = {"transport": room} if room != "box" else {"special_case": None, "transport": room}
+            for name, frame_room in lights.items():
+                linear, wall = frame_linear(ctx, desc, preset, light, frame_room)
+                flip = metrics.flip_map(acc.neutral_display(linear, scale), shown_reference)
+                row[name] = {"mean_flip": float(flip.mean()), "frame_ms": 1e3 * wall,
+                             "regions": acc.region_flip(flip, masks)}
+            rows.append(row)
+            print(room, row["label"], {k: round(row[k]["mean_flip"], 4) for k in lights},
+                  "noise", round(noise, 4), flush=True)
+    summary = {}
+    for room in rooms:
+        sel = [r for r in rows if r["room"] == room]
+        summary[room] = {name: {"median_mean_flip": float(np.median([r[name]["mean_flip"] for r in sel])),
+                                "max_mean_flip": float(np.max([r[name]["mean_flip"] for r in sel]))}
+                         for name in ("special_case", "transport") if name in sel[0]}
+    return {"commit": git_commit(), "settings": {"scenes": scenes, "seed": seed, "size": list(size),
+                                                 "spp": spp, "display": "benchmarks.accuracy neutral"},
+            "rows": rows, "summary": summary}
+
+
+def cost(size=(1280, 720), repeats: int = 5) -> dict:
+    """Median wall time (ms) of a room update (the curtain moved: every room pass and the frame)
+    and of a static frame (nothing stale), with the special-case light, the transport's and no
+    room light (the constant room)."""
+    from benchmarks.timing import median_wall_and_cpu  # noqa: PLC0415
+    from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+
+    ctx = create_headless_context()
+    out = {}
+    for name, room, lit in (("none", None, False), ("special_case", None, True),
+                            ("transport_box", "box", True), ("transport_living", "living", True)):
+        renderer = FrameRenderer(ctx, size)
+        try:
+            renderer.set_fabric("lace-fwa")
+            renderer.set_light("D65")
+            renderer.set_room_lighting(lit)
+            if room is not None:
+                start = time.perf_counter()
+                renderer.set_room(room)
+                setup_s = time.perf_counter() - start
+            renderer.set_camera(20.0, -5.0, 2.8, inside=True)
+            renderer.render()
+            static, _ = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)
+
+            def update():
+                renderer.invalidate_room_light()
+                renderer.render()
+            moved, _ = median_wall_and_cpu(update, repeats, warmup=1, finish=ctx.finish)
+            profile: dict = {}
+            renderer.invalidate_room_light()
+            renderer.render(profile=profile)
+            out[name] = {"static_frame_ms": 1e3 * static, "room_update_frame_ms": 1e3 * moved,
+                         "profile_ms": {k: round(1e3 * v, 2) for k, v in profile.items()}}
+            if room is not None:
+                out[name]["set_room_s"] = setup_s
+        finally:
+            renderer.release()
+        print(name, out[name], flush=True)
+    base = out["none"]["static_frame_ms"]
+    for name in out:
+        out[name]["static_vs_no_room_light"] = out[name]["static_frame_ms"] / base
+    return {"commit": git_commit(), "size": list(size), "repeats": repeats, "gl": describe(ctx),
+            "results": out,
+            "note": ("a room update redraws every room pass and the frame (invalidate_room_light); "
+                     "static: nothing stale. Medians of wall time on a shared llvmpipe machine.")}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.room_light")
+    parser.add_argument("what", choices=("accuracy", "cost"))
+    parser.add_argument("--scenes", type=int, default=6)
+    parser.add_argument("--seed", type=int, default=33033)
+    parser.add_argument("--rooms", default="box,living")
+    parser.add_argument("--size", default="160x90")
+    parser.add_argument("--spp", type=int, default=128)
+    parser.add_argument("--out", default=None)
+    args = parser.parse_args(argv)
+    if args.what == "accuracy":
+        w, h = (int(v) for v in args.size.split("x"))
+        result = accuracy(args.scenes, args.seed, args.rooms.split(","), (w, h), args.spp)
+    else:
+        result = cost()
+    path = Path(args.out or HERE / f"bench_room_light_{args.what}.json")
+    path.write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
+    print(json.dumps(result.get("summary", result.get("results")), indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
