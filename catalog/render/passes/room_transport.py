@@ -181,6 +181,36 @@ class RoomTransportPass:
             program["u_albedo_texture"].value = 0
             vao.render(moderngl.TRIANGLES, vertices=count, first=first)
 
+    def draw_props(self, view_proj: np.ndarray, positions, normals, irradiance, albedo,
+                   beam_uniforms=None) -> None:
+        """Props outside the room's file (the curtain's rod and rings), grey Lambertian, with
+        an irradiance per vertex (N, 3), drawn as :meth:`draw` draws the room."""
+        import moderngl  # noqa: PLC0415
+
+        count = len(positions)
+        if count == 0:
+            return
+        data = np.concatenate([np.asarray(positions, "f4"), np.asarray(irradiance, "f4"),
+                               np.asarray(normals, "f4"), np.zeros((count, 2), "f4")], axis=1)
+        buffer = self.ctx.buffer(np.ascontiguousarray(data).tobytes())
+        program = self.program({"KEY_BEAM": beam_uniforms is not None})
+        program["u_view_proj"].write(gl_bytes(view_proj))
+        if beam_uniforms is not None:
+            beam_uniforms(program)
+        fields = [("in_position", "3f", "12x"), ("in_irradiance", "3f", "12x"),
+                  ("in_normal", "3f", "12x"), ("in_uv", "2f", "8x")]
+        layout = " ".join(fmt if name in program else skip for name, fmt, skip in fields)
+        names = [name for name, _f, _s in fields if name in program]
+        vao = self.ctx.vertex_array(program, [(buffer, layout, *names)])
+        program["u_albedo_factor"].value = tuple(float(albedo) for _ in range(3))
+        self._white.use(location=0)
+        program["u_albedo_texture"].value = 0
+        self.ctx.enable(moderngl.DEPTH_TEST)
+        self.ctx.disable(moderngl.CULL_FACE)
+        vao.render(moderngl.TRIANGLES)
+        vao.release()
+        buffer.release()
+
     def draw_depth(self, view_proj: np.ndarray) -> None:
         """The room's triangles' depth alone into the bound framebuffer (no culling)."""
         import moderngl  # noqa: PLC0415

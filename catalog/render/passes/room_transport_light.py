@@ -112,6 +112,8 @@ class RoomTransportLight(Pass):
         self._capture = None
         self._room_depth = None
         self._lamp_key = None
+        self._room_side = np.zeros((self._side_size[1], self._side_size[0], 3))
+        self._window_mean = np.zeros(3)
         self.irradiance = np.zeros((ops.count, 3))
         self.coefficients = np.zeros((nu * nv, self._basis.shape[1], 3))
 
@@ -317,6 +319,8 @@ class RoomTransportLight(Pass):
         self.draw_pass.update(self.irradiance)
         room_side = t.gather_side.dot(rho * (self.irradiance + beam))
         tw, th = self._side_size
+        self._room_side = room_side.reshape(th, tw, 3)
+        self._window_mean = c_window[:, 0, :].mean(axis=0) / self._uniform_c0   # mean radiance
         rgba = np.concatenate([room_side.reshape(th, tw, 3), np.ones((th, tw, 1))], axis=-1)
         self.frame.room_targets.get()["room_side"].write(np.ascontiguousarray(rgba, dtype="f4").tobytes())
 
@@ -339,7 +343,28 @@ class RoomTransportLight(Pass):
         s(program, "u_room_depth_view_proj", gl_bytes(self.room_depth_view_projection(inputs.key_to_light)))
         s(program, "u_room_depth_offset_m", DEPTH_OFFSET_M)
 
+    def prop_irradiance(self, positions, normals) -> np.ndarray:
+        """(N, 3) the irradiance of the curtain's rod and rings (not in the room's file, so not
+        receivers): the room's side (the room-side grid at the point, clamped) over the half
+        of the sphere facing the room and the window's mean radiance x pi over the half facing
+        it, blended by the normal (a sphere split in two halves, exact for a point on the
+        window's plane seeing the room on one side and the window on the other)."""
+        tw, th, x0, y0, w, h = self.ops.side_grid
+        side = self._room_side
+        i = np.clip(((positions[:, 0] - x0) / w * tw).astype(int), 0, tw - 1)
+        j = np.clip(((positions[:, 1] - y0) / h * th).astype(int), 0, th - 1)
+        towards_room = 0.5 * (1.0 + normals @ self.ops.window_normal)
+        window = math.pi * self._window_mean
+        return towards_room[:, None] * side[j, i] + (1.0 - towards_room)[:, None] * window[None, :]
+
     def draw(self, view_proj, inputs) -> None:
-        """The room into the bound framebuffer (depth-tested)."""
+        """The room, then the curtain's rod and rings, into the bound framebuffer (depth-tested)."""
         self._targets()
-        self.draw_pass.draw(view_proj, lambda program: self.beam_uniforms(program, inputs))
+        beam = lambda program: self.beam_uniforms(program, inputs)  # noqa: E731
+        self.draw_pass.draw(view_proj, beam)
+        rod_p, rod_n = scene_lib.rod_mesh()
+        ring_p, ring_n = self.frame.room.ring_arrays
+        positions = np.concatenate([rod_p, np.asarray(ring_p, "f4").reshape(-1, 3)])
+        normals = np.concatenate([rod_n, np.asarray(ring_n, "f4").reshape(-1, 3)])
+        irradiance = self.prop_irradiance(positions.astype(np.float64), normals.astype(np.float64))
+        self.draw_pass.draw_props(view_proj, positions, normals, irradiance, scene_lib.ROOM_ALBEDO, beam)
