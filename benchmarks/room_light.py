@@ -53,7 +53,28 @@ def frame_linear(ctx, desc, preset, light, room: str | None, repeats: int = 3) -
         renderer.release()
 
 
-def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int) -> dict:
+def cached_reference(acc, scene, size, spp, own, cache_dir):
+    """benchmarks.accuracy.reference_halves, kept in ``cache_dir`` (None: not kept) by scene,
+    room, size and spp (a rerun of the frame's side reuses the references)."""
+    if cache_dir is None:
+        return acc.reference_halves(scene, size, spp, own)
+    import hashlib  # noqa: PLC0415
+
+    key = hashlib.sha256(json.dumps([scene["label"], scene["room"], list(size), spp]).encode()).hexdigest()[:16]
+    path = Path(cache_dir) / f"reference-{key}.npz"
+    if path.exists():
+        with np.load(path) as data:
+            return {"a": data["a"], "b": data["b"], "seconds": float(data["seconds"]),
+                    "masks": {k[5:]: data[k] for k in data.files if k.startswith("mask_")}}
+    halves = acc.reference_halves(scene, size, spp, own)
+    Path(cache_dir).mkdir(parents=True, exist_ok=True)
+    np.savez(path, a=halves["a"], b=halves["b"], seconds=halves["seconds"],
+             **{f"mask_{k}": v for k, v in halves["masks"].items()})
+    return halves
+
+
+def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int, cache_dir=None,
+             only: list[int] | None = None, variants: dict | None = None) -> dict:
     from benchmarks import accuracy as acc  # noqa: PLC0415
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
@@ -65,14 +86,16 @@ def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int) -> dict:
     own: dict = {}
     rows = []
     for room in rooms:
-        for scene in acc.draw_scenes(scenes, seed, room):
+        for number, scene in enumerate(acc.draw_scenes(scenes, seed, room)):
+            if only is not None and number not in only:
+                continue
             preset = load_preset(find_preset(scene["fabric"]))
             light = get_light(scene["light"])
             cam = scene["camera"]
             desc = describe_scene(preset, light, size=tuple(size), yaw_deg=cam["yaw_deg"],
                                   pitch_deg=cam["pitch_deg"], distance_m=cam["distance_m"], room=room)
             scene["_desc"] = desc
-            halves = acc.reference_halves(scene, size, spp, own)
+            halves = cached_reference(acc, scene, size, spp, own, cache_dir)
             scene.pop("_desc")
             reference = 0.5 * (halves["a"] + halves["b"])
             scale = acc.exposure_from_reference(reference)
@@ -84,6 +107,9 @@ def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int) -> dict:
                         "reference_s": float(halves["seconds"])})
             masks = halves["masks"]
             lights = {"transport": room} if room != "box" else {"special_case": None, "transport": room}
+            if variants:
+                lights = {name: value for name, value in variants.items()
+                          if room == "box" or value is not None}
             for name, frame_room in lights.items():
                 linear, wall = frame_linear(ctx, desc, preset, light, frame_room)
                 flip = metrics.flip_map(acc.neutral_display(linear, scale), shown_reference)
@@ -95,9 +121,11 @@ def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int) -> dict:
     summary = {}
     for room in rooms:
         sel = [r for r in rows if r["room"] == room]
+        names = [k for k in sel[0] if isinstance(sel[0][k], dict) and "mean_flip" in sel[0][k]] if sel else []
         summary[room] = {name: {"median_mean_flip": float(np.median([r[name]["mean_flip"] for r in sel])),
+                                "mean_mean_flip": float(np.mean([r[name]["mean_flip"] for r in sel])),
                                 "max_mean_flip": float(np.max([r[name]["mean_flip"] for r in sel]))}
-                         for name in ("special_case", "transport") if name in sel[0]}
+                         for name in names}
     return {"commit": git_commit(), "settings": {"scenes": scenes, "seed": seed, "size": list(size),
                                                  "spp": spp, "display": "benchmarks.accuracy neutral"},
             "rows": rows, "summary": summary}
@@ -161,10 +189,14 @@ def main(argv=None) -> int:
     parser.add_argument("--size", default="160x90")
     parser.add_argument("--spp", type=int, default=128)
     parser.add_argument("--out", default=None)
+    parser.add_argument("--reference-cache", default=None, help="a folder keeping the references")
+    parser.add_argument("--only", default=None, help="scene numbers to measure, e.g. 3,4")
     args = parser.parse_args(argv)
     if args.what == "accuracy":
         w, h = (int(v) for v in args.size.split("x"))
-        result = accuracy(args.scenes, args.seed, args.rooms.split(","), (w, h), args.spp)
+        only = None if args.only is None else [int(v) for v in args.only.split(",")]
+        result = accuracy(args.scenes, args.seed, args.rooms.split(","), (w, h), args.spp,
+                          args.reference_cache, only)
     else:
         result = cost()
     path = Path(args.out or HERE / f"bench_room_light_{args.what}.json")

@@ -24,7 +24,15 @@ from pathlib import Path
 import numpy as np
 
 #: Bumped when the bundle's content changes.
-BUNDLE_VERSION = 1
+BUNDLE_VERSION = 3
+#: Cosine-weighted rays from each receiver for its view of the outside (receivers outside
+#: the aperture: the reveals, a sill) and of the aperture from outside (the curtain's window side).
+OUTSIDE_RAYS = 64
+#: How far into the room the curtain hangs before its aperture (m): the box's, as the room
+#: format places it (catalog.render.scene CURTAIN_Z - WINDOW_Z).
+CURTAIN_OFFSET_M = 0.12
+#: The outside's basis: the hemispherical harmonics about the window's outward normal.
+OUTSIDE_ORDER = 3
 #: Cosine-weighted rays from each window patch centre and each point of the cloth's grid.
 GATHER_RAYS_PATCH = 512
 GATHER_RAYS_SIDE = 128
@@ -82,7 +90,11 @@ class RoomOperators:
     bounce_right: np.ndarray
     gather_patch: Csr
     gather_side: Csr
-    side_grid: tuple          # (tw, th, x0, y0, w, h, plane z)
+    side_grid: tuple          # (tw, th, x0, y0, w, h)
+    outside_frame: np.ndarray  # (3, 3) rows x, y, z: z the window's outward normal
+    outside: np.ndarray        # (E, K) irradiance per unit coefficient of the outside's radiance
+    window_back: np.ndarray    # (E,) pi x share of rays meeting the aperture from outside
+    gather_wall: Csr           # the cloth's plane towards the window: the surfaces round it
     bounds: np.ndarray        # (2, 3)
     triangles: np.ndarray     # (T, 3, 3) the room's triangles (its depth from the key)
 
@@ -150,6 +162,38 @@ def gather(transport, caster, points: np.ndarray, normal: np.ndarray, rays: int,
     return _csr(rows[ok], receiver[ok], np.full(int(ok.sum()), 1.0 / rays), (len(points), rec.count))
 
 
+def outside_operators(transport, caster, window, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The outside seen directly by receivers outside the aperture's plane (the reveals, a
+    sill): (frame (3, 3), O (E, K), B (E,)). O: pi / N x the sum over a receiver's
+    cosine-weighted rays that meet nothing (and do not cross the aperture) of the outward
+    hemispherical basis, so that E_outside = O c for the outside's radiance coefficients c;
+    B: pi x the share of rays from a receiver outside the aperture's plane that cross it (the
+    closed curtain's window side, hung just inside it). Rays from inside the room that leave
+    through the aperture are the window's (the transport's D), not these."""
+    from catalog.room import sh  # noqa: PLC0415
+    from catalog.room.rays import ray_caster  # noqa: PLC0415
+    from catalog.room.receivers import cosine_directions  # noqa: PLC0415
+
+    rec = transport.receivers
+    frame = sh.frame_of(-np.asarray(window.normal, dtype=np.float64), window.u_edge)
+    window_caster = ray_caster(window.triangles())
+    idx = np.repeat(np.arange(rec.count), OUTSIDE_RAYS)
+    n = np.ascontiguousarray(rec.normal[idx])
+    o = rec.sample_points(idx, rng) + 1e-4 * n
+    d = cosine_directions(n, rng)
+    dist_room, tri_room = caster.intersect(o, d)
+    dist_win, tri_win = window_caster.intersect(o, d)
+    crosses = (tri_win >= 0) & ((tri_room < 0) | (dist_win < dist_room))
+    escaped = (tri_room < 0) & ~crosses
+    outside_side = ((rec.centre - window.origin) @ window.normal) < 0
+    local = d @ frame.T
+    basis = sh.hemi_basis(np.where(local[:, 2:3] >= 0, local, local * [1, 1, -1]), OUTSIDE_ORDER)
+    basis = basis * escaped[:, None]
+    o_matrix = math.pi / OUTSIDE_RAYS * basis.reshape(rec.count, OUTSIDE_RAYS, -1).sum(axis=1)
+    back = math.pi * crosses.reshape(rec.count, OUTSIDE_RAYS).mean(axis=1) * outside_side
+    return frame, o_matrix, back
+
+
 def _weld(transport) -> np.ndarray:
     from catalog.room.lightmap import WELD_M  # noqa: PLC0415
 
@@ -197,6 +241,7 @@ def build(room) -> RoomOperators:
     side_points = np.stack([gx.ravel(), gy.ravel(), gz.ravel()], axis=1)
     surface, uvs = receiver_uvs(room, t)
     f = t.form_factors.tocsr()
+    outside_frame, outside, window_back = outside_operators(t, caster, room.window, rng)
     return RoomOperators(
         name=room.name, content_sha256=room.content_sha256,
         surfaces=tuple(SurfaceData(s_.name, np.asarray(s_.factor, dtype=np.float64), s_.texture)
@@ -211,7 +256,9 @@ def build(room) -> RoomOperators:
         bounce_left=t.bounce_left, bounce_right=t.bounce_right,
         gather_patch=gather(t, caster, patch_points, n, GATHER_RAYS_PATCH, rng),
         gather_side=gather(t, caster, side_points, n, GATHER_RAYS_SIDE, rng),
-        side_grid=(tw, th, x0, y0, w, h), bounds=room.bounds(), triangles=room.triangles())
+        gather_wall=gather(t, caster, side_points + CURTAIN_OFFSET_M * n, -n, GATHER_RAYS_SIDE, rng),
+        side_grid=(tw, th, x0, y0, w, h), outside_frame=outside_frame, outside=outside,
+        window_back=window_back, bounds=room.bounds(), triangles=room.triangles())
 
 
 # --------------------------------------------------------------------------- the cache
@@ -221,7 +268,9 @@ def bundle_key(content_sha256: str) -> str:
 
     text = json.dumps({"room": content_sha256, "params": TransportParams().key(),
                        "version": BUNDLE_VERSION, "patch_rays": GATHER_RAYS_PATCH,
-                       "side_rays": GATHER_RAYS_SIDE, "side_grid": side_grid()}, sort_keys=True)
+                       "side_rays": GATHER_RAYS_SIDE, "side_grid": side_grid(),
+                       "outside_rays": OUTSIDE_RAYS, "outside_order": OUTSIDE_ORDER,
+                       "curtain_offset_m": CURTAIN_OFFSET_M}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()
 
 
@@ -241,9 +290,9 @@ def save(bundle: RoomOperators, path: Path, key: str) -> None:
     arrays = {}
     for name in ("window_corners", "window_normal", "frame", "corners", "normal", "area_m2", "albedo",
                  "surface", "uvs", "vertex", "window_basis", "window_modes", "bounce_left",
-                 "bounce_right", "bounds", "triangles"):
+                 "bounce_right", "bounds", "triangles", "outside_frame", "outside", "window_back"):
         arrays[name] = getattr(bundle, name)
-    for name in ("form_factors", "gather_patch", "gather_side"):
+    for name in ("form_factors", "gather_patch", "gather_side", "gather_wall"):
         m = getattr(bundle, name)
         arrays.update({f"{name}_data": m.data, f"{name}_indices": m.indices, f"{name}_indptr": m.indptr,
                        f"{name}_shape": np.asarray(m.shape)})
@@ -285,11 +334,11 @@ def load(path: Path, key: str) -> RoomOperators | None:
     plain = {name: arrays[name] for name in ("window_corners", "window_normal", "frame", "corners", "normal",
                                              "area_m2", "albedo", "surface", "uvs", "vertex", "window_basis",
                                              "window_modes", "bounce_left", "bounce_right", "bounds",
-                                             "triangles")}
+                                             "triangles", "outside_frame", "outside", "window_back")}
     return RoomOperators(name=meta["name"], content_sha256=meta["content_sha256"], surfaces=surfaces,
                          patches=tuple(meta["patches"]), order=int(meta["order"]),
                          form_factors=csr("form_factors"), gather_patch=csr("gather_patch"),
-                         gather_side=csr("gather_side"), side_grid=tuple(meta["side_grid"]), **plain)
+                         gather_side=csr("gather_side"), gather_wall=csr("gather_wall"), side_grid=tuple(meta["side_grid"]), **plain)
 
 
 def room_operators(spec) -> RoomOperators:

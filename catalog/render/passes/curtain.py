@@ -55,6 +55,8 @@ class CurtainPass(Pass):
                 # the wall and its reveals where the outside is walled
                 defines["WALL_LIGHT"] = True
                 defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
+            elif defines.get("SKY_OCCLUSION"):   # the same from the room's transport
+                defines["WALL_GRID"] = True
         if self.frame.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.frame.patterned and not gbuffer:
@@ -71,6 +73,7 @@ class CurtainPass(Pass):
             defines.pop("OCCLUSION_MAPS", None)
             defines.pop("WALL_LIGHT", None)
             defines.pop("WALL_LOBE_SAMPLES", None)
+            defines.pop("WALL_GRID", None)
             if folds_behind and defines.get("SKY_OCCLUSION"):
                 # the folds' window side where they hide the outside (curtain.frag FOLDS_BEHIND;
                 # ROOM_SIDE without the room's part under ROOM_CAPTURE)

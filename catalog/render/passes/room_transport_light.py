@@ -47,6 +47,10 @@ GATHER_RAYS = 512
 REFLECTION_ITERATIONS = 4
 #: The room's depth map from the key (texels a side).
 ROOM_DEPTH_TEXELS = 1024
+#: The outside's radiance sampled for its basis (receivers outside the aperture): Gauss nodes
+#: in cos(theta) and azimuths over the outward hemisphere.
+OUTSIDE_THETA = 4
+OUTSIDE_PHI = 8
 #: Points of each receiver where the key's visibility is read (the beam's bounces).
 VISIBILITY_SAMPLES = 4
 #: The depth map's offset along the receiver's normal (m) against self-shadowing.
@@ -109,6 +113,13 @@ class RoomTransportLight(Pass):
         root = np.sqrt(r1)
         bary = np.stack([1 - root, root * (1 - r2), root * r2], axis=-1)    # (E, S, 3)
         self._visibility_points = np.einsum("esk,ekj->esj", bary, ops.corners)
+        from catalog.render.room_operators import OUTSIDE_ORDER  # noqa: PLC0415
+
+        out_dirs, out_weights = sh.hemisphere_quadrature(OUTSIDE_THETA, OUTSIDE_PHI)
+        self._outside_weights = out_weights
+        self._outside_dirs = out_dirs @ ops.outside_frame
+        self._outside_basis = sh.hemi_basis(out_dirs, OUTSIDE_ORDER)
+        self._outside_target = None
         self._capture = None
         self._room_depth = None
         self._lamp_key = None
@@ -137,19 +148,66 @@ class RoomTransportLight(Pass):
             self._room_depth = (room_depth, self.ctx.framebuffer(depth_attachment=room_depth))
         return self._capture
 
+    def wall_grid_texture(self):
+        """The cloth's window side's light from the room's surfaces round the window (WALL_GRID)."""
+        if getattr(self, "_wall_grid", None) is None:
+            tw, th = self._side_size
+            texture = self.ctx.texture((tw, th), 4, data=np.zeros((th, tw, 4), "f4").tobytes(), dtype="f4")
+            texture.filter = (self.mgl.LINEAR, self.mgl.LINEAR)
+            texture.repeat_x = texture.repeat_y = False
+            self._wall_grid = texture
+        return self._wall_grid
+
+    def outside_radiance(self, inputs) -> np.ndarray:
+        """(K, 3) the outside's radiance (the background without the sun's disc, which the
+        beam carries) in the outward hemispherical basis: one texel per quadrature direction."""
+        from catalog.render.passes.room_transport import look_at_view_projection  # noqa: PLC0415
+
+        count = len(self._outside_weights)
+        if self._outside_target is None:
+            texture = self.ctx.texture((count, 1), 4, dtype="f4")
+            self._outside_target = (texture, self.ctx.framebuffer([texture]))
+        texture, fbo = self._outside_target
+        fbo.use()
+        self.ctx.disable(self.mgl.DEPTH_TEST)
+        for j, d in enumerate(self._outside_dirs):
+            up = (0.0, 1.0, 0.0) if abs(d[1]) < 0.9 else (1.0, 0.0, 0.0)
+            self.ctx.viewport = (j, 0, 1, 1)
+            view_proj = look_at_view_projection((0.0, 0.0, 0.0), d, up, 0.5, 1.0)
+            self.frame.background.draw(view_proj, inputs, camera_position=(0.0, 0.0, 0.0), sun_disc=False)
+        radiance = np.frombuffer(texture.read(), dtype="f4").reshape(count, 4)[:, :3].astype(np.float64)
+        return np.einsum("jk,j,jc->kc", self._outside_basis, self._outside_weights, radiance)
+
+    def outside_irradiance(self, inputs) -> np.ndarray:
+        """(E, 3) what receivers outside the aperture (the reveals, a sill) take directly from
+        the outside and from the closed curtain's window side (its capture's mean radiance)."""
+        ops = self.ops
+        e = ops.outside @ self.outside_radiance(inputs)
+        if not self.frame.curtain_open and self.frame.room_side_active() and np.any(ops.window_back):
+            from catalog.render import room_light  # noqa: PLC0415
+
+            back = self.frame.capture.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL)
+            e = e + ops.window_back[:, None] * back.reshape(-1, 3).mean(axis=0)[None, :]
+        return e
+
     def framebuffers(self) -> list:
         out = []
         if self._capture is not None:
             out.append(self._capture[2])
         if self._room_depth is not None:
             out.append(self._room_depth[1])
+        if self._outside_target is not None:
+            out.append(self._outside_target[1])
         return out
 
     def release(self) -> None:
-        for group in (self._capture, self._room_depth):
+        for group in (self._capture, self._room_depth, self._outside_target):
             for obj in group or ():
                 obj.release()
-        self._capture = self._room_depth = None
+        self._capture = self._room_depth = self._outside_target = None
+        if getattr(self, "_wall_grid", None) is not None:
+            self._wall_grid.release()
+            self._wall_grid = None
         self.draw_pass.release()
 
     # ------------------------------------------------------------------ 1. the captures
@@ -302,6 +360,9 @@ class RoomTransportLight(Pass):
         rho = t.albedo
         beam = self.beam_irradiance(inputs)
         beam_bounces = t.bounced(beam) - beam if np.any(beam) else np.zeros_like(beam)
+        # the outside on the receivers outside the aperture, and its bounces
+        outside = self.outside_irradiance(inputs)
+        beam_bounces = beam_bounces + t.bounced(outside)
         if self.frame.room_lamps:   # the lamps' light and its bounces, in the light map
             beam_bounces = beam_bounces + t.bounced(self.lamp_irradiance())
         e_window = t.irradiance(c_window)
@@ -319,6 +380,9 @@ class RoomTransportLight(Pass):
         self.draw_pass.update(self.irradiance)
         room_side = t.gather_side.dot(rho * (self.irradiance + beam))
         tw, th = self._side_size
+        walled = t.gather_wall.dot(rho * (self.irradiance + beam))
+        self.wall_grid_texture().write(np.ascontiguousarray(np.concatenate(
+            [walled.reshape(th, tw, 3), np.ones((th, tw, 1))], axis=-1), dtype="f4").tobytes())
         self._room_side = room_side.reshape(th, tw, 3)
         self._window_mean = c_window[:, 0, :].mean(axis=0) / self._uniform_c0   # mean radiance
         rgba = np.concatenate([room_side.reshape(th, tw, 3), np.ones((th, tw, 1))], axis=-1)
