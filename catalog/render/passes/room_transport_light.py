@@ -80,6 +80,13 @@ def aperture_view_projection(corners, normal, direction, near_m: float = 1.5, fa
     return ndc @ m
 
 
+def project_captures(basis: np.ndarray, weights: np.ndarray, radiance: np.ndarray) -> np.ndarray:
+    """(P, K, 3) the patches' coefficients from captures (J, nv, nu, 3) along the quadrature's
+    directions (basis (J, K) there, weights (J,) sr): c_pk = sum_j w_j L_pj H_k(w_j)."""
+    per_patch = radiance.reshape(len(weights), -1, 3)      # (J, P, 3), p = iu + nu iv
+    return np.einsum("jk,j,jpc->pkc", basis, weights, per_patch)
+
+
 class RoomTransportLight(Pass):
     """The room's light by the precomputed transport, for the frame's room (a built-in name
     or a .glb): the captures, the operator, the cloth's reflection, the beam's bounces, the
@@ -252,9 +259,8 @@ class RoomTransportLight(Pass):
         return data.reshape(nv, count, nu, 3).transpose(1, 0, 2, 3).astype(np.float64)
 
     def project(self, radiance: np.ndarray) -> np.ndarray:
-        """(P, K, 3) coefficients of captures (J, nv, nu, 3): c_pk = sum_j w_j L_pj H_k(w_j)."""
-        per_patch = radiance.reshape(len(self._weights), -1, 3)      # (J, P, 3), p = iu + nu iv
-        return np.einsum("jk,j,jpc->pkc", self._basis, self._weights, per_patch)
+        """(P, K, 3) coefficients of captures (J, nv, nu, 3) (:func:`project_captures`)."""
+        return project_captures(self._basis, self._weights, radiance)
 
     # ------------------------------------------------------------------ 2. the beam
     def room_depth_view_projection(self, to_light) -> np.ndarray:
