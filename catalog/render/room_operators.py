@@ -194,6 +194,32 @@ def outside_operators(transport, caster, window, rng) -> tuple[np.ndarray, np.nd
     return frame, o_matrix, back
 
 
+def receiver_uvs(room, transport) -> tuple[np.ndarray, np.ndarray]:
+    """(E,) the surface of each receiver and (E, 3, 2) its corners' texture coordinates
+    (zeros where the surface has none), by the corners' barycentrics in their triangle."""
+    rec = transport.receivers
+    surface_of, local_of = room.surface_of_triangle()
+    surface = surface_of[rec.triangle]
+    uvs = np.zeros((rec.count, 3, 2))
+    tri = rec.triangles[rec.triangle]                       # (E, 3, 3)
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    d11, d12, d22 = (np.einsum("ni,ni->n", e1, e1), np.einsum("ni,ni->n", e1, e2),
+                     np.einsum("ni,ni->n", e2, e2))
+    det = d11 * d22 - d12 * d12
+    for k in range(3):
+        p = rec.corners[:, k] - tri[:, 0]
+        p1, p2 = np.einsum("ni,ni->n", p, e1), np.einsum("ni,ni->n", p, e2)
+        b1 = (d22 * p1 - d12 * p2) / det
+        b2 = (d11 * p2 - d12 * p1) / det
+        bary = np.stack([1 - b1 - b2, b1, b2], axis=1)
+        for s_index, s in enumerate(room.surfaces):
+            if s.uvs is None:
+                continue
+            sel = np.flatnonzero(surface == s_index)
+            uvs[sel, k] = np.einsum("nk,nkj->nj", bary[sel], s.uvs[local_of[rec.triangle[sel]]])
+    return surface, uvs
+
+
 def _weld(transport) -> np.ndarray:
     from catalog.room.lightmap import WELD_M  # noqa: PLC0415
 
@@ -218,7 +244,6 @@ def side_grid() -> tuple:
 def build(room) -> RoomOperators:
     """The bundle of a loaded room (catalog.room.model.Room): its transport from the cache
     (computed there when absent), the gathers by Mitsuba's rays."""
-    from catalog.render.passes.room_transport import receiver_uvs  # noqa: PLC0415
     from catalog.room.cache import room_transport  # noqa: PLC0415
     from catalog.room.rays import ray_caster  # noqa: PLC0415
 

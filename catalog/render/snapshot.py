@@ -105,7 +105,7 @@ class SnapshotRequest:
     room_light: bool = True
     bloom: bool = True
     lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
-    room: str | None = None           # a built-in room or FILE.glb (its transport); None: the box's special-case light
+    room: str | None = "box"          # a built-in room or FILE.glb (its transport); None: the box's special-case light (the API only)
 
 
 def simulated_curtain(preset, frames: int):
