@@ -50,9 +50,8 @@ class Csr:
     def dot(self, x: np.ndarray) -> np.ndarray:
         rows = np.repeat(np.arange(self.shape[0]), np.diff(self.indptr))
         contrib = self.data[:, None] * x[self.indices]
-        out = np.zeros((self.shape[0], x.shape[1]))
-        np.add.at(out, rows, contrib)
-        return out
+        return np.stack([np.bincount(rows, weights=contrib[:, c], minlength=self.shape[0])
+                         for c in range(x.shape[1])], axis=1)
 
 
 @dataclass(frozen=True)
@@ -127,8 +126,9 @@ class RoomOperators:
         vertex, as catalog.room.lightmap.corner_irradiance)."""
         weight = np.repeat(self.area_m2, 3)
         count = int(self.vertex.max()) + 1
-        total = np.zeros((count, 3))
-        np.add.at(total, self.vertex, weight[:, None] * np.repeat(irradiance, 3, axis=0))
+        values = weight[:, None] * np.repeat(irradiance, 3, axis=0)
+        total = np.stack([np.bincount(self.vertex, weights=values[:, c], minlength=count)
+                          for c in range(3)], axis=1)
         norm = np.bincount(self.vertex, weights=weight, minlength=count)
         return (total / norm[:, None])[self.vertex].reshape(self.count, 3, 3)
 

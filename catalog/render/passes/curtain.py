@@ -95,7 +95,7 @@ class CurtainPass(Pass):
 
     def draw_curtain(self, view_proj, fragment: str | None = None, gbuffer: bool = False,
                      camera_position=None, overrides: dict | None = None,
-                     folds_behind: bool = False) -> None:
+                     folds_behind: bool = False, coarse: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer.
 
         ``fragment``: draw the same mesh (same vertex shader and uniforms of the mesh and
@@ -146,9 +146,10 @@ class CurtainPass(Pass):
             if "u_vertex_occlusion" in program:
                 self.frame.shadow.vertex_occlusion_uniforms(program)
         self.ctx.disable(self.mgl.CULL_FACE)  # two-sided cloth
-        self.frame.mesh.curtain_vao(program).render(self.mgl.TRIANGLES)
+        self.frame.mesh.curtain_vao(program, coarse).render(self.mgl.TRIANGLES)
 
-    def draw_flat(self, view_proj, eye, overrides: dict, folds_behind: bool = False) -> None:
+    def draw_flat(self, view_proj, eye, overrides: dict, folds_behind: bool = False,
+                  coarse: bool = False) -> None:
         """The room's captures draw the flat cloth (the pattern averaged, model.md section 9):
         each capture texel is a mean over a window patch anyway, and the flat variant draws in
         one pass. The whole mesh, not the coarse grid of the shadow map: under the UV lamp the
@@ -160,7 +161,7 @@ class CurtainPass(Pass):
             self.frame.patterned = False
         try:
             self.draw_curtain(view_proj, camera_position=eye, overrides=overrides,
-                              folds_behind=folds_behind)
+                              folds_behind=folds_behind, coarse=coarse)
         finally:
             if patterned:
                 self.frame.patterned = patterned

@@ -41,6 +41,9 @@ CAPTURE_THETA = 3
 CAPTURE_PHI = 6
 #: Texels a window patch takes in a capture (a power of two: the mip chain averages them).
 CAPTURE_TEXELS_PER_PATCH = 8
+#: The views draw the mesh's coarse grid (its 40 rows and columns: a patch's 8 texels span
+#: about 6 of its cells), not every triangle: a CPU rasteriser's cost is the triangles'.
+CAPTURE_COARSE = True
 #: Cosine-weighted rays from each point of the cloth's grids into the room.
 GATHER_RAYS = 512
 #: Fixed-point iterations of the cloth's reflection of the room's light back into it.
@@ -243,7 +246,7 @@ class RoomTransportLight(Pass):
             view_proj = aperture_view_projection(self.ops.window_corners, self.ops.window_normal, w)
             eye = tuple(float(v) for v in centre + 1e3 * w)   # the view's rays all ~ -w
             if not self.frame.curtain_open:
-                self.frame.curtain.draw_flat(view_proj, eye, overrides)
+                self.frame.curtain.draw_flat(view_proj, eye, overrides, coarse=CAPTURE_COARSE)
             self.frame.background.draw(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
@@ -365,12 +368,13 @@ class RoomTransportLight(Pass):
         t = self.ops
         rho = t.albedo
         beam = self.beam_irradiance(inputs)
-        beam_bounces = t.bounced(beam) - beam if np.any(beam) else np.zeros_like(beam)
-        # the outside on the receivers outside the aperture, and its bounces
-        outside = self.outside_irradiance(inputs)
-        beam_bounces = beam_bounces + t.bounced(outside)
-        if self.frame.room_lamps:   # the lamps' light and its bounces, in the light map
-            beam_bounces = beam_bounces + t.bounced(self.lamp_irradiance())
+        # the direct light the window's operator does not hold (the operator is linear: one
+        # bounced() of their sum): the beam (drawn per pixel, so only its bounces are added),
+        # the outside on the receivers outside the aperture, the lamps
+        direct = beam + self.outside_irradiance(inputs)
+        if self.frame.room_lamps:
+            direct = direct + self.lamp_irradiance()
+        beam_bounces = t.bounced(direct) - beam
         e_window = t.irradiance(c_window)
         reflectance = np.asarray(self.frame.terms.window_albedo_rgb(inputs), dtype=np.float64)
         c = c_window
