@@ -1,27 +1,26 @@
-"""The frame's room light by the precomputed transport (docs/room-transport.md).
+"""The frame's room light by the room's precomputed transport (docs/room-light.md).
 
-Each room update:
+Each room update (the curtain moved, the light moved):
 
 1. the window's radiance into the room, from the curtain's own shading: the flat cloth and
    the outside drawn in oblique parallel views of the aperture, one per direction of a Gauss
    hemisphere quadrature in the window's frame (catalog.room.sh.hemisphere_quadrature;
    exact for the basis' products), a texel block per window patch averaged by the mip chain
    to the patch level, projected onto the hemispherical basis: c_pk = sum_j w_j L_pj H_k(w_j);
-2. the receivers' irradiance E = T c (:meth:`Transport.irradiance`, every bounce), plus the
-   bounces of the key's beam: its irradiance at each receiver (the normal irradiance x cos x
-   the curtain's transmittance map x the room's own visibility to the key, by rays through
-   the room's geometry) through :meth:`Transport.bounced` less the beam itself, which the
-   room's pass draws per pixel;
+2. the receivers' irradiance E = T c (every bounce), plus the bounces of the direct light the
+   window's operator does not hold: the key's beam (normal irradiance x cos x the curtain's
+   transmittance map x the room's visibility to the key, read from the room's depth map as
+   the room's pass reads it per pixel), the outside on receivers outside the aperture (the
+   reveals) and the lamps, through the bounce operator; the beam itself is drawn per pixel;
 3. the closed cloth reflects the room's light back in: its room side's irradiance at the
    window's patches (cosine-weighted rays from the aperture into the room, each landing on a
    receiver: E_side = G rho E) times its diffuse reflectance, a uniform radiance per patch
-   added to c; the loop solved by fixed-point iteration (its gain, reflectance x the room's
-   return, is well under one);
+   added to c, solved by fixed-point iteration (its gain is well under one);
 4. the curtain's room side: the same gather from the points of the cloth's room-side grid
-   (the texture curtain.frag ROOM_SIDE reads per vertex).
+   (curtain.frag ROOM_SIDE) and from the cloth's plane towards the window (WALL_GRID).
 
-Numpy on the host for 2-4 (the operators are compressed: a few milliseconds); GL for the
-captures and the draw (catalog/render/passes/room_transport.py).
+Numpy on the host for 2-4 (catalog/render/room_operators.py: compressed operators, a few
+milliseconds each); GL for the views and the draw (catalog/render/passes/room_transport.py).
 """
 
 from __future__ import annotations
