@@ -74,25 +74,16 @@ class RoomTransportPass:
         self.room = room
         self._programs = {}
         self._create_program = create_program
-        surface = room.surface
-        order = np.argsort(surface, kind="stable")
-        self._order = order
-        self._ranges = []   # (surface index, first vertex, count)
-        for s_index in np.unique(surface):
-            sel = np.flatnonzero(surface[order] == s_index)
-            self._ranges.append((int(s_index), 3 * int(sel[0]), 3 * int(sel.size)))
-        self._positions = room.corners[order].reshape(-1, 3).astype("f4")
-        self._normals = np.repeat(room.normal[order], 3, axis=0).astype("f4")
-        self._uvs = room.uvs[order].reshape(-1, 2).astype("f4")
-        flat = getattr(room, "flat_albedo", None)
-        self._flat_albedo = None if flat is None else flat[order]
+        self._key = ()
+        self.set_key(None)
         self._buffer = ctx.buffer(reserve=self._positions.shape[0] * 11 * 4)
         # the key's depth map: the room's own triangles (not the receivers': fewer)
         self._depth_buffer = ctx.buffer(np.asarray(room.triangles, dtype="f4").reshape(-1, 3).tobytes())
         self._vaos = {}
         self._textures = {}
         white = ctx.texture((1, 1), 3, data=np.ones(3, dtype="f4").tobytes(), dtype="f4")
-        for s_index, _first, _count in self._ranges:
+        for s_index in np.unique(room.surface):
+            s_index = int(s_index)
             texture = room.surfaces[s_index].texture
             if texture is None:
                 self._textures[s_index] = white
@@ -127,6 +118,32 @@ class RoomTransportPass:
                 self._vaos[key] = self.ctx.vertex_array(program, [(self._buffer, layout, *names)])
         return self._vaos[key]
 
+    def set_key(self, to_light) -> None:
+        """Order the receivers by surface, those facing the key light first (None: all taken
+        as facing it): only those are drawn with KEY_BEAM (a CPU rasteriser runs both sides of
+        a branch). Takes effect at the next :meth:`update`."""
+        room = self.room
+        key = None if to_light is None else tuple(round(float(v), 6) for v in to_light)
+        if key == self._key:
+            return
+        self._key = key
+        facing = (np.ones(room.count, dtype=bool) if key is None
+                  else room.normal @ np.asarray(key, dtype=np.float64) > 0.0)
+        order = np.lexsort((~facing, room.surface))
+        self._order = order
+        self._ranges = []   # (surface index, facing the key, first vertex, count)
+        surface, lit = room.surface[order], facing[order]
+        for s_index in np.unique(surface):
+            for side in (True, False):
+                sel = np.flatnonzero((surface == s_index) & (lit == side))
+                if sel.size:
+                    self._ranges.append((int(s_index), side, 3 * int(sel[0]), 3 * int(sel.size)))
+        self._positions = room.corners[order].reshape(-1, 3).astype("f4")
+        self._normals = np.repeat(room.normal[order], 3, axis=0).astype("f4")
+        self._uvs = room.uvs[order].reshape(-1, 2).astype("f4")
+        flat = getattr(room, "flat_albedo", None)
+        self._flat_albedo = None if flat is None else flat[order]
+
     def update(self, irradiance: np.ndarray) -> None:
         """Upload the receivers' irradiance (E, 3)."""
         corner = self.room.corner_irradiance(np.asarray(irradiance, dtype=np.float64))[self._order]
@@ -141,19 +158,22 @@ class RoomTransportPass:
         sets KEY_BEAM's inputs on the program (None: the light map alone)."""
         import moderngl  # noqa: PLC0415
 
-        program = self.program({"KEY_BEAM": beam_uniforms is not None})
-        program["u_view_proj"].write(gl_bytes(view_proj))
-        if beam_uniforms is not None:
-            beam_uniforms(program)
+        programs = {}
+        for beam in {beam_uniforms is not None and side for _s, side, _f, _c in self._ranges}:
+            program = self.program({"KEY_BEAM": beam})
+            program["u_view_proj"].write(gl_bytes(view_proj))
+            if beam:
+                beam_uniforms(program)
+            programs[beam] = program
         self.ctx.enable(moderngl.DEPTH_TEST)
         self.ctx.disable(moderngl.CULL_FACE)
-        vao = self._vao(program)
-        for s_index, first, count in self._ranges:
+        for s_index, side, first, count in self._ranges:
+            program = programs[beam_uniforms is not None and side]
             factor = self.room.surfaces[s_index].factor
             program["u_albedo_factor"].value = tuple(float(v) for v in factor)
             self._textures[s_index].use(location=0)
             program["u_albedo_texture"].value = 0
-            vao.render(moderngl.TRIANGLES, vertices=count, first=first)
+            self._vao(program).render(moderngl.TRIANGLES, vertices=count, first=first)
 
     def draw_props(self, view_proj: np.ndarray, positions, normals, irradiance, albedo,
                    beam_uniforms=None) -> None:

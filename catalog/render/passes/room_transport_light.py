@@ -386,6 +386,7 @@ class RoomTransportLight(Pass):
                 e = t.irradiance(c)
         self.coefficients = c
         self.irradiance = e + beam_bounces
+        self.draw_pass.set_key(inputs.key_to_light)
         self.draw_pass.update(self.irradiance)
         room_side = t.gather_side.dot(rho * (self.irradiance + beam))
         tw, th = self._side_size
