@@ -165,7 +165,7 @@ INTERPOLATION in float v_view_occlusion;
 uniform vec3 u_room_side_reflectance;
 uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
 uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
-#ifdef WALL_LIGHT
+#if defined(WALL_LIGHT) || defined(WALL_GRID)
 INTERPOLATION in vec3 v_wall_light;   // curtain.vert: the wall and its reveals, each lobe's share passed
 #endif
 #endif
@@ -380,7 +380,7 @@ void main() {
 #ifdef ROOM_SIDE
     rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance * v_room_side_light;
     rgb += (g_view_outside * g_occlusion) * (u_window_side_diffuse + u_window_side_directional) * v_window_side_light;
-#ifdef WALL_LIGHT
+#if defined(WALL_LIGHT) || defined(WALL_GRID)
     rgb += g_view_outside * v_wall_light;   // the wall and its reveals where the outside is walled
 #endif
 #if defined(FOLDS_BEHIND) && defined(SEE_THROUGH)
@@ -430,7 +430,7 @@ void main() {
 #ifdef ROOM_SIDE
     out_room_side_light = vec4(v_room_side_light, 1.0);
     out_window_side_light = vec4(v_window_side_light, 1.0);
-#ifdef WALL_LIGHT
+#if defined(WALL_LIGHT) || defined(WALL_GRID)
     out_wall_light = vec4(v_wall_light, g_second_coverage);
 #endif
 #else

@@ -73,6 +73,16 @@ uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
 uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
 INTERPOLATION out vec3 v_wall_light;
 #endif
+#ifdef WALL_GRID
+// The room's surfaces round the window (the wall beside the opening, its reveals, a frame)
+// as the cloth's window side sees them (the room's transport: catalog/render/passes/
+// room_transport_light.py): their irradiance on the cloth's plane from that side, a grid over
+// the room side's rectangle; both lobes pass it by their forward transmittance of diffuse light.
+uniform sampler2D u_wall_grid;           // irradiance, linear sRGB (x pi cd m^-2)
+uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
+uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
+INTERPOLATION out vec3 v_wall_light;
+#endif
 #endif
 
 INTERPOLATION out vec3 v_view_ray;
@@ -140,6 +150,10 @@ void main() {
         vec3 directional = lobe / float(WALL_LOBE_SAMPLES) + v_occlusion.y * 0.5 * (sky + ground);
         v_wall_light = u_window_side_diffuse * walled + u_window_side_directional * directional;
     }
+#endif
+#ifdef WALL_GRID
+    v_wall_light = (u_window_side_diffuse + u_window_side_directional)
+                 * ((1.0 / PI) * textureLod(u_wall_grid, side_uv, 0.0).rgb);
 #endif
 #if defined(SKY_OCCLUSION) && defined(OCCLUSION_MAPS) && (defined(FOLDS_BEHIND) || defined(GBUFFER))
     // (read by the room's captures, FOLDS_BEHIND, and written to the G-buffer; the frame's

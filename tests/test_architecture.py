@@ -172,7 +172,7 @@ FRAME_SETTERS = {
     "set_bands", "set_camera", "set_exposure", "set_ev", "set_white_balance", "set_antialiasing",
     "set_room_lighting", "set_bloom", "set_shadow_map_size", "set_curtain_open", "set_room_lamps",
     "set_sky_model", "set_environment", "set_patterned", "set_key_second_layer",
-    "set_mesh", "set_fabric_size", "set_mesh_offset", "set_rings",
+    "set_mesh", "set_fabric_size", "set_mesh_offset", "set_rings", "set_room",
 }
 
 

@@ -133,6 +133,7 @@ class FabricTask:
     pitch_deg: float
     distance_m: float
     exposure: float
+    room: str = "box"
 
 
 @dataclass(frozen=True)
@@ -150,13 +151,15 @@ class JobSpec:
     pitch_deg: float = 0.0
     distance_m: float = 2.6
     exposure: float = 1.0
+    room: str = "box"                 # a built-in name or a .glb path (lit by its transport)
+    room_sha256: str = field(default="", compare=False)
     preset_paths: tuple[str, ...] = field(default=(), compare=False)
     preset_hashes: tuple[str, ...] = field(default=(), compare=False)
 
     @classmethod
     def create(cls, *, fabrics, lights, frames, size, image_format, out_dir, yaws=None,
                fluorescence: str = "physical", bands: int = 3, pitch_deg: float = 0.0,
-               distance_m: float = 2.6, exposure: float = 1.0) -> "JobSpec":
+               distance_m: float = 2.6, exposure: float = 1.0, room: str = "box") -> "JobSpec":
         """Check and normalise: ``fabrics``/``lights`` as lists or ``A,B`` strings,
         ``frames`` as ``A:B[:STEP]`` or a range, ``yaws`` as text or numbers, ``size`` as
         ``WxH`` or (w, h). Raises InputError naming the option."""
@@ -202,6 +205,10 @@ class JobSpec:
         from catalog.core.validate import check_camera  # noqa: PLC0415
 
         check_camera({"--distance": distance_m, "--exposure": exposure, "--pitch": pitch_deg})
+        from catalog.room.load import room_path  # noqa: PLC0415
+
+        room_file = room_path(room)
+        room_sha256 = hashlib.sha256(room_file.read_bytes()).hexdigest()
         out_dir = Path(out_dir)
         if out_dir.exists() and not out_dir.is_dir():
             raise InputError(f"{str(out_dir)!r} exists and is not a folder", field="--out")
@@ -225,6 +232,8 @@ class JobSpec:
                    yaws=yaws, size=size, image_format=image_format, out_dir=out_dir,
                    fluorescence=fluorescence, bands=int(bands), pitch_deg=float(pitch_deg),
                    distance_m=float(distance_m), exposure=float(exposure),
+                   room=str(room) if str(room) in ("box", "living") else str(room_file.resolve()),
+                   room_sha256=room_sha256,
                    preset_paths=tuple(paths), preset_hashes=tuple(hashes))
 
     @property
@@ -239,7 +248,7 @@ class JobSpec:
                 "yaw_deg": list(self.yaws), "size": list(self.size), "format": self.image_format,
                 "fluorescence": self.fluorescence, "bands": self.bands,
                 "pitch_deg": self.pitch_deg, "distance_m": self.distance_m,
-                "exposure": self.exposure, "images": self.image_count}
+                "exposure": self.exposure, "room": self.room, "images": self.image_count}
 
     def image_key(self, index: int, light: str, frame: int, yaw_deg: float) -> str:
         """SHA-256 of everything the image depends on (fabric ``index`` in the job)."""
@@ -251,6 +260,8 @@ class JobSpec:
                   "distance_m": self.distance_m, "size": list(self.size),
                   "format": self.image_format, "fluorescence": self.fluorescence,
                   "bands": self.bands, "exposure": self.exposure}
+        if self.room != "box" or self.room_sha256:
+            inputs.update({"room": self.room, "room_sha256": self.room_sha256})
         text = json.dumps(inputs, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
@@ -269,4 +280,4 @@ class JobSpec:
                           size=tuple(self.size), image_format=self.image_format,
                           fluorescence=self.fluorescence, bands=self.bands,
                           pitch_deg=self.pitch_deg, distance_m=self.distance_m,
-                          exposure=self.exposure)
+                          exposure=self.exposure, room=self.room)

@@ -237,7 +237,8 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
                                       out=out_dir / image.path, frame=frame,
                                       fluorescence=task.fluorescence, bands=task.bands,
                                       yaw_deg=image.yaw_deg, pitch_deg=task.pitch_deg,
-                                      distance_m=task.distance_m, exposure=task.exposure)
+                                      distance_m=task.distance_m, exposure=task.exposure,
+                                      room=task.room)
             configure_renderer(renderer, request, preset, lights[image.light])
             if image is by_frame[frame][0]:
                 # once a frame: a new mesh makes the room's light be drawn again, which the

@@ -12,6 +12,7 @@ from catalog.core.constants import FLUORESCENT_MODES
 
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
+INPUT_FILES = ("room",)
 HELP = "render a whole catalog (fabrics x lights x frames x yaws) with a resumable manifest"
 #: Exit status when some fabrics failed and the rest finished.
 EXIT_PARTIAL = 3
@@ -50,6 +51,9 @@ def add_arguments(parser) -> None:
                         default=2.6, help="camera distance, m")
     parser.add_argument("--exposure", type=number_type(*validate.EXPOSURE), default=1.0,
                         help="exposure multiplier")
+    parser.add_argument("--room", default="box", metavar="NAME|FILE.glb",
+                        help="the room: a built-in name (box, living) or a room .glb "
+                             "(docs/formats.md, Rooms; default box)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
 
@@ -74,7 +78,7 @@ def run(args) -> int:
         fabrics=fabrics, lights=args.lights, frames=args.frames, yaws=args.yaw,
         size=args.size, image_format=args.format, out_dir=args.out,
         fluorescence="off" if args.no_fluorescence else args.mode, bands=args.bands,
-        pitch_deg=args.pitch, distance_m=args.distance, exposure=args.exposure)
+        pitch_deg=args.pitch, distance_m=args.distance, exposure=args.exposure, room=args.room)
     summary = render_catalog(spec, workers=args.workers, scheduler=args.scheduler,
                              retries=args.retries, lp_threads=args.lp_threads,
                              progress=not (args.json or args.no_progress))

@@ -7,6 +7,7 @@ from catalog.core.constants import FLUORESCENT_MODES
 
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
+INPUT_FILES = ("room",)
 HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
 
@@ -25,6 +26,9 @@ def add_arguments(parser) -> None:
     add_display_arguments(parser)
     parser.add_argument("--no-labels", action="store_true",
                         help="grid without the fabric (row) and light (column) labels")
+    parser.add_argument("--room", default="living", metavar="NAME|FILE.glb",
+                        help="the room: a built-in name (box, living) or a room .glb "
+                             "(docs/formats.md, Rooms; default living)")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
@@ -43,7 +47,7 @@ def run(args) -> int:
     report = render_sheet(lights, Path(args.out), parse_size(args.size), fabrics=args.fabric,
                           fluorescence="off" if args.no_fluorescence else args.mode,
                           bands=args.bands, progress=not args.json, ev=ev,
-                          white_balance=white_balance, labels=not args.no_labels)
+                          white_balance=white_balance, labels=not args.no_labels, room=args.room)
     if args.json:
         print_json(report)
     else:

@@ -7,7 +7,7 @@ from catalog.core.constants import FLUORESCENT_MODES
 
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
-INPUT_FILES = ("fabric", "environment")
+INPUT_FILES = ("fabric", "environment", "room")
 OUTPUT_FILES = ("out",)
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
 
@@ -56,6 +56,9 @@ def add_arguments(parser) -> None:
                              "window at z = -0.2); up to 4")
     parser.add_argument("--no-room-light", action="store_true",
                         help="the earlier constant room instead of the room lit through the curtain")
+    parser.add_argument("--room", default="box", metavar="NAME|FILE.glb",
+                        help="the room: a built-in name (box, living) or a room .glb "
+                             "(docs/formats.md, Rooms; default box)")
     parser.add_argument("--no-bloom", action="store_true", help="no glare before the tone map")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
@@ -94,7 +97,8 @@ def run(args) -> int:
         target=view.target, fov_y_deg=view.fov_y_deg, exposure=args.exposure, ev=ev,
         white_balance=white_balance, environment=args.environment,
         curtain_open=args.curtain == "open", room_light=not args.no_room_light,
-        bloom=not args.no_bloom, lamps=tuple(parse_lamp(text) for text in args.lamp))
+        bloom=not args.no_bloom, lamps=tuple(parse_lamp(text) for text in args.lamp),
+        room=args.room)
     report = render_snapshot(request)
     if args.json:
         print_json(report)

@@ -12,7 +12,7 @@ from catalog.commands.displayargs import add_display_arguments
 
 RESOURCES = ("fabrics",)
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
-INPUT_FILES = ("fabric", "compare")
+INPUT_FILES = ("fabric", "compare", "room")
 OUTPUT_FILES = ("screenshot",)
 HELP = "browse the fabrics, animated, under any light, in a window (needs a display)"
 
@@ -85,6 +85,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")
     parser.add_argument("--no-room-light", action="store_true",
                         help="the earlier constant room and flat sky, no glare (docs/room.md)")
+    parser.add_argument("--room", default="living", metavar="NAME|FILE.glb",
+                        help="the room: a built-in name (box, living) or a room .glb "
+                             "(docs/formats.md, Rooms; default living)")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
     parser.add_argument("--compare-fluorescence", choices=FLUORESCENCE_CHOICES, default=None,
@@ -132,6 +135,9 @@ def run(args: argparse.Namespace) -> int:
                            "room; snapshot and reference allow (0.05, 50])")
     if args.wind is not None and not 0.0 <= args.wind <= 50.0:
         raise CatalogError(f"--wind: {args.wind:g} m/s is outside 0-50 m/s")
+    from catalog.room.load import room_path
+
+    room_path(args.room)   # a name or a file (its rules are checked as it loads)
     if not display_available():  # say so before any heavy import or preset read
         raise NoDisplayError("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): "
                              + NO_DISPLAY_HINT)
@@ -150,6 +156,6 @@ def run(args: argparse.Namespace) -> int:
         cloth_backend=None if args.cloth_backend == "auto" else args.cloth_backend,
         panel=not args.no_panel, paused=args.paused, render_scale=args.render_scale,
         ev100=ev, white_balance=white_balance, compare_fluorescence=args.compare_fluorescence,
-        room_light=not args.no_room_light,
+        room_light=not args.no_room_light, room=args.room,
         fabric_dir=fabric_dir)
     return ViewerApp(options).run()

@@ -115,6 +115,10 @@ class FrameRenderer:
         self.environment = None    # (path, texture, upper-hemisphere illuminance) or None
         self.antialiasing = "fxaa"
         self.room_targets = RoomTargets(ctx, self.shadow_texels)
+        #: the room drawn and lit by its precomputed transport (set_room: what it was given, a
+        #: name or a path; None: the box's special-case room light of catalog/render/room_light)
+        self.room_spec = None
+        self.room_transport = None
         # the passes, in the order a frame runs them (render_hdr, render)
         self.gl = GLPrograms(ctx)
         self.terms = SceneTerms(self)
@@ -198,6 +202,21 @@ class FrameRenderer:
         the front-layer map peeled into a second map) or through the nearest alone (False: what
         the web page shows, catalog.web.export.DESKTOP_MODES)."""
         self.key_second_layer = bool(on)
+
+    def set_room(self, room) -> None:
+        """The room (a built-in name or a .glb path), drawn and lit by its precomputed
+        transport (catalog/render/passes/room_transport_light.py; its bundle from the cache,
+        built on first use); None: the box's special-case light."""
+        from catalog.render.passes.room_transport_light import RoomTransportLight  # noqa: PLC0415
+
+        light = None if room is None else RoomTransportLight(self, str(room))   # refused before any change
+        if self.room_transport is not None:
+            if self.ctx.fbo in self.room_transport.framebuffers():
+                (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
+            self.room_transport.release()
+        self.room_transport = light
+        self.room_spec = None if room is None else str(room)
+        self.lightmap.invalidate()
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -338,7 +357,14 @@ class FrameRenderer:
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
         if self.lightmap.stale():
-            if self.room_lighting:   # the room's passes (the cloth's own shadow maps with them)
+            if self.room_lighting and self.room_transport is not None:
+                # the room's transport: the beam's map (and the cloth's own), the captures of the
+                # cloth for its room side, then the window's light through the operator
+                self._timed(profile, "room_shadow", lambda: self.shadow.draw_room_shadow(inputs))
+                if self.room_side_active():
+                    self._timed(profile, "room_luminaire", lambda: self.capture.draw_room_luminaire(inputs))
+                self._timed(profile, "room_transport", lambda: self.room_transport.update(inputs))
+            elif self.room_lighting:   # the room's passes (the cloth's own shadow maps with them)
                 self._timed(profile, "room_shadow", lambda: self.shadow.draw_room_shadow(inputs))
                 self._timed(profile, "room_luminaire", lambda: self.capture.draw_room_luminaire(inputs))
                 self._timed(profile, "room_lightmap", lambda: self.lightmap.draw_room_lightmap(inputs))
@@ -355,7 +381,10 @@ class FrameRenderer:
         if not self.curtain_open and not self.patterned:
             # the opaque flat curtain first: the depth test then skips the room behind it
             self._timed(profile, "curtain", lambda: self.curtain.draw_curtain(view_proj))
-        self._timed(profile, "room", lambda: self.room.draw(view_proj, inputs))
+        if self.room_lighting and self.room_transport is not None:
+            self._timed(profile, "room", lambda: self.room_transport.draw(view_proj, inputs))
+        else:
+            self._timed(profile, "room", lambda: self.room.draw(view_proj, inputs))
         # on the far plane: the depth test leaves only the pixels nothing covers
         self._timed(profile, "background", lambda: self.background.draw(view_proj, inputs))
         if not self.curtain_open and self.patterned:
@@ -552,13 +581,17 @@ class FrameRenderer:
     def release(self) -> None:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
         ours = (self.targets.framebuffers() + self.room_targets.framebuffers()
-                + self.glare.framebuffers())
+                + self.glare.framebuffers()
+                + (self.room_transport.framebuffers() if self.room_transport is not None else []))
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self.targets.release_msaa()
         self.gl.release_vaos()
         self.mesh.release()
         self.room.release()
+        if self.room_transport is not None:
+            self.room_transport.release()
+            self.room_transport = None
         self.fabric_pattern.release()
         self.targets.release()
         self.gl.release()

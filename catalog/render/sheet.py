@@ -109,7 +109,8 @@ def put_inset(cell: np.ndarray, swatch: np.ndarray, fraction: float = INSET_FRAC
 def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fabrics=None,
                  fluorescence: str = "physical", bands: int = 3, progress: bool = True,
                  ctx=None, ev: float | None = None, white_balance: str = "room",
-                 labels: bool = True) -> dict:
+                 labels: bool = True, room: str | None = "living") -> dict:
+    """``room``: a built-in name or a .glb, lit by its transport (None: the box's special-case light)."""
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.render import bands as band_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
@@ -126,6 +127,10 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     from catalog.render.snapshot import check_display_choices  # noqa: PLC0415
 
     check_display_choices(ev, white_balance)
+    if room is not None:
+        from catalog.room.load import room_path  # noqa: PLC0415
+
+        room_path(room)
     if out_dir.exists() and not out_dir.is_dir():
         raise InputError(f"{str(out_dir)!r} exists and is not a folder", field="--out")
     width, height = size
@@ -133,12 +138,12 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     estimate_bytes = 2 * len(presets) * len(light_objects) * width * height * 3
     with staged_folder(out_dir, estimate_bytes=estimate_bytes) as stage:
         report = _render_into(stage, out_dir, presets, light_objects, size, fluorescence,
-                              bands, progress, ctx, ev, white_balance, labels)
+                              bands, progress, ctx, ev, white_balance, labels, room)
     return report
 
 
 def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluorescence,
-                 bands, progress, ctx, ev, white_balance, labels) -> dict:
+                 bands, progress, ctx, ev, white_balance, labels, room=None) -> dict:
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.imagefile import write_image  # noqa: PLC0415
 
@@ -150,6 +155,8 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
     renderer.set_bands(bands)
     renderer.set_ev(ev)
     renderer.set_white_balance(white_balance)
+    if room is not None:
+        renderer.set_room(room)
     width, height = size
     grid = np.zeros((height * len(presets), width * len(light_objects), 3), dtype=np.uint8)
     images = []

@@ -105,6 +105,7 @@ class SnapshotRequest:
     room_light: bool = True
     bloom: bool = True
     lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
+    room: str | None = "box"          # a built-in room or FILE.glb (its transport); None: the box's special-case light (the API only)
 
 
 def simulated_curtain(preset, frames: int):
@@ -192,6 +193,10 @@ def validate(request: SnapshotRequest):
         from catalog.render.environment import load_environment  # noqa: PLC0415
 
         load_environment(request.environment)  # refused now, before a context exists
+    if request.room is not None:
+        from catalog.room.load import room_path  # noqa: PLC0415
+
+        room_path(request.room)   # a name or a file; its rules are checked as it loads (set_room)
     from catalog.render import room_light  # noqa: PLC0415
 
     if len(request.lamps) > room_light.MAX_ROOM_LAMPS:
@@ -262,6 +267,8 @@ def configure_renderer(renderer, request: SnapshotRequest, preset, light):
     renderer.set_white_balance(request.white_balance)
     renderer.set_curtain_open(request.curtain_open)
     renderer.set_room_lighting(request.room_light)
+    if request.room != renderer.room_spec:
+        renderer.set_room(request.room)
     renderer.set_bloom(request.bloom)
     if request.environment is not None:
         renderer.set_environment(request.environment)

@@ -61,6 +61,7 @@ class ViewerOptions:
     render_scale: float | None = None  # scene resolution / window resolution; None: auto
     room_light: bool = True  # the room lit through the curtain, the clear sky, glare (issue 13)
     fabric_dir: Path | None = None  # None: --fabrics / $CATALOG_FABRICS, then the built-in catalog
+    room: str | None = "living"  # the room (a built-in name or FILE.glb) lit by its transport
     ev100: float | None = None  # fixed exposure; None: automatic
     white_balance: str = "room"
     compare_fluorescence: str | None = None  # the right half's fluorescence (None: the left's)
@@ -412,6 +413,8 @@ class ViewerApp:
             renderer.set_room_lighting(self.room_settings["room_light"])
             renderer.set_sky_model(self.room_settings["room_light"])
             renderer.room_update_every = self.room_settings["room_update_every"]
+            if self.room_settings["room_light"] and self.options.room is not None:
+                renderer.set_room(self.options.room)
             self._renderers.append(renderer)
 
     def _choose_render_scale(self) -> float:

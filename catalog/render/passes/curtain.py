@@ -51,9 +51,12 @@ class CurtainPass(Pass):
             defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
             if defines.get("SKY_OCCLUSION"):
                 defines["OCCLUSION_MAPS"] = True   # the folds' maps (the G-buffer's view continuation)
+            if defines.get("SKY_OCCLUSION") and self.frame.room_transport is None:
                 # the wall and its reveals where the outside is walled
                 defines["WALL_LIGHT"] = True
                 defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
+            elif defines.get("SKY_OCCLUSION"):   # the same from the room's transport
+                defines["WALL_GRID"] = True
         if self.frame.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.frame.patterned and not gbuffer:
@@ -71,6 +74,7 @@ class CurtainPass(Pass):
             defines.pop("OCCLUSION_MAPS", None)
             defines.pop("WALL_LIGHT", None)
             defines.pop("WALL_LOBE_SAMPLES", None)
+            defines.pop("WALL_GRID", None)
             if folds_behind and defines.get("SKY_OCCLUSION"):
                 # the folds' window side where they hide the outside (curtain.frag FOLDS_BEHIND;
                 # ROOM_SIDE without the room's part under ROOM_CAPTURE)
@@ -92,7 +96,7 @@ class CurtainPass(Pass):
 
     def draw_curtain(self, view_proj, fragment: str | None = None, gbuffer: bool = False,
                      camera_position=None, overrides: dict | None = None,
-                     folds_behind: bool = False) -> None:
+                     folds_behind: bool = False, coarse: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer.
 
         ``fragment``: draw the same mesh (same vertex shader and uniforms of the mesh and
@@ -140,9 +144,10 @@ class CurtainPass(Pass):
             if "u_vertex_occlusion" in program:
                 self.frame.shadow.vertex_occlusion_uniforms(program)
         self.ctx.disable(self.mgl.CULL_FACE)  # two-sided cloth
-        self.frame.mesh.curtain_vao(program).render(self.mgl.TRIANGLES)
+        self.frame.mesh.curtain_vao(program, coarse).render(self.mgl.TRIANGLES)
 
-    def draw_flat(self, view_proj, eye, overrides: dict, folds_behind: bool = False) -> None:
+    def draw_flat(self, view_proj, eye, overrides: dict, folds_behind: bool = False,
+                  coarse: bool = False) -> None:
         """The room's captures draw the flat cloth (the pattern averaged, model.md section 9):
         each capture texel is a mean over a window patch anyway, and the flat variant draws in
         one pass. The whole mesh, not the coarse grid of the shadow map: under the UV lamp the
@@ -154,7 +159,7 @@ class CurtainPass(Pass):
             self.frame.patterned = False
         try:
             self.draw_curtain(view_proj, camera_position=eye, overrides=overrides,
-                              folds_behind=folds_behind)
+                              folds_behind=folds_behind, coarse=coarse)
         finally:
             if patterned:
                 self.frame.patterned = patterned

@@ -149,8 +149,10 @@ class CurtainMesh(Pass):
             buffer.release()
         self._own_buffers = []
 
-    def curtain_vao(self, program):
-        key = ("curtain", id(program))
+    def curtain_vao(self, program, coarse: bool = False):
+        """The mesh drawn with ``program``; ``coarse``: the coarse grid's triangles (where the
+        mesh has one), for the room's views of the aperture, a few texels a patch."""
+        key = ("curtain", id(program), coarse)
         if key not in self.gl.vaos:
             b = self.buffers
             if self.format == "interleaved":
@@ -166,8 +168,9 @@ class CurtainMesh(Pass):
                     content.append((b["tangent"], "3f", "in_tangent"))
             if "in_uv" in program:
                 content.append((b["uv"], "2f", "in_uv"))
+            index = b.get("coarse_index", b["index"]) if coarse else b["index"]
             self.gl.vaos[key] = self.ctx.vertex_array(
-                program, content, index_buffer=b["index"], index_element_size=4)
+                program, content, index_buffer=index, index_element_size=4)
         return self.gl.vaos[key]
 
     def shadow_vao(self, program, fine: bool = False):

@@ -106,9 +106,10 @@ class GLPrograms:
         specialised = [k for k in self.programs if dict(k[2]).get("SPECIALISED")]
         for key in specialised[:max(0, len(specialised) - MAX_SPECIALISED + 1)]:
             program = self.programs.pop(key)
-            vao = self.vaos.pop(("curtain", id(program)), None)
-            if vao is not None:
-                vao.release()
+            for coarse in (False, True):   # (CurtainMesh.curtain_vao's keys)
+                vao = self.vaos.pop(("curtain", id(program), coarse), None)
+                if vao is not None:
+                    vao.release()
             program.release()
 
     def compiled_variants(self) -> list[dict]:

@@ -160,6 +160,9 @@ class LightmapPass(Pass):
         set_uniform(program, "u_window_side_directional", directional)
         if "u_occlusion_maps" in program:   # beside the per-vertex occlusion (OCCLUSION_UNIT)
             self.frame.shadow.occlusion_uniforms(program, OCCLUSION_MAPS_UNIT)
+        if "u_wall_grid" in program:   # the room's transport's (WALL_GRID)
+            self.frame.room_transport.wall_grid_texture().use(location=VERTEX_WALL_LIGHT_UNIT)
+            set_uniform(program, "u_wall_grid", VERTEX_WALL_LIGHT_UNIT)
         if "u_vertex_wall_light" in program:
             self._wall_light_uniforms(program, self.frame.terms.shading_inputs())
             set_uniform(program, "u_wall_lobe", np.asarray(

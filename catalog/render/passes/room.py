@@ -21,6 +21,7 @@ class RoomPass(Pass):
         positions, normals = scene_lib.room_props()
         self._room_vbo = self.ctx.buffer(np.hstack([positions, normals]).astype("f4").tobytes())
         self._ring_vbo = None
+        self.ring_arrays = (np.zeros((0, 3), "f4"), np.zeros((0, 3), "f4"))
         self._room_order_key = None
         self._room_facing = 0
 
@@ -113,6 +114,7 @@ class RoomPass(Pass):
     def set_rings(self, xs_m) -> None:
         """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
         positions, normals = scene_lib.ring_mesh(xs_m)
+        self.ring_arrays = (positions, normals)   # the transport's room light draws them too
         if self._ring_vbo is not None:
             self._ring_vbo.release()
             self._ring_vbo = None
