@@ -555,6 +555,7 @@ class ViewerApp:
                 "facts": {entry.name: entry.facts.lines() for entry in self.catalog.entries
                           if entry.facts is not None},
                 "labels": {entry.name: entry.label for entry in self.catalog.entries},
+                "panel": self.panel.layout,
                 "ev100": [r.info().get("ev100") for r in self._renderers],
                 "fluorescence": [r.mode for r in self._renderers]}
 
