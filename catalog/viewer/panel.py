@@ -143,7 +143,7 @@ class Panel:
                 settings.fabric_index = index
             imgui.same_line()
             imgui.begin_group()
-            imgui.push_text_wrap_pos(self.width_px - 12)
+            imgui.push_text_wrap_pos(0.0)   # the list's right edge (its scrollbar left of it)
             if entry.error is not None:
                 imgui.text_colored(ERROR_COLOUR, f"{entry.name}: broken preset")
             else:
