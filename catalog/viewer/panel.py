@@ -156,6 +156,9 @@ class Panel:
                 if entry.facts is not None:
                     for line in entry.facts.lines():
                         imgui.text_colored(DIM_COLOUR, line)
+                    if imgui.is_item_hovered():   # the rows the web page lists, the same words
+                        imgui.set_tooltip("\n".join(f"{label}: {value}"
+                                                     for label, value in entry.facts.rows()))
             imgui.pop_text_wrap_pos()
             imgui.end_group()
             imgui.pop_id()
