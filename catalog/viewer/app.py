@@ -37,7 +37,7 @@ SOFTWARE_BLOOM = False
 MIN_FRAME_DT_S, MAX_FRAME_DT_S = 1.0 / 240.0, 1.0 / 15.0
 #: The panel alone is shown for at most this long before the scene's first frame, while the
 #: thumbnails' drafts are drawn (ViewerApp._first_look), s.
-FIRST_LOOK_MAX_S = 8.0
+FIRST_LOOK_MAX_S = 3.0
 
 
 @dataclass
