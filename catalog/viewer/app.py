@@ -580,9 +580,11 @@ class ViewerApp:
                                    self.thumbnails.get(entry.name).pixels.reshape(-1, 3).mean(axis=0)]
                       for entry in self.catalog.entries
                       if self.thumbnails.get(entry.name) is not None
-                      and self.thumbnails.is_current(entry, scene)}
+                      and self.thumbnails.has_draft(entry, scene)}   # draft or final
+        final = sorted(entry.name for entry in self.catalog.entries
+                       if self.thumbnails.is_current(entry, scene))
         return {"thumbnails": thumbnails, "thumbnail_renders": self.thumbnails.renders,
-                "thumbnail_drafts": self.thumbnails.draft_renders,
+                "thumbnail_drafts": self.thumbnails.draft_renders, "thumbnails_final": final,
                 "thumbnail_times_s": {k: round(v, 3) for k, v in self.thumbnails.times_s.items()},
                 "facts": {entry.name: entry.facts.lines() for entry in self.catalog.entries
                           if entry.facts is not None},

@@ -593,16 +593,16 @@
 
   // One replayer per canvas, made when the pane is first shown (again after a lost context);
   // input is installed once per canvas.
-  const inputInstalled = new Set(), paneFailed = [false, false];
+  const inputInstalled = new Set(), paneFailed = [false, false], paneLost = [false, false];
   function makePane(i) {
     const canvas = $(i === 0 ? 'canvas-a' : 'canvas-b');
-    if (paneFailed[i]) return;
+    if (paneFailed[i] || paneLost[i]) return;
     try { panes[i] = new Replayer(canvas); } catch (e) { paneFailed[i] = true; fail(e); return; }
     if (!inputInstalled.has(canvas)) {
       inputInstalled.add(canvas); installInput(canvas);
       // a lost context (the GPU process reset, memory) shows black until it is made again
-      canvas.addEventListener('webglcontextlost', (e) => { e.preventDefault(); panes[i] = null; stats.contextsLost++; });
-      canvas.addEventListener('webglcontextrestored', () => { paneFailed[i] = false; ensurePanes(); dirty = true; });
+      canvas.addEventListener('webglcontextlost', (e) => { e.preventDefault(); panes[i] = null; paneLost[i] = true; stats.contextsLost++; });
+      canvas.addEventListener('webglcontextrestored', () => { paneLost[i] = false; ensurePanes(); dirty = true; });
     }
   }
   function ensurePanes() {
