@@ -88,6 +88,13 @@ class Panel:
                      | imgui.WindowFlags_.no_collapse)
             imgui.begin("Fabric catalog", None, flags)
             top = imgui.get_cursor_screen_pos().y
+            # errors first: in view in any window (a broken preset, a light, a save)
+            catalog.load_all()  # facts for every preset; a file is read once per version
+            for error in catalog.errors():
+                imgui.push_text_wrap_pos(self.width_px - 10)
+                imgui.text_colored(ERROR_COLOUR, error)
+                imgui.pop_text_wrap_pos()
+            self._messages(info)
             if self._section("light", "Light  (L)"):
                 self._light(settings, info)
             self.layout = {"window_px": [int(window_size_px[0]), int(window_height_px)],
@@ -104,7 +111,6 @@ class Panel:
                 self._timing(settings, timer)
             if self._section("compare", "Compare (split screen)"):
                 self._compare(settings, catalog)
-            self._messages(info)
             self._fabrics(settings, catalog, info)
             self.layout["top_px"] = top
             self.layout["sections"] = dict(self.sections)
@@ -115,7 +121,6 @@ class Panel:
     # ------------------------------------------------------------------------------
     def _fabrics(self, settings: ViewerSettings, catalog: FabricCatalog, info: PanelInfo) -> None:
         imgui.separator_text("Fabric  (Left / Right)")
-        catalog.load_all()  # facts for every preset; a file is read once per version
         self._filter(settings)
         # the list scrolls in the height the sections above leave (at least FABRIC_ROWS_MIN
         # rows): the light picker and the other controls stay in the window
@@ -164,10 +169,6 @@ class Panel:
             imgui.pop_id()
         if shown == 0:
             imgui.text_colored(DIM_COLOUR, "no fabric has these facts")
-        for error in catalog.errors():
-            imgui.push_text_wrap_pos(self.width_px - 10)
-            imgui.text_colored(ERROR_COLOUR, error)
-            imgui.pop_text_wrap_pos()
         imgui.end_child()
         self.layout["fabric_list_px"][1] = imgui.get_item_rect_max().y
         self.layout["content_bottom_px"] = imgui.get_item_rect_max().y
@@ -362,8 +363,15 @@ class Panel:
         io = imgui.get_io()
         imgui.set_next_window_pos(imgui.ImVec2(io.display_size.x * 0.5, io.display_size.y * 0.5),
                                   imgui.Cond_.always, imgui.ImVec2(0.5, 0.5))
-        imgui.begin("Keys", None, imgui.WindowFlags_.always_auto_resize
-                    | imgui.WindowFlags_.no_collapse)
-        for key, what in KEY_HELP:
-            imgui.text(f"{key:>6}  {what}")
+        # sized from its text, not auto-resized: an auto-resized window is hidden in the frame
+        # it first appears (imgui measures it then), so a screenshot of that frame missed it
+        lines = [f"{key:>6}  {what}" for key, what in KEY_HELP]
+        style = imgui.get_style()
+        width = max(imgui.calc_text_size(line).x for line in lines) + 2 * style.window_padding.x
+        height = (len(lines) * imgui.get_text_line_height_with_spacing() + imgui.get_frame_height()
+                  + 2 * style.window_padding.y)
+        imgui.set_next_window_size(imgui.ImVec2(width, height), imgui.Cond_.always)
+        imgui.begin("Keys", None, imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_resize)
+        for line in lines:
+            imgui.text(line)
         imgui.end()
