@@ -46,7 +46,9 @@ def panel_runs(xdisplay, tmp_path_factory):
 def test_thumbnails_differ_between_fabrics_and_change_with_the_light(panel_runs):
     d65, _ = panel_runs["D65"]
     uva, _ = panel_runs["UV-A"]
-    assert d65["thumbnail_renders"] >= 2 and {LACE, GREY} <= set(d65["thumbnails"])
+    # in 8 frames under load the drafts may be all there is: they are drawn under the light too
+    assert d65["thumbnail_renders"] + d65["thumbnail_drafts"] >= 2
+    assert {LACE, GREY} <= set(d65["thumbnails"])
     lace, grey = np.array(d65["thumbnails"][LACE]), np.array(d65["thumbnails"][GREY])
     assert np.abs(lace - grey).max() > 5.0
     lace_uva = np.array(uva["thumbnails"][LACE])
@@ -109,17 +111,29 @@ def test_thumbnail_cache_renders_once_per_scene_and_again_on_change(gl):
 
     catalog = FabricCatalog()
     entries = [catalog.load(catalog.index_of(name)) for name in (LACE, GREY)]
-    cache = ThumbnailCache(gl, size=(32, 24), per_frame=1)
+    cache = ThumbnailCache(gl, size=(32, 24), per_frame=1, draft_budget_s=60.0)
     light = {"name": "D65"}
 
     def apply_scene(renderer):
         renderer.set_light(light["name"])
 
-    assert cache.update(entries, ("D65",), apply_scene) == 1  # one per frame
+    # the drafts first (both in one frame: the budget is not spent), then the finals, one a frame
+    assert cache.update(entries, ("D65",), apply_scene) == 2
+    assert cache.has_draft(entries[0], ("D65",)) and not cache.is_current(entries[0], ("D65",))
+    draft = cache.get(LACE).pixels.copy()
+    assert cache.update(entries, ("D65",), apply_scene) == 1
     assert cache.update(entries, ("D65",), apply_scene) == 1
     assert cache.update(entries, ("D65",), apply_scene) == 0  # cached
+    assert cache.draft_renders == 2 and cache.renders == 2
     before = cache.get(LACE).pixels.copy()
+    assert before.shape == draft.shape == (24, 32, 3)
+    # the final carries the close-up inset in its lower right corner: there it differs from
+    # the draft (the whole curtain) more than elsewhere
+    diff = np.abs(before.astype(int) - draft).mean(axis=-1)
+    assert diff[12:, 16:].mean() > diff[:12, :16].mean() + 5
+    assert {"first_draft_s", "all_drafts_s", "all_final_s"} <= set(cache.times_s)
     light["name"] = "UV-A"
+    assert cache.update(entries, ("UV-A",), apply_scene) == 2
     assert cache.update(entries, ("UV-A",), apply_scene) == 1
     assert np.abs(cache.get(LACE).pixels.astype(int) - before).mean() > 10
     cache.release()
@@ -151,10 +165,11 @@ def test_thumbnails_are_drawn_again_when_the_light_changes(xdisplay, tmp_path):
     viewer = Viewer(xdisplay, tmp_path, ["--fabric", LACE, "--light", "D65", "--paused", "--stats"])
     try:
         viewer.wait_title("light D65")
-        _wait_frames(viewer, count + 2)  # two thumbnails a frame: count / 2 frames, and margin
+        _wait_frames(viewer, 2 * count + 2)  # the drafts (one or more a frame), then two
+        # finals a frame: count / 2 frames, and margin
         viewer.keys("l")
         viewer.wait_title("light A ")
-        _wait_frames(viewer, count + 2)
+        _wait_frames(viewer, 2 * count + 2)
         assert viewer.quit() == 0
         summary = [r for r in _stats_records(viewer.stdout_text()) if r.get("summary")][0]
     finally:

@@ -35,6 +35,9 @@ SOFTWARE_BLOOM = False
 #: Bounds on the simulated time per frame in interactive use (slow machines run slow motion
 #: rather than let the cloth take huge steps), s.
 MIN_FRAME_DT_S, MAX_FRAME_DT_S = 1.0 / 240.0, 1.0 / 15.0
+#: The panel alone is shown for at most this long before the scene's first frame, while the
+#: thumbnails' drafts are drawn (ViewerApp._first_look), s.
+FIRST_LOOK_MAX_S = 3.0
 
 
 @dataclass
@@ -182,6 +185,8 @@ class ViewerApp:
         self._layout_key = None
         self._applied: dict[int, dict] = {}
 
+        if self.settings.show_panel:
+            self._first_look(imgui)
         frame = 0
         last_time = time.perf_counter()
         while not glfw.window_should_close(window) and not self._quit:
@@ -278,6 +283,31 @@ class ViewerApp:
         if self.options.frames is not None and self.frame_error is not None:
             raise self.frame_error  # one line on stderr, exit 2 (or 3 for the environment)
         return 0
+
+    def _first_look(self, imgui) -> None:
+        """Before the scene's first frame (its shaders and the fabric's tables take seconds on
+        a software rasteriser): the panel alone, redrawn while the thumbnails' drafts come in,
+        until every fabric has one or FIRST_LOOK_MAX_S passed. Not a frame of --frames."""
+        deadline = time.perf_counter() + FIRST_LOOK_MAX_S
+        self.catalog.load_all()
+        while not self.glfw.window_should_close(self.window) and time.perf_counter() < deadline:
+            self.glfw.poll_events()
+            self._ensure_targets()
+            self._update_thumbnails()
+            self._update_panel_info()
+            self._fbo.use()
+            self._fbo.clear(0.0, 0.0, 0.0, 1.0)
+            self.gui.process_inputs()
+            imgui.new_frame()
+            self.panel.draw(self.settings, self.catalog, self.timer, self.panel_info,
+                            tuple(self.glfw.get_window_size(self.window)), camera=self.camera)
+            imgui.render()
+            self._fbo.use()
+            self.gui.render(imgui.get_draw_data())
+            self.ctx.copy_framebuffer(self.ctx.screen, self._fbo)
+            self.glfw.swap_buffers(self.window)
+            if "all_drafts_s" in self.thumbnails.times_s:
+                break
 
     def _refresh_catalog(self) -> None:
         """Pick up changed, added and removed preset files; keep showing the same fabrics
@@ -553,11 +583,16 @@ class ViewerApp:
                                    self.thumbnails.get(entry.name).pixels.reshape(-1, 3).mean(axis=0)]
                       for entry in self.catalog.entries
                       if self.thumbnails.get(entry.name) is not None
-                      and self.thumbnails.is_current(entry, scene)}
+                      and self.thumbnails.has_draft(entry, scene)}   # draft or final
+        final = sorted(entry.name for entry in self.catalog.entries
+                       if self.thumbnails.is_current(entry, scene))
         return {"thumbnails": thumbnails, "thumbnail_renders": self.thumbnails.renders,
+                "thumbnail_drafts": self.thumbnails.draft_renders, "thumbnails_final": final,
+                "thumbnail_times_s": {k: round(v, 3) for k, v in self.thumbnails.times_s.items()},
                 "facts": {entry.name: entry.facts.lines() for entry in self.catalog.entries
                           if entry.facts is not None},
                 "labels": {entry.name: entry.label for entry in self.catalog.entries},
+                "panel": self.panel.layout,
                 "ev100": [r.info().get("ev100") for r in self._renderers],
                 "fluorescence": [r.mode for r in self._renderers]}
 

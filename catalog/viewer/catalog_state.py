@@ -20,6 +20,7 @@ import numpy as np
 from catalog.core.resources import fabric_dirs
 from catalog.core.errors import CatalogError
 from catalog.presets import Preset, list_presets, load_preset
+from catalog.presets.facts import KINDS, FabricFacts, fabric_facts  # noqa: F401  (the panel's)
 
 
 def _srgb_encode(linear: np.ndarray) -> np.ndarray:
@@ -66,44 +67,6 @@ def swatch_srgb(preset: Preset) -> tuple[float, float, float]:
     peak = float(np.max(weights))
     linear = weights / peak if peak > 0 else np.zeros(3)
     return tuple(float(v) for v in _srgb_encode(linear))  # type: ignore[return-value]
-
-
-#: What a fabric's colour comes from (the panel's filter groups, in its order).
-KINDS = ("optical brightener", "fluorescent dye", "dye", "undyed")
-
-
-@dataclass(frozen=True)
-class FabricFacts:
-    """What the panel states about a preset, read from its file (nothing estimated)."""
-
-    openness_pct: float              # LD, the open-area see-through fraction, in per cent
-    kind: str                        # one of KINDS
-    weight_g_m2: float | None        # [cloth] areal_density_kg_m2 x 1000, where the file has it
-    weave: str | None                # [cloth] weave, where the file has it
-
-    def lines(self) -> list[str]:
-        parts = [f"open {self.openness_pct:.0f} %", self.kind]
-        if self.weight_g_m2 is not None:
-            parts.append(f"{self.weight_g_m2:.0f} g/m2")
-        if self.weave:
-            parts.append(self.weave)
-        return [", ".join(parts)]
-
-
-def fabric_facts(preset: Preset) -> FabricFacts:
-    """Openness (btdf.direct), brightener or dye ([fluorescence] with or without [dye]),
-    weight and weave ([cloth]) of a preset."""
-    has_dye = bool(preset.table("dye")) or isinstance(preset.table("btdf").get("rgb"), dict)
-    if preset.has_fluorescence:
-        kind = "fluorescent dye" if has_dye else "optical brightener"
-    else:
-        kind = "dye" if has_dye else "undyed"
-    cloth = preset.table("cloth")
-    density = cloth.get("areal_density_kg_m2")
-    weight = float(density) * 1000.0 if isinstance(density, (int, float)) and density > 0 else None
-    weave = cloth.get("weave") if isinstance(cloth.get("weave"), str) else None
-    return FabricFacts(openness_pct=100.0 * float(preset.btdf.direct), kind=kind,
-                       weight_g_m2=weight, weave=weave)
 
 
 @dataclass

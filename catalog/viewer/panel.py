@@ -4,6 +4,10 @@ fluorescence (per half when comparing), bands, exposure and white balance, the v
 slider for the camera's distance and a reset button, beside the wheel and the R key), wind,
 curtain, frame time (the graphs behind a toggle); and the help overlay.
 
+Layout: the controls come first, each section under a header that collapses it (SECTIONS_OPEN
+says which start open), the light picker at the top; the fabric list comes last and scrolls
+in the height the sections leave, so a 1280x720 window shows every open control.
+
 Immediate mode: :meth:`Panel.draw` is called once per frame between ``imgui.new_frame()``
 and ``imgui.render()``; it reads and writes a :class:`ViewerSettings` and reads the
 catalog and the frame timer. It never touches GL itself.
@@ -26,6 +30,12 @@ from catalog.viewer.timing import FrameTimer
 PANEL_WIDTH_PX = 360
 #: The thumbnails' size on the panel (px).
 THUMBNAIL_PX = (72, 54)
+#: The panel's sections and whether each starts open: in a 1280x720 window the open ones,
+#: the fabric list's header and FABRIC_ROWS_MIN rows of it fit (tests/test_viewer_panel.py).
+SECTIONS_OPEN = {"light": True, "fluorescence": True, "display": True, "view": True,
+                 "curtain": False, "timing": False, "compare": False}
+#: The fabric list's least height, in thumbnail rows (below it the panel scrolls).
+FABRIC_ROWS_MIN = 3
 ERROR_COLOUR = imgui.ImVec4(1.0, 0.42, 0.35, 1.0)
 DIM_COLOUR = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
 
@@ -53,6 +63,12 @@ class Panel:
         self.width_px = width_px
         self.zoom_rect_px = None    # ((x0, y0), (x1, y1)) of the zoom slider, last frame
         self.reset_rect_px = None   # ... of the reset button
+        #: which sections are open (their headers collapse them); the fabric list below them
+        #: takes the height they leave
+        self.sections = dict(SECTIONS_OPEN)
+        #: the last frame's layout, screen px from the window's top: where the light section
+        #: ends, the fabric list's top and bottom, the content's bottom (tests, --stats)
+        self.layout: dict = {}
 
     def width_for(self, window_width_px: int) -> int:
         """The strip the panel takes in a window this wide: at most half of it."""
@@ -71,15 +87,33 @@ class Panel:
             flags = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                      | imgui.WindowFlags_.no_collapse)
             imgui.begin("Fabric catalog", None, flags)
-            self._fabrics(settings, catalog, info)
-            self._light(settings, info)
-            self._fluorescence(settings, info)
-            self._display(settings, info)
-            if camera is not None:
-                self._view(camera)
-            self._simulation(settings)
-            self._timing(settings, timer)
+            top = imgui.get_cursor_screen_pos().y
+            # errors first: in view in any window (a broken preset, a light, a save)
+            catalog.load_all()  # facts for every preset; a file is read once per version
+            for error in catalog.errors():
+                imgui.push_text_wrap_pos(self.width_px - 10)
+                imgui.text_colored(ERROR_COLOUR, error)
+                imgui.pop_text_wrap_pos()
             self._messages(info)
+            if self._section("light", "Light  (L)"):
+                self._light(settings, info)
+            self.layout = {"window_px": [int(window_size_px[0]), int(window_height_px)],
+                           "light_bottom_px": imgui.get_cursor_screen_pos().y}
+            if self._section("fluorescence", "Fluorescence  (F)"):
+                self._fluorescence(settings, info)
+            if self._section("display", "Display"):
+                self._display(settings, info)
+            if camera is not None and self._section("view", "View"):
+                self._view(camera)
+            if self._section("curtain", "Curtain"):
+                self._simulation(settings)
+            if self._section("timing", "Frame time"):
+                self._timing(settings, timer)
+            if self._section("compare", "Compare (split screen)"):
+                self._compare(settings, catalog)
+            self._fabrics(settings, catalog, info)
+            self.layout["top_px"] = top
+            self.layout["sections"] = dict(self.sections)
             imgui.end()
         if settings.show_help:
             self._help()
@@ -87,8 +121,14 @@ class Panel:
     # ------------------------------------------------------------------------------
     def _fabrics(self, settings: ViewerSettings, catalog: FabricCatalog, info: PanelInfo) -> None:
         imgui.separator_text("Fabric  (Left / Right)")
-        catalog.load_all()  # facts for every preset; a file is read once per version
         self._filter(settings)
+        # the list scrolls in the height the sections above leave (at least FABRIC_ROWS_MIN
+        # rows): the light picker and the other controls stay in the window
+        row_px = THUMBNAIL_PX[1] + imgui.get_style().item_spacing.y
+        left_px = imgui.get_content_region_avail().y
+        list_px = max(left_px, FABRIC_ROWS_MIN * row_px)
+        self.layout["fabric_list_px"] = [imgui.get_cursor_screen_pos().y, 0.0]
+        imgui.begin_child("fabric-list", imgui.ImVec2(0, list_px))
         shown = 0
         for index, entry in enumerate(catalog.entries):
             if not settings.fabric_filter.matches(entry.facts):
@@ -108,7 +148,7 @@ class Panel:
                 settings.fabric_index = index
             imgui.same_line()
             imgui.begin_group()
-            imgui.push_text_wrap_pos(self.width_px - 12)
+            imgui.push_text_wrap_pos(0.0)   # the list's right edge (its scrollbar left of it)
             if entry.error is not None:
                 imgui.text_colored(ERROR_COLOUR, f"{entry.name}: broken preset")
             else:
@@ -121,17 +161,27 @@ class Panel:
                 if entry.facts is not None:
                     for line in entry.facts.lines():
                         imgui.text_colored(DIM_COLOUR, line)
+                    if imgui.is_item_hovered():   # the rows the web page lists, the same words
+                        imgui.set_tooltip("\n".join(f"{label}: {value}"
+                                                     for label, value in entry.facts.rows()))
             imgui.pop_text_wrap_pos()
             imgui.end_group()
             imgui.pop_id()
         if shown == 0:
             imgui.text_colored(DIM_COLOUR, "no fabric has these facts")
-        for error in catalog.errors():
-            imgui.push_text_wrap_pos(self.width_px - 10)
-            imgui.text_colored(ERROR_COLOUR, error)
-            imgui.pop_text_wrap_pos()
+        imgui.end_child()
+        self.layout["fabric_list_px"][1] = imgui.get_item_rect_max().y
+        self.layout["content_bottom_px"] = imgui.get_item_rect_max().y
 
-        imgui.separator_text("Compare (split screen)")
+    def _section(self, name: str, label: str) -> bool:
+        """A collapsing header whose open state lives in :attr:`sections` (a click toggles
+        it; setting the dict opens or closes it at the next frame)."""
+        imgui.set_next_item_open(bool(self.sections[name]), imgui.Cond_.always)
+        opened = imgui.collapsing_header(f"{label}###{name}")
+        self.sections[name] = bool(opened)
+        return opened
+
+    def _compare(self, settings: ViewerSettings, catalog: FabricCatalog) -> None:
         names = ["(none)"] + [entry.name for entry in catalog.entries]
         current = 0 if settings.compare_index is None else settings.compare_index + 1
         changed, current = imgui.combo("right half", current, names)
@@ -168,7 +218,6 @@ class Panel:
             fabric_filter.openness_pct = (max(0.0, low), min(100.0, max(low, high)))
 
     def _light(self, settings: ViewerSettings, info: PanelInfo) -> None:
-        imgui.separator_text("Light  (L)")
         kind = self._light_kind(settings.light, info)
         if imgui.radio_button("Sun", kind == "sun"):
             settings.light = SUN
@@ -226,7 +275,6 @@ class Panel:
         return "other"
 
     def _fluorescence(self, settings: ViewerSettings, info: PanelInfo) -> None:
-        imgui.separator_text("Fluorescence  (F)")
         for mode in FLUORESCENCE_MODES:
             if imgui.radio_button(mode, settings.fluorescence == mode):
                 settings.fluorescence = mode
@@ -241,7 +289,6 @@ class Panel:
                 settings.bands = bands
 
     def _display(self, settings: ViewerSettings, info: PanelInfo) -> None:
-        imgui.separator_text("Display")
         auto = settings.ev100 is None
         changed, auto = imgui.checkbox("auto exposure", auto)
         if changed:
@@ -261,7 +308,6 @@ class Panel:
     def _view(self, camera) -> None:
         """Zoom: the camera's distance to the curtain on a logarithmic slider (0.2 m shows
         the threads), clamped as the wheel is (inside the room); reset = the R key."""
-        imgui.separator_text("View")
         near, far = camera.distance_limits_m()
         slider_width_px = imgui.calc_item_width()   # the slider's frame, left of its label
         changed, value = imgui.slider_float("distance", float(camera.distance_m), near, far,
@@ -278,7 +324,6 @@ class Panel:
         imgui.text_colored(DIM_COLOUR, "wheel: zoom, drag: orbit")
 
     def _simulation(self, settings: ViewerSettings) -> None:
-        imgui.separator_text("Curtain")
         changed, wind = imgui.slider_float("wind", settings.wind_m_s, *WIND_RANGE_M_S,
                                            "%.1f m/s")
         if changed:
@@ -289,7 +334,6 @@ class Panel:
         _, settings.paused = imgui.checkbox("pause (Space)", settings.paused)
 
     def _timing(self, settings: ViewerSettings, timer: FrameTimer) -> None:
-        imgui.separator_text("Frame time")
         medians = timer.median_ms()
         if not medians:
             imgui.text("(measuring)")
@@ -319,8 +363,15 @@ class Panel:
         io = imgui.get_io()
         imgui.set_next_window_pos(imgui.ImVec2(io.display_size.x * 0.5, io.display_size.y * 0.5),
                                   imgui.Cond_.always, imgui.ImVec2(0.5, 0.5))
-        imgui.begin("Keys", None, imgui.WindowFlags_.always_auto_resize
-                    | imgui.WindowFlags_.no_collapse)
-        for key, what in KEY_HELP:
-            imgui.text(f"{key:>6}  {what}")
+        # sized from its text, not auto-resized: an auto-resized window is hidden in the frame
+        # it first appears (imgui measures it then), so a screenshot of that frame missed it
+        lines = [f"{key:>6}  {what}" for key, what in KEY_HELP]
+        style = imgui.get_style()
+        width = max(imgui.calc_text_size(line).x for line in lines) + 2 * style.window_padding.x
+        height = (len(lines) * imgui.get_text_line_height_with_spacing() + imgui.get_frame_height()
+                  + 2 * style.window_padding.y)
+        imgui.set_next_window_size(imgui.ImVec2(width, height), imgui.Cond_.always)
+        imgui.begin("Keys", None, imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_resize)
+        for line in lines:
+            imgui.text(line)
         imgui.end()

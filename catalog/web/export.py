@@ -290,25 +290,10 @@ def decode_texels(texture: dict) -> np.ndarray:
 
 
 def fabric_facts(preset) -> dict:
-    """What the page shows of a fabric: openness, brightener, dye, weave."""
-    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    """What the page shows of a fabric: the desktop panel's facts (catalog/web/facts.py)."""
+    from catalog.web.facts import page_facts  # noqa: PLC0415
 
-    dye = scene_lib.dye_transmittance(preset)
-    cloth = preset.table("cloth")
-    fluorescence = preset.fluorescence
-    return {
-        "openness_pct": round(100.0 * float(preset.btdf.direct), 1),
-        "brightener": None if fluorescence is None else {
-            key: float(fluorescence.extra[key]) for key in ("quantum_yield", "peak_absorptance")
-            if key in fluorescence.extra},
-        "dye": None if preset.table("dye").get("transmittance") is None else {
-            "mean_transmittance_pct": round(100.0 * float(np.mean(dye)), 1),
-            "min_transmittance_pct": round(100.0 * float(np.min(dye)), 1)},
-        "weave": cloth.get("weave"),
-        "areal_density_g_m2": (round(1000.0 * float(cloth["areal_density_kg_m2"]), 1)
-                               if "areal_density_kg_m2" in cloth else None),
-        "g_spec": float(preset.btdf.g_spec),
-    }
+    return page_facts(preset)
 
 
 class SiteExporter:
@@ -511,12 +496,14 @@ def _sized(entry: dict) -> dict:
 
 
 def swatch_png(ctx, preset, size=SWATCH_SIZE) -> bytes:
-    """A small desktop frame of the fabric under D65 (the grid's swatch), PNG bytes."""
+    """A small desktop frame of the fabric under D65 with the close-up inset (the grid's
+    swatch, catalog/web/facts.py), PNG bytes."""
     import io  # noqa: PLC0415
 
     from PIL import Image  # noqa: PLC0415
 
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.web.facts import catalog_card  # noqa: PLC0415
 
     renderer = FrameRenderer(ctx, size)
     try:
@@ -524,7 +511,7 @@ def swatch_png(ctx, preset, size=SWATCH_SIZE) -> bytes:
         renderer.set_light("D65")
         renderer.set_camera(0.0, 0.0, 1.9)
         renderer.render()
-        pixels = renderer.read_srgb8()
+        pixels = catalog_card(renderer, renderer.read_srgb8())
     finally:
         renderer.release()
     out = io.BytesIO()

@@ -462,7 +462,8 @@
     yaw_deg: D.camera.yaw_deg, pitch_deg: D.camera.pitch_deg, distance_m: D.camera.distance_m,
     t: 0, playing: true, size: null,
   };
-  const stats = { loadStartMs: performance.timeOrigin ? 0 : 0, firstFrameMs: null, frames: 0, errors: [] };
+  const stats = { loadStartMs: performance.timeOrigin ? 0 : 0, firstFrameMs: null, frames: 0, errors: [],
+                  panesDrawn: 0, contextsLost: 0 };
   let panes = null, dirty = true, lastTime = null, readyResolve, ready = new Promise((r) => (readyResolve = r));
 
   // export.scene_key: fabric, light and the three switches
@@ -477,7 +478,7 @@
       li.setAttribute('role', 'button');
       li.innerHTML = '<img alt=""><h2></h2><p></p>';
       li.querySelector('img').src = 'data:image/png;base64,' + f.swatch;
-      li.querySelector('img').alt = f.display_name + ' under D65';
+      li.querySelector('img').alt = f.display_name + ' under D65, with a close-up of the cloth';
       li.querySelector('h2').textContent = f.display_name;
       li.querySelector('p').textContent = factsLine(f.facts);
       const open = () => set({ view: 'viewer', fabric: f.name });
@@ -486,9 +487,8 @@
       ul.appendChild(li);
     }
   }
-  function factsLine(x) {
-    return x.openness_pct + '% open' + (x.brightener ? ', optical brightener' : '') + (x.dye ? ', dyed' : '') + (x.weave ? ', ' + x.weave : '');
-  }
+  // the desktop panel's words (catalog/presets/facts.py, exported by catalog/web/facts.py)
+  function factsLine(x) { return x.line; }
   function buildControls() {
     const fab = $('fabric'), cmp = $('compare'), light = $('light');
     for (const f of D.fabrics) { fab.add(new Option(f.display_name, f.name)); cmp.add(new Option(f.display_name, f.name)); }
@@ -522,11 +522,8 @@
   }
 
   function showFacts() {
-    const f = fabricByName[state.fabric], x = f.facts, dl = $('facts');
-    const rows = [['Fabric', f.display_name + ' (' + f.name + ')'], ['Openness', x.openness_pct + ' % see-through'],
-      ['Optical brightener', x.brightener ? 'yes, quantum yield ' + x.brightener.quantum_yield + ', peak absorptance ' + x.brightener.peak_absorptance : 'none'],
-      ['Dye', x.dye ? 'transmittance ' + x.dye.mean_transmittance_pct + ' % mean, ' + x.dye.min_transmittance_pct + ' % least' : 'undyed'],
-      ['Weave', (x.weave || '?') + (x.areal_density_g_m2 ? ', ' + x.areal_density_g_m2 + ' g/m²' : '')]];
+    const f = fabricByName[state.fabric], dl = $('facts');
+    const rows = [['Fabric', f.display_name + ' (' + f.name + ')'], ...f.facts.rows];
     const scene = D.scenes[sceneKey(state.fabric)];
     rows.push(['Light', lightOf(state.light).label + ' (' + Math.round(scene.illuminance_lx) + ' lx)']);
     rows.push(['Fluorescence', state.fluorescence === 'on' ? 'on (' + scene.fluorescence_variant + ')' : 'off']);
@@ -551,12 +548,24 @@
     $('caption-b').textContent = state.compare ? fabricByName[state.compare].display_name : '';
     showFacts();
   }
+  let shownHash = null;  // the hash the page wrote last (its own writes are no change)
+  function onHashChange() {
+    if (location.hash === shownHash) return;
+    const p = readHash();
+    if (!('t' in p)) p.playing = true;
+    set({ ...DEFAULTS, ...p });
+  }
   function writeHash() {
     const h = new URLSearchParams({ view: state.view, fabric: state.fabric, light: state.light, fluorescence: state.fluorescence,
                                     glare: state.glare, lamp: state.lamp });
     if (state.compare) h.set('compare', state.compare);
-    history.replaceState(null, '', '#' + h.toString());
+    if (state.size) h.set('size', state.size[0] + 'x' + state.size[1]);
+    const text = '#' + h.toString();
+    if (text !== location.hash) history.replaceState(null, '', text);
+    shownHash = location.hash;
   }
+  const DEFAULTS = { view: 'grid', fabric: D.fabrics[0].name, light: D.lights[0].id, fluorescence: 'on',
+                     glare: 'on', lamp: 'none', compare: '', size: null };
   function readHash() {
     const h = new URLSearchParams(location.hash.slice(1)), p = {};
     if (h.get('fabric') && fabricByName[h.get('fabric')]) p.fabric = h.get('fabric');
@@ -582,46 +591,77 @@
     if (state.view === 'viewer') ensurePanes();
   }
 
+  // One replayer per canvas, made when the pane is first shown (again after a lost context);
+  // input is installed once per canvas.
+  const inputInstalled = new Set(), paneFailed = [false, false], paneLost = [false, false];
+  function makePane(i) {
+    const canvas = $(i === 0 ? 'canvas-a' : 'canvas-b');
+    if (paneFailed[i] || paneLost[i]) return;
+    try { panes[i] = new Replayer(canvas); } catch (e) { paneFailed[i] = true; fail(e); return; }
+    if (!inputInstalled.has(canvas)) {
+      inputInstalled.add(canvas); installInput(canvas);
+      // a lost context (the GPU process reset, memory) shows black until it is made again
+      canvas.addEventListener('webglcontextlost', (e) => { e.preventDefault(); panes[i] = null; paneLost[i] = true; stats.contextsLost++; });
+      canvas.addEventListener('webglcontextrestored', () => { paneLost[i] = false; ensurePanes(); dirty = true; });
+    }
+  }
   function ensurePanes() {
-    if (!panes) {
-      try {
-        panes = [new Replayer($('canvas-a')), null];
-      } catch (e) { fail(e); return; }
-      installInput($('canvas-a'));
-    }
-    if (state.compare && !panes[1]) {
-      try { panes[1] = new Replayer($('canvas-b')); installInput($('canvas-b')); } catch (e) { fail(e); }
-    }
+    if (!panes) panes = [null, null];
+    if (!panes[0]) makePane(0);
+    if (state.compare && !panes[1]) makePane(1);
   }
   function fail(e) { stats.errors.push(String(e)); $('status').textContent = String(e.message || e); console.error(e); }
 
+  // The canvas's size: the pane's width at 4:3, no taller than the window leaves below the
+  // toolbar (with the caption under it), so the whole picture shows without scrolling.
+  const ASPECT = 0.75, MIN_CANVAS_PX = 120;
+  function canvasCssSize(canvas) {
+    const pane = canvas.parentElement, caption = pane.querySelector('figcaption');
+    const top = pane.getBoundingClientRect().top + window.scrollY;
+    const room = window.innerHeight - top - (caption ? caption.offsetHeight : 0) - 8;
+    const width = pane.clientWidth, height = Math.max(MIN_CANVAS_PX, Math.min(width * ASPECT, room));
+    return [Math.floor(Math.min(width, height / ASPECT)), Math.floor(Math.min(width, height / ASPECT) * ASPECT)];
+  }
   function sizeCanvas(canvas) {
-    if (state.size) { canvas.width = state.size[0]; canvas.height = state.size[1]; canvas.style.width = state.size[0] + 'px'; return; }
-    const dpr = Math.min(window.devicePixelRatio || 1, 2), rect = canvas.getBoundingClientRect();
-    const w = Math.max(1, Math.round(rect.width * dpr)), h = Math.max(1, Math.round(rect.width * 0.75 * dpr));
+    if (state.size) {
+      canvas.width = state.size[0]; canvas.height = state.size[1];
+      canvas.style.width = state.size[0] + 'px'; canvas.style.height = state.size[1] + 'px'; return;
+    }
+    const [cssW, cssH] = canvasCssSize(canvas), dpr = Math.min(window.devicePixelRatio || 1, 2);
+    if (canvas.style.width !== cssW + 'px') canvas.style.width = cssW + 'px';
+    if (canvas.style.height !== cssH + 'px') canvas.style.height = cssH + 'px';
+    const w = Math.max(1, Math.round(cssW * dpr)), h = Math.max(1, Math.round(cssH * dpr));
     if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
   }
 
+  // Every pane shown is drawn in the same frame or none is: each pane's cloth is asked for
+  // before any is drawn, and a frame counts as drawn (settle, the first frame) only when every
+  // shown pane has its replayer and its cloth; a pane still waiting keeps the page dirty.
   let pendingLoads = 0;
-  function drawPanes() {
-    const jobs = [[panes[0], state.fabric]];
-    if (state.compare && panes[1]) jobs.push([panes[1], state.compare]);
-    for (const [pane, fabric] of jobs) {
-      const key = fabricByName[fabric].animation;
-      const p = animations[key] && animations[key].done ? animations[key].value : null;
-      if (!p) {
-        if (!animations[key] || !animations[key].pending) {
-          pendingLoads++;
-          animation(key).then((a) => { animations[key].done = true; animations[key].value = a; pendingLoads--; dirty = true; },
-            (e) => { pendingLoads--; fail(e); });
-          animations[key].pending = true;
-        }
-        return false;
-      }
-      sizeCanvas(pane.canvas);
-      pane.setCurtain(p, state.t);
-      pane.render(D.scenes[sceneKey(fabric)], state);
+  function loadedAnimation(fabric) {
+    const key = fabricByName[fabric].animation;
+    if (!animations[key]) {
+      pendingLoads++;
+      animation(key).then((a) => { animations[key].done = true; animations[key].value = a; pendingLoads--; dirty = true; },
+        (e) => { pendingLoads--; animations[key].failed = true; fail(e); });
     }
+    return animations[key].done ? animations[key].value : null;
+  }
+  function drawPanes() {
+    ensurePanes();
+    const jobs = [[0, state.fabric]];
+    if (state.compare) jobs.push([1, state.compare]);
+    for (let k = jobs.length - 1; k >= 0; k--) if (paneFailed[jobs[k][0]]) jobs.splice(k, 1);  // said in the status line
+    if (!jobs.length) return false;
+    const loaded = jobs.map(([, fabric]) => loadedAnimation(fabric));
+    if (loaded.some((a) => !a) || jobs.some(([i]) => !panes[i])) return false;
+    jobs.forEach(([i, fabric], k) => {
+      const pane = panes[i];
+      sizeCanvas(pane.canvas);
+      pane.setCurtain(loaded[k], state.t);
+      pane.render(D.scenes[sceneKey(fabric)], state);
+    });
+    stats.panesDrawn = jobs.length;
     return true;
   }
 
@@ -734,6 +774,7 @@
     buildGrid(); buildControls();
     document.addEventListener('keydown', onKey);
     window.addEventListener('resize', () => (dirty = true));
+    window.addEventListener('hashchange', onHashChange);
     set(readHash());
     stats.unpackMs = unpackMs; stats.gridReadyMs = performance.now();
     requestAnimationFrame(frame);
