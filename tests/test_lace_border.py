@@ -1,4 +1,4 @@
-"""The laces' scalloped border along the hem (tools/lace_motifs.scalloped_border; the
+"""The laces' scalloped border along the hem (scalloped_border in tools/lace_motifs.py; the
 [pattern] border band, common.glsl HEM_BORDER): the band joins the all-over pattern without a
 seam, is cut away below its scallops, and the frame draws the scallops where the band puts them."""
 
