@@ -163,17 +163,13 @@ def test_the_checker_sees_a_forbidden_import(tmp_path):
 
 #: The longest a module of catalog/ may be (docs/GUIDE: small modules with one job each).
 MAX_MODULE_LINES = 900
-#: The frame's setters: what a user chooses (light, fabric, camera, exposure, white balance,
-#: bands, fluorescence, anti-aliasing, room lighting, glare, shadow-map size, curtain,
-#: lamps, sky, environment) and the mesh it draws. Earlier variants of the method are in
-#: git history, not behind switches (issue 31): a setter outside this list fails.
-FRAME_SETTERS = {
-    "set_fabric", "set_light", "set_sun_hour", "set_key_direction", "set_fluorescence",
-    "set_bands", "set_camera", "set_exposure", "set_ev", "set_white_balance", "set_antialiasing",
-    "set_room_lighting", "set_bloom", "set_shadow_map_size", "set_curtain_open", "set_room_lamps",
-    "set_sky_model", "set_environment", "set_patterned", "set_key_second_layer",
-    "set_mesh", "set_fabric_size", "set_mesh_offset", "set_rings",
-}
+#: The frame's only setters: the geometry it draws (the cloth's mesh, its size and offset, the
+#: rings), which the cloth simulation hands it. What a user chooses (light, fabric, camera,
+#: exposure, white balance, bands, fluorescence, anti-aliasing, room lighting, glare,
+#: shadow-map size, curtain, lamps, sky, environment) is one FrameSettings value given to
+#: FrameRenderer(..., settings) or FrameRenderer.update (issue 31); earlier variants of the
+#: method are in git history, not behind switches: any other setter fails.
+FRAME_SETTERS = {"set_mesh", "set_fabric_size", "set_mesh_offset", "set_rings"}
 
 
 def test_no_module_is_over_the_size_limit():
@@ -198,9 +194,9 @@ def _setters_by_name(tree) -> list[int]:
 
 
 def test_the_frame_has_no_ablation_switches():
-    """Every setter of FrameRenderer is a user's choice (FRAME_SETTERS), and no module picks a
-    setter by its name (the image bench's ``getattr(renderer, f"set_{name}")`` of issue 11's
-    switches)."""
+    """FrameRenderer has no setter but the geometry's (FRAME_SETTERS: a user's choices are
+    its FrameSettings), and no module picks a setter by its name (the image bench's
+    ``getattr(renderer, f"set_{name}")`` of issue 11's switches)."""
     extra = _frame_setters(PACKAGE / "render" / "frame.py") - FRAME_SETTERS
     assert extra == set()
     by_name = {p.relative_to(PACKAGE.parent).as_posix(): lines for p in PACKAGE.rglob("*.py")
@@ -211,7 +207,8 @@ def test_the_frame_has_no_ablation_switches():
 def test_the_size_and_switch_checks_can_fail(tmp_path):
     """The checks see a setter outside the list and a setter picked by name."""
     probe = tmp_path / "frame.py"
-    probe.write_text("class FrameRenderer:\n    def set_room_bounces(self, b):\n        pass\n")
-    assert _frame_setters(probe) - FRAME_SETTERS == {"set_room_bounces"}
+    probe.write_text("class FrameRenderer:\n    def set_room_bounces(self, b):\n        pass\n"
+                     "    def set_bands(self, n):\n        pass\n")
+    assert _frame_setters(probe) - FRAME_SETTERS == {"set_room_bounces", "set_bands"}
     tree = ast.parse('def f(r, name):\n    getattr(r, f"set_{name}")(True)\n')
     assert _setters_by_name(tree) == [2]

@@ -64,7 +64,7 @@ class ThumbnailCache:
                 continue
             renderer = self._ensure_renderer()
             try:
-                renderer.set_fabric(entry.preset)
+                renderer.update(fabric=entry.preset)
                 apply_scene(renderer)
                 renderer.render()
                 pixels = renderer.read_srgb8()
@@ -79,9 +79,11 @@ class ThumbnailCache:
     def _ensure_renderer(self):
         if self._renderer is None:
             from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+            from catalog.render.settings import FrameSettings, orbit  # noqa: PLC0415
 
-            self._renderer = FrameRenderer(self.ctx, self.size, specialise=False)
-            self._renderer.set_camera(0.0, 0.0, 2.9)
+            self._renderer = FrameRenderer(self.ctx, self.size,
+                                           FrameSettings(camera=orbit(0.0, 0.0, 2.9)),
+                                           specialise=False)
         return self._renderer
 
     def _store(self, name: str, key: tuple, pixels: np.ndarray) -> None:
