@@ -53,6 +53,7 @@ def render(out: Path, meshes_path: Path) -> None:
     from catalog.gl.context import create_headless_context
     from catalog.presets import find_preset, load_preset
     from catalog.render.frame import FrameRenderer
+    from catalog.render.settings import FrameSettings, SunHour, orbit
     from catalog.render.snapshot import ring_xs_m, simulated_curtain
 
     meshes = dict(np.load(meshes_path, allow_pickle=True)) if meshes_path.exists() else {}
@@ -68,24 +69,12 @@ def render(out: Path, meshes_path: Path) -> None:
                 meshes[f"{fabric}/{k}"] = new_meshes[f"{fabric}/{k}"] = np.asarray(a)
             meshes[f"{fabric}/rings"] = new_meshes[f"{fabric}/rings"] = np.asarray(ring_xs_m(preset))
         mesh = [meshes[f"{fabric}/{k}"] for k in "pnuti"]
-        r = FrameRenderer(ctx, SIZE)
-        r.set_fabric(preset)
-        if light is not None:
-            r.set_light(light)
-        if "sun_hour" in opts: r.set_sun_hour(opts["sun_hour"])
-        if "bands" in opts: r.set_bands(opts["bands"])
-        if "fluorescence" in opts: r.set_fluorescence(opts["fluorescence"])
-        if "antialiasing" in opts: r.set_antialiasing(opts["antialiasing"])
-        else: r.set_antialiasing("fxaa")
-        if "room_lighting" in opts: r.set_room_lighting(opts["room_lighting"])
-        if "shadow_map_size" in opts: r.set_shadow_map_size(opts["shadow_map_size"])
-        if "patterned" in opts: r.set_patterned(opts["patterned"])
-        if "curtain_open" in opts: r.set_curtain_open(opts["curtain_open"])
-        if "lamps" in opts: r.set_room_lamps(opts["lamps"])
-        if "bloom" in opts: r.set_bloom(opts["bloom"])
-        if "ev" in opts: r.set_ev(opts["ev"])
-        if "white_balance" in opts: r.set_white_balance(opts["white_balance"])
-        r.set_camera(*VIEWS[view])
+        options = {"antialiasing": "fxaa", **opts}
+        if "sun_hour" in options:
+            options["light"] = SunHour(options.pop("sun_hour"))
+        elif light is not None:
+            options["light"] = light
+        r = FrameRenderer(ctx, SIZE, FrameSettings(fabric=preset, camera=orbit(*VIEWS[view]), **options))
         r.set_mesh(*mesh, fabric_size_m=tuple(meshes[f"{fabric}/f"]))
         r.set_rings(list(meshes[f"{fabric}/rings"]))
         r.render(); r.render()
