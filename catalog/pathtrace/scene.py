@@ -103,7 +103,7 @@ def rgb_weights(key_irradiance: np.ndarray) -> np.ndarray:
 
 def key_light_for(light) -> tuple[np.ndarray, bool]:
     """The key light's direction (unit, to the light) and whether it is the sun, as the
-    real-time frame places it (:meth:`catalog.render.frame.FrameRenderer.set_light`)."""
+    real-time frame places it (:class:`catalog.render.settings.FrameSettings`' ``key_to_light``)."""
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
     return scene_lib.key_direction(scene_lib.key_elevation_for(light)), light.is_sun

@@ -55,7 +55,7 @@ GLARE = {"on": True, "off": False}
 #: room, 1.5 m above the floor; a floor lamp beside the curtain).
 ROOM_LAMP_POSITION_M = (1.3, 0.2, 1.0)
 #: The room-lamp switch: none, or one lamp of the light library at ROOM_LAMP_POSITION_M
-#: (FrameRenderer.set_room_lamps, `catalog snapshot --lamp`): it lights the room and the cloth.
+#: (FrameSettings.lamps, `catalog snapshot --lamp`): it lights the room and the cloth.
 ROOM_LAMPS = {"none": None, "A": "Incandescent lamp (A)", "LED-B4": "White LED lamp (LED-B4)"}
 #: Sizes that follow the canvas: the recorded frame's (level 0) and its halvings rounded up
 #: (level k: ceil(size / 2^k); the glare's half- and quarter-size targets). The page puts its
@@ -128,7 +128,7 @@ def scene_key(fabric: str, light: str, fluorescence: str, glare: str, lamp: str)
 
 
 def room_lamps(lamp: str) -> list:
-    """FrameRenderer.set_room_lamps' argument for a ROOM_LAMPS choice."""
+    """FrameSettings.lamps for a ROOM_LAMPS choice."""
     if lamp not in ROOM_LAMPS:
         raise CatalogError(f"room lamp {lamp!r}: choose one of {', '.join(ROOM_LAMPS)}")
     return [] if lamp == "none" else [(lamp, ROOM_LAMP_POSITION_M)]
