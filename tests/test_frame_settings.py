@@ -82,7 +82,6 @@ def test_every_field_has_its_row_in_the_stale_table():
     ({"lamps": [("A", (0.5, 0.3, 1.5))]}, {"room_light"}),
     ({"shadow_map_size": 512}, {"room_targets", "room_light"}),
     ({"antialiasing": "off"}, {"msaa_targets"}),
-    ({"environment": "sky.exr"}, {"environment", "room_light"}),
 ])
 def test_what_a_change_makes_stale(change, expected):
     """Only the parts STALE names for the changed fields; an unchanged value nothing."""
@@ -96,3 +95,64 @@ def test_the_same_sun_hour_again_is_no_change():
     s = FrameSettings(light=SunHour(10.0))
     assert settings_lib.changed(s, s.replace(light=SunHour(10.0))) <= {"light"}
     assert settings_lib.changed(s, s.replace(light=SunHour(11.0))) == {"light"}
+
+
+def test_a_missing_environment_is_refused_when_the_value_is_made(tmp_path):
+    with pytest.raises(CatalogError, match="environment image not found"):
+        FrameSettings(environment=tmp_path / "missing.exr")
+
+
+@pytest.fixture
+def no_file_reads(monkeypatch):
+    """Any open() or Path read from here on fails the test."""
+    import builtins
+    import io
+    from pathlib import Path
+
+    def refuse(*args, **kwargs):
+        raise AssertionError(f"a file was read below the edge: {args[:1]}")
+
+    for owner, name in ((builtins, "open"), (io, "open"), (Path, "open"), (Path, "read_text"),
+                        (Path, "read_bytes"), (np, "load"), (np, "loadtxt")):
+        monkeypatch.setattr(owner, name, refuse)
+
+
+def _fluorescent_fabric():
+    from catalog.presets import find_preset, load_preset
+
+    return load_preset(find_preset("lace-fwa"))
+
+
+@pytest.mark.slow
+def test_the_fabric_is_resolved_once_at_the_edge(request):
+    """FrameSettings resolves the fabric's files (catalog.presets.fabric.Fabric: dye,
+    fluorescence spectra, pattern); what the frame derives from it afterwards, under any light
+    and fluorescence mode, reads no file."""
+    from catalog.optics.lights import get_light
+    from catalog.presets.fabric import Fabric, resolve_fabric
+
+    preset = _fluorescent_fabric()
+    s = FrameSettings(fabric=preset, light="D65")
+    assert isinstance(s.resolved_fabric, Fabric) and s.resolved_fabric.preset is preset
+    assert resolve_fabric(preset) is s.resolved_fabric
+    assert s.resolved_fabric.fluorescent_materials and s.resolved_fabric.pattern is not None
+    assert s.resolved_fabric.dye_transmittance.shape == scene_lib.GRID_NM.shape
+    uva = get_light("UV-A")
+    request.getfixturevalue("no_file_reads")
+    for mode in ("off", "paper", "physical"):
+        for light in (s.key_light, uva):
+            inputs, _ = scene_lib.build_shading_inputs(
+                s.fabric, light.irradiance_w_m2_nm, s.key_to_light, is_sun=False,
+                fluorescence=mode, viewer_inside=True)
+            assert np.all(np.isfinite(inputs.key_irradiance))
+    assert s.replace(light=SunHour(10.0), bands=6).resolved_fabric is s.resolved_fabric
+
+
+def test_the_no_read_fixture_sees_a_read(request):
+    """The check above can fail: reading a fabric's spectrum under it is refused."""
+    from catalog.optics.spectra import read_spectrum
+
+    preset = _fluorescent_fabric()
+    request.getfixturevalue("no_file_reads")
+    with pytest.raises(AssertionError, match="below the edge"):
+        read_spectrum(preset.fluorescence.emission)

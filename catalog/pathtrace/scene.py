@@ -145,9 +145,9 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
                                          np.asarray(ring_positions).reshape(-1, 3)])
     pattern = None
-    from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
 
-    loaded = load_pattern(preset)
+    loaded = resolve_fabric(preset).pattern
     if loaded is not None:
         cloth_m = fabric_size or (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
         pattern = {"coverage": np.asarray(loaded.coverage, dtype=np.float32),

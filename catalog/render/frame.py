@@ -141,16 +141,14 @@ class FrameRenderer:
     def _apply(self, new: FrameSettings, parts) -> None:
         """Act on the stale parts (see :data:`settings.STALE`), then keep ``new``."""
         if "fabric_tables" in parts and new.fabric is not None:
-            scene_lib.dye_transmittance(new.fabric)  # refuse a bad dye file now, not at render
-            scene_lib.fluorescent_material(new.fabric)
-            self.fabric_pattern.set_fabric(new.fabric)
+            self.fabric_pattern.set_fabric(new.fabric)   # its tables resolved with the settings
         if "msaa_targets" in parts:
             self.antialiasing = self._resolve_antialiasing(new.antialiasing)
         if "room_targets" in parts and new.shadow_map_size != self.room_targets.shadow_texels:
             self.room_targets.release()
             self.room_targets.shadow_texels = new.shadow_map_size
         if "environment" in parts:
-            self._load_environment(new.environment)
+            self._load_environment(new.environment, new.resolved_environment)
         self._settings = new
         if "room_light" in parts:
             self.lightmap.invalidate()
@@ -170,22 +168,20 @@ class FrameRenderer:
             self.targets.release_msaa()
         return mode
 
-    def _load_environment(self, path) -> None:
-        """The environment image (catalog/render/environment.py) as a texture, or none."""
-        from catalog.render import environment as env  # noqa: PLC0415
-
+    def _load_environment(self, path, resolved) -> None:
+        """The environment image (read with the settings) as a texture, or none."""
         if self.environment is not None:
             self.environment[1].release()
             self.environment = None
         if path is None:
             return
-        pixels = env.load_environment(path)
+        pixels, upper_lx = resolved
         h, w = pixels.shape[:2]
         texture = self.ctx.texture((w, h), 3, data=np.ascontiguousarray(pixels[::-1]).tobytes(),
                                    dtype="f4")
         texture.filter = (self._moderngl.LINEAR, self._moderngl.LINEAR)
         texture.repeat_x, texture.repeat_y = True, False
-        self.environment = (str(path), texture, env.upper_illuminance(pixels))
+        self.environment = (str(path), texture, upper_lx)
 
     # what the passes read, from the settings (read-only)
     preset = property(lambda self: self._settings.fabric, doc="The fabric's Preset.")

@@ -8,7 +8,7 @@ same). The renderer compares the new value with the old one field by field and r
 :data:`STALE` says the changed fields make stale; nothing else is redrawn.
 
 Names are resolved once, when the value is made: a fabric name to its
-:class:`catalog.presets.Preset`, a light name to its :class:`catalog.optics.lights.Light`,
+:class:`catalog.presets.Preset` and its files to a :class:`catalog.presets.fabric.Fabric`, a light name to its :class:`catalog.optics.lights.Light`,
 ``SunHour(h)`` to the sun at that hour. A bad value raises :class:`SettingsError` (a
 ``ValueError`` and an ``InputError``: the CLI prints its one line and exits 2) naming the field.
 """
@@ -16,6 +16,7 @@ Names are resolved once, when the value is made: a fabric name to its
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -106,7 +107,13 @@ class FrameSettings:
     #: while the cloth moves, the room's light is redrawn every this many frames
     room_update_every: int = 1
 
-    # resolved from the fields above when the value is made (not compared, not replaced)
+    # resolved from the fields above when the value is made (not compared, not replaced):
+    # the fabric's tables (catalog.presets.fabric.Fabric: dye, fluorescence, residual, pattern),
+    # the key light, its direction (unit, to the light) and the sun at the hour asked
+    resolved_fabric: object = field(init=False, compare=False, repr=False, default=None)
+    #: the environment image: (linear RGB float32 (H, W, 3), row 0 = zenith; its upper
+    #: hemisphere's horizontal illuminance), or None
+    resolved_environment: tuple | None = field(init=False, compare=False, repr=False, default=None)
     key_light: object = field(init=False, compare=False, repr=False, default=None)
     key_to_light: np.ndarray = field(init=False, compare=False, repr=False, default=None)
     sun: object = field(init=False, compare=False, repr=False, default=None)
@@ -114,6 +121,10 @@ class FrameSettings:
     def __post_init__(self) -> None:
         set_ = object.__setattr__
         set_(self, "fabric", _resolve_fabric(self.fabric))
+        if self.fabric is not None:
+            from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
+
+            set_(self, "resolved_fabric", resolve_fabric(self.fabric))   # every file read here
         key_light, sun, elevation_azimuth = _resolve_light(self.light)
         if isinstance(self.light, str):
             set_(self, "light", key_light)
@@ -164,6 +175,7 @@ class FrameSettings:
             object.__setattr__(self, name, bool(value))
         if self.environment is not None:
             object.__setattr__(self, "environment", str(self.environment))
+            object.__setattr__(self, "resolved_environment", _environment(self.environment))
 
     def replace(self, **changes) -> "FrameSettings":
         """``dataclasses.replace(self, **changes)``."""
@@ -207,6 +219,27 @@ def _resolve_light(light):
     if not isinstance(light, Light):
         raise _refuse("light", f"{light!r}: give a light name, a Light or SunHour(hour)")
     return light, None, (scene_lib.key_elevation_for(light), scene_lib.KEY_AZIMUTH_DEG)
+
+
+def _environment(path: str) -> tuple:
+    """The image at ``path`` read once while it is unchanged (its size and time as the key)."""
+    import os  # noqa: PLC0415
+
+    try:
+        stat = os.stat(path)
+        stamp = (stat.st_size, stat.st_mtime_ns)
+    except OSError:
+        stamp = None   # load_environment names the missing file
+    return _environment_read(path, stamp)
+
+
+@functools.lru_cache(maxsize=2)
+def _environment_read(path: str, _stamp) -> tuple:
+    from catalog.render import environment as env  # noqa: PLC0415
+
+    pixels = env.load_environment(path)
+    pixels.setflags(write=False)
+    return pixels, env.upper_illuminance(pixels)
 
 
 def _resolve_lamps(lamps) -> tuple:
@@ -259,8 +292,8 @@ def changed(old: FrameSettings, new: FrameSettings) -> frozenset[str]:
 
 
 #: What changed -> what is stale. The renderer (FrameRenderer.update) acts on each name:
-#:   fabric_tables  re-read nothing: check the fabric's dye and fluorescence tables, upload its
-#:                  pattern (PatternTexture)
+#:   fabric_tables  the fabric's pattern uploaded (PatternTexture); its files were read when
+#:                  the settings were made (resolved_fabric), none is read here
 #:   scene_terms    the shading inputs (SceneTerms, keyed on fabric, light, key, mode, the
 #:                  viewer's side of the window) and what follows them: the curtain's uniforms
 #:                  or specialised program, the background's sky
