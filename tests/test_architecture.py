@@ -212,3 +212,65 @@ def test_the_size_and_switch_checks_can_fail(tmp_path):
     assert _frame_setters(probe) - FRAME_SETTERS == {"set_room_bounces", "set_bands"}
     tree = ast.parse('def f(r, name):\n    getattr(r, f"set_{name}")(True)\n')
     assert _setters_by_name(tree) == [2]
+
+
+#: Below the edge (issue 31): the renderers draw the resolved scene (FrameSettings, its
+#: catalog.presets.fabric.Fabric) and read no file. The packages checked:
+BELOW_THE_EDGE = ("render", "pathtrace", "cloth")
+#: The modules among them that may read a file, and why.
+MAY_READ = {
+    "catalog/render/settings.py": "the edge's resolution: a preset name, the environment image",
+    "catalog/render/snapshot.py": "the snapshot command: its request resolved (the edge)",
+    "catalog/render/sheet.py": "the sheet command: its presets resolved (the edge)",
+    "catalog/pathtrace/render.py": "the reference command: its request resolved (the edge)",
+    "catalog/render/environment.py": "the environment image's reader (settings call it)",
+    "catalog/render/imagefile.py": "image files written and read back (the commands' outputs)",
+    "catalog/render/display.py": "the display's own tables (package data, not the scene)",
+    "catalog/render/room_light/geometry.py": "the room's stored ambient occlusion (package data)",
+    "catalog/cloth/drape_cache.py": "the drape cache (results kept, not inputs)",
+    "catalog/render/scene.py": "load_props: a prop mesh by path (not yet resolved at the edge)",
+    "catalog/pathtrace/scene.py": "a room given by path (not yet resolved at the edge)",
+}
+#: What reads a file: a call of open(), np.load, json/tomllib/pickle/trimesh.load, an image
+#: input's open, a Path's read_text/read_bytes, an imread/read_image/loadtxt, or one of the
+#: project's readers (presets, spectra, patterns, residuals, environments, rooms).
+_LOADERS = {"load": {"np", "numpy", "json", "tomllib", "pickle", "trimesh"}, "loads": {"tomllib"},
+            "open": {"ImageInput", "Image", "gzip", "zipfile", "tarfile", "io"}}
+_READ_METHODS = {"read_text", "read_bytes", "imread", "read_image", "loadtxt", "genfromtxt",
+                 "fromfile"}
+_READERS = {"open", "read_spectrum", "load_preset", "find_preset", "load_pattern",
+            "pattern_from_images", "read_residual", "load_environment", "load_room"}
+
+
+def _file_reads(tree) -> list[tuple[int, str]]:
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        f = node.func
+        if isinstance(f, ast.Name) and f.id in _READERS:
+            found.append((node.lineno, f.id))
+        elif isinstance(f, ast.Attribute):
+            base = f.value.attr if isinstance(f.value, ast.Attribute) else getattr(f.value, "id", None)
+            if f.attr in _READ_METHODS or f.attr in _READERS or base in _LOADERS.get(f.attr, ()):
+                found.append((node.lineno, ast.unparse(f)))
+    return found
+
+
+def test_no_file_is_read_below_the_edge():
+    """No module of render/, pathtrace/ or cloth/ reads a file but those MAY_READ names; the
+    frame, its passes and the scene terms draw what the edge resolved."""
+    reads = {}
+    for package in BELOW_THE_EDGE:
+        for path in sorted((PACKAGE / package).rglob("*.py")):
+            name = path.relative_to(PACKAGE.parent).as_posix()
+            if name not in MAY_READ and (found := _file_reads(ast.parse(path.read_text(encoding="utf-8")))):
+                reads[name] = found
+    assert reads == {}
+
+
+def test_the_file_read_check_can_fail():
+    tree = ast.parse("import numpy as np\nfrom pathlib import Path\n"
+                     "def f(p):\n    a = np.load(p)\n    b = Path(p).read_text()\n"
+                     "    c = open(p)\n    d = read_spectrum(p)\n    e = self.backend.load(p)\n")
+    assert [line for line, _ in _file_reads(tree)] == [4, 5, 6, 7]
