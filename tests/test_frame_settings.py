@@ -156,3 +156,36 @@ def test_the_no_read_fixture_sees_a_read(request):
     request.getfixturevalue("no_file_reads")
     with pytest.raises(AssertionError, match="below the edge"):
         read_spectrum(preset.fluorescence.emission)
+
+
+@pytest.mark.slow
+def test_the_renderer_redraws_what_the_table_says(gl):
+    """FrameRenderer.update acts on settings.STALE: after a frame, a change of the glare or
+    the exposure leaves the room's light as it is (LightmapPass.stale false) and the frame
+    as it was where nothing changed; a lamp or the curtain makes the room's light stale; the
+    frame's read-only views follow the value; a bad value leaves the renderer's settings."""
+    from catalog.render.frame import FrameRenderer
+
+    settings = FrameSettings(fabric="voile-white", light="D65", ev=10.0, antialiasing="off",
+                             camera=orbit(20.0, 15.0, 2.6, inside=True))
+    r = FrameRenderer(gl, (64, 36), settings)
+    try:
+        r.render()
+        first = r.read_linear()
+        assert r.update(bloom=False) == {"glare"}
+        assert not r.lightmap.stale()
+        assert r.update(ev=11.0) == {"display"} and r.ev100 == 11.0
+        r.render()
+        assert np.array_equal(r.read_linear(), first)   # the HDR frame: untouched by either
+        assert r.update(lamps=[("A", (0.5, 0.3, 1.5))]) == {"room_light"}
+        assert r.lightmap.stale()
+        r.render()
+        assert not r.lightmap.stale()
+        assert r.update(curtain_open=True) == {"room_light"} and r.curtain_open
+        before = r.settings
+        with pytest.raises(SettingsError, match="^bands: "):
+            r.update(bands=7)
+        assert r.settings is before
+        assert r.update(before) == frozenset()
+    finally:
+        r.release()

@@ -43,11 +43,9 @@ OIT composite.
 
 from __future__ import annotations
 
-import math
+import dataclasses
 
 import numpy as np
-
-import dataclasses
 
 from catalog.core.errors import CatalogError
 from catalog.render import display as display_lib
