@@ -513,9 +513,10 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
 
 @pytest.mark.slow
 def test_shadow_map_size_is_a_frame_option(gl):
-    """set_shadow_map_size (issue 11's Pareto): the maps are made again at the new side (read
-    back at that size), the room's beam patch keeps its mean within 2 % (the map's resolution
-    moves its edges, not its light), and a size outside SHADOW_MAP_SIZES is one InputError."""
+    """FrameSettings.shadow_map_size (issue 11's Pareto): the maps are made again at the new
+    side (read back at that size), the room's beam patch keeps its mean within 2 % (the map's
+    resolution moves its edges, not its light), and a size outside SHADOW_MAP_SIZES is one
+    InputError naming the field."""
     from catalog.core.errors import InputError
     from catalog.render.passes.shadow import SHADOW_MAP_SIZES
 
@@ -529,7 +530,7 @@ def test_shadow_map_size_is_a_frame_option(gl):
         means[texels] = _luma(image[patch]).mean()
     assert means[128] == pytest.approx(means[512], rel=0.02)
     assert r.info()["shadow_map_size"] == 512
-    with pytest.raises(InputError, match="shadow map size"):
+    with pytest.raises(InputError, match="^shadow_map_size: 300: choose one of"):
         r.update(shadow_map_size=300)
     assert 300 not in SHADOW_MAP_SIZES
     r.release()
