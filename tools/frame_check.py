@@ -3,8 +3,9 @@
     PYTHONPATH=TREE python tools/frame_check.py render OUT.npz MESHES.npz
     python tools/frame_check.py compare BEFORE.npz AFTER.npz
 
-``render`` draws CASES (the image bench's six scenes and options a user changes) at 320x180
-with the tree on PYTHONPATH (e.g. ``git archive before-31 | tar -x -C /tmp/base``) and writes
+``render`` draws CASES (the image bench's six scenes and options a user changes; an option
+is a FrameSettings field) at 320x180 with the tree on PYTHONPATH (e.g. ``git archive
+before-31 | tar -x -C /tmp/base``: a tree without FrameSettings is driven by its setters) and writes
 each frame's linear radiance and its sRGB8 display image; the cloth's settled meshes are
 written to MESHES.npz on the first run and read on the next, so both trees draw the same
 vertices. ``compare`` prints per case the largest and mean relative difference of the linear
@@ -53,7 +54,6 @@ def render(out: Path, meshes_path: Path) -> None:
     from catalog.gl.context import create_headless_context
     from catalog.presets import find_preset, load_preset
     from catalog.render.frame import FrameRenderer
-    from catalog.render.settings import FrameSettings, SunHour, orbit
     from catalog.render.snapshot import ring_xs_m, simulated_curtain
 
     meshes = dict(np.load(meshes_path, allow_pickle=True)) if meshes_path.exists() else {}
@@ -69,12 +69,7 @@ def render(out: Path, meshes_path: Path) -> None:
                 meshes[f"{fabric}/{k}"] = new_meshes[f"{fabric}/{k}"] = np.asarray(a)
             meshes[f"{fabric}/rings"] = new_meshes[f"{fabric}/rings"] = np.asarray(ring_xs_m(preset))
         mesh = [meshes[f"{fabric}/{k}"] for k in "pnuti"]
-        options = {"antialiasing": "fxaa", **opts}
-        if "sun_hour" in options:
-            options["light"] = SunHour(options.pop("sun_hour"))
-        elif light is not None:
-            options["light"] = light
-        r = FrameRenderer(ctx, SIZE, FrameSettings(fabric=preset, camera=orbit(*VIEWS[view]), **options))
+        r = _renderer(FrameRenderer, ctx, preset, light, view, opts)
         r.set_mesh(*mesh, fabric_size_m=tuple(meshes[f"{fabric}/f"]))
         r.set_rings(list(meshes[f"{fabric}/rings"]))
         r.render(); r.render()
@@ -85,6 +80,29 @@ def render(out: Path, meshes_path: Path) -> None:
     np.savez_compressed(out, **{f"lin:{k}": v for k, v in frames.items()}, **{f"srgb:{k}": v for k, v in srgb.items()})
     if new_meshes and not meshes_path.exists():
         np.savez(meshes_path, **meshes)
+
+
+def _renderer(FrameRenderer, ctx, preset, light, view, opts):
+    """A FrameRenderer of the case: from its FrameSettings, or (a tree before the settings
+    value, e.g. the tag before-31) through the setters the options name."""
+    options = {"antialiasing": "fxaa", **opts}
+    try:
+        from catalog.render.settings import FrameSettings, SunHour, orbit
+    except ImportError:
+        r = FrameRenderer(ctx, SIZE)
+        r.set_fabric(preset)
+        if light is not None:
+            r.set_light(light)
+        setters = {"lamps": "room_lamps"}
+        for name, value in options.items():
+            getattr(r, f"set_{setters.get(name, name)}")(value)
+        r.set_camera(*VIEWS[view])
+        return r
+    if "sun_hour" in options:
+        options["light"] = SunHour(options.pop("sun_hour"))
+    elif light is not None:
+        options["light"] = light
+    return FrameRenderer(ctx, SIZE, FrameSettings(fabric=preset, camera=orbit(*VIEWS[view]), **options))
 
 
 def compare(before: Path, after: Path) -> float:
