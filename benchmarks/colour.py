@@ -68,7 +68,7 @@ def truth_inputs(renderer):
     own test background); the truth does not."""
     from catalog.render.scene import fluorescent_material, with_physical_emission  # noqa: PLC0415
 
-    renderer.set_fluorescence("physical")
+    renderer.update(fluorescence="physical")
     inputs = renderer.shading_inputs()
     material = fluorescent_material(renderer.preset)
     if material is None or inputs.fluorescence_mode == "physical":
@@ -85,8 +85,7 @@ def case_errors(renderer, reference_inputs) -> tuple[dict[str, np.ndarray], dict
     truth = None
     info: dict = {}
     for label, mode, bands in VARIANTS:
-        renderer.set_fluorescence(mode)
-        renderer.set_bands(bands)
+        renderer.update(fluorescence=mode, bands=bands)
         gbuffer = renderer.render_gbuffer()
         mask = gbuffer["mask"]
         if truth is None:
@@ -110,8 +109,7 @@ def case_errors(renderer, reference_inputs) -> tuple[dict[str, np.ndarray], dict
 
 def frame_seconds(renderer, mode: str, bands: int, repeats: int) -> tuple[float, float]:
     """(median wall s, median process CPU s) of one whole frame."""
-    renderer.set_fluorescence(mode)
-    renderer.set_bands(bands)
+    renderer.update(fluorescence=mode, bands=bands)
     return median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=renderer.ctx.finish)
 
 
@@ -142,16 +140,16 @@ def run(quick: bool = False, ctx=None, *, fabrics=None, lights=None, error_size=
     # the colours of the bands and the glow against their spectral truth: the room side's
     # stand-ins kept, the room unlit (the room's solved light is an RGB term outside the
     # bands, which tests/test_render_frame.py holds to its twin per pixel)
-    error_renderer.set_room_lighting(False)
+    error_renderer.update(room_lighting=False)
     time_renderer = FrameRenderer(ctx, time_size)
     rows = []
     try:
         for preset in presets:
             for renderer in (error_renderer, time_renderer):
-                renderer.set_fabric(preset)
+                renderer.update(fabric=preset)
             for light in lights:
                 for renderer in (error_renderer, time_renderer):
-                    renderer.set_light(light)
+                    renderer.update(light=light)
                 errors, info = case_errors(error_renderer, truth_inputs(error_renderer))
                 times = {label: frame_seconds(time_renderer, mode, bands, repeats)
                          for label, mode, bands in VARIANTS}

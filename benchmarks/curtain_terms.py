@@ -73,15 +73,14 @@ def _drawer(renderer, drop=(), fragment=None):
 def run_scene(ctx, size, fabric, light, repeats) -> dict:
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.settings import orbit  # noqa: PLC0415
     from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
 
     preset = load_preset(find_preset(fabric))
     *mesh, fabric_size_m = simulated_curtain(preset, 0)
     renderer = FrameRenderer(ctx, size)
     try:
-        renderer.set_fabric(preset)
-        renderer.set_light(_light_name(light))
-        renderer.set_camera(20.0, 15.0, 2.6)
+        renderer.update(fabric=preset, light=_light_name(light), camera=orbit(20.0, 15.0, 2.6))
         renderer.set_mesh(*mesh, fabric_size_m=fabric_size_m)
         renderer.set_rings(ring_xs_m(preset))
         renderer.render()   # the room's light, shadow and occlusion maps the terms read

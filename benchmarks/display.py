@@ -34,9 +34,7 @@ def run(quick: bool = False, ctx=None, size=(640, 360)) -> dict:
     rows = []
     try:
         for fabric, light in SCENES:
-            renderer.set_fabric(fabric)
-            renderer.set_light(light)
-            renderer.set_ev(None)
+            renderer.update(fabric=fabric, light=light, ev=None)
             renderer.render()
             w, h = renderer.size
             row = {"fabric": fabric, "light": light, "size": list(size)}

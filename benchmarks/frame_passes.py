@@ -52,16 +52,17 @@ def run_scene(ctx, size, fabric, light, camera, repeats) -> dict:
     from benchmarks.timing import median_wall_and_cpu  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.settings import orbit  # noqa: PLC0415
     from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
 
     preset = load_preset(find_preset(fabric))
     *mesh, fabric_size_m = simulated_curtain(preset, 0)
     renderer = FrameRenderer(ctx, size)
     try:
-        renderer.set_fabric(preset)
-        renderer.set_light(_light_name(light))
-        renderer.set_antialiasing("fxaa")
-        renderer.set_camera(*camera)
+        renderer.update(fabric=preset,
+                        light=_light_name(light),
+                        antialiasing="fxaa",
+                        camera=orbit(*camera))
         renderer.set_mesh(*mesh, fabric_size_m=fabric_size_m)
         renderer.set_rings(ring_xs_m(preset))
         renderer.render()

@@ -72,13 +72,8 @@ def run_case(ctx, size: tuple[int, int], grid: tuple[int, int], backend: str, fr
     preset = load_preset(find_preset(fabric))
     scene = CurtainScene(grid, backend=backend, wind_m_s=wind_m_s, ctx=ctx)
     renderer = FrameRenderer(ctx, size)
-    renderer.set_antialiasing(antialiasing)
-    renderer.set_bloom(True)
-    renderer.set_room_lighting(True)
-    renderer.set_sky_model(True)
-    renderer.room_update_every = 1
-    renderer.set_fabric(preset)
-    renderer.set_light(light)
+    renderer.update(antialiasing=antialiasing, bloom=True, room_lighting=True, sky_model=True,
+                    room_update_every=1, fabric=preset, light=light)
     scene.set_fabric(preset)
     scene.set_wind(wind_m_s)
     start = time.perf_counter()

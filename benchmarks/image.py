@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.timing import median_wall_and_cpu
+from catalog.render.settings import orbit
 
 #: The camera of each view: (yaw deg, pitch deg, distance m). The room view looks down
 #: across the room so that the floor by the window is in the picture.
@@ -195,18 +196,15 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
     width, height = desc.size
     renderer = FrameRenderer(ctx, (width * supersample, height * supersample))
     try:
-        renderer.set_fabric(preset)
-        renderer.set_light(light)
-        renderer.set_fluorescence(mode)
-        renderer.set_bands(bands)
+        renderer.update(fabric=preset, light=light, fluorescence=mode, bands=bands)
         if antialiasing is not None:
-            renderer.set_antialiasing(antialiasing)
+            renderer.update(antialiasing=antialiasing)
         if room_lighting is not None:
-            renderer.set_room_lighting(room_lighting)
+            renderer.update(room_lighting=room_lighting)
         if shadow_map_size is not None:
-            renderer.set_shadow_map_size(shadow_map_size)
+            renderer.update(shadow_map_size=shadow_map_size)
         cam = desc.info["camera"]
-        renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
+        renderer.update(camera=orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"]))
         renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
         renderer.set_rings(list(desc.ring_xs_m))
         wall, _cpu = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)

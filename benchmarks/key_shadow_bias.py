@@ -20,6 +20,7 @@ the share of the remaining pixels where the G-buffer's "behind" (front coverage 
 from __future__ import annotations
 
 import numpy as np
+from catalog.render.settings import orbit
 
 #: (base bias m, slope texels, tangent cap, normal offset texels); the first is the frame's
 #: earlier constant 2 cm.
@@ -86,12 +87,12 @@ def run(ctx=None, size=(96, 72), fabric: str = "voile-white") -> dict:
             for (elevation, azimuth), (m, mesh) in [(k, d) for d in enumerate(meshes) for k in KEYS]:
                 renderer = frame_lib.FrameRenderer(ctx, size)
                 try:
-                    renderer.set_fabric(preset)
-                    renderer.set_light("D65")
-                    renderer.set_fluorescence("off")
-                    renderer.set_camera(0.0, 0.0, 1.6)
+                    renderer.update(fabric=preset,
+                                    light="D65",
+                                    fluorescence="off",
+                                    camera=orbit(0.0, 0.0, 1.6))
                     renderer.set_mesh(mesh.positions, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices)
-                    renderer.set_key_direction(elevation_deg=elevation, azimuth_deg=azimuth)
+                    renderer.update(key_direction_deg=(elevation, azimuth))
                     g = renderer.render_gbuffer()
                     to_light = np.asarray(renderer.shading_inputs().key_to_light, dtype=np.float64)
                 finally:

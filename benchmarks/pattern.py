@@ -58,17 +58,13 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = N
     static = draped_curtain()
     *settled, fabric_size = simulated_curtain(preset, 0)
     renderer = FrameRenderer(ctx, size)
-    renderer.set_fabric(preset)
-    renderer.set_light(LIGHT)
+    renderer.update(fabric=preset, light=LIGHT)
     # issue 13's room light, sky and glare off on both sides: issue 12's additions alone
     # (benchmarks.room measures those against the frame without them)
-    renderer.set_room_lighting(False)
-    renderer.set_sky_model(False)
-    renderer.set_bloom(False)
+    renderer.update(room_lighting=False, sky_model=False, bloom=False)
 
     def configure(patterned, aa, mesh):
-        renderer.set_patterned(patterned)
-        renderer.set_antialiasing(aa)
+        renderer.update(patterned=patterned, antialiasing=aa)
         if mesh == "static":
             renderer.set_mesh(static.positions, static.normals, static.uvs, static.tangents,
                               static.indices)

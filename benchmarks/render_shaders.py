@@ -185,13 +185,13 @@ def band_errors(ctx, preset) -> dict:
 
     rows = {}
     renderer = FrameRenderer(ctx, (96, 64))
-    renderer.set_fabric(preset)
+    renderer.update(fabric=preset)
     for light in ("D65", "A", "sun:100"):
-        renderer.set_light(light)
+        renderer.update(light=light)
         for mode in ("off", "physical", "paper"):
-            renderer.set_fluorescence(mode)
+            renderer.update(fluorescence=mode)
             for n in (3, 6, 9, 16):
-                renderer.set_bands(n)
+                renderer.update(bands=n)
                 gb = renderer.render_gbuffer()
                 m = gb["mask"]
                 inputs = renderer.curtain_inputs()
@@ -223,8 +223,7 @@ def main(argv=None) -> int:
     preset = bench_preset(args.fabric)
     ctx = create_headless_context()
     renderer = FrameRenderer(ctx, size)
-    renderer.set_fabric(preset)
-    renderer.set_light("D65")
+    renderer.update(fabric=preset, light="D65")
 
     variants = [("trivial", None, None, None)]
     # context for the ratios (not floors that the goal is measured against): the trivial shader
@@ -257,14 +256,10 @@ def main(argv=None) -> int:
         variant = replace(base, btdf=replace(base.btdf, direct=direct))
         if direct != base.btdf.direct:   # a pattern's open area must equal LD: the flat cloth
             variant = replace(variant, raw={k: v for k, v in base.raw.items() if k != "pattern"})
-        variant_renderer.set_fabric(variant)
-        variant_renderer.set_light("D65")
-        variant_renderer.set_fluorescence(mode)
-        variant_renderer.set_bands(n_bands)
+        variant_renderer.update(fabric=variant, light="D65", fluorescence=mode, bands=n_bands)
         defines_of[label] = {k: v for k, v in variant_renderer.curtain.variant_defines().items() if v}
         drawers[label] = curtain_timer(variant_renderer, None)
-    renderer.set_fluorescence("physical")
-    renderer.set_bands(3)
+    renderer.update(fluorescence="physical", bands=3)
     frame_label = "whole frame (rgb physical: background, room, curtain, tone map)"
     drawers[frame_label] = renderer.render
     for draw in drawers.values():  # compile and warm up

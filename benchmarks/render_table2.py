@@ -15,6 +15,7 @@ import sys
 
 
 from catalog.core.resources import FABRIC_DIR
+from catalog.render.settings import SunHour
 
 RESULT_JSON = "benchmarks/render_table2.json"
 MODES = ("physical", "paper")
@@ -25,10 +26,7 @@ def _lit_cloth_mean(ctx, size, preset, mode: str, hour: float, ev):
 
     renderer = FrameRenderer(ctx, size)
     try:
-        renderer.set_ev(ev)
-        renderer.set_fabric(preset)
-        renderer.set_sun_hour(hour)
-        renderer.set_fluorescence(mode)
+        renderer.update(ev=ev, fabric=preset, light=SunHour(hour), fluorescence=mode)
         mask = renderer.render_gbuffer()["mask"]
         renderer.render()
         linear = renderer.read_linear()[mask].mean(axis=0)

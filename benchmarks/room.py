@@ -51,9 +51,9 @@ CONFIGS = (
 
 
 def _configure(renderer, config) -> None:
-    renderer.set_room_lighting(config["room_lighting"])
-    renderer.set_sky_model(config["sky_model"])
-    renderer.set_bloom(config["bloom"])
+    renderer.update(room_lighting=config["room_lighting"],
+                    sky_model=config["sky_model"],
+                    bloom=config["bloom"])
 
 
 def _frame(renderer, ctx, config, index: int = 0) -> float:
@@ -131,8 +131,7 @@ def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int = 7) -> di
     if quick:
         size, repeats = (320, 180), 3
     renderer = FrameRenderer(ctx, size)
-    renderer.set_fabric("lace-fwa")
-    renderer.set_light("sun:60")
+    renderer.update(fabric="lace-fwa", light="sun:60")
     samples = {name: [] for name, _ in CONFIGS}
     for name, config in CONFIGS:  # warm-up: compile every variant
         _configure(renderer, config)

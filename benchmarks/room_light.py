@@ -34,17 +34,15 @@ def frame_linear(ctx, desc, preset, light, room: str | None, repeats: int = 3) -
     (None: the box's special-case light), and its median render time (s)."""
     from benchmarks.timing import median_wall_and_cpu  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.settings import orbit  # noqa: PLC0415
 
     renderer = FrameRenderer(ctx, desc.size)
     try:
-        renderer.set_fabric(preset)
-        renderer.set_light(light)
-        renderer.set_fluorescence("physical")
-        renderer.set_bands(3)
+        renderer.update(fabric=preset, light=light, fluorescence="physical", bands=3)
         if room is not None:
-            renderer.set_room(room)
+            renderer.update(room=room)
         cam = desc.info["camera"]
-        renderer.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
+        renderer.update(camera=orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"]))
         renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
         renderer.set_rings(list(desc.ring_xs_m))
         wall, _cpu = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)
@@ -140,6 +138,7 @@ def cost(size=(1280, 720), repeats: int = 7) -> dict:
     included) and little of other processes', its ratios the steadier."""
     from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.settings import orbit  # noqa: PLC0415
 
     ctx = create_headless_context()
     configs = (("none", None, False), ("special_case", None, True),
@@ -147,14 +146,12 @@ def cost(size=(1280, 720), repeats: int = 7) -> dict:
     renderers, setup = {}, {}
     for name, room, lit in configs:
         renderer = FrameRenderer(ctx, size)
-        renderer.set_fabric("lace-fwa")
-        renderer.set_light("D65")
-        renderer.set_room_lighting(lit)
+        renderer.update(fabric="lace-fwa", light="D65", room_lighting=lit)
         if room is not None:
             start = time.perf_counter()
-            renderer.set_room(room)
+            renderer.update(room=room)
             setup[name] = time.perf_counter() - start
-        renderer.set_camera(20.0, -5.0, 2.8, inside=True)
+        renderer.update(camera=orbit(20.0, -5.0, 2.8, inside=True))
         renderer.render()
         renderers[name] = renderer
     samples = {name: {"static": [], "update": [], "static_cpu": [], "update_cpu": []} for name in renderers}

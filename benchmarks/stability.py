@@ -160,13 +160,13 @@ def render_sweep(ctx, scales, quick: bool) -> list[dict]:
     rows = []
     try:
         for label, preset in variants:
-            renderer.set_fabric(preset)
+            renderer.update(fabric=preset)
             for light_name in (("sun:22",) if quick else ("sun:22", "UV-A")):
                 light0 = get_light(light_name)
                 worst, bad, checked = 0.0, 0, 0
                 for scale in scales:
                     light = replace(light0, irradiance_w_m2_nm=light0.irradiance_w_m2_nm * scale)
-                    renderer.set_light(light)
+                    renderer.update(light=light)
                     gb = renderer.render_gbuffer()
                     m = gb["mask"]
                     rgb = gb["radiance"][m].astype(np.float64)
@@ -196,15 +196,14 @@ def band_scaling(ctx, scales) -> list[dict]:
     renderer = FrameRenderer(ctx, (48, 27))
     rows = []
     try:
-        renderer.set_fabric(load_preset(find_preset("sheer-teal")))
-        renderer.set_bands(16)
+        renderer.update(fabric=load_preset(find_preset("sheer-teal")), bands=16)
         light0 = get_light("D65")
-        renderer.set_light(light0)
+        renderer.update(light=light0)
         unit = renderer.render_gbuffer()["radiance"].astype(np.float64)
         mask = np.any(unit != 0, axis=-1)
         worst, bad = 0.0, 0
         for scale in scales:
-            renderer.set_light(replace(light0, irradiance_w_m2_nm=light0.irradiance_w_m2_nm * scale))
+            renderer.update(light=replace(light0, irradiance_w_m2_nm=light0.irradiance_w_m2_nm * scale))
             frame = renderer.render_gbuffer()["radiance"].astype(np.float64)
             bad += int(np.sum(~np.isfinite(frame)))
             y = np.abs(unit[mask]).max(axis=1)

@@ -524,9 +524,7 @@ def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> d
     renderers = {}
     for label, preset in (("single band (today)", single), ("banded", banded)):
         renderer = FrameRenderer(ctx, tuple(size))
-        renderer.set_fabric(preset)
-        renderer.set_light("LED-405")
-        renderer.set_fluorescence("physical")
+        renderer.update(fabric=preset, light="LED-405", fluorescence="physical")
         renderer.render()
         renderers[label] = renderer
     ctx.finish()

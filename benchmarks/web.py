@@ -51,11 +51,9 @@ class DesktopFrames:
         from catalog.web.export import GLARE as GLARE_SWITCH  # noqa: PLC0415
         from catalog.web.export import room_lamps  # noqa: PLC0415
 
-        self.renderer.set_fabric(FABRIC)
+        self.renderer.update(fabric=FABRIC)
         configure_desktop_frame(self.renderer)
-        self.renderer.set_bloom(GLARE_SWITCH[GLARE])
-        self.renderer.set_room_lamps(room_lamps(LAMP))
-        self.renderer.set_light(LIGHT)
+        self.renderer.update(bloom=GLARE_SWITCH[GLARE], lamps=room_lamps(LAMP), light=LIGHT)
         self.renderer.set_mesh(positions, normals, animation.uv, tangents,
                                animation.indices.astype(np.int32),
                                fabric_size_m=animation.fabric_size_m)
@@ -63,7 +61,7 @@ class DesktopFrames:
         self.renderer.set_rings(animation.rings_x_m)
         self.times(1)  # compile, and meter the exposure once
         # like the page: a fixed exposure (no per-frame read-back and histogram)
-        self.renderer.set_ev(self.renderer.current_ev100())
+        self.renderer.update(ev=self.renderer.current_ev100())
 
     def times(self, frames: int) -> list[float]:
         """ms of each of ``frames`` frames (render + finish). Two of these frames run side by

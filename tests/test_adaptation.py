@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from catalog.render import adaptation, display
+from catalog.render.settings import SunHour, orbit
 
 
 def test_degree_of_adaptation_is_cat16s():
@@ -108,12 +109,11 @@ def curtain_lab(gl_context):
             preset = load_preset(find_preset(fabric))
             r = FrameRenderer(gl_context, (160, 90))
             try:
-                r.set_fabric(preset)
-                r.set_camera(0.0, 0.0, 0.8)
+                r.update(fabric=preset, camera=orbit(0.0, 0.0, 0.8))
                 *mesh, size = simulated_curtain(preset, 0)
                 r.set_mesh(*mesh, fabric_size_m=size)
                 r.set_rings(ring_xs_m(preset))
-                r.set_sun_hour(hour)
+                r.update(light=SunHour(hour))
                 r.render()
                 lab = _lab(r.read_srgb8()[20:70, 30:130]).reshape(-1, 3)
             finally:

@@ -163,17 +163,13 @@ def test_the_checker_sees_a_forbidden_import(tmp_path):
 
 #: The longest a module of catalog/ may be (docs/GUIDE: small modules with one job each).
 MAX_MODULE_LINES = 900
-#: The frame's setters: what a user chooses (light, fabric, camera, exposure, white balance,
-#: bands, fluorescence, anti-aliasing, room lighting, glare, shadow-map size, curtain,
-#: lamps, sky, environment) and the mesh it draws. Earlier variants of the method are in
-#: git history, not behind switches (issue 31): a setter outside this list fails.
-FRAME_SETTERS = {
-    "set_fabric", "set_light", "set_sun_hour", "set_key_direction", "set_fluorescence",
-    "set_bands", "set_camera", "set_exposure", "set_ev", "set_white_balance", "set_antialiasing",
-    "set_room_lighting", "set_bloom", "set_shadow_map_size", "set_curtain_open", "set_room_lamps",
-    "set_sky_model", "set_environment", "set_patterned", "set_key_second_layer",
-    "set_mesh", "set_fabric_size", "set_mesh_offset", "set_rings", "set_room",
-}
+#: The frame's only setters: the geometry it draws (the cloth's mesh, its size and offset, the
+#: rings), which the cloth simulation hands it. What a user chooses (light, fabric, camera,
+#: exposure, white balance, bands, fluorescence, anti-aliasing, room lighting, glare,
+#: shadow-map size, curtain, lamps, sky, environment) is one FrameSettings value given to
+#: FrameRenderer(..., settings) or FrameRenderer.update (issue 31); earlier variants of the
+#: method are in git history, not behind switches: any other setter fails.
+FRAME_SETTERS = {"set_mesh", "set_fabric_size", "set_mesh_offset", "set_rings"}
 
 
 def test_no_module_is_over_the_size_limit():
@@ -198,9 +194,9 @@ def _setters_by_name(tree) -> list[int]:
 
 
 def test_the_frame_has_no_ablation_switches():
-    """Every setter of FrameRenderer is a user's choice (FRAME_SETTERS), and no module picks a
-    setter by its name (the image bench's ``getattr(renderer, f"set_{name}")`` of issue 11's
-    switches)."""
+    """FrameRenderer has no setter but the geometry's (FRAME_SETTERS: a user's choices are
+    its FrameSettings), and no module picks a setter by its name (the image bench's
+    ``getattr(renderer, f"set_{name}")`` of issue 11's switches)."""
     extra = _frame_setters(PACKAGE / "render" / "frame.py") - FRAME_SETTERS
     assert extra == set()
     by_name = {p.relative_to(PACKAGE.parent).as_posix(): lines for p in PACKAGE.rglob("*.py")
@@ -211,7 +207,71 @@ def test_the_frame_has_no_ablation_switches():
 def test_the_size_and_switch_checks_can_fail(tmp_path):
     """The checks see a setter outside the list and a setter picked by name."""
     probe = tmp_path / "frame.py"
-    probe.write_text("class FrameRenderer:\n    def set_room_bounces(self, b):\n        pass\n")
-    assert _frame_setters(probe) - FRAME_SETTERS == {"set_room_bounces"}
+    probe.write_text("class FrameRenderer:\n    def set_room_bounces(self, b):\n        pass\n"
+                     "    def set_bands(self, n):\n        pass\n")
+    assert _frame_setters(probe) - FRAME_SETTERS == {"set_room_bounces", "set_bands"}
     tree = ast.parse('def f(r, name):\n    getattr(r, f"set_{name}")(True)\n')
     assert _setters_by_name(tree) == [2]
+
+
+#: Below the edge (issue 31): the renderers draw the resolved scene (FrameSettings, its
+#: catalog.presets.fabric.Fabric) and read no file. The packages checked:
+BELOW_THE_EDGE = ("render", "pathtrace", "cloth")
+#: The modules among them that may read a file, and why.
+MAY_READ = {
+    "catalog/render/settings.py": "the edge's resolution: a preset name, the environment image",
+    "catalog/render/snapshot.py": "the snapshot command: its request resolved (the edge)",
+    "catalog/render/sheet.py": "the sheet command: its presets resolved (the edge)",
+    "catalog/pathtrace/render.py": "the reference command: its request resolved (the edge)",
+    "catalog/render/environment.py": "the environment image's reader (settings call it)",
+    "catalog/render/imagefile.py": "image files written and read back (the commands' outputs)",
+    "catalog/render/display.py": "the display's own tables (package data, not the scene)",
+    "catalog/render/room_light/geometry.py": "the room's stored ambient occlusion (package data)",
+    "catalog/cloth/drape_cache.py": "the drape cache (results kept, not inputs)",
+    "catalog/render/scene.py": "load_props: a prop mesh by path (not yet resolved at the edge)",
+    "catalog/pathtrace/scene.py": "a room given by path (not yet resolved at the edge)",
+    "catalog/render/room_operators.py": "the room's bundle: read from its cache (or built) when the settings name a room (not yet resolved at the edge)",
+}
+#: What reads a file: a call of open(), np.load, json/tomllib/pickle/trimesh.load, an image
+#: input's open, a Path's read_text/read_bytes, an imread/read_image/loadtxt, or one of the
+#: project's readers (presets, spectra, patterns, residuals, environments, rooms).
+_LOADERS = {"load": {"np", "numpy", "json", "tomllib", "pickle", "trimesh"}, "loads": {"tomllib"},
+            "open": {"ImageInput", "Image", "gzip", "zipfile", "tarfile", "io"}}
+_READ_METHODS = {"read_text", "read_bytes", "imread", "read_image", "loadtxt", "genfromtxt",
+                 "fromfile"}
+_READERS = {"open", "read_spectrum", "load_preset", "find_preset", "load_pattern",
+            "pattern_from_images", "read_residual", "load_environment", "load_room"}
+
+
+def _file_reads(tree) -> list[tuple[int, str]]:
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        f = node.func
+        if isinstance(f, ast.Name) and f.id in _READERS:
+            found.append((node.lineno, f.id))
+        elif isinstance(f, ast.Attribute):
+            base = f.value.attr if isinstance(f.value, ast.Attribute) else getattr(f.value, "id", None)
+            if f.attr in _READ_METHODS or f.attr in _READERS or base in _LOADERS.get(f.attr, ()):
+                found.append((node.lineno, ast.unparse(f)))
+    return found
+
+
+def test_no_file_is_read_below_the_edge():
+    """No module of render/, pathtrace/ or cloth/ reads a file but those MAY_READ names; the
+    frame, its passes and the scene terms draw what the edge resolved."""
+    reads = {}
+    for package in BELOW_THE_EDGE:
+        for path in sorted((PACKAGE / package).rglob("*.py")):
+            name = path.relative_to(PACKAGE.parent).as_posix()
+            if name not in MAY_READ and (found := _file_reads(ast.parse(path.read_text(encoding="utf-8")))):
+                reads[name] = found
+    assert reads == {}
+
+
+def test_the_file_read_check_can_fail():
+    tree = ast.parse("import numpy as np\nfrom pathlib import Path\n"
+                     "def f(p):\n    a = np.load(p)\n    b = Path(p).read_text()\n"
+                     "    c = open(p)\n    d = read_spectrum(p)\n    e = self.backend.load(p)\n")
+    assert [line for line, _ in _file_reads(tree)] == [4, 5, 6, 7]

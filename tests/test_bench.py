@@ -139,12 +139,10 @@ def test_truth_switches_on_the_emission_as_the_renderer_does(gl):
 
     renderer = FrameRenderer(gl, (16, 16))
     try:
-        renderer.set_fabric("lace-fwa")
-        renderer.set_light("D65")
-        renderer.set_fluorescence("physical")
+        renderer.update(fabric="lace-fwa", light="D65", fluorescence="physical")
         kept = renderer.shading_inputs()
         assert kept.fluorescence_mode == "physical"
-        renderer.set_fluorescence("off")
+        renderer.update(fluorescence="off")
         forced = with_physical_emission(renderer.shading_inputs(),
                                         fluorescent_material(renderer.preset))
     finally:

@@ -26,6 +26,8 @@ from catalog.render import scene as scene_lib
 from catalog.render.frame import FrameRenderer
 from benchmarks import key_shadow_bias
 from catalog.render.raycast import first_hit, mesh_triangles
+from catalog.render.settings import orbit
+from catalog.render.scene import KEY_AZIMUTH_DEG
 
 pytestmark = [pytest.mark.gl, pytest.mark.slow]   # each takes 0.5 s or more
 
@@ -35,10 +37,7 @@ LUMA = np.array([0.2126, 0.7152, 0.0722])
 
 def _renderer(gl, preset, light="D65", mesh=None, camera=(0.0, 0.0, 1.6)):
     r = FrameRenderer(gl, SIZE)
-    r.set_fabric(preset)
-    r.set_light(light)
-    r.set_fluorescence("off")
-    r.set_camera(*camera)
+    r.update(fabric=preset, light=light, fluorescence="off", camera=orbit(*camera))
     if mesh is not None:
         r.set_mesh(mesh.positions, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices)
     return r
@@ -78,7 +77,7 @@ def test_window_wall_shades_the_upper_curtain(gl, make_preset):
     float64 twin without it)."""
     mesh = scene_lib.draped_curtain(columns=40, rows=30, depth_m=0.0)
     r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh, camera=(0.0, 0.0, 2.6))
-    r.set_key_direction(elevation_deg=60.0)
+    r.update(key_direction_deg=(60.0, KEY_AZIMUTH_DEG))
     g = r.render_gbuffer()
     mask = g["mask"]
     p = g["position"][mask].astype(np.float64)
@@ -101,8 +100,7 @@ def _key_across_the_folds(gl, make_preset, mesh):
     key's shadows, and these tests are about the key on the cloth alone): the renderer, its
     G-buffer, the curtain mask, the pixels' positions and the direction to the light."""
     r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), mesh=mesh)
-    r.set_key_direction(elevation_deg=20.0, azimuth_deg=60.0)
-    r.set_room_lighting(False)
+    r.update(key_direction_deg=(20.0, 60.0), room_lighting=False)
     g = r.render_gbuffer()
     mask = g["mask"]
     p = g["position"][mask].astype(np.float64)
@@ -171,7 +169,7 @@ def test_the_key_shadow_counts_a_second_layer(gl, make_preset):
     assert (second[two] > 0.5).mean() >= 0.8, (second[two] > 0.5).mean()
     assert (second[one] < 0.5).mean() >= 0.95, (second[one] < 0.5).mean()
     on = g["radiance"][mask] @ LUMA
-    r.set_key_second_layer(False)
+    r.update(key_second_layer=False)
     g_off = r.render_gbuffer()
     assert not g_off["second_coverage"][mask].any()
     off = g_off["radiance"][mask] @ LUMA
@@ -222,7 +220,7 @@ def test_outside_occlusion_matches_rays_cast_in_numpy(gl, make_preset):
     assert np.abs(hidden_room[pick] - room).mean() < 0.15
     # ROOM_SIDE's view's continuation, seen obliquely across the folds: the direction nearest
     # the view ray, cast from the pixel
-    r.set_camera(55.0, 0.0, 2.0)
+    r.update(camera=orbit(55.0, 0.0, 2.0))
     oblique = r.render_gbuffer()
     assert r.room_side_active()
     all_o = oblique["position"][oblique["mask"]].astype(np.float64)
@@ -236,7 +234,7 @@ def test_outside_occlusion_matches_rays_cast_in_numpy(gl, make_preset):
     assert view_hit.mean() > 0.1   # the folds hide part of the continuations
     seen = oblique["room_occlusion_view"][oblique["mask"]][chosen]
     assert np.abs(seen - view_hit).mean() < 0.15
-    r.set_camera(0.0, 0.0, 2.0)
+    r.update(camera=orbit(0.0, 0.0, 2.0))
     amplitude = np.ptp(np.asarray(mesh.positions)[:, 2]) / 2
     trough = p[:, 2] > scene_lib.CURTAIN_Z + 0.6 * amplitude
     crest = p[:, 2] < scene_lib.CURTAIN_Z - 0.6 * amplitude
@@ -318,9 +316,7 @@ def test_the_sill_is_lit_by_the_sun(gl, make_preset):
     albedo / pi x the key's luminance x cos(incidence) where the sun's ray from it leaves
     through the outer plane 2 cm or more inside the opening (it was black before issue 11)."""
     r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), camera=(0.0, 35.0, 1.2))
-    r.set_key_direction(elevation_deg=60.0)
-    r.set_curtain_open(True)
-    r.set_bloom(False)
+    r.update(key_direction_deg=(60.0, KEY_AZIMUTH_DEG), curtain_open=True, bloom=False)
     r.render()
     img = r.read_linear()
     w, h = r.size

@@ -35,6 +35,7 @@ from catalog.core.resources import FABRIC_DIR
 from catalog.optics.colorimetry import delta_e_2000_lab, linear_srgb_to_xyz, srgb_decode, xyz_to_lab
 from catalog.render import display
 from catalog.render.frame import FrameRenderer
+from catalog.render.settings import SunHour
 
 pytestmark = pytest.mark.gl
 
@@ -49,16 +50,13 @@ def _presets():
 
 def _frame(gl, fabric, light, *, ev=None, white_balance="room", mode="physical", hour=None):
     renderer = FrameRenderer(gl, SIZE)
-    renderer.set_fabric(fabric)
+    renderer.update(fabric=fabric)
     if hour is not None:
-        renderer.set_sun_hour(hour)
+        renderer.update(light=SunHour(hour))
     else:
-        renderer.set_light(light)
-    renderer.set_fluorescence(mode)
-    renderer.set_white_balance(white_balance)
-    renderer.set_ev(ev)
-    renderer.set_bloom(False)  # the display pass is compared with the HDR frame it reads
-    renderer.set_antialiasing("off")  # the display pass alone (issue 12's FXAA moves edge pixels)
+        renderer.update(light=light)
+    renderer.update(fluorescence=mode, white_balance=white_balance, ev=ev, bloom=False)  # the display pass is compared with the HDR frame it reads
+    renderer.update(antialiasing="off")  # the display pass alone (issue 12's FXAA moves edge pixels)
     mask = renderer.render_gbuffer()["mask"]
     renderer.render()
     return renderer, mask
@@ -112,9 +110,9 @@ def test_at_most_one_percent_of_curtain_pixels_clip_under_every_light(gl, capsys
     worst = []
     for fabric in _presets():
         renderer = FrameRenderer(gl, SIZE)
-        renderer.set_fabric(fabric)
+        renderer.update(fabric=fabric)
         for light in LIGHTS:
-            renderer.set_light(light)
+            renderer.update(light=light)
             mask = renderer.render_gbuffer()["mask"]
             renderer.render()
             pixels = renderer.read_srgb8()[mask].astype(int)

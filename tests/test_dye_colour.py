@@ -107,8 +107,7 @@ def test_the_frame_passes_the_rooms_and_folds_light_by_the_secondary_dye(gl):
     from catalog.render.frame import FrameRenderer
 
     r = FrameRenderer(gl, (32, 24))
-    r.set_fabric("safety-yellow")
-    r.set_light("UV-A")
+    r.update(fabric="safety-yellow", light="UV-A")
     inputs = r.shading_inputs()
     secondary, key = dye_colour.secondary_dye_rgb(inputs), dye_colour.key_dye_rgb(inputs)
     back = (inputs.a_diff * hg_hemisphere_factors(inputs.g_diff)[1]

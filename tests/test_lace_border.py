@@ -12,6 +12,7 @@ import pytest
 from catalog.presets import load_preset
 from catalog.presets.patterns import load_pattern
 from catalog.render.frame import FrameRenderer
+from catalog.render.settings import orbit
 
 LACES = ("lace-fwa", "raschel-ivory", "tulle-embroidered")
 #: The catalog's scallops per pattern repeat across (tools/make_patterns.py PATTERNS).
@@ -69,12 +70,11 @@ def test_the_frame_cuts_the_scallops_where_the_band_puts_them(gl):
     size = (320, 240)
     renderer = FrameRenderer(gl, size)
     try:
-        renderer.set_fabric("lace-fwa")
-        renderer.set_light("D65")
+        renderer.update(fabric="lace-fwa", light="D65")
         renderer.set_mesh(*_hem_quad(), fabric_size_m=(1.8, 2.05))
-        renderer.set_ev(12.0)
+        renderer.update(ev=12.0)
         distance, fov = 0.45, 40.0
-        renderer.set_camera(0.0, 0.0, distance, target=(0.0, -0.80, -0.08), fov_y_deg=fov)
+        renderer.update(camera=orbit(0.0, 0.0, distance, target=(0.0, -0.80, -0.08), fov_y_deg=fov))
         metres_per_px = 2 * distance * math.tan(math.radians(fov / 2)) / size[1]
         profiles, frames = [], []
         for with_band in (True, False):

@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from catalog.pathtrace.backend import find_llvm
+from catalog.render.settings import orbit
 
 pytestmark = pytest.mark.skipif(find_llvm() is None,
                                 reason="no LLVM >= 16 library for Mitsuba (tools/setup.sh installs libllvm19)")
@@ -451,8 +452,7 @@ def test_the_reference_builds_the_frames_shading_inputs(gl, light):
     preset = desc_preset("lace-fwa")
     desc = describe_scene(preset, get_light(light), size=(8, 6), curtain=curtain)
     r = FrameRenderer(gl, (8, 6))
-    r.set_fabric(preset)
-    r.set_light(light)
+    r.update(fabric=preset, light=light)
     frame = r.shading_inputs()
     for f in dataclasses.fields(frame):
         a, b = getattr(frame, f.name), getattr(desc.inputs, f.name)
@@ -657,9 +657,7 @@ def _safety_yellow_under_the_lamp(gl, depth_m: float):
     light = get_light("UV-A")
     desc = describe_scene(preset, light, size=(8, 6), curtain=curtain)
     r = FrameRenderer(gl, (8, 6))
-    r.set_fabric(preset)
-    r.set_light(light)
-    r.set_fluorescence("physical")
+    r.update(fabric=preset, light=light, fluorescence="physical")
     r.set_mesh(*curtain)
     r.render()
     return r, desc
@@ -816,11 +814,9 @@ def test_the_folds_light_the_shadowed_flanks_as_the_path_tracer_does(gl, mi):
     reference = render_radiance(mi, build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH), 128, seed=0)
     masks = region_masks(mi, build_mitsuba_scene(mi, desc, max_depth=2), desc)
     r = FrameRenderer(gl, size)
-    r.set_fabric(preset)
-    r.set_light(light)
-    r.set_fluorescence("physical")
+    r.update(fabric=preset, light=light, fluorescence="physical")
     cam = desc.info["camera"]
-    r.set_camera(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"])
+    r.update(camera=orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"]))
     r.set_mesh(*curtain, fabric_size_m=desc.fabric_size_m)
     r.render()
     frame = r.read_linear()

@@ -11,6 +11,7 @@ import pytest
 from catalog.core.errors import InputError
 from catalog.render import environment as env
 from catalog.render.snapshot import write_image
+from catalog.render.settings import orbit
 
 
 def _write(path, pixels):
@@ -58,16 +59,16 @@ def test_the_procedural_sky_as_an_image_renders_as_the_sky(gl, tmp_path):
     from catalog.render.frame import FrameRenderer
 
     r = FrameRenderer(gl, (96, 64))
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:60")
-    r.set_curtain_open(True)
-    r.set_bloom(False)
-    r.set_camera(0.0, 5.0, 1.0)
+    r.update(fabric="lace-fwa",
+             light="sun:60",
+             curtain_open=True,
+             bloom=False,
+             camera=orbit(0.0, 5.0, 1.0))
     path = tmp_path / "sky.exr"
     env.write_sky_environment(path, r.background.sky_model_for(r.shading_inputs()), height=256)
     r.render()
     analytic = r.read_linear()
-    r.set_environment(path)
+    r.update(environment=path)
     r.render()
     image = r.read_linear()
     assert r.background.environment_scale(r.shading_inputs()) == pytest.approx(1.0, rel=0.01)
@@ -99,19 +100,14 @@ def test_the_flat_curtains_see_through_shows_the_environment(gl, tmp_path):
     from catalog.render.frame import FrameRenderer
 
     r = FrameRenderer(gl, (96, 64))
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:60")
-    r.set_curtain_open(False)
-    r.set_patterned(False)
-    r.set_bloom(False)
+    r.update(fabric="lace-fwa", light="sun:60", curtain_open=False, patterned=False, bloom=False)
     # the see-through alone: the room's light on the cloth's room side (ROOM_SIDE) changes with
     # the outside too, through the room's captures, and is held to its twin elsewhere: unlit
-    r.set_room_lighting(False)
-    r.set_camera(0.0, 5.0, 1.0)
+    r.update(room_lighting=False, camera=orbit(0.0, 5.0, 1.0))
     red, blue = np.array([2.0, 1.0, 0.5]), np.array([0.5, 1.0, 2.0])
     out = []
     for name, colour in (("red", red), ("blue", blue)):
-        r.set_environment(_write(tmp_path / f"{name}.exr", np.ones((32, 64, 3)) * colour))
+        r.update(environment=_write(tmp_path / f"{name}.exr", np.ones((32, 64, 3)) * colour))
         g = r.render_gbuffer()
         out.append((g, r.background.environment_scale(r.shading_inputs()) * colour))
     (g1, l1), (g2, l2) = out

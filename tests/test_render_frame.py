@@ -14,6 +14,7 @@ import pytest
 from catalog.optics import shading_reference as ref
 from catalog.optics.colorimetry import delta_e_2000, linear_srgb_to_xyz
 from catalog.render.frame import FrameRenderer
+from catalog.render.settings import orbit
 
 pytestmark = pytest.mark.gl
 
@@ -23,10 +24,7 @@ YELLOW_DYE = [(300, 0.05), (440, 0.08), (500, 0.6), (540, 0.9), (780, 0.92)]
 
 def _renderer(gl, preset_path, light="D65", mode="physical", bands=3):
     renderer = FrameRenderer(gl, SIZE)
-    renderer.set_fabric(preset_path)
-    renderer.set_light(light)
-    renderer.set_fluorescence(mode)
-    renderer.set_bands(bands)
+    renderer.update(fabric=preset_path, light=light, fluorescence=mode, bands=bands)
     return renderer
 
 
@@ -63,7 +61,7 @@ def test_rgb_radiance_matches_float64_reference_per_pixel(gl, make_preset, light
     extra = f"anisotropy = {options['anisotropy']}" if "anisotropy" in options else ""
     path = make_preset(dye=YELLOW_DYE if options.get("dye") else None, extra_btdf=extra)
     renderer = _renderer(gl, path, light, mode)
-    renderer.set_camera(yaw_deg=20.0, pitch_deg=-10.0, distance_m=2.2)
+    renderer.update(camera=orbit(yaw_deg=20.0, pitch_deg=-10.0, distance_m=2.2))
     gl_rgb, reference = _compare(renderer)
     error = _relative_error(gl_rgb, reference)
     record_figure(f"render.rgb_vs_reference|{light}|{mode}|{','.join(options) or '-'}",
@@ -79,7 +77,7 @@ def test_band_counts_delta_e_against_spectral_reference(gl, make_preset, capsys)
     renderer = _renderer(gl, make_preset(dye=YELLOW_DYE), "sun:100", "physical")
     rows = {}
     for n_bands in (3, 6, 9, 16):
-        renderer.set_bands(n_bands)
+        renderer.update(bands=n_bands)
         gl_rgb, reference = _compare(renderer)
         white = ref.white_xyz(renderer.shading_inputs())
         de = delta_e_2000(linear_srgb_to_xyz(gl_rgb), linear_srgb_to_xyz(reference), white)
@@ -98,11 +96,11 @@ def test_grey_fabric_same_in_every_band_count_under_a_lamp(gl, make_preset):
     """Invariant: with no dye, no emission and every spectrum a multiple of the lamp's, the
     bands only regroup the same integrals."""
     renderer = _renderer(gl, make_preset(fluorescent=False), "FL2", "physical")
-    renderer.set_bands(3)
+    renderer.update(bands=3)
     renderer.render()
     rgb = renderer.read_linear()
     for n_bands in (6, 9, 16):
-        renderer.set_bands(n_bands)
+        renderer.update(bands=n_bands)
         renderer.render()
         other = renderer.read_linear()
         assert np.allclose(other, rgb, rtol=1e-4, atol=1e-4 * rgb.max())
@@ -129,7 +127,7 @@ def test_two_sided_flipped_normals_and_tangents_render_the_same(gl, make_preset)
 def test_front_lit_curtain_is_not_black(gl, make_preset):
     """A light on the viewer's side: the thin layer scatters back (eq. 6 at theta > 90 deg)."""
     renderer = _renderer(gl, make_preset(direct=0.0, fluorescent=False), "D65")
-    renderer.set_key_direction(elevation_deg=30.0, azimuth_deg=180.0)  # behind the viewer
+    renderer.update(key_direction_deg=(30.0, 180.0))  # behind the viewer
     gl_rgb, reference = _compare(renderer)
     inputs = renderer.shading_inputs()
     assert inputs.key_to_light[2] > 0  # the light really is on the room side
@@ -148,10 +146,10 @@ def test_see_through_pass_only_when_direct_is_positive(gl, make_preset):
     renderer = _renderer(gl, make_preset(direct=0.0, fluorescent=False), "D65")
     renderer.render()
     assert all(v.get("PATTERN") and not v.get("SEE_THROUGH") for v in renderer.compiled_variants())
-    renderer.set_patterned(False)
+    renderer.update(patterned=False)
     renderer.render()
     assert all(not v.get("SEE_THROUGH") for v in renderer.compiled_variants())
-    renderer.set_fabric(make_preset("gappy", direct=0.2, fluorescent=False))
+    renderer.update(fabric=make_preset("gappy", direct=0.2, fluorescent=False))
     renderer.render()
     assert any(v.get("SEE_THROUGH") for v in renderer.compiled_variants())
     renderer.release()
@@ -293,15 +291,13 @@ def test_specialised_and_uniform_programs_agree(gl, make_preset):
     frames = []
     for specialise in (True, False):
         renderer = FrameRenderer(gl, SIZE, specialise=specialise)
-        renderer.set_fabric(path)
-        renderer.set_light("sun:120")
-        renderer.set_bands(6)
+        renderer.update(fabric=path, light="sun:120", bands=6)
         renderer.render()
         frames.append(renderer.read_linear())
         if specialise:
             for n_lights, light in enumerate(["D65", "A", "FL2", "FL11", "LED-B4", "D50",
                                               "sun:30", "sun:300", "UV-A", "D75"]):
-                renderer.set_light(light)
+                renderer.update(light=light)
                 renderer.render()
             kept = [v for v in renderer.compiled_variants() if v.get("SPECIALISED")]
             assert len(kept) <= MAX_SPECIALISED
@@ -332,7 +328,7 @@ def test_room_side_term_is_part_of_the_per_pixel_comparison(gl, make_preset):
     0.5 % (so the per-pixel tests above hold it, not a zero), and without it the frame would
     miss the 1e-3 bound."""
     renderer = _renderer(gl, make_preset(), "D65", "physical")
-    renderer.set_camera(yaw_deg=20.0, pitch_deg=-10.0, distance_m=2.2)
+    renderer.update(camera=orbit(yaw_deg=20.0, pitch_deg=-10.0, distance_m=2.2))
     assert renderer.room_side_active()
     gbuffer = renderer.render_gbuffer()
     mask = gbuffer["mask"]

@@ -18,6 +18,7 @@ import pytest
 from catalog.presets.patterns import mip_chain
 from catalog.render.frame import FrameRenderer
 from catalog.render.passes.pattern import PATTERN_LOD_BIAS
+from catalog.render.settings import orbit
 
 SUPERSAMPLE = 4
 
@@ -73,15 +74,14 @@ def test_mip_chain_keeps_the_mean_and_removes_what_a_level_cannot_hold():
 @pytest.mark.parametrize("fabric", ["lace-fwa", "raschel-ivory", "jacquard-white"])
 def test_no_energy_above_nyquist_at_any_distance(gl, fabric):
     renderer = FrameRenderer(gl, (96 * SUPERSAMPLE, 64 * SUPERSAMPLE))
-    renderer.set_fabric(fabric)
-    renderer.set_light("D65")
+    renderer.update(fabric=fabric, light="D65")
     renderer.set_mesh(*_quad_mesh(), fabric_size_m=(1.8, 2.05))
-    renderer.set_ev(12.0)
+    renderer.update(ev=12.0)
     # filtered for the pixel the supersampled frame is measured at
     renderer.fabric_pattern.lod_bias = PATTERN_LOD_BIAS + math.log2(SUPERSAMPLE)
     shares = []
     for distance in np.geomspace(0.3, 4.0, 8):
-        renderer.set_camera(0.0, 0.0, float(distance))
+        renderer.update(camera=orbit(0.0, 0.0, float(distance)))
         renderer.render()
         shares.append(energy_above_nyquist(renderer.read_linear()))
     renderer.release()

@@ -19,6 +19,7 @@ from catalog.optics.colorimetry import delta_e_2000, linear_srgb_to_xyz, srgb_de
 from catalog.presets.patterns import OPEN_AREA_TOLERANCE
 from catalog.presets import list_presets, load_preset
 from catalog.render.frame import FrameRenderer
+from catalog.render.settings import orbit
 
 pytestmark = pytest.mark.gl
 
@@ -73,7 +74,7 @@ def test_mip_far_limit_is_the_fitted_open_area(gl, path):
     """The last mip level GL builds (what the far cloth samples) holds coverage 1 - LD
     within the 1 % of the pattern's own rule, and the averaged normal tilts less than 1 deg."""
     renderer = FrameRenderer(gl, (16, 16))
-    renderer.set_fabric(path)
+    renderer.update(fabric=path)
     levels = int(math.log2(max(renderer.fabric_pattern.texture.size)))
     top = renderer.fabric_pattern.pattern_mip_level(levels)
     direct = load_preset(path).btdf.direct
@@ -101,13 +102,12 @@ def test_two_layers_multiply_and_match_the_sorted_reference(gl, make_preset, ant
     if antialiasing == "msaa" and int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
         pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
     renderer = FrameRenderer(gl, (96, 72))
-    renderer.set_antialiasing(antialiasing)
-    renderer.set_fabric(make_preset("layer", direct=0.4, fluorescent=False))
-    renderer.set_light("D65")
-    renderer.set_camera(0.0, 0.0, 1.6)
+    renderer.update(antialiasing=antialiasing,
+                    fabric=make_preset("layer", direct=0.4, fluorescent=False),
+                    light="D65",
+                    camera=orbit(0.0, 0.0, 1.6))
     # the room as a fixed backdrop: lit through the sheets (issue 13) it would change with them
-    renderer.set_room_lighting(False)
-    renderer.set_bloom(False)
+    renderer.update(room_lighting=False, bloom=False)
     front = _quad(-0.5, 0.15, -0.3, 0.6, lambda x, y: np.full_like(x, 0.05))
     back = _quad(-0.15, 0.5, -0.3, 0.6, lambda x, y: -0.12 + 0.7 * (x - 0.5))
     far = _quad(50.0, 50.1, 0.0, 0.1, lambda x, y: np.full_like(x, 0.0))
@@ -160,9 +160,7 @@ def test_a_known_pattern_appears_where_the_texture_coordinates_put_it(gl, make_p
     preset.write_text(preset.read_text()
                       + '[pattern]\ncoverage = "quarter.png"\nrepeat_m = 0.8\n')
     renderer = FrameRenderer(gl, (128, 128))
-    renderer.set_fabric(preset)
-    renderer.set_light("D65")
-    renderer.set_camera(0.0, 0.0, 1.2)
+    renderer.update(fabric=preset, light="D65", camera=orbit(0.0, 0.0, 1.2))
     renderer.fabric_pattern.set_pattern_filtering(False)
     target_y = renderer.camera.target[1]
     quad = _quad(-0.4, 0.4, target_y - 0.4, target_y + 0.4, lambda x, y: np.full_like(x, -0.08))
@@ -199,13 +197,11 @@ def test_far_limit_equals_the_unpatterned_cloth(gl, name, record_figure):
     (the lace's 0.1 m): the curtain's mean displayed colour equals the flat cloth's (eq. 8
     with LD times the background) within Delta E 2000 0.5 (issue 12)."""
     renderer = FrameRenderer(gl, (48, 36))
-    renderer.set_fabric(name)
-    renderer.set_light("D65")
-    renderer.set_camera(0.0, 0.0, 4.3)
+    renderer.update(fabric=name, light="D65", camera=orbit(0.0, 0.0, 4.3))
     mask = renderer.render_gbuffer()["mask"]
     means = []
     for patterned in (True, False):
-        renderer.set_patterned(patterned)
+        renderer.update(patterned=patterned)
         renderer.render()
         means.append(_display_xyz(renderer)[mask].mean(axis=0))
     delta = float(delta_e_2000(means[0], means[1], WHITE_XYZ))
@@ -225,11 +221,11 @@ def test_white_fabrics_differ_pairwise_at_the_default_view(gl, record_figure):
     from catalog.render.snapshot import simulated_curtain
 
     renderer = FrameRenderer(gl, (256, 144))
-    renderer.set_light("D65")
+    renderer.update(light="D65")
     images, masks = {}, {}
     for name in WHITES:
         preset = load_preset(FABRIC_DIR / f"{name}.toml")
-        renderer.set_fabric(preset)
+        renderer.update(fabric=preset)
         *mesh, fabric_size = simulated_curtain(preset, 0)
         renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
         renderer.render()
@@ -258,9 +254,7 @@ def test_close_up_luminance_spectrum_peaks_at_the_lace_repeat(gl, record_figure)
     scene behind the holes has straight edges (the horizon, the light's gradient) whose
     energy lies there, while the motif's fundamentals lie off them."""
     renderer = FrameRenderer(gl, (256, 256))
-    renderer.set_fabric("lace-fwa")
-    renderer.set_light("D65")
-    renderer.set_camera(0.0, 0.0, 0.3)
+    renderer.update(fabric="lace-fwa", light="D65", camera=orbit(0.0, 0.0, 0.3))
     target = renderer.camera.target
     flat = _quad(-0.6, 0.6, target[1] - 0.6, target[1] + 0.6,
                  lambda x, y: np.full_like(x, target[2]), columns=8, rows=8)
@@ -294,7 +288,7 @@ def dolly_change(renderer, mask_frames, filtered: bool, frames: int = 40) -> flo
     previous = None
     changes = []
     for k, distance in enumerate(np.geomspace(3.0, 0.2, frames)):
-        renderer.set_camera(0.0, 0.0, float(distance))
+        renderer.update(camera=orbit(0.0, 0.0, float(distance)))
         renderer.render()
         y = renderer.read_srgb8().astype(np.float64) @ [0.2126, 0.7152, 0.0722]
         if previous is not None:
@@ -318,16 +312,15 @@ def test_a_slow_dolly_does_not_shimmer(gl, record_figure):
     mid-tones and the same dolly reads 6.2: the bound follows the display, the ratio is the
     test)."""
     renderer = FrameRenderer(gl, (128, 96))
-    renderer.set_fabric("lace-fwa")
-    renderer.set_light("D65")
+    renderer.update(fabric="lace-fwa", light="D65")
     # one exposure for the whole dolly (the one metered at 3 m): the auto exposure's own
     # changes between frames are the display's, not shimmer
-    renderer.set_camera(0.0, 0.0, 3.0)
+    renderer.update(camera=orbit(0.0, 0.0, 3.0))
     renderer.render()
-    renderer.set_ev(renderer.current_ev100())
+    renderer.update(ev=renderer.current_ev100())
     masks = []
     for distance in np.geomspace(3.0, 0.2, 40):
-        renderer.set_camera(0.0, 0.0, float(distance))
+        renderer.update(camera=orbit(0.0, 0.0, float(distance)))
         masks.append(renderer.render_gbuffer()["mask"])
     filtered = dolly_change(renderer, masks, True)
     unfiltered = dolly_change(renderer, masks, False)
@@ -353,10 +346,7 @@ def test_antialiasing_brings_edges_closer_to_a_supersampled_frame(gl, mode, reco
 
     def frame(size, mode):
         renderer = FrameRenderer(gl, size)
-        renderer.set_fabric("lace-fwa")
-        renderer.set_light("D65")
-        renderer.set_antialiasing(mode)
-        renderer.set_bloom(False)  # the edges alone (the glare would blur both frames)
+        renderer.update(fabric="lace-fwa", light="D65", antialiasing=mode, bloom=False)  # the edges alone (the glare would blur both frames)
         renderer.render()
         image = renderer.read_srgb8().astype(np.float64)
         renderer.release()
@@ -402,9 +392,7 @@ def test_msaa_keeps_the_curtain_interior_and_the_layers(gl, record_figure):
     if int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
         pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
     renderer = FrameRenderer(gl, (96, 72))
-    renderer.set_fabric("voile-white")
-    renderer.set_light("D65")
-    renderer.set_ev(10.0)
+    renderer.update(fabric="voile-white", light="D65", ev=10.0)
     mask = renderer.render_gbuffer()["mask"]
     interior = mask.copy()
     for dy in (-1, 0, 1):
@@ -413,7 +401,7 @@ def test_msaa_keeps_the_curtain_interior_and_the_layers(gl, record_figure):
     assert interior.sum() > 500
     images = {}
     for mode in ("off", "msaa"):
-        renderer.set_antialiasing(mode)
+        renderer.update(antialiasing=mode)
         renderer.render()
         images[mode] = renderer.read_linear().astype(np.float64)
     y = {k: v @ [0.2126, 0.7152, 0.0722] for k, v in images.items()}
@@ -446,11 +434,9 @@ def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl, record_figure):
     for mode in ("off", "msaa"):
         renderer = FrameRenderer(gl, (320, 180))
         try:
-            renderer.set_fabric(preset)
-            renderer.set_light("D65")
+            renderer.update(fabric=preset, light="D65")
             renderer.set_mesh(*settled, fabric_size_m=fabric_size)
-            renderer.set_ev(11.5)
-            renderer.set_antialiasing(mode)
+            renderer.update(ev=11.5, antialiasing=mode)
             if mask is None:
                 mask = renderer.render_gbuffer()["mask"]
             renderer.render()

@@ -19,6 +19,7 @@ from catalog.render import room_light
 from catalog.render import scene as scene_lib
 from catalog.render.bands import spectrum_to_display_rgb
 from catalog.render.frame import FrameRenderer
+from catalog.render.settings import orbit
 
 pytestmark = pytest.mark.gl
 
@@ -32,10 +33,10 @@ def _luma(rgb):
 
 def _renderer(gl, fabric="lace-fwa", light="sun:60", azimuth_deg=15.0):
     r = FrameRenderer(gl, SIZE)
-    r.set_fabric(fabric)
-    r.set_light(light)
-    r.set_key_direction(45.0, azimuth_deg)
-    r.set_camera(0.0, 18.0, 4.3)
+    r.update(fabric=fabric,
+             light=light,
+             key_direction_deg=(45.0, azimuth_deg),
+             camera=orbit(0.0, 18.0, 4.3))
     return r
 
 
@@ -47,7 +48,7 @@ def _floor_regions(r):
 
 
 def _frame(r, curtain_open):
-    r.set_curtain_open(curtain_open)
+    r.update(curtain_open=curtain_open)
     r.render()
     return r.read_linear()
 
@@ -95,7 +96,7 @@ def _patch_ratio_cv(gl, azimuth_deg, patterned):
     """The patch's closed/open ratio's spread (the key's lobe, spread from the window, adds a
     smooth gradient across the patch)."""
     r = _renderer(gl, azimuth_deg=azimuth_deg)
-    r.set_patterned(patterned)
+    r.update(patterned=patterned)
     patch, _ = _floor_regions(r)
     ratio = _luma(_frame(r, False)[patch]) / _luma(_frame(r, True)[patch])
     r.release()
@@ -113,7 +114,7 @@ def test_folds_pattern_the_patch(gl):
     patch (its closed/open ratio varies by 2.9 % at 15 deg)."""
     def map_cv(azimuth_deg):
         r = _renderer(gl, azimuth_deg=azimuth_deg)
-        r.set_patterned(False)
+        r.update(patterned=False)
         r.render()
         t = _luma(r.lightmap.read_room_shadow())
         covered = t < 0.999 * t.max()   # the cloth's shadow (1 where the beam passes nothing)
@@ -168,11 +169,10 @@ def test_uv_fluorescence_raises_the_rooms_blue(gl):
     blue rises by more than 20 % against the same scene without fluorescence, and more than
     its red."""
     r = FrameRenderer(gl, SIZE)
-    r.set_fabric("lace-fwa")
-    r.set_light("UV-A")
+    r.update(fabric="lace-fwa", light="UV-A")
     walls = {}
     for mode in ("off", "physical"):
-        r.set_fluorescence(mode)
+        r.update(fluorescence=mode)
         r.render()
         walls[mode] = _wall_strips(r.read_linear()).mean(axis=0)
     gain = walls["physical"] / np.maximum(walls["off"], 1e-12)
@@ -192,14 +192,13 @@ def test_walls_differ_between_fabrics(gl):
     names = sorted(p.stem for p in list_presets())
     assert len(names) >= 10
     r = FrameRenderer(gl, (96, 54))
-    r.set_light("D65")
+    r.update(light="D65")
     lit, constant = [], []
     for name in names:
-        r.set_fabric(name)
-        r.set_room_lighting(True)
+        r.update(fabric=name, room_lighting=True)
         r.render()
         lit.append(_wall_strips(r.read_linear()).mean(axis=0))
-        r.set_room_lighting(False)
+        r.update(room_lighting=False)
         r.render()
         constant.append(_wall_strips(r.read_linear()).mean(axis=0))
     lit = np.array(lit)
@@ -219,7 +218,7 @@ def test_layers_multiply_in_the_shadow_map(gl):
     one sheet passes T (half-float storage: 2e-3); the flat cloth, so that T is uniform: LD,
     the key's directional lobe being spread from the window (issue 11), not in the beam."""
     r = _renderer(gl, "lace-fwa")
-    r.set_patterned(False)
+    r.update(patterned=False)
     quads = []
     for z in (-0.15, 0.05):
         quads.append([[-1.2, -1.2, z], [1.2, -1.2, z], [1.2, 1.6, z], [-1.2, 1.6, z]])
@@ -253,10 +252,10 @@ def test_room_lamp_lights_the_floor_by_inverse_square(gl):
     centre = floor.origin + (i + 0.5) / k * floor.axis_s + (j + 0.5) / k * floor.axis_t
     height = 1.5
     lamp = (float(centre[0]), float(centre[1] + height), float(centre[2]))
-    r.set_curtain_open(False)
+    r.update(curtain_open=False)
     r.render()
     before = r.lightmap.read_room_lightmap()[j, i]
-    r.set_room_lamps([("A", lamp)])
+    r.update(lamps=[("A", lamp)])
     r.render()
     after = r.lightmap.read_room_lightmap()[j, i]
     intensity = _luma(spectrum_to_display_rgb(r.room_lamps[0][0].irradiance_w_m2_nm))
@@ -278,7 +277,7 @@ def test_light_map_is_the_float64_radiosity_of_its_direct_light(gl):
     map's largest value (float32 sums of 96 terms); the one-bounce variant differs from it
     by more than 10 % on the walls, so the check can tell them apart."""
     r = _renderer(gl)
-    r.set_room_lamps([("A", (0.5, 1.0, 2.0))])
+    r.update(lamps=[("A", (0.5, 1.0, 2.0))])
     r.render()
     light_map = r.lightmap.read_room_lightmap().astype(np.float64)
     res = r.room_targets.get()
@@ -318,7 +317,7 @@ def test_room_lamp_outside_the_room_is_refused(gl):
 
     r = FrameRenderer(gl, (16, 16))
     with pytest.raises(CatalogError, match="inside the room"):
-        r.set_room_lamps([("A", (0.0, 5.0, 1.0))])
+        r.update(lamps=[("A", (0.0, 5.0, 1.0))])
     r.release()
 
 
@@ -334,8 +333,7 @@ def test_room_light_is_stable_as_the_cloth_moves(gl):
     beside the curtain changed the ceiling over the window's corner by 7.5 % in one step, a
     real change of the light, not the flicker this test is about."""
     r = FrameRenderer(gl, (64, 36))
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:60")
+    r.update(fabric="lace-fwa", light="sun:60")
     previous, worst = None, 0.0
     for step in range(5):
         mesh = scene_lib.draped_curtain(fold_shift_m=0.02 * step)
@@ -474,15 +472,14 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
     from catalog.render import bands as band_lib
 
     r = _renderer(gl)
-    r.set_bands(n_bands)
-    r.set_curtain_open(False)
+    r.update(bands=n_bands, curtain_open=False)
     before = r.render_gbuffer()
     side_before = r.twin_room_side_rgb(before, before["mask"])
     faces = room_light.room_faces()
     floor = faces[0]
     centre = floor.origin + 0.5 * floor.axis_s + 0.5 * floor.axis_t
     lamp = np.array([centre[0], centre[1] + 1.5, centre[2]])
-    r.set_room_lamps([("A", tuple(float(v) for v in lamp))])
+    r.update(lamps=[("A", tuple(float(v) for v in lamp))])
     after = r.render_gbuffer()
     mask = before["mask"] & after["mask"]
     assert mask.sum() > 500
@@ -516,9 +513,10 @@ def test_a_room_lamp_lights_the_curtains_room_side(gl, n_bands):
 
 @pytest.mark.slow
 def test_shadow_map_size_is_a_frame_option(gl):
-    """set_shadow_map_size (issue 11's Pareto): the maps are made again at the new side (read
-    back at that size), the room's beam patch keeps its mean within 2 % (the map's resolution
-    moves its edges, not its light), and a size outside SHADOW_MAP_SIZES is one InputError."""
+    """FrameSettings.shadow_map_size (issue 11's Pareto): the maps are made again at the new
+    side (read back at that size), the room's beam patch keeps its mean within 2 % (the map's
+    resolution moves its edges, not its light), and a size outside SHADOW_MAP_SIZES is one
+    InputError naming the field."""
     from catalog.core.errors import InputError
     from catalog.render.passes.shadow import SHADOW_MAP_SIZES
 
@@ -526,14 +524,14 @@ def test_shadow_map_size_is_a_frame_option(gl):
     patch, _ = _floor_regions(r)
     means = {}
     for texels in (128, 512):
-        r.set_shadow_map_size(texels)
+        r.update(shadow_map_size=texels)
         image = _frame(r, False)
         assert r.lightmap.read_room_shadow().shape == (texels, texels, 3)
         means[texels] = _luma(image[patch]).mean()
     assert means[128] == pytest.approx(means[512], rel=0.02)
     assert r.info()["shadow_map_size"] == 512
-    with pytest.raises(InputError, match="shadow map size"):
-        r.set_shadow_map_size(300)
+    with pytest.raises(InputError, match="^shadow_map_size: 300: choose one of"):
+        r.update(shadow_map_size=300)
     assert 300 not in SHADOW_MAP_SIZES
     r.release()
 
@@ -604,8 +602,7 @@ def test_window_light_is_the_float64_sum_over_both_sides(gl, fabric, light):
     (measured 0.91). The window wall's finer grid beside the opening (room_window_near.frag,
     room_light.window_near_points) is the same sum at its points, same bound."""
     r = FrameRenderer(gl, (32, 18))
-    r.set_fabric(fabric)
-    r.set_light(light)
+    r.update(fabric=fabric, light=light)
     res = r.room_targets.get()
     aw, ah = room_light.atlas_size()
     rf = room_light.FACE_TEXELS
@@ -620,7 +617,7 @@ def test_window_light_is_the_float64_sum_over_both_sides(gl, fabric, light):
         return np.frombuffer(res[name].read(level=lvl), dtype=np.float32).reshape(h, w, 4)
 
     for curtain_open in (False, True):
-        r.set_curtain_open(curtain_open)
+        r.update(curtain_open=curtain_open)
         r.render()
         direct = np.frombuffer(res["direct"].read(level=0), dtype=np.float32).reshape(ah, aw, 4)[..., :3]
         captured = level("luminaire", room_light.LUMINAIRE_LEVEL)
@@ -699,7 +696,7 @@ def test_capture_alpha_is_the_key_on_the_nearest_cloth(gl):
     that layer passes, LD + a_spec fwd(g_spec) (the front-layer map's thread part). Middle
     patches, 2e-3 (the depth bias and float32)."""
     r = _renderer(gl, "lace-fwa")
-    r.set_patterned(False)
+    r.update(patterned=False)
     cos_i = abs(float(r.shading_inputs().key_to_light[2]))
     t = _beam_transmittance(r.shading_inputs())
     res = r.room_targets.get()
@@ -751,7 +748,7 @@ def test_room_side_grid_matches_float64_gather(gl, light):
     (room_light.curtain_side_irradiance from the same read-back totals) within 1e-3 of the
     grid's largest value; and it is light (above 0) everywhere, the glow's under UV-A too."""
     r = _renderer(gl, light=light)
-    r.set_curtain_open(False)
+    r.update(curtain_open=False)
     r.render()
     assert r.room_side_active()
     side = r.lightmap.read_room_side()
@@ -771,7 +768,7 @@ def test_room_side_replaces_the_stand_ins(gl):
     than the stand-ins did (they knew nothing of the glow: more than 10x, measured about 100x).
     The shading itself is held to its twin per pixel by test_render_frame."""
     r = _renderer(gl, fabric="safety-yellow", light="UV-A")
-    r.set_curtain_open(False)
+    r.update(curtain_open=False)
     inputs, solved = r.shading_inputs(), r.curtain_inputs()
     assert r.curtain.variant_defines().get("ROOM_SIDE")
     assert not np.any(solved.fill_irradiance) and inputs.fill_irradiance.max() > 0
@@ -783,11 +780,10 @@ def test_room_side_replaces_the_stand_ins(gl):
     colours = r.terms.display_colours(inputs)
     stand_in = math.pi * _luma(colours["u_room_rgb"]) + math.pi / scene_lib.ROOM_ALBEDO * _luma(colours["u_fill_rgb"])
     assert _luma(side).mean() > 10.0 * stand_in
-    r.set_room_lighting(False)
+    r.update(room_lighting=False)
     assert not r.room_side_active()
     assert not r.curtain.variant_defines().get("ROOM_SIDE") and r.curtain_inputs() is r.shading_inputs()
-    r.set_room_lighting(True)
-    r.set_camera(180.0, 0.0, 2.0)   # yaw 180: from outside, looking in
+    r.update(room_lighting=True, camera=orbit(180.0, 0.0, 2.0))   # yaw 180: from outside, looking in
     assert not r.viewer_inside and not r.room_side_active()
     r.release()
 
@@ -806,11 +802,11 @@ def test_the_window_outside_the_wall_is_lit_by_the_outside_and_the_key(gl):
     2 cm inside the edges) against this twin, albedo / pi x (diffuse + key cos mask
     (room_light.window_beam_mask; 1 on the outer face)), within 1 %."""
     r = FrameRenderer(gl, (160, 120))
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:60")
-    r.set_key_direction(5.0, 0.0)
-    r.set_camera(180.0, 35.0, 1.6)   # outside, above the sill
-    r.set_curtain_open(False)
+    r.update(fabric="lace-fwa",
+             light="sun:60",
+             key_direction_deg=(5.0, 0.0),
+             camera=orbit(180.0, 35.0, 1.6))   # outside, above the sill
+    r.update(curtain_open=False)
     r.render()
     image = r.read_linear()
     w, h = r.size
@@ -863,7 +859,7 @@ def test_room_side_light_per_vertex_matches_its_numpy_evaluation(gl):
     folds the median within 2 %, and 80 % of the pixels within 10 % (a patch's edge falls
     between two vertices: the per-vertex value ramps where the per-pixel one steps)."""
     r = _renderer(gl, fabric="safety-yellow", light="UV-A")
-    r.set_curtain_open(False)
+    r.update(curtain_open=False)
     for flat in (True, False):
         if flat:
             mesh = scene_lib.draped_curtain(columns=60, rows=40, depth_m=0.0)
@@ -900,11 +896,11 @@ def test_wall_light_per_vertex_matches_its_numpy_evaluation(gl):
     (a walled direction switches between two vertices: the per-vertex value ramps where the
     per-pixel one steps). Off (stand-ins for the room side) it is 0."""
     r = FrameRenderer(gl, (192, 144))
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:100")
-    r.set_key_direction(60.0, 15.0)
-    r.set_camera(20.0, 15.0, 2.6)
-    r.set_curtain_open(False)
+    r.update(fabric="lace-fwa",
+             light="sun:100",
+             key_direction_deg=(60.0, 15.0),
+             camera=orbit(20.0, 15.0, 2.6),
+             curtain_open=False)
     g = r.render_gbuffer()
     mask = g["mask"]
     got = g["wall_light"][mask].astype(np.float64)
@@ -918,7 +914,7 @@ def test_wall_light_per_vertex_matches_its_numpy_evaluation(gl):
     top = mask & (np.arange(mask.shape[0])[:, None] < rows[0] + 0.2 * (rows[-1] - rows[0]))
     bottom = mask & (np.arange(mask.shape[0])[:, None] > rows[-1] - 0.2 * (rows[-1] - rows[0]))
     assert _luma(g["wall_light"][bottom]).mean() > 2 * _luma(g["wall_light"][top]).mean()
-    r.set_room_lighting(False)   # the room side by the stand-ins: no wall light
+    r.update(room_lighting=False)   # the room side by the stand-ins: no wall light
     g = r.render_gbuffer()
     assert np.abs(g["wall_light"][g["mask"]]).max() == 0.0
     r.release()
@@ -935,12 +931,12 @@ def test_the_cloth_sees_the_window_wall_as_the_viewer_does(gl):
     pixel's radiance and the twin's within 2 % for 95 % of them and 0.5 % at the median
     (bilinear light-map filtering in float32 against float64)."""
     r = FrameRenderer(gl, (160, 120))
-    r.set_fabric("voile-white")
-    r.set_light("sun:100")
-    r.set_key_direction(50.0, 20.0)
-    r.set_curtain_open(True)
-    r.set_camera(10.0, 35.0, 1.1)
-    r.set_bloom(False)
+    r.update(fabric="voile-white",
+             light="sun:100",
+             key_direction_deg=(50.0, 20.0),
+             curtain_open=True,
+             camera=orbit(10.0, 35.0, 1.1),
+             bloom=False)
     r.render()
     image = r.read_linear().astype(np.float64)
     w, h = r.size
@@ -1097,8 +1093,7 @@ def test_the_beams_flux_into_the_room_is_the_sheets_shadow_integrated(gl, elevat
     0.90: the map's clear margin around the sheet blurred into the footprint's edges (under
     the bench's voile at the D65 key, 1.3x the path tracer's beam into the room)."""
     r = _renderer(gl, "voile-white", "D65")
-    r.set_key_direction(elevation_deg, azimuth_deg)
-    r.set_patterned(False)
+    r.update(key_direction_deg=(elevation_deg, azimuth_deg), patterned=False)
     wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
     z = scene_lib.CURTAIN_Z
     positions = np.array([[wx0, wy0, z], [wx1, wy0, z], [wx1, wy1, z], [wx0, wy1, z]], dtype="f4")

@@ -13,6 +13,7 @@ from catalog.optics.sun import sky
 from catalog.optics.shading_reference import spectral_to_linear_srgb
 from catalog.render import scene as scene_lib
 from catalog.render.frame import FrameRenderer
+from catalog.render.settings import orbit
 
 pytestmark = pytest.mark.gl
 
@@ -69,11 +70,11 @@ def test_no_seam_at_the_horizon():
 def _looking_out_under_the_sun(gl):
     """A renderer with the curtain open, looking out of the window under sun:60 (no glare)."""
     r = FrameRenderer(gl, SIZE)
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:60")
-    r.set_curtain_open(True)
-    r.set_bloom(False)
-    r.set_camera(0.0, 5.0, 1.0)
+    r.update(fabric="lace-fwa",
+             light="sun:60",
+             curtain_open=True,
+             bloom=False,
+             camera=orbit(0.0, 5.0, 1.0))
     return r
 
 
@@ -160,7 +161,7 @@ def test_band_frame_sky_is_the_band_integral_of_the_spectral_sky(gl, n_bands):
     from catalog.render import bands as band_lib
 
     r = _looking_out_under_the_sun(gl)
-    r.set_bands(n_bands)
+    r.update(bands=n_bands)
     r.render()
     img = r.read_linear()
     d, ok = _window_rays(r)
@@ -184,11 +185,8 @@ def test_bloom_keeps_the_frames_energy_and_glows_around_the_sun(gl):
     from catalog.render.passes import glare as glare_lib
 
     r = FrameRenderer(gl, (256, 192))   # 0.26 deg a pixel: the sun's disc (0.53 deg) is drawn
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:60")
-    r.set_curtain_open(True)
-    r.set_camera(0.0, -10.0, 1.0)   # looking up at the sun through the window
-    r.set_bloom(True)
+    r.update(fabric="lace-fwa", light="sun:60", curtain_open=True, camera=orbit(0.0, -10.0, 1.0))   # looking up at the sun through the window
+    r.update(bloom=True)
     r.render()
     sharp = r.read_linear()
     w, h = r.size
@@ -216,11 +214,11 @@ def test_another_image_shown_through_the_frames_display_step(gl):
     from catalog.pathtrace import metrics
 
     r = FrameRenderer(gl, (128, 96))
-    r.set_fabric("lace-fwa")
-    r.set_light("sun:60")
-    r.set_curtain_open(True)
-    r.set_camera(0.0, -10.0, 1.0)
-    r.set_antialiasing("off")
+    r.update(fabric="lace-fwa",
+             light="sun:60",
+             curtain_open=True,
+             camera=orbit(0.0, -10.0, 1.0),
+             antialiasing="off")
     r.render()
     own = r.read_srgb8().astype(int)
     linear = r.read_linear()

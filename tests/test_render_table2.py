@@ -18,6 +18,7 @@ import pytest
 
 from catalog.core.resources import FABRIC_DIR
 from catalog.render.frame import FrameRenderer
+from catalog.render.settings import SunHour
 
 pytestmark = pytest.mark.gl
 
@@ -31,13 +32,13 @@ def _lace(make_preset):
 
 def _lit_cloth_mean(gl, preset, mode, *, hour=None, light=None, paper_mode=False, ev=None):
     renderer = FrameRenderer(gl, SIZE)
-    renderer.set_ev(ev)  # None: automatic exposure, metered from this frame
-    renderer.set_fabric(preset)
+    renderer.update(ev=ev)  # None: automatic exposure, metered from this frame
+    renderer.update(fabric=preset)
     if hour is not None:
-        renderer.set_sun_hour(hour)
+        renderer.update(light=SunHour(hour))
     else:
-        renderer.set_light(light)
-    renderer.set_fluorescence(mode)
+        renderer.update(light=light)
+    renderer.update(fluorescence=mode)
     gbuffer = renderer.render_gbuffer()
     mask = gbuffer["mask"]
     renderer.render()

@@ -80,16 +80,17 @@ def test_frame_draws_each_built_in_room(gl):
     refused before anything changes."""
     from catalog.core.errors import InputError
     from catalog.render.frame import FrameRenderer
+    from catalog.render.settings import orbit
     from catalog.render.scene import draped_curtain
 
     means = {}
     for room in ("box", "living"):
         renderer = FrameRenderer(gl, (96, 54))
         try:
-            renderer.set_fabric("lace-fwa")
-            renderer.set_light("D65")
-            renderer.set_room(room)
-            renderer.set_camera(0.0, -25.0, 2.5, inside=True)   # looking down at the floor
+            renderer.update(fabric="lace-fwa",
+                            light="D65",
+                            room=room,
+                            camera=orbit(0.0, -25.0, 2.5, inside=True))   # looking down at the floor
             mesh = draped_curtain()
             renderer.set_mesh(mesh.positions, mesh.normals, mesh.uvs, mesh.tangents, mesh.indices)
             renderer.render()
@@ -99,7 +100,7 @@ def test_frame_draws_each_built_in_room(gl):
             assert floor.mean() > 0.0
             means[room] = floor.reshape(-1, 3).mean(axis=0)
             with pytest.raises(InputError):
-                renderer.set_room("attic")
+                renderer.update(room="attic")
             assert renderer.room_spec == room
         finally:
             renderer.release()

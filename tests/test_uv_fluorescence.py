@@ -279,9 +279,7 @@ def test_violet_lamp_shows_the_brightened_lace_glow(gl, record_figure):
     renderer = FrameRenderer(gl, (64, 48))
     means = {}
     for fabric in ("lace-fwa", "voile-white"):
-        renderer.set_fabric(fabric)
-        renderer.set_light("LED-405")
-        renderer.set_fluorescence("physical")
+        renderer.update(fabric=fabric, light="LED-405", fluorescence="physical")
         renderer.render()
         image = renderer.read_srgb8().astype(np.float64)[..., :3]
         means[fabric] = image[16:36, 24:40].reshape(-1, 3).mean(axis=0)

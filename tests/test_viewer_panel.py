@@ -115,7 +115,7 @@ def test_thumbnail_cache_renders_once_per_scene_and_again_on_change(gl):
     light = {"name": "D65"}
 
     def apply_scene(renderer):
-        renderer.set_light(light["name"])
+        renderer.update(light=light["name"])
 
     # the drafts first (both in one frame: the budget is not spent), then the finals, one a frame
     assert cache.update(entries, ("D65",), apply_scene) == 2

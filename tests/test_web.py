@@ -139,8 +139,7 @@ def test_recording_context_changes_nothing_of_the_desktop_frame(gl):
     for ctx in (gl, RecordingContext(gl)):
         renderer = FrameRenderer(ctx, (48, 36), specialise=False)
         try:
-            renderer.set_fabric("lace-fwa")
-            renderer.set_light("UV-A")
+            renderer.update(fabric="lace-fwa", light="UV-A")
             renderer.render()
             images.append(renderer.read_srgb8())
         finally:
@@ -190,8 +189,7 @@ def test_split_commands_keeps_every_uniform_value_in_order(gl):
     ctx = RecordingContext(gl)
     renderer = FrameRenderer(ctx, (16, 12), specialise=False)
     try:
-        renderer.set_fabric("fluoro-pink")
-        renderer.set_light("D65")
+        renderer.update(fabric="fluoro-pink", light="D65")
         ctx.recording.start()
         renderer.render()
         commands = ctx.recording.stop()

@@ -28,22 +28,23 @@ from catalog.gl.context import create_headless_context
 from catalog.render.frame import FrameRenderer
 from catalog.render.snapshot import ring_xs_m, simulated_curtain
 from catalog.presets import find_preset, load_preset
+from catalog.render.settings import orbit
 fabrics, repeats, views = sys.argv[1].split(","), int(sys.argv[2]), sys.argv[3].split(",")
 ctx = create_headless_context()
 r = FrameRenderer(ctx, (1280, 720))
 out = {}
 for name in fabrics:
     preset = load_preset(find_preset(name))
-    r.set_fabric(preset); r.set_light("D65")
+    r.update(fabric=preset, light="D65")
     *mesh, size = simulated_curtain(preset, 0)
     r.set_mesh(*mesh, fabric_size_m=size); r.set_rings(ring_xs_m(preset))
     for view in views:
         if view == "front":
-            r.set_camera(0.0, 0.0, 2.6)
+            r.update(camera=orbit(0.0, 0.0, 2.6))
         else:
             from catalog.render.views import VIEWS
             v = VIEWS[view]
-            r.set_camera(v.yaw_deg, v.pitch_deg, v.distance_m, target=v.target, fov_y_deg=v.fov_y_deg)
+            r.update(camera=orbit(v.yaw_deg, v.pitch_deg, v.distance_m, target=v.target, fov_y_deg=v.fov_y_deg))
         r.render(); r.read_srgb8()
         times = []
         for _ in range(repeats):

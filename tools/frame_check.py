@@ -3,8 +3,9 @@
     PYTHONPATH=TREE python tools/frame_check.py render OUT.npz MESHES.npz
     python tools/frame_check.py compare BEFORE.npz AFTER.npz
 
-``render`` draws CASES (the image bench's six scenes and options a user changes) at 320x180
-with the tree on PYTHONPATH (e.g. ``git archive before-31 | tar -x -C /tmp/base``) and writes
+``render`` draws CASES (the image bench's six scenes and options a user changes; an option
+is a FrameSettings field) at 320x180 with the tree on PYTHONPATH (e.g. ``git archive
+before-31 | tar -x -C /tmp/base``: a tree without FrameSettings is driven by its setters) and writes
 each frame's linear radiance and its sRGB8 display image; the cloth's settled meshes are
 written to MESHES.npz on the first run and read on the next, so both trees draw the same
 vertices. ``compare`` prints per case the largest and mean relative difference of the linear
@@ -69,24 +70,7 @@ def render(out: Path, meshes_path: Path) -> None:
                 meshes[f"{fabric}/{k}"] = new_meshes[f"{fabric}/{k}"] = np.asarray(a)
             meshes[f"{fabric}/rings"] = new_meshes[f"{fabric}/rings"] = np.asarray(ring_xs_m(preset))
         mesh = [meshes[f"{fabric}/{k}"] for k in "pnuti"]
-        r = FrameRenderer(ctx, SIZE)
-        r.set_fabric(preset)
-        if light is not None:
-            r.set_light(light)
-        if "sun_hour" in opts: r.set_sun_hour(opts["sun_hour"])
-        if "bands" in opts: r.set_bands(opts["bands"])
-        if "fluorescence" in opts: r.set_fluorescence(opts["fluorescence"])
-        if "antialiasing" in opts: r.set_antialiasing(opts["antialiasing"])
-        else: r.set_antialiasing("fxaa")
-        if "room_lighting" in opts: r.set_room_lighting(opts["room_lighting"])
-        if "shadow_map_size" in opts: r.set_shadow_map_size(opts["shadow_map_size"])
-        if "patterned" in opts: r.set_patterned(opts["patterned"])
-        if "curtain_open" in opts: r.set_curtain_open(opts["curtain_open"])
-        if "lamps" in opts: r.set_room_lamps(opts["lamps"])
-        if "bloom" in opts: r.set_bloom(opts["bloom"])
-        if "ev" in opts: r.set_ev(opts["ev"])
-        if "white_balance" in opts: r.set_white_balance(opts["white_balance"])
-        r.set_camera(*VIEWS[view])
+        r = _renderer(FrameRenderer, ctx, preset, light, view, opts)
         r.set_mesh(*mesh, fabric_size_m=tuple(meshes[f"{fabric}/f"]))
         r.set_rings(list(meshes[f"{fabric}/rings"]))
         r.render(); r.render()
@@ -97,6 +81,29 @@ def render(out: Path, meshes_path: Path) -> None:
     np.savez_compressed(out, **{f"lin:{k}": v for k, v in frames.items()}, **{f"srgb:{k}": v for k, v in srgb.items()})
     if new_meshes and not meshes_path.exists():
         np.savez(meshes_path, **meshes)
+
+
+def _renderer(FrameRenderer, ctx, preset, light, view, opts):
+    """A FrameRenderer of the case: from its FrameSettings, or (a tree before the settings
+    value, e.g. the tag before-31) through the setters the options name."""
+    options = {"antialiasing": "fxaa", **opts}
+    try:
+        from catalog.render.settings import FrameSettings, SunHour, orbit
+    except ImportError:
+        r = FrameRenderer(ctx, SIZE)
+        r.set_fabric(preset)
+        if light is not None:
+            r.set_light(light)
+        setters = {"lamps": "room_lamps"}
+        for name, value in options.items():
+            getattr(r, f"set_{setters.get(name, name)}")(value)
+        r.set_camera(*VIEWS[view])
+        return r
+    if "sun_hour" in options:
+        options["light"] = SunHour(options.pop("sun_hour"))
+    elif light is not None:
+        options["light"] = light
+    return FrameRenderer(ctx, SIZE, FrameSettings(fabric=preset, camera=orbit(*VIEWS[view]), **options))
 
 
 def compare(before: Path, after: Path) -> float:

@@ -103,7 +103,7 @@ def rgb_weights(key_irradiance: np.ndarray) -> np.ndarray:
 
 def key_light_for(light) -> tuple[np.ndarray, bool]:
     """The key light's direction (unit, to the light) and whether it is the sun, as the
-    real-time frame places it (:meth:`catalog.render.frame.FrameRenderer.set_light`)."""
+    real-time frame places it (:class:`catalog.render.settings.FrameSettings`' ``key_to_light``)."""
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
     return scene_lib.key_direction(scene_lib.key_elevation_for(light)), light.is_sun
@@ -145,9 +145,9 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
                                          np.asarray(ring_positions).reshape(-1, 3)])
     pattern = None
-    from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
 
-    loaded = load_pattern(preset)
+    loaded = resolve_fabric(preset).pattern
     if loaded is not None:
         cloth_m = fabric_size or (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
         pattern = {"coverage": np.asarray(loaded.coverage, dtype=np.float32),

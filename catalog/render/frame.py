@@ -29,9 +29,13 @@ Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
    target): exposure (EV100, fixed or metered from a luminance histogram of this frame),
    white balance (CAT16), tone curve, gamut compression in OKLab, the sRGB curve
    (:mod:`catalog.render.display`, docs/display.md); then FXAA (fxaa.frag, issue 12) on
-   the display image; ``set_antialiasing("off")`` displays straight into the target.
+   the display image; ``antialiasing="off"`` displays straight into the target.
 
-Anti-aliasing (:meth:`FrameRenderer.set_antialiasing`, default ``auto``): FXAA (step 4), or
+What the frame draws with is one :class:`catalog.render.settings.FrameSettings` value
+(:meth:`FrameRenderer.update`); the renderer redraws what the changed fields make stale
+(``settings.STALE``).
+
+Anti-aliasing (``FrameSettings.antialiasing``, default ``auto``): FXAA (step 4), or
 MSAA where the context has MSAA_SAMPLES samples and is a GPU (:func:`choose_antialiasing`):
 steps 1-3 then draw into multisampled targets (the OIT targets too), resolved before the
 OIT composite.
@@ -39,17 +43,15 @@ OIT composite.
 
 from __future__ import annotations
 
-import math
+import dataclasses
 
 import numpy as np
 
-from catalog.core.constants import FLUORESCENCE_MODES
-from catalog.core.errors import CatalogError, InputError
-from catalog.render import bands as band_lib
+from catalog.core.errors import CatalogError
 from catalog.render import display as display_lib
-from catalog.render import room_light
 from catalog.render import scene as scene_lib
-from catalog.render.camera import OrbitCamera
+from catalog.render import settings as settings_lib
+from catalog.render.settings import FrameSettings, SettingsError
 from catalog.render.passes.background import BackgroundPass
 from catalog.render.passes.curtain import CurtainPass
 from catalog.render.passes.curtain_mesh import CurtainMesh
@@ -60,8 +62,8 @@ from catalog.render.passes.lightmap import LightmapPass
 from catalog.render.passes.pattern import PatternTexture
 from catalog.render.passes.room import RoomPass
 from catalog.render.passes.scene_terms import SceneTerms
-from catalog.render.passes.shadow import SHADOW_MAP_SIZES, ShadowPass
-from catalog.render.passes.targets import (ANTIALIASING_MODES, MSAA_SAMPLES, FrameTargets, RoomTargets,
+from catalog.render.passes.shadow import ShadowPass
+from catalog.render.passes.targets import (MSAA_SAMPLES, FrameTargets, RoomTargets,
                                            check_size, choose_antialiasing, choose_specialise)
 from catalog.render.passes.twin import FrameTwin
 from catalog.render.passes.window_capture import WindowCapturePass
@@ -70,9 +72,11 @@ from catalog.render.passes.window_capture import WindowCapturePass
 class FrameRenderer:
     """Renders the curtain scene with a given moderngl context at a given size (w, h)."""
 
-    def __init__(self, ctx, size: tuple[int, int], specialise: bool | None = None):
-        """``specialise``: compile the scene's values into the curtain shader as constants
-        (recompiled when the light, fabric, mode or band count changes; a CPU rasteriser then
+    def __init__(self, ctx, size: tuple[int, int], settings: FrameSettings | None = None, *,
+                 specialise: bool | None = None):
+        """``settings``: what to draw with (:class:`FrameSettings`; None: its defaults, with
+        no fabric or light yet: :meth:`update` gives them). ``specialise``: compile the
+        scene's values into the curtain shader as constants (recompiled when the light, fabric, mode or band count changes; a CPU rasteriser then
         loads no uniforms per fragment) rather than passing them as uniforms; None (default):
         :func:`choose_specialise` for this context (constants on a CPU rasteriser only)."""
         import moderngl  # noqa: PLC0415
@@ -83,41 +87,17 @@ class FrameRenderer:
         self.targets = FrameTargets(ctx, self.size)
         self.specialise = (choose_specialise(dict(ctx.info)) if specialise is None
                            else bool(specialise))
-        self.patterned = True
-        self.preset = None
-        self.light = None
-        self._key_to_light = scene_lib.key_direction(scene_lib.LAMP_ELEVATION_DEG)
-        self._is_sun = False
-        self.mode = "physical"
-        self.n_bands = 3
-        self.camera = OrbitCamera()
-        self.exposure = 1.0              # a multiplier on top of the EV (compensation)
-        self.ev100 = None                # None: metered per frame (auto exposure)
-        self.white_balance = display_lib.DEFAULT_WHITE_BALANCE
-        self.metered_ev100 = None        # the auto exposure's current EV100 (adapted)
+        #: the auto exposure's current EV100 (adapted)
+        self.metered_ev100 = None
         self._last = None  # (vw, vh, fbo, viewport)
-        #: issue 13: the room lit through the curtain (False: the earlier constant room)
-        self.room_lighting = True
-        #: the key's shadow on the cloth through two layers of its folds (False: the nearest
-        #: alone; the web page's frame, catalog.web.export.DESKTOP_MODES)
-        self.key_second_layer = True
-        #: the side (texels) of the key light's maps: the room's transmittance map and the
-        #: cloth's front-layer map (set_shadow_map_size)
-        self.shadow_texels = room_light.SHADOW_TEXELS
-        self.curtain_open = False
-        self.room_lamps: list[tuple] = []   # (catalog.optics.lights.Light, (x, y, z) m)
-        #: the room's light (shadow map, capture, light map) is redrawn at once when the light,
-        #: fabric, curtain or lamps change, and every ``room_update_every`` frames while the
-        #: cloth moves (a cloth drawn from GPU buffers is taken as moving); 1: every frame
-        self.room_update_every = 1
-        self.sky_model = True      # the clear sky of catalog/optics/sun/sky.py behind the window (a sun)
-        self.bloom = True          # glare before the tone map (glare.py)
+        #: the curtain pass draws the flat cloth for the room's captures (see ``patterned``)
+        self.drawing_flat = False
         self.environment = None    # (path, texture, upper-hemisphere illuminance) or None
-        self.antialiasing = "fxaa"
-        self.room_targets = RoomTargets(ctx, self.shadow_texels)
-        #: the room drawn and lit by its precomputed transport (set_room: what it was given, a
-        #: name or a path; None: the box's special-case room light of catalog/render/room_light)
-        self.room_spec = None
+        self.antialiasing = "fxaa"   # the mode in use (settings.antialiasing resolved)
+        self._settings = FrameSettings()
+        self.room_targets = RoomTargets(ctx, self._settings.shadow_map_size)
+        #: the room drawn and lit by its precomputed transport (settings.room), or None: the
+        #: box's special-case room light of catalog/render/room_light
         self.room_transport = None
         # the passes, in the order a frame runs them (render_hdr, render)
         self.gl = GLPrograms(ctx)
@@ -133,90 +113,119 @@ class FrameRenderer:
         self.glare = GlarePass(self)
         self.display = DisplayPass(self)
         self.twin = FrameTwin(self)
-        self.set_antialiasing("auto")
+        self._apply(self._settings, frozenset({"msaa_targets"}))
+        if settings is not None:
+            self.update(settings)
         default = scene_lib.draped_curtain()
         self.mesh.set_mesh(default.positions, default.normals, default.uvs, default.tangents,
                            default.indices)
 
-    def set_fabric(self, preset) -> None:
-        """A preset object, a preset name (fabrics/NAME.toml) or a path to a .toml."""
-        from catalog.presets import Preset, find_preset, load_preset  # noqa: PLC0415
+    # ------------------------------------------------------------------ the settings
+    @property
+    def settings(self) -> FrameSettings:
+        """What the frame draws with (:class:`catalog.render.settings.FrameSettings`)."""
+        return self._settings
 
-        if not isinstance(preset, Preset):
-            preset = load_preset(find_preset(preset))
-        scene_lib.dye_transmittance(preset)  # refuse a bad dye file now, not at render
-        scene_lib.fluorescent_material(preset)
-        self.fabric_pattern.set_fabric(preset)
-        self.preset = preset
+    def update(self, settings: FrameSettings | None = None, **changes) -> frozenset[str]:
+        """Draw with ``settings`` from now on (or ``dataclasses.replace(self.settings,
+        **changes)``); returns what the change made stale (:data:`settings.STALE`), which
+        this method frees, reloads or marks for the next frame."""
+        new = self._settings if settings is None else settings
+        if not isinstance(new, FrameSettings):
+            raise SettingsError(f"{new!r} is not a FrameSettings", field="settings")
+        if changes:
+            new = dataclasses.replace(new, **changes)
+        parts = settings_lib.stale(self._settings, new)
+        self._apply(new, parts)
+        return parts
 
-    def set_rings(self, xs_m) -> None:
-        """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
-        self.room.set_rings(xs_m)
+    def _apply(self, new: FrameSettings, parts) -> None:
+        """Act on the stale parts (see :data:`settings.STALE`), then keep ``new``."""
+        if "room_transport" in parts:   # first: a bad room is refused before any change
+            self._set_room_transport(new.room)
+        if "fabric_tables" in parts and new.fabric is not None:
+            self.fabric_pattern.set_fabric(new.fabric)   # its tables resolved with the settings
+        if "msaa_targets" in parts:
+            self.antialiasing = self._resolve_antialiasing(new.antialiasing)
+        if "room_targets" in parts and new.shadow_map_size != self.room_targets.shadow_texels:
+            self.room_targets.release()
+            self.room_targets.shadow_texels = new.shadow_map_size
+        if "environment" in parts:
+            self._load_environment(new.environment, new.resolved_environment)
+        self._settings = new
+        if "room_light" in parts:
+            self.lightmap.invalidate()
 
-    def set_patterned(self, patterned: bool) -> None:
-        """True (default): the fabric's pattern, holes and layers (OIT); False: the flat,
-        opaque cloth of eq. 8 with LD times the background by ray direction."""
-        self.patterned = bool(patterned)
-
-    def set_light(self, light) -> None:
-        """A light name of the library (``D65``, ``sun:22``, ...) or a catalog.optics.lights.Light.
-
-        The sun stands behind the window at the elevation its path length implies; a lamp at
-        scene.LAMP_ELEVATION_DEG. :meth:`set_sun_hour` and :meth:`set_key_direction` move it.
-        """
-        from catalog.optics.lights import get_light  # noqa: PLC0415
-
-        if isinstance(light, str):
-            light = get_light(light)
-        self.light = light
-        self._is_sun = light.is_sun
-        self._key_to_light = scene_lib.key_direction(scene_lib.key_elevation_for(light))
-
-    def set_sun_hour(self, hour: float) -> dict:
-        """The sun at ``hour`` (local solar time, summer solstice, 34.7 N) behind the window."""
-        from catalog.optics.lights import get_light  # noqa: PLC0415
-
-        sun = scene_lib.sun_at_hour(hour)
-        self.light = get_light(sun.light_name)
-        self._is_sun = True
-        self._key_to_light = scene_lib.key_direction(90.0 - sun.zenith_deg, sun.azimuth_deg)
-        return {"hour": hour, "zenith_deg": sun.zenith_deg, "path_km": sun.path_km,
-                "light": sun.light_name}
-
-    def set_key_direction(self, elevation_deg: float, azimuth_deg: float = scene_lib.KEY_AZIMUTH_DEG) -> None:
-        """Move the key light: azimuth 0 = straight behind the window, 180 = behind the viewer."""
-        self._key_to_light = scene_lib.key_direction(elevation_deg, azimuth_deg)
-
-    def set_fluorescence(self, mode: str) -> None:
-        if mode not in FLUORESCENCE_MODES:
-            raise CatalogError(f"fluorescence mode {mode!r}: choose one of {', '.join(FLUORESCENCE_MODES)}")
-        self.mode = mode
-
-    def set_room_lighting(self, on: bool) -> None:
-        """Light the room through the curtain (shadow map, area light, bounce: issue 13) or
-        keep the earlier constant room (a fraction of the key light plus the fill light)."""
-        self.room_lighting = bool(on)
-
-    def set_key_second_layer(self, on: bool) -> None:
-        """Shade the cloth behind two layers of its folds with the key's beam through both (True,
-        the front-layer map peeled into a second map) or through the nearest alone (False: what
-        the web page shows, catalog.web.export.DESKTOP_MODES)."""
-        self.key_second_layer = bool(on)
-
-    def set_room(self, room) -> None:
-        """The room (a built-in name or a .glb path), drawn and lit by its precomputed
-        transport (catalog/render/passes/room_transport_light.py; its bundle from the cache,
-        built on first use); None: the box's special-case light."""
+    def _set_room_transport(self, room) -> None:
+        """The room (a built-in name or a .glb path) drawn and lit by its precomputed transport
+        (catalog/render/passes/room_transport_light.py; its bundle from the cache, built on
+        first use); None: the box's special-case light. A bad room is refused before any change."""
         from catalog.render.passes.room_transport_light import RoomTransportLight  # noqa: PLC0415
 
-        light = None if room is None else RoomTransportLight(self, str(room))   # refused before any change
+        light = None if room is None else RoomTransportLight(self, str(room))
         if self.room_transport is not None:
             if self.ctx.fbo in self.room_transport.framebuffers():
                 (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
             self.room_transport.release()
         self.room_transport = light
-        self.room_spec = None if room is None else str(room)
-        self.lightmap.invalidate()
+
+    def _resolve_antialiasing(self, mode: str) -> str:
+        """``auto``: :func:`choose_antialiasing` for this context (FXAA on llvmpipe); ``fxaa``:
+        the post-process on the display image (shaders/fxaa.frag); ``msaa``: MSAA_SAMPLES
+        samples per pixel in the HDR passes (refused where the context has fewer); ``off``:
+        the tone-mapped image as it is. Returns the mode in use (never ``auto``)."""
+        info = dict(self.ctx.info)   # GL_RENDERER, GL_MAX_SAMPLES
+        if mode == "auto":
+            mode = choose_antialiasing(info)
+        if mode == "msaa" and int(info.get("GL_MAX_SAMPLES", 0) or 0) < MSAA_SAMPLES:
+            raise SettingsError(f"msaa: this context has fewer than {MSAA_SAMPLES} samples "
+                                "(GL_MAX_SAMPLES); use fxaa", field="antialiasing")
+        if mode != "msaa":
+            self.targets.release_msaa()
+        return mode
+
+    def _load_environment(self, path, resolved) -> None:
+        """The environment image (read with the settings) as a texture, or none."""
+        if self.environment is not None:
+            self.environment[1].release()
+            self.environment = None
+        if path is None:
+            return
+        pixels, upper_lx = resolved
+        h, w = pixels.shape[:2]
+        texture = self.ctx.texture((w, h), 3, data=np.ascontiguousarray(pixels[::-1]).tobytes(),
+                                   dtype="f4")
+        texture.filter = (self._moderngl.LINEAR, self._moderngl.LINEAR)
+        texture.repeat_x, texture.repeat_y = True, False
+        self.environment = (str(path), texture, upper_lx)
+
+    # what the passes read, from the settings (read-only)
+    preset = property(lambda self: self._settings.fabric, doc="The fabric's Preset.")
+    light = property(lambda self: self._settings.key_light, doc="The key light (a Light).")
+    _key_to_light = property(lambda self: self._settings.key_to_light)
+    _is_sun = property(lambda self: self._settings.key_light is not None and self._settings.key_light.is_sun)
+    mode = property(lambda self: self._settings.fluorescence)
+    n_bands = property(lambda self: self._settings.bands)
+    camera = property(lambda self: self._settings.camera)
+    exposure = property(lambda self: self._settings.exposure)
+    ev100 = property(lambda self: self._settings.ev, doc="The fixed EV100, None: auto exposure.")
+    white_balance = property(lambda self: self._settings.white_balance)
+    room_lighting = property(lambda self: self._settings.room_lighting)
+    key_second_layer = property(lambda self: self._settings.key_second_layer)
+    shadow_texels = property(lambda self: self._settings.shadow_map_size)
+    curtain_open = property(lambda self: self._settings.curtain_open)
+    room_lamps = property(lambda self: list(self._settings.lamps))
+    sky_model = property(lambda self: self._settings.sky_model)
+    bloom = property(lambda self: self._settings.bloom)
+    room_spec = property(lambda self: self._settings.room,
+                         doc="The room drawn by its transport (a name or a path), or None.")
+    room_update_every = property(lambda self: self._settings.room_update_every)
+    patterned = property(lambda self: self._settings.patterned and not self.drawing_flat,
+                         doc="The pattern drawn (False: the flat cloth, or a capture's flat pass).")
+
+    def set_rings(self, xs_m) -> None:
+        """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
+        self.room.set_rings(xs_m)
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -224,98 +233,11 @@ class FrameRenderer:
         cloth and the stand-ins stay)."""
         return bool(self.room_lighting and self.viewer_inside)
 
-    def set_shadow_map_size(self, texels: int) -> None:
-        """The side of the key light's maps (the room's transmittance map and the cloth's
-        front-layer map): a power of two in SHADOW_MAP_SIZES' range (issue 11's Pareto)."""
-        texels = int(texels)
-        if texels not in SHADOW_MAP_SIZES:
-            raise InputError(f"{texels}: choose one of {', '.join(map(str, SHADOW_MAP_SIZES))}",
-                             field="shadow map size")
-        if texels != self.shadow_texels:
-            self.shadow_texels = texels
-            self.room_targets.release()
-            self.room_targets.shadow_texels = texels
-
-    def set_curtain_open(self, open_: bool) -> None:
-        """Open: the curtain is drawn aside (not drawn, casts nothing, lights nothing)."""
-        self.curtain_open = bool(open_)
-
-    def set_room_lamps(self, lamps) -> None:
-        """Lamps placed in the room: (light name or Light, (x, y, z) m) pairs, at most
-        room_light.MAX_ROOM_LAMPS; each an isotropic point whose normal irradiance at 1 m is
-        the light's spectrum. They light the room (not the curtain's shading)."""
-        from catalog.optics.lights import get_light  # noqa: PLC0415
-
-        lamps = list(lamps)
-        if len(lamps) > room_light.MAX_ROOM_LAMPS:
-            raise CatalogError(f"at most {room_light.MAX_ROOM_LAMPS} room lamps, got {len(lamps)}")
-        self.room_lamps = [(get_light(light) if isinstance(light, str) else light,
-                            room_light.check_lamp_position(position)) for light, position in lamps]
-
-    def set_sky_model(self, on: bool) -> None:
-        """The clear sky by direction (catalog/optics/sun/sky.py) or the earlier flat sky and ground."""
-        self.sky_model = bool(on)
-        self.lightmap.invalidate()  # the window's capture sees the sky
-
-    def set_environment(self, path) -> None:
-        """An HDR latitude-longitude image (EXR, ...) as the view behind the window, scaled to
-        the light's sky (catalog/render/environment.py); None: the procedural clear sky."""
-        from catalog.render import environment as env  # noqa: PLC0415
-
-        if self.environment is not None:
-            self.environment[1].release()
-            self.environment = None
-        self.lightmap.invalidate()  # the window's capture sees the outside
-        if path is None:
-            return
-        pixels = env.load_environment(path)
-        h, w = pixels.shape[:2]
-        texture = self.ctx.texture((w, h), 3, data=np.ascontiguousarray(pixels[::-1]).tobytes(),
-                                   dtype="f4")
-        texture.filter = (self._moderngl.LINEAR, self._moderngl.LINEAR)
-        texture.repeat_x, texture.repeat_y = True, False
-        self.environment = (str(path), texture, env.upper_illuminance(pixels))
-        self.lightmap.invalidate()
-
-    def set_bloom(self, on: bool) -> None:
-        """Glare before the tone map (energy-preserving, glare.py) on or off."""
-        self.bloom = bool(on)
-
-    def set_bands(self, n_bands: int) -> None:
-        self.n_bands = band_lib.check_band_count(n_bands)
-
-    def set_camera(self, yaw_deg: float, pitch_deg: float, distance_m: float,
-                   target=None, fov_y_deg: float | None = None, inside: bool = False) -> None:
-        """The orbit camera (catalog.render.camera); ``inside``: kept inside the room's box
-        (what every command asks for; the library also draws the room from outside)."""
-        extra = {} if fov_y_deg is None else {"fov_y_deg": float(fov_y_deg)}
-        if target is not None:
-            extra["target"] = tuple(float(v) for v in target)
-        self.camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                                  distance_m=float(distance_m),
-                                  bounds=scene_lib.ROOM_BOX if inside else None, **extra)
-
-    def set_exposure(self, multiplier: float) -> None:
-        if not (math.isfinite(multiplier) and multiplier > 0):
-            raise CatalogError(f"exposure {multiplier!r} must be a positive number")
-        self.exposure = float(multiplier)
-
-    def set_ev(self, ev100: float | None) -> None:
-        """A fixed exposure (EV100, as a camera's), or None for the automatic exposure."""
-        self.ev100 = None if ev100 is None else display_lib.check_ev(ev100)
-
-    def set_white_balance(self, white_balance: str) -> None:
-        """"room" (adapt to the light's white) or "camera" (fixed D65), see display.py."""
-        if white_balance not in display_lib.WHITE_BALANCES:
-            raise CatalogError(f"white balance {white_balance!r}: choose one of "
-                               f"{', '.join(display_lib.WHITE_BALANCES)}")
-        self.white_balance = white_balance
-
     def _require_ready(self) -> None:
         if self.preset is None:
-            raise CatalogError("no fabric set: call set_fabric first")
+            raise CatalogError("no fabric set: update(fabric=...) first")
         if self.light is None:
-            raise CatalogError("no light set: call set_light first")
+            raise CatalogError("no light set: update(light=...) first")
 
     @property
     def viewer_inside(self) -> bool:
@@ -395,31 +317,13 @@ class FrameRenderer:
         self.ctx.disable(mgl.DEPTH_TEST)
         return vw, vh
 
-    def set_antialiasing(self, mode: str) -> None:
-        """``auto`` (default): :func:`choose_antialiasing` for this context (FXAA on llvmpipe);
-        ``fxaa``: the post-process on the display image (shaders/fxaa.frag); ``msaa``:
-        MSAA_SAMPLES samples per pixel in the HDR passes (refused where the context has
-        fewer); ``off``: the tone-mapped image as it is. :attr:`antialiasing` holds the
-        mode in use (never ``auto``)."""
-        if mode not in ANTIALIASING_MODES:
-            raise CatalogError(f"anti-aliasing {mode!r}: choose one of {', '.join(ANTIALIASING_MODES)}")
-        info = dict(self.ctx.info)   # GL_RENDERER, GL_MAX_SAMPLES
-        if mode == "auto":
-            mode = choose_antialiasing(info)
-        if mode == "msaa" and int(info.get("GL_MAX_SAMPLES", 0) or 0) < MSAA_SAMPLES:
-            raise CatalogError(f"anti-aliasing msaa: this context has fewer than "
-                               f"{MSAA_SAMPLES} samples (GL_MAX_SAMPLES); use fxaa")
-        if mode != "msaa":
-            self.targets.release_msaa()
-        self.antialiasing = mode
-
     def render(self, fbo=None, viewport=None, dt_s: float | None = None,
                profile: dict | None = None) -> None:
         """One frame: HDR passes, the glare (bloom, when on), then the display pass into
         ``fbo`` (default: our RGBA8 target) at ``viewport`` (x, y, w, h; default the whole
         renderer size).
 
-        Auto exposure (no :meth:`set_ev`): this frame is metered (before the glare); ``dt_s``
+        Auto exposure (``settings.ev`` None): this frame is metered (before the glare); ``dt_s``
         (the viewer's frame time) adapts the exposure toward it over
         display.ADAPTATION_TAU_S, None jumps. ``profile``: see :meth:`render_hdr` (adds
         "meter", "bloom" and "display")."""

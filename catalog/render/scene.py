@@ -289,18 +289,11 @@ def key_elevation_for(light) -> float:
 # --------------------------------------------------------------------------- fabric spectra
 
 def dye_transmittance(preset) -> np.ndarray:
-    """T(l) of a preset's ``[dye] transmittance`` CSV on GRID_NM (edge values held), or 1."""
-    from catalog.optics.spectra import read_spectrum  # noqa: PLC0415
+    """T(l) of a preset's ``[dye] transmittance`` CSV on GRID_NM (edge values held), or 1
+    (:func:`catalog.presets.fabric.resolve_fabric`: read once per preset)."""
+    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
 
-    rel = preset.table("dye").get("transmittance")
-    if rel is None:
-        return np.ones(GRID_NM.size)
-    spectrum = read_spectrum(preset.resolve(rel))
-    values = np.interp(GRID_NM, spectrum.wavelength_nm, spectrum.values)
-    if np.any(values > 1.0):
-        raise InputError("dye transmittance must lie in [0, 1]", path=spectrum.source,
-                         field="intensity")
-    return values
+    return resolve_fabric(preset).dye_transmittance
 
 
 def relative_dye(transmittance: np.ndarray) -> np.ndarray:
@@ -319,17 +312,6 @@ def relative_dye(transmittance: np.ndarray) -> np.ndarray:
     return transmittance / mean
 
 
-@functools.lru_cache(maxsize=32)
-def _material_cached(excitation_path: str, emission_path: str, peak_absorptance: float,
-                     quantum_yield: float, saturation: float):
-    from catalog.optics.fluorescence import material_from_spectra  # noqa: PLC0415
-    from catalog.optics.spectra import read_spectrum  # noqa: PLC0415
-
-    return material_from_spectra(read_spectrum(excitation_path), read_spectrum(emission_path),
-                                 peak_absorptance=peak_absorptance, quantum_yield=quantum_yield,
-                                 saturation_photon_irradiance=saturation)
-
-
 def fluorescent_material(preset, irradiance: np.ndarray | None = None):
     """The physical-mode material of a preset with a ``[fluorescence]`` table (else None).
 
@@ -340,86 +322,32 @@ def fluorescent_material(preset, irradiance: np.ndarray | None = None):
     light), so the shader's work is the same. Without ``irradiance`` the main band is
     returned (and every band's files are checked)."""
     from catalog.optics import fluorescence as fl  # noqa: PLC0415
+    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
 
-    if preset.fluorescence is None:
+    materials = resolve_fabric(preset).fluorescent_materials
+    if not materials:
         return None
-    extra = preset.fluorescence.extra
-    for path in (preset.fluorescence.excitation, preset.fluorescence.emission):
-        if not path.is_file():
-            raise InputError("fluorescence spectrum file not found", path=path)
-    saturation = float(extra.get("saturation_photon_irradiance",
-                                 fl.DEFAULT_SATURATION_PHOTON_IRRADIANCE))
-    main = _material_cached(str(preset.fluorescence.excitation), str(preset.fluorescence.emission),
-                            float(extra.get("peak_absorptance", fl.DEFAULT_PEAK_ABSORPTANCE)),
-                            float(extra.get("quantum_yield", fl.DEFAULT_QUANTUM_YIELD)),
-                            saturation)
-    bands = extra.get("bands") or []
-    if not bands:
-        return main
-    base = preset.path.parent if preset.path is not None else preset.fluorescence.excitation.parent
-    materials = [main]
-    for i, band in enumerate(bands):
-        where = f"fluorescence.bands[{i}]"
-        if not isinstance(band, dict):
-            raise InputError("must be a table", path=preset.path, field=where)
-        paths = []
-        for key in ("excitation", "emission"):
-            rel = band.get(key)
-            if not isinstance(rel, str) or not rel:
-                raise InputError("must be a path string", path=preset.path, field=f"{where}.{key}")
-            path = (base / rel).resolve()
-            if not path.is_file():
-                raise InputError("fluorescence spectrum file not found", path=path,
-                                 field=f"{where}.{key}")
-            paths.append(str(path))
-        numbers = []
-        for key in ("peak_absorptance", "quantum_yield"):
-            value = band.get(key)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value <= 1:
-                raise InputError(f"must be a number in (0, 1], not {value!r}", path=preset.path,
-                                 field=f"{where}.{key}")
-            numbers.append(float(value))
-        materials.append(_material_cached(*paths, *numbers, saturation))
-    if irradiance is None:
-        return main
-    return fl.combine_under_light(materials, np.asarray(irradiance, dtype=np.float64))
-
-
-@functools.lru_cache(maxsize=32)
-def _residual_cached(path: str):
-    from catalog.optics.measured_residual import read_residual  # noqa: PLC0415
-
-    return read_residual(path)
+    if irradiance is None or len(materials) == 1:
+        return materials[0]
+    return fl.combine_under_light(list(materials), np.asarray(irradiance, dtype=np.float64))
 
 
 def fluorescence_residual(preset):
     """The preset's measured residual (``[fluorescence] residual``, a file beside the preset;
     catalog.optics.measured_residual), or None. Bad fields: one-line InputError."""
-    if preset.fluorescence is None:
-        return None
-    rel = preset.fluorescence.extra.get("residual")
-    if rel is None:
-        return None
-    if not isinstance(rel, str) or not rel:
-        raise InputError(f"must be a path string, not {rel!r}", path=preset.path,
-                         field="fluorescence.residual")
-    if not preset.fluorescence.extra.get("bands") and "quantum_yield" not in preset.fluorescence.extra:
-        raise InputError("a residual needs the fitted bands it belongs to (quantum_yield, "
-                         "peak_absorptance, bands)", path=preset.path, field="fluorescence.residual")
-    base = preset.path.parent if preset.path is not None else preset.fluorescence.excitation.parent
-    path = (base / rel).resolve()
-    if not path.is_file():
-        raise InputError("residual file not found", path=path, field="fluorescence.residual")
-    return _residual_cached(str(path))
+    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
+
+    return resolve_fabric(preset).residual
 
 
 def paper_emission_shape(preset) -> np.ndarray:
     """The emission Le on GRID_NM, 380-780 nm only (eq. 1), scaled so that sum ybar s dl = 1
     (eq. 3's K / 100): F = 100 sum cmf s is the paper's fluorescence colour."""
     from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
-    from catalog.optics.spectra import VISIBLE_NM, read_spectrum  # noqa: PLC0415
+    from catalog.optics.spectra import VISIBLE_NM  # noqa: PLC0415
+    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
 
-    emission = read_spectrum(preset.fluorescence.emission).resample(GRID_NM)
+    emission = resolve_fabric(preset).emission_on_grid
     emission = np.where((GRID_NM >= VISIBLE_NM[0]) & (GRID_NM <= VISIBLE_NM[1]), emission, 0.0)
     y = float(emission @ cmfs(GRID_NM)[:, 1])
     if not y > 0:
@@ -621,6 +549,6 @@ def with_room_solved(inputs: ShadingInputs) -> ShadingInputs:
 
 
 def _excitation_on_grid(preset) -> np.ndarray:
-    from catalog.optics.spectra import read_spectrum  # noqa: PLC0415
+    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
 
-    return read_spectrum(preset.fluorescence.excitation, normalise=True).resample(GRID_NM)
+    return resolve_fabric(preset).excitation_on_grid

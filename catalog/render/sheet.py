@@ -77,17 +77,18 @@ def _wrap(text: str, width_px: int, font_px: int) -> list[str]:
 def close_up(renderer) -> np.ndarray:
     """The renderer's fabric and light seen from the close-up view (sRGB8), the camera put
     back as it was."""
+    from catalog.render.settings import orbit  # noqa: PLC0415
     from catalog.render.views import VIEWS  # noqa: PLC0415
 
     camera = renderer.camera
     view = VIEWS["close"]
-    renderer.set_camera(view.yaw_deg, view.pitch_deg, view.distance_m, target=view.target,
-                        fov_y_deg=view.fov_y_deg, inside=True)
+    renderer.update(camera=orbit(view.yaw_deg, view.pitch_deg, view.distance_m, target=view.target,
+                                 fov_y_deg=view.fov_y_deg, inside=True))
     try:
         renderer.render()
         return renderer.read_srgb8()
     finally:
-        renderer.camera = camera
+        renderer.update(camera=camera)
 
 
 def put_inset(cell: np.ndarray, swatch: np.ndarray, fraction: float = INSET_FRACTION) -> None:
@@ -151,12 +152,8 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
 
     ctx = ctx or create_headless_context()
     renderer = new_renderer(ctx, size)  # the size checked against the context first
-    renderer.set_fluorescence(fluorescence)
-    renderer.set_bands(bands)
-    renderer.set_ev(ev)
-    renderer.set_white_balance(white_balance)
-    if room is not None:
-        renderer.set_room(room)
+    renderer.update(fluorescence=fluorescence, bands=bands, ev=ev, white_balance=white_balance,
+                    room=room)
     width, height = size
     grid = np.zeros((height * len(presets), width * len(light_objects), 3), dtype=np.uint8)
     images = []
@@ -173,8 +170,7 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
                 renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
                 renderer.set_rings(ring_xs_m(preset))
                 shown = preset
-            renderer.set_fabric(preset)
-            renderer.set_light(light)
+            renderer.update(fabric=preset, light=light)
             renderer.render()
             pixels = renderer.read_srgb8()
             safe_light = "".join(c if c.isalnum() or c in "-._" else "_" for c in light.name)

@@ -252,28 +252,18 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
 def configure_renderer(renderer, request: SnapshotRequest, preset, light):
     """Every renderer setting a snapshot depends on but the mesh, from ``request`` (the
     preset and light already loaded). Returns the sun's report with ``request.hour``."""
-    renderer.set_fabric(preset)
-    sun = None
-    if request.hour is not None:
-        sun = renderer.set_sun_hour(request.hour)
-    else:
-        renderer.set_light(light)
-    renderer.set_fluorescence(request.fluorescence)
-    renderer.set_bands(request.bands)
-    renderer.set_camera(request.yaw_deg, request.pitch_deg, request.distance_m,
-                        target=request.target, fov_y_deg=request.fov_y_deg, inside=True)
-    renderer.set_exposure(request.exposure)
-    renderer.set_ev(request.ev)
-    renderer.set_white_balance(request.white_balance)
-    renderer.set_curtain_open(request.curtain_open)
-    renderer.set_room_lighting(request.room_light)
-    if request.room != renderer.room_spec:
-        renderer.set_room(request.room)
-    renderer.set_bloom(request.bloom)
-    if request.environment is not None:
-        renderer.set_environment(request.environment)
-    renderer.set_room_lamps(request.lamps)
-    return sun
+    from catalog.render.settings import SunHour, orbit  # noqa: PLC0415
+
+    renderer.update(
+        fabric=preset, light=light if request.hour is None else SunHour(request.hour),
+        fluorescence=request.fluorescence, bands=request.bands,
+        camera=orbit(request.yaw_deg, request.pitch_deg, request.distance_m,
+                     target=request.target, fov_y_deg=request.fov_y_deg, inside=True),
+        exposure=request.exposure, ev=request.ev, white_balance=request.white_balance,
+        curtain_open=request.curtain_open, room_lighting=request.room_light,
+        bloom=request.bloom, environment=request.environment, lamps=request.lamps,
+        room=request.room)
+    return renderer.settings.sun_hour
 
 
 def image_metadata(info: dict, frame: int, linear: bool) -> dict:

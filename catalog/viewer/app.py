@@ -147,6 +147,7 @@ class ViewerApp:
         from imgui_bundle.python_backends.glfw_backend import GlfwRenderer  # noqa: PLC0415
 
         from catalog.gl.context import wrap_window_context  # noqa: PLC0415
+        from catalog.render.settings import orbit  # noqa: PLC0415
         from catalog.viewer.panel import Panel, PanelInfo  # noqa: PLC0415
         from catalog.viewer.scene import CurtainScene  # noqa: PLC0415
 
@@ -220,9 +221,9 @@ class ViewerApp:
                 self._fbo.clear(0.0, 0.0, 0.0, 1.0)
                 for slot, (renderer, viewport) in enumerate(zip(self._renderers,
                                                                 self._viewports())):
-                    renderer.set_camera(self.camera.yaw_deg, self.camera.pitch_deg,
-                                        self.camera.distance_m, target=self.camera.target,
-                                        fov_y_deg=self.camera.fov_y_deg, inside=True)
+                    renderer.update(camera=orbit(
+                        self.camera.yaw_deg, self.camera.pitch_deg, self.camera.distance_m,
+                        target=self.camera.target, fov_y_deg=self.camera.fov_y_deg, inside=True))
                     try:
                         self._set_exposure(slot, renderer)
                         if self._scaled_fbos:
@@ -439,12 +440,13 @@ class ViewerApp:
                         max(1, round(size[1] * self.render_scale)))
                 self._scaled_fbos.append(self.ctx.simple_framebuffer(size, components=4))
             renderer = FrameRenderer(self.ctx, size)
-            renderer.set_bloom(self.room_settings["bloom"])
-            renderer.set_room_lighting(self.room_settings["room_light"])
-            renderer.set_sky_model(self.room_settings["room_light"])
-            renderer.room_update_every = self.room_settings["room_update_every"]
-            if self.room_settings["room_light"] and self.options.room is not None:
-                renderer.set_room(self.options.room)
+            renderer.update(bloom=self.room_settings["bloom"],
+                            room_lighting=self.room_settings["room_light"],
+                            sky_model=self.room_settings["room_light"],
+                            room_update_every=self.room_settings["room_update_every"],
+                            **({"room": self.options.room}
+                               if self.room_settings["room_light"] and self.options.room is not None
+                               else {}))
             self._renderers.append(renderer)
 
     def _choose_render_scale(self) -> float:
@@ -492,6 +494,8 @@ class ViewerApp:
 
     def _sync_renderers(self) -> None:
         """Pass the settings to each renderer, only what changed since the last frame."""
+        from catalog.render.settings import SunHour  # noqa: PLC0415
+
         settings = self.settings
         if len(self.catalog) == 0:
             self.messages["catalog"] = f"no presets (*.toml) in {self.catalog.where}"
@@ -505,7 +509,7 @@ class ViewerApp:
             entry = self.catalog.load(fabric_index)
             if entry.preset is not None and applied.get("fabric") != (entry.name, id(entry.preset)):
                 try:
-                    renderer.set_fabric(entry.preset)
+                    renderer.update(fabric=entry.preset)
                     if slot == 0:
                         self.scene.set_fabric(entry.preset)
                     self.messages.pop(f"fabric{slot}", None)
@@ -517,10 +521,11 @@ class ViewerApp:
             if applied.get("light") != light_key:
                 try:
                     if settings.light == SUN:
-                        self._sun = renderer.set_sun_hour(settings.sun_hour)
+                        renderer.update(light=SunHour(settings.sun_hour))
+                        self._sun = renderer.settings.sun_hour
                     else:
                         self._sun = None
-                        renderer.set_light(settings.light)
+                        renderer.update(light=settings.light)
                     self.messages.pop("light", None)
                 except CatalogError as exc:
                     self.messages["light"] = str(exc)
@@ -528,13 +533,13 @@ class ViewerApp:
                 applied["light"] = light_key
             mode = settings.fluorescence if slot == 0 else settings.right_fluorescence
             if applied.get("fluorescence") != mode:
-                renderer.set_fluorescence(mode)
+                renderer.update(fluorescence=mode)
                 applied["fluorescence"] = mode
             if applied.get("white_balance") != settings.white_balance:
-                renderer.set_white_balance(settings.white_balance)
+                renderer.update(white_balance=settings.white_balance)
                 applied["white_balance"] = settings.white_balance
             if applied.get("bands") != settings.bands:
-                renderer.set_bands(settings.bands)
+                renderer.update(bands=settings.bands)
                 applied["bands"] = settings.bands
         if self.scene.preset_name is None:
             entry = self.catalog.load(settings.fabric_index)
@@ -546,12 +551,12 @@ class ViewerApp:
         shows at the left's exposure (a comparison at one exposure, e.g. fluorescence on |
         off, shows the difference instead of metering it away)."""
         if self.settings.ev100 is not None:
-            renderer.set_ev(self.settings.ev100)
+            renderer.update(ev=self.settings.ev100)
         elif slot == 0:
-            renderer.set_ev(None)
+            renderer.update(ev=None)
         else:
             left = self._renderers[0]
-            renderer.set_ev(left.metered_ev100 if left.ev100 is None and
+            renderer.update(ev=left.metered_ev100 if left.ev100 is None and
                             left.metered_ev100 is not None else None)
 
     def _thumbnail_scene(self) -> tuple:
@@ -561,16 +566,18 @@ class ViewerApp:
 
     def _update_thumbnails(self) -> None:
         """Draw the thumbnails that are missing or stale (a few per frame)."""
+        from catalog.render.settings import SunHour  # noqa: PLC0415
+
         settings = self.settings
 
         def apply_scene(renderer) -> None:
             if settings.light == SUN:
-                renderer.set_sun_hour(settings.sun_hour)
+                renderer.update(light=SunHour(settings.sun_hour))
             else:
-                renderer.set_light(settings.light)
-            renderer.set_fluorescence(settings.fluorescence)
-            renderer.set_white_balance(settings.white_balance)
-            renderer.set_ev(settings.ev100)
+                renderer.update(light=settings.light)
+            renderer.update(fluorescence=settings.fluorescence,
+                            white_balance=settings.white_balance,
+                            ev=settings.ev100)
 
         entries = [entry for entry in self.catalog.entries
                    if settings.fabric_filter.matches(entry.facts)]

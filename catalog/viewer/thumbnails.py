@@ -131,7 +131,7 @@ class ThumbnailCache:
 
         renderer = self._ensure_renderer("final" if final else "draft")
         try:
-            renderer.set_fabric(entry.preset)
+            renderer.update(fabric=entry.preset)
             apply_scene(renderer)
             renderer.render()
             pixels = renderer.read_srgb8()
@@ -150,16 +150,18 @@ class ThumbnailCache:
         renderer = self._renderers.get(kind)
         if renderer is None:
             from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+            from catalog.render.settings import FrameSettings, orbit  # noqa: PLC0415
 
             if kind == "final":
-                renderer = FrameRenderer(self.ctx, self.size, specialise=False)
+                renderer = FrameRenderer(self.ctx, self.size, FrameSettings(camera=orbit(0.0, 0.0, 2.9)),
+                                         specialise=False)
             else:
                 size = tuple(-(-side // DRAFT_SCALE) for side in self.size)
-                renderer = FrameRenderer(self.ctx, size, specialise=False)
-                renderer.set_room_lighting(False)
-                renderer.set_bloom(False)
+                renderer = FrameRenderer(self.ctx, size,
+                                         FrameSettings(camera=orbit(0.0, 0.0, 2.9),
+                                                       room_lighting=False, bloom=False),
+                                         specialise=False)
                 renderer.fabric_pattern.set_prefilter(False)
-            renderer.set_camera(0.0, 0.0, 2.9)
             self._renderers[kind] = renderer
         return renderer
 

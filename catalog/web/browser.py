@@ -120,6 +120,7 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
     0 = top. ``ev100``: the page's fixed exposure of the scene (None: the desktop meters)."""
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
+    from catalog.render.settings import SunHour, orbit  # noqa: PLC0415
     from catalog.web import bake as bake_lib  # noqa: PLC0415
     from catalog.web.export import (FLUORESCENCE, GLARE, configure_desktop_frame,  # noqa: PLC0415
                                     room_lamps)
@@ -127,19 +128,18 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
     positions, normals, tangents = bake_lib.decode_frame(animation, frame)
     renderer = FrameRenderer(ctx or create_headless_context(), size)
     try:
-        renderer.set_fabric(fabric)
+        renderer.update(fabric=fabric)
         if light.startswith("sun@"):
-            renderer.set_sun_hour(float(light[4:]))
+            renderer.update(light=SunHour(float(light[4:])))
         else:
-            renderer.set_light(light)
-        renderer.set_fluorescence(FLUORESCENCE[fluorescence])
+            renderer.update(light=light)
+        renderer.update(fluorescence=FLUORESCENCE[fluorescence])
         configure_desktop_frame(renderer)
-        renderer.set_bloom(GLARE[glare])
-        renderer.set_room_lamps(room_lamps(lamp))
+        renderer.update(bloom=GLARE[glare], lamps=room_lamps(lamp))
         if camera is not None:
-            renderer.set_camera(*camera)
+            renderer.update(camera=orbit(*camera))
         if ev100 is not None:
-            renderer.set_ev(ev100)
+            renderer.update(ev=ev100)
         renderer.set_mesh(positions, normals, animation.uv, tangents,
                           animation.indices.astype(np.int32),
                           fabric_size_m=animation.fabric_size_m)

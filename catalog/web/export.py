@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
+from catalog.render.settings import SunHour, orbit
 
 #: The lamps of the light switch when ``--lights`` is not given.
 DEFAULT_LAMPS = ("D65", "A", "FL2", "LED-B4", "LED-warm", "UV-A")
@@ -54,7 +55,7 @@ GLARE = {"on": True, "off": False}
 #: room, 1.5 m above the floor; a floor lamp beside the curtain).
 ROOM_LAMP_POSITION_M = (1.3, 0.2, 1.0)
 #: The room-lamp switch: none, or one lamp of the light library at ROOM_LAMP_POSITION_M
-#: (FrameRenderer.set_room_lamps, `catalog snapshot --lamp`): it lights the room and the cloth.
+#: (FrameSettings.lamps, `catalog snapshot --lamp`): it lights the room and the cloth.
 ROOM_LAMPS = {"none": None, "A": "Incandescent lamp (A)", "LED-B4": "White LED lamp (LED-B4)"}
 #: Sizes that follow the canvas: the recorded frame's (level 0) and its halvings rounded up
 #: (level k: ceil(size / 2^k); the glare's half- and quarter-size targets). The page puts its
@@ -94,10 +95,10 @@ DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa
 
 def configure_desktop_frame(renderer) -> None:
     """Put a FrameRenderer in the modes the page shows (:data:`DESKTOP_MODES`)."""
-    renderer.set_patterned(DESKTOP_MODES["patterned"])
-    renderer.set_room_lighting(DESKTOP_MODES["room_lighting"])
-    renderer.set_antialiasing(DESKTOP_MODES["antialiasing"])
-    renderer.set_key_second_layer(DESKTOP_MODES["key_second_layer"])
+    renderer.update(patterned=DESKTOP_MODES["patterned"],
+                    room_lighting=DESKTOP_MODES["room_lighting"],
+                    antialiasing=DESKTOP_MODES["antialiasing"],
+                    key_second_layer=DESKTOP_MODES["key_second_layer"])
     renderer.fabric_pattern.set_prefilter(DESKTOP_MODES["pattern_prefilter"])
 #: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
 #: the page shows each scene at the EV100 a desktop frame of this size meters at the default
@@ -127,7 +128,7 @@ def scene_key(fabric: str, light: str, fluorescence: str, glare: str, lamp: str)
 
 
 def room_lamps(lamp: str) -> list:
-    """FrameRenderer.set_room_lamps' argument for a ROOM_LAMPS choice."""
+    """FrameSettings.lamps for a ROOM_LAMPS choice."""
     if lamp not in ROOM_LAMPS:
         raise CatalogError(f"room lamp {lamp!r}: choose one of {', '.join(ROOM_LAMPS)}")
     return [] if lamp == "none" else [(lamp, ROOM_LAMP_POSITION_M)]
@@ -347,20 +348,20 @@ class SiteExporter:
         """One scene's structure index and values; ``ev100``: its exposure (None: metered by
         a METER_SIZE desktop frame at the default camera, with the glare and lamp asked)."""
         for r in (self.meter, self.renderer):
-            r.set_fabric(preset)
+            r.update(fabric=preset)
             if light.kind == "sun":
-                r.set_sun_hour(light.hour)
+                r.update(light=SunHour(light.hour))
             else:
-                r.set_light(light.id)
-            r.set_fluorescence(FLUORESCENCE[fluorescence])
-            r.set_bloom(GLARE[glare])
-            r.set_room_lamps(room_lamps(lamp))
+                r.update(light=light.id)
+            r.update(fluorescence=FLUORESCENCE[fluorescence],
+                     bloom=GLARE[glare],
+                     lamps=room_lamps(lamp))
         if ev100 is None:
-            self.meter.set_ev(None)
+            self.meter.update(ev=None)
             self.meter.render()
             ev100 = self.meter.current_ev100()
         r = self.renderer
-        r.set_ev(ev100)
+        r.update(ev=ev100)
         rec = self.ctx.recording
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
         rec.start()
@@ -406,9 +407,9 @@ class SiteExporter:
         richest = {"glare": "on", "lamp": list(ROOM_LAMPS)[-1]}  # every pass the page has
         ev100 = self.record(preset, light, "on", **richest)["ev100"]  # one exposure for both
         first = self.record(preset, light, "on", ev100=ev100, **richest)
-        r.set_camera(saved.yaw_deg + 30.0, saved.pitch_deg + 20.0, saved.distance_m * 0.8)
+        r.update(camera=orbit(saved.yaw_deg + 30.0, saved.pitch_deg + 20.0, saved.distance_m * 0.8))
         second = self.record(preset, light, "on", ev100=ev100, **richest)
-        r.camera = saved
+        r.update(camera=saved)
         structure = self.structures[first["structure"]]
         if first["structure"] != second["structure"]:
             raise CatalogError("the desktop frame's passes change with the camera; the web "
@@ -507,9 +508,7 @@ def swatch_png(ctx, preset, size=SWATCH_SIZE) -> bytes:
 
     renderer = FrameRenderer(ctx, size)
     try:
-        renderer.set_fabric(preset)
-        renderer.set_light("D65")
-        renderer.set_camera(0.0, 0.0, 1.9)
+        renderer.update(fabric=preset, light="D65", camera=orbit(0.0, 0.0, 1.9))
         renderer.render()
         pixels = catalog_card(renderer, renderer.read_srgb8())
     finally:

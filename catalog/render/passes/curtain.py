@@ -154,15 +154,13 @@ class CurtainPass(Pass):
         grid's chords cut into the folds, which its front-layer map then shadowed, and the
         room's capture was 0.78x the path tracer's radiance along the same rays (0.93x with
         the mesh)."""
-        patterned = self.frame.patterned
-        if patterned:
-            self.frame.patterned = False
+        drawing_flat = self.frame.drawing_flat
+        self.frame.drawing_flat = True
         try:
             self.draw_curtain(view_proj, camera_position=eye, overrides=overrides,
                               folds_behind=folds_behind, coarse=coarse)
         finally:
-            if patterned:
-                self.frame.patterned = patterned
+            self.frame.drawing_flat = drawing_flat
 
     def oit_depth_reference_m(self) -> float:
         """The view distance (m) where the OIT depth weight is 1: just before the nearest

@@ -48,13 +48,13 @@ class PatternTexture(Pass):
     def set_fabric(self, preset) -> None:
         """The preset's pattern as a mipmapped RGBA32F texture (thread normal, coverage);
         without a [pattern] a uniform coverage 1 - LD (one texel)."""
-        from catalog.presets.patterns import load_pattern  # noqa: PLC0415
+        from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
 
         table = preset.table("pattern")
         key = (str(preset.path), repr(sorted(table.items())), preset.btdf.direct)
         if key == self.key:
             return
-        pattern = load_pattern(preset)
+        pattern = resolve_fabric(preset).pattern
         if pattern is None:
             texels = np.array([[[0.0, 0.0, 1.0, 1.0 - preset.btdf.direct]]], dtype=np.float32)
             repeat = self.frame.mesh.fabric_size_m

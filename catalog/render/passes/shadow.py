@@ -31,7 +31,7 @@ KEY_PEEL_SPAN_TEXELS = 1.5
 KEY_SHADOW_BIAS_M = 0.004
 
 
-#: The key light's map sides set_shadow_map_size accepts (texels).
+#: The key light's map sides FrameSettings.shadow_map_size accepts (texels).
 SHADOW_MAP_SIZES = (64, 128, 256, 512, 1024, 2048)
 
 
