@@ -5,6 +5,7 @@ folder still works after it is moved."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 import shutil
 
 import pytest
@@ -97,3 +98,30 @@ def test_a_banded_export_of_a_dyed_base_carries_its_dye_and_moves(tmp_path):
     assert np.array_equal(scene.dye_transmittance(moved),
                           scene.dye_transmittance(load_preset(find_preset("organza-ivory"))))
     assert scene.fluorescent_material(moved) is not None
+
+
+def test_every_file_a_pattern_names_is_bundled():
+    """A pattern key naming a file (validate.PATTERN_PATHS) left out of the bundle's list would
+    leave a self-contained preset pointing at a file it does not carry (the lace border did)."""
+    from catalog.core.validate import PATTERN_PATHS
+    from catalog.presets.bundle import PATH_KEYS
+
+    assert {("pattern", key) for key in PATTERN_PATHS} <= set(PATH_KEYS)
+
+
+def test_a_bordered_lace_bundles_its_border(tmp_path):
+    """lace-fwa's border band and its height travel with the preset: bundled into a new folder,
+    the copies lie inside it and the preset loads from there with its border."""
+    from catalog.presets import find_preset, load_preset, preset_from_dict, preset_to_dict
+
+    source = find_preset("lace-fwa")
+    preset = load_preset(source)
+    doc = preset_to_dict(preset)
+    out = tmp_path / "mine" / "lace-fwa.toml"
+    bundle_files(doc, out, lambda _k, v: Path(source).parent / v)
+    for key in ("border", "border_height"):
+        named = out.parent / doc["pattern"][key]
+        assert named.is_file() and out.parent.resolve() in named.resolve().parents
+    from catalog.presets.patterns import load_pattern
+
+    assert load_pattern(preset_from_dict(doc, out)).border is not None

@@ -29,6 +29,8 @@ PATH_KEYS: dict[tuple[str, str], str] = {
     ("fluorescence", "residual"): "measurements",
     ("pattern", "coverage"): "patterns",
     ("pattern", "height"): "patterns",
+    ("pattern", "border"): "patterns",
+    ("pattern", "border_height"): "patterns",
     ("import", "source"): "source",      # what ``catalog import`` read (kept for provenance)
 }
 #: A file a preset names is copied whole; larger ones are refused (a preset's spectra and
