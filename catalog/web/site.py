@@ -56,6 +56,27 @@ def _json_length(value, depth: int = 2) -> int:
     return len(json.dumps(value, separators=(",", ":")))
 
 
+def _plain_length(data: dict) -> int:
+    """:func:`_json_length` of ``data`` with its scenes' values as values, not indices into
+    its ``value_pool`` (the plain form, :func:`plain_data_js`), when it has one."""
+    pool = data.get("value_pool")
+    if pool is None or "scenes" not in data:
+        return _json_length(data)
+    sizes = [len(json.dumps(v, separators=(",", ":"))) for v in pool]
+    rest = {k: v for k, v in data.items() if k not in ("value_pool", "scenes")}
+    scenes = data.get("scenes", {})
+
+    def scene_length(scene: dict) -> int:
+        values = scene["values"]
+        return (len(json.dumps({**scene, "values": []}, separators=(",", ":")))
+                + (sum(sizes[i] for i in values) + len(values) - 1 if values else 0))
+
+    scenes_length = 2 + max(len(scenes) - 1, 0) + sum(
+        len(json.dumps(str(key))) + 1 + scene_length(scene) for key, scene in scenes.items())
+    return (_json_length(rest) + (1 if rest else 0) + len(json.dumps("scenes")) + 1
+            + scenes_length)
+
+
 def pack_data(data: dict) -> tuple[str, int]:
     """data.js's text, and the bytes a plain ``window.CATALOG_DATA = JSON`` would take.
 
@@ -73,13 +94,14 @@ def pack_data(data: dict) -> tuple[str, int]:
     # plain JSON text of it whole. The plain size is counted part by part (_json_length), and
     # only what packing changes is copied (the scenes' value lists, the entries whose bytes
     # move out).
-    plain = len(plain_data_js({})) - 2 + _json_length(data)
+    plain = len(plain_data_js({})) - 2 + _plain_length(data)
     data = dict(data)
     binary: list[str] = []
     # every distinct uniform value once ("values": [0.5, ..] -> "values": [i, ..] into
-    # "value_pool"): scenes of one fabric or light share most of theirs
+    # "value_pool"): scenes of one fabric or light share most of theirs. Data that comes
+    # pooled (the exporter pools as it records) is kept as it is.
     pool: dict[str, int] = {}
-    if "scenes" in data:
+    if "scenes" in data and "value_pool" not in data:
         data["scenes"] = {key: {**scene, "values": [
             pool.setdefault(json.dumps(v, separators=(",", ":")), len(pool))
             for v in scene["values"]]} for key, scene in data["scenes"].items()}
@@ -243,6 +265,12 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         timings["bake_s"] = time.perf_counter() - t
 
         t = time.perf_counter()
+        if ctx is None:
+            from catalog.gl.context import create_headless_context  # noqa: PLC0415
+            ctx = create_headless_context()
+        # the swatches first, their renderer released before the recording's two are made
+        swatches = {name: base64.b64encode(png).decode("ascii")
+                    for name, png in export.swatch_pngs(ctx, presets).items()}
         exporter = export.SiteExporter(ctx)
         try:
             positions, normals, tangents = bake_lib.decode_frame(first, 0)
@@ -271,11 +299,10 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                                                      lamp=lamp))
                             bar.advance()
             objects = exporter.objects()
-            swatches = {p.name: base64.b64encode(export.swatch_png(exporter.ctx._ctx, p))
-                        .decode("ascii") for p in presets}
         finally:
             exporter.release()
         timings["record_s"] = time.perf_counter() - t
+        scenes, value_pool = exporter.pooled_scenes(scenes)
 
         camera = exporter.renderer.camera
         data = {
@@ -290,6 +317,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             "structures": exporter.structures,
             "blobs": exporter.blobs,
             "scenes": scenes,
+            "value_pool": value_pool,   # the scenes' values index it
             "fabrics": [{"name": p.name, "display_name": p.display_name,
                          "facts": export.fabric_facts(p), "swatch": swatches[p.name],
                          "animation": fabric_animation[p.name].key} for p in presets],
