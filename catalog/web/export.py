@@ -281,17 +281,20 @@ def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
         return {"data": _b64(data)}
     if bits not in (8, 16):
         raise CatalogError(f"texel bits must be 8 or 16, not {bits}")
-    texels = np.frombuffer(data, dtype="<f4").reshape(-1, texture["components"]).astype(np.float64)
+    texels = np.frombuffer(data, dtype="<f4").reshape(-1, texture["components"])
     if not np.all(np.isfinite(texels)):
         raise CatalogError("a recorded float texture has non-finite texels")
-    lo, hi = texels.min(axis=0), texels.max(axis=0)
+    lo = texels.min(axis=0).astype(np.float64)
+    hi = texels.max(axis=0).astype(np.float64)
     top = (1 << bits) - 1
     span = np.where(hi > lo, hi - lo, 1.0)
-    q = np.rint((texels - lo) / span * top)
     # in planes (every texel's channel 0, then channel 1, ..): deflate (site.pack_data) then
     # finds each channel's own repetitions (a third of the interleaved bytes' deflated size
-    # on the lace's pattern)
-    encoded = np.ascontiguousarray(q.T).astype("<u2" if bits == 16 else "u1").tobytes()
+    # on the lace's pattern); quantised in float64 a channel at a time (a pattern of 27 MB
+    # needs no float64 copy of all its channels at once)
+    encoded = b"".join(
+        np.rint((texels[:, c].astype(np.float64) - lo[c]) / span[c] * top)
+        .astype("<u2" if bits == 16 else "u1").tobytes() for c in range(texels.shape[1]))
     return {"data": _b64(encoded),
             "quantised": {"bits": bits, "lo": [float(v) for v in lo],
                           "hi": [float(v) for v in lo + span], "planar": True}}
@@ -562,8 +565,9 @@ def _sized(entry: dict) -> dict:
 
 
 def swatch_pngs(ctx, presets, size=SWATCH_SIZE) -> dict[str, bytes]:
-    """A small desktop frame of each fabric under D65 (the grid's swatches), PNG bytes by
-    fabric name; one renderer for them all (its programs compiled once)."""
+    """A small desktop frame of each fabric under D65 (the grid's swatches) in the modes the
+    page shows (:data:`DESKTOP_MODES`), PNG bytes by fabric name; one renderer for them all
+    (its programs compiled once)."""
     import io  # noqa: PLC0415
 
     from PIL import Image  # noqa: PLC0415
@@ -573,6 +577,7 @@ def swatch_pngs(ctx, presets, size=SWATCH_SIZE) -> dict[str, bytes]:
     renderer = FrameRenderer(ctx, size)
     swatches = {}
     try:
+        configure_desktop_frame(renderer)
         renderer.set_light("D65")
         renderer.set_camera(0.0, 0.0, 1.9)
         for preset in presets:

@@ -245,17 +245,17 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
     with staged_folder(out, replace_listed=_replace_listed(new_files)) as stage:
         timings = {}
         t = time.perf_counter()
-        animations = {}
         fabric_animation = {}
         keys = {preset.name: bake_lib.cloth_key(bake_lib.bake_params(preset)) for preset in presets}
-        with progress_bar("catalog web: bake", total=len(set(keys.values())), unit="cloths",
+        firsts = {}   # one preset per distinct cloth
+        for preset in presets:
+            firsts.setdefault(keys[preset.name], preset)
+        with progress_bar("catalog web: bake", total=len(firsts), unit="cloths",
                           enabled=progress) as bar:
-            for preset in presets:
-                key = keys[preset.name]
-                if key not in animations:
-                    animations[key] = bake_lib.bake(preset)
-                    bar.advance()
-                fabric_animation[preset.name] = animations[key]
+            animations = dict(zip(firsts, bake_lib.bake_apart(list(firsts.values()),
+                                                              on_baked=bar.advance)))
+        for preset in presets:
+            fabric_animation[preset.name] = animations[keys[preset.name]]
         first = next(iter(animations.values()))
         for animation in animations.values():  # the page swaps the curtain's buffers only
             if not (np.array_equal(animation.indices, first.indices)
