@@ -253,10 +253,14 @@ def _bake_child() -> None:
     """The child of :func:`bake_apart`: presets (pickled) on stdin; ("ok", animation) or
     ("error", message) on stdout, one per preset as it is baked."""
     import pickle  # noqa: PLC0415
+    import signal  # noqa: PLC0415
     import sys  # noqa: PLC0415
 
     from catalog.core.errors import CatalogError  # noqa: PLC0415
 
+    # Ctrl-C reaches the whole terminal's process group: the parent stops and ends this child
+    # (no second traceback from here)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     presets = pickle.load(sys.stdin.buffer)
     out = sys.stdout.buffer
     for preset in presets:
