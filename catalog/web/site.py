@@ -56,6 +56,23 @@ def _json_length(value, depth: int = 2) -> int:
     return len(json.dumps(value, separators=(",", ":")))
 
 
+def _json_pieces(value, depth: int = 3):
+    """json.dumps(value, separators=(",", ":")) in pieces: the top ``depth`` levels of dicts
+    and lists part by part (joined, the same text)."""
+    if depth and isinstance(value, dict) and value:
+        for k, (key, item) in enumerate(value.items()):
+            yield ("{" if k == 0 else ",") + json.dumps(str(key)) + ":"
+            yield from _json_pieces(item, depth - 1)
+        yield "}"
+    elif depth and isinstance(value, list) and value:
+        for k, item in enumerate(value):
+            yield "[" if k == 0 else ","
+            yield from _json_pieces(item, depth - 1)
+        yield "]"
+    else:
+        yield json.dumps(value, separators=(",", ":"))
+
+
 def _plain_length(data: dict) -> int:
     """:func:`_json_length` of ``data`` with its scenes' values as values, not indices into
     its ``value_pool`` (the plain form, :func:`plain_data_js`), when it has one."""
@@ -118,9 +135,13 @@ def pack_data(data: dict) -> tuple[str, int]:
         data[section] = {key: ({**entry, field: move(entry[field])}
                                if isinstance(entry.get(field), str) else entry)
                          for key, entry in data[section].items()}
-    text = json.dumps(data, separators=(",", ":")).encode("utf-8")
+    # deflated part by part (the scenes and the pool an item at a time): the same bytes as
+    # zlib.compress of the whole text, without the whole text in memory
+    deflate = zlib.compressobj(9)
+    deflated = [deflate.compress(piece.encode("utf-8")) for piece in _json_pieces(data)]
+    deflated.append(deflate.flush())
     packed = {"format": FORMAT_VERSION,
-              "json": base64.b64encode(zlib.compress(text, 9)).decode("ascii"),
+              "json": base64.b64encode(b"".join(deflated)).decode("ascii"),
               "binary": binary}
     return "window.CATALOG_PACKED = " + json.dumps(packed, separators=(",", ":")) + ";\n", plain
 
