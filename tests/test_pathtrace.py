@@ -954,6 +954,33 @@ def test_a_spectral_render_leaves_a_pixels_nan_pass_out_of_its_mean():
     assert mi.calls == [(20, 1)]
 
 
+def test_a_reference_renders_in_passes_that_its_progress_counts():
+    """catalog reference's passes (REFERENCE_PASSES, distinct seeds, in an RGB variant too):
+    each reported to ``on_pass`` with its samples, which add up to spp; the image is their
+    spp-weighted mean; fewer samples than passes: one pass a sample."""
+    from catalog.pathtrace.render import REFERENCE_PASSES, render_radiance
+
+    class FakeMitsuba:
+        is_spectral = False
+
+        def __init__(self):
+            self.calls = []
+
+        def render(self, scene, spp, seed):
+            self.calls.append((spp, seed))
+            return np.full((2, 3, 4), float(seed), dtype=np.float32)
+
+    mi, done = FakeMitsuba(), []
+    image = render_radiance(mi, None, 20, seed=2, passes=REFERENCE_PASSES, on_pass=done.append)
+    assert done == [c for c, _ in mi.calls] and sum(done) == 20 and len(done) == REFERENCE_PASSES
+    assert len({s for _, s in mi.calls}) == REFERENCE_PASSES
+    assert np.isclose(image[0, 0, 0], sum(c * s for c, s in mi.calls) / 20)
+    mi.calls.clear()
+    done.clear()
+    render_radiance(mi, None, 3, seed=0, passes=REFERENCE_PASSES, on_pass=done.append)
+    assert done == [1, 1, 1]
+
+
 @pytest.mark.slow
 def test_the_spectral_key_and_backdrop_keep_their_luminance():
     """scene.in_gamut_same_luminance: in-gamut colours unchanged (1e-12), out-of-gamut ones

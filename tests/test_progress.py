@@ -74,3 +74,47 @@ def test_sheet_reports_progress_on_stderr_and_none_with_json(tmp_path, capsys):
     assert main([*base, "--out", str(tmp_path / "b"), "--json"]) == 0
     captured = capsys.readouterr()
     assert captured.err == "" and len(json.loads(captured.out)["images"]) == 2
+
+
+def test_a_delayed_reporter_is_silent_while_quick_and_shows_all_done_once_slow():
+    """progress(delay_s=..): nothing for work done within the delay; after it, the real
+    reporter starts from what is already done (the fit's starts)."""
+    clock, shown = _Clock(), []
+
+    def start(total):
+        bar = PlainProgress("catalog fit", total, "starts", io.StringIO(), clock)
+        shown.append(bar)
+        return bar
+
+    quick = progress_lib._Delayed(start, 6, 2.0, clock)
+    for _ in range(6):
+        clock.now += 0.01
+        quick.advance()
+    assert shown == [] and quick.done == 6
+    slow = progress_lib._Delayed(start, 6, 2.0, clock)
+    clock.now += 1.0
+    slow.advance()
+    clock.now += 1.5
+    slow.advance()
+    assert len(shown) == 1 and shown[0].done == 2
+    slow.advance(4)
+    lines = shown[0].stream.getvalue().splitlines()
+    assert lines[0].startswith("catalog fit: 2/6 starts") and lines[-1].startswith("catalog fit: 6/6")
+
+
+@pytest.mark.slow
+def test_the_fit_counts_its_starts_when_slow(monkeypatch, capsys):
+    from pathlib import Path
+
+    from catalog.fit import preset_build
+    from catalog.fit.fitting import SCAN_STARTS
+    from catalog.fit.gonio import read_gonio
+
+    data = read_gonio(Path(__file__).parents[1] / "fabrics/measurements/voile-white/gonio.csv")
+    monkeypatch.setattr(preset_build, "FIT_PROGRESS_DELAY_S", 1e9)  # never slow: silent
+    preset_build.fit_measurement(data, "relative", progress=True)
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(preset_build, "FIT_PROGRESS_DELAY_S", 1e-9)
+    preset_build.fit_measurement(data, "relative", progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[-1].startswith(f"catalog fit: {2 * SCAN_STARTS}/{2 * SCAN_STARTS} starts (100 %)")

@@ -110,6 +110,21 @@ def test_baked_loop_is_seamless_and_small():
     assert manifest["encoded_bytes"] <= 0.6 * manifest["raw_bytes"]
 
 
+@pytest.mark.slow
+def test_a_bake_in_the_child_process_is_the_bake_here():
+    """bake_apart (the site's bake, in a child Python) gives the animation bake() gives in
+    this process, byte for byte, and counts it as it arrives."""
+    from catalog.presets import find_preset, load_preset
+    from catalog.web import bake
+
+    preset = load_preset(find_preset("voile-white"))
+    arrived = []
+    (apart,) = bake.bake_apart([preset], on_baked=lambda: arrived.append(1))
+    here = bake.bake(preset)
+    assert arrived == [1] and apart.script() == here.script()
+    assert bake.bake_apart([]) == []
+
+
 def test_bake_hangs_the_desktops_settled_drape():
     """The baked loop's cloth is the curtain `catalog snapshot` shows: the drape's parameters
     (grid, fullness, rings) in the page's wind (test_baked_loop_... checks where it hangs)."""

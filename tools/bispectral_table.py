@@ -1,9 +1,9 @@
-"""The colour-error table of docs/bispectral.md: fluorescence models against the measured
+"""The colour-error table of docs/bispectral-results.md: fluorescence models against the measured
 Donaldson matrices of the validation data's bispectral/ folder (catalog.optics.bispectral.study).
 
     .venv/bin/python tools/bispectral_table.py                       # markdown on stdout
     .venv/bin/python tools/bispectral_table.py --json out.json       # also the rows as JSON
-    .venv/bin/python tools/bispectral_table.py --update-doc docs/bispectral.md
+    .venv/bin/python tools/bispectral_table.py --update-doc docs/bispectral-results.md
 
 ``--update-doc`` replaces what lies between the lines ``<!-- bispectral-table:begin -->``
 and ``<!-- bispectral-table:end -->`` of that file (atomically).

@@ -59,7 +59,7 @@ def run(args) -> int:
         spp=args.spp, frame=args.frame, distance_m=distance, yaw_deg=args.yaw,
         pitch_deg=args.pitch, fluorescence="off" if args.no_fluorescence else args.mode,
         variant=args.variant, seed=args.seed, max_depth=args.max_depth, room=args.room)
-    _, report = render_reference(request)
+    _, report = render_reference(request, progress=not args.json)
     if args.json:
         print_json(report)
     else:

@@ -123,13 +123,48 @@ def _is_terminal(stream) -> bool:
         return False
 
 
+class _Delayed:
+    """A reporter that shows nothing until the work has taken ``delay_s``: then the plain
+    lines or the rich bar (from what is done so far). For work that is usually quick."""
+
+    def __init__(self, start_reporter, total: int, delay_s: float, clock=time.monotonic):
+        self._start, self.total, self._delay_s, self._clock = start_reporter, int(total), delay_s, clock
+        self._started_at = clock()
+        self.done = 0
+        self.shown = None   # the real reporter, once the work is slow
+        self._lock = threading.Lock()
+
+    def set_total(self, total: int) -> None:
+        with self._lock:
+            self.total = int(total)
+            if self.shown is not None:
+                self.shown.set_total(total)
+
+    def advance(self, count: int = 1) -> None:
+        with self._lock:
+            self.done += count
+            if self.shown is None and self._clock() - self._started_at >= self._delay_s:
+                self.shown = self._start(self.total)
+                self.shown.advance(self.done)
+            elif self.shown is not None:
+                self.shown.advance(count)
+
+
 @contextlib.contextmanager
 def progress(label: str, total: int, unit: str = "items", *, enabled: bool = True,
-             stream=None) -> Iterator[object]:
-    """A progress reporter for ``total`` items (see the module's docstring)."""
+             stream=None, delay_s: float = 0.0) -> Iterator[object]:
+    """A progress reporter for ``total`` items (see the module's docstring). ``delay_s``:
+    shown only once the work has taken that long (an item done after it), for work that is
+    usually quick (the fit's starts)."""
     stream = stream if stream is not None else sys.stderr
     if not enabled or stream is None:
         yield _Silent()
+        return
+    if delay_s > 0:
+        with contextlib.ExitStack() as stack:
+            def start(total_now: int):
+                return stack.enter_context(progress(label, total_now, unit, stream=stream))
+            yield _Delayed(start, total, delay_s)
         return
     if not _is_terminal(stream):
         yield PlainProgress(label, total, unit, stream)

@@ -354,14 +354,15 @@ def _hg_start_from_guess(guess, size: int = 5) -> np.ndarray:
 
 
 def fit_hg(one_minus_cos, straight, values, *, weighting: str = "relative", starts=(),
-           scan: bool = True, spread=None) -> FitResult:
+           scan: bool = True, spread=None, on_start=None) -> FitResult:
     """Fit eq. 7 (direct, a_diff, a_spec, g_diff, g_spec) to ``values``.
 
     ``one_minus_cos``: 1 - cos theta per point; ``straight``: where the direct
     see-through reaches the camera; ``starts``: extra initial guesses (dicts keyed by
     HG_NAMES or 5-sequences); ``scan=False`` uses only those; ``spread``: also fit the
-    directional lobe's warp/weft ``anisotropy`` (see :class:`_HGProblem`). ``time_s``
-    of the result excludes importing scipy.
+    directional lobe's warp/weft ``anisotropy`` (see :class:`_HGProblem`); ``on_start()``:
+    called as each start is done (the progress). ``time_s`` of the result excludes
+    importing scipy.
     """
     import scipy.optimize  # noqa: F401  (lazily, and outside the timing)
 
@@ -390,6 +391,8 @@ def fit_hg(one_minus_cos, straight, values, *, weighting: str = "relative", star
         key = (not (x[1] >= 0 and x[2] >= 0), cost)
         if best is None or key < best_key:
             best, best_key, best_evals = x, key, evals
+        if on_start is not None:
+            on_start()
     residual = problem.residual(best)
     # Jacobian in the reported parameters: d/dg = d/du / (dg/du), d/dA = d/dw / (dA/dw)
     jac = problem.jacobian(best)
@@ -515,8 +518,9 @@ class _CTProblem:
 
 
 def fit_cook_torrance(to_light, view, straight, values, *,
-                      weighting: str = "relative") -> FitResult:
-    """Fit the Cook-Torrance baseline (btdf module docstring) to the same data."""
+                      weighting: str = "relative", on_start=None) -> FitResult:
+    """Fit the Cook-Torrance baseline (btdf module docstring) to the same data;
+    ``on_start()``: called as each start is done."""
     import scipy.optimize  # noqa: F401  (lazily, and outside the timing)
 
     t0 = time.perf_counter()
@@ -539,6 +543,8 @@ def fit_cook_torrance(to_light, view, straight, values, *,
         cost = float(np.sum(problem.residual(x) ** 2))
         if cost < best_cost:
             best, best_cost, best_evals = x, cost, problem.evaluations - before
+        if on_start is not None:
+            on_start()
     residual = problem.residual(best)
     m = math.exp(best[3])
     jac = problem.jacobian(best)

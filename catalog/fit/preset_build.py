@@ -48,7 +48,7 @@ def fit_preset(args, started_s: float) -> dict:
                              "azimuth 0/180) is not in this file", path=data.path)
         data = data.subset(mask)
 
-    result = fit_measurement(data, args.weighting)
+    result = fit_measurement(data, args.weighting, progress=not args.json)
     hg, ct = result["hg"], result["ct"]
     dye_path = _dye_path(args, Path(args.gonio))
     tau = args.tau if args.tau is not None else (
@@ -111,12 +111,21 @@ def _fitted_pattern(args, doc):
     return replace(pattern, coverage=coverage, height=None)
 
 
-def fit_measurement(data, weighting: str) -> dict:
-    """HG (grey and per channel) and Cook-Torrance fits of one measurement."""
-    from catalog.fit.fitting import fit_channels, fit_gonio_ct, fit_gonio_hg
+#: The fit's progress (its starts) shows only when the fit has taken this long (s): it
+#: usually takes milliseconds.
+FIT_PROGRESS_DELAY_S = 2.0
 
-    hg = fit_gonio_hg(data, weighting=weighting)
-    ct = fit_gonio_ct(data, weighting=weighting)
+
+def fit_measurement(data, weighting: str, progress: bool = False) -> dict:
+    """HG (grey and per channel) and Cook-Torrance fits of one measurement. ``progress``:
+    their starts on stderr when the fit is slow (FIT_PROGRESS_DELAY_S)."""
+    from catalog.core.progress import progress as progress_bar
+    from catalog.fit.fitting import SCAN_STARTS, fit_channels, fit_gonio_ct, fit_gonio_hg
+
+    with progress_bar("catalog fit", total=2 * SCAN_STARTS, unit="starts", enabled=progress,
+                      delay_s=FIT_PROGRESS_DELAY_S) as bar:
+        hg = fit_gonio_hg(data, weighting=weighting, on_start=bar.advance)
+        ct = fit_gonio_ct(data, weighting=weighting, on_start=bar.advance)
     channels = None
     if data.rgb is not None:
         anisotropy = hg.params.get("anisotropy")

@@ -126,16 +126,24 @@ def describe(request: ReferenceRequest):
 #: integrator or in the RGB variant), which makes the whole pixel NaN. A pixel's pass that is
 #: NaN is left out of its mean, a 1/8 of its samples; the passes' seeds are distinct.
 SPECTRAL_PASSES = 8
+#: `catalog reference` renders in this many passes in any variant (or one a sample when spp
+#: is smaller): the progress counts them, and the image is the same with or without it.
+REFERENCE_PASSES = 8
 
 
-def render_radiance(mi, scene, spp: int, seed: int = 0, report: dict | None = None) -> np.ndarray:
-    """(H, W, 3) float32 linear radiance of a loaded scene. In a spectral variant, the mean of
-    SPECTRAL_PASSES passes per pixel over those that are finite (``report``, when given,
-    gets ``nan_pixel_passes``: how many pixel-passes were left out)."""
+def render_radiance(mi, scene, spp: int, seed: int = 0, report: dict | None = None,
+                    passes: int = 1, on_pass=None) -> np.ndarray:
+    """(H, W, 3) float32 linear radiance of a loaded scene: the spp-weighted mean of
+    ``passes`` renders with distinct seeds (at least SPECTRAL_PASSES in a spectral variant; at
+    most one a sample), each pixel over its finite passes (``report``, when given, gets
+    ``nan_pixel_passes``: how many pixel-passes were left out). ``on_pass(samples)``: called
+    after each pass with its samples per pixel (the progress)."""
     spp, seed = int(spp), int(seed)
-    passes = min(SPECTRAL_PASSES, spp) if mi.is_spectral else 1
+    passes = min(max(int(passes), SPECTRAL_PASSES if mi.is_spectral else 1), spp)
     if passes == 1:
         image = np.asarray(mi.render(scene, spp=spp, seed=seed), dtype=np.float32)[..., :3]
+        if on_pass is not None:
+            on_pass(spp)
         if report is not None:
             report["nan_pixel_passes"] = int(np.sum(~np.all(np.isfinite(image), axis=-1)))
         return image
@@ -148,14 +156,20 @@ def render_radiance(mi, scene, spp: int, seed: int = 0, report: dict | None = No
         contribution = np.where(finite, image * count, 0.0)
         total = contribution if total is None else total + contribution
         weight = finite * count if weight is None else weight + finite * count
+        if on_pass is not None:
+            on_pass(count)
     if report is not None:
         report["nan_pixel_passes"] = dropped
     with np.errstate(invalid="ignore", divide="ignore"):
         return (total / weight).astype(np.float32)   # NaN only where every pass was
 
 
-def render_reference(request: ReferenceRequest, desc=None) -> tuple[np.ndarray, dict]:
-    """Render the reference; write it when ``request.out`` is set. Returns (pixels, report)."""
+def render_reference(request: ReferenceRequest, desc=None,
+                     progress: bool = False) -> tuple[np.ndarray, dict]:
+    """Render the reference (REFERENCE_PASSES passes); write it when ``request.out`` is set.
+    ``progress``: the samples rendered, their rate and the time left on stderr
+    (catalog.core.progress). Returns (pixels, report)."""
+    from catalog.core.progress import progress as progress_bar  # noqa: PLC0415
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
     from catalog.pathtrace.scene import build_mitsuba_scene  # noqa: PLC0415
 
@@ -166,7 +180,10 @@ def render_reference(request: ReferenceRequest, desc=None) -> tuple[np.ndarray, 
     scene = build_mitsuba_scene(mi, desc, max_depth=request.max_depth)
     build_s = time.perf_counter() - start
     start = time.perf_counter()
-    pixels = render_radiance(mi, scene, request.spp, request.seed)
+    with progress_bar("catalog reference", total=request.spp, unit="spp",
+                      enabled=progress) as bar:
+        pixels = render_radiance(mi, scene, request.spp, request.seed,
+                                 passes=REFERENCE_PASSES, on_pass=bar.advance)
     render_s = time.perf_counter() - start
     if not np.all(np.isfinite(pixels)):
         raise CatalogError("the reference has NaN or infinite pixels; nothing written")

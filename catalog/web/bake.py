@@ -205,6 +205,75 @@ def bake(preset, fps: float = BAKE_FPS, loop_s: float = LOOP_S) -> BakedAnimatio
                           grid=(params.grid_w, params.grid_h))
 
 
+def bake_apart(presets, on_baked=None) -> list[BakedAnimation]:
+    """:func:`bake` of each preset, in order, in one child Python (this interpreter, this
+    import path): the cloth simulation's compiled kernels (numba, about 190 MB) stay out of
+    the caller, which renders the site's frames after. ``on_baked()``: called as each
+    animation arrives (the progress). An error in the child is raised here (CatalogError);
+    the child is ended if the caller stops."""
+    import os  # noqa: PLC0415
+    import pickle  # noqa: PLC0415
+    import subprocess  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+
+    if not presets:
+        return []
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    child = subprocess.Popen([sys.executable, "-c", "from catalog.web.bake import _bake_child; "
+                              "_bake_child()"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                             env=env)
+    try:
+        pickle.dump(list(presets), child.stdin)
+        child.stdin.close()
+        animations = []
+        for _ in presets:
+            try:
+                kind, value = pickle.load(child.stdout)
+            except EOFError:
+                raise CatalogError(f"the cloth bake's child process ended (exit "
+                                   f"{child.wait()})") from None
+            if kind == "error":
+                raise CatalogError(value)
+            animations.append(value)
+            if on_baked is not None:
+                on_baked()
+        child.stdout.close()
+        if child.wait() != 0:
+            raise CatalogError(f"the cloth bake's child process failed (exit {child.returncode})")
+        return animations
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+
+
+def _bake_child() -> None:
+    """The child of :func:`bake_apart`: presets (pickled) on stdin; ("ok", animation) or
+    ("error", message) on stdout, one per preset as it is baked."""
+    import pickle  # noqa: PLC0415
+    import signal  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
+
+    # Ctrl-C reaches the whole terminal's process group: the parent stops and ends this child
+    # (no second traceback from here)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    presets = pickle.load(sys.stdin.buffer)
+    out = sys.stdout.buffer
+    for preset in presets:
+        try:
+            result = ("ok", bake(preset))
+        except CatalogError as error:
+            result = ("error", str(error))
+        pickle.dump(result, out)
+        out.flush()
+        if result[0] == "error":
+            return
+
+
 def decode_frames(animation: BakedAnimation):
     """Every frame as the page builds it: float32 (F, V, 3) positions in the scene
     ((lo + q step) + offset, in float64, then rounded to float32), and the unit normals and

@@ -205,12 +205,32 @@ def _same(a, b) -> bool:
                             rtol=1e-5, atol=1e-6) if np.size(a) == np.size(b) else False)
 
 
-def split_commands(commands: list[dict], camera_values: dict | None = None
-                   ) -> tuple[list[dict], list]:
+class CleanCache:
+    """:func:`_clean` of recorded values, each distinct value cleaned once: the scenes of a
+    catalog set the same few thousand values over and over (0.1 M per fabric). Equal values
+    give the same object back (:class:`SiteExporter` pools them by identity)."""
+
+    def __init__(self):
+        self._cleaned: dict = {}
+
+    def __call__(self, value):
+        key = (type(value), tuple(value) if isinstance(value, list) else value)
+        try:
+            return self._cleaned[key]
+        except KeyError:
+            cleaned = self._cleaned[key] = _clean(value)
+            return cleaned
+        except TypeError:  # unhashable (nested): cleaned each time
+            return _clean(value)
+
+
+def split_commands(commands: list[dict], camera_values: dict | None = None,
+                   clean=_clean) -> tuple[list[dict], list]:
     """(structure, values): every uniform command's value moved into ``values`` (in order).
     ``camera_values``: the frame camera's value of each of CAMERA_UNIFORMS; a uniform of that
     name set to it is marked ``camera`` (the page computes it from its own camera); set to
-    another (e.g. the room's window capture or the light's view) it is an ordinary value."""
+    another (e.g. the room's window capture or the light's view) it is an ordinary value.
+    ``clean``: :func:`_clean` or a :class:`CleanCache`."""
     structure, values = [], []
     camera_values = camera_values or {}
     inverse = [_f32(1.0 / RECORD_SIZE[0]), _f32(1.0 / RECORD_SIZE[1])]
@@ -218,7 +238,7 @@ def split_commands(commands: list[dict], camera_values: dict | None = None
         if command["op"] == "uniform":
             entry = {"op": "uniform", "program": command["program"], "name": command["name"],
                      "slot": len(values)}
-            value = _clean(command["value"])
+            value = clean(command["value"])
             if command["name"] in camera_values and _same(value, camera_values[command["name"]]):
                 entry["camera"] = True
             # a value that is the recorded frame's size or texel size: the page puts its own
@@ -262,17 +282,20 @@ def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
         return {"data": _b64(data)}
     if bits not in (8, 16):
         raise CatalogError(f"texel bits must be 8 or 16, not {bits}")
-    texels = np.frombuffer(data, dtype="<f4").reshape(-1, texture["components"]).astype(np.float64)
+    texels = np.frombuffer(data, dtype="<f4").reshape(-1, texture["components"])
     if not np.all(np.isfinite(texels)):
         raise CatalogError("a recorded float texture has non-finite texels")
-    lo, hi = texels.min(axis=0), texels.max(axis=0)
+    lo = texels.min(axis=0).astype(np.float64)
+    hi = texels.max(axis=0).astype(np.float64)
     top = (1 << bits) - 1
     span = np.where(hi > lo, hi - lo, 1.0)
-    q = np.rint((texels - lo) / span * top)
     # in planes (every texel's channel 0, then channel 1, ..): deflate (site.pack_data) then
     # finds each channel's own repetitions (a third of the interleaved bytes' deflated size
-    # on the lace's pattern)
-    encoded = np.ascontiguousarray(q.T).astype("<u2" if bits == 16 else "u1").tobytes()
+    # on the lace's pattern); quantised in float64 a channel at a time (a pattern of 27 MB
+    # needs no float64 copy of all its channels at once)
+    encoded = b"".join(
+        np.rint((texels[:, c].astype(np.float64) - lo[c]) / span[c] * top)
+        .astype("<u2" if bits == 16 else "u1").tobytes() for c in range(texels.shape[1]))
     return {"data": _b64(encoded),
             "quantised": {"bits": bits, "lo": [float(v) for v in lo],
                           "hi": [float(v) for v in lo + span], "planar": True}}
@@ -316,6 +339,12 @@ class SiteExporter:
         self.curtain_tags: dict[int, str] = {}
         self.blobs: list[str] = []   # base64 bytes the frames write into buffers (shared)
         self._blob_index: dict[str, int] = {}
+        # every distinct uniform value once (site.pack_data's "value_pool"): a scene holds
+        # indices into it from the start, so the catalog's scenes cost a list of ints each
+        self.value_pool: list = []
+        self._pool_index: dict[str, int] = {}   # JSON text -> index
+        self._pool_of: dict[int, tuple] = {}    # id() of a cleaned value -> (index, value)
+        self._clean = CleanCache()
         self._rings: tuple | None = None
 
     # -- the curtain's buffers: found by their bytes after set_mesh
@@ -345,7 +374,7 @@ class SiteExporter:
 
     def record(self, preset, light: LightChoice, fluorescence: str,
                ev100: float | None = None, glare: str = "off", lamp: str = "none") -> dict:
-        """One scene's structure index and values; ``ev100``: its exposure (None: metered by
+        """One scene's structure index and values (indices into :attr:`value_pool`); ``ev100``: its exposure (None: metered by
         a METER_SIZE desktop frame at the default camera, with the glare and lamp asked)."""
         for r in (self.meter, self.renderer):
             r.update(fabric=preset)
@@ -364,12 +393,13 @@ class SiteExporter:
         r.update(ev=ev100)
         rec = self.ctx.recording
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
-        rec.start()
+        rec.start(dry=True)  # only the commands are kept: no pixels drawn
         r.render()
-        structure, values = split_commands(rec.stop(), self.camera_values())
+        structure, values = split_commands(rec.stop(), self.camera_values(), clean=self._clean)
         for command in structure:  # bytes written in a frame: shared by the scenes alike
             if command["op"] == "buffer_write":
                 values[command["slot"]] = {"blob": self._blob(values[command["slot"]])}
+        values = [self._pooled(v) for v in values]
         key = hashlib.sha256(json.dumps(structure, sort_keys=True).encode()).hexdigest()
         if key not in self._structure_index:
             self._structure_index[key] = len(self.structures)
@@ -379,6 +409,30 @@ class SiteExporter:
                 "ev100": round(float(ev100), 6),
                 "fluorescence_variant": info["fluorescence_variant"],
                 "illuminance_lx": info["illuminance_lx"]}
+
+    def _pooled(self, value) -> int:
+        """Index of ``value`` in :attr:`value_pool` (added once)."""
+        known = self._pool_of.get(id(value))  # a CleanCache value: the same object each time
+        if known is not None:
+            return known[0]
+        text = json.dumps(value, separators=(",", ":"))
+        index = self._pool_index.setdefault(text, len(self.value_pool))
+        if index == len(self.value_pool):
+            self.value_pool.append(value)
+        if not isinstance(value, dict):  # (a blob reference is new each time)
+            self._pool_of[id(value)] = (index, value)  # held: its id stays its own
+        return index
+
+    def pooled_scenes(self, scenes: dict) -> tuple[dict, list]:
+        """(scenes, value_pool) with only the values these scenes use, in the order they first
+        use them (the exporter's own frames, e.g. :meth:`check_camera_uniforms`', leave out)."""
+        remap: dict[int, int] = {}
+        out = {key: {**scene, "values": [remap.setdefault(i, len(remap)) for i in scene["values"]]}
+               for key, scene in scenes.items()}
+        pool = [None] * len(remap)
+        for old, new in remap.items():
+            pool[new] = self.value_pool[old]
+        return out, pool
 
     def _blob(self, text: str) -> int:
         """Index of ``text`` in :attr:`blobs` (added once)."""
@@ -496,9 +550,10 @@ def _sized(entry: dict) -> dict:
     return entry
 
 
-def swatch_png(ctx, preset, size=SWATCH_SIZE) -> bytes:
-    """A small desktop frame of the fabric under D65 with the close-up inset (the grid's
-    swatch, catalog/web/facts.py), PNG bytes."""
+def swatch_pngs(ctx, presets, size=SWATCH_SIZE) -> dict[str, bytes]:
+    """A small desktop frame of each fabric under D65 with the close-up inset (the grid's
+    swatches, catalog/web/facts.py) in the modes the page shows (:data:`DESKTOP_MODES`), PNG
+    bytes by fabric name; one renderer for them all (its programs compiled once)."""
     import io  # noqa: PLC0415
 
     from PIL import Image  # noqa: PLC0415
@@ -507,12 +562,17 @@ def swatch_png(ctx, preset, size=SWATCH_SIZE) -> bytes:
     from catalog.web.facts import catalog_card  # noqa: PLC0415
 
     renderer = FrameRenderer(ctx, size)
+    swatches = {}
     try:
-        renderer.update(fabric=preset, light="D65", camera=orbit(0.0, 0.0, 1.9))
-        renderer.render()
-        pixels = catalog_card(renderer, renderer.read_srgb8())
+        configure_desktop_frame(renderer)
+        renderer.update(light="D65", camera=orbit(0.0, 0.0, 1.9))
+        for preset in presets:
+            renderer.update(fabric=preset)
+            renderer.render()  # auto exposure: metered afresh (no dt), nothing carried over
+            out = io.BytesIO()
+            Image.fromarray(catalog_card(renderer, renderer.read_srgb8())).save(
+                out, format="PNG", optimize=True)
+            swatches[preset.name] = out.getvalue()
     finally:
         renderer.release()
-    out = io.BytesIO()
-    Image.fromarray(pixels).save(out, format="PNG", optimize=True)
-    return out.getvalue()
+    return swatches

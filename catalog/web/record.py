@@ -36,6 +36,9 @@ class Recording:
     framebuffers: dict[int, dict] = field(default_factory=dict)  # id -> {colour: [ids], depth}
     vertex_arrays: dict[int, dict] = field(default_factory=dict)
     commands: list[dict] | None = None
+    #: While recording: skip the GL work whose pixels nobody reads (draws, clears, mipmap
+    #: builds); the commands and every object's state are noted all the same.
+    dry: bool = False
     bound_framebuffer: object = None
     _next_id: int = 1
     _pending_recipe: dict | None = None
@@ -48,11 +51,20 @@ class Recording:
         if self.commands is not None:
             self.commands.append(command)
 
-    def start(self) -> None:
+    def start(self, dry: bool = False) -> None:
+        """Note the commands from now on; ``dry``: without doing the GL work that only makes
+        pixels (a frame recorded for its commands alone, whose image is not read)."""
         self.commands = []
+        self.dry = dry
+
+    @property
+    def skipping(self) -> bool:
+        """Whether pixel work is skipped now (a dry recording in progress)."""
+        return self.dry and self.commands is not None
 
     def stop(self) -> list[dict]:
         commands, self.commands = self.commands or [], None
+        self.dry = False
         return commands
 
 
@@ -129,6 +141,8 @@ class _Texture(_Proxy):
         self._rec.textures[self.rid]["mipmaps"] = True
         if self.rid not in self._rec.texture_data:  # texels drawn by the frame, not given
             self._rec.note({"op": "mipmaps", "texture": self.rid})
+            if self._rec.skipping:
+                return None
         return self._real.build_mipmaps(base, max_level)
 
     @property
@@ -186,6 +200,8 @@ class _Framebuffer(_Proxy):
                         "colour": [float(red), float(green), float(blue), float(alpha)],
                         "depth": float(depth),
                         "viewport": None if viewport is None else [int(v) for v in viewport]})
+        if self._rec.skipping:
+            return None
         return self._real.clear(red, green, blue, alpha, depth=depth, viewport=viewport, **kw)
 
 
@@ -233,6 +249,8 @@ class _VertexArray(_Proxy):
         self._rec.note({"op": "draw", "vertex_array": self.rid, "mode": int(mode)
                         if mode is not None else 4, "vertices": int(vertices),
                         "first": int(first)})
+        if self._rec.skipping:
+            return None
         if mode is None:
             return self._real.render(vertices=vertices, first=first)
         return self._real.render(mode, vertices=vertices, first=first)

@@ -56,6 +56,44 @@ def _json_length(value, depth: int = 2) -> int:
     return len(json.dumps(value, separators=(",", ":")))
 
 
+def _json_pieces(value, depth: int = 3):
+    """json.dumps(value, separators=(",", ":")) in pieces: the top ``depth`` levels of dicts
+    and lists part by part (joined, the same text)."""
+    if depth and isinstance(value, dict) and value:
+        for k, (key, item) in enumerate(value.items()):
+            yield ("{" if k == 0 else ",") + json.dumps(str(key)) + ":"
+            yield from _json_pieces(item, depth - 1)
+        yield "}"
+    elif depth and isinstance(value, list) and value:
+        for k, item in enumerate(value):
+            yield "[" if k == 0 else ","
+            yield from _json_pieces(item, depth - 1)
+        yield "]"
+    else:
+        yield json.dumps(value, separators=(",", ":"))
+
+
+def _plain_length(data: dict) -> int:
+    """:func:`_json_length` of ``data`` with its scenes' values as values, not indices into
+    its ``value_pool`` (the plain form, :func:`plain_data_js`), when it has one."""
+    pool = data.get("value_pool")
+    if pool is None or "scenes" not in data:
+        return _json_length(data)
+    sizes = [len(json.dumps(v, separators=(",", ":"))) for v in pool]
+    rest = {k: v for k, v in data.items() if k not in ("value_pool", "scenes")}
+    scenes = data.get("scenes", {})
+
+    def scene_length(scene: dict) -> int:
+        values = scene["values"]
+        return (len(json.dumps({**scene, "values": []}, separators=(",", ":")))
+                + (sum(sizes[i] for i in values) + len(values) - 1 if values else 0))
+
+    scenes_length = 2 + max(len(scenes) - 1, 0) + sum(
+        len(json.dumps(str(key))) + 1 + scene_length(scene) for key, scene in scenes.items())
+    return (_json_length(rest) + (1 if rest else 0) + len(json.dumps("scenes")) + 1
+            + scenes_length)
+
+
 def pack_data(data: dict) -> tuple[str, int]:
     """data.js's text, and the bytes a plain ``window.CATALOG_DATA = JSON`` would take.
 
@@ -73,13 +111,14 @@ def pack_data(data: dict) -> tuple[str, int]:
     # plain JSON text of it whole. The plain size is counted part by part (_json_length), and
     # only what packing changes is copied (the scenes' value lists, the entries whose bytes
     # move out).
-    plain = len(plain_data_js({})) - 2 + _json_length(data)
+    plain = len(plain_data_js({})) - 2 + _plain_length(data)
     data = dict(data)
     binary: list[str] = []
     # every distinct uniform value once ("values": [0.5, ..] -> "values": [i, ..] into
-    # "value_pool"): scenes of one fabric or light share most of theirs
+    # "value_pool"): scenes of one fabric or light share most of theirs. Data that comes
+    # pooled (the exporter pools as it records) is kept as it is.
     pool: dict[str, int] = {}
-    if "scenes" in data:
+    if "scenes" in data and "value_pool" not in data:
         data["scenes"] = {key: {**scene, "values": [
             pool.setdefault(json.dumps(v, separators=(",", ":")), len(pool))
             for v in scene["values"]]} for key, scene in data["scenes"].items()}
@@ -96,9 +135,13 @@ def pack_data(data: dict) -> tuple[str, int]:
         data[section] = {key: ({**entry, field: move(entry[field])}
                                if isinstance(entry.get(field), str) else entry)
                          for key, entry in data[section].items()}
-    text = json.dumps(data, separators=(",", ":")).encode("utf-8")
+    # deflated part by part (the scenes and the pool an item at a time): the same bytes as
+    # zlib.compress of the whole text, without the whole text in memory
+    deflate = zlib.compressobj(9)
+    deflated = [deflate.compress(piece.encode("utf-8")) for piece in _json_pieces(data)]
+    deflated.append(deflate.flush())
     packed = {"format": FORMAT_VERSION,
-              "json": base64.b64encode(zlib.compress(text, 9)).decode("ascii"),
+              "json": base64.b64encode(b"".join(deflated)).decode("ascii"),
               "binary": binary}
     return "window.CATALOG_PACKED = " + json.dumps(packed, separators=(",", ":")) + ";\n", plain
 
@@ -223,17 +266,17 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
     with staged_folder(out, replace_listed=_replace_listed(new_files)) as stage:
         timings = {}
         t = time.perf_counter()
-        animations = {}
         fabric_animation = {}
         keys = {preset.name: bake_lib.cloth_key(bake_lib.bake_params(preset)) for preset in presets}
-        with progress_bar("catalog web: bake", total=len(set(keys.values())), unit="cloths",
+        firsts = {}   # one preset per distinct cloth
+        for preset in presets:
+            firsts.setdefault(keys[preset.name], preset)
+        with progress_bar("catalog web: bake", total=len(firsts), unit="cloths",
                           enabled=progress) as bar:
-            for preset in presets:
-                key = keys[preset.name]
-                if key not in animations:
-                    animations[key] = bake_lib.bake(preset)
-                    bar.advance()
-                fabric_animation[preset.name] = animations[key]
+            animations = dict(zip(firsts, bake_lib.bake_apart(list(firsts.values()),
+                                                              on_baked=bar.advance)))
+        for preset in presets:
+            fabric_animation[preset.name] = animations[keys[preset.name]]
         first = next(iter(animations.values()))
         for animation in animations.values():  # the page swaps the curtain's buffers only
             if not (np.array_equal(animation.indices, first.indices)
@@ -243,6 +286,12 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         timings["bake_s"] = time.perf_counter() - t
 
         t = time.perf_counter()
+        if ctx is None:
+            from catalog.gl.context import create_headless_context  # noqa: PLC0415
+            ctx = create_headless_context()
+        # the swatches first, their renderer released before the recording's two are made
+        swatches = {name: base64.b64encode(png).decode("ascii")
+                    for name, png in export.swatch_pngs(ctx, presets).items()}
         exporter = export.SiteExporter(ctx)
         try:
             positions, normals, tangents = bake_lib.decode_frame(first, 0)
@@ -271,11 +320,10 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                                                      lamp=lamp))
                             bar.advance()
             objects = exporter.objects()
-            swatches = {p.name: base64.b64encode(export.swatch_png(exporter.ctx._ctx, p))
-                        .decode("ascii") for p in presets}
         finally:
             exporter.release()
         timings["record_s"] = time.perf_counter() - t
+        scenes, value_pool = exporter.pooled_scenes(scenes)
 
         camera = exporter.renderer.camera
         data = {
@@ -290,6 +338,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             "structures": exporter.structures,
             "blobs": exporter.blobs,
             "scenes": scenes,
+            "value_pool": value_pool,   # the scenes' values index it
             "fabrics": [{"name": p.name, "display_name": p.display_name,
                          "facts": export.fabric_facts(p), "swatch": swatches[p.name],
                          "animation": fabric_animation[p.name].key} for p in presets],
