@@ -228,8 +228,7 @@ MAY_READ = {
     "catalog/render/display.py": "the display's own tables (package data, not the scene)",
     "catalog/render/room_light/geometry.py": "the room's stored ambient occlusion (package data)",
     "catalog/cloth/drape_cache.py": "the drape cache (results kept, not inputs)",
-    "catalog/render/scene.py": "load_props: a prop mesh by path (not yet resolved at the edge)",
-    "catalog/pathtrace/scene.py": "a room given by path (not yet resolved at the edge)",
+    "catalog/pathtrace/scene.py": "describe_scene's library callers may name a room; catalog reference resolves it at the edge (pathtrace/render.validate) and passes the Room",
     "catalog/render/room_operators.py": "the room's bundle: read from its cache (or built) when the settings name a room (not yet resolved at the edge)",
 }
 #: What reads a file: a call of open(), np.load, json/tomllib/pickle/trimesh.load, an image

@@ -74,7 +74,8 @@ def check_out(path) -> Path:
 
 
 def validate(request: ReferenceRequest):
-    """Refuse bad input before Mitsuba is loaded. Returns (preset, light)."""
+    """Refuse bad input before Mitsuba is loaded; the scene's files are read here, once (the
+    edge). Returns (preset, light, room: a loaded catalog.room.model.Room)."""
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace.backend import check_variant  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
@@ -106,18 +107,18 @@ def validate(request: ReferenceRequest):
     light = get_light(request.light)
     from catalog.room.load import load_room  # noqa: PLC0415
 
-    load_room(request.room)          # a bad room is refused before Mitsuba loads
-    return preset, light
+    room = load_room(request.room)   # a bad room is refused before Mitsuba loads
+    return preset, light, room
 
 
 def describe(request: ReferenceRequest):
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
 
-    preset, light = validate(request)
+    preset, light, room = validate(request)
     return describe_scene(preset, light, size=request.size, frame=request.frame,
                           yaw_deg=request.yaw_deg, pitch_deg=request.pitch_deg,
                           distance_m=request.distance_m, fluorescence=request.fluorescence,
-                          room=request.room)
+                          room=room)
 
 
 #: A spectral variant renders in this many passes (or one a sample when spp is smaller):
@@ -173,9 +174,12 @@ def render_reference(request: ReferenceRequest, desc=None,
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
     from catalog.pathtrace.scene import build_mitsuba_scene  # noqa: PLC0415
 
-    validate(request)  # bad input first, then the library (one line each), then the scene
+    # bad input first, then the library (one line each), then the scene
+    if desc is None:
+        desc = describe(request)
+    else:
+        validate(request)
     mi = load_mitsuba(request.variant)
-    desc = desc if desc is not None else describe(request)
     start = time.perf_counter()
     scene = build_mitsuba_scene(mi, desc, max_depth=request.max_depth)
     build_s = time.perf_counter() - start

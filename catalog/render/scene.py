@@ -198,7 +198,6 @@ def room_props() -> tuple[np.ndarray, np.ndarray]:
 
     Built with numpy, not trimesh: importing trimesh imports scipy, which a frame must not
     (the viewer's rule); tests/test_render_scene.py checks these solids against trimesh's.
-    Extra props from a mesh file go through :func:`load_props` (trimesh, on demand).
     """
     triangles = np.concatenate(_room_parts())
     return _flat_shaded(triangles)
@@ -214,19 +213,6 @@ def _flat_shaded(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     normals = np.repeat(normals[:, None, :], 3, axis=1)
     return (triangles.reshape(-1, 3).astype(np.float32), normals.reshape(-1, 3).astype(np.float32))
-
-
-def load_props(path) -> tuple[np.ndarray, np.ndarray]:
-    """Props from a mesh file (OBJ, PLY, GLB, ... through trimesh), flat-shaded like the room."""
-    import trimesh  # noqa: PLC0415  (imports scipy: only when a prop file is asked for)
-
-    try:
-        mesh = trimesh.load(str(path), force="mesh")
-    except (ValueError, OSError) as exc:
-        raise InputError(f"cannot read the mesh: {exc}", path=path) from None
-    if len(mesh.faces) == 0:
-        raise InputError("the mesh has no triangles", path=path)
-    return _flat_shaded(np.asarray(mesh.vertices, dtype=np.float64)[np.asarray(mesh.faces)])
 
 
 # --------------------------------------------------------------------------- the sun
