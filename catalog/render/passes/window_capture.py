@@ -110,7 +110,7 @@ class WindowCapturePass(Pass):
             if not self.frame.curtain_open:
                 self.frame.curtain.draw_flat(view_proj, eye, overrides, folds_behind=True)
             self.frame.background.draw(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
-        for name in {name for name, _eye, _tile, _level in targets}:
+        for name in sorted({name for name, _eye, _tile, _level in targets}):   # a fixed order: the page replays these calls
             gl[name].build_mipmaps()   # level LUMINAIRE_LEVEL: each patch's mean radiance
         if self.wall_eyes_active():   # the box's sides from the wall eyes (no outside: their ways
             gl["luminaire_walls_fbo"].use()   # through a side rise into the room)
