@@ -12,8 +12,10 @@ room's limit); the room (``box``, the one built-in room of this branch). The cur
 
 For each scene the frame (:class:`catalog.render.frame.FrameRenderer`, the linear radiance
 ``catalog snapshot`` writes to EXR) and the reference (``catalog reference``'s Mitsuba scene, two
-independent renders of spp / 2) are both shown through ONE neutral display defined here, not the
-product's (:func:`neutral_display`):
+independent halves) are rendered at SIZE and compared at SIZE / MEASURE_REDUCTION (each compared
+pixel the mean of MEASURE_REDUCTION^2 rendered ones, linear radiance: the view as seen from
+twice as far, FLIP at the same pixels per degree), both shown through ONE neutral display
+defined here, not the product's (:func:`neutral_display`):
 
 - exposure from the reference alone: its luminance's 99th percentile maps to
   :data:`P99_TARGET` (1.0) before the tone curve; the frame gets the same scale;
@@ -22,15 +24,20 @@ product's (:func:`neutral_display`):
 - no white balance (the sRGB white, D65), no glare, the sRGB curve.
 
 Measured per scene: the mean LDR-FLIP of the two display images; the curtain's Delta E 2000
-(colour-science's CIEDE2000 on CIELAB of the display images, D65 white, on the pixels whose
-centre ray meets the cloth in the reference's own geometry), its mean; the reference's own noise,
-the mean FLIP of its two half renders shown through the same display (each half has sqrt(2) the
-noise of their mean, so this bounds the noise's share from above); the frame's time (median of
-repeats with glFinish) and the reference's (its two halves, scene building excluded).
+(colour-science's CIEDE2000 on CIELAB of the display images, D65 white, on the compared pixels
+wholly on the cloth, by centre rays through the reference's own geometry), its mean; the
+reference's own noise, the mean FLIP of its two halves (two seeds) shown through the same
+display (each half has sqrt(2) the noise of their mean, so this bounds the noise's share from
+above); the same two figures at the rendered size (``*_full_size``); the frame's time (median of
+repeats with glFinish) and the reference's (its halves at the spp it ended with, scene building
+excluded), both at SIZE.
 
-The noise rule: the spp is fixed before the report (:data:`SPP`) and each row says whether the
-reference's noise is below a fifth of the FLIP it judges (``noise_below_fifth``); the summary
-counts the scenes where it is not.
+The noise rule (:func:`adaptive_reference`): the reference is rendered in rounds of new seeds,
+START_SPP first and each round doubling the total, until its noise is below NOISE_SHARE (a fifth)
+of the FLIP it judges, or the next round would pass the SPP cap or REFERENCE_BUDGET_S (a round
+takes about as long as all before it). The reference is never judged by the frame's look, only
+by its own noise against the error; each row says whether the rule holds
+(``noise_below_fifth``), the spp it ended with and each round's figures (``spp_rounds``).
 
 Seeds: :data:`TUNE_SEED` for choosing, :data:`REPORT_SEED` (fixed before the report run) for the
 published figures (``python -m benchmarks.accuracy record`` regenerates them).
@@ -434,7 +441,12 @@ def summarise(rows: list[dict]) -> dict:
     for r in rows:
         by_family.setdefault(r["light_family"], []).append(r["mean_flip"])
         by_fabric.setdefault(r["fabric"], []).append(r["mean_flip"])
-    return {"scenes": len(rows), "mean_flip": flip, "curtain_delta_e_mean": de,
+    extra = {}
+    if all("spp_rounds" in r for r in rows):
+        extra = {"mean_flip_full_size": stats([r["mean_flip_full_size"] for r in rows]),
+                 "spp_median": float(np.median([r["spp"] for r in rows])),
+                 "measure_size": rows[0]["measure_size"]}
+    return {**extra, "scenes": len(rows), "mean_flip": flip, "curtain_delta_e_mean": de,
             "flip_share_by_region": split,
             "median_flip_by_light_family": {k: float(np.median(v)) for k, v in by_family.items()},
             "median_flip_by_fabric": {k: float(np.median(v)) for k, v in sorted(by_fabric.items())},
@@ -537,12 +549,15 @@ def _cell(value) -> str:
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """``accuracy`` (per scene) and ``accuracy-summary`` of one run."""
-    columns = ("label", "light_family", "mean_flip", "reference_flip_noise", "curtain_delta_e_mean",
-               "frame_ms", "reference_s", "speedup", "reference_variant")
-    headers = ("scene", "light family", "mean FLIP", "ref. noise (FLIP of halves)", "curtain dE2000 mean",
-               "frame ms", "reference s", "x faster", "reference variant")
+    columns = ("label", "light_family", "mean_flip", "reference_flip_noise", "noise_below_fifth", "spp",
+               "mean_flip_full_size", "curtain_delta_e_mean", "frame_ms", "reference_s", "speedup",
+               "reference_variant")
+    headers = ("scene", "light family", "mean FLIP", "ref. noise (FLIP of halves)", "noise < FLIP / 5",
+               "ref. spp", "mean FLIP at the rendered size", "curtain dE2000 mean", "frame ms",
+               "reference s", "x faster", "reference variant")
     lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
-    lines += ["| " + " | ".join(_cell(r.get(c)) for c in columns) + " |" for r in result["rows"]]
+    lines += ["| " + " | ".join("yes" if r.get(c) is True else "no" if r.get(c) is False else _cell(r.get(c))
+                                for c in columns) + " |" for r in result["rows"]]
     s = result["summary"]
     f, d, n = s["mean_flip"], s["curtain_delta_e_mean"], s["reference_flip_noise"]
     g = s["goal_met"]
@@ -561,12 +576,18 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"| reference noise (FLIP of its halves) | {_cell(n['median'])} | {_cell(n['p90'])} | {_cell(n['max'])} | "
         f"< 1/5 of the FLIP judged: {s['scenes'] - s['scenes_noise_not_below_fifth']} of {s['scenes']} scenes |",
         "",
-        f"The noise rule (the reference's noise below a fifth of the FLIP it judges) would need "
-        f"{s.get('spp_for_noise_rule_median', 0):,.0f} spp at the median scene; these references at that "
-        f"spp would take {s.get('reference_s_for_noise_rule_total', 0) / 3600:.1f} h on this machine.",
+        f"Where the noise rule (the reference's noise below a fifth of the FLIP it judges) does not "
+        f"hold at the spp a reference ended with (its cap or its time budget), it would need "
+        f"{s.get('spp_for_noise_rule_median', 0):,.0f} spp at the median scene (noise ~ 1 / sqrt(spp)); "
+        f"all the references at the spp they need would take "
+        f"{s.get('reference_s_for_noise_rule_total', 0) / 3600:.1f} h on this machine.",
         "",
-        f"{s['scenes']} scenes (seed {cfg['seed']}; report seed {cfg['report_seed']}), "
-        f"{cfg['size'][0]}x{cfg['size'][1]} px, reference {cfg['spp']} spp (2 x {cfg['spp'] // 2}). "
+        f"{s['scenes']} scenes (seed {cfg['seed']}; report seed {cfg['report_seed']}), rendered at "
+        f"{cfg['size'][0]}x{cfg['size'][1]} px and compared at {s.get('measure_size', ['?', '?'])[0]}x"
+        f"{s.get('measure_size', ['?', '?'])[1]} px (2x2 means); reference spp chosen per scene by the noise rule "
+        f"(median {s.get('spp_median', 0):,.0f}, cap {cfg['spp']}); at the rendered size the mean FLIP is "
+        f"median {_cell(s.get('mean_flip_full_size', {}).get('median'))}, p90 "
+        f"{_cell(s.get('mean_flip_full_size', {}).get('p90'))}, max {_cell(s.get('mean_flip_full_size', {}).get('max'))}. "
         f"Frame {_cell(s['frame_ms_median'])} ms, reference {_cell(s['reference_s_median'])} s (medians); "
         f"the frame {s['speedup']['min']:,.0f}x (least) to {s['speedup']['median']:,.0f}x (median) faster "
         f"(goal >= {GOAL['speedup_at_least']:g}x: {yes('speedup')}). Worst: {'; '.join(s['worst'])}.",
@@ -633,7 +654,11 @@ def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RE
                 row[key] = None
     summary = summarise(rows)
     first = rows[0]
-    result = {"commit": commit, "planned_scenes": planned, "rows": rows, "summary": summary,
+    from benchmarks.results import machine_info  # noqa: PLC0415
+    from catalog.gl.context import create_headless_context  # noqa: PLC0415
+
+    machine = {**machine_info(create_headless_context()), "commit": commit}
+    result = {"commit": commit, "machine": machine, "planned_scenes": planned, "rows": rows, "summary": summary,
               "settings": {"size": first["size"], "spp": first["spp"], "seed": REPORT_SEED,
                            "report_seed": REPORT_SEED, "tune_seed": TUNE_SEED, "room": None,
                            "display": {"exposure": f"reference luminance p99 -> {P99_TARGET}",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from catalog.core.errors import CatalogError
-from catalog.render import display as display_lib
+from catalog.render import adaptation as adaptation_lib, display as display_lib
 from catalog.render.passes.gl_common import Pass, set_uniform
 
 #: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
@@ -38,15 +38,18 @@ class DisplayPass(Pass):
 
     def white_balance_matrix(self) -> np.ndarray:
         """Linear sRGB -> linear sRGB: CAT16 from the white of the light reaching the viewer to
-        D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity."""
-        inputs = self.frame.terms.shading_inputs()
-        key = (self.frame.terms.inputs_key, self.frame.white_balance)
+        D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity.
+        The white is measured (a G-buffer draw) when the light, the size or the view change
+        (the view by adaptation.view_key's steps: the eye does not re-adapt to a small turn)."""
+        self.frame.terms.shading_inputs()
+        cam = self.frame.camera
+        key = (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
+               adaptation_lib.view_key(cam.yaw_deg, cam.pitch_deg, cam.distance_m),
+               self.frame.room_side_active())
         if self._wb_cache is None or self._wb_cache[0] != key:
-            from catalog.render import adaptation  # noqa: PLC0415
-
             self._wb_cache = (key, display_lib.white_balance_matrix(
-                adaptation.adapting_white_xyz(inputs), self.frame.white_balance,
-                adaptation.degree_of_adaptation()))
+                adaptation_lib.visible_white_xyz(self.frame), self.frame.white_balance,
+                adaptation_lib.degree_of_adaptation()))
         return self._wb_cache[1]
 
     def display_uniforms(self) -> dict:
@@ -71,6 +74,7 @@ class DisplayPass(Pass):
         """The display transform of the HDR target's (vw, vh) corner (the benchmark times it);
         ``hdr``: the texture to show (default the HDR target; the glare's output when on);
         ``stages``: tonemap.frag's DISPLAY_STAGES (3, all; fewer for the benchmark's cost per stage)."""
+        self.white_balance_matrix()   # first: measuring a new white draws
         target = fbo if fbo is not None else self.frame.targets.ldr_fbo
         target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
                            else (0, 0, vw, vh))
