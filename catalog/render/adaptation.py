@@ -124,14 +124,15 @@ def field_samples(shape, samples_px: int = FIELD_SAMPLES_PX) -> tuple[slice, sli
 def visible_white_xyz(frame) -> np.ndarray:
     """XYZ (cd m^-2) of the mean light reaching the viewer from the surfaces in view, each made
     neutral (module docstring), from the frame's HDR target as last drawn and its G-buffer (drawn
-    here; the bound framebuffer and viewport are restored)."""
+    here with the room's light and shadow maps of that frame; the bound framebuffer and viewport
+    are restored)."""
     from catalog.optics import shading_reference as ref  # noqa: PLC0415
     from catalog.optics.colorimetry import linear_srgb_to_xyz  # noqa: PLC0415
 
     ctx = frame.ctx
     bound, viewport = ctx.fbo, ctx.viewport
     try:
-        gbuffer = frame.render_gbuffer()
+        gbuffer = frame.curtain.render_gbuffer(refresh_light=False)   # the maps as this frame drew them
         w, h = frame.size
         data = frame.targets.hdr_fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4")
     finally:
