@@ -607,8 +607,11 @@ def markdown_tables(result: dict) -> dict[str, str]:
     summary += ("\n\nMedian mean FLIP by light family: " + ", ".join(
         f"{k} {v:.3f}" for k, v in s["median_flip_by_light_family"].items())
         + "; by fabric: " + ", ".join(f"{k} {v:.3f}" for k, v in s.get("median_flip_by_fabric", {}).items()) + ".")
+    compared = s.get("measure_size") or cfg["size"]
     readme = (f"Over {s['scenes']} scenes drawn at random from the whole scene space (report seed "
-              f"{cfg['seed']}, {cfg['size'][0]}x{cfg['size'][1]} px, docs/accuracy.md; measured on "
+              f"{cfg['seed']}, rendered at {cfg['size'][0]}x{cfg['size'][1]} px, compared at "
+              f"{compared[0]}x{compared[1]}; the reference's noise below a fifth of the error on "
+              f"{s['scenes'] - s['scenes_noise_not_below_fifth']} of them; docs/accuracy.md; measured on "
               f"{result.get('commit', '?')}): mean FLIP median {_cell(f['median'])}, p90 {_cell(f['p90'])}, "
               f"max {_cell(f['max'])} (goals 0.06 / 0.09 / 0.12); curtain Delta E 2000 median "
               f"{_cell(d['median'])} (goal 1.5); the frame {s['speedup']['min']:,.0f}x to "
