@@ -398,8 +398,14 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
     from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
+    import json  # noqa: PLC0415
+
+    cache_path = Path(rows_out).with_suffix(".regions.json")   # labels -> their split, kept between publishes
+    cache = json.loads(cache_path.read_text(encoding="utf-8")) if cache_path.is_file() else {}
     mi = load_mitsuba("llvm_ad_rgb")
     for number, row in enumerate(rows, 1):
+        if row["label"] in cache:
+            row["flip_by_region"] = cache[row["label"]]
         if "flip_by_region" in row:
             continue
         cam = row["camera"]
@@ -409,6 +415,8 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
         masks = region_masks(mi, build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH), desc)
         with np.load(Path(rows_out).with_suffix(f".{number:02d}.npz")) as data:
             row["flip_by_region"] = region_flip(data["flip"], masks)
+        cache[row["label"]] = row["flip_by_region"]
+        cache_path.write_text(json.dumps(cache), encoding="utf-8")
 
 
 def stats(values: list[float]) -> dict:
@@ -434,8 +442,9 @@ def summarise(rows: list[dict]) -> dict:
     }
     worst = sorted(rows, key=lambda r: -r["mean_flip"])[:WORST_SHOWN]
     split = {}
-    if all("flip_by_region" in r for r in rows):
-        split = {name: float(np.mean([r["flip_by_region"][name]["flip_share"] for r in rows]))
+    if all("flip_by_region" in r for r in rows):   # over the scenes with an error to split
+        judged = [r for r in rows if sum(r["flip_by_region"][n]["flip_share"] for n in SPLIT_REGIONS) > 0] or rows
+        split = {name: float(np.mean([r["flip_by_region"][name]["flip_share"] for r in judged]))
                  for name in SPLIT_REGIONS}
     by_family, by_fabric = {}, {}
     for r in rows:
