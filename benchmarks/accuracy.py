@@ -671,7 +671,8 @@ def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RE
 
     machine = {**machine_info(create_headless_context()), "commit": commit}
     result = {"commit": commit, "machine": machine, "planned_scenes": planned, "rows": rows, "summary": summary,
-              "settings": {"size": first["size"], "spp": first["spp"], "seed": REPORT_SEED,
+              "settings": {"size": first["size"], "spp": max(r["spp"] for r in rows) if "spp_rounds" not in first else SPP,
+                           "seed": REPORT_SEED,
                            "report_seed": REPORT_SEED, "tune_seed": TUNE_SEED, "room": None,
                            "display": {"exposure": f"reference luminance p99 -> {P99_TARGET}",
                                        "tone": f"x (1 + x / {TONE_WHITE:g}^2) / (1 + x)",
