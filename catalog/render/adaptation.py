@@ -43,10 +43,6 @@ import numpy as np
 
 #: The adapting field's grid: at most this many samples along the frame's longer side.
 FIELD_SAMPLES_PX = 48
-#: The view's steps at which the white is measured again (view_key): yaw and pitch in
-#: degrees, the distance as a ratio.
-VIEW_STEP_DEG = 15.0
-VIEW_STEP_RATIO = 1.5
 #: The display's viewing conditions that set D (IEC 61966-2-1's reference: an 80 cd m^-2
 #: display white, L_A a fifth of it, average surround).
 DISPLAY_WHITE_CD_M2 = 80.0
@@ -92,13 +88,6 @@ def adapting_white_xyz(inputs) -> np.ndarray:
     if not (np.all(np.isfinite(xyz)) and xyz[1] > 0):
         return white_xyz(inputs)
     return np.asarray(xyz, dtype=np.float64)
-
-
-def view_key(yaw_deg: float, pitch_deg: float, distance_m: float) -> tuple[int, int, int]:
-    """The view's cell for re-measuring the white: yaw and pitch in VIEW_STEP_DEG steps, the
-    distance in VIEW_STEP_RATIO steps (log)."""
-    return (round(yaw_deg / VIEW_STEP_DEG), round(pitch_deg / VIEW_STEP_DEG),
-            round(math.log(max(distance_m, 1e-6)) / math.log(VIEW_STEP_RATIO)))
 
 
 def neutral_curtain_inputs(frame):

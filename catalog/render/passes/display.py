@@ -39,12 +39,11 @@ class DisplayPass(Pass):
     def white_balance_matrix(self) -> np.ndarray:
         """Linear sRGB -> linear sRGB: CAT16 from the white of the light reaching the viewer to
         D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity.
-        The white is measured (a G-buffer draw) when the light, the size or the view change
-        (the view by adaptation.view_key's steps: the eye does not re-adapt to a small turn)."""
+        The white is measured (a G-buffer draw) at the view of the first frame after the light,
+        the fabric or the size change, and kept while the camera moves (the web page replays
+        camera-independent passes: catalog.web.export.check_camera_uniforms)."""
         self.frame.terms.shading_inputs()
-        cam = self.frame.camera
         key = (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
-               adaptation_lib.view_key(cam.yaw_deg, cam.pitch_deg, cam.distance_m),
                self.frame.room_side_active())
         if self._wb_cache is None or self._wb_cache[0] != key:
             self._wb_cache = (key, display_lib.white_balance_matrix(
