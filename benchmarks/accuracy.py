@@ -12,8 +12,10 @@ room's limit); the room (``box``, the one built-in room of this branch). The cur
 
 For each scene the frame (:class:`catalog.render.frame.FrameRenderer`, the linear radiance
 ``catalog snapshot`` writes to EXR) and the reference (``catalog reference``'s Mitsuba scene, two
-independent renders of spp / 2) are both shown through ONE neutral display defined here, not the
-product's (:func:`neutral_display`):
+independent halves) are rendered at SIZE and compared at SIZE / MEASURE_REDUCTION (each compared
+pixel the mean of MEASURE_REDUCTION^2 rendered ones, linear radiance: the view as seen from
+twice as far, FLIP at the same pixels per degree), both shown through ONE neutral display
+defined here, not the product's (:func:`neutral_display`):
 
 - exposure from the reference alone: its luminance's 99th percentile maps to
   :data:`P99_TARGET` (1.0) before the tone curve; the frame gets the same scale;
@@ -22,15 +24,20 @@ product's (:func:`neutral_display`):
 - no white balance (the sRGB white, D65), no glare, the sRGB curve.
 
 Measured per scene: the mean LDR-FLIP of the two display images; the curtain's Delta E 2000
-(colour-science's CIEDE2000 on CIELAB of the display images, D65 white, on the pixels whose
-centre ray meets the cloth in the reference's own geometry), its mean; the reference's own noise,
-the mean FLIP of its two half renders shown through the same display (each half has sqrt(2) the
-noise of their mean, so this bounds the noise's share from above); the frame's time (median of
-repeats with glFinish) and the reference's (its two halves, scene building excluded).
+(colour-science's CIEDE2000 on CIELAB of the display images, D65 white, on the compared pixels
+wholly on the cloth, by centre rays through the reference's own geometry), its mean; the
+reference's own noise, the mean FLIP of its two halves (two seeds) shown through the same
+display (each half has sqrt(2) the noise of their mean, so this bounds the noise's share from
+above); the same two figures at the rendered size (``*_full_size``); the frame's time (median of
+repeats with glFinish) and the reference's (its halves at the spp it ended with, scene building
+excluded), both at SIZE.
 
-The noise rule: the spp is fixed before the report (:data:`SPP`) and each row says whether the
-reference's noise is below a fifth of the FLIP it judges (``noise_below_fifth``); the summary
-counts the scenes where it is not.
+The noise rule (:func:`adaptive_reference`): the reference is rendered in rounds of new seeds,
+START_SPP first and each round doubling the total, until its noise is below NOISE_SHARE (a fifth)
+of the FLIP it judges, or the next round would pass the SPP cap or REFERENCE_BUDGET_S (a round
+takes about as long as all before it). The reference is never judged by the frame's look, only
+by its own noise against the error; each row says whether the rule holds
+(``noise_below_fifth``), the spp it ended with and each round's figures (``spp_rounds``).
 
 Seeds: :data:`TUNE_SEED` for choosing, :data:`REPORT_SEED` (fixed before the report run) for the
 published figures (``python -m benchmarks.accuracy record`` regenerates them).
@@ -52,9 +59,22 @@ REPORT_SEED = 33033
 ROOMS = ("box",)
 SIZE = (160, 90)
 QUICK_SIZE = (64, 36)
-#: The references' samples per pixel (two halves of SPP / 2).
-SPP = 512
+#: The noise rule: a scene's reference is rendered in rounds (the first of START_SPP, each
+#: next one doubling the total) until its own noise, the mean FLIP of its two halves (two seeds),
+#: is below NOISE_SHARE of the FLIP it judges, or SPP (the cap) is reached, or the next round
+#: would take the scene's reference past REFERENCE_BUDGET_S (its time so far doubles).
+NOISE_SHARE = 0.2
+START_SPP = 64
+QUICK_START_SPP = 32
+SPP = 1024
 QUICK_SPP = 64
+REFERENCE_BUDGET_S = 90.0
+QUICK_REFERENCE_BUDGET_S = 30.0
+#: Both images are compared at SIZE / MEASURE_REDUCTION: each compared pixel the mean of
+#: MEASURE_REDUCTION^2 rendered ones (linear radiance, before the display), the view as it is
+#: seen from MEASURE_REDUCTION times farther at the same FLIP pixels per degree. The rendered
+#: size (and the speed comparison, at equal size) stays SIZE.
+MEASURE_REDUCTION = 2
 DEFAULT_SCENES = 48
 QUICK_SCENES = 2
 #: The neutral display: the reference's luminance 99th percentile -> P99_TARGET, then the tone
@@ -208,7 +228,7 @@ def curtain_delta_e(frame_display: np.ndarray, reference_display: np.ndarray, ma
     return np.asarray(colour.delta_E(lab(frame_display), lab(reference_display), method="CIE 2000"))
 
 
-def reference_halves(scene: dict, size, spp: int, own: dict) -> dict:
+def reference_halves(scene: dict, size, spp: int, own: dict, first_seed: int = 0) -> dict:
     """The scene's reference: two halves, region masks, time, variant. RGB references render in
     this process (``own["mi"]``, loaded once); a spectral one in a child process (Mitsuba's JIT
     crashed when the variant was switched in one process: benchmarks.image_reference)."""
@@ -225,7 +245,7 @@ def reference_halves(scene: dict, size, spp: int, own: dict) -> dict:
     if variant == REFERENCE_VARIANT:
         if own.get("mi") is None:
             own["mi"] = load_mitsuba(REFERENCE_VARIANT)
-        halves = render_halves(own["mi"], desc, spp)
+        halves = render_halves(own["mi"], desc, spp, first_seed)
     else:
         cam = scene["camera"]
         with tempfile.TemporaryDirectory() as scratch:
@@ -233,7 +253,7 @@ def reference_halves(scene: dict, size, spp: int, own: dict) -> dict:
             subprocess.run([sys.executable, "-m", "benchmarks.image_reference", scene["fabric"],
                             scene["light"], repr(cam["yaw_deg"]), repr(cam["pitch_deg"]),
                             repr(cam["distance_m"]), str(size[0]), str(size[1]), str(spp),
-                            variant, str(out)], check=True)
+                            variant, str(out), str(first_seed)], check=True)
             with np.load(out) as data:
                 halves = {"a": data["a"], "b": data["b"], "seconds": float(data["seconds"]),
                           "nan_pixel_passes": int(data["nan_pixel_passes"]),
@@ -242,11 +262,70 @@ def reference_halves(scene: dict, size, spp: int, own: dict) -> dict:
     return halves
 
 
-def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5) -> tuple[dict, dict]:
-    """One scene: its row (JSON) and its images (frame, reference, FLIP map)."""
+def reduce_box(image: np.ndarray, factor: int) -> np.ndarray:
+    """The mean of each factor x factor block (the image cropped to whole blocks); (H, W) or
+    (H, W, C)."""
+    image = np.asarray(image, dtype=np.float64)
+    if factor == 1:
+        return image
+    h, w = image.shape[0] // factor, image.shape[1] // factor
+    blocks = image[:h * factor, :w * factor].reshape(h, factor, w, factor, *image.shape[2:])
+    return blocks.mean(axis=(1, 3))
+
+
+def judge(frame_linear, a, b, factor: int) -> dict:
+    """At SIZE / factor: the display scale (from the reference alone), the displayed frame and
+    reference, the FLIP map and the reference's noise (the mean FLIP of its two halves)."""
+    from catalog.pathtrace import metrics  # noqa: PLC0415
+
+    a, b = reduce_box(a, factor), reduce_box(b, factor)
+    reference = 0.5 * (a + b)
+    scale = exposure_from_reference(reference)
+    shown_frame = neutral_display(reduce_box(frame_linear, factor), scale)
+    shown_reference = neutral_display(reference, scale)
+    flip = metrics.flip_map(shown_frame, shown_reference)
+    noise = float(metrics.flip_map(neutral_display(a, scale), neutral_display(b, scale)).mean())
+    return {"scale": scale, "frame": shown_frame, "reference": shown_reference, "flip": flip,
+            "mean_flip": float(flip.mean()), "noise": noise}
+
+
+def adaptive_reference(scene: dict, size, frame_linear, own: dict, start_spp: int, spp_cap: int,
+                       budget_s: float) -> tuple[dict, list[dict]]:
+    """The noise rule (NOISE_SHARE): the reference's halves accumulated over rounds of new seeds
+    (START_SPP, then doubling the total) until the rule holds at the measure's size, the cap is
+    reached or the next round would pass ``budget_s``. Returns the halves (as reference_halves,
+    spp the total) and the rounds (spp, FLIP, noise at the measure's size)."""
+    total, rounds, halves, seed = 0, [], None, 0
+    step = int(start_spp)
+    while True:
+        new = reference_halves(scene, size, step, own, first_seed=seed)
+        if halves is None:
+            halves = new
+        else:   # weighted by the samples each holds
+            w_old, w_new = total / (total + step), step / (total + step)
+            for half in ("a", "b"):
+                halves[half] = (w_old * halves[half] + w_new * new[half]).astype(np.float32)
+            halves["seconds"] += new["seconds"]
+            halves["nan_pixel_passes"] += new["nan_pixel_passes"]
+        total += step
+        seed += 2
+        measured = judge(frame_linear, halves["a"], halves["b"], MEASURE_REDUCTION)
+        rounds.append({"spp": total, "mean_flip": measured["mean_flip"], "noise": measured["noise"],
+                       "reference_s": float(halves["seconds"])})
+        if measured["noise"] < NOISE_SHARE * measured["mean_flip"] or 2 * total > spp_cap \
+                or 2 * halves["seconds"] > budget_s:
+            break
+        step = total
+    halves["spp"] = total
+    return halves, rounds
+
+
+def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5,
+                  start_spp: int = START_SPP, budget_s: float = REFERENCE_BUDGET_S) -> tuple[dict, dict]:
+    """One scene: its row (JSON) and its images at the measure's size (frame, reference, FLIP
+    map). ``spp``: the reference's cap (the noise rule: :func:`adaptive_reference`)."""
     from benchmarks.image import frame_images  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
-    from catalog.pathtrace import metrics  # noqa: PLC0415
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
@@ -255,39 +334,38 @@ def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5)
     cam = scene["camera"]
     desc = describe_scene(preset, light, size=tuple(size), yaw_deg=cam["yaw_deg"],
                           pitch_deg=cam["pitch_deg"], distance_m=cam["distance_m"])
-    scene["_desc"] = desc
-    halves = reference_halves(scene, size, spp, own)
-    scene.pop("_desc")
-    reference = 0.5 * (halves["a"] + halves["b"])
     frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=repeats)
-    scale = exposure_from_reference(reference)
-    shown_frame = neutral_display(frame["linear"], scale)
-    shown_reference = neutral_display(reference, scale)
-    flip = metrics.flip_map(shown_frame, shown_reference)
-    noise = float(metrics.flip_map(neutral_display(halves["a"], scale),
-                                   neutral_display(halves["b"], scale)).mean())
-    de = curtain_delta_e(shown_frame, shown_reference, halves["masks"]["curtain"])
-    mean_flip = float(flip.mean())
+    scene["_desc"] = desc
+    halves, rounds = adaptive_reference(scene, size, frame["linear"], own, min(start_spp, spp), spp, budget_s)
+    scene.pop("_desc")
+    measured = judge(frame["linear"], halves["a"], halves["b"], MEASURE_REDUCTION)
+    full = judge(frame["linear"], halves["a"], halves["b"], 1)
+    curtain = reduce_box(halves["masks"]["curtain"].astype(np.float64), MEASURE_REDUCTION) > 0.999
+    de = curtain_delta_e(measured["frame"], measured["reference"], curtain)
+    mean_flip, noise = measured["mean_flip"], measured["noise"]
     frame_s = float(frame["seconds"])
     row = {k: v for k, v in scene.items() if not k.startswith("_")}
     row.update({
-        "size": list(size), "spp": spp, "reference_variant": halves["variant"],
+        "size": list(size), "measure_size": list(measured["flip"].shape[::-1]),
+        "spp": int(halves["spp"]), "spp_rounds": rounds, "reference_variant": halves["variant"],
         "mean_flip": mean_flip,
         "curtain_delta_e_mean": None if de is None else float(np.nanmean(de)),
         "curtain_delta_e_p95": None if de is None else float(np.nanpercentile(de, 95)),
         "curtain_delta_e_nan_pixels": 0 if de is None else int(np.isnan(de).sum()),
-        "curtain_pixels": int(halves["masks"]["curtain"].sum()),
+        "curtain_pixels": int(curtain.sum()),
         "reference_flip_noise": noise,
-        "noise_below_fifth": bool(noise < mean_flip / 5.0),
+        "noise_below_fifth": bool(noise < NOISE_SHARE * mean_flip),
         # the spp at which the noise would be a fifth of this FLIP (noise ~ 1 / sqrt(spp))
-        "spp_for_noise_rule": float(spp * (5.0 * noise / mean_flip) ** 2) if mean_flip > 0 else None,
+        "spp_for_noise_rule": float(halves["spp"] * (noise / (NOISE_SHARE * mean_flip)) ** 2) if mean_flip > 0 else None,
+        # the same comparison at the rendered size (the previous report's measure)
+        "mean_flip_full_size": full["mean_flip"], "reference_flip_noise_full_size": full["noise"],
         "frame_ms": 1e3 * frame_s, "reference_s": float(halves["seconds"]),
         "speedup": float(halves["seconds"]) / frame_s if frame_s > 0 else math.inf,
-        "display_scale": scale,
+        "display_scale": measured["scale"],
         "reference_nan_pixel_passes": int(halves["nan_pixel_passes"]),
         "fluorescence": desc.info["fluorescence_variant"],
     })
-    return row, {"frame": shown_frame, "reference": shown_reference, "flip": flip}
+    return row, {"frame": measured["frame"], "reference": measured["reference"], "flip": measured["flip"]}
 
 
 #: The regions the FLIP is split by (catalog.pathtrace.render.region_masks): the curtain, the
@@ -300,11 +378,14 @@ def region_flip(flip: np.ndarray, masks: dict) -> dict:
     total = float(flip.sum()) or 1.0
     out = {}
     for name, parts in SPLIT_REGIONS.items():
-        mask = np.zeros(flip.shape, dtype=bool)
+        mask = np.zeros(next(iter(masks.values())).shape, dtype=bool)
         for part in parts:
             mask |= masks[part]
-        out[name] = {"flip_share": float(flip[mask].sum()) / total, "pixel_share": float(mask.mean()),
-                     "mean_flip": float(flip[mask].mean()) if mask.any() else None}
+        # each compared pixel's share of the region (the masks are at the rendered size)
+        weight = reduce_box(mask.astype(np.float64), mask.shape[0] // flip.shape[0])
+        weight = weight[:flip.shape[0], :flip.shape[1]]
+        out[name] = {"flip_share": float((flip * weight).sum()) / total, "pixel_share": float(weight.mean()),
+                     "mean_flip": float((flip * weight).sum() / weight.sum()) if weight.sum() > 0 else None}
     return out
 
 
@@ -317,8 +398,14 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
     from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
+    import json  # noqa: PLC0415
+
+    cache_path = Path(rows_out).with_suffix(".regions.json")   # labels -> their split, kept between publishes
+    cache = json.loads(cache_path.read_text(encoding="utf-8")) if cache_path.is_file() else {}
     mi = load_mitsuba("llvm_ad_rgb")
     for number, row in enumerate(rows, 1):
+        if row["label"] in cache:
+            row["flip_by_region"] = cache[row["label"]]
         if "flip_by_region" in row:
             continue
         cam = row["camera"]
@@ -328,6 +415,8 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
         masks = region_masks(mi, build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH), desc)
         with np.load(Path(rows_out).with_suffix(f".{number:02d}.npz")) as data:
             row["flip_by_region"] = region_flip(data["flip"], masks)
+        cache[row["label"]] = row["flip_by_region"]
+        cache_path.write_text(json.dumps(cache), encoding="utf-8")
 
 
 def stats(values: list[float]) -> dict:
@@ -353,14 +442,20 @@ def summarise(rows: list[dict]) -> dict:
     }
     worst = sorted(rows, key=lambda r: -r["mean_flip"])[:WORST_SHOWN]
     split = {}
-    if all("flip_by_region" in r for r in rows):
-        split = {name: float(np.mean([r["flip_by_region"][name]["flip_share"] for r in rows]))
+    if all("flip_by_region" in r for r in rows):   # over the scenes with an error to split
+        judged = [r for r in rows if sum(r["flip_by_region"][n]["flip_share"] for n in SPLIT_REGIONS) > 0] or rows
+        split = {name: float(np.mean([r["flip_by_region"][name]["flip_share"] for r in judged]))
                  for name in SPLIT_REGIONS}
     by_family, by_fabric = {}, {}
     for r in rows:
         by_family.setdefault(r["light_family"], []).append(r["mean_flip"])
         by_fabric.setdefault(r["fabric"], []).append(r["mean_flip"])
-    return {"scenes": len(rows), "mean_flip": flip, "curtain_delta_e_mean": de,
+    extra = {}
+    if all("spp_rounds" in r for r in rows):
+        extra = {"mean_flip_full_size": stats([r["mean_flip_full_size"] for r in rows]),
+                 "spp_median": float(np.median([r["spp"] for r in rows])),
+                 "measure_size": rows[0]["measure_size"]}
+    return {**extra, "scenes": len(rows), "mean_flip": flip, "curtain_delta_e_mean": de,
             "flip_share_by_region": split,
             "median_flip_by_light_family": {k: float(np.median(v)) for k, v in by_family.items()},
             "median_flip_by_fabric": {k: float(np.median(v)) for k, v in sorted(by_fabric.items())},
@@ -397,7 +492,9 @@ def run(quick: bool = False, ctx=None, scenes: int | None = None, seed: int | No
     rows, images = [], {}
     start = time.perf_counter()
     for number, scene in enumerate(chosen, 1):
-        row, pictures = measure_scene(ctx, dict(scene), size, spp, own, repeats=3 if quick else 5)
+        row, pictures = measure_scene(ctx, dict(scene), size, spp, own, repeats=3 if quick else 5,
+                                      start_spp=QUICK_START_SPP if quick else START_SPP,
+                                      budget_s=QUICK_REFERENCE_BUDGET_S if quick else REFERENCE_BUDGET_S)
         rows.append(row)
         images[row["label"]] = pictures
         if rows_out is not None:
@@ -408,7 +505,8 @@ def run(quick: bool = False, ctx=None, scenes: int | None = None, seed: int | No
             np.savez_compressed(Path(rows_out).with_suffix(f".{number:02d}.npz"), **pictures)
         if progress is not None:
             progress(f"accuracy {number}/{len(chosen)}: {row['label']}: FLIP {row['mean_flip']:.3f}, "
-                     f"noise {row['reference_flip_noise']:.3f}, reference {row['reference_s']:.0f} s, "
+                     f"noise {row['reference_flip_noise']:.3f} at {row['spp']} spp, "
+                     f"reference {row['reference_s']:.0f} s, "
                      f"{time.perf_counter() - start:.0f} s so far")
     summary = summarise(rows)
     result = {"rows": rows, "summary": summary,
@@ -460,12 +558,15 @@ def _cell(value) -> str:
 
 def markdown_tables(result: dict) -> dict[str, str]:
     """``accuracy`` (per scene) and ``accuracy-summary`` of one run."""
-    columns = ("label", "light_family", "mean_flip", "reference_flip_noise", "curtain_delta_e_mean",
-               "frame_ms", "reference_s", "speedup", "reference_variant")
-    headers = ("scene", "light family", "mean FLIP", "ref. noise (FLIP of halves)", "curtain dE2000 mean",
-               "frame ms", "reference s", "x faster", "reference variant")
+    columns = ("label", "light_family", "mean_flip", "reference_flip_noise", "noise_below_fifth", "spp",
+               "mean_flip_full_size", "curtain_delta_e_mean", "frame_ms", "reference_s", "speedup",
+               "reference_variant")
+    headers = ("scene", "light family", "mean FLIP", "ref. noise (FLIP of halves)", "noise < FLIP / 5",
+               "ref. spp", "mean FLIP at the rendered size", "curtain dE2000 mean", "frame ms",
+               "reference s", "x faster", "reference variant")
     lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
-    lines += ["| " + " | ".join(_cell(r.get(c)) for c in columns) + " |" for r in result["rows"]]
+    lines += ["| " + " | ".join("yes" if r.get(c) is True else "no" if r.get(c) is False else _cell(r.get(c))
+                                for c in columns) + " |" for r in result["rows"]]
     s = result["summary"]
     f, d, n = s["mean_flip"], s["curtain_delta_e_mean"], s["reference_flip_noise"]
     g = s["goal_met"]
@@ -484,12 +585,18 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"| reference noise (FLIP of its halves) | {_cell(n['median'])} | {_cell(n['p90'])} | {_cell(n['max'])} | "
         f"< 1/5 of the FLIP judged: {s['scenes'] - s['scenes_noise_not_below_fifth']} of {s['scenes']} scenes |",
         "",
-        f"The noise rule (the reference's noise below a fifth of the FLIP it judges) would need "
-        f"{s.get('spp_for_noise_rule_median', 0):,.0f} spp at the median scene; these references at that "
-        f"spp would take {s.get('reference_s_for_noise_rule_total', 0) / 3600:.1f} h on this machine.",
+        f"Where the noise rule (the reference's noise below a fifth of the FLIP it judges) does not "
+        f"hold at the spp a reference ended with (its cap or its time budget), it would need "
+        f"{s.get('spp_for_noise_rule_median', 0):,.0f} spp at the median scene (noise ~ 1 / sqrt(spp)); "
+        f"all the references at the spp they need would take "
+        f"{s.get('reference_s_for_noise_rule_total', 0) / 3600:.1f} h on this machine.",
         "",
-        f"{s['scenes']} scenes (seed {cfg['seed']}; report seed {cfg['report_seed']}), "
-        f"{cfg['size'][0]}x{cfg['size'][1]} px, reference {cfg['spp']} spp (2 x {cfg['spp'] // 2}). "
+        f"{s['scenes']} scenes (seed {cfg['seed']}; report seed {cfg['report_seed']}), rendered at "
+        f"{cfg['size'][0]}x{cfg['size'][1]} px and compared at {s.get('measure_size', ['?', '?'])[0]}x"
+        f"{s.get('measure_size', ['?', '?'])[1]} px (2x2 means); reference spp chosen per scene by the noise rule "
+        f"(median {s.get('spp_median', 0):,.0f}, cap {cfg['spp']}); at the rendered size the mean FLIP is "
+        f"median {_cell(s.get('mean_flip_full_size', {}).get('median'))}, p90 "
+        f"{_cell(s.get('mean_flip_full_size', {}).get('p90'))}, max {_cell(s.get('mean_flip_full_size', {}).get('max'))}. "
         f"Frame {_cell(s['frame_ms_median'])} ms, reference {_cell(s['reference_s_median'])} s (medians); "
         f"the frame {s['speedup']['min']:,.0f}x (least) to {s['speedup']['median']:,.0f}x (median) faster "
         f"(goal >= {GOAL['speedup_at_least']:g}x: {yes('speedup')}). Worst: {'; '.join(s['worst'])}.",
@@ -509,8 +616,11 @@ def markdown_tables(result: dict) -> dict[str, str]:
     summary += ("\n\nMedian mean FLIP by light family: " + ", ".join(
         f"{k} {v:.3f}" for k, v in s["median_flip_by_light_family"].items())
         + "; by fabric: " + ", ".join(f"{k} {v:.3f}" for k, v in s.get("median_flip_by_fabric", {}).items()) + ".")
+    compared = s.get("measure_size") or cfg["size"]
     readme = (f"Over {s['scenes']} scenes drawn at random from the whole scene space (report seed "
-              f"{cfg['seed']}, {cfg['size'][0]}x{cfg['size'][1]} px, docs/accuracy.md; measured on "
+              f"{cfg['seed']}, rendered at {cfg['size'][0]}x{cfg['size'][1]} px, compared at "
+              f"{compared[0]}x{compared[1]}; the reference's noise below a fifth of the error on "
+              f"{s['scenes'] - s['scenes_noise_not_below_fifth']} of them; docs/accuracy.md; measured on "
               f"{result.get('commit', '?')}): mean FLIP median {_cell(f['median'])}, p90 {_cell(f['p90'])}, "
               f"max {_cell(f['max'])} (goals 0.06 / 0.09 / 0.12); curtain Delta E 2000 median "
               f"{_cell(d['median'])} (goal 1.5); the frame {s['speedup']['min']:,.0f}x to "
@@ -556,8 +666,13 @@ def publish(rows_out: Path, commit: str, planned: int, json_path: Path = Path(RE
                 row[key] = None
     summary = summarise(rows)
     first = rows[0]
-    result = {"commit": commit, "planned_scenes": planned, "rows": rows, "summary": summary,
-              "settings": {"size": first["size"], "spp": first["spp"], "seed": REPORT_SEED,
+    from benchmarks.results import machine_info  # noqa: PLC0415
+    from catalog.gl.context import create_headless_context  # noqa: PLC0415
+
+    machine = {**machine_info(create_headless_context()), "commit": commit}
+    result = {"commit": commit, "machine": machine, "planned_scenes": planned, "rows": rows, "summary": summary,
+              "settings": {"size": first["size"], "spp": max(r["spp"] for r in rows) if "spp_rounds" not in first else SPP,
+                           "seed": REPORT_SEED,
                            "report_seed": REPORT_SEED, "tune_seed": TUNE_SEED, "room": None,
                            "display": {"exposure": f"reference luminance p99 -> {P99_TARGET}",
                                        "tone": f"x (1 + x / {TONE_WHITE:g}^2) / (1 + x)",

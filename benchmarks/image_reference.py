@@ -7,7 +7,7 @@ the bench process's own is rendered here, in a child process, and handed back as
 the two half renders ``a`` and ``b``, the region masks ``mask_*``, the render time
 ``seconds`` (the two halves, scene building excluded) and ``nan_pixel_passes``.
 
-    python -m benchmarks.image_reference FABRIC LIGHT YAW PITCH DISTANCE WIDTH HEIGHT SPP VARIANT OUT.npz
+    python -m benchmarks.image_reference FABRIC LIGHT YAW PITCH DISTANCE WIDTH HEIGHT SPP VARIANT OUT.npz [FIRST_SEED]
 
 (LIGHT a light's name; YAW, PITCH in degrees and DISTANCE in metres: the view's camera.)
 """
@@ -20,17 +20,18 @@ import time
 import numpy as np
 
 
-def render_halves(mi, desc, spp: int) -> dict:
-    """The scene ``desc``'s two half renders (spp / 2 each, seeds 0 and 1), its region masks,
-    the halves' wall time and the pixel-passes left out as NaN."""
+def render_halves(mi, desc, spp: int, first_seed: int = 0) -> dict:
+    """The scene ``desc``'s two half renders (spp / 2 each, seeds ``first_seed`` and
+    ``first_seed + 1``), its region masks, the halves' wall time and the pixel-passes left out
+    as NaN."""
     from catalog.pathtrace.render import MAX_DEPTH, region_masks, render_radiance  # noqa: PLC0415
     from catalog.pathtrace.scene import build_mitsuba_scene  # noqa: PLC0415
 
     scene = build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH)
     start = time.perf_counter()
     report_a, report_b = {}, {}
-    a = render_radiance(mi, scene, spp // 2, seed=0, report=report_a)
-    b = render_radiance(mi, scene, spp // 2, seed=1, report=report_b)
+    a = render_radiance(mi, scene, spp // 2, seed=first_seed, report=report_a)
+    b = render_radiance(mi, scene, spp // 2, seed=first_seed + 1, report=report_b)
     seconds = time.perf_counter() - start
     return {"a": a, "b": b, "masks": region_masks(mi, scene, desc), "seconds": seconds,
             "nan_pixel_passes": report_a["nan_pixel_passes"] + report_b["nan_pixel_passes"]}
@@ -43,10 +44,12 @@ def main(argv=None) -> int:
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
-    fabric, light, yaw, pitch, distance, width, height, spp, variant, out = (argv or sys.argv[1:])
+    args = list(argv or sys.argv[1:])
+    first_seed = int(args.pop()) if len(args) == 11 else 0
+    fabric, light, yaw, pitch, distance, width, height, spp, variant, out = args
     desc = describe_scene(load_preset(find_preset(fabric)), get_light(light), size=(int(width), int(height)),
                           yaw_deg=float(yaw), pitch_deg=float(pitch), distance_m=float(distance))
-    result = render_halves(load_mitsuba(variant), desc, int(spp))
+    result = render_halves(load_mitsuba(variant), desc, int(spp), first_seed)
     with atomic_path(out) as tmp:
         with open(tmp, "wb") as handle:
             np.savez(handle, a=result["a"], b=result["b"], seconds=result["seconds"],

@@ -1,10 +1,23 @@
-"""The white the eye adapts to: the light that reaches the viewer, and CAT16 with its degree
-of adaptation (issue 33; docs/display.md).
+"""The white the eye adapts to: the light that reaches the viewer from the surfaces in view,
+and CAT16 with its degree of adaptation (docs/display.md).
 
-A person in the room adapts to the light around them, not to the key light's own white: under
-a high sun a south window lets in little of the beam and much of the blue sky, so the room's
-light is bluer than the sun. The room's surfaces are neutral (ROOM_ALBEDO is one number), so
-the chromaticity of the room's mean irradiance is that of the light entering it:
+A person in the room adapts to the light around them, not to the key light's own white, and
+not to the colours of the things lit: the adapting white is the mean light that reaches the
+eye from the field of view with every surface in it made neutral (:func:`visible_white_xyz`),
+on a grid of at most FIELD_SAMPLES_PX samples along the frame's longer side:
+
+- the curtain: the frame's float64 twin (eq. 8, catalog.optics.shading_reference.shade_spectral)
+  at the G-buffer's pixels, with the cloth's dye left out and no fluorescence
+  (build_shading_inputs(neutral=True, fluorescence="off")): the light a white cloth of the
+  same weave shows the viewer there, its diffuse transmission of the window's light, the sky
+  seen through its open area and what its room side reflects, with the pixels' own shadows.
+  So a pink curtain is not taken for a pink illuminant and the brightener's blue-white
+  survives: the eye adapts to the light, not to the cloth's glow;
+- the rest of the view (the room's grey surfaces, the outside through the window): the frame's
+  own linear radiance there, the room's surfaces being neutral (ROOM_ALBEDO is one number).
+
+Where nothing in view is lit (a zero mean) the light entering the room is taken
+(:func:`adapting_white_xyz`):
 
     E_in(l) = K(l) max(0, -d_z) + (pi / 2) (L_sky(l) + L_ground(l))
 
@@ -14,17 +27,12 @@ the chromaticity of the room's mean irradiance is that of the light entering it:
   horizon and the ground's below, each over a quarter sphere, which a vertical plane sees with
   weight pi / 2 each.
 
-The curtain's own filtering is left out on purpose, its dye as well as its fluorescence: the
-adapting white is the window's light, the same for every fabric, so that fabrics compare under
-one adaptation (a pink curtain is not discounted as a pink illuminant, and the brightener's
-blue-white survives: the eye adapts to the light, not to the cloth).
-
 Adaptation is CAT16 (Li et al. 2017) with its degree of adaptation D (eq. of CIECAM02 / CAM16):
 D = F (1 - (1 / 3.6) exp((-L_A - 42) / 92)), for the viewer of the display image: the sRGB
 reference viewing (IEC 61966-2-1: an 80 cd m^-2 display, L_A = 80 / 5 = 16 cd m^-2, average
-surround F = 1), D = 0.853. The incomplete share 1 - D keeps a strong light's colour: a
-sunset stays warm. Lights far from the Planckian locus (the UV-A lamp's two violet lines) are
-not adapted to at all (catalog.render.display.adapts_to), so the lamp stays violet.
+surround F = 1), D = 0.852. The incomplete share 1 - D keeps a strong light's colour. Lights far
+from the Planckian locus (the UV-A lamp's two violet lines) are not adapted to at all
+(catalog.render.display.adapts_to), so the lamp stays violet.
 """
 
 from __future__ import annotations
@@ -33,6 +41,8 @@ import math
 
 import numpy as np
 
+#: The adapting field's grid: at most this many samples along the frame's longer side.
+FIELD_SAMPLES_PX = 48
 #: The display's viewing conditions that set D (IEC 61966-2-1's reference: an 80 cd m^-2
 #: display white, L_A a fifth of it, average surround).
 DISPLAY_WHITE_CD_M2 = 80.0
@@ -78,3 +88,58 @@ def adapting_white_xyz(inputs) -> np.ndarray:
     if not (np.all(np.isfinite(xyz)) and xyz[1] > 0):
         return white_xyz(inputs)
     return np.asarray(xyz, dtype=np.float64)
+
+
+def neutral_curtain_inputs(frame):
+    """The frame's curtain inputs (SceneTerms.curtain_inputs) for a white cloth of the same
+    weave: the dye left out, no fluorescence."""
+    from catalog.render import scene as scene_lib  # noqa: PLC0415
+
+    light = frame.light
+    inputs, _ = scene_lib.build_shading_inputs(
+        frame.preset, light.irradiance_w_m2_nm, frame._key_to_light, is_sun=frame._is_sun,
+        fluorescence="off", viewer_inside=frame.viewer_inside, neutral=True,
+        paper_beam=light.sun is not None and light.sun.model == "paper")
+    return scene_lib.with_room_solved(inputs) if frame.room_side_active() else inputs
+
+
+def field_samples(shape, samples_px: int = FIELD_SAMPLES_PX) -> tuple[slice, slice]:
+    """The adapting field's grid on an (H, W) image: every s-th pixel from s // 2, s the
+    smallest stride giving at most ``samples_px`` along the longer side."""
+    stride = max(1, -(-max(shape[:2]) // int(samples_px)))
+    return slice(stride // 2, None, stride), slice(stride // 2, None, stride)
+
+
+def visible_white_xyz(frame) -> np.ndarray:
+    """XYZ (cd m^-2) of the mean light reaching the viewer from the surfaces in view, each made
+    neutral (module docstring), from the frame's HDR target as last drawn and its G-buffer (drawn
+    here with the room's light and shadow maps of that frame; the bound framebuffer and viewport
+    are restored)."""
+    from catalog.optics import shading_reference as ref  # noqa: PLC0415
+    from catalog.optics.colorimetry import linear_srgb_to_xyz  # noqa: PLC0415
+
+    ctx = frame.ctx
+    bound, viewport = ctx.fbo, ctx.viewport
+    try:
+        gbuffer = frame.curtain.render_gbuffer(refresh_light=False)   # the maps as this frame drew them
+        w, h = frame.size
+        data = frame.targets.hdr_fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4")
+    finally:
+        bound.use()
+        ctx.viewport = viewport
+    rows, columns = field_samples((h, w))
+    linear = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1, :, :3][rows, columns]
+    field = {name: value[rows, columns] for name, value in gbuffer.items()}
+    mask = field["mask"]
+    xyz = linear_srgb_to_xyz(linear.reshape(-1, 3).astype(np.float64))
+    if mask.any():
+        neutral = ref.spectral_to_xyz(ref.shade_spectral(
+            neutral_curtain_inputs(frame), field["position"][mask], field["normal"][mask],
+            field["tangent"][mask], frame.camera.position,
+            **ref.shadow_terms(field["shadows"][mask], field["second_coverage"][mask])))
+        neutral = neutral + linear_srgb_to_xyz(frame.twin.twin_room_side_rgb(field, mask))
+        xyz[mask.reshape(-1)] = neutral
+    white = xyz.mean(axis=0)
+    if not (np.all(np.isfinite(white)) and white[1] > 0):
+        return adapting_white_xyz(frame.terms.shading_inputs())
+    return white

@@ -405,8 +405,9 @@ def outside_radiances(key_irradiance: np.ndarray, to_light: np.ndarray, is_sun: 
 
 def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.ndarray, *,
                          is_sun: bool, fluorescence: str = "physical", paper_beam: bool = False,
-                         viewer_inside: bool = True) -> tuple[ShadingInputs, FluorescenceDecision]:
-    """The spectral description of the scene's light on the curtain for a preset."""
+                         viewer_inside: bool = True, neutral: bool = False) -> tuple[ShadingInputs, FluorescenceDecision]:
+    """The spectral description of the scene's light on the curtain for a preset; ``neutral``:
+    its dye left out (T = 1), the light a white cloth of the same weave passes and reflects."""
     from catalog.optics.colorimetry import cmfs  # noqa: PLC0415
     from catalog.optics.fluorescence import paper_intensity  # noqa: PLC0415
 
@@ -424,7 +425,7 @@ def build_shading_inputs(preset, key_irradiance: np.ndarray, key_to_light: np.nd
     if not -1.0 < anisotropy < 1.0:
         raise InputError(f"{anisotropy:g} is out of range (-1, 1)", path=preset.path,
                          field="btdf.anisotropy")
-    dye = relative_dye(dye_transmittance(preset))
+    dye = np.ones_like(GRID_NM, dtype=np.float64) if neutral else relative_dye(dye_transmittance(preset))
     behind = 0.5 * (sky + ground)  # mean radiance of the outside half-space
     front = room
     if not viewer_inside:

@@ -203,17 +203,18 @@ class CurtainPass(Pass):
         ctx.disable(mgl.BLEND)
         ctx.blend_func = mgl.DEFAULT_BLENDING
 
-    def render_gbuffer(self) -> dict[str, np.ndarray]:
+    def render_gbuffer(self, refresh_light: bool = True) -> dict[str, np.ndarray]:
         """The curtain alone with the G-buffer variant: radiance and the per-pixel geometry the
         shader used (world position, unit normal, weft tangent), float32 (H, W, 3) each, a
         boolean mask of curtain pixels, and ``shadows`` (H, W, 4): the key's window mask, the
         coverage of the layer in front of the key and the outside's occlusion by the cloth and
-        by the window wall (issue 11; 1, 0, 0, 0 where those are off). The reference shades these positions in float64."""
+        by the window wall (issue 11; 1, 0, 0, 0 where those are off). The reference shades these positions in float64.
+        ``refresh_light`` False: the room's light and the shadow maps as the last frame drew them."""
         mgl = self.mgl
         w, h = self.frame.size
-        if self.frame.room_side_active():   # the room's light on the cloth's room side (and its maps)
+        if refresh_light and self.frame.room_side_active():   # the room's light on the cloth's room side (and its maps)
             self.frame.lightmap.draw_room_light(self.frame.terms.shading_inputs())
-        else:   # the cloth's shadow maps of this mesh
+        elif refresh_light:   # the cloth's shadow maps of this mesh
             self.frame.shadow.draw_cloth_shadow_maps(self.frame.terms.shading_inputs())
         if self.frame.targets.gbuffer is None:
             textures = [self.ctx.texture((w, h), 4, dtype="f4") for _ in range(8)]

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from catalog.core.errors import CatalogError
-from catalog.render import display as display_lib
+from catalog.render import adaptation as adaptation_lib, display as display_lib
 from catalog.render.passes.gl_common import Pass, set_uniform
 
 #: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
@@ -39,15 +39,17 @@ class DisplayPass(Pass):
 
     def white_balance_matrix(self) -> np.ndarray:
         """Linear sRGB -> linear sRGB: CAT16 from the white of the light reaching the viewer to
-        D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity."""
-        inputs = self.frame.terms.shading_inputs()
-        key = (self.frame.terms.inputs_key, self.frame.white_balance)
+        D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity.
+        The white is measured (a G-buffer draw) at the view of the first frame after the light,
+        the fabric or the size change, and kept while the camera moves (the web page replays
+        camera-independent passes: catalog.web.export.check_camera_uniforms)."""
+        self.frame.terms.shading_inputs()
+        key = (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
+               self.frame.room_side_active())
         if self._wb_cache is None or self._wb_cache[0] != key:
-            from catalog.render import adaptation  # noqa: PLC0415
-
             self._wb_cache = (key, display_lib.white_balance_matrix(
-                adaptation.adapting_white_xyz(inputs), self.frame.white_balance,
-                adaptation.degree_of_adaptation()))
+                adaptation_lib.visible_white_xyz(self.frame), self.frame.white_balance,
+                adaptation_lib.degree_of_adaptation()))
         return self._wb_cache[1]
 
     def display_uniforms(self) -> dict:
@@ -73,6 +75,7 @@ class DisplayPass(Pass):
         ``glare``: the glare pass's :class:`~catalog.render.passes.glare.Glare` to mix in first
         (None: the HDR target as it is);
         ``stages``: tonemap.frag's DISPLAY_STAGES (3, all; fewer for the benchmark's cost per stage)."""
+        self.white_balance_matrix()   # first: measuring a new white draws
         target = fbo if fbo is not None else self.frame.targets.ldr_fbo
         target_viewport = (tuple(viewport) if (fbo is not None and viewport is not None)
                            else (0, 0, vw, vh))
