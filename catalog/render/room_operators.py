@@ -221,16 +221,9 @@ def receiver_uvs(room, transport) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _weld(transport) -> np.ndarray:
-    from catalog.room.lightmap import WELD_M  # noqa: PLC0415
+    from catalog.room.lightmap import weld_vertices  # noqa: PLC0415
 
-    rec = transport.receivers
-    corners = rec.corners.reshape(-1, 3)
-    normal = np.repeat(rec.normal, 3, axis=0)
-    offset = np.einsum("ni,ni->n", corners, normal)
-    key = np.concatenate([np.round(corners / WELD_M), np.round(normal * 1e4),
-                          np.round(offset[:, None] / WELD_M)], axis=1).astype(np.int64)
-    _, vertex = np.unique(key, axis=0, return_inverse=True)
-    return vertex.ravel()
+    return weld_vertices(transport.receivers)
 
 
 def side_grid() -> tuple:

@@ -11,16 +11,22 @@ import numpy as np
 WELD_M = 1e-5
 
 
-def corner_irradiance(transport, irradiance: np.ndarray) -> np.ndarray:
-    """(E, 3, 3) the irradiance at each receiver's three corners from receiver values (E, 3)."""
-    rec = transport.receivers
-    corners = rec.corners.reshape(-1, 3)
-    normal = np.repeat(rec.normal, 3, axis=0)
+def weld_vertices(receivers) -> np.ndarray:
+    """(3E,) the light-map vertex of each receiver corner: corners within WELD_M of each
+    other on one plane (same normal and offset) share one vertex."""
+    corners = receivers.corners.reshape(-1, 3)
+    normal = np.repeat(receivers.normal, 3, axis=0)
     offset = np.einsum("ni,ni->n", corners, normal)
     key = np.concatenate([np.round(corners / WELD_M), np.round(normal * 1e4),
                           np.round(offset[:, None] / WELD_M)], axis=1).astype(np.int64)
     _, vertex = np.unique(key, axis=0, return_inverse=True)
-    vertex = vertex.ravel()
+    return vertex.ravel()
+
+
+def corner_irradiance(transport, irradiance: np.ndarray) -> np.ndarray:
+    """(E, 3, 3) the irradiance at each receiver's three corners from receiver values (E, 3)."""
+    rec = transport.receivers
+    vertex = weld_vertices(rec)
     weight = np.repeat(rec.area_m2, 3)
     total = np.zeros((vertex.max() + 1, irradiance.shape[1]))
     np.add.at(total, vertex, weight[:, None] * np.repeat(irradiance, 3, axis=0))
