@@ -28,6 +28,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # lace_motifs beside this file
 FABRICS = ROOT / "fabrics"
 SQRT3 = math.sqrt(3.0)
+sys.path.insert(0, str(ROOT))   # the checkout's catalog package
+from catalog.presets.weave_patterns import bisect, make_structure  # noqa: E402
 
 #: name -> the pattern's named parameters (lengths in mm). ``size`` = texture side in px.
 PATTERNS: dict[str, dict] = {
@@ -64,69 +66,6 @@ PATTERNS: dict[str, dict] = {
     "jacquard-white": {"kind": "damask", "pitch_mm": 0.4, "threads": 250, "medallion_mm": 34.0,
                        "ground_end": 8, "motif_end": 3, "size": 1024},
 }
-
-#: Soft edge of a thread (fraction of a pixel's width the coverage ramps over): 1 px.
-EDGE_PX = 1.0
-
-
-def _grid(size_u: int, size_v: int, repeat_u: float, repeat_v: float):
-    """Pixel centres in metres: x along u (image columns), y along v (image rows, down)."""
-    x = (np.arange(size_u) + 0.5) * (repeat_u / size_u)
-    y = (np.arange(size_v) + 0.5) * (repeat_v / size_v)
-    return np.meshgrid(x, y)
-
-
-def _ramp(distance, half_width, px):
-    """Coverage of a thread whose centre line is ``distance`` away: 1 inside half_width,
-    0 outside, a linear ramp one pixel wide across the edge."""
-    return np.clip(0.5 - (distance - half_width) / (EDGE_PX * px), 0.0, 1.0)
-
-
-def _hex_edge_distance(x, y, cell):
-    """Distance to the nearest edge of the hexagonal (Voronoi) cells around a triangular
-    lattice of hole centres with spacing ``cell`` (basis (cell, 0), (cell/2, cell sqrt3/2))."""
-    t = y / (cell * SQRT3 / 2)
-    s = x / cell - 0.5 * t
-    s0, t0 = np.floor(s), np.floor(t)
-    d = []
-    for ds in (-1, 0, 1, 2):
-        for dt in (-1, 0, 1, 2):
-            ps, pt = s0 + ds, t0 + dt
-            px = (ps + 0.5 * pt) * cell
-            py = pt * cell * SQRT3 / 2
-            d.append((x - px) ** 2 + (y - py) ** 2)
-    d = np.sort(np.stack(d), axis=0)
-    return (d[1] - d[0]) / (2 * cell)  # distance to the bisector of the two nearest centres
-
-
-def _bisect(mean_of, target, low, high, iterations=60):
-    """The parameter in [low, high] at which mean_of (increasing) equals target."""
-    for _ in range(iterations):
-        mid = 0.5 * (low + high)
-        if mean_of(mid) < target:
-            low = mid
-        else:
-            high = mid
-    return 0.5 * (low + high)
-
-
-def net_pattern(p, direct):
-    cell = p["cell_mm"] * 1e-3
-    ru, rv = p["cells_u"] * cell, p["row_pairs_v"] * cell * SQRT3
-    n = p["size"]
-    x, y = _grid(n, n, ru, rv)
-    edge = _hex_edge_distance(x, y, cell)
-    px = ru / n
-
-    def coverage(half):
-        return _ramp(edge, half, px)
-
-    half = _bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, cell / 2)
-    c = coverage(half)
-    height = np.clip(1.0 - (edge / max(half, 1e-9)) ** 2, 0.0, 1.0) ** 0.5 * c
-    return c, height, (ru, rv), {"thread_mm": round(2 * half * 1e3, 4),
-                                  "height_m": round(1.4 * half, 8)}
-
 
 def _leavers(lace, ru, rv):
     """A Leavers floral all-over: per half-drop column a large six-petal flower with two
@@ -198,90 +137,12 @@ def lace_pattern(p, direct):
 
     cord = p["cord_mm"] * 1e-3
     coverage, height = lace_fields(lace_of_rows(), cell, cord, 2 * cell)
-    half = _bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, cell / 2)
+    half = bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, cell / 2)
     info = {"net_thread_mm": round(2 * half * 1e3, 4), "height_m": round(0.5 * cord, 8)}
     if "border" in p:
         info["border"] = scalloped_border(p["border"], lace_of_rows, half, cell, cord)
         info["border_m"] = round(p["border"]["border_rows"] * rv / rows_v, 8)
     return coverage(half), height(half), (ru, rv), info
-
-
-def weave_pattern(p, direct, basket=False):
-    pitch = p["pitch_mm"] * 1e-3
-    group = 2 if basket else 1
-    threads = 2 * group                 # threads per repeat in each direction
-    r = threads * pitch
-    n = p["size"]
-    x, y = _grid(n, n, r, r)
-    px = r / n
-    i = np.floor(x / pitch)             # warp index (vertical threads, spaced along x)
-    j = np.floor(y / pitch)             # weft index
-    dx = np.abs(x - (i + 0.5) * pitch)
-    dy = np.abs(y - (j + 0.5) * pitch)
-
-    def coverage(half):
-        return np.maximum(_ramp(dx, half, px), _ramp(dy, half, px))
-
-    half = _bisect(lambda h: coverage(h).mean(), 1.0 - direct, 0.0, pitch / 2)
-    c = coverage(half)
-    # over and under: warp i is up where it crosses weft j with (i//g + j//g) even
-    phase_warp = math.pi * (y / (group * pitch) - 0.5 / group) + math.pi * np.floor(i / group)
-    phase_weft = math.pi * (x / (group * pitch) - 0.5 / group) + math.pi * np.floor(j / group)
-    warp_centre = 0.5 + 0.3 * np.cos(phase_warp)
-    weft_centre = 0.5 - 0.3 * np.cos(phase_weft)
-    hw = max(half, 1e-9)
-    warp_h = (warp_centre + 0.2 * np.sqrt(np.clip(1 - (dx / hw) ** 2, 0, 1))) * _ramp(dx, half, px)
-    weft_h = (weft_centre + 0.2 * np.sqrt(np.clip(1 - (dy / hw) ** 2, 0, 1))) * _ramp(dy, half, px)
-    height = np.maximum(warp_h, weft_h)
-    return c, np.clip(height, 0, 1), (r, r), {"yarn_mm": round(2 * half * 1e3, 4),
-                                              "height_m": round(half, 8)}
-
-
-def damask_pattern(p, direct):
-    pitch = p["pitch_mm"] * 1e-3
-    r = p["threads"] * pitch
-    n = p["size"]
-    x, y = _grid(n, n, r, r)
-    px = r / n
-    radius = p["medallion_mm"] * 1e-3
-    motif = np.full(x.shape, np.inf)
-    for cx in (0.0, r / 2, r):
-        for cy in (0.0, r / 2, r):
-            if (cx == r / 2) != (cy == r / 2):
-                continue
-            dx, dy = x - cx, y - cy
-            rr = np.hypot(dx, dy)
-            theta = np.arctan2(dy, dx)
-            shape = radius * (0.6 + 0.4 * np.cos(4 * theta)) * (1.0 - 0.25 * np.cos(8 * theta))
-            motif = np.minimum(motif, rr - shape)
-    in_motif = _ramp(motif, 0.0, px)                  # 1 in the medallion (weft-faced twill)
-    i = np.floor(x / pitch)
-    j = np.floor(y / pitch)
-    # interlacing points: satin (ground) where (2 i - j) mod end == 0 (a sateen step of 2),
-    # twill (motif) where (i + j) mod end == 0; an interstice opens where threads interlace
-    ground_points = np.mod(2 * i - j, p["ground_end"]) == 0
-    motif_points = np.mod(i + j, p["motif_end"]) == 0
-    # an interstice opens where threads interlace: the open area of a region is in proportion
-    # to its interlacings per crossing (1 / end), spread over the crossings' corners so that
-    # the threads show at the thread scale
-    lx = (x / pitch) - i - 0.5
-    ly = (y / pitch) - j - 0.5
-    corner = np.exp(-((np.abs(lx) - 0.5) ** 2 + (np.abs(ly) - 0.5) ** 2) / (2 * 0.25 ** 2))
-    points = (1 - in_motif) * ground_points + in_motif * motif_points
-    density = (1 - in_motif) / p["ground_end"] + in_motif / p["motif_end"]
-    interstice = density * (0.6 + 0.4 * corner) * (0.7 + 0.3 * points)
-
-    def coverage(scale):
-        return 1.0 - np.clip(scale * interstice, 0.0, 0.9)
-
-    scale = _bisect(lambda s: -coverage(s).mean(), -(1.0 - direct), 0.0, 10.0)
-    c = coverage(scale)
-    # floats: warp-faced satin ground shows vertical ridges, the twill motif horizontal ones
-    ridges = (1 - in_motif) * (0.5 + 0.5 * np.cos(2 * math.pi * (x / pitch - 0.5))) \
-        + in_motif * (0.5 + 0.5 * np.cos(2 * math.pi * (y / pitch - 0.5)))
-    height = 0.2 + 0.7 * ridges
-    return c, np.clip(height, 0, 1), (r, r), {"interstice_scale": round(scale, 6),
-                                              "height_m": round(0.5 * pitch, 8)}
 
 
 def make_pattern(name: str, direct: float):
@@ -290,13 +151,7 @@ def make_pattern(name: str, direct: float):
     kind = p["kind"]
     if kind == "lace":
         return lace_pattern(p, direct)
-    if kind == "net":
-        return net_pattern(p, direct)
-    if kind in ("plain", "basket"):
-        return weave_pattern(p, direct, basket=kind == "basket")
-    if kind == "damask":
-        return damask_pattern(p, direct)
-    raise ValueError(f"unknown pattern kind {kind!r}")
+    return make_structure(p, direct)   # net, plain, basket, damask
 
 
 def pattern_table(name: str, repeat) -> dict:

@@ -53,7 +53,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--pattern", metavar="IMAGE",
                         help="the fabric's pattern: a grey tileable coverage image (1 = thread), "
                              "remapped to the fitted open area and written beside the preset as "
-                             "patterns/NAME.png with a [pattern] table (needs --pattern-repeat)")
+                             "patterns/NAME.png with a [pattern] table (needs --pattern-repeat); "
+                             "default: the weave's own structure at the fitted open area (a tulle "
+                             "net for a lace, a plain weave, a twill or a satin)")
     parser.add_argument("--pattern-repeat", metavar="W[,H]",
                         help="the pattern image's size on the cloth, m (one number: the width, "
                              "the height by the pixel aspect)")

@@ -61,14 +61,18 @@ def fit_preset(args, started_s: float) -> dict:
     # (catalog.presets.bundle, catalog.core.atomic.commit_together)
     from catalog.core.atomic import commit_together  # noqa: PLC0415
 
-    pattern = _fitted_pattern(args, doc) if getattr(args, "pattern", None) else None
+    pattern = _fitted_pattern(args, doc) if getattr(args, "pattern", None) else _weave_pattern(doc)
     with tempfile.TemporaryDirectory() as scratch:
-        if pattern is not None:  # drawn once, then bundled like every other file it names
-            from catalog.presets.patterns import write_pattern_images
+        # drawn once, then bundled like every other file it names
+        from catalog.presets.patterns import write_pattern_images
 
-            drawn = Path(scratch) / Path(doc["pattern"]["coverage"]).name
-            write_pattern_images(pattern, drawn, None)
-            doc["pattern"]["coverage"] = str(drawn)
+        drawn = Path(scratch) / Path(doc["pattern"]["coverage"]).name
+        drawn_height = None
+        if pattern.height is not None:
+            drawn_height = Path(scratch) / Path(doc["pattern"]["height"]).name
+            doc["pattern"]["height"] = str(drawn_height)
+        write_pattern_images(pattern, drawn, drawn_height)
+        doc["pattern"]["coverage"] = str(drawn)
         with commit_together(), staged_folder(out.parent) as stage:
             staged = stage / out.name
             bundle_files(doc, staged, lambda _key, value: out.parent / value,
@@ -109,6 +113,22 @@ def _fitted_pattern(args, doc):
     doc["pattern"] = {"coverage": rel, "repeat_m": [round(v, 8) for v in pattern.repeat_m],
                       "kind": "image"}
     return replace(pattern, coverage=coverage, height=None)
+
+
+def _weave_pattern(doc):
+    """Without ``--pattern``: the default structure of the fabric's weave
+    (catalog.presets.weave_patterns.default_pattern: a tulle net for a lace, a plain weave
+    for a voile or a plain cloth, a twill or a satin) at the fitted open area, named in
+    ``doc``'s [pattern] table (patterns/NAME.png and NAME-height.png beside the preset).
+    Returns the pattern to write (16-bit values, as the files will hold)."""
+    from catalog.presets.patterns import Pattern, quantise16  # noqa: PLC0415
+    from catalog.presets.weave_patterns import default_pattern  # noqa: PLC0415
+
+    name = doc["name"]
+    coverage, height, repeat, info = default_pattern(doc["cloth"]["weave"], doc["btdf"]["direct"])
+    doc["pattern"] = {"coverage": f"patterns/{name}.png", "height": f"patterns/{name}-height.png",
+                      "repeat_m": [round(v, 8) for v in repeat], **info}
+    return Pattern(quantise16(coverage), quantise16(height), tuple(repeat), info["height_m"], name)
 
 
 #: The fit's progress (its starts) shows only when the fit has taken this long (s): it
