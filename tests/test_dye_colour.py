@@ -124,3 +124,28 @@ def test_the_frame_passes_the_rooms_and_folds_light_by_the_secondary_dye(gl):
     r.release()
 
 
+
+
+def test_an_ill_conditioned_channel_keeps_the_fallback():
+    """Under the HP1 sodium lamp the light's linear-sRGB blue is a near-cancellation of the
+    colour-matching lobes (a few 1e-6 of its largest channel); sheer-teal's dye made the ratio
+    there about -1.4e4, which sent rare huge sparkles through the RGB reference. That channel
+    now keeps the fallback; the well-conditioned channels keep the exact ratio, and a dye's
+    ordinary out-of-gamut channels (sheer-teal's green under D65, 1.42) are untouched."""
+    from catalog.optics.lights import get_light
+    from catalog.presets import find_preset, load_preset
+    from catalog.render import scene as scene_lib
+
+    teal = scene_lib.dye_transmittance(load_preset(find_preset("sheer-teal")))
+    sodium = get_light("HP1").irradiance_w_m2_nm
+    light = dye_colour._rgb(sodium)
+    dyed = dye_colour._rgb(sodium * teal)
+    ours = dye_colour.dye_rgb_under(sodium, teal, (7.0, 8.0, 9.0))
+    bad = np.abs(dyed) > dye_colour.MAX_CHANNEL_RATIO * np.abs(light)
+    assert bad.any()                                   # the case this guards exists
+    assert np.all(np.abs(ours) <= dye_colour.MAX_CHANNEL_RATIO)
+    np.testing.assert_array_equal(ours[bad], np.array([7.0, 8.0, 9.0])[bad])
+    np.testing.assert_allclose(ours[~bad], dyed[~bad] / light[~bad], rtol=1e-12)
+    d65 = get_light("D65").irradiance_w_m2_nm
+    np.testing.assert_allclose(dye_colour.dye_rgb_under(d65, teal, np.ones(3)),
+                               dye_colour._rgb(d65 * teal) / dye_colour._rgb(d65), rtol=1e-12)

@@ -33,6 +33,13 @@ import numpy as np
 #: A channel whose secondary light is below this fraction of the largest channel's keeps the
 #: key's dye (the ratio of two numbers near 0 says nothing).
 NEGLIGIBLE_CHANNEL = 1e-6
+#: A channel whose dyed light exceeds the undyed by more than this factor keeps the fallback:
+#: a transmittance <= 1 cannot raise a light's channel that far unless the channel is a
+#: near-cancellation of the colour-matching lobes (a sodium lamp's blue, -2.6e-6 of its
+#: largest channel, gave sheer-teal a blue "dye" of -13,903, and rare paths through two
+#: layers of cloth became huge sparkles). Saturated dyes stay well inside it (sheer-teal's
+#: green under D65 is 1.42, safety-yellow's blue -0.04).
+MAX_CHANNEL_RATIO = 10.0
 
 
 def _rgb(spectrum: np.ndarray) -> np.ndarray:
@@ -43,10 +50,12 @@ def _rgb(spectrum: np.ndarray) -> np.ndarray:
 
 def dye_rgb_under(spectrum: np.ndarray, dye: np.ndarray, fallback) -> np.ndarray:
     """RGB(spectrum x dye) / RGB(spectrum) per linear sRGB channel, ``fallback`` (3,) where the
-    spectrum's channel is negligible (NEGLIGIBLE_CHANNEL of its largest magnitude)."""
+    spectrum's channel is negligible (NEGLIGIBLE_CHANNEL of its largest magnitude) or the ratio
+    ill-conditioned (beyond MAX_CHANNEL_RATIO)."""
     light = _rgb(spectrum)
     dyed = _rgb(np.asarray(spectrum, dtype=np.float64) * np.asarray(dye, dtype=np.float64))
-    usable = np.abs(light) > NEGLIGIBLE_CHANNEL * max(float(np.abs(light).max()), 1e-300)
+    usable = ((np.abs(light) > NEGLIGIBLE_CHANNEL * max(float(np.abs(light).max()), 1e-300))
+              & (np.abs(dyed) <= MAX_CHANNEL_RATIO * np.abs(light)))
     return np.where(usable, dyed / np.where(usable, light, 1.0), np.asarray(fallback, dtype=np.float64))
 
 
