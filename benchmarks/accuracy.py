@@ -7,7 +7,7 @@ user can choose: every catalog fabric; a light family drawn uniformly from :data
 (the sun by hour 6-20 h, the sun by path, CIE illuminants, LEDs, the UV and violet lamps) and a
 light within it; the camera's yaw, pitch and distance over the viewer's range on the room side
 (:data:`YAW_RANGE_DEG`, :data:`PITCH_RANGE_DEG`, the distance log-uniform from 0.3 m to the
-room's limit); the room (``box``, the one built-in room of this branch). The curtain is closed:
+room's limit); the room (one of the built-in rooms, :data:`ROOMS`). The curtain is closed:
 ``catalog reference`` has no open curtain, so an open one cannot be judged yet.
 
 For each scene the frame (:class:`catalog.render.frame.FrameRenderer`, the linear radiance
@@ -55,8 +55,9 @@ import numpy as np
 #: Seeds: choose on TUNE_SEED, report on REPORT_SEED (fixed before the report was run).
 TUNE_SEED = 1
 REPORT_SEED = 33033
-#: Rooms this bench knows (the built-in rooms of this branch).
-ROOMS = ("box",)
+#: Rooms this bench draws among (the built-in rooms, catalog.room.load.BUILTIN_ROOMS), each
+#: drawn in the frame by its transport and in the reference from the same file.
+ROOMS = ("box", "living", "bedroom")
 SIZE = (160, 90)
 QUICK_SIZE = (64, 36)
 #: The noise rule: a scene's reference is rendered in rounds (the first of START_SPP, each
@@ -333,8 +334,11 @@ def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5,
     light = get_light(scene["light"])
     cam = scene["camera"]
     desc = describe_scene(preset, light, size=tuple(size), yaw_deg=cam["yaw_deg"],
-                          pitch_deg=cam["pitch_deg"], distance_m=cam["distance_m"])
-    frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=repeats)
+                          pitch_deg=cam["pitch_deg"], distance_m=cam["distance_m"],
+                          room=scene["room"])
+    # the frame as ``catalog snapshot --room ROOM`` draws it: the room lit by its transport
+    frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=repeats,
+                         room=scene["room"])
     scene["_desc"] = desc
     halves, rounds = adaptive_reference(scene, size, frame["linear"], own, min(start_spp, spp), spp, budget_s)
     scene.pop("_desc")

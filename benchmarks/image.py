@@ -181,7 +181,8 @@ def _reference_in_child(fabric: str, light_key: str, view: str, size, spp: int, 
 
 def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
                  antialiasing: str | None = None, room_lighting: bool | None = None,
-                 repeats: int = 5, shadow_map_size: int | None = None, show: dict | None = None) -> dict:
+                 repeats: int = 5, shadow_map_size: int | None = None, show: dict | None = None,
+                 room: str | None = None) -> dict:
     """The real-time frame at desc.size: ``linear`` radiance (H, W, 3), ``display`` (the
     frame's own display image, sRGB in [0, 1]), the ``exposure`` and ``white_balance`` its
     display step used, and ``seconds``, the median wall time of render + glFinish.
@@ -189,7 +190,9 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
     with the same exposure and white balance, no glare); ``antialiasing`` None keeps the
     default. ``show``: other radiance images (name -> (H, W, 3)), returned under ``shown``
     as the frame's own display step shows them (FrameRenderer.display_of: its glare, exposure
-    and tone curve; the supersampled frame's: metrics.display)."""
+    and tone curve; the supersampled frame's: metrics.display). ``room``: a built-in room or
+    a .glb drawn by its transport, as ``catalog snapshot --room`` (None: the box's
+    special-case light)."""
     from catalog.pathtrace import metrics  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
@@ -203,6 +206,8 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
             renderer.update(room_lighting=room_lighting)
         if shadow_map_size is not None:
             renderer.update(shadow_map_size=shadow_map_size)
+        if room is not None:
+            renderer.update(room=room)
         cam = desc.info["camera"]
         renderer.update(camera=orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"]))
         renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)

@@ -37,6 +37,10 @@ def test_draw_is_seeded_and_covers_the_space():
         assert accuracy.PITCH_RANGE_DEG[0] <= cam["pitch_deg"] <= accuracy.PITCH_RANGE_DEG[1]
         assert accuracy.DISTANCE_MIN_M * 0.999 <= cam["distance_m"] <= 12.0
         assert scene["room"] in accuracy.ROOMS
+    from catalog.room.load import BUILTIN_ROOMS
+
+    assert set(accuracy.ROOMS) == set(BUILTIN_ROOMS)          # every built-in room is drawn
+    assert {s["room"] for s in first} == set(BUILTIN_ROOMS)
 
 
 def test_the_image_benchs_scenes_are_named_cases():
