@@ -240,6 +240,7 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
                                       distance_m=task.distance_m, exposure=task.exposure,
                                       room=task.room)
             configure_renderer(renderer, request, preset, lights[image.light])
+            renderer.display.forget_white()   # each image adapts to its own view, as a snapshot
             if image is by_frame[frame][0]:
                 # once a frame: a new mesh makes the room's light be drawn again, which the
                 # frame's other lights and yaws need not pay (its key holds the light; the

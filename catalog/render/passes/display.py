@@ -52,6 +52,11 @@ class DisplayPass(Pass):
                 adaptation_lib.degree_of_adaptation()))
         return self._wb_cache[1]
 
+    def forget_white(self) -> None:
+        """Measure the white again at the next frame, from its view (a still image adapts to
+        its own view, as ``catalog snapshot`` does; the viewer keeps the white while orbiting)."""
+        self._wb_cache = None
+
     def display_uniforms(self) -> dict:
         return display_lib.shader_uniforms(self.exposure_scale(), self.white_balance_matrix())
 
