@@ -26,7 +26,7 @@ echo "wheel_check: fit"
 cp "$ROOT/fabrics/measurements/voile-white/gonio.csv" gonio.csv
 "$CATALOG" fit --gonio gonio.csv --name my-voile --out my-voile.toml --json > fit.json
 echo "wheel_check: sheet (the built-in catalog and the user's folder)"
-mkdir -p mine && cp my-voile.toml mine/
+mkdir -p mine && cp -r my-voile.toml my-voile mine/   # a preset travels with its folder (its pattern)
 "$CATALOG" sheet --lights D65 --fabric lace-fwa,my-voile --fabrics mine --size 48x36 --out sheet --json > sheet.json
 echo "wheel_check: view --frames under Xvfb"
 xvfb-run -a "$CATALOG" view --frames 2 --size 160x120 --grid 12x16 --cloth-backend numpy \
