@@ -193,6 +193,7 @@ def _setters_by_name(tree) -> list[int]:
             and (ast.unparse(node.args[1]).lstrip("f").strip("'\"").startswith("set_"))]
 
 
+@pytest.mark.slow   # builds a frame renderer and walks its methods (about 1.1 s)
 def test_the_frame_has_no_ablation_switches():
     """FrameRenderer has no setter but the geometry's (FRAME_SETTERS: a user's choices are
     its FrameSettings), and no module picks a setter by its name (the image bench's

@@ -232,6 +232,7 @@ def test_simulate_refuses_bad_options(tmp_path, capsys, option, draw):
              capsys, tmp_path, [out])
 
 
+@pytest.mark.slow   # each example resolves the whole catalog and the sheet's room (1.3 s)
 @SETTINGS
 @given(option=st.sampled_from(["--size", "--lights", "--bands"]), draw=st.data())
 def test_sheet_refuses_bad_options(tmp_path, capsys, option, draw):

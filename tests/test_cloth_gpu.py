@@ -66,6 +66,7 @@ def test_the_windless_drape_sleeps_on_the_gpu_within_five_seconds(gl):
     assert sim.run(10, 1 / 60) == 10 and not sim.sleeping
 
 
+@pytest.mark.slow   # a GPU cloth and its buffers (about 0.8 s)
 def test_vertex_buffer_holds_the_mesh(gl):
     _, gpu = _pair(gl, opening=0.6, wind_speed_m_s=1.0)
     gpu.run(10, 1 / 30)
