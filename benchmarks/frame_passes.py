@@ -142,28 +142,12 @@ def markdown_tables(result: dict) -> dict[str, str]:
     return {"frame_passes": head + "\n".join(lines) + foot}
 
 
-def main() -> int:
-    import argparse  # noqa: PLC0415
-    import json  # noqa: PLC0415
-    from pathlib import Path  # noqa: PLC0415
+def main(argv: list[str] | None = None) -> int:
+    import sys  # noqa: PLC0415
 
-    from catalog.core.atomic import write_text_atomic  # noqa: PLC0415
-    from catalog.core.resources import PROJECT_ROOT  # noqa: PLC0415
+    from benchmarks.results import sized_study_main  # noqa: PLC0415
 
-    parser = argparse.ArgumentParser(description="the display step and glare in the static frame")
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES))
-    parser.add_argument("--json-out", type=Path, default=PROJECT_ROOT / RESULT_JSON)
-    args = parser.parse_args()
-    try:
-        sizes = [tuple(int(v) for v in s.lower().split("x")) for s in args.sizes.split(",")]
-    except ValueError:
-        parser.exit(2, f"frame_passes: --sizes: {args.sizes!r} is not WxH[,WxH...]\n")
-    result = run(quick=args.quick, sizes=sizes)
-    print(markdown_tables(result)["frame_passes"])
-    write_text_atomic(args.json_out, json.dumps(result, indent=1) + "\n")
-    print(f"wrote {args.json_out}")
-    return 0
+    return sized_study_main(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":

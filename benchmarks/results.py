@@ -150,3 +150,25 @@ def study_main(module, argv: list[str] | None = None, make_result=None,
         print(f"<!-- generated:{name} -->\n{text}\n<!-- /generated:{name} -->\n")
     print(f"wrote {args.json_out}")
     return 0
+
+
+def sized_study_main(module, argv: list[str] | None = None) -> int:
+    """:func:`study_main` for a study run at frame sizes: ``--quick`` and ``--sizes WxH[,WxH..]``
+    (default the module's DEFAULT_SIZES), then ``module.run(quick=, sizes=)``."""
+    def add_arguments(parser) -> None:
+        parser.add_argument("--quick", action="store_true", help="fewer cases and repeats")
+        parser.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in module.DEFAULT_SIZES),
+                            help="frame sizes, WxH[,WxH..]")
+
+    def make_result(args) -> dict:
+        from catalog.core.errors import InputError  # noqa: PLC0415
+
+        try:
+            sizes = [tuple(int(v) for v in s.lower().split("x")) for s in args.sizes.split(",")]
+        except ValueError:
+            raise InputError(f"{args.sizes!r} is not WxH[,WxH...]", field="--sizes") from None
+        if not all(len(size) == 2 for size in sizes):
+            raise InputError(f"{args.sizes!r} is not WxH[,WxH...]", field="--sizes")
+        return module.run(quick=args.quick, sizes=sizes)
+
+    return study_main(module, argv, make_result=make_result, add_arguments=add_arguments)
