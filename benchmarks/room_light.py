@@ -32,23 +32,10 @@ def git_commit() -> str:
 def frame_linear(ctx, desc, preset, light, room: str | None, repeats: int = 3) -> tuple[np.ndarray, float]:
     """The frame's linear radiance as benchmarks.image.frame_images draws it, in ``room``
     (None: the box's special-case light), and its median render time (s)."""
-    from benchmarks.timing import median_wall_and_cpu  # noqa: PLC0415
-    from catalog.render.frame import FrameRenderer  # noqa: PLC0415
-    from catalog.render.settings import orbit  # noqa: PLC0415
+    from benchmarks.image import frame_images  # noqa: PLC0415
 
-    renderer = FrameRenderer(ctx, desc.size)
-    try:
-        renderer.update(fabric=preset, light=light, fluorescence="physical", bands=3)
-        if room is not None:
-            renderer.update(room=room)
-        cam = desc.info["camera"]
-        renderer.update(camera=orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"]))
-        renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
-        renderer.set_rings(list(desc.ring_xs_m))
-        wall, _cpu = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)
-        return renderer.read_linear(), wall
-    finally:
-        renderer.release()
+    frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=repeats, room=room)
+    return frame["linear"], frame["seconds"]
 
 
 def cached_reference(acc, scene, size, spp, own, cache_dir):
