@@ -14,10 +14,8 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
 import subprocess
 import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -322,15 +320,10 @@ def save(bundle: RoomOperators, path: Path, key: str) -> None:
             "patches": list(bundle.patches), "order": bundle.order, "side_grid": list(bundle.side_grid),
             "surfaces": [s.name for s in bundle.surfaces]}
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
-    os.close(fd)
-    try:
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+
+    with atomic_path(path) as tmp:   # the project's atomic write (its temporaries, signals)
         np.savez(tmp, **arrays)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
 
 
 def load(path: Path, key: str) -> RoomOperators | None:

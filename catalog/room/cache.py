@@ -12,7 +12,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -53,14 +52,10 @@ def save(transport: Transport, path: Path, key: str) -> None:
     arrays["window_normal"] = transport.window.normal
     meta = {"key": key, "params": transport.params.key(), "timings_s": transport.timings_s}
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
-    os.close(fd)
-    try:
+    from catalog.core.atomic import atomic_path  # noqa: PLC0415
+
+    with atomic_path(path) as tmp:   # the project's atomic write (its temporaries, signals)
         np.savez(tmp, **arrays)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
 
 
 def load(path: Path, key: str) -> Transport | None:
