@@ -124,3 +124,41 @@ def test_the_frame_and_the_path_tracer_draw_one_value(gl):
                 np.testing.assert_array_equal(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
     finally:
         r.release()
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_a_web_scene_is_resolved_once_and_drawn_with_each_switch(gl, monkeypatch):
+    """The web export makes one value per fabric and light (SiteExporter.scene); recording
+    its switches resolves no name again (the light library and the preset reader patched
+    to fail) and both frames draw that value's own fabric and key light, differing from it
+    only in the switches, the exposure and the recording frame's camera."""
+    from catalog.optics import lights
+    from catalog.presets import fabric as fabric_lib
+    from catalog.render import settings as settings_lib
+    from catalog.render import scene as scene_lib
+    from catalog.web import export
+
+    exporter = export.SiteExporter(gl)
+    try:
+        d = scene_lib.draped_curtain(12, 8)
+        exporter.use_mesh(d.positions, d.normals, d.uvs, d.tangents, d.indices)
+        choice = export.LightChoice(id="sun@10", label="sun at 10 h", kind="sun", hour=10.0)
+        scene = exporter.scene(settings_lib.FrameSettings(fabric="voile-white").fabric, choice)
+
+        def refuse(*args, **kw):
+            raise AssertionError("a name resolved again while recording")
+
+        monkeypatch.setattr(lights, "get_light", refuse)
+        monkeypatch.setattr(fabric_lib, "_dye", refuse)
+        metered = exporter.record(scene, "on")
+        exporter.record(scene, "off", ev100=metered["ev100"], glare="on")
+        for frame in (exporter.meter, exporter.renderer):
+            assert frame.settings.fabric is scene.fabric
+            assert frame.settings.resolved_fabric is scene.resolved_fabric
+            np.testing.assert_array_equal(frame.settings.key_to_light, scene.key_to_light)
+        assert exporter.renderer.settings.ev == pytest.approx(metered["ev100"])
+        assert settings_lib.changed(scene, exporter.renderer.settings) == {"fluorescence", "bloom", "ev"}
+        assert settings_lib.changed(scene, exporter.meter.settings) == set()
+    finally:
+        exporter.release()

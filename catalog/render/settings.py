@@ -257,17 +257,30 @@ def _resolve_light(light):
         return None, None, (scene_lib.LAMP_ELEVATION_DEG, scene_lib.KEY_AZIMUTH_DEG)
     if isinstance(light, SunHour):
         try:
-            sun = scene_lib.sun_at_hour(float(light.hour))
+            hour = float(light.hour)
         except (TypeError, ValueError) as exc:
             raise _refuse("light", f"SunHour({light.hour!r}): {exc}") from None
-        except InputError as exc:   # the hour's own field (--hour), as the CLI names it
-            raise SettingsError(exc.problem, field=exc.field or "light") from None
-        return get_light(sun.light_name), sun, (90.0 - sun.zenith_deg, sun.azimuth_deg)
+        return _sun_at(hour)
     if isinstance(light, str):
         light = get_light(light)
     if not isinstance(light, Light):
         raise _refuse("light", f"{light!r}: give a light name, a Light or SunHour(hour)")
     return light, None, (scene_lib.key_elevation_for(light), scene_lib.KEY_AZIMUTH_DEG)
+
+
+@functools.lru_cache(maxsize=64)
+def _sun_at(hour: float) -> tuple:
+    """SunHour(hour) resolved once (a value replaced keeps its sun: the web export draws
+    each hour's scene with eight switches): (its Light, the SunAtHour, (elevation, azimuth))."""
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+
+    try:
+        sun = scene_lib.sun_at_hour(hour)
+    except (TypeError, ValueError) as exc:
+        raise _refuse("light", f"SunHour({hour!r}): {exc}") from None
+    except InputError as exc:   # the hour's own field (--hour), as the CLI names it
+        raise SettingsError(exc.problem, field=exc.field or "light") from None
+    return get_light(sun.light_name), sun, (90.0 - sun.zenith_deg, sun.azimuth_deg)
 
 
 def _environment(path: str) -> tuple:
