@@ -327,15 +327,17 @@ def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5,
     map). ``spp``: the reference's cap (the noise rule: :func:`adaptive_reference`)."""
     from benchmarks.image import frame_images  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace.render import reference_settings  # noqa: PLC0415
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
     preset = load_preset(find_preset(scene["fabric"]))
     light = get_light(scene["light"])
     cam = scene["camera"]
-    desc = describe_scene(preset, light, size=tuple(size), yaw_deg=cam["yaw_deg"],
-                          pitch_deg=cam["pitch_deg"], distance_m=cam["distance_m"],
-                          room=scene["room"])
+    desc = describe_scene(reference_settings(preset, light, yaw_deg=cam["yaw_deg"],
+                                             pitch_deg=cam["pitch_deg"],
+                                             distance_m=cam["distance_m"], room=scene["room"]),
+                          size=tuple(size))
     # the frame as ``catalog snapshot --room ROOM`` draws it: the room lit by its transport
     frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=repeats,
                          room=scene["room"])
@@ -399,6 +401,7 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
     from catalog.pathtrace.render import MAX_DEPTH, region_masks  # noqa: PLC0415
+    from catalog.pathtrace.render import reference_settings  # noqa: PLC0415
     from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
@@ -413,9 +416,11 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
         if "flip_by_region" in row:
             continue
         cam = row["camera"]
-        desc = describe_scene(load_preset(find_preset(row["fabric"])), get_light(row["light"]),
-                              size=tuple(row["size"]), yaw_deg=cam["yaw_deg"], pitch_deg=cam["pitch_deg"],
-                              distance_m=cam["distance_m"])
+        desc = describe_scene(reference_settings(load_preset(find_preset(row["fabric"])),
+                                                 get_light(row["light"]), yaw_deg=cam["yaw_deg"],
+                                                 pitch_deg=cam["pitch_deg"],
+                                                 distance_m=cam["distance_m"]),
+                              size=tuple(row["size"]))
         masks = region_masks(mi, build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH), desc)
         with np.load(Path(rows_out).with_suffix(f".{number:02d}.npz")) as data:
             row["flip_by_region"] = region_flip(data["flip"], masks)

@@ -41,14 +41,17 @@ def main(argv=None) -> int:
     from catalog.core.atomic import atomic_path  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
+    from catalog.pathtrace.render import reference_settings  # noqa: PLC0415
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
     args = list(argv or sys.argv[1:])
     first_seed = int(args.pop()) if len(args) == 11 else 0
     fabric, light, yaw, pitch, distance, width, height, spp, variant, out = args
-    desc = describe_scene(load_preset(find_preset(fabric)), get_light(light), size=(int(width), int(height)),
-                          yaw_deg=float(yaw), pitch_deg=float(pitch), distance_m=float(distance))
+    desc = describe_scene(reference_settings(load_preset(find_preset(fabric)), get_light(light),
+                                             yaw_deg=float(yaw), pitch_deg=float(pitch),
+                                             distance_m=float(distance)),
+                          size=(int(width), int(height)))
     result = render_halves(load_mitsuba(variant), desc, int(spp), first_seed)
     with atomic_path(out) as tmp:
         with open(tmp, "wb") as handle:

@@ -109,23 +109,25 @@ def key_light_for(light) -> tuple[np.ndarray, bool]:
     return scene_lib.key_direction(scene_lib.key_elevation_for(light)), light.is_sun
 
 
-def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: float = 0.0,
-                   pitch_deg: float = 0.0, distance_m: float = 2.6,
-                   fluorescence: str = "physical", curtain=None, room="box") -> SceneDescription:
-    """The snapshot scene for ``preset`` under ``light`` (a catalog.optics.lights.Light) in
-    ``room`` (a loaded catalog.room.model.Room, or a built-in name or .glb path)."""
+def describe_scene(settings, *, size=(256, 192), frame: int = 0, curtain=None) -> SceneDescription:
+    """The scene the real-time frame draws with ``settings`` (a
+    :class:`catalog.render.settings.FrameSettings`: its fabric and Fabric tables, key light
+    and direction, fluorescence mode, camera and room), at ``size``, for the path tracer.
+    The room must be resolved (``settings.room`` a loaded catalog.room.model.Room: the edge
+    loads it, :func:`catalog.pathtrace.render.reference_settings`); nothing is read here.
+    ``curtain``: the cloth's (positions, normals, uvs, tangents, indices[, fabric size]);
+    None: the settled drape after ``frame`` frames, as catalog snapshot draws it."""
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
-    from catalog.render.camera import OrbitCamera  # noqa: PLC0415
 
-    camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                         distance_m=float(distance_m))
-    to_light, is_sun = key_light_for(light)
-    inside = bool(camera.position[2] > scene_lib.WINDOW_Z)
-    # as the frame builds them (FrameRenderer.shading_inputs): a ``sun:PATH_KM`` light is the
-    # paper's beam, whose sky and ground are that beam Rayleigh-scattered (paper_beam)
-    inputs, decision = scene_lib.build_shading_inputs(
-        preset, light.irradiance_w_m2_nm, to_light, is_sun=is_sun, fluorescence=fluorescence,
-        paper_beam=light.sun is not None and light.sun.model == "paper", viewer_inside=inside)
+    room = getattr(settings, "resolved_room", None)
+    if room is None:
+        raise CatalogError("describe_scene draws a resolved room: give FrameSettings whose room "
+                           "is a loaded Room (catalog.pathtrace.render.reference_settings)")
+    preset, light, camera = settings.fabric, settings.key_light, settings.camera
+    is_sun = light.is_sun
+    # the frame's own shading inputs (FrameSettings.shading_inputs: passes/scene_terms.py)
+    inputs, decision = settings.shading_inputs()
     fabric_size = None
     rings: tuple = ()
     if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth
@@ -135,19 +137,13 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         rings = tuple(ring_xs_m(preset))
     elif len(curtain) == 6:
         *curtain, fabric_size = curtain
-    if isinstance(room, (str, bytes)) or hasattr(room, "__fspath__"):
-        from catalog.room.load import load_room  # noqa: PLC0415
-
-        room = load_room(room)
     room_positions, _ = scene_lib.rod_mesh()
     if rings:
         ring_positions, _ = scene_lib.ring_mesh(list(rings))
         room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
                                          np.asarray(ring_positions).reshape(-1, 3)])
     pattern = None
-    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
-
-    loaded = resolve_fabric(preset).pattern
+    loaded = settings.resolved_fabric.pattern
     if loaded is not None:
         cloth_m = fabric_size or (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
         pattern = {"coverage": np.asarray(loaded.coverage, dtype=np.float32),
@@ -172,7 +168,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
     if inputs.fluorescence_mode == "physical":
         from catalog.optics.fluorescence import absorbed_photon_irradiance  # noqa: PLC0415
 
-        material = scene_lib.fluorescent_material(preset)
+        material = scene_lib.fluorescent_material(settings.resolved_fabric)
         outside = math.pi * 0.5 * (inputs.sky_radiance + inputs.ground_radiance)
         fl = {"mode": "physical", "key_photons": float(inputs.absorbed_photons[0]),
               "outside_photons": absorbed_photon_irradiance(material, outside),

@@ -372,25 +372,34 @@ class SiteExporter:
                 renderer.set_rings(rings)
         self._rings = rings
 
-    def record(self, preset, light: LightChoice, fluorescence: str,
-               ev100: float | None = None, glare: str = "off", lamp: str = "none") -> dict:
-        """One scene's structure index and values (indices into :attr:`value_pool`); ``ev100``: its exposure (None: metered by
-        a METER_SIZE desktop frame at the default camera, with the glare and lamp asked)."""
-        for r in (self.meter, self.renderer):
-            r.update(fabric=preset)
-            if light.kind == "sun":
-                r.update(light=SunHour(light.hour))
-            else:
-                r.update(light=light.id)
-            r.update(fluorescence=FLUORESCENCE[fluorescence],
-                     bloom=GLARE[glare],
-                     lamps=room_lamps(lamp))
+    def scene(self, preset, light: LightChoice):
+        """The scene value (:class:`catalog.render.settings.FrameSettings`) of ``preset``
+        under ``light``, resolved once (the fabric's tables, the light or the sun at its
+        hour): the modes the page shows (:data:`DESKTOP_MODES`), the default camera, the
+        desktop's fluorescence, no glare, no lamp. :meth:`record` draws it with each switch."""
+        from catalog.render.settings import FrameSettings  # noqa: PLC0415
+
+        return FrameSettings(
+            fabric=preset, light=SunHour(light.hour) if light.kind == "sun" else light.id,
+            fluorescence=FLUORESCENCE["on"], bloom=GLARE["off"], lamps=room_lamps("none"),
+            patterned=DESKTOP_MODES["patterned"], room_lighting=DESKTOP_MODES["room_lighting"],
+            antialiasing=DESKTOP_MODES["antialiasing"],
+            key_second_layer=DESKTOP_MODES["key_second_layer"])
+
+    def record(self, scene, fluorescence: str, ev100: float | None = None, glare: str = "off",
+               lamp: str = "none") -> dict:
+        """One scene's structure index and values (indices into :attr:`value_pool`): the
+        value :meth:`scene` made, with the page's switches; ``ev100``: its exposure (None:
+        metered by a METER_SIZE desktop frame at the default camera, with the glare and lamp
+        asked)."""
+        scene = scene.replace(fluorescence=FLUORESCENCE[fluorescence], bloom=GLARE[glare],
+                              lamps=room_lamps(lamp))
         if ev100 is None:
-            self.meter.update(ev=None)
+            self.meter.update(scene)   # (the meter stays at the default camera)
             self.meter.render()
             ev100 = self.meter.current_ev100()
         r = self.renderer
-        r.update(ev=ev100)
+        r.update(scene.replace(camera=r.camera, ev=ev100))
         rec = self.ctx.recording
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
         rec.start(dry=True)  # only the commands are kept: no pixels drawn
@@ -453,16 +462,16 @@ class SiteExporter:
                 "u_camera_position": [float(v) for v in r.camera.position],
                 "u_oit_depth_ref": float(r.curtain.oit_depth_reference_m())}
 
-    def check_camera_uniforms(self, preset, light: LightChoice) -> None:
+    def check_camera_uniforms(self, scene) -> None:
         """Refuse a desktop frame whose other uniforms depend on the camera: the page would
         not follow them (it computes only CAMERA_UNIFORMS)."""
         r = self.renderer
         saved = r.camera
         richest = {"glare": "on", "lamp": list(ROOM_LAMPS)[-1]}  # every pass the page has
-        ev100 = self.record(preset, light, "on", **richest)["ev100"]  # one exposure for both
-        first = self.record(preset, light, "on", ev100=ev100, **richest)
+        ev100 = self.record(scene, "on", **richest)["ev100"]  # one exposure for both
+        first = self.record(scene, "on", ev100=ev100, **richest)
         r.update(camera=orbit(saved.yaw_deg + 30.0, saved.pitch_deg + 20.0, saved.distance_m * 0.8))
-        second = self.record(preset, light, "on", ev100=ev100, **richest)
+        second = self.record(scene, "on", ev100=ev100, **richest)
         r.update(camera=saved)
         structure = self.structures[first["structure"]]
         if first["structure"] != second["structure"]:

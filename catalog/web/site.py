@@ -297,7 +297,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             positions, normals, tangents = bake_lib.decode_frame(first, 0)
             exporter.use_mesh(positions, normals, first.uv, tangents, first.indices)
             exporter.use_drape(fabric_animation[presets[0].name])
-            exporter.check_camera_uniforms(presets[0], choices[0])
+            exporter.check_camera_uniforms(exporter.scene(presets[0], choices[0]))
             scenes = {}
             variants = list(itertools.product(export.FLUORESCENCE, export.GLARE,
                                               export.ROOM_LAMPS))
@@ -306,7 +306,8 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                 for preset in presets:
                     exporter.use_drape(fabric_animation[preset.name])
                     for choice in choices:
-                        metered = exporter.record(preset, choice, "on")
+                        scene = exporter.scene(preset, choice)   # resolved once, drawn 8 ways
+                        metered = exporter.record(scene, "on")
                         # the switches keep the exposure metered with fluorescence on, no
                         # glare, no lamp: they show the brightener's, the glare's and the
                         # lamp's light
@@ -315,7 +316,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                                                    lamp)
                             scenes[key] = (
                                 metered if (fluorescence, glare, lamp) == ("on", "off", "none")
-                                else exporter.record(preset, choice, fluorescence,
+                                else exporter.record(scene, fluorescence,
                                                      ev100=metered["ev100"], glare=glare,
                                                      lamp=lamp))
                             bar.advance()
