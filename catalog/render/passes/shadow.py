@@ -102,10 +102,10 @@ class ShadowPass(Pass):
         matrix = room_light.light_view_projection(inputs.key_to_light)
         s(program, "u_light_view_proj", gl_bytes(matrix))
         metre = self.frame.terms.key_depth_per_metre(inputs)
-        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels)
+        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.frame.room_targets.key_texels)
         s(program, "u_key_depth_bias", (KEY_SHADOW_BIAS_M * metre, slope_m * metre, KEY_SHADOW_SLOPE_CAP))
         s(program, "u_key_normal_offset", KEY_SHADOW_NORMAL_OFFSET_TEXELS
-          * room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))
+          * room_light.shadow_texel_m(inputs.key_to_light, self.frame.room_targets.key_texels))
         wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
         z0 = scene_lib.ROOM_BOX[2][0]
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
@@ -271,7 +271,7 @@ class ShadowPass(Pass):
         """The key light's front-layer map (curtain.frag KEY_SHADOW): per texel the layer of
         cloth nearest the light, its transmittance (as the room's map, one layer) and depth."""
         mgl, gl = self.mgl, self.frame.room_targets.get()
-        n = self.frame.shadow_texels
+        n = self.frame.room_targets.key_texels
         gl["key_front_fbo"].use()
         self.ctx.viewport = (0, 0, n, n)
         gl["key_front_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
