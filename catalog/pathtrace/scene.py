@@ -468,13 +468,16 @@ def _window_area_m2(desc: SceneDescription) -> float:
 
 
 def room_surface_bsdf(mi, surface) -> object:
-    """A room surface's Lambertian BSDF: its factor, times its texture (linear) where it has one."""
+    """A room surface's Lambertian BSDF: its factor, times its texture (linear) where it has one.
+    A spectral variant upsamples the texture's linear RGB to spectra (``raw`` off: a float
+    bitmap is linear, no transfer curve is applied); an RGB variant reads it as it is."""
     if surface.texture is None:
         return mi.load_dict({"type": "diffuse", "reflectance": {
             "type": "rgb", "value": [float(v) for v in surface.factor]}})
     albedo = np.ascontiguousarray(surface.texture * surface.factor[None, None, :], dtype=np.float32)
     return mi.load_dict({"type": "diffuse", "reflectance": {
-        "type": "bitmap", "bitmap": mi.Bitmap(albedo), "raw": True, "filter_type": "bilinear",
+        "type": "bitmap", "bitmap": mi.Bitmap(albedo), "raw": "spectral" not in mi.variant(),
+        "filter_type": "bilinear",
         "wrap_mode": "repeat"}})
 
 
