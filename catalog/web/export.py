@@ -87,10 +87,11 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: pixels of 19 200 in the fluoro-pink D65 scene (182 with one layer), over the 1 % the
 #: browser test allows (web/browser.py); the peel's slope taken from the normal instead of
 #: depth derivatives gave 194 too. Not yet understood; the page keeps the one-layer shadow.
-#: ``pattern_prefilter``: off: the page builds the pattern's mips with
-#: generateMipmap (the box chain), not yet the desktop's prefiltered levels (level writes).
+#: The pattern's prefiltered mip levels (catalog.presets.patterns.mip_chain) travel with its
+#: texels (given_texels) and the page writes them over its generateMipmap chain, as the desktop
+#: writes them over its built one.
 DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa",
-                 "key_second_layer": False, "pattern_prefilter": False}
+                 "key_second_layer": False}
 
 
 def configure_desktop_frame(renderer) -> None:
@@ -99,7 +100,6 @@ def configure_desktop_frame(renderer) -> None:
                     room_lighting=DESKTOP_MODES["room_lighting"],
                     antialiasing=DESKTOP_MODES["antialiasing"],
                     key_second_layer=DESKTOP_MODES["key_second_layer"])
-    renderer.fabric_pattern.set_prefilter(DESKTOP_MODES["pattern_prefilter"])
 #: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
 #: the page shows each scene at the EV100 a desktop frame of this size meters at the default
 #: camera (fixed while orbiting, like a photograph's), recorded as an ordinary uniform. The
@@ -269,8 +269,8 @@ def _b64(data: bytes) -> str:
 #: greatest value, so the error is at most (hi - lo) / (2 (2^bits - 1)) per texel. 8 bits:
 #: a quarter of the float32 bytes; the browser test's frames still match the EGL frame
 #: (fluoro-pink under D65: mean 0.046/255 against 0.025/255 at 16 bits, no pixel off but
-#: one-pixel edge shifts). The page decodes them to float32 and builds the mipmaps itself,
-#: as the desktop frame does.
+#: one-pixel edge shifts). The page decodes them to float32, builds the mipmaps and writes
+#: the prefiltered levels given over them, as the desktop frame does.
 TEXEL_BITS = 8
 
 
@@ -299,6 +299,23 @@ def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
     return {"data": _b64(encoded),
             "quantised": {"bits": bits, "lo": [float(v) for v in lo],
                           "hi": [float(v) for v in lo + span], "planar": True}}
+
+
+def given_texels(rec, rid: int) -> dict:
+    """The page's entry for the texels the frame gave texture ``rid`` (none: {}): level 0 and
+    the mip levels it wrote over its built chain (the pattern's prefiltered levels 1..n, each
+    w >> k by h >> k), in one quantised block, and ``levels``: n."""
+    if rid not in rec.texture_data:
+        return {}
+    given = rec.texture_levels.get(rid, {})
+    levels = 0
+    while levels + 1 in given:
+        levels += 1
+    if len(given) != levels:
+        raise CatalogError("the web page replays only mip levels 1..n given in order")
+    data = rec.texture_data[rid] + b"".join(given[k] for k in range(1, levels + 1))
+    entry = encode_texels(data, rec.textures[rid])
+    return {**entry, "levels": levels} if levels else entry
 
 
 def decode_texels(texture: dict) -> np.ndarray:
@@ -427,14 +444,18 @@ class SiteExporter:
 
     def _encode_given_texels(self) -> None:
         """Move the texels frames have given (Recording.texture_data) into :attr:`_texels` in
-        the page's form; the recording keeps an empty :class:`_EncodedTexels` in their place
-        (still "given": the recording replays no mipmap command for it). A texture written
-        again holds bytes again and is encoded again."""
-        given = self.ctx.recording.texture_data
-        for rid, data in given.items():
+        the page's form, with the mip levels written over them (:func:`given_texels`); the
+        recording keeps an empty :class:`_EncodedTexels` in their place (still "given": the
+        recording replays no mipmap command for it). A texture written again holds bytes again
+        and is encoded again; a level written after its texels were encoded is refused
+        (catalog.web.record)."""
+        rec = self.ctx.recording
+        for rid, data in rec.texture_data.items():
             if not isinstance(data, _EncodedTexels):
-                self._texels[rid] = encode_texels(data, self.ctx.recording.textures[rid])
-                given[rid] = _EncodedTexels()
+                # level 0 and the prefiltered levels the frame wrote after it (one block)
+                self._texels[rid] = given_texels(rec, rid)
+                rec.texture_data[rid] = _EncodedTexels()
+                rec.texture_levels.pop(rid, None)
 
     def _page_texels(self, rid: int) -> dict:
         """The texels of texture ``rid`` in the page's form ({} when no frame gave any)."""
