@@ -185,7 +185,7 @@ def _reference_in_child(fabric: str, light_key: str, view: str, size, spp: int, 
 def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: int = 1,
                  antialiasing: str | None = None, room_lighting: bool | None = None,
                  repeats: int = 5, shadow_map_size: int | None = None, show: dict | None = None,
-                 room: str | None = None) -> dict:
+                 room: str = "box") -> dict:
     """The real-time frame at desc.size: ``linear`` radiance (H, W, 3), ``display`` (the
     frame's own display image, sRGB in [0, 1]), the ``exposure`` and ``white_balance`` its
     display step used, and ``seconds``, the median wall time of render + glFinish.
@@ -194,8 +194,7 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
     default. ``show``: other radiance images (name -> (H, W, 3)), returned under ``shown``
     as the frame's own display step shows them (FrameRenderer.display_of: its glare, exposure
     and tone curve; the supersampled frame's: metrics.display). ``room``: a built-in room or
-    a .glb drawn by its transport, as ``catalog snapshot --room`` (None: the box's
-    special-case light)."""
+    a .glb drawn by its transport, as ``catalog snapshot --room``."""
     from catalog.pathtrace import metrics  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 

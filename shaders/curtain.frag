@@ -140,48 +140,28 @@ float g_second_coverage = 0.0;     // coverage of a second layer in front (0: no
 const float g_second_coverage = 0.0;
 #endif
 #ifdef ROOM_SIDE
-// The curtain's room side lit by the room's own light (issue 11, fourth round), not by the
-// stand-ins (the fill light and the room's share of the ambient term, which frame.py then
-// leaves out: scene.with_room_solved), and the cloth by its own folds; curtain.vert reads the
-// light per vertex (it varies over the room's grid and the captures' patches, 16 cm apart):
+// The curtain's room side lit by the room's own light, not by the stand-ins (the fill light
+// and the room's share of the ambient term, which frame.py then leaves out:
+// scene.with_room_solved), and the cloth by its own folds, all from the room's transport
+// (catalog/render/passes/room_transport_light.py); curtain.vert reads the light per vertex:
 // v_room_side_light, the irradiance on the room side, scattered back towards the viewer by
 // the lobes' backward factors as the room's share of eq. 8's ambient term is
 // (u_room_side_reflectance: dye (a_diff backward(g_diff) + a_spec backward(g_spec)) in display
-// RGB, the radiosity's curtain reflectance) at the view's ratio g_view_room; and
-// v_window_side_light, the radiance of the folds in front of the window side, passed towards
-// the viewer by both lobes over the hemisphere's share they hide (g_occlusion), the share
-// the outside's term takes away for both lobes (issue 11, sixth round: with the directional
-// lobe's share taken where the folds hide the view's continuation alone, the lace's shadowed
-// flanks under the UV lamp were 0.83-0.85x the path tracer's on a drape and views outside
-// the bench; with the hemisphere's, 0.87-0.91x). RGB like the room's light, so added after
-// the bands' conversion.
+// RGB) at the view's ratio g_view_room; and v_window_side_light, the mean radiance of the
+// cloth's window side, passed towards the viewer by both lobes over the hemisphere's share
+// the folds hide (g_occlusion), the share the outside's term takes away for both lobes. RGB
+// like the room's light, so added after the bands' conversion.
 INTERPOLATION in vec3 v_room_side_light;
 INTERPOLATION in vec3 v_window_side_light;
 INTERPOLATION in float v_view_occlusion;
 uniform vec3 u_room_side_reflectance;
 uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
 uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
-#if defined(WALL_LIGHT) || defined(WALL_GRID)
-INTERPOLATION in vec3 v_wall_light;   // curtain.vert: the wall and its reveals, each lobe's share passed
+#ifdef WALL_GRID
+INTERPOLATION in vec3 v_wall_light;   // curtain.vert: the wall and its reveals, both lobes' share passed
 #endif
 #endif
 float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own folds (SKY_OCCLUSION)
-#ifdef FOLDS_BEHIND
-// The room's window capture (issue 11, sixth round; with ROOM_SIDE and OCCLUSION_MAPS): the
-// share of the view's continuation that a fold hides, set in main. Through the holes (LD) the
-// capture then sees that fold's window side (the window-side capture at the patch) where it
-// saw the outside. The frame's own patterned curtain composites the folds behind (OIT), but
-// the capture draws the flat cloth: from the side eyes, looking across the folds, the holes
-// of a safety-yellow mesh (LD 0.36) show the glowing folds behind, and without them the
-// capture was 0.55x the path tracer's radiance there.
-float g_fold_behind = 0.0;
-#else
-const float g_fold_behind = 0.0;
-#endif
-#ifdef ROOM_CAPTURE
-uniform float u_capture_thread;    // the key a thread passes, a_spec forward(g_spec) / (1 - LD)
-float g_key_reach = 1.0;           // set in main: see out_radiance.a below
-#endif
 #ifdef SKY_OCCLUSION
 // The outside hidden by the cloth's own folds and by the window wall (issue 11, model.md
 // section 9), per vertex (curtain.vert) and interpolated: the ambient term loses that
@@ -232,13 +212,10 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
     band += bg.x * outside;
     constant += u_direct * u_room[k];
 #elif defined(SEE_THROUGH)
-    // FOLDS_BEHIND (the room's window capture): where a fold hides the view's continuation, the
-    // holes show that fold (main adds it), not the outside; the room's share stays 1 - bg.x.
-    // Elsewhere g_fold_behind is the constant 0 and this is the plain see-through.
     vec4 outside = bg.y * (u_direct * (u_sky[k] - u_ground[k]) + bg.z * (u_direct * u_sun_disc[k]))
                  + u_direct * (u_ground[k] - u_room[k]);
-    band += (bg.x * (1.0 - g_fold_behind)) * outside;
-    constant += (u_direct * (1.0 - bg.x * g_fold_behind)) * u_room[k];
+    band += bg.x * outside;
+    constant += u_direct * u_room[k];
 #endif
     band += constant;
 #ifdef FLUORESCENCE_PHYSICAL
@@ -289,14 +266,7 @@ void main() {
         g_front_coverage = visibility.g;
         g_second_coverage = visibility.b;
         key_uv = g_key_beam * (1.0 - g_front_coverage) * (1.0 - g_second_coverage);   // UV passes the holes only
-#ifdef ROOM_CAPTURE
-        g_key_reach = g_key_beam * (1.0 - g_front_coverage * (1.0 - u_capture_thread))
-                                 * (1.0 - g_second_coverage * (1.0 - u_capture_thread));
-#endif
     }
-#endif
-#ifdef ROOM_CAPTURE
-    g_key_reach *= abs(cos_key);
 #endif
 #ifdef SKY_OCCLUSION
     g_occlusion = v_occlusion.x;
@@ -340,9 +310,6 @@ void main() {
 #ifdef SEE_THROUGH
     bg = background_terms(ray, u_sun_direction, u_sun_chord2.x, u_sun_chord2.y);
 #endif
-#ifdef FOLDS_BEHIND
-    g_fold_behind = v_view_occlusion;
-#endif
 
     vec3 rgb = shade_chunk(0, g_key, g_fill, bg, effective);
 #if NV4 > 1
@@ -360,11 +327,8 @@ void main() {
 #ifdef ROOM_SIDE
     rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance * v_room_side_light;
     rgb += (g_view_outside * g_occlusion) * (u_window_side_diffuse + u_window_side_directional) * v_window_side_light;
-#if defined(WALL_LIGHT) || defined(WALL_GRID)
+#ifdef WALL_GRID
     rgb += g_view_outside * v_wall_light;   // the wall and its reveals where the outside is walled
-#endif
-#if defined(FOLDS_BEHIND) && defined(SEE_THROUGH)
-    rgb += (u_direct * bg.x * g_fold_behind) * v_window_side_light;   // the fold behind, through the holes
 #endif
 #endif
 #ifdef PATTERN
@@ -380,11 +344,6 @@ void main() {
     float w = oit_weight(length(v_view_ray) - u_oit_depth_ref);
     out_radiance = vec4(rgb * (alpha * w), alpha);
     out_oit_weight = vec4(alpha * w, 0.0, 0.0, 0.0);
-#elif defined(ROOM_CAPTURE)
-    // the room's window capture (issue 11): alpha is the key's irradiance on this fragment per
-    // unit of its normal irradiance, |cos_i| x the window's mask x what a layer nearer the
-    // light passes; room_lightmap.frag spreads the key's directional lobe by its patch mean
-    out_radiance = vec4(rgb, g_key_reach);
 #else
     out_radiance = vec4(rgb, 1.0);
 #endif
@@ -410,7 +369,7 @@ void main() {
 #ifdef ROOM_SIDE
     out_room_side_light = vec4(v_room_side_light, 1.0);
     out_window_side_light = vec4(v_window_side_light, 1.0);
-#if defined(WALL_LIGHT) || defined(WALL_GRID)
+#ifdef WALL_GRID
     out_wall_light = vec4(v_wall_light, g_second_coverage);
 #endif
 #else

@@ -195,12 +195,11 @@ def test_visible_white_is_not_the_dye(close_up):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="issue 33 goal missed at noon since the drape's springs rest "
-                                      "at their pleated length: chroma 6.04 at 12 h, 4.6-5.5 at the "
-                                      "other hours 7-18 h (it was 4.4-5.5 on the flat-rest drape)")
 def test_voile_near_neutral_in_the_day(curtain_lab):
     """The goal (chroma <= 6) at 7-18 h, adapted to the visible white (7.2-7.5 adapted to the
-    light entering the room, 15.4 at noon to the sun's own white)."""
+    light entering the room, 15.4 at noon to the sun's own white). Missed at noon (6.04) while
+    the box's curtain took its room side from the special-case captures; met since it takes
+    it from the room's transport."""
     chroma = {hour: round(float(curtain_lab("voile-white", hour)[1]), 2) for hour in HOURS[:-1]}
     assert max(chroma.values()) <= 6.0, chroma
 

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from catalog.optics import shading_reference as ref
-from catalog.render import room_light
+from catalog.render import curtain_frames
 from catalog.render import scene as scene_lib
 from catalog.render.frame import FrameRenderer
 from benchmarks import key_shadow_bias
@@ -204,7 +204,7 @@ def test_outside_occlusion_matches_rays_cast_in_numpy(gl, make_preset):
     cloth = np.zeros(q.shape[0])
     wall = np.zeros(q.shape[0])
     room = np.zeros(q.shape[0])
-    directions = room_light.occlusion_directions()
+    directions = curtain_frames.occlusion_directions()
     for d in directions:
         opening, _ = _through_opening(q, np.repeat(d[None], q.shape[0], 0))
         hit = np.isfinite(first_hit(q + 0.03 * d, d, triangles))
@@ -311,29 +311,36 @@ def test_sky_share_against_a_brute_force_quadrature():
 
 @pytest.mark.slow
 def test_the_sill_is_lit_by_the_sun(gl, make_preset):
-    """Curtain open, a key 60 deg high: the sill (the opening's bottom face, within the wall's
-    depth) seen from the room receives the beam: its radiance is at least 90 % of
-    albedo / pi x the key's luminance x cos(incidence) where the sun's ray from it leaves
-    through the outer plane 2 cm or more inside the opening (it was black before issue 11)."""
+    """Curtain open, a key 60 deg high, the living room (its window frame fills the wall's
+    depth round the aperture): the frame's bottom (its top face at the aperture's bottom,
+    between the wall's planes) seen from the room receives the beam: its radiance is at least
+    90 % of albedo / pi x the key's luminance x cos(incidence) where the sun's ray from it
+    leaves through the outer plane 2 cm or more inside the opening (it was black before issue 11)."""
     r = _renderer(gl, make_preset(direct=0.0, fluorescent=False), camera=(0.0, 35.0, 1.2))
-    r.update(key_direction_deg=(60.0, KEY_AZIMUTH_DEG), curtain_open=True, bloom=False)
+    r.update(key_direction_deg=(60.0, KEY_AZIMUTH_DEG), curtain_open=True, bloom=False, room="living")
     r.render()
     img = r.read_linear()
     w, h = r.size
     eye = np.asarray(r.camera.position, dtype=np.float64)
-    d = room_light.pixel_rays(r.camera.view_projection(w / h), eye, r.size)
-    wx0, wx1, wy0, _ = scene_lib.WINDOW_RECT
-    z0 = scene_lib.ROOM_BOX[2][0]
-    s = (wy0 - eye[1]) / d[..., 1]
-    p = eye + s[..., None] * d
-    sill = ((s > 0) & (p[..., 0] > wx0 + 0.05) & (p[..., 0] < wx1 - 0.05)
-            & (p[..., 2] < z0 - 0.01) & (p[..., 2] > z0 - scene_lib.WALL_THICKNESS_M + 0.01))
+    d = curtain_frames.pixel_rays(r.camera.view_projection(w / h), eye, r.size)
+    # the pixels whose centre ray first meets the frame's bottom facing up (the room's own
+    # triangles, float64 rays)
+    from catalog.room.rays import NumpyRays
+
+    ops = r.room_transport.ops
+    names = [surface.name for surface in ops.surfaces]
+    dist, hit = NumpyRays(ops.corners).intersect(np.repeat(eye[None], d[..., 0].size, 0), d.reshape(-1, 3))
+    hit = hit.reshape(d.shape[:2])
+    frame_bottom = (ops.surface == names.index("window_frame_bottom")) & (ops.normal[:, 1] > 0.99)
+    sill = (hit >= 0) & frame_bottom[np.maximum(hit, 0)]
+    p = eye + dist.reshape(d.shape[:2])[..., None] * d
     to_light = np.asarray(r.shading_inputs().key_to_light, dtype=np.float64)
     _, margin = _through_opening(p[sill], np.repeat(to_light[None], sill.sum(), 0))
     assert sill.sum() >= 10
     open_ = margin > 0.02
     assert open_.sum() >= 10
+    albedo = float(np.asarray(ops.surfaces[names.index("window_frame_bottom")].factor) @ LUMA)
     key_y = float(np.asarray(r.terms.display_colours(r.shading_inputs())["u_key_rgb"]) @ LUMA)
-    expected = scene_lib.ROOM_ALBEDO / math.pi * key_y * to_light[1]
+    expected = albedo / math.pi * key_y * to_light[1]
     assert (img[sill][open_] @ LUMA).min() > 0.9 * expected
     r.release()

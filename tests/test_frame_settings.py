@@ -173,14 +173,14 @@ def test_the_renderer_redraws_what_the_table_says(gl):
         r.render()
         first = r.read_linear()
         assert r.update(bloom=False) == {"glare"}
-        assert not r.lightmap.stale()
+        assert not r.schedule.stale()
         assert r.update(ev=11.0) == {"display"} and r.ev100 == 11.0
         r.render()
         assert np.array_equal(r.read_linear(), first)   # the HDR frame: untouched by either
         assert r.update(lamps=[("A", (0.5, 0.3, 1.5))]) == {"room_light"}
-        assert r.lightmap.stale()
+        assert r.schedule.stale()
         r.render()
-        assert not r.lightmap.stale()
+        assert not r.schedule.stale()
         assert r.update(curtain_open=True) == {"room_light"} and r.curtain_open
         before = r.settings
         with pytest.raises(SettingsError, match="^bands: "):

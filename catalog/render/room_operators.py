@@ -226,7 +226,7 @@ def _weld(transport) -> np.ndarray:
 
 def side_grid() -> tuple:
     """The cloth's room-side grid: (tw, th, x0, y0, w, h) of curtain.vert's ROOM_SIDE texture."""
-    from catalog.render.room_light import CURTAIN_SIDE_TEXELS, curtain_side_rect  # noqa: PLC0415
+    from catalog.render.curtain_frames import CURTAIN_SIDE_TEXELS, curtain_side_rect  # noqa: PLC0415
 
     tw, th = CURTAIN_SIDE_TEXELS
     return (int(tw), int(th), *(float(v) for v in curtain_side_rect()))

@@ -25,7 +25,7 @@ import numpy as np
 from catalog.core.constants import FLUORESCENCE_MODES
 from catalog.core.errors import CatalogError, InputError
 from catalog.render import scene as scene_lib
-from catalog.render import room_light
+from catalog.render import curtain_frames
 from catalog.render.camera import OrbitCamera
 from catalog.render.passes.shadow import SHADOW_MAP_SIZES
 from catalog.render.passes.targets import ANTIALIASING_MODES
@@ -93,7 +93,7 @@ class FrameSettings:
     #: alone, what the web page shows: catalog.web.export.DESKTOP_MODES)
     key_second_layer: bool = True
     #: the side (texels) of the key light's maps, SHADOW_MAP_SIZES
-    shadow_map_size: int = room_light.SHADOW_TEXELS
+    shadow_map_size: int = curtain_frames.SHADOW_TEXELS
     #: drawn aside: the curtain is not drawn, casts nothing, lights nothing
     curtain_open: bool = False
     #: lamps in the room: (light name or Light, (x, y, z) m) pairs, at most MAX_ROOM_LAMPS;
@@ -109,9 +109,9 @@ class FrameSettings:
     room_update_every: int = 1
     #: the room drawn and lit by its precomputed transport: a built-in name (catalog.room),
     #: a .glb path, or the loaded catalog.room.model.Room (what the path tracer needs: the
-    #: edge resolves it, catalog.pathtrace.render.reference_settings); None: the box's
-    #: special-case room light (catalog/render/room_light). Compared by :attr:`room_spec`.
-    room: object = None
+    #: edge resolves it, catalog.pathtrace.render.reference_settings); None: the built-in
+    #: box. Compared by :attr:`room_spec`.
+    room: object = "box"
 
     # resolved from the fields above when the value is made (not compared, not replaced):
     # the fabric's tables (catalog.presets.fabric.Fabric: dye, fluorescence, residual, pattern),
@@ -179,7 +179,9 @@ class FrameSettings:
             if not isinstance(value, (bool, np.bool_)):
                 raise _refuse(name, f"{value!r} must be True or False")
             object.__setattr__(self, name, bool(value))
-        if self.room is not None and not isinstance(self.room, Room):
+        if self.room is None:
+            object.__setattr__(self, "room", "box")
+        if not isinstance(self.room, Room):
             if not isinstance(self.room, str) and not hasattr(self.room, "__fspath__"):
                 raise _refuse("room", f"{self.room!r}: give a built-in room name, a .glb path "
                               "or a loaded Room")
@@ -311,14 +313,14 @@ def _resolve_lamps(lamps) -> tuple:
         lamps = tuple(lamps)
     except TypeError:
         raise _refuse("lamps", f"{lamps!r}: give (light, (x, y, z) m) pairs") from None
-    if len(lamps) > room_light.MAX_ROOM_LAMPS:
-        raise _refuse("lamps", f"at most {room_light.MAX_ROOM_LAMPS} room lamps, got {len(lamps)}")
+    if len(lamps) > curtain_frames.MAX_ROOM_LAMPS:
+        raise _refuse("lamps", f"at most {curtain_frames.MAX_ROOM_LAMPS} room lamps, got {len(lamps)}")
     resolved = []
     for lamp in lamps:
         try:
             light, position = lamp
             resolved.append((get_light(light) if isinstance(light, str) else light,
-                             room_light.check_lamp_position(position)))
+                             curtain_frames.check_lamp_position(position)))
         except InputError:
             raise
         except (CatalogError, TypeError, ValueError) as exc:

@@ -111,7 +111,7 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
                  fluorescence: str = "physical", bands: int = 3, progress: bool = True,
                  ctx=None, ev: float | None = None, white_balance: str = "room",
                  labels: bool = True, room: str | None = "living") -> dict:
-    """``room``: a built-in name or a .glb, lit by its transport (None: the box's special-case light)."""
+    """``room``: a built-in name or a .glb, lit by its transport (None: the box)."""
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.render import bands as band_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415

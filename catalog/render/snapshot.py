@@ -105,7 +105,7 @@ class SnapshotRequest:
     room_light: bool = True
     bloom: bool = True
     lamps: tuple = ()                 # (light name, (x, y, z) m) placed in the room
-    room: str | None = "box"          # a built-in room or FILE.glb (its transport); None: the box's special-case light (the API only)
+    room: str = "box"                 # a built-in room or FILE.glb (lit by its transport)
 
 
 def simulated_curtain(preset, frames: int):
@@ -193,19 +193,18 @@ def validate(request: SnapshotRequest):
         from catalog.render.environment import load_environment  # noqa: PLC0415
 
         load_environment(request.environment)  # refused now, before a context exists
-    if request.room is not None:
-        from catalog.room.load import room_path  # noqa: PLC0415
+    from catalog.room.load import room_path  # noqa: PLC0415
 
-        room_path(request.room)   # a name or a file; its rules are checked as it loads (set_room)
-    from catalog.render import room_light  # noqa: PLC0415
+    room_path(request.room)   # a name or a file; its rules are checked as it loads (set_room)
+    from catalog.render import curtain_frames  # noqa: PLC0415
 
-    if len(request.lamps) > room_light.MAX_ROOM_LAMPS:
-        raise InputError(f"at most {room_light.MAX_ROOM_LAMPS} lamps, got {len(request.lamps)}",
+    if len(request.lamps) > curtain_frames.MAX_ROOM_LAMPS:
+        raise InputError(f"at most {curtain_frames.MAX_ROOM_LAMPS} lamps, got {len(request.lamps)}",
                          field="--lamp")
     for name, position in request.lamps:
         get_light(name)
         try:
-            room_light.check_lamp_position(position)
+            curtain_frames.check_lamp_position(position)
         except CatalogError as exc:
             raise InputError(str(exc), field="--lamp") from None
     return preset, light

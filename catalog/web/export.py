@@ -424,6 +424,8 @@ class SiteExporter:
         r.update(scene.replace(camera=r.camera, ev=ev100))
         rec = self.ctx.recording
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
+        r.render()  # drawn once for real: the room transport reads its views of the window back
+        r.invalidate_room_light()
         rec.start(dry=True)  # only the commands are kept: no pixels drawn
         r.render()
         structure, values = split_commands(rec.stop(), self.camera_values(), clean=self._clean)

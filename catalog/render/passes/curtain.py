@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from catalog.gl.shaderlib import glsl_literal
-from catalog.render import bands as band_lib, room_light
+from catalog.render import bands as band_lib
+from catalog.render.curtain_frames import OCCLUSION_DIRECTIONS
 from catalog.render.camera import gl_bytes
 from catalog.render.passes.gl_common import ENVIRONMENT_UNIT, PATTERN_UNIT, Pass, set_uniform
 
@@ -46,17 +47,12 @@ class CurtainPass(Pass):
         if not self.frame.curtain_open:
             defines["KEY_SHADOW"] = True   # the wall's and the folds' shadow on the cloth
             defines["SKY_OCCLUSION"] = True   # the folds hide part of the outside
-            defines["N_OCCLUSION"] = room_light.OCCLUSION_DIRECTIONS
+            defines["N_OCCLUSION"] = OCCLUSION_DIRECTIONS
         if self.frame.room_side_active():
-            defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side
+            defines["ROOM_SIDE"] = True   # the room's own light on the cloth's room side (its transport)
             if defines.get("SKY_OCCLUSION"):
                 defines["OCCLUSION_MAPS"] = True   # the folds' maps (the G-buffer's view continuation)
-            if defines.get("SKY_OCCLUSION") and self.frame.room_transport is None:
-                # the wall and its reveals where the outside is walled
-                defines["WALL_LIGHT"] = True
-                defines["WALL_LOBE_SAMPLES"] = room_light.WALL_LOBE_SAMPLES
-            elif defines.get("SKY_OCCLUSION"):   # the same from the room's transport
-                defines["WALL_GRID"] = True
+                defines["WALL_GRID"] = True   # the wall and its reveals where the outside is walled
         if self.frame.antialiasing == "msaa" and not gbuffer:
             defines["INTERPOLATION"] = "centroid"   # attributes from inside the triangle
         if self.frame.patterned and not gbuffer:
@@ -66,19 +62,13 @@ class CurtainPass(Pass):
             defines.update(self.frame.fabric_pattern.defines())
         return defines
 
-    def _curtain_program(self, gbuffer: bool, overrides: dict | None = None, folds_behind: bool = False):
+    def _curtain_program(self, gbuffer: bool, overrides: dict | None = None):
         defines = self.variant_defines(gbuffer)
         if overrides:
-            defines["ROOM_CAPTURE"] = True  # the room's window capture (issue 13), not the frame's
-            defines.pop("ROOM_SIDE", None)  # the radiosity reflects the room's light off the cloth
+            defines["ROOM_CAPTURE"] = True  # the transport's views of the window, not the frame's
+            defines.pop("ROOM_SIDE", None)  # the transport reflects the room's light off the cloth
             defines.pop("OCCLUSION_MAPS", None)
-            defines.pop("WALL_LIGHT", None)
-            defines.pop("WALL_LOBE_SAMPLES", None)
             defines.pop("WALL_GRID", None)
-            if folds_behind and defines.get("SKY_OCCLUSION"):
-                # the folds' window side where they hide the outside (curtain.frag FOLDS_BEHIND;
-                # ROOM_SIDE without the room's part under ROOM_CAPTURE)
-                defines.update({"ROOM_SIDE": True, "OCCLUSION_MAPS": True, "FOLDS_BEHIND": True})
         if self.frame.specialise:
             for name, value in self.frame.terms.scene_values_with(overrides).items():
                 defines["S_" + name[2:].upper()] = glsl_literal(value)
@@ -96,7 +86,7 @@ class CurtainPass(Pass):
 
     def draw_curtain(self, view_proj, fragment: str | None = None, gbuffer: bool = False,
                      camera_position=None, overrides: dict | None = None,
-                     folds_behind: bool = False, coarse: bool = False) -> None:
+                     coarse: bool = False) -> None:
         """The curtain pass alone into the bound framebuffer.
 
         ``fragment``: draw the same mesh (same vertex shader and uniforms of the mesh and
@@ -104,8 +94,7 @@ class CurtainPass(Pass):
         measures the rasteriser's floor with shaders of its own (benchmarks/shaders/).
         ``camera_position``: the eye for the view-dependent terms (default the camera's; the
         room's passes draw the curtain as seen from the key light or the room);
-        ``overrides``: scene values replaced for this draw; ``folds_behind``: with ``overrides``, the room capture's variant that
-        shows the folds behind through the holes (curtain.frag FOLDS_BEHIND)."""
+        ``overrides``: scene values replaced for this draw (the room transport's views)."""
         eye = tuple(float(v) for v in (self.frame.camera.position if camera_position is None
                                        else camera_position))
         if fragment is not None:
@@ -114,7 +103,7 @@ class CurtainPass(Pass):
             set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
             set_uniform(program, "u_camera_position", eye)
         else:
-            program = self._curtain_program(gbuffer, overrides, folds_behind)
+            program = self._curtain_program(gbuffer, overrides)
             set_uniform(program, "u_view_proj", gl_bytes(view_proj))
             set_uniform(program, "u_camera_position", eye)
             set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
@@ -136,18 +125,14 @@ class CurtainPass(Pass):
                 set_uniform(program, "u_environment_scale", self.frame.background.environment_scale(self.frame.terms.shading_inputs()))
             if "u_key_visibility" in program:
                 self.frame.shadow.key_shadow_uniforms(program, self.frame.terms.shading_inputs(), coarse)
-            if "u_room_side" in program or "u_window_side_cloth" in program:   # (FOLDS_BEHIND: no room part)
-                self.frame.lightmap.room_side_uniforms(program)
-            if "u_capture_thread" in program:
-                inputs = self.frame.terms.shading_inputs()
-                set_uniform(program, "u_capture_thread", float(self.frame.terms.room_colours(inputs)["capture_thread"]))
+            if "u_room_side" in program:
+                self.frame.room_transport.cloth_uniforms(program)
             if "u_vertex_occlusion" in program:
                 self.frame.shadow.vertex_occlusion_uniforms(program)
         self.ctx.disable(self.mgl.CULL_FACE)  # two-sided cloth
         self.frame.mesh.curtain_vao(program, coarse).render(self.mgl.TRIANGLES)
 
-    def draw_flat(self, view_proj, eye, overrides: dict, folds_behind: bool = False,
-                  coarse: bool = False) -> None:
+    def draw_flat(self, view_proj, eye, overrides: dict, coarse: bool = False) -> None:
         """The room's captures draw the flat cloth (the pattern averaged, model.md section 9):
         each capture texel is a mean over a window patch anyway, and the flat variant draws in
         one pass. The whole mesh, not the coarse grid of the shadow map: under the UV lamp the
@@ -158,7 +143,7 @@ class CurtainPass(Pass):
         self.frame.drawing_flat = True
         try:
             self.draw_curtain(view_proj, camera_position=eye, overrides=overrides,
-                              folds_behind=folds_behind, coarse=coarse)
+                              coarse=coarse)
         finally:
             self.frame.drawing_flat = drawing_flat
 
@@ -213,7 +198,7 @@ class CurtainPass(Pass):
         mgl = self.mgl
         w, h = self.frame.size
         if refresh_light and self.frame.room_side_active():   # the room's light on the cloth's room side (and its maps)
-            self.frame.lightmap.draw_room_light(self.frame.terms.shading_inputs())
+            self.frame.draw_room_light(self.frame.terms.shading_inputs())
         elif refresh_light:   # the cloth's shadow maps of this mesh
             self.frame.shadow.draw_cloth_shadow_maps(self.frame.terms.shading_inputs())
         if self.frame.targets.gbuffer is None:

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from catalog.core.errors import CatalogError
-from catalog.render import room_light, scene as scene_lib
+from catalog.render import curtain_frames, scene as scene_lib
 from catalog.render.passes.gl_common import Pass
 
 def fabric_size_from_mesh(positions, uvs, indices) -> tuple[float, float]:
@@ -69,7 +69,7 @@ class CurtainMesh(Pass):
             "uv": self.ctx.buffer(uvs.tobytes()),
             "index": self.ctx.buffer(indices.tobytes()),
         }
-        coarse = room_light.coarse_grid_indices(uvs)
+        coarse = curtain_frames.coarse_grid_indices(uvs)
         if coarse is not None:  # the room's shadow map and occlusion maps draw this coarser grid
             self.buffers["coarse_index"] = self.ctx.buffer(coarse.tobytes())
         self._own_buffers = list(self.buffers.values())  # the cloth's are not ours

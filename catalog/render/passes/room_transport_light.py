@@ -17,7 +17,11 @@ Each room update (the curtain moved, the light moved):
    receiver: E_side = G rho E) times its diffuse reflectance, a uniform radiance per patch
    added to c, solved by fixed-point iteration (its gain is well under one);
 4. the curtain's room side: the same gather from the points of the cloth's room-side grid
-   (curtain.frag ROOM_SIDE) and from the cloth's plane towards the window (WALL_GRID).
+   (curtain.frag ROOM_SIDE) and from the cloth's plane towards the window (WALL_GRID); where
+   the folds hide the room from a fold, the folds' own exitance towards the room (the window
+   patches' coefficients integrated against the cosine: M_p = sum_k c_pk int H_k cos); where
+   they hide the outside, the folds' window side, from the same parallel views of the aperture
+   along the outward hemisphere's quadrature (its cosine-weighted mean radiance per patch).
 
 Numpy on the host for 2-4 (catalog/render/room_operators.py: compressed operators, a few
 milliseconds each); GL for the views and the draw (catalog/render/passes/room_transport.py).
@@ -53,6 +57,11 @@ ROOM_DEPTH_TEXELS = 1024
 #: in cos(theta) and azimuths over the outward hemisphere.
 OUTSIDE_THETA = 4
 OUTSIDE_PHI = 8
+#: The cloth's window side's views (outward hemisphere): Gauss nodes in cos(theta) and
+#: azimuths; only its cosine-weighted mean per patch is used (exact for radiance linear in
+#: the direction's cosine), so fewer than the room side's.
+WINDOW_SIDE_THETA = 2
+WINDOW_SIDE_PHI = 3
 #: Points of each receiver where the key's visibility is read (the beam's bounces).
 VISIBILITY_SAMPLES = 4
 #: The depth map's offset along the receiver's normal (m) against self-shadowing.
@@ -61,9 +70,11 @@ DEPTH_OFFSET_M = 0.01
 
 def aperture_view_projection(corners, normal, direction, near_m: float = 1.5, far_m: float = 30.0) -> np.ndarray:
     """The oblique parallel projection of the window seen along -``direction`` (a unit
-    direction into the room): a point maps to the aperture point it projects onto along the
-    direction (NDC x, y = 2 (s, t) - 1 over the window's u and v edges), its depth its
-    distance into the room along the normal, from ``near_m`` (near) to -``far_m`` (far)."""
+    direction, into the room or out of it): a point maps to the aperture point it projects
+    onto along the direction (NDC x, y = 2 (s, t) - 1 over the window's u and v edges), its
+    depth its distance into the room along the normal, from ``near_m`` (near) to -``far_m``
+    (far) for a direction into the room, the other way round for one out of it (a view from
+    outside: the nearest point is the farthest out)."""
     corners = np.asarray(corners, dtype=np.float64)
     o, u, v, n = corners[0], corners[1] - corners[0], corners[3] - corners[0], np.asarray(normal, dtype=np.float64)
     w = np.asarray(direction, dtype=np.float64)
@@ -79,6 +90,8 @@ def aperture_view_projection(corners, normal, direction, near_m: float = 1.5, fa
     # depth d (m into the room): near_m -> -1, -far_m -> +1
     ndc[2, 2] = -2.0 / (near_m + far_m)
     ndc[2, 3] = (near_m - far_m) / (near_m + far_m)
+    if float(w @ n) < 0.0:     # from outside: nearer is farther out
+        ndc[2, 2:] = -ndc[2, 2:]
     return ndc @ m
 
 
@@ -87,6 +100,22 @@ def project_captures(basis: np.ndarray, weights: np.ndarray, radiance: np.ndarra
     directions (basis (J, K) there, weights (J,) sr): c_pk = sum_j w_j L_pj H_k(w_j)."""
     per_patch = radiance.reshape(len(weights), -1, 3)      # (J, P, 3), p = iu + nu iv
     return np.einsum("jk,j,jpc->pkc", basis, weights, per_patch)
+
+
+def exitance_basis(basis: np.ndarray, weights: np.ndarray, cos_theta: np.ndarray) -> np.ndarray:
+    """(K,) the exitance of a patch per unit of each basis coefficient, int H_k(w) cos(theta) dw
+    by the quadrature (directions' basis (J, K), weights (J,) sr, their cos theta (J,)): a
+    patch's exitance towards the room is M_p = sum_k c_pk m_k."""
+    return np.einsum("jk,j,j->k", basis, weights, cos_theta)
+
+
+def outward_mean_quadrature(n_theta: int, n_phi: int) -> tuple[np.ndarray, np.ndarray]:
+    """Directions (J, 3) out of the room in the window's local frame (z < 0: the normal points
+    into the room) and weights (J,) of the cosine-weighted mean over that hemisphere,
+    sum_j v_j L(w_j) = (1 / pi) int L cos dw (Gauss in cos theta: exact for polynomials of
+    degree 2 n_theta - 2 in cos theta times the cosine)."""
+    dirs, weights = sh.hemisphere_quadrature(n_theta, n_phi)
+    return dirs * np.array([1.0, 1.0, -1.0]), weights * dirs[:, 2] / math.pi
 
 
 class RoomTransportLight(Pass):
@@ -128,11 +157,23 @@ class RoomTransportLight(Pass):
         self._outside_weights = out_weights
         self._outside_dirs = out_dirs @ ops.outside_frame
         self._outside_basis = sh.hemi_basis(out_dirs, OUTSIDE_ORDER)
+        # the cloth's window side: the outward hemisphere's quadrature (z flipped: out of the room)
+        side_dirs, self._back_weights = outward_mean_quadrature(WINDOW_SIDE_THETA, WINDOW_SIDE_PHI)
+        self._back_world_dirs = side_dirs @ ops.frame
+        # the cloth's exitance towards the room per unit coefficient: int H_k cos (exact: the
+        # capture's quadrature integrates degree 4 in cos theta)
+        self._exitance_basis = exitance_basis(self._basis, weights, dirs[:, 2])
         self._outside_target = None
+        self._constant_key = None
         self._capture = None
+        self._back_capture = None
+        self._cloth_textures = None
+        self._back_mean = np.zeros((nv, nu, 3))
         self._room_depth = None
         self._lamp_key = None
         self._room_side = np.zeros((self._side_size[1], self._side_size[0], 3))
+        self._walled = np.zeros_like(self._room_side)
+        self._exitance = np.zeros((nv, nu, 3))
         self._window_mean = np.zeros(3)
         self.irradiance = np.zeros((ops.count, 3))
         self.coefficients = np.zeros((nu * nv, self._basis.shape[1], 3))
@@ -156,6 +197,33 @@ class RoomTransportLight(Pass):
             room_depth.repeat_x = room_depth.repeat_y = False
             self._room_depth = (room_depth, self.ctx.framebuffer(depth_attachment=room_depth))
         return self._capture
+
+    def _back_targets(self):
+        if self._back_capture is None:
+            mgl = self.mgl
+            nu, nv = self._patches
+            k = CAPTURE_TEXELS_PER_PATCH
+            size = (nu * k * len(self._back_weights), nv * k)
+            texture = self.ctx.texture(size, 4, dtype="f4")
+            texture.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
+            depth = self.ctx.depth_renderbuffer(size)
+            self._back_capture = (texture, depth, self.ctx.framebuffer([texture], depth))
+        return self._back_capture
+
+    def cloth_textures(self):
+        """(room side, window side) textures of the window's patches (nu x nv, linear): the
+        cloth's exitance towards the room (x pi cd m^-2, curtain.vert's fold-hidden room side)
+        and its window side's cosine-weighted mean radiance (the folds in front of the window side)."""
+        if self._cloth_textures is None:
+            nu, nv = self._patches
+            out = []
+            for _ in range(2):
+                texture = self.ctx.texture((nu, nv), 4, data=np.zeros((nv, nu, 4), "f4").tobytes(), dtype="f4")
+                texture.filter = (self.mgl.LINEAR, self.mgl.LINEAR)
+                texture.repeat_x = texture.repeat_y = False
+                out.append(texture)
+            self._cloth_textures = tuple(out)
+        return self._cloth_textures
 
     def wall_grid_texture(self):
         """The cloth's window side's light from the room's surfaces round the window (WALL_GRID)."""
@@ -192,11 +260,8 @@ class RoomTransportLight(Pass):
         the outside and from the closed curtain's window side (its capture's mean radiance)."""
         ops = self.ops
         e = ops.outside @ self.outside_radiance(inputs)
-        if not self.frame.curtain_open and self.frame.room_side_active() and np.any(ops.window_back):
-            from catalog.render import room_light  # noqa: PLC0415
-
-            back = self.frame.capture.read_luminaire_back(room_light.BACK_LUMINAIRE_LEVEL)
-            e = e + ops.window_back[:, None] * back.reshape(-1, 3).mean(axis=0)[None, :]
+        if not self.frame.curtain_open and np.any(ops.window_back):
+            e = e + ops.window_back[:, None] * self._back_mean.reshape(-1, 3).mean(axis=0)[None, :]
         return e
 
     def framebuffers(self) -> list:
@@ -207,13 +272,17 @@ class RoomTransportLight(Pass):
             out.append(self._room_depth[1])
         if self._outside_target is not None:
             out.append(self._outside_target[1])
+        if self._back_capture is not None:
+            out.append(self._back_capture[2])
         return out
 
     def release(self) -> None:
-        for group in (self._capture, self._room_depth, self._outside_target):
+        for group in (self._capture, self._room_depth, self._outside_target, self._back_capture,
+                      self._cloth_textures):
             for obj in group or ():
                 obj.release()
         self._capture = self._room_depth = self._outside_target = None
+        self._back_capture = self._cloth_textures = None
         if getattr(self, "_wall_grid", None) is not None:
             self._wall_grid.release()
             self._wall_grid = None
@@ -251,6 +320,40 @@ class RoomTransportLight(Pass):
         self.ctx.disable(mgl.DEPTH_TEST)
         texture.build_mipmaps()
 
+    def draw_window_side(self) -> None:
+        """The cloth's window side in parallel views of the aperture from outside (the
+        outward quadrature's directions), as the room's light sees it there: its back capture's
+        values (catalog.render.passes.scene_terms.back_capture_overrides: no see-through, the
+        outside reflected), nothing where there is no cloth; its cosine-weighted mean radiance
+        per patch (:attr:`_back_mean`, (nv, nu, 3))."""
+        mgl = self.mgl
+        nu, nv = self._patches
+        if self.frame.curtain_open:
+            self._back_mean = np.zeros((nv, nu, 3))
+            return
+        texture, _depth, fbo = self._back_targets()
+        k = CAPTURE_TEXELS_PER_PATCH
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self.ctx.enable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        self.ctx.depth_func = "<="
+        overrides = self.frame.terms.back_capture_overrides()
+        centre = self.ops.window_centre
+        for j, w in enumerate(self._back_world_dirs):
+            self.ctx.viewport = (j * nu * k, 0, nu * k, nv * k)
+            view_proj = aperture_view_projection(self.ops.window_corners, self.ops.window_normal, w)
+            eye = tuple(float(v) for v in centre + 1e3 * w)
+            self.frame.curtain.draw_flat(view_proj, eye, overrides, coarse=CAPTURE_COARSE)
+        self.ctx.depth_func = "<"
+        self.ctx.disable(mgl.DEPTH_TEST)
+        texture.build_mipmaps()
+        level = int(math.log2(k))
+        count = len(self._back_weights)
+        data = np.frombuffer(texture.read(level=level), dtype="f4").reshape(nv, count * nu, 4)[..., :3]
+        radiance = data.reshape(nv, count, nu, 3).transpose(1, 0, 2, 3).astype(np.float64)
+        self._back_mean = np.einsum("j,jvuc->vuc", self._back_weights, radiance)
+
     def read_captures(self) -> np.ndarray:
         """(J, nv, nu, 3) each direction's mean radiance over each patch (row 0: the v edge's start)."""
         texture = self._capture[0]
@@ -268,9 +371,9 @@ class RoomTransportLight(Pass):
     def room_depth_view_projection(self, to_light) -> np.ndarray:
         """The key's parallel view of the window's cross-section (the transmittance map's),
         its depth over the whole room."""
-        from catalog.render import room_light  # noqa: PLC0415
+        from catalog.render.curtain_frames import light_view_projection  # noqa: PLC0415
 
-        m = room_light.light_view_projection(to_light).copy()
+        m = light_view_projection(to_light).copy()
         to_light = np.asarray(to_light, dtype=np.float64) / np.linalg.norm(to_light)
         b = self.ops.bounds
         corners = np.array([[x, y, z] for x in b[:, 0] for y in b[:, 1] for z in b[:, 2]])
@@ -312,7 +415,7 @@ class RoomTransportLight(Pass):
     def beam_irradiance(self, inputs) -> np.ndarray:
         """(E, 3) the key's beam at the receivers: key x cos x visibility x the curtain's
         transmittance (the map's coarse level read back at the receivers' centres)."""
-        from catalog.render import room_light  # noqa: PLC0415
+        from catalog.render.curtain_frames import light_view_projection  # noqa: PLC0415
 
         vis = self._key_visibility(inputs.key_to_light)
         key_rgb = np.asarray(self.frame.terms.room_colours(inputs)["u_key_rgb"], dtype=np.float64)
@@ -323,7 +426,7 @@ class RoomTransportLight(Pass):
         level = max(0, int(math.log2(n)) - 7)      # 128 texels a side at most
         side = max(n >> level, 1)
         t = np.frombuffer(shadow.read(level=level), dtype=np.float16).reshape(side, side, 4)[..., :3]
-        m = room_light.light_view_projection(inputs.key_to_light)
+        m = light_view_projection(inputs.key_to_light)
         centre = self.ops.centre
         clip = np.c_[centre, np.ones(len(centre))] @ m.T
         uv = np.clip(clip[:, :2] * 0.5 + 0.5, 0.0, 1.0 - 1e-6)
@@ -361,6 +464,7 @@ class RoomTransportLight(Pass):
     # ------------------------------------------------------------------ the whole update
     def update(self, inputs) -> None:
         """Steps 1-4 (the shadow pass has drawn the transmittance map)."""
+        self.draw_window_side()
         self.draw_captures(inputs)
         self.draw_room_depth(inputs)
         c_window = self.project(self.read_captures())
@@ -388,18 +492,81 @@ class RoomTransportLight(Pass):
         self.irradiance = e + beam_bounces
         self.draw_pass.set_key(inputs.key_to_light)
         self.draw_pass.update(self.irradiance)
+        self._constant_key = None
         room_side = t.gather_side.dot(rho * (self.irradiance + beam))
         tw, th = self._side_size
         walled = t.gather_wall.dot(rho * (self.irradiance + beam))
         self.wall_grid_texture().write(np.ascontiguousarray(np.concatenate(
             [walled.reshape(th, tw, 3), np.ones((th, tw, 1))], axis=-1), dtype="f4").tobytes())
         self._room_side = room_side.reshape(th, tw, 3)
+        self._walled = walled.reshape(th, tw, 3)
         self._window_mean = c_window[:, 0, :].mean(axis=0) / self._uniform_c0   # mean radiance
         rgba = np.concatenate([room_side.reshape(th, tw, 3), np.ones((th, tw, 1))], axis=-1)
         self.frame.room_targets.get()["room_side"].write(np.ascontiguousarray(rgba, dtype="f4").tobytes())
+        nu, nv = self._patches
+        self._exitance = np.clip(np.einsum("pkc,k->pc", c, self._exitance_basis).reshape(nv, nu, 3), 0.0, None)
+        for texture, value in zip(self.cloth_textures(), (self._exitance, self._back_mean)):
+            texture.write(np.ascontiguousarray(np.concatenate(
+                [value, np.ones((nv, nu, 1))], axis=-1), dtype="f4").tobytes())
+
+    def cloth_light_at(self, positions, room_hidden) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """curtain.vert ROOM_SIDE's light in float64 at world ``positions`` (P, 3) with the room's
+        side hidden by ``room_hidden`` (P,), as the shader reads the last update's textures
+        (GL's bilinear filter, clamped): the room side's irradiance (the gather's grid where
+        open, the folds' exitance where hidden), the window side's mean radiance, and the
+        wall's irradiance on the cloth's plane (WALL_GRID), (P, 3) each."""
+        from catalog.render.curtain_frames import sample_bilinear  # noqa: PLC0415
+
+        p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+        _tw, _th, x0, y0, w, h = self.ops.side_grid
+        side_uv = np.stack([(p[:, 0] - x0) / w, (p[:, 1] - y0) / h], axis=-1)
+        corners = np.asarray(self.ops.window_corners, dtype=np.float64)
+        u, v = corners[1] - corners[0], corners[3] - corners[0]
+        aperture_uv = np.stack([(p - corners[0]) @ (u / (u @ u)), (p - corners[0]) @ (v / (v @ v))], axis=-1)
+        hidden = np.asarray(room_hidden, dtype=np.float64).reshape(-1, 1)
+        room = ((1.0 - hidden) * sample_bilinear(self._room_side, side_uv)
+                + hidden * sample_bilinear(self._exitance, aperture_uv))
+        return room, sample_bilinear(self._back_mean, aperture_uv), sample_bilinear(self._walled, side_uv)
+
+    def cloth_uniforms(self, program) -> None:
+        """curtain.vert/.frag ROOM_SIDE's inputs: the room's irradiance on the cloth's room side
+        (the gather's grid) and its rectangle, the cloth's two sides at the window's patches
+        (:meth:`cloth_textures`) and the aperture's coordinates, the cloth's reflectance of the
+        room's light and its forward transmittance of the window side's, the wall round the
+        window (WALL_GRID)."""
+        from catalog.render.passes.gl_common import (OCCLUSION_MAPS_UNIT, ROOM_SIDE_CLOTH_UNIT,  # noqa: PLC0415
+                                                     ROOM_SIDE_UNIT, VERTEX_WALL_LIGHT_UNIT,
+                                                     WINDOW_SIDE_CLOTH_UNIT)
+
+        s = set_uniform
+        terms = self.frame.terms
+        inputs = terms.shading_inputs()
+        self.frame.room_targets.get()["room_side"].use(location=ROOM_SIDE_UNIT)
+        s(program, "u_room_side", ROOM_SIDE_UNIT)
+        _tw, _th, x0, y0, w, h = self.ops.side_grid
+        s(program, "u_room_side_rect", (float(x0), float(y0), 1.0 / float(w), 1.0 / float(h)))
+        s(program, "u_room_side_reflectance", terms.curtain_room_reflectance_rgb(inputs))
+        room_side, window_side = self.cloth_textures()
+        room_side.use(location=ROOM_SIDE_CLOTH_UNIT)
+        s(program, "u_room_side_cloth", ROOM_SIDE_CLOTH_UNIT)
+        window_side.use(location=WINDOW_SIDE_CLOTH_UNIT)
+        s(program, "u_window_side_cloth", WINDOW_SIDE_CLOTH_UNIT)
+        corners = np.asarray(self.ops.window_corners, dtype=np.float64)
+        u, v = corners[1] - corners[0], corners[3] - corners[0]
+        s(program, "u_aperture_origin", tuple(float(x) for x in corners[0]))
+        s(program, "u_aperture_s", tuple(float(x) for x in u / float(u @ u)))
+        s(program, "u_aperture_t", tuple(float(x) for x in v / float(v @ v)))
+        diffuse, directional = terms.curtain_forward_rgb(inputs)
+        s(program, "u_window_side_diffuse", diffuse)
+        s(program, "u_window_side_directional", directional)
+        if "u_occlusion_maps" in program:   # beside the per-vertex occlusion (OCCLUSION_UNIT)
+            self.frame.shadow.occlusion_uniforms(program, OCCLUSION_MAPS_UNIT)
+        if "u_wall_grid" in program:
+            self.wall_grid_texture().use(location=VERTEX_WALL_LIGHT_UNIT)
+            s(program, "u_wall_grid", VERTEX_WALL_LIGHT_UNIT)
 
     def beam_uniforms(self, program, inputs) -> None:
-        from catalog.render import room_light  # noqa: PLC0415
+        from catalog.render.curtain_frames import light_view_projection, shadow_texel_m  # noqa: PLC0415
 
         gl = self.frame.room_targets.get()
         s = set_uniform
@@ -407,8 +574,8 @@ class RoomTransportLight(Pass):
         s(program, "u_key_rgb", self.frame.terms.room_colours(inputs)["u_key_rgb"])
         gl["shadow"].use(location=2)
         s(program, "u_shadow", 2)
-        s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
-        s(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))
+        s(program, "u_light_view_proj", gl_bytes(light_view_projection(inputs.key_to_light)))
+        s(program, "u_shadow_texel_m", shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))
         s(program, "u_curtain_z", scene_lib.CURTAIN_Z)
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
         s(program, "u_window_z", scene_lib.WINDOW_Z)
@@ -431,14 +598,40 @@ class RoomTransportLight(Pass):
         window = math.pi * self._window_mean
         return towards_room[:, None] * side[j, i] + (1.0 - towards_room)[:, None] * window[None, :]
 
+    def _props(self):
+        rod_p, rod_n = scene_lib.rod_mesh()
+        ring_p, ring_n = self.frame.ring_arrays
+        positions = np.concatenate([rod_p, np.asarray(ring_p, "f4").reshape(-1, 3)])
+        normals = np.concatenate([rod_n, np.asarray(ring_n, "f4").reshape(-1, 3)])
+        return positions, normals
+
     def draw(self, view_proj, inputs) -> None:
         """The room, then the curtain's rod and rings, into the bound framebuffer (depth-tested)."""
         self._targets()
         beam = lambda program: self.beam_uniforms(program, inputs)  # noqa: E731
         self.draw_pass.draw(view_proj, beam)
-        rod_p, rod_n = scene_lib.rod_mesh()
-        ring_p, ring_n = self.frame.room.ring_arrays
-        positions = np.concatenate([rod_p, np.asarray(ring_p, "f4").reshape(-1, 3)])
-        normals = np.concatenate([rod_n, np.asarray(ring_n, "f4").reshape(-1, 3)])
+        positions, normals = self._props()
         irradiance = self.prop_irradiance(positions.astype(np.float64), normals.astype(np.float64))
         self.draw_pass.draw_props(view_proj, positions, normals, irradiance, scene_lib.ROOM_ALBEDO, beam)
+
+    def constant_irradiance(self, inputs, normals) -> np.ndarray:
+        """(N, 3) the constant room's irradiance (room lighting off) at surfaces of ``normals``:
+        the room's diffuse radiance as a grey wall of the scene's albedo shows it, pi L / rho,
+        plus the fill light's normal irradiance x cos (the stand-ins eq. 8 takes for the room)."""
+        colours = self.frame.terms.display_colours(inputs)
+        ambient = math.pi * np.asarray(colours["u_room_rgb"], dtype=np.float64) / scene_lib.ROOM_ALBEDO
+        fill = math.pi * np.asarray(colours["u_fill_rgb"], dtype=np.float64) / scene_lib.ROOM_ALBEDO
+        cos = np.clip(np.asarray(normals, dtype=np.float64) @ np.asarray(inputs.fill_to_light, dtype=np.float64),
+                      0.0, None)
+        return ambient[None, :] + cos[:, None] * fill[None, :]
+
+    def draw_constant(self, view_proj, inputs) -> None:
+        """The room, the rod and the rings in the constant room's light (no beam, no window)."""
+        key = self.frame.terms.inputs_key
+        if self._constant_key != key:   # uploaded once per scene (update() uploads the transport's)
+            self.draw_pass.update(self.constant_irradiance(inputs, self.ops.normal))
+            self._constant_key = key
+        self.draw_pass.draw(view_proj, None)
+        positions, normals = self._props()
+        irradiance = self.constant_irradiance(inputs, normals.astype(np.float64))
+        self.draw_pass.draw_props(view_proj, positions, normals, irradiance, scene_lib.ROOM_ALBEDO, None)
