@@ -45,14 +45,14 @@ def shadow_truth(points: np.ndarray, to_light: np.ndarray, mesh) -> tuple[np.nda
     """(behind, clear) per point: a ray towards the light meets the mesh farther than
     TRUTH_MIN_M; and the same answer for the ray moved 1.5 map texels either side (away from
     a shadow's edge)."""
-    from catalog.render import room_light  # noqa: PLC0415
+    from catalog.render import curtain_frames  # noqa: PLC0415
     from catalog.render.raycast import first_hit, mesh_triangles  # noqa: PLC0415
 
     triangles = mesh_triangles(mesh)
     start = points + 1e-4 * to_light
     distance = first_hit(start, to_light, triangles)
     behind = np.isfinite(distance) & (distance > TRUTH_MIN_M)
-    texel = room_light.shadow_texel_m(to_light)
+    texel = curtain_frames.shadow_texel_m(to_light)
     side = np.cross(to_light, [0.0, 1.0, 0.0])
     side /= np.linalg.norm(side)
     clear = np.ones_like(behind)

@@ -7,8 +7,8 @@ In one run, one context, one renderer (lace-fwa under sun:60, the default view),
 four configurations, interleaved round by round so that the shared machine's load falls on
 all alike (median of the rounds):
 
-- ``without``: the earlier room (constant fraction of the key + fill), flat sky, no bloom;
-- ``room+sky, static``: room lighting (shadow map, area light, bounce, AO) and the clear
+- ``without``: the constant room (the box file under the ambient and fill stand-ins), flat sky, no bloom;
+- ``room+sky, static``: room lighting (the key's maps, the room's transport) and the clear
   sky; the room's light drawn once and reused (a still cloth: the viewer's usual case);
 - ``room+sky, moving, light every 4th frame``: the viewer's choice on llvmpipe for a moving
   cloth (the frame time is the mean over 4 frames, one of them a redraw);
@@ -29,15 +29,11 @@ import statistics
 import time
 from pathlib import Path
 
-import numpy as np
 
 #: Nominal GPU throughput for the estimate: shaded fragment-iterations per second (a
 #: mid-range discrete GPU runs ~1e11 simple fragment operations/s; a loop iteration of the
 #: light-map gather is ~10 of them).
 GPU_ITERATIONS_PER_S = 1.0e10
-#: An exact form factor (room_light.rectangle_irradiance_factor: four edges, an arc tangent
-#: each) in units of the point form's loop iteration, for the estimate.
-EXACT_FACTOR_ITERATIONS = 5.0
 
 #: moving: the room's light is redrawn every this many frames (0: never, a still cloth).
 CONFIGS = (
@@ -67,52 +63,22 @@ def _frame(renderer, ctx, config, index: int = 0) -> float:
 
 def work_counts(size) -> dict[str, float]:
     """Fragment-iterations per pass (the GPU estimate's numerator)."""
-    from catalog.render import room_light  # noqa: PLC0415
-
-    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.render.curtain_frames import SHADOW_TEXELS  # noqa: PLC0415
+    from catalog.render.passes import room_transport_light as rtl  # noqa: PLC0415
+    from catalog.render.room_operators import room_operators  # noqa: PLC0415
 
     w, h = size
-    aw, ah = room_light.atlas_size()
-    lw, lh = room_light.LUMINAIRE_TEXELS
-    coarse = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
-    n = room_light.SHADOW_TEXELS
-    # issue 11's third round: an exact form factor (four edges, an arc tangent each) costs
-    # about EXACT_FACTOR point-form iterations; the window's term is the mean of 4 points on
-    # the texels near the window, and the window wall's texels add the curtain's window side
-    exact = EXACT_FACTOR_ITERATIONS
-    points, _ = room_light.texel_points()
-    z = points[..., 2]
-    wall_z = scene_lib.ROOM_BOX[2][0]
-    samples = float(np.where(z < wall_z + room_light.WINDOW_SUPERSAMPLE_M, 4, 1).sum())
-    behind = float(np.where(z < scene_lib.CURTAIN_Z, 4, 0).sum())
-    side_points = float(np.prod(room_light.CURTAIN_SIDE_TEXELS))
+    n = SHADOW_TEXELS
+    nu, nv = room_operators("box").patches
+    views = (rtl.CAPTURE_THETA * rtl.CAPTURE_PHI + rtl.WINDOW_SIDE_THETA * rtl.WINDOW_SIDE_PHI)
+    texels = nu * nv * rtl.CAPTURE_TEXELS_PER_PATCH ** 2
     return {
         "room_shadow": 0.6 * n * n,
-        # the captures' curtain fragments (room side from the middle and, since issue 11's
-        # sixth round, two side eyes; window side)
-        "room_luminaire": float(lw * lh * (4 ** room_light.LUMINAIRE_LEVEL
-                                           + 2 * 4 ** room_light.SIDE_LUMINAIRE_LEVEL
-                                           + 4 ** room_light.BACK_LUMINAIRE_LEVEL)
-                                # the ninth round's wall eyes: a column of patch rows each
-                                + 2 * int(np.prod(room_light.wall_eye_capture_size()))),
-        # the window's term and the gather per atlas texel, and the radiosity pass (issue 11):
-        # one fragment per coarse patch, summing over every patch; the beam's samples (sixth
-        # round: BEAM_SAMPLES^2 map reads a texel, about a fifth of an exact factor each)
-        "room_lightmap": float((samples + behind) * lw * lh * exact
-                               # the ninth round's box: a point meets one side's rows and
-                               # their gaps and one of top and bottom; and the window wall's
-                               # finer grid (the window side's patches, a side, top or bottom)
-                               + samples * (2 * lh + lw) * exact
-                               + room_light.WINDOW_NEAR_TEXELS ** 2 * (lw * lh + lh + lw) * exact
-                               + aw * ah * room_light.BEAM_SAMPLES ** 2 * 0.2
-                               + aw * ah * 5 * coarse * coarse * exact
-                               + (len(room_light.FACE_NAMES) * coarse * coarse) ** 2
-                               # issue 11's fourth round: R4b, the room's light on the
-                               # curtain's room side, the same gather at a grid's points
-                               + side_points * 5 * coarse * coarse * exact),
+        # the room transport's parallel views of the window: the flat cloth (about 5 iterations
+        # a fragment, as the curtain's) over each view's texels; its host work is not counted
+        "room_transport": float(views * texels * 5),
         "room": 0.5 * w * h,
-        # the fourth round's ROOM_SIDE: the grid, two captures' patches, the view's continuation
-        # (16 directions compared, one occlusion map read bilinearly): about one iteration more
+        # ROOM_SIDE: the transport's grid and the cloth's two sides per vertex
         "curtain": 0.5 * w * h * 5,
         "background": 0.2 * w * h,
         "bloom": w * h * (0.25 + 6 / 16 + 1),

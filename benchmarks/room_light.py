@@ -1,4 +1,4 @@
-"""The room light by the precomputed transport against the box's special-case light, on the
+"""The room light by the precomputed transport, on the
 path tracer (the accuracy bench's scenes, neutral display and FLIP: benchmarks/accuracy.py),
 and what a room update and a static frame cost (llvmpipe, 1280x720).
 
@@ -29,9 +29,9 @@ def git_commit() -> str:
         return "unknown"
 
 
-def frame_linear(ctx, desc, preset, light, room: str | None, repeats: int = 3) -> tuple[np.ndarray, float]:
-    """The frame's linear radiance as benchmarks.image.frame_images draws it, in ``room``
-    (None: the box's special-case light), and its median render time (s)."""
+def frame_linear(ctx, desc, preset, light, room: str, repeats: int = 3) -> tuple[np.ndarray, float]:
+    """The frame's linear radiance as benchmarks.image.frame_images draws it, in ``room``,
+    and its median render time (s)."""
     from benchmarks.image import frame_images  # noqa: PLC0415
 
     frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=repeats, room=room)
@@ -94,10 +94,9 @@ def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int, cache_dir
             row.update({"size": list(size), "spp": spp, "reference_flip_noise": noise,
                         "reference_s": float(halves["seconds"])})
             masks = halves["masks"]
-            lights = {"transport": room} if room != "box" else {"special_case": None, "transport": room}
+            lights = {"transport": room}
             if variants:
-                lights = {name: value for name, value in variants.items()
-                          if room == "box" or value is not None}
+                lights = dict(variants)
             for name, frame_room in lights.items():
                 linear, wall = frame_linear(ctx, desc, preset, light, frame_room)
                 flip = metrics.flip_map(acc.neutral_display(linear, scale), shown_reference)
@@ -122,7 +121,7 @@ def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int, cache_dir
 def cost(size=(1280, 720), repeats: int = 7) -> dict:
     """Wall and process CPU time (ms, medians) of a room update (the curtain moved: every room
     pass and the frame) and of a static frame (nothing stale), with no room light (the
-    constant room), the special-case light and the transport's in box and living. The
+    constant room) and the transport's in box and living. The
     configurations are measured in turns, one frame each per round, so that a shared
     machine's load falls on all alike; CPU time counts this process's threads (llvmpipe's
     included) and little of other processes', its ratios the steadier."""
@@ -131,8 +130,7 @@ def cost(size=(1280, 720), repeats: int = 7) -> dict:
     from catalog.render.settings import orbit  # noqa: PLC0415
 
     ctx = create_headless_context()
-    configs = (("none", None, False), ("special_case", None, True),
-               ("transport_box", "box", True), ("transport_living", "living", True))
+    configs = (("none", "box", False), ("transport_box", "box", True), ("transport_living", "living", True))
     renderers, setup = {}, {}
     for name, room, lit in configs:
         renderer = FrameRenderer(ctx, size)

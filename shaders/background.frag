@@ -65,39 +65,19 @@ vec3 environment_radiance(vec3 dir) {
 
 layout(location = 0) out vec4 out_radiance;
 
-// ROOM_CAPTURE (the room's window capture, issue 11): alpha 0, no cloth here (the capture's
-// alpha is the key's irradiance on the cloth, curtain.frag)
-#ifdef ROOM_CAPTURE
-const float BACKGROUND_ALPHA = 0.0;
-// The capture's patches lie before the window wall (issue 11, ninth round: the box around the
-// folds); a ray through them that meets the wall beside the opening sees the wall, whose light
-// the room's bounces carry, not the outside.
-uniform vec4 u_capture_opening;      // x0, x1, y0, y1 (m)
-uniform float u_capture_wall_z;      // the window wall's inner plane (m)
-#else
-const float BACKGROUND_ALPHA = 1.0;
-#endif
-
 void main() {
     vec4 far_point = u_inverse_view_proj * vec4(v_ndc, 1.0, 1.0);
     vec3 ray = normalize(far_point.xyz / far_point.w - u_camera_position);
     vec4 w = background_weights(ray, u_sun_direction, u_sun_chord2.x, u_sun_chord2.y);
-#ifdef ROOM_CAPTURE
-    vec2 at = u_camera_position.xy + ray.xy * ((u_capture_wall_z - u_camera_position.z) / min(ray.z, -1e-6));
-    if (ray.z >= 0.0 || any(lessThan(at, u_capture_opening.xz)) || any(greaterThan(at, u_capture_opening.yw))) {
-        out_radiance = vec4(0.0, 0.0, 0.0, BACKGROUND_ALPHA);
-        return;
-    }
-#endif
 #if defined(ENVIRONMENT)
     vec3 outside = environment_radiance(ray);
-    out_radiance = vec4((w.x + w.y) * outside + w.z * u_sun_disc_rgb + w.w * u_room_rgb, BACKGROUND_ALPHA);
+    out_radiance = vec4((w.x + w.y) * outside + w.z * u_sun_disc_rgb + w.w * u_room_rgb, 1.0);
 #elif defined(SKY_MODEL)
     vec3 sky = sky_radiance(ray);
     float fade = exp(-asin(clamp(-ray.y, 0.0, 1.0)) / u_haze_rad);
     vec3 below = fade * sky + (1.0 - fade) * u_ground_rgb;
-    out_radiance = vec4(w.x * sky + w.y * below + w.z * u_sun_disc_rgb + w.w * u_room_rgb, BACKGROUND_ALPHA);
+    out_radiance = vec4(w.x * sky + w.y * below + w.z * u_sun_disc_rgb + w.w * u_room_rgb, 1.0);
 #else
-    out_radiance = vec4(w.x * u_sky_rgb + w.y * u_ground_rgb + w.z * u_sun_disc_rgb + w.w * u_room_rgb, BACKGROUND_ALPHA);
+    out_radiance = vec4(w.x * u_sky_rgb + w.y * u_ground_rgb + w.z * u_sun_disc_rgb + w.w * u_room_rgb, 1.0);
 #endif
 }

@@ -87,7 +87,7 @@ layout(location = 1) out vec4 out_position;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_tangent;
 layout(location = 4) out vec4 out_shadows;   // key beam, front coverage, the outside's occlusion: cloth, wall
-layout(location = 5) out vec4 out_wall_light;      // WALL_LIGHT's per-vertex light, interpolated
+layout(location = 5) out vec4 out_wall_light;      // WALL_GRID's per-vertex light, interpolated
 layout(location = 6) out vec4 out_room_side_light;  // ROOM_SIDE's per-vertex light, interpolated
 layout(location = 7) out vec4 out_window_side_light;
 #endif

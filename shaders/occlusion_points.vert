@@ -2,8 +2,7 @@
 // Per vertex of the curtain, a value drawn as one point onto texel (index % width,
 // index / width) of a float texture, when the room's light is updated (not every frame):
 // common.glsl's outside_occlusion at the vertex's position and normal (issue 11, curtain.vert
-// SKY_OCCLUSION) or, with WALL_LIGHT, walled_radiance at its position (curtain.vert ROOM_SIDE:
-// what the window wall and its reveals show the cloth's window side).
+// SKY_OCCLUSION).
 #include "common.glsl"
 
 in vec3 in_position;
@@ -15,11 +14,7 @@ uniform ivec2 u_target_size;        // the per-vertex texture (texels)
 out vec3 v_value;
 
 void main() {
-#ifdef WALL_LIGHT
-    v_value = walled_radiance(in_position + u_mesh_offset);
-#else
     v_value = outside_occlusion(in_position + u_mesh_offset, in_normal);
-#endif
     ivec2 texel = ivec2(gl_VertexID % u_target_size.x, gl_VertexID / u_target_size.x);
     gl_Position = vec4((vec2(texel) + 0.5) / vec2(u_target_size) * 2.0 - 1.0, 0.0, 1.0);
     gl_PointSize = 1.0;

@@ -1,6 +1,6 @@
 #version 430
 // The transmittance shadow map (issue 13): the curtain seen from the key light, orthographic
-// along its travel (catalog/render/room_light/: light_view_projection).
+// along its travel (catalog/render/curtain_frames.py: light_view_projection).
 in vec3 in_position;
 #ifdef HAS_UV
 in vec2 in_uv;

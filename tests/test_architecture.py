@@ -227,7 +227,6 @@ MAY_READ = {
     "catalog/render/environment.py": "the environment image's reader (settings call it)",
     "catalog/render/imagefile.py": "image files written and read back (the commands' outputs)",
     "catalog/render/display.py": "the display's own tables (package data, not the scene)",
-    "catalog/render/room_light/geometry.py": "the room's stored ambient occlusion (package data)",
     "catalog/cloth/drape_cache.py": "the drape cache (results kept, not inputs)",
     "catalog/render/room_operators.py": "the room's bundle: read from its cache (or built) when the settings name a room (not yet resolved at the edge)",
 }

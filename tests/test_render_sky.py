@@ -21,7 +21,7 @@ SIZE = (96, 64)
 
 
 def _rays(r):
-    from catalog.render.room_light import pixel_rays
+    from catalog.render.curtain_frames import pixel_rays
 
     w, h = r.size
     return pixel_rays(r.camera.view_projection(w / h), r.camera.position, r.size)

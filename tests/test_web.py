@@ -31,7 +31,7 @@ def test_es_variant_is_the_same_file_with_another_version_line():
 
 
 def test_es_variant_of_every_frame_shader_has_no_include_left():
-    for name in ("curtain.vert", "curtain.frag", "room.vert", "room.frag", "fullscreen.vert",
+    for name in ("curtain.vert", "curtain.frag", "room_transport.vert", "room_transport.frag", "fullscreen.vert",
                  "background.frag", "tonemap.frag"):
         source = shaderlib.load_source(name, dialect="es300")
         directives = [line.strip() for line in source.splitlines() if line.strip().startswith("#")]
@@ -43,7 +43,7 @@ def test_unknown_dialect_is_refused():
     from catalog.core.errors import CatalogError
 
     with pytest.raises(CatalogError, match="dialect"):
-        shaderlib.load_source("room.frag", dialect="es100")
+        shaderlib.load_source("room_transport.frag", dialect="es100")
 
 
 # ---------------------------------------------------------------- baked cloth codec
@@ -154,7 +154,8 @@ def test_recording_context_changes_nothing_of_the_desktop_frame(gl):
     for ctx in (gl, RecordingContext(gl)):
         renderer = FrameRenderer(ctx, (48, 36), specialise=False)
         try:
-            renderer.update(fabric="lace-fwa", light="UV-A")
+            # the page's modes (catalog.web.export.DESKTOP_MODES: the constant room)
+            renderer.update(fabric="lace-fwa", light="UV-A", room_lighting=False)
             renderer.render()
             images.append(renderer.read_srgb8())
         finally:
@@ -162,7 +163,7 @@ def test_recording_context_changes_nothing_of_the_desktop_frame(gl):
     assert np.array_equal(images[0], images[1])
     recipes = list(ctx.recording.programs.values())
     assert {(r["vertex"], r["fragment"]) for r in recipes} >= {
-        ("curtain.vert", "curtain.frag"), ("room.vert", "room.frag"),
+        ("curtain.vert", "curtain.frag"), ("room_transport.vert", "room_transport.frag"),
         ("fullscreen.vert", "background.frag"), ("fullscreen.vert", "tonemap.frag")}
 
 
@@ -415,16 +416,16 @@ def test_site_carries_each_fabrics_pattern(web_site):
     from catalog.presets.patterns import load_pattern, mip_chain
     from catalog.web.export import DESKTOP_MODES, decode_texels
 
-    assert DESKTOP_MODES["patterned"] is True and DESKTOP_MODES["room_lighting"] is True
+    assert DESKTOP_MODES["patterned"] is True
     out, report = web_site
     from catalog.web.browser import site_data
 
     data = site_data(out)
     assert any(s["defines"].get("PATTERN") and s["defines"].get("OIT") for s in data["shaders"])
-    # and the room's light passes: the key's map, the transport's views of the window, the lit room
+    # and the room (its file, under the constant room's light until the page applies its
+    # transport) with the cloth's own shadow maps
     files = {f for s in data["shaders"] for f in s["files"]}
     assert {"room_shadow.frag", "room_transport.frag"} <= files
-    assert any(s["defines"].get("KEY_BEAM") for s in data["shaders"])
     quantised = [t for t in data["textures"].values() if t.get("quantised")]
     for name in report["fabrics"]:
         texels = load_pattern(load_preset(FABRIC_DIR / f"{name}.toml")).normal_map()

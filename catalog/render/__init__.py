@@ -7,7 +7,8 @@ Nothing heavy is imported here; import the submodule you need:
 - :mod:`catalog.render.scene`, :mod:`catalog.render.camera`: curtain, window, room, sun, camera;
 - :mod:`catalog.render.frame`: :class:`~catalog.render.frame.FrameRenderer`, used by the viewer:
   it orders the passes of :mod:`catalog.render.passes` and owns the targets;
-- :mod:`catalog.render.room_light`: the room light's numpy side (geometry, radiosity, the
-  maps' frames, the float64 twins of the window's and the wall's light);
+- :mod:`catalog.render.curtain_frames`: where the curtain's maps look from (the key's frame,
+  the occlusion directions, the room-side grid); :mod:`catalog.render.room_operators`: the
+  room's transport as the frame loads it;
 - :mod:`catalog.render.snapshot`: headless EXR/PNG images with metadata.
 """

@@ -363,11 +363,11 @@ def changed(old: FrameSettings, new: FrameSettings) -> frozenset[str]:
 #:   scene_terms    the shading inputs (SceneTerms, keyed on fabric, light, key, mode, the
 #:                  viewer's side of the window) and what follows them: the curtain's uniforms
 #:                  or specialised program, the background's sky
-#:   room_light     the room's light (key shadow maps, window capture, light map) at the next frame
+#:   room_light     the room's light (the key's maps, the room transport's update) at the next frame
 #:   room_transport the room's precomputed transport loaded (or dropped), then room_light
 #:   room_targets   the key light's maps reallocated at the new size (then room_light)
 #:   msaa_targets   the anti-aliasing mode resolved again; multisampled targets freed if unused
-#:   environment    the environment image loaded (or freed), then room_light (the capture sees it)
+#:   environment    the environment image loaded (or freed), then room_light (the window's views see it)
 #:   view           nothing cached: the next frame's view-projection
 #:   display        the display pass's uniforms (exposure, white balance)
 #:   glare          whether the glare pass runs

@@ -75,9 +75,8 @@ def canvas_level(size) -> int | None:
 ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_m": [1.2, 4.0]}
 #: The desktop frame's modes the page shows: the thread patterns (issue 12: each fabric's
 #: normal/coverage texture, quantised to TEXEL_BITS on the page; the layers' order-independent
-#: transparency) and the room lit through the curtain (issue 13: transmittance shadow map,
-#: window capture, light map with bounce, recorded with every scene and replayed by the page
-#: each frame, so that they follow its moving cloth). The glare and the room lamp are the
+#: transparency) and the room's file with the cloth's own shadow maps (recorded with every
+#: scene and replayed by the page each frame, so that they follow its moving cloth). The glare and the room lamp are the
 #: page's switches (GLARE, ROOM_LAMPS: recorded per scene); the browser test compares against
 #: the same modes.
 #: ``antialiasing``: FXAA, a pass the page replays (the renderer's ``auto`` would take MSAA
@@ -90,7 +89,11 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: The pattern's prefiltered mip levels (catalog.presets.patterns.mip_chain) travel with its
 #: texels (given_texels) and the page writes them over its generateMipmap chain, as the desktop
 #: writes them over its built one.
-DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa",
+#: ``room_lighting``: off (the constant room: the room file under the ambient and fill
+#: stand-ins) until the page applies the room's transport (its pack, catalog/room/web_pack.py):
+#: the transport's update reads its views of the window back and works on the host, which a
+#: replayed recording cannot do for a moving cloth.
+DESKTOP_MODES = {"patterned": True, "room_lighting": False, "antialiasing": "fxaa",
                  "key_second_layer": False}
 
 
@@ -424,8 +427,6 @@ class SiteExporter:
         r.update(scene.replace(camera=r.camera, ev=ev100))
         rec = self.ctx.recording
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
-        r.render()  # drawn once for real: the room transport reads its views of the window back
-        r.invalidate_room_light()
         rec.start(dry=True)  # only the commands are kept: no pixels drawn
         r.render()
         structure, values = split_commands(rec.stop(), self.camera_values(), clean=self._clean)

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from catalog.render import bands as band_lib, scene as scene_lib
+from catalog.render import bands as band_lib
 from catalog.render.camera import gl_bytes
 from catalog.render.passes.gl_common import ENVIRONMENT_UNIT, Pass, set_uniform
 
@@ -83,15 +83,13 @@ class BackgroundPass(Pass):
                                         (0.2126, 0.7152, 0.0722)))
         return target / self.frame.environment[2]
 
-    def draw(self, view_proj, inputs, camera_position=None, sun_disc=True,
-                         capture: bool = False) -> None:
-        """The outside by direction; ``capture``: for the room's window capture (alpha 0)."""
+    def draw(self, view_proj, inputs, camera_position=None, sun_disc=True) -> None:
+        """The outside by direction (``sun_disc`` False: without the sun's disc)."""
         sky = None if self.frame.environment is not None else self._sky(inputs)
         program = self.gl.program("fullscreen.vert", "background.frag",
                                 {"SKY_MODEL": sky is not None,
                                  "SKY_BANDS": sky is not None and self.frame.n_bands != 3,
-                                 "ENVIRONMENT": self.frame.environment is not None,
-                                 "ROOM_CAPTURE": capture})
+                                 "ENVIRONMENT": self.frame.environment is not None})
         self.frame.curtain.scene_uniforms(program, view_proj, inputs, camera_position)
         if self.frame.environment is not None:
             self.frame.environment[1].use(location=ENVIRONMENT_UNIT)
@@ -106,7 +104,4 @@ class BackgroundPass(Pass):
                 set_uniform(program, name, value)
         if not sun_disc:
             set_uniform(program, "u_sun_disc_rgb", (0.0, 0.0, 0.0))
-        if capture:
-            set_uniform(program, "u_capture_opening", scene_lib.WINDOW_RECT)
-            set_uniform(program, "u_capture_wall_z", scene_lib.ROOM_BOX[2][0])
         self.gl.fullscreen_vao(program).render(self.mgl.TRIANGLES, vertices=3)

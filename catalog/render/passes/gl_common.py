@@ -44,13 +44,13 @@ OCCLUSION_UNIT = 7
 ROOM_SIDE_UNIT = 8
 
 
-#: Texture unit of the room's capture of the cloth's room side (ROOM_SIDE: what a fold sees of
-#: its neighbours where they hide the room).
+#: Texture unit of the cloth's exitance towards the room at the window's patches (ROOM_SIDE:
+#: what a fold sees of its neighbours where they hide the room; the room's transport).
 ROOM_SIDE_CLOTH_UNIT = 9
 
 
-#: Texture unit of the capture of the cloth's window side (ROOM_SIDE: the folds in front of
-#: the outside light the cloth behind them).
+#: Texture unit of the cloth's window side's mean radiance at the window's patches (ROOM_SIDE:
+#: the folds in front of the outside light the cloth behind them; the room's transport).
 WINDOW_SIDE_CLOTH_UNIT = 10
 
 
@@ -58,12 +58,8 @@ WINDOW_SIDE_CLOTH_UNIT = 10
 OCCLUSION_MAPS_UNIT = 11
 
 
-#: Texture units of the room's light map and the per-vertex walled radiance in the curtain pass
-#: (WALL_LIGHT: what the window wall and its reveals show the cloth's window side).
-WALL_LIGHTMAP_UNIT = 12
-
-
-VERTEX_WALL_LIGHT_UNIT = 13
+#: Texture unit of the wall round the window as the cloth's window side sees it (WALL_GRID).
+WALL_GRID_UNIT = 13
 
 
 def set_uniform(program, name, value) -> None:

@@ -290,7 +290,7 @@ class RoomTransportLight(Pass):
 
     # ------------------------------------------------------------------ 1. the captures
     def capture_overrides(self) -> dict:
-        """The curtain's values as the room sees them: the luminaire capture's (no sun disc
+        """The curtain's values as the room sees them: SceneTerms.capture_overrides' (no sun disc
         seen through it, which the beam carries; no room light on its room side, which step 3
         reflects), with the directional lobe kept: the views resolve it by direction."""
         out = self.frame.terms.capture_overrides()
@@ -315,7 +315,7 @@ class RoomTransportLight(Pass):
             eye = tuple(float(v) for v in centre + 1e3 * w)   # the view's rays all ~ -w
             if not self.frame.curtain_open:
                 self.frame.curtain.draw_flat(view_proj, eye, overrides, coarse=CAPTURE_COARSE)
-            self.frame.background.draw(view_proj, inputs, camera_position=eye, sun_disc=False, capture=True)
+            self.frame.background.draw(view_proj, inputs, camera_position=eye, sun_disc=False)
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
         texture.build_mipmaps()
@@ -535,7 +535,7 @@ class RoomTransportLight(Pass):
         room's light and its forward transmittance of the window side's, the wall round the
         window (WALL_GRID)."""
         from catalog.render.passes.gl_common import (OCCLUSION_MAPS_UNIT, ROOM_SIDE_CLOTH_UNIT,  # noqa: PLC0415
-                                                     ROOM_SIDE_UNIT, VERTEX_WALL_LIGHT_UNIT,
+                                                     ROOM_SIDE_UNIT, WALL_GRID_UNIT,
                                                      WINDOW_SIDE_CLOTH_UNIT)
 
         s = set_uniform
@@ -562,8 +562,8 @@ class RoomTransportLight(Pass):
         if "u_occlusion_maps" in program:   # beside the per-vertex occlusion (OCCLUSION_UNIT)
             self.frame.shadow.occlusion_uniforms(program, OCCLUSION_MAPS_UNIT)
         if "u_wall_grid" in program:
-            self.wall_grid_texture().use(location=VERTEX_WALL_LIGHT_UNIT)
-            s(program, "u_wall_grid", VERTEX_WALL_LIGHT_UNIT)
+            self.wall_grid_texture().use(location=WALL_GRID_UNIT)
+            s(program, "u_wall_grid", WALL_GRID_UNIT)
 
     def beam_uniforms(self, program, inputs) -> None:
         from catalog.render.curtain_frames import light_view_projection, shadow_texel_m  # noqa: PLC0415

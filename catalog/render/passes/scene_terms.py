@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from catalog.render import bands as band_lib, room_light, scene as scene_lib
+from catalog.render import bands as band_lib, curtain_frames, scene as scene_lib
 
 
 class SceneTerms:
@@ -101,12 +101,12 @@ class SceneTerms:
         return values
 
     def capture_overrides(self) -> dict:
-        """The curtain's values for the luminaire capture: without the sun's disc seen through
+        """The curtain's values for the room transport's views of the window: without the sun's disc seen through
         it (the key light's beam reaches the room through the shadow map instead), without the
         key light scattered by the directional lobe (the beam carries it: counted in both, the
         room was up to 1.6x too bright under a low key), and without the room's light on its
         room side (the fill light and the room's share of the ambient term, stand-ins for it,
-        and the lamps): the radiosity pass reflects the room's own
+        and the lamps): the transport reflects the room's own
         light off the closed curtain (:meth:`window_albedo_rgb`), so the capture holds only
         what comes from outside and the glow."""
         values = self.scene_values()
@@ -179,18 +179,6 @@ class SceneTerms:
             self._display_key = self.inputs_key
         return self._display
 
-    def reveal_inputs(self, inputs) -> dict:
-        """common.glsl reveal_irradiance's inputs besides the point (room.frag's reveals and
-        WALL_LIGHT's): 0.5 pi x the sky's and the ground's radiance (linear sRGB), and the
-        window-side capture's level of 2 x 2 patches a texel and that level's size."""
-        colours = self.display_colours(inputs)
-        level = room_light.BACK_LUMINAIRE_LEVEL + 1
-        return {"sky_half": tuple(0.5 * math.pi * v for v in colours["u_sky_rgb"]),
-                "ground_half": tuple(0.5 * math.pi * v for v in colours["u_ground_rgb"]),
-                "back_level": level,
-                "back_size": tuple(max(v >> level, 1) for v in
-                                   room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL))}
-
     def _dye_rgb(self, inputs, light: str) -> np.ndarray:
         """The dye per display channel (catalog.optics.dye_colour), once per scene change:
         ``"key"``, under the key, RGB(key x dye) / RGB(key), as the beam takes it; or
@@ -217,7 +205,6 @@ class SceneTerms:
         thread = np.clip(float(inputs.a_spec) * forward * dye_rgb / coverage, 0.0, 1.0)
         lobe = key * float(inputs.a_spec) * dye_rgb
         return {"u_key_rgb": tuple(float(v) for v in key), "u_mean_coverage": 1.0 - float(inputs.direct),
-                "capture_thread": min(float(inputs.a_spec) * forward / coverage, 1.0),
                 "u_thread_beam_rgb": tuple(float(v) for v in thread),
                 "u_lobe_rgb": tuple(float(v) for v in lobe)}
 
@@ -225,7 +212,7 @@ class SceneTerms:
     def key_depth_per_metre(inputs) -> float:
         """The key's maps' depth (0..1) per metre along the key's travel: orthographic, window
         depth = 0.5 ndc z + 0.5 with ndc z = m[2, 2] z_view + .., so a metre is -m[2, 2] / 2."""
-        return abs(float(room_light.light_view_projection(inputs.key_to_light)[2, 2])) / 2
+        return abs(float(curtain_frames.light_view_projection(inputs.key_to_light)[2, 2])) / 2
 
     def window_albedo_rgb(self, inputs) -> tuple[float, float, float]:
         """The closed curtain's room-side reflectance under diffuse light (linear sRGB): the
@@ -241,7 +228,7 @@ class SceneTerms:
         forward(g_diff) and dye a_spec forward(g_spec): what passes towards a viewer in the
         room of the light on the cloth's window side (curtain.frag ROOM_SIDE, the folds' light
         where they hide the outside, both lobes by the hemisphere's occlusion; and the window
-        wall's, WALL_LIGHT). The dye per channel for the secondary light (:meth:`_dye_rgb`, since
+        wall's, WALL_GRID). The dye per channel for the secondary light (:meth:`_dye_rgb`, since
         issue 11's seventh round; the key's before): the folds' light is the cloth's own, and
         the wall's reveals see the cloth's window side too. With no glow it is the key's."""
         from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
@@ -255,7 +242,7 @@ class SceneTerms:
         """The cloth's reflectance under the room's diffuse light (linear sRGB), dye (a_diff
         backward(g_diff) + a_spec backward(g_spec)), the dye per channel for the secondary
         light (:meth:`_dye_rgb`; the key's before issue 11's seventh round): what the
-        radiosity's window reflects and what the curtain's room side sends back of the room's
+        transport's window reflects and what the curtain's room side sends back of the room's
         light (curtain.frag ROOM_SIDE)."""
         from catalog.optics.shading_reference import hg_hemisphere_factors  # noqa: PLC0415
 

@@ -7,7 +7,9 @@ import math
 import numpy as np
 
 from catalog.gl.shaderlib import glsl_literal
-from catalog.render import curtain_frames as room_light, scene as scene_lib  # the cloth's light-space frames
+# the cloth's light-space frames (catalog.render.curtain_frames), under the old module's name
+# until the key-shadow work in this file merges (then a rename)
+from catalog.render import curtain_frames as room_light, scene as scene_lib
 from catalog.render.camera import gl_bytes
 from catalog.render.passes.gl_common import (KEY_FRONT_UNIT, KEY_SECOND_UNIT, OCCLUSION_UNIT, Pass,
                                              set_uniform)

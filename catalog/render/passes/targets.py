@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from catalog.core.errors import CatalogError
-from catalog.render import room_light
+from catalog.render import curtain_frames
 
 
 #: Anti-aliasing: a post-process on the display image (shaders/fxaa.frag), multisampling of
@@ -117,7 +117,7 @@ def check_size(size, ctx=None) -> tuple[int, int]:
 
 def occlusion_grid() -> int:
     """Tiles a side of the occlusion maps' atlas (one tile per occlusion direction)."""
-    return math.ceil(math.sqrt(room_light.OCCLUSION_DIRECTIONS))
+    return math.ceil(math.sqrt(curtain_frames.OCCLUSION_DIRECTIONS))
 
 
 class FrameTargets:
@@ -212,13 +212,11 @@ KEY_FRONT_TEXELS = 256
 
 
 class RoomTargets:
-    """The room light's maps (docs/room.md), made on first use by :meth:`get` as a dict of
-    name -> GL object: the key light's transmittance map ``shadow`` and the cloth's
-    front-layer maps ``key_front`` / ``key_second`` (``key_texels`` a side), the occlusion
-    maps, the window's captures (``luminaire``, ``luminaire_sides``, ``luminaire_walls``,
-    ``luminaire_back``), the light map's parts (``direct``, ``beam``, ``lightmap``, ``ao``,
-    ``window_near``), the radiosity's ``radiosity_operator`` and ``total``, the curtain's
-    ``room_side`` grid; the per-vertex textures are added by the shadow and light-map passes."""
+    """The curtain's maps the room's light draws (docs/room-light.md), made on first use by
+    :meth:`get` as a dict of name -> GL object: the key light's transmittance map ``shadow``
+    (``shadow_texels`` a side) and the cloth's front-layer maps ``key_front`` / ``key_second``
+    (``key_texels`` a side), the occlusion maps, the cloth's room-side grid ``room_side``
+    (written by the room's transport); the per-vertex textures are added by the shadow pass."""
 
     def __init__(self, ctx, shadow_texels: int):
         import moderngl  # noqa: PLC0415
@@ -226,8 +224,6 @@ class RoomTargets:
         self.ctx, self.mgl = ctx, moderngl
         self.shadow_texels = int(shadow_texels)
         self.objects: dict | None = None
-        #: the window reflectance the radiosity operator was last uploaded for (None: none)
-        self.operator_albedo = None
 
     def get(self) -> dict:
         """The maps, made on first use."""
@@ -237,39 +233,6 @@ class RoomTargets:
             shadow = ctx.texture((n, n), 4, dtype="f2")
             shadow.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
             shadow.repeat_x = shadow.repeat_y = False
-            lw, lh = room_light.luminaire_capture_size()
-            luminaire = ctx.texture((lw, lh), 4, dtype="f4")
-            luminaire.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
-            luminaire_depth = ctx.depth_renderbuffer((lw, lh))
-            sw, sh = room_light.luminaire_capture_size(room_light.SIDE_LUMINAIRE_LEVEL)
-            sides = ctx.texture((2 * sw, sh), 4, dtype="f4")   # the side eyes', left then right
-            sides.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
-            sides_depth = ctx.depth_renderbuffer((2 * sw, sh))
-            nt = room_light.WINDOW_NEAR_TEXELS
-            # room_window_near.frag's grid, half floats: a web page filters them linearly
-            # without OES_texture_float_linear (3e3 at most under the noon sun; 5e-4 relative)
-            window_near = ctx.texture((nt, nt), 4, dtype="f2")
-            window_near.filter = (mgl.LINEAR, mgl.LINEAR)
-            window_near.repeat_x = window_near.repeat_y = False
-            ww, wh = room_light.wall_eye_capture_size()
-            walls = ctx.texture((2 * ww, wh), 4, dtype="f4")   # the wall eyes', left then right
-            walls.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
-            walls_depth = ctx.depth_renderbuffer((2 * ww, wh))
-            bw, bh = room_light.luminaire_capture_size(room_light.BACK_LUMINAIRE_LEVEL)
-            luminaire_back = ctx.texture((bw, bh), 4, dtype="f4")
-            luminaire_back.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
-            luminaire_back_depth = ctx.depth_renderbuffer((bw, bh))
-            aw, ah = room_light.atlas_size()
-            direct = ctx.texture((aw, ah), 4, dtype="f4")
-            direct.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
-            beam = ctx.texture((aw, ah), 4, dtype="f4")
-            beam.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
-            lightmap = ctx.texture((aw, ah), 4, dtype="f4")
-            lightmap.filter = (mgl.LINEAR, mgl.LINEAR)
-            lightmap.repeat_x = lightmap.repeat_y = False
-            ao = ctx.texture((aw, ah), 4, data=room_light.ao_and_mask_texture().tobytes(), dtype="f4")
-            ao.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
-            ao.build_mipmaps()
             n = self.key_texels
             key_front = ctx.texture((n, n), 4, dtype="f4")
             key_front.filter = (mgl.NEAREST, mgl.NEAREST)
@@ -279,10 +242,14 @@ class RoomTargets:
             key_second.filter = (mgl.NEAREST, mgl.NEAREST)
             key_second.repeat_x = key_second.repeat_y = False
             key_second_depth = ctx.depth_renderbuffer((n, n))
-            side = occlusion_grid() * room_light.OCCLUSION_TEXELS
+            side = occlusion_grid() * curtain_frames.OCCLUSION_TEXELS
             occlusion = ctx.texture((side, side), 4, dtype="f4")
             occlusion.filter = (mgl.NEAREST, mgl.NEAREST)
             occlusion_depth = ctx.depth_renderbuffer((side, side))
+            tw, th = curtain_frames.CURTAIN_SIDE_TEXELS
+            side_light = ctx.texture((tw, th), 4, data=np.zeros((th, tw, 4), "f4").tobytes(), dtype="f4")
+            side_light.filter = (mgl.LINEAR, mgl.LINEAR)
+            side_light.repeat_x = side_light.repeat_y = False
             self.objects = {
                 "key_front": key_front, "key_front_depth": key_front_depth,
                 "key_front_fbo": ctx.framebuffer([key_front], key_front_depth),
@@ -291,32 +258,9 @@ class RoomTargets:
                 "occlusion": occlusion, "occlusion_depth": occlusion_depth,
                 "occlusion_fbo": ctx.framebuffer([occlusion], occlusion_depth),
                 "shadow": shadow, "shadow_fbo": ctx.framebuffer([shadow]),
-                "luminaire": luminaire, "luminaire_depth": luminaire_depth,
-                "luminaire_fbo": ctx.framebuffer([luminaire], luminaire_depth),
-                "luminaire_sides": sides, "luminaire_sides_fbo": ctx.framebuffer([sides], sides_depth),
-                "luminaire_walls": walls, "luminaire_walls_fbo": ctx.framebuffer([walls], walls_depth),
-                "window_near": window_near, "window_near_fbo": ctx.framebuffer([window_near]),
-                "luminaire_back": luminaire_back,
-                "luminaire_back_fbo": ctx.framebuffer([luminaire_back], luminaire_back_depth),
-                "direct": direct, "beam": beam, "direct_fbo": ctx.framebuffer([direct, beam]),
-                "lightmap": lightmap, "lightmap_fbo": ctx.framebuffer([lightmap]), "ao": ao,
+                "room_side": side_light,
             }
-            rc = room_light.FACE_TEXELS >> room_light.BOUNCE_LEVEL
-            patches = len(room_light.FACE_NAMES) * rc * rc
-            bounces = ctx.texture((patches, patches), 3, dtype="f4")   # written by _radiosity_operator
-            bounces.filter = (mgl.NEAREST, mgl.NEAREST)
-            total = ctx.texture((len(room_light.FACE_NAMES) * rc, rc), 4, dtype="f4")
-            total.filter = (mgl.NEAREST, mgl.NEAREST)
-            tw, th = room_light.CURTAIN_SIDE_TEXELS
-            side_light = ctx.texture((tw, th), 4, data=np.zeros((th, tw, 4), "f4").tobytes(), dtype="f4")
-            side_light.filter = (mgl.LINEAR, mgl.LINEAR)
-            side_light.repeat_x = side_light.repeat_y = False
-            self.objects.update({"radiosity_operator": bounces, "total": total,
-                                  "total_fbo": ctx.framebuffer([total]),
-                                  "room_side": side_light, "room_side_fbo": ctx.framebuffer([side_light])})
-            self.operator_albedo = None
         return self.objects
-
 
     @property
     def key_texels(self) -> int:
