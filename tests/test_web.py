@@ -205,7 +205,8 @@ def test_split_commands_keeps_every_uniform_value_in_order(gl):
     ctx = RecordingContext(gl)
     renderer = FrameRenderer(ctx, (16, 12), specialise=False)
     try:
-        renderer.update(fabric="fluoro-pink", light="D65")
+        # the page's modes (catalog.web.export.DESKTOP_MODES: the constant room)
+        renderer.update(fabric="fluoro-pink", light="D65", room_lighting=False)
         ctx.recording.start()
         renderer.render()
         commands = ctx.recording.stop()
