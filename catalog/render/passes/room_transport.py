@@ -186,7 +186,18 @@ class RoomTransportPass:
             return
         data = np.concatenate([np.asarray(positions, "f4"), np.asarray(irradiance, "f4"),
                                np.asarray(normals, "f4"), np.zeros((count, 2), "f4")], axis=1)
-        buffer = self.ctx.buffer(np.ascontiguousarray(data).tobytes())
+        raw = np.ascontiguousarray(data).tobytes()
+        # one buffer and vertex array kept between draws (a recorded frame's objects must be
+        # the same from frame to frame), grown when the props grow
+        if getattr(self, "_props_buffer", None) is None or self._props_buffer.size < len(raw):
+            if getattr(self, "_props_buffer", None) is not None:
+                self._props_buffer.release()
+                for vao in self._props_vaos.values():
+                    vao.release()
+            self._props_buffer = self.ctx.buffer(reserve=len(raw))
+            self._props_vaos = {}
+        self._props_buffer.write(raw)
+        buffer = self._props_buffer
         program = self.program({"KEY_BEAM": beam_uniforms is not None})
         program["u_view_proj"].write(gl_bytes(view_proj))
         if beam_uniforms is not None:
@@ -195,15 +206,15 @@ class RoomTransportPass:
                   ("in_normal", "3f", "12x"), ("in_uv", "2f", "8x")]
         layout = " ".join(fmt if name in program else skip for name, fmt, skip in fields)
         names = [name for name, _f, _s in fields if name in program]
-        vao = self.ctx.vertex_array(program, [(buffer, layout, *names)])
+        if id(program) not in self._props_vaos:
+            self._props_vaos[id(program)] = self.ctx.vertex_array(program, [(buffer, layout, *names)])
+        vao = self._props_vaos[id(program)]
         program["u_albedo_factor"].value = tuple(float(albedo) for _ in range(3))
         self._white.use(location=0)
         program["u_albedo_texture"].value = 0
         self.ctx.enable(moderngl.DEPTH_TEST)
         self.ctx.disable(moderngl.CULL_FACE)
-        vao.render(moderngl.TRIANGLES)
-        vao.release()
-        buffer.release()
+        vao.render(moderngl.TRIANGLES, vertices=count)
 
     def draw_depth(self, view_proj: np.ndarray) -> None:
         """The room's triangles' depth alone into the bound framebuffer (no culling)."""
@@ -226,3 +237,8 @@ class RoomTransportPass:
             program.release()
         self._buffer.release()
         self._depth_buffer.release()
+        if getattr(self, "_props_buffer", None) is not None:
+            for vao in self._props_vaos.values():
+                vao.release()
+            self._props_buffer.release()
+            self._props_buffer = None

@@ -164,7 +164,6 @@ class RoomTransportLight(Pass):
         # capture's quadrature integrates degree 4 in cos theta)
         self._exitance_basis = exitance_basis(self._basis, weights, dirs[:, 2])
         self._outside_target = None
-        self._constant_key = None
         self._capture = None
         self._back_capture = None
         self._cloth_textures = None
@@ -492,7 +491,6 @@ class RoomTransportLight(Pass):
         self.irradiance = e + beam_bounces
         self.draw_pass.set_key(inputs.key_to_light)
         self.draw_pass.update(self.irradiance)
-        self._constant_key = None
         room_side = t.gather_side.dot(rho * (self.irradiance + beam))
         tw, th = self._side_size
         walled = t.gather_wall.dot(rho * (self.irradiance + beam))
@@ -627,10 +625,8 @@ class RoomTransportLight(Pass):
 
     def draw_constant(self, view_proj, inputs) -> None:
         """The room, the rod and the rings in the constant room's light (no beam, no window)."""
-        key = self.frame.terms.inputs_key
-        if self._constant_key != key:   # uploaded once per scene (update() uploads the transport's)
-            self.draw_pass.update(self.constant_irradiance(inputs, self.ops.normal))
-            self._constant_key = key
+        # uploaded with every frame: a recorded frame's commands must not depend on the one before
+        self.draw_pass.update(self.constant_irradiance(inputs, self.ops.normal))
         self.draw_pass.draw(view_proj, None)
         positions, normals = self._props()
         irradiance = self.constant_irradiance(inputs, normals.astype(np.float64))
