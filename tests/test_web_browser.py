@@ -67,12 +67,16 @@ def test_page_loads_without_errors_and_renders(page, web_site):
     assert page.console_errors() == []
 
 
-#: Since the drape's heading pleats keep their rest length (longer folds): the page and the
-#: desktop frame differ on a few more edge pixels than the 1 % the rule allows (196 and 164 of
-#: 19 200, one off-edge pixel 11/255 apart) in these scenes; the cause is not yet isolated
-#: (SwiftShader's and llvmpipe's rasterisation of the new folds, or a term the page lacks).
-_EDGE_MISMATCH = pytest.mark.xfail(reason="page vs desktop: edge pixels just over the 1 % rule "
-                                          "since the longer heading pleats; not yet isolated",
+#: Measured (fluoro-pink under D65, glare off / on): the edge clause holds (172 and 160 of
+#: 19 200 pixels off by a one-pixel edge shift, the rule allows 192; no pixel unmatched) but
+#: the mean is 0.86-0.89/255 (the rule: 0.5), on main as on the branch with the prefiltered
+#: mips: a frame-wide signed shift (R +1.3, G -0.7, B +0.2 /255), in the room as on the
+#: curtain. Not the recording's white (a recording with pixels drawn: 0.85; the desktop with
+#: the white of a RECORD_SIZE frame: 0.76), not the texels' 8-bit quantisation (16 bits:
+#: 0.90). Not yet isolated: SwiftShader's and llvmpipe's arithmetic, or a uniform the page
+#: computes itself.
+_EDGE_MISMATCH = pytest.mark.xfail(reason="page vs desktop: mean 0.86-0.89/255 over the 0.5 rule "
+                                          "(a frame-wide colour shift, not edges); not yet isolated",
                                    strict=False)
 #: Since the display adapts to the light of the surfaces in view (measured from the frame's
 #: drawn HDR target and G-buffer): the export records its scenes dry (no pixels drawn), so the
@@ -93,7 +97,7 @@ _WHITE_MISMATCH = pytest.mark.xfail(reason="page vs desktop under the sun: the e
     pytest.param("fluoro-pink", "D65", "on", 0, None, "on", "none",      # the glare's targets
                  marks=_EDGE_MISMATCH),
     pytest.param("linen-dense", "sun@18", "on", 3, None, "on", "A",      # a room lamp
-                 marks=_EDGE_MISMATCH),
+                 marks=_WHITE_MISMATCH),  # measured: mean 3.1/255, 11 136 pixels unmatched
 ])
 def test_page_frame_matches_the_egl_frame(page, web_site, animations, gl, fabric, light,
                                           fluorescence, frame, camera, glare, lamp):
