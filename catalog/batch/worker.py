@@ -166,7 +166,7 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
     ``on_image(record)`` is called after each image is on disk (progress). A CatalogError
     (bad preset, non-finite render) returns ``ok: False`` with the error; anything else
     is raised (an engine may retry it)."""
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     pool = pool or process_pool()
     out_dir = Path(task.out_dir)
     records: list[dict] = []
@@ -193,6 +193,8 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
                 "worker": pool.describe()}
     return {"fabric": task.fabric, "ok": True, "error": None, "records": records,
             "wall_s": round(time.perf_counter() - start, 4),
+            # CPU seconds of this process in the task, llvmpipe's and numba's threads included
+            "cpu_s": round(time.process_time() - cpu_start, 4),
             **{k: round(v, 4) for k, v in timings.items()}, "worker": pool.describe()}
 
 

@@ -501,6 +501,7 @@ class FrameRenderer:
         self.gl.release()
         self.room_targets.release()
         self.glare.release()
+        self.display.release()
         if self.environment is not None:
             self.environment[1].release()
             self.environment = None

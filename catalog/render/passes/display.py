@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from catalog.core.errors import CatalogError
-from catalog.render import adaptation as adaptation_lib, display as display_lib
+from catalog.render import adaptation as adaptation_lib, display as display_lib, display_lut
 from catalog.render.passes.gl_common import Pass, set_uniform
 
 #: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
@@ -24,6 +24,24 @@ class DisplayPass(Pass):
     def __init__(self, frame):
         super().__init__(frame)
         self._wb_cache = None
+        self._gamut_lut = None
+
+    def gamut_boundary(self):
+        """The gamut boundary's table as a float texture (display_lut.boundary_table, made
+        once): linear, repeating along the hue, clamped along the lightness."""
+        if self._gamut_lut is None:
+            table = display_lut.boundary_table()
+            self._gamut_lut = self.ctx.texture((table.shape[1], table.shape[0]), 1,
+                                               table.tobytes(), dtype="f4")
+            self._gamut_lut.filter = (self.mgl.LINEAR, self.mgl.LINEAR)
+            self._gamut_lut.repeat_x = True
+            self._gamut_lut.repeat_y = False
+        return self._gamut_lut
+
+    def release(self) -> None:
+        if self._gamut_lut is not None:
+            self._gamut_lut.release()
+            self._gamut_lut = None
 
     def current_ev100(self) -> float:
         """The EV100 the next display pass uses (fixed, or the auto exposure's)."""
@@ -101,6 +119,11 @@ class DisplayPass(Pass):
             set_uniform(program, "u_glow_rect", glare.rect)
             set_uniform(program, "u_glare_strength", glare.strength)
         set_uniform(program, "u_hdr_rect", (0.0, 0.0, vw / self.frame.size[0], vh / self.frame.size[1]))
+        if stages >= 3:
+            self.gamut_boundary().use(location=2)
+            set_uniform(program, "u_gamut_boundary", 2)
+            for name, value in display_lut.shader_uniforms().items():
+                set_uniform(program, name, value)
         for name, value in self.display_uniforms().items():
             set_uniform(program, name, value)
         self.gl.fullscreen_vao(program).render(self.mgl.TRIANGLES, vertices=3)
