@@ -55,9 +55,13 @@ OCCLUSION_OFFSET_M = 0.03
 
 
 #: The key's visibility baked over the fabric's uv (curtain.frag KEY_SHADOW): a texel every
-#: this many metres of the rest fabric, finer than the front-layer map's texels on the cloth
-#: (room_light.shadow_texel_m: ~9 mm at 256), at most KEY_VISIBILITY_MAX_TEXELS a side.
-KEY_VISIBILITY_PITCH_M = 0.003
+#: this many metres of the rest fabric, half the front-layer map's texel on the cloth
+#: (room_light.shadow_texel_m: ~1 cm at 256), at most KEY_VISIBILITY_MAX_TEXELS a side. The
+#: coarse grid's (the room's captures, a few texels a 16 cm patch) every COARSE_PITCH_M.
+KEY_VISIBILITY_PITCH_M = 0.005
+
+
+KEY_VISIBILITY_COARSE_PITCH_M = 0.02
 
 
 KEY_VISIBILITY_MAX_TEXELS = 2048
@@ -299,11 +303,13 @@ class ShadowPass(Pass):
         self.ctx.disable(mgl.DEPTH_TEST)
 
     def _key_visibility_target(self, name: str):
-        """The texture of the key's visibility over the fabric's uv (key_visibility.frag), one
-        texel every KEY_VISIBILITY_PITCH_M of the rest fabric (at most KEY_VISIBILITY_MAX_TEXELS a
-        side), made or remade when the fabric's size asks for another; cleared to fully lit."""
+        """The texture ``name`` of the key's visibility over the fabric's uv (key_visibility.frag),
+        one texel every KEY_VISIBILITY_PITCH_M of the rest fabric (``*_coarse``: the coarse
+        grid's, every KEY_VISIBILITY_COARSE_PITCH_M; at most KEY_VISIBILITY_MAX_TEXELS a side),
+        made or remade when the fabric's size asks for another; cleared to fully lit."""
         mgl, gl = self.mgl, self.frame.room_targets.get()
-        size = tuple(int(min(KEY_VISIBILITY_MAX_TEXELS, max(16, math.ceil(m / KEY_VISIBILITY_PITCH_M))))
+        pitch = KEY_VISIBILITY_COARSE_PITCH_M if name.endswith("_coarse") else KEY_VISIBILITY_PITCH_M
+        size = tuple(int(min(KEY_VISIBILITY_MAX_TEXELS, max(16, math.ceil(m / pitch))))
                      for m in self.frame.mesh.fabric_size_m)
         texture = gl.get(name)
         if texture is None or tuple(texture.size) != size:
