@@ -31,6 +31,13 @@ midpoints and centre (shadow rays to a fixed grid of window points), spans more 
 ``max_receivers`` receivers (the worst split first). Near the window and at the edges of
 its light patches (the sill's shadow, furniture) this halves the element size per level;
 where the light is smooth the elements stay large.
+
+Receivers are measured on their exposed part only (:func:`buried`, :func:`exposed_fraction`):
+furniture stands on the floor and against walls, so parts of those surfaces lie inside
+other geometry, seen by no one and lit by nothing. A receiver's sample points (the direct
+term's, the form factors', the refinement's) are drawn on its exposed part, and the light
+map welds corners by exposed area (Receivers.weld_weight_m2): a buried part neither darkens
+its receiver nor, through a shared corner, its visible neighbours.
 """
 
 from __future__ import annotations
