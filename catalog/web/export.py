@@ -423,6 +423,11 @@ class SiteExporter:
         r = self.renderer
         r.update(scene.replace(camera=r.camera, ev=ev100))
         rec = self.ctx.recording
+        if not r.display.white_is_measured():
+            # the display's white is measured from the HDR target the frame draws, which a dry
+            # recording leaves undrawn: a real frame first (not recorded) when its key changes
+            # (the light, the fabric, the fluorescence: a few per fabric), kept by the one recorded
+            r.render()
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
         rec.start(dry=True)  # only the commands are kept: no pixels drawn
         r.render()

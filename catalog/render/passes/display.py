@@ -61,14 +61,24 @@ class DisplayPass(Pass):
         The white is measured (a G-buffer draw) at the view of the first frame after the light,
         the fabric or the size change, and kept while the camera moves (the web page replays
         camera-independent passes: catalog.web.export.check_camera_uniforms)."""
-        self.frame.terms.shading_inputs()
-        key = (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
-               self.frame.room_side_active())
+        key = self._white_key()
         if self._wb_cache is None or self._wb_cache[0] != key:
             self._wb_cache = (key, display_lib.white_balance_matrix(
                 adaptation_lib.visible_white_xyz(self.frame), self.frame.white_balance,
                 adaptation_lib.degree_of_adaptation()))
         return self._wb_cache[1]
+
+    def _white_key(self) -> tuple:
+        """What the measured white depends on: the light and fabric (the shading inputs), the
+        setting, the size and whether the room side is drawn (not the camera)."""
+        self.frame.terms.shading_inputs()
+        return (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
+                self.frame.room_side_active())
+
+    def white_is_measured(self) -> bool:
+        """Whether the next frame keeps the white it has (False: it measures a new one from
+        the HDR target it draws, which a dry recording does not draw: catalog.web.export)."""
+        return self._wb_cache is not None and self._wb_cache[0] == self._white_key()
 
     def forget_white(self) -> None:
         """Measure the white again at the next frame, from its view (a still image adapts to
