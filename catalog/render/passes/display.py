@@ -41,11 +41,12 @@ class DisplayPass(Pass):
         """Linear sRGB -> linear sRGB: CAT16 from the white of the light reaching the viewer to
         D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity.
         The white is measured (a G-buffer draw) at the view of the first frame after the light,
-        the fabric or the size change, and kept while the camera moves (the web page replays
+        the fabric, the room's lamps or the size change, and kept while the camera moves (the web page replays
         camera-independent passes: catalog.web.export.check_camera_uniforms)."""
         self.frame.terms.shading_inputs()
         key = (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
-               self.frame.room_side_active())
+               self.frame.room_side_active(),   # and the room's lamps, which light what is seen
+               tuple((light.name, position) for light, position in self.frame.room_lamps))
         if self._wb_cache is None or self._wb_cache[0] != key:
             self._wb_cache = (key, display_lib.white_balance_matrix(
                 adaptation_lib.visible_white_xyz(self.frame), self.frame.white_balance,
