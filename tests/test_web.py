@@ -484,3 +484,23 @@ def test_packed_data_round_trips_and_is_smaller():
     assert text.startswith("window.CATALOG_PACKED = ")
     assert unpack_data(text) == data
     assert len(text) < 0.5 * plain
+
+
+def test_frame_comparison_reports_a_frame_wide_shift():
+    """compare_frames' signed mean per channel: a shift of the whole frame (another white
+    balance) reads as itself, sign included; a moved edge counts by its share of the frame
+    (a column of 200/255 lost from 40: -5/255 in each channel)."""
+    from catalog.web.browser import compare_frames, frames_match
+
+    rng = np.random.default_rng(3)
+    desktop = rng.integers(40, 200, size=(30, 40, 3), dtype=np.uint8)
+    shifted = desktop.astype(np.int16) + np.array([1, -1, 0], dtype=np.int16)
+    figures = compare_frames(shifted.astype(np.uint8), desktop)
+    assert figures["signed_mean_8bit"] == [1.0, -1.0, 0.0]
+    assert figures["unmatched"] == 0 and not frames_match(figures)  # mean 0.67 > 0.5
+    edge = np.zeros((30, 40, 3), dtype=np.uint8)
+    edge[:, 20:] = 200
+    moved = np.roll(edge, 1, axis=1)
+    moved[:, 0] = 0
+    figures = compare_frames(moved, edge)
+    assert figures["edge_shift"] == 30 and figures["signed_mean_8bit"] == [-5.0] * 3

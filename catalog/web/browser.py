@@ -205,6 +205,9 @@ def compare_frames(page: np.ndarray, desktop: np.ndarray) -> dict:
     edge = ~close & shift
     unmatched = ~close & ~shift
     return {"mean_abs_8bit": float(diff.mean()), "max_abs_8bit": int(diff.max()),
+            # page minus desktop, per channel (R, G, B): a frame-wide shift (e.g. another
+            # white balance or exposure) shows here, where edges average out
+            "signed_mean_8bit": [round(float(v), 3) for v in (p - d).reshape(-1, 3).mean(axis=0)],
             "pixels": int(worst.size), "within_tolerance": int(close.sum()),
             "edge_shift": int(edge.sum()), "unmatched": int(unmatched.sum()),
             "max_abs_unmatched_8bit": int(worst[unmatched].max()) if unmatched.any() else 0}

@@ -386,7 +386,16 @@ class SiteExporter:
 
     def use_drape(self, animation) -> None:
         """The fabric's drape (the desktop's settled drape, baked): the rest size its uv spans
-        (the pattern's scale) and the rings on the rod, as ``catalog snapshot`` sets them."""
+        (the pattern's scale) and the rings on the rod, as ``catalog snapshot`` sets them; the
+        meter draws the fabric's own cloth (its baked frame 0), so that a fabric's exposure does
+        not depend on which fabric the site lists first (the recorded frame's buffers keep the
+        first fabric's bytes: the page puts each fabric's own)."""
+        from catalog.web import bake as bake_lib  # noqa: PLC0415
+
+        positions, normals, tangents = bake_lib.decode_frame(animation, 0)
+        self.meter.set_mesh(positions, normals, animation.uv, tangents,
+                            animation.indices.astype(np.int32))
+        self.meter.set_mesh_offset((0.0, 0.0, 0.0))
         rings = tuple(animation.rings_x_m)
         for renderer in (self.renderer, self.meter):
             renderer.set_fabric_size(animation.fabric_size_m)

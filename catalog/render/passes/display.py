@@ -59,7 +59,7 @@ class DisplayPass(Pass):
         """Linear sRGB -> linear sRGB: CAT16 from the white of the light reaching the viewer to
         D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity.
         The white is measured (a G-buffer draw) at the view of the first frame after the light,
-        the fabric or the size change, and kept while the camera moves (the web page replays
+        the fabric, the room's lamps or the size change, and kept while the camera moves (the web page replays
         camera-independent passes: catalog.web.export.check_camera_uniforms)."""
         key = self._white_key()
         if self._wb_cache is None or self._wb_cache[0] != key:
@@ -70,10 +70,12 @@ class DisplayPass(Pass):
 
     def _white_key(self) -> tuple:
         """What the measured white depends on: the light and fabric (the shading inputs), the
-        setting, the size and whether the room side is drawn (not the camera)."""
+        setting, the size, whether the room side is drawn and the room's lamps, which light
+        what is seen (not the camera)."""
         self.frame.terms.shading_inputs()
         return (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
-                self.frame.room_side_active())
+                self.frame.room_side_active(),
+                tuple((light.name, position) for light, position in self.frame.room_lamps))
 
     def white_is_measured(self) -> bool:
         """Whether the next frame keeps the white it has (False: it measures a new one from
