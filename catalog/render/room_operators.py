@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 #: Bumped when the bundle's content changes.
-BUNDLE_VERSION = 3
+BUNDLE_VERSION = 4
 #: Cosine-weighted rays from each receiver for its view of the outside (receivers outside
 #: the aperture: the reveals, a sill) and of the aperture from outside (the curtain's window side).
 OUTSIDE_RAYS = 64
@@ -61,7 +61,7 @@ class SurfaceData:
 
 @dataclass(frozen=True)
 class RoomOperators:
-    """A room's runtime bundle. Receivers: ``corners`` (E, 3, 3), ``normal``, ``area_m2``,
+    """A room's runtime bundle. Receivers: ``corners`` (E, 3, 3), ``normal``, ``area_m2`` (exposed),
     ``albedo`` (E, 3), ``surface`` (E,) and ``uvs`` (E, 3, 2); ``vertex`` (3 E,) the welded
     light-map vertex of each corner (catalog.room.lightmap's weld) and its weights."""
 
@@ -264,7 +264,7 @@ def build(room) -> RoomOperators:
                        for s_ in room.surfaces),
         window_corners=room.window.corners, window_normal=room.window.normal, frame=t.frame,
         patches=tuple(t.params.patches), order=int(t.params.order),
-        corners=t.receivers.corners, normal=t.receivers.normal, area_m2=t.receivers.area_m2,
+        corners=t.receivers.corners, normal=t.receivers.normal, area_m2=t.receivers.weld_weight_m2,
         albedo=t.receivers.albedo, surface=surface, uvs=uvs, vertex=_weld(t),
         window_basis=t.window_basis, window_modes=t.window_modes,
         form_factors=Csr(f.data.astype(np.float64), f.indices.astype(np.int64),
