@@ -48,12 +48,9 @@ def run(args) -> int:
     from catalog.pathtrace.render import ReferenceRequest, render_reference  # noqa: PLC0415
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
-    from catalog.render.camera import OrbitCamera  # noqa: PLC0415
-    from catalog.render.scene import ROOM_BOX  # noqa: PLC0415
-
-    # the camera kept inside the room, as catalog snapshot keeps it (catalog.render.camera)
-    distance = OrbitCamera(yaw_deg=args.yaw, pitch_deg=args.pitch, distance_m=args.distance,
-                           bounds=ROOM_BOX).distance_m
+    # the camera is kept inside the room (its own inside: catalog.render.placement) as
+    # catalog snapshot keeps it, where the room is loaded (catalog.pathtrace.render.describe)
+    distance = args.distance
     request = ReferenceRequest(
         fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
         spp=args.spp, frame=args.frame, distance_m=distance, yaw_deg=args.yaw,

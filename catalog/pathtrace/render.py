@@ -114,10 +114,17 @@ def validate(request: ReferenceRequest):
 def describe(request: ReferenceRequest):
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
 
+    from catalog.render.camera import OrbitCamera  # noqa: PLC0415
+    from catalog.render.placement import placement_of_room  # noqa: PLC0415
+
     preset, light, room = validate(request)
+    placement = placement_of_room(room)   # the camera kept inside this room, as a snapshot's
+    distance = OrbitCamera(target=placement.curtain_middle, yaw_deg=request.yaw_deg,
+                           pitch_deg=request.pitch_deg, distance_m=request.distance_m,
+                           bounds=placement.interior).distance_m
     return describe_scene(preset, light, size=request.size, frame=request.frame,
                           yaw_deg=request.yaw_deg, pitch_deg=request.pitch_deg,
-                          distance_m=request.distance_m, fluorescence=request.fluorescence,
+                          distance_m=distance, fluorescence=request.fluorescence,
                           room=room)
 
 

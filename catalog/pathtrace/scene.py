@@ -117,10 +117,17 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
     from catalog.render import scene as scene_lib  # noqa: PLC0415
     from catalog.render.camera import OrbitCamera  # noqa: PLC0415
 
-    camera = OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                         distance_m=float(distance_m))
+    from catalog.render.placement import placement_of_room  # noqa: PLC0415
+
+    if isinstance(room, (str, bytes)) or hasattr(room, "__fspath__"):
+        from catalog.room.load import load_room  # noqa: PLC0415
+
+        room = load_room(room)
+    placement = placement_of_room(room)   # the curtain, rod and camera target from its window
+    camera = OrbitCamera(target=placement.curtain_middle, yaw_deg=float(yaw_deg),
+                         pitch_deg=float(pitch_deg), distance_m=float(distance_m))
     to_light, is_sun = key_light_for(light)
-    inside = bool(camera.position[2] > scene_lib.WINDOW_Z)
+    inside = bool(camera.position[2] > placement.window_z)
     # as the frame builds them (FrameRenderer.shading_inputs): a ``sun:PATH_KM`` light is the
     # paper's beam, whose sky and ground are that beam Rayleigh-scattered (paper_beam)
     inputs, decision = scene_lib.build_shading_inputs(
@@ -131,17 +138,13 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
     if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth
         from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
 
-        *curtain, fabric_size = simulated_curtain(preset, frame)
-        rings = tuple(ring_xs_m(preset))
+        *curtain, fabric_size = simulated_curtain(preset, frame, placement)
+        rings = tuple(ring_xs_m(preset, placement))
     elif len(curtain) == 6:
         *curtain, fabric_size = curtain
-    if isinstance(room, (str, bytes)) or hasattr(room, "__fspath__"):
-        from catalog.room.load import load_room  # noqa: PLC0415
-
-        room = load_room(room)
-    room_positions, _ = scene_lib.rod_mesh()
+    room_positions, _ = scene_lib.rod_mesh(placement)
     if rings:
-        ring_positions, _ = scene_lib.ring_mesh(list(rings))
+        ring_positions, _ = scene_lib.ring_mesh(list(rings), placement)
         room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
                                          np.asarray(ring_positions).reshape(-1, 3)])
     pattern = None
@@ -199,7 +202,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         info={"room": room.name, "fabric": preset.name, "light": light.name, "fluorescence_requested": decision.requested,
               "fluorescence_variant": inputs.fluorescence_mode, "frame": int(frame),
               "camera": {"yaw_deg": camera.yaw_deg, "pitch_deg": camera.pitch_deg,
-                         "distance_m": camera.distance_m}})
+                         "distance_m": camera.distance_m, "target": list(camera.target)}})
 
 
 # --------------------------------------------------------------------------- environment

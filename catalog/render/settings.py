@@ -44,15 +44,19 @@ class SunHour:
 
 
 def orbit(yaw_deg: float, pitch_deg: float, distance_m: float, target=None,
-          fov_y_deg: float | None = None, inside: bool = False) -> OrbitCamera:
-    """The orbit camera (:class:`catalog.render.camera.OrbitCamera`); ``inside``: kept inside
-    the room's box (what every command asks for; the library also draws the room from outside)."""
+          fov_y_deg: float | None = None, inside: bool = False, placement=None) -> OrbitCamera:
+    """The orbit camera (:class:`catalog.render.camera.OrbitCamera`) in the room of
+    ``placement`` (catalog.render.placement; None: the box): ``target`` None looks at its
+    curtain's middle; ``inside``: kept inside its interior (what every command asks for; the
+    library also draws the room from outside)."""
     extra = {} if fov_y_deg is None else {"fov_y_deg": float(fov_y_deg)}
     if target is not None:
         extra["target"] = tuple(float(v) for v in target)
+    elif placement is not None:
+        extra["target"] = tuple(float(v) for v in placement.curtain_middle)
+    bounds = (placement.interior if placement is not None else scene_lib.ROOM_BOX) if inside else None
     return OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                       distance_m=float(distance_m),
-                       bounds=scene_lib.ROOM_BOX if inside else None, **extra)
+                       distance_m=float(distance_m), bounds=bounds, **extra)
 
 
 def _refuse(name: str, problem) -> SettingsError:

@@ -86,8 +86,8 @@ class ShadowPass(Pass):
         s(program, "u_key_depth_bias", (KEY_SHADOW_BIAS_M * metre, slope_m * metre, KEY_SHADOW_SLOPE_CAP))
         s(program, "u_key_normal_offset", KEY_SHADOW_NORMAL_OFFSET_TEXELS
           * room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))
-        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-        z0 = scene_lib.ROOM_BOX[2][0]
+        wx0, wx1, wy0, wy1 = self.frame.placement.window_rect   # the frame's room's window
+        z0 = self.frame.placement.window_z
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
         s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
@@ -158,8 +158,8 @@ class ShadowPass(Pass):
         s(program, "u_occlusion_direction", np.asarray(directions, dtype="f4"))
         s(program, "u_occlusion_grid", float(occlusion_grid()))
         s(program, "u_occlusion_offset_m", OCCLUSION_OFFSET_M)
-        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-        z0 = scene_lib.ROOM_BOX[2][0]
+        wx0, wx1, wy0, wy1 = self.frame.placement.window_rect   # the frame's room's window
+        z0 = self.frame.placement.window_z
         s(program, "u_occlusion_window", (wx0, wx1, wy0, wy1))
         s(program, "u_occlusion_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
 
