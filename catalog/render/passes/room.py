@@ -87,7 +87,7 @@ class RoomPass(Pass):
         set_uniform(program, "u_lightmap", 1)
         gl["shadow"].use(location=2)
         set_uniform(program, "u_shadow", 2)
-        set_uniform(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))
+        set_uniform(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels, placement=self.frame.placement))
         set_uniform(program, "u_curtain_z", scene_lib.CURTAIN_Z)
         reveals = self.frame.terms.reveal_inputs(inputs)
         set_uniform(program, "u_reveal_sky", reveals["sky_half"])

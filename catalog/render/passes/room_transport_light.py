@@ -274,7 +274,7 @@ class RoomTransportLight(Pass):
         its depth over the whole room."""
         from catalog.render import room_light  # noqa: PLC0415
 
-        m = room_light.light_view_projection(to_light).copy()
+        m = room_light.light_view_projection(to_light, placement=self.frame.placement).copy()
         to_light = np.asarray(to_light, dtype=np.float64) / np.linalg.norm(to_light)
         b = self.ops.bounds
         corners = np.array([[x, y, z] for x in b[:, 0] for y in b[:, 1] for z in b[:, 2]])
@@ -327,7 +327,7 @@ class RoomTransportLight(Pass):
         level = max(0, int(math.log2(n)) - 7)      # 128 texels a side at most
         side = max(n >> level, 1)
         t = np.frombuffer(shadow.read(level=level), dtype=np.float16).reshape(side, side, 4)[..., :3]
-        m = room_light.light_view_projection(inputs.key_to_light)
+        m = room_light.light_view_projection(inputs.key_to_light, placement=self.frame.placement)
         centre = self.ops.centre
         clip = np.c_[centre, np.ones(len(centre))] @ m.T
         uv = np.clip(clip[:, :2] * 0.5 + 0.5, 0.0, 1.0 - 1e-6)
@@ -411,8 +411,8 @@ class RoomTransportLight(Pass):
         s(program, "u_key_rgb", self.frame.terms.room_colours(inputs)["u_key_rgb"])
         gl["shadow"].use(location=2)
         s(program, "u_shadow", 2)
-        s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
-        s(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))
+        s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light, placement=self.frame.placement)))
+        s(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels, placement=self.frame.placement))
         s(program, "u_curtain_z", self.placement.curtain_z)
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
         s(program, "u_window_z", self.placement.window_z)
