@@ -172,3 +172,27 @@ def test_the_drawn_curtain_is_centred_on_its_window(room):
     assert rows.min() >= max(py[1], 0) - 1, (rows.min(), py)
     if py[2] < h:                               # the hem in view: it ends near the sill's line
         assert abs(rows.max() + 1 - py[2]) < 0.08 * h, (rows.max(), py)
+
+
+@pytest.mark.slow
+def test_export_hangs_the_curtain_in_the_rooms_own_window(tmp_path):
+    """``catalog export --room bedroom``: the glTF curtain is centred on the bedroom's window
+    (x -0.2 m, within 1 cm) and hangs from its rod; with the box, on the box's (x 0)."""
+    import json
+    import struct
+
+    from catalog.commands.cli import main
+
+    centres = {}
+    for room in ("box", "bedroom"):
+        out = tmp_path / f"{room}.glb"
+        assert main(["export", "--fabric", "voile-white", "--room", room, "--out", str(out)]) == 0
+        data = out.read_bytes()
+        length = struct.unpack_from("<I", data, 12)[0]
+        doc = json.loads(data[20:20 + length])
+        position = doc["accessors"][doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]]
+        lo, hi = np.array(position["min"]), np.array(position["max"])
+        centres[room] = (0.5 * (lo[0] + hi[0]), hi[1])
+    assert centres["box"][0] == pytest.approx(0.0, abs=0.01)
+    assert centres["bedroom"][0] == pytest.approx(-0.2, abs=0.01)
+    assert centres["bedroom"][1] < centres["box"][1] - 0.3      # its window's top is 0.35 m lower
