@@ -196,3 +196,26 @@ def test_export_hangs_the_curtain_in_the_rooms_own_window(tmp_path):
     assert centres["box"][0] == pytest.approx(0.0, abs=0.01)
     assert centres["bedroom"][0] == pytest.approx(-0.2, abs=0.01)
     assert centres["bedroom"][1] < centres["box"][1] - 0.3      # its window's top is 0.35 m lower
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("room", BUILT_IN)
+def test_the_views_frame_each_rooms_window(room):
+    """The default (room) view of each built-in room, as the camera stands (kept inside):
+    the whole window in the 16:9 frame with a margin (|ndc| <= 0.9), at least a fifth of its
+    width; the fabric view: the curtain's span across at least 60 % of the frame's width."""
+    from catalog.render.camera import OrbitCamera
+    from catalog.render.placement import room_placement
+
+    p = room_placement(room)
+    x0, x1, y0, y1 = p.window_rect
+    window = np.array([[x, y, p.window_z] for x in (x0, x1) for y in (y0, y1)])
+    camera = OrbitCamera.from_view(p.view("room"), bounds=p.interior)
+    ndc = _project(camera, 16 / 9, window)
+    assert np.abs(ndc).max() <= 0.9, ndc
+    assert np.ptp(ndc[:, 0]) >= 0.4, ndc
+    fabric = OrbitCamera.from_view(p.view("fabric"), bounds=p.interior)
+    cx, half = p.window_centre_x, 0.5 * p.rod_span_m
+    span = _project(fabric, 16 / 9, np.array([[cx - half, p.curtain_top_y, p.curtain_z],
+                                              [cx + half, p.curtain_top_y, p.curtain_z]]))
+    assert np.ptp(span[:, 0]) >= 1.2 and abs(span[:, 0].mean()) < 1e-6, span
