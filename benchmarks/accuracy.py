@@ -34,8 +34,10 @@ excluded), both at SIZE.
 
 The noise rule (:func:`adaptive_reference`): the reference is rendered in rounds of new seeds,
 START_SPP first and each round doubling the total, until its noise is below NOISE_SHARE (a fifth)
-of the FLIP it judges, or the next round would pass the SPP cap or REFERENCE_BUDGET_S (a round
-takes about as long as all before it). The reference is never judged by the frame's look, only
+of the FLIP it judges, or the next round would pass the SPP cap or REFERENCE_BUDGET_CPU_S (a
+round takes about as long as all before it). The budget counts the reference's CPU time (its
+process's, every Mitsuba thread), not wall time, so where the rule stops does not depend on how
+loaded the machine is. The reference is never judged by the frame's look, only
 by its own noise against the error; each row says whether the rule holds
 (``noise_below_fifth``), the spp it ended with and each round's figures (``spp_rounds``).
 
@@ -63,14 +65,16 @@ QUICK_SIZE = (64, 36)
 #: The noise rule: a scene's reference is rendered in rounds (the first of START_SPP, each
 #: next one doubling the total) until its own noise, the mean FLIP of its two halves (two seeds),
 #: is below NOISE_SHARE of the FLIP it judges, or SPP (the cap) is reached, or the next round
-#: would take the scene's reference past REFERENCE_BUDGET_S (its time so far doubles).
+#: would take the scene's reference past REFERENCE_BUDGET_CPU_S of CPU time (its CPU time so far
+#: doubles). CPU time, not wall: the rule must not depend on the machine's load (a wall budget
+#: bought 64-1024 spp for like scenes as others' load came and went).
 NOISE_SHARE = 0.2
 START_SPP = 64
 QUICK_START_SPP = 32
 SPP = 1024
 QUICK_SPP = 64
-REFERENCE_BUDGET_S = 90.0
-QUICK_REFERENCE_BUDGET_S = 30.0
+REFERENCE_BUDGET_CPU_S = 120.0
+QUICK_REFERENCE_BUDGET_CPU_S = 40.0
 #: Both images are compared at SIZE / MEASURE_REDUCTION: each compared pixel the mean of
 #: MEASURE_REDUCTION^2 rendered ones (linear radiance, before the display), the view as it is
 #: seen from MEASURE_REDUCTION times farther at the same FLIP pixels per degree. The rendered
@@ -254,9 +258,10 @@ def reference_halves(scene: dict, size, spp: int, own: dict, first_seed: int = 0
             subprocess.run([sys.executable, "-m", "benchmarks.image_reference", scene["fabric"],
                             scene["light"], repr(cam["yaw_deg"]), repr(cam["pitch_deg"]),
                             repr(cam["distance_m"]), str(size[0]), str(size[1]), str(spp),
-                            variant, str(out), str(first_seed)], check=True)
+                            variant, str(out), str(first_seed), scene["room"]], check=True)
             with np.load(out) as data:
                 halves = {"a": data["a"], "b": data["b"], "seconds": float(data["seconds"]),
+                          "cpu_seconds": float(data["cpu_seconds"]),
                           "nan_pixel_passes": int(data["nan_pixel_passes"]),
                           "masks": {k[5:]: data[k] for k in data.files if k.startswith("mask_")}}
     halves["variant"] = variant
@@ -291,10 +296,11 @@ def judge(frame_linear, a, b, factor: int) -> dict:
 
 
 def adaptive_reference(scene: dict, size, frame_linear, own: dict, start_spp: int, spp_cap: int,
-                       budget_s: float) -> tuple[dict, list[dict]]:
+                       budget_cpu_s: float) -> tuple[dict, list[dict]]:
     """The noise rule (NOISE_SHARE): the reference's halves accumulated over rounds of new seeds
     (START_SPP, then doubling the total) until the rule holds at the measure's size, the cap is
-    reached or the next round would pass ``budget_s``. Returns the halves (as reference_halves,
+    reached or the next round would pass ``budget_cpu_s`` of the reference's CPU time. Returns
+    the halves (as reference_halves,
     spp the total) and the rounds (spp, FLIP, noise at the measure's size)."""
     total, rounds, halves, seed = 0, [], None, 0
     step = int(start_spp)
@@ -307,14 +313,16 @@ def adaptive_reference(scene: dict, size, frame_linear, own: dict, start_spp: in
             for half in ("a", "b"):
                 halves[half] = (w_old * halves[half] + w_new * new[half]).astype(np.float32)
             halves["seconds"] += new["seconds"]
+            halves["cpu_seconds"] += new["cpu_seconds"]
             halves["nan_pixel_passes"] += new["nan_pixel_passes"]
         total += step
         seed += 2
         measured = judge(frame_linear, halves["a"], halves["b"], MEASURE_REDUCTION)
         rounds.append({"spp": total, "mean_flip": measured["mean_flip"], "noise": measured["noise"],
-                       "reference_s": float(halves["seconds"])})
+                       "reference_s": float(halves["seconds"]),
+                       "reference_cpu_s": float(halves["cpu_seconds"])})
         if measured["noise"] < NOISE_SHARE * measured["mean_flip"] or 2 * total > spp_cap \
-                or 2 * halves["seconds"] > budget_s:
+                or 2 * halves["cpu_seconds"] > budget_cpu_s:
             break
         step = total
     halves["spp"] = total
@@ -322,25 +330,28 @@ def adaptive_reference(scene: dict, size, frame_linear, own: dict, start_spp: in
 
 
 def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5,
-                  start_spp: int = START_SPP, budget_s: float = REFERENCE_BUDGET_S) -> tuple[dict, dict]:
+                  start_spp: int = START_SPP, budget_cpu_s: float = REFERENCE_BUDGET_CPU_S) -> tuple[dict, dict]:
     """One scene: its row (JSON) and its images at the measure's size (frame, reference, FLIP
     map). ``spp``: the reference's cap (the noise rule: :func:`adaptive_reference`)."""
     from benchmarks.image import frame_images  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace.render import reference_settings  # noqa: PLC0415
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
     preset = load_preset(find_preset(scene["fabric"]))
     light = get_light(scene["light"])
     cam = scene["camera"]
-    desc = describe_scene(preset, light, size=tuple(size), yaw_deg=cam["yaw_deg"],
-                          pitch_deg=cam["pitch_deg"], distance_m=cam["distance_m"],
-                          room=scene["room"])
+    desc = describe_scene(reference_settings(preset, light, yaw_deg=cam["yaw_deg"],
+                                             pitch_deg=cam["pitch_deg"],
+                                             distance_m=cam["distance_m"], room=scene["room"]),
+                          size=tuple(size))
     # the frame as ``catalog snapshot --room ROOM`` draws it: the room lit by its transport
     frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=repeats,
                          room=scene["room"])
     scene["_desc"] = desc
-    halves, rounds = adaptive_reference(scene, size, frame["linear"], own, min(start_spp, spp), spp, budget_s)
+    halves, rounds = adaptive_reference(scene, size, frame["linear"], own, min(start_spp, spp), spp,
+                                        budget_cpu_s)
     scene.pop("_desc")
     measured = judge(frame["linear"], halves["a"], halves["b"], MEASURE_REDUCTION)
     full = judge(frame["linear"], halves["a"], halves["b"], 1)
@@ -364,6 +375,7 @@ def measure_scene(ctx, scene: dict, size, spp: int, own: dict, repeats: int = 5,
         # the same comparison at the rendered size (the previous report's measure)
         "mean_flip_full_size": full["mean_flip"], "reference_flip_noise_full_size": full["noise"],
         "frame_ms": 1e3 * frame_s, "reference_s": float(halves["seconds"]),
+        "reference_cpu_s": float(halves["cpu_seconds"]),
         "speedup": float(halves["seconds"]) / frame_s if frame_s > 0 else math.inf,
         "display_scale": measured["scale"],
         "reference_nan_pixel_passes": int(halves["nan_pixel_passes"]),
@@ -399,6 +411,7 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
     from catalog.pathtrace.render import MAX_DEPTH, region_masks  # noqa: PLC0415
+    from catalog.pathtrace.render import reference_settings  # noqa: PLC0415
     from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
@@ -413,9 +426,12 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
         if "flip_by_region" in row:
             continue
         cam = row["camera"]
-        desc = describe_scene(load_preset(find_preset(row["fabric"])), get_light(row["light"]),
-                              size=tuple(row["size"]), yaw_deg=cam["yaw_deg"], pitch_deg=cam["pitch_deg"],
-                              distance_m=cam["distance_m"])
+        desc = describe_scene(reference_settings(load_preset(find_preset(row["fabric"])),
+                                                 get_light(row["light"]), yaw_deg=cam["yaw_deg"],
+                                                 pitch_deg=cam["pitch_deg"],
+                                                 distance_m=cam["distance_m"],
+                                                 room=row.get("room", "box")),
+                              size=tuple(row["size"]))
         masks = region_masks(mi, build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH), desc)
         with np.load(Path(rows_out).with_suffix(f".{number:02d}.npz")) as data:
             row["flip_by_region"] = region_flip(data["flip"], masks)
@@ -498,7 +514,7 @@ def run(quick: bool = False, ctx=None, scenes: int | None = None, seed: int | No
     for number, scene in enumerate(chosen, 1):
         row, pictures = measure_scene(ctx, dict(scene), size, spp, own, repeats=3 if quick else 5,
                                       start_spp=QUICK_START_SPP if quick else START_SPP,
-                                      budget_s=QUICK_REFERENCE_BUDGET_S if quick else REFERENCE_BUDGET_S)
+                                      budget_cpu_s=QUICK_REFERENCE_BUDGET_CPU_S if quick else REFERENCE_BUDGET_CPU_S)
         rows.append(row)
         images[row["label"]] = pictures
         if rows_out is not None:
@@ -590,7 +606,7 @@ def markdown_tables(result: dict) -> dict[str, str]:
         f"< 1/5 of the FLIP judged: {s['scenes'] - s['scenes_noise_not_below_fifth']} of {s['scenes']} scenes |",
         "",
         f"Where the noise rule (the reference's noise below a fifth of the FLIP it judges) does not "
-        f"hold at the spp a reference ended with (its cap or its time budget), it would need "
+        f"hold at the spp a reference ended with (its cap or its CPU-time budget), it would need "
         f"{s.get('spp_for_noise_rule_median', 0):,.0f} spp at the median scene (noise ~ 1 / sqrt(spp)); "
         f"all the references at the spp they need would take "
         f"{s.get('reference_s_for_noise_rule_total', 0) / 3600:.1f} h on this machine.",

@@ -143,12 +143,15 @@ def describe_bench_scene(fabric: str, light_key: str, view: str, size):
     """The scene description of one of the section's scenes (fabric, light key of SCENES,
     view of VIEWS) at ``size``."""
     from catalog.optics.lights import get_light  # noqa: PLC0415
+    from catalog.pathtrace.render import reference_settings  # noqa: PLC0415
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
     yaw, pitch, distance = VIEWS[view]
-    return describe_scene(load_preset(find_preset(fabric)), get_light(light_name(light_key)),
-                          size=tuple(size), yaw_deg=yaw, pitch_deg=pitch, distance_m=distance)
+    return describe_scene(reference_settings(load_preset(find_preset(fabric)),
+                                             get_light(light_name(light_key)), yaw_deg=yaw,
+                                             pitch_deg=pitch, distance_m=distance),
+                          size=tuple(size))
 
 
 def reference_variant_for(inputs) -> str:

@@ -145,6 +145,10 @@ def study_main(module, argv: list[str] | None = None, make_result=None,
     except CatalogError as exc:
         print(f"{short}: error: {exc}", file=sys.stderr)
         return exc.exit_code
+    if isinstance(result, dict) and "machine" not in result:
+        # every published result names the commit and machine it was measured on
+        # (tools/figures_age.py dates it by that commit, tools/docs_figures.py prints it)
+        result["machine"] = machine_info()
     write_text_atomic(args.json_out, json.dumps(result, indent=1, default=float) + "\n")
     for name, text in module.markdown_tables(result).items():
         print(f"<!-- generated:{name} -->\n{text}\n<!-- /generated:{name} -->\n")

@@ -64,6 +64,7 @@ def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int, cache_dir
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace import metrics  # noqa: PLC0415
+    from catalog.pathtrace.render import reference_settings  # noqa: PLC0415
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
@@ -77,8 +78,10 @@ def accuracy(scenes: int, seed: int, rooms: list[str], size, spp: int, cache_dir
             preset = load_preset(find_preset(scene["fabric"]))
             light = get_light(scene["light"])
             cam = scene["camera"]
-            desc = describe_scene(preset, light, size=tuple(size), yaw_deg=cam["yaw_deg"],
-                                  pitch_deg=cam["pitch_deg"], distance_m=cam["distance_m"], room=room)
+            desc = describe_scene(reference_settings(preset, light, yaw_deg=cam["yaw_deg"],
+                                                     pitch_deg=cam["pitch_deg"],
+                                                     distance_m=cam["distance_m"], room=room),
+                                  size=tuple(size))
             scene["_desc"] = desc
             halves = cached_reference(acc, scene, size, spp, own, cache_dir)
             scene.pop("_desc")

@@ -55,6 +55,7 @@ def run(fabric: str = "linen-dense", spp: int = 256, hours=HOURS) -> dict:
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.pathtrace.backend import load_mitsuba  # noqa: PLC0415
+    from catalog.pathtrace.render import reference_settings  # noqa: PLC0415
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
     from catalog.render.scene import sun_at_hour  # noqa: PLC0415
@@ -65,7 +66,7 @@ def run(fabric: str = "linen-dense", spp: int = 256, hours=HOURS) -> dict:
     rows = []
     for hour in hours:
         light = get_light(sun_at_hour(hour).light_name)
-        desc = describe_scene(preset, light, size=SIZE)
+        desc = describe_scene(reference_settings(preset, light), size=SIZE)
         halves = render_halves(mi, desc, spp)
         frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=1)
         mask = binary_erosion(halves["masks"]["curtain"], iterations=1)

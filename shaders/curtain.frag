@@ -24,7 +24,7 @@ uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to th
 #ifdef OIT
 uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth weight is 1
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
 INTERPOLATION in vec3 v_position;
 #endif
 
@@ -128,15 +128,11 @@ float g_room_lamp[N_ROOM_LAMPS];   // G / r^2 of each lamp at this fragment (set
 // was 1.15-1.55x the path tracer's.
 SCENE_VALUE(vec4, u_key_thread[NV4], S_KEY_THREAD);
 SCENE_VALUE(vec4, u_key_thread2[NV4], S_KEY_THREAD2);
-uniform sampler2D u_key_front;     // r: the nearest layer's coverage, a: its depth (0..1)
-uniform sampler2D u_key_second;    // the same of the second layer (cleared: coverage 0)
-uniform mat4 u_light_view_proj;
-uniform float u_key_normal_offset; // m: the lookup's offset along the normal at a grazing key
-uniform vec3 u_key_depth_bias;     // depth (0..1 units) a fragment must lie behind to be shaded:
-                                   // x + y tan(normal, key), the tangent at most z (slope-scaled)
-uniform vec4 u_window_rect;
-uniform vec2 u_wall_z;
-uniform float u_tan_sun_radius;
+// The window's mask and the two layers' coverage do not depend on the view: they are baked
+// over the fabric's uv when the light or the mesh changes (key_visibility.frag: r the mask,
+// g, b the first and second layers' coverage) and read here with one bilinear lookup.
+uniform sampler2D u_key_visibility;
+INTERPOLATION in vec2 v_key_uv;
 float g_key_beam = 1.0;            // the window's mask (set in main)
 float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
 float g_second_coverage = 0.0;     // coverage of a second layer in front (0: none; set in main)
@@ -288,26 +284,10 @@ void main() {
     float key_uv = 1.0;   // the key's excitation reaching the fragment (KEY_SHADOW)
 #ifdef KEY_SHADOW
     {
-        // the window's mask where the key shines through it (a light in the room: none)
-        g_key_beam = u_key_to_light.z < 0.0
-                   ? room_window_beam(v_position, u_key_to_light, u_window_rect, u_wall_z, u_tan_sun_radius)
-                   : 1.0;
-        // the lookup moved off the cloth towards the light along its normal, by
-        // u_key_normal_offset x sin(normal, key) (normal-offset shadows: a flank lit at a
-        // grazing angle does not shade itself, without a depth bias that would let a fold
-        // close in front of it through)
-        vec3 n_geometric = normalize(v_normal);
-        float facing = dot(n_geometric, u_key_to_light);
-        float cos_surface = abs(facing);
-        vec3 offset = n_geometric * ((facing >= 0.0 ? 1.0 : -1.0) * u_key_normal_offset
-                                     * sqrt(max(1.0 - cos_surface * cos_surface, 0.0)));
-        vec4 clip = u_light_view_proj * vec4(v_position + offset, 1.0);
-        float tan_surface = min(sqrt(max(1.0 - cos_surface * cos_surface, 0.0)) / max(cos_surface, 1e-3),
-                                u_key_depth_bias.z);
-        vec2 layers = front_layers_coverage(u_key_front, u_key_second, clip.xyz * 0.5 + 0.5,
-                                            u_key_depth_bias.x + u_key_depth_bias.y * tan_surface);
-        g_front_coverage = layers.x;
-        g_second_coverage = layers.y;
+        vec3 visibility = texture(u_key_visibility, v_key_uv).rgb;
+        g_key_beam = visibility.r;
+        g_front_coverage = visibility.g;
+        g_second_coverage = visibility.b;
         key_uv = g_key_beam * (1.0 - g_front_coverage) * (1.0 - g_second_coverage);   // UV passes the holes only
 #ifdef ROOM_CAPTURE
         g_key_reach = g_key_beam * (1.0 - g_front_coverage * (1.0 - u_capture_thread))

@@ -16,8 +16,13 @@
 in vec3 in_position;
 in vec3 in_normal;
 in vec3 in_tangent;
-#ifdef PATTERN
+#if defined(PATTERN) || defined(KEY_SHADOW)
 in vec2 in_uv;                       // 0..1 across the fabric (u: weft), 0..1 along it (v: warp)
+#endif
+#ifdef KEY_SHADOW
+INTERPOLATION out vec2 v_key_uv;     // the key's visibility baked over uv (key_visibility.frag)
+#endif
+#ifdef PATTERN
 uniform vec2 u_uv_to_repeats;        // fabric size / pattern repeat: uv -> pattern repeats
 INTERPOLATION out vec2 v_pattern_uv;
 #endif
@@ -90,7 +95,7 @@ INTERPOLATION out vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 INTERPOLATION out vec3 v_tangent;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
 INTERPOLATION out vec3 v_position;
 #endif
 
@@ -104,8 +109,11 @@ void main() {
 #ifdef PATTERN
     v_pattern_uv = in_uv * u_uv_to_repeats;
 #endif
-#if defined(GBUFFER) || defined(N_ROOM_LAMPS) || defined(KEY_SHADOW)
+#if defined(GBUFFER) || defined(N_ROOM_LAMPS)
     v_position = position;
+#endif
+#ifdef KEY_SHADOW
+    v_key_uv = in_uv;
 #endif
 #ifdef SKY_OCCLUSION
     v_occlusion = texelFetch(u_vertex_occlusion, ivec2(gl_VertexID % u_vertex_occlusion_width,

@@ -223,13 +223,12 @@ MAY_READ = {
     "catalog/render/settings.py": "the edge's resolution: a preset name, the environment image",
     "catalog/render/snapshot.py": "the snapshot command: its request resolved (the edge)",
     "catalog/render/sheet.py": "the sheet command: its presets resolved (the edge)",
-    "catalog/pathtrace/render.py": "the reference command: its request resolved (the edge)",
+    "catalog/pathtrace/render.py": "the reference's scene resolved (reference_settings: the edge)",
     "catalog/render/environment.py": "the environment image's reader (settings call it)",
     "catalog/render/imagefile.py": "image files written and read back (the commands' outputs)",
     "catalog/render/display.py": "the display's own tables (package data, not the scene)",
     "catalog/render/room_light/geometry.py": "the room's stored ambient occlusion (package data)",
     "catalog/cloth/drape_cache.py": "the drape cache (results kept, not inputs)",
-    "catalog/pathtrace/scene.py": "describe_scene's library callers may name a room; catalog reference resolves it at the edge (pathtrace/render.validate) and passes the Room",
     "catalog/render/room_operators.py": "the room's bundle: read from its cache (or built) when the settings name a room (not yet resolved at the edge)",
 }
 #: What reads a file: a call of open(), np.load, json/tomllib/pickle/trimesh.load, an image

@@ -158,10 +158,13 @@ def desc_preset(name):
 
 def _lace_d65(size=(48, 36), **kw):
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import describe_scene
     from catalog.presets import find_preset, load_preset
 
-    return describe_scene(load_preset(find_preset("lace-fwa")), get_light("D65"), size=size, **kw)
+    scene_kw = {k: kw.pop(k) for k in ("yaw_deg", "pitch_deg", "distance_m", "fluorescence", "room") if k in kw}
+    return describe_scene(reference_settings(load_preset(find_preset("lace-fwa")), get_light("D65"), **scene_kw),
+                          size=size, **kw)
 
 
 @pytest.mark.slow
@@ -417,14 +420,17 @@ def test_the_pareto_plot_numbers_its_points(tmp_path):
 
 def test_a_sun_brings_the_frames_clear_sky_into_the_environment():
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import describe_scene, environment_map, texel_directions
     from catalog.render import scene as scene_lib
 
     d = scene_lib.draped_curtain(20, 10)
     curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
-    lamp = describe_scene(desc_preset("voile-white"), get_light("D65"), size=(8, 6), curtain=curtain)
+    lamp = describe_scene(reference_settings(desc_preset("voile-white"), get_light("D65")),
+                          size=(8, 6), curtain=curtain)
     assert lamp.sky is None  # a lamp: the flat lit backdrop, as the frame draws it
-    sun = describe_scene(desc_preset("voile-white"), get_light("sun:100"), size=(8, 6), curtain=curtain)
+    sun = describe_scene(reference_settings(desc_preset("voile-white"), get_light("sun:100")),
+                         size=(8, 6), curtain=curtain)
     assert sun.sky is not None
     env = environment_map(sun.sky_rgb, sun.ground_rgb, np.zeros(3), sun.key_to_light, 0.005,
                           width=64, sky=sun.sky)
@@ -443,6 +449,7 @@ def test_the_reference_builds_the_frames_shading_inputs(gl, light):
     import dataclasses
 
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import describe_scene
     from catalog.render import scene as scene_lib
     from catalog.render.frame import FrameRenderer
@@ -450,7 +457,8 @@ def test_the_reference_builds_the_frames_shading_inputs(gl, light):
     d = scene_lib.draped_curtain(20, 10)
     curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
     preset = desc_preset("lace-fwa")
-    desc = describe_scene(preset, get_light(light), size=(8, 6), curtain=curtain)
+    desc = describe_scene(reference_settings(preset, get_light(light)),
+                          size=(8, 6), curtain=curtain)
     r = FrameRenderer(gl, (8, 6))
     r.update(fabric=preset, light=light)
     frame = r.shading_inputs()
@@ -507,11 +515,13 @@ def test_glow_reaches_the_room_alike_by_emitter_and_by_bsdf_sampling(mi):
     pixels (measured 2.4 % at 96x72 and 1024 spp, where BSDF sampling is the noisier side)."""
     from catalog.optics.lights import get_light
     from catalog.pathtrace.render import region_masks
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
     from catalog.presets import find_preset, load_preset
 
-    desc = describe_scene(load_preset(find_preset("lace-fwa")), get_light("UV-A"), size=(96, 72),
-                          yaw_deg=20.0, pitch_deg=15.0, distance_m=2.6)
+    desc = describe_scene(reference_settings(load_preset(find_preset("lace-fwa")), get_light("UV-A"),
+                                             yaw_deg=20.0, pitch_deg=15.0, distance_m=2.6),
+                          size=(96, 72))
     means = []
     for emitter_samples, bsdf_samples in ((1, 0), (0, 1)):
         scene = build_mitsuba_scene(mi, desc, environment=False, integrator={
@@ -532,10 +542,13 @@ def test_glow_shells_lie_on_the_cloth_finer_than_its_mesh():
     the curtain's own triangles (midpoints of midpoints: the same plane, 1e-9 m), the normals
     are unit and the uvs stay in [0, 1]; the total area is unchanged (1e-9 relative)."""
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import GLOW_SUBDIVISIONS, describe_scene, glow_shell_mesh
     from catalog.presets import find_preset, load_preset
 
-    desc = describe_scene(load_preset(find_preset("voile-white")), get_light("D65"), size=(8, 8))
+    desc = describe_scene(reference_settings(load_preset(find_preset("voile-white")),
+                                             get_light("D65")),
+                          size=(8, 8))
     positions, _normals, _uvs, _tangents, indices = desc.curtain
     p0 = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     t0 = np.asarray(indices).reshape(-1, 3)
@@ -565,10 +578,13 @@ def test_the_key_reaches_the_glow_through_cloth_not_through_the_wall(mi):
     in the room behind the curtain's middle, and by the floor where the ray meets the wall
     under the sill."""
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene, key_visibility
     from catalog.presets import find_preset, load_preset
 
-    desc = describe_scene(load_preset(find_preset("voile-white")), get_light("D65"), size=(8, 8))
+    desc = describe_scene(reference_settings(load_preset(find_preset("voile-white")),
+                                             get_light("D65")),
+                          size=(8, 8))
     scene = build_mitsuba_scene(mi, desc)
     points = np.array([[0.0, 0.2, -0.6], [0.0, 0.2, 0.4], [0.0, -1.25, 0.3]])
     visible = key_visibility(desc, scene, mi, points)
@@ -583,6 +599,7 @@ def test_the_key_reaches_the_glow_through_each_layer_of_cloth(mi):
     window: LD between them, LD^2 behind both (LD before, for any number of layers), as the
     frame's two-layer key shadow passes the excitation through the holes of each."""
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene, key_visibility
     from catalog.presets import find_preset, load_preset
     from catalog.render import scene as scene_lib
@@ -594,8 +611,9 @@ def test_the_key_reaches_the_glow_through_each_layer_of_cloth(mi):
     curtain = (np.concatenate([front, back]), np.concatenate([sheet.normals] * 2),
                np.concatenate([sheet.uvs] * 2), np.concatenate([sheet.tangents] * 2),
                np.concatenate([sheet.indices, sheet.indices + count]))
-    desc = describe_scene(load_preset(find_preset("voile-white")), get_light("D65"), size=(8, 8),
-                          curtain=curtain)
+    desc = describe_scene(reference_settings(load_preset(find_preset("voile-white")),
+                                             get_light("D65")),
+                          size=(8, 8), curtain=curtain)
     scene = build_mitsuba_scene(mi, desc)
     z = float(np.mean(sheet.positions[:, 2]))
     points = np.array([[0.0, 0.3, z], [0.0, 0.3, z + 0.3]])   # between the sheets, behind both
@@ -612,10 +630,12 @@ def test_the_dye_per_channel_reproduces_the_dyed_key(fabric, light):
     saturated dye may be negative in a channel (safety-yellow's blue under D65), as the
     frame's linear bands carry it."""
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import describe_scene, rgb_weights
 
     d = scene_lib_draped()
-    desc = describe_scene(desc_preset(fabric), get_light(light), size=(8, 6), curtain=d)
+    desc = describe_scene(reference_settings(desc_preset(fabric), get_light(light)),
+                          size=(8, 6), curtain=d)
     w = rgb_weights(desc.inputs.key_irradiance)
     dyed = w @ (desc.inputs.key_irradiance * desc.inputs.dye_transmittance)
     assert np.allclose(desc.fabric["dye_rgb"] * desc.key_rgb, dyed, rtol=1e-9, atol=1e-12)
@@ -647,6 +667,7 @@ def _safety_yellow_under_the_lamp(gl, depth_m: float):
     """The safety-yellow under the UV lamp (physical fluorescence) on the static drape folded
     ``depth_m`` deep, 8 x 6: (the renderer after one frame, the scene's description)."""
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import describe_scene
     from catalog.render import scene as scene_lib
     from catalog.render.frame import FrameRenderer
@@ -655,7 +676,7 @@ def _safety_yellow_under_the_lamp(gl, depth_m: float):
     curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
     preset = desc_preset("safety-yellow")
     light = get_light("UV-A")
-    desc = describe_scene(preset, light, size=(8, 6), curtain=curtain)
+    desc = describe_scene(reference_settings(preset, light), size=(8, 6), curtain=curtain)
     r = FrameRenderer(gl, (8, 6))
     r.update(fabric=preset, light=light, fluorescence="physical")
     r.set_mesh(*curtain)
@@ -800,6 +821,7 @@ def test_the_folds_light_the_shadowed_flanks_as_the_path_tracer_does(gl, mi):
     yaw_deg = -15.0
     from catalog.optics.lights import get_light
     from catalog.pathtrace.render import MAX_DEPTH, region_masks, render_radiance
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
     from catalog.render import scene as scene_lib
     from catalog.render.frame import FrameRenderer
@@ -809,8 +831,9 @@ def test_the_folds_light_the_shadowed_flanks_as_the_path_tracer_does(gl, mi):
     preset = desc_preset("lace-fwa")
     light = get_light("UV-A")
     size = (96, 72)
-    desc = describe_scene(preset, light, size=size, yaw_deg=yaw_deg, pitch_deg=5.0, distance_m=1.1,
-                          curtain=curtain)
+    desc = describe_scene(reference_settings(preset, light, yaw_deg=yaw_deg, pitch_deg=5.0,
+                                             distance_m=1.1),
+                          size=size, curtain=curtain)
     reference = render_radiance(mi, build_mitsuba_scene(mi, desc, max_depth=MAX_DEPTH), 128, seed=0)
     masks = region_masks(mi, build_mitsuba_scene(mi, desc, max_depth=2), desc)
     r = FrameRenderer(gl, size)
@@ -837,23 +860,24 @@ import numpy as np
 from catalog.optics.lights import get_light
 from catalog.pathtrace.backend import load_mitsuba
 from catalog.pathtrace.render import region_masks, render_radiance
+from catalog.pathtrace.render import reference_settings
 from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
 from catalog.presets import find_preset, load_preset
 from catalog.render import scene as scene_lib
 
 d = scene_lib.draped_curtain(columns=24, rows=16, depth_m=0.0)
 curtain = (d.positions, d.normals, d.uvs, d.tangents, d.indices)
-desc = describe_scene(load_preset(find_preset("lace-fwa")), get_light("UV-A"), size=(32, 24),
-                      distance_m=0.6, curtain=curtain)
+desc = describe_scene(reference_settings(load_preset(find_preset("lace-fwa")), get_light("UV-A"),
+                                         distance_m=0.6), size=(32, 24), curtain=curtain)
 out = {"emission": np.asarray(desc.fluorescence["emission_spectrum"]).tolist()}
 # the room under the UV lamp without the glow, a white cloth: the lamp's visible leak alone (out of gamut)
-room = dataclasses.replace(describe_scene(load_preset(find_preset("voile-white")), get_light("UV-A"),
-                                          size=(32, 24), yaw_deg=20.0, pitch_deg=15.0, distance_m=2.6,
-                                          curtain=curtain), fluorescence=None)
+room = dataclasses.replace(describe_scene(reference_settings(load_preset(find_preset("voile-white")), get_light("UV-A"),
+                                                             yaw_deg=20.0, pitch_deg=15.0, distance_m=2.6),
+                                          size=(32, 24), curtain=curtain), fluorescence=None)
 # the lamp-lit outside through the open window: the curtain moved behind the camera
 away = (d.positions + np.array([0.0, 0.0, 4.0]), d.normals, d.uvs, d.tangents, d.indices)
-outside = dataclasses.replace(describe_scene(load_preset(find_preset("voile-white")), get_light("UV-A"),
-                                             size=(32, 24), distance_m=2.0, curtain=away),
+outside = dataclasses.replace(describe_scene(reference_settings(load_preset(find_preset("voile-white")), get_light("UV-A"),
+                                                                distance_m=2.0), size=(32, 24), curtain=away),
                               fluorescence=None)
 for variant in ("llvm_ad_rgb", "llvm_ad_spectral"):
     m = load_mitsuba(variant)
@@ -989,6 +1013,7 @@ def test_the_spectral_key_and_backdrop_keep_their_luminance():
     Mitsuba's normalisation) equals the RGB key's, under the UV lamp (whose RGB is out of
     gamut) and D65 (1e-9)."""
     from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import describe_scene, film_luminance, in_gamut_same_luminance, key_spectrum
 
     luma = np.array([0.2126, 0.7152, 0.0722])
@@ -1000,7 +1025,8 @@ def test_the_spectral_key_and_backdrop_keep_their_luminance():
     np.testing.assert_allclose(mapped @ luma, np.clip(outside @ luma, 0, None), rtol=1e-9)
     assert not in_gamut_same_luminance(np.array([[-1.0, -1.0, 0.5]])).any()
     for light in ("UV-A", "D65"):
-        desc = describe_scene(desc_preset("voile-white"), get_light(light), size=(8, 6))
+        desc = describe_scene(reference_settings(desc_preset("voile-white"), get_light(light)),
+                              size=(8, 6))
         wavelengths, values = key_spectrum(desc)
         assert np.all(values >= 0)
         np.testing.assert_allclose(film_luminance(wavelengths, values), desc.key_rgb @ luma, rtol=1e-9)
@@ -1017,10 +1043,12 @@ def test_the_window_filter_gives_the_outside_the_keys_spectrum():
     texel's luminance, negative channels included (1e-6)."""
     from catalog.optics.lights import get_light
     from catalog.pathtrace import window_filter
+    from catalog.pathtrace.render import reference_settings
     from catalog.pathtrace.scene import describe_scene, film_luminance, key_spectrum
 
     luma = np.array([0.2126, 0.7152, 0.0722])
-    desc = describe_scene(desc_preset("voile-white"), get_light("UV-A"), size=(8, 6))
+    desc = describe_scene(reference_settings(desc_preset("voile-white"), get_light("UV-A")),
+                          size=(8, 6))
     wavelengths, values = key_spectrum(desc)
     d65 = 1.0 + 0.3 * np.sin(wavelengths / 40.0)   # any positive spectrum stands in for it
     y = film_luminance(wavelengths, values)
@@ -1030,12 +1058,16 @@ def test_the_window_filter_gives_the_outside_the_keys_spectrum():
     assert not window_filter.transmission(values, 0.0, d65).any()
     assert window_filter.outside_carries_key_spectrum(desc)
     assert window_filter.outside_carries_key_spectrum(
-        describe_scene(desc_preset("voile-white"), get_light("D65"), size=(8, 6)))
+        describe_scene(reference_settings(desc_preset("voile-white"), get_light("D65")),
+                       size=(8, 6)))
     assert not window_filter.outside_carries_key_spectrum(
-        describe_scene(desc_preset("voile-white"), get_light("sun:1.5"), size=(8, 6)))
+        describe_scene(reference_settings(desc_preset("voile-white"), get_light("sun:1.5")),
+                       size=(8, 6)))
     # from outside the camera would see the room through the sheet: none there
     assert window_filter.sheet_applies(desc)
-    outside = describe_scene(desc_preset("voile-white"), get_light("UV-A"), size=(8, 6), yaw_deg=180.0)
+    outside = describe_scene(reference_settings(desc_preset("voile-white"), get_light("UV-A"),
+                                                yaw_deg=180.0),
+                             size=(8, 6))
     assert outside.camera_position[2] < -0.5
     assert not window_filter.sheet_applies(outside)
     env = np.array([[[0.29, -0.27, 2.06], [0.1, 0.2, 0.3]]])

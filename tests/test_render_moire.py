@@ -69,11 +69,10 @@ def test_mip_chain_keeps_the_mean_and_removes_what_a_level_cannot_hold():
     assert all(c.min() >= 0.0 and c.max() <= 1.0 for c in chain)
 
 
-@pytest.mark.gl
-@pytest.mark.slow
-@pytest.mark.parametrize("fabric", ["lace-fwa", "raschel-ivory", "jacquard-white"])
-def test_no_energy_above_nyquist_at_any_distance(gl, fabric):
+def _sweep(gl, fabric: str, prefilter: bool = True) -> list[float]:
+    """The share above the 1x Nyquist at each of 8 distances, 0.3-4 m (the quad face on)."""
     renderer = FrameRenderer(gl, (96 * SUPERSAMPLE, 64 * SUPERSAMPLE))
+    renderer.fabric_pattern.set_prefilter(prefilter)
     renderer.update(fabric=fabric, light="D65")
     renderer.set_mesh(*_quad_mesh(), fabric_size_m=(1.8, 2.05))
     renderer.update(ev=12.0)
@@ -85,5 +84,25 @@ def test_no_energy_above_nyquist_at_any_distance(gl, fabric):
         renderer.render()
         shares.append(energy_above_nyquist(renderer.read_linear()))
     renderer.release()
-    print(fabric, " ".join(f"{s:.4f}" for s in shares))
-    assert max(shares) <= 0.015, shares
+    print(fabric, "prefiltered" if prefilter else "box", " ".join(f"{s:.4f}" for s in shares))
+    return shares
+
+
+#: The share of the image's energy the prefilter may leave above the pixel's Nyquist.
+MOIRE_BOUND = 0.015
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+@pytest.mark.parametrize("fabric", ["lace-fwa", "raschel-ivory", "jacquard-white"])
+def test_no_energy_above_nyquist_at_any_distance(gl, fabric):
+    shares = _sweep(gl, fabric)
+    assert max(shares) <= MOIRE_BOUND, shares
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_the_measure_sees_the_box_chains_moire(gl):
+    """The same sweep with the hardware's 2x2 box chain (the mips before): the net folds into
+    stripes and the share rises over the bound (measured 4.2 % at 1.3-1.9 m; prefiltered 0.8 %)."""
+    assert max(_sweep(gl, "lace-fwa", prefilter=False)) > MOIRE_BOUND

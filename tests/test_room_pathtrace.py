@@ -11,10 +11,10 @@ from catalog.core.errors import InputError
 
 
 def test_reference_refuses_an_unknown_room():
-    from catalog.pathtrace.render import ReferenceRequest, validate
+    from catalog.pathtrace.render import reference_settings
 
     with pytest.raises(InputError, match="--room.*unknown room 'attic'"):
-        validate(ReferenceRequest(fabric="lace-fwa", light="D65", size=(32, 24), out=None, room="attic"))
+        reference_settings("lace-fwa", "D65", room="attic")
 
 
 _LIVING_ROOM_RENDER = """
@@ -22,13 +22,14 @@ import json
 import numpy as np
 from catalog.optics.lights import get_light
 from catalog.pathtrace.backend import load_mitsuba
-from catalog.pathtrace.render import region_masks, render_radiance
+from catalog.pathtrace.render import reference_settings, region_masks, render_radiance
 from catalog.pathtrace.scene import build_mitsuba_scene, describe_scene
 from catalog.presets import find_preset, load_preset
 
 mi = load_mitsuba()
-desc = describe_scene(load_preset(find_preset("lace-fwa")), get_light("D65"), size=(64, 48),
-                      pitch_deg=30.0, fluorescence="off", room="living")
+desc = describe_scene(reference_settings(load_preset(find_preset("lace-fwa")), get_light("D65"),
+                                         pitch_deg=30.0, fluorescence="off", room="living"),
+                      size=(64, 48))
 floor = next(s for s in desc.room_surfaces if s.name == "floor")
 scene = build_mitsuba_scene(mi, desc, max_depth=8)
 pixels = render_radiance(mi, scene, spp=8)

@@ -380,6 +380,30 @@ def test_float_texels_quantised_within_half_a_step():
     assert decode_texels({"dtype": "f1", "components": 4, **encode_texels(raw, {"dtype": "f1", "components": 4})}).tobytes() == raw
 
 
+def test_given_mip_levels_travel_after_level_0():
+    """A texture the frame filled and whose levels 1..n it wrote: one quantised block, level 0
+    then each level (w >> k by h >> k), ``levels`` n; no levels without them; a gap refused."""
+    from catalog.core.errors import CatalogError
+    from catalog.web.export import decode_texels, given_texels
+    from catalog.web.record import Recording
+
+    rng = np.random.default_rng(5)
+    levels = [rng.uniform(0, 1, (8 >> k, 4 >> k, 4)).astype("f4") for k in range(3)]
+    rec = Recording()
+    rec.textures[7] = {"dtype": "f4", "components": 4, "size": [4, 8], "mipmaps": True}
+    rec.texture_data[7] = levels[0].tobytes()
+    assert "levels" not in given_texels(rec, 7) and given_texels(rec, 8) == {}
+    rec.texture_levels[7] = {1: levels[1].tobytes(), 2: levels[2].tobytes()}
+    entry = given_texels(rec, 7)
+    assert entry["levels"] == 2
+    back = decode_texels({**rec.textures[7], **entry})
+    want = np.concatenate([lv.ravel() for lv in levels])
+    assert back.shape == want.shape and np.max(np.abs(back - want)) <= 0.5 / 255 + 1e-6
+    rec.texture_levels[7] = {2: levels[2].tobytes()}
+    with pytest.raises(CatalogError, match="levels 1..n"):
+        given_texels(rec, 7)
+
+
 @pytest.mark.gl
 @pytest.mark.slow
 def test_site_carries_each_fabrics_pattern(web_site):
@@ -388,7 +412,7 @@ def test_site_carries_each_fabrics_pattern(web_site):
     (TEXEL_BITS), decoding to the desktop's texels within half a quantum per channel."""
     from catalog.presets import load_preset
     from catalog.core.resources import FABRIC_DIR
-    from catalog.presets.patterns import load_pattern
+    from catalog.presets.patterns import load_pattern, mip_chain
     from catalog.web.export import DESKTOP_MODES, decode_texels
 
     assert DESKTOP_MODES["patterned"] is True and DESKTOP_MODES["room_lighting"] is True
@@ -409,8 +433,13 @@ def test_site_carries_each_fabrics_pattern(web_site):
         assert match, f"no {w}x{h} pattern texture for {name}"
         q = match[0]["quantised"]
         half_step = (np.array(q["hi"]) - np.array(q["lo"])) / (2 * ((1 << q["bits"]) - 1))
-        assert min(np.max(np.abs(decode_texels(t).reshape(h, w, 4) - texels) - half_step)
-                   for t in match) <= 1e-6
+        assert min(np.max(np.abs(decode_texels(t)[:h * w * 4].reshape(h, w, 4) - texels)
+                          - half_step) for t in match) <= 1e-6
+        # and the desktop's prefiltered levels after level 0 (the page writes them over its chain)
+        chain = mip_chain(texels)
+        level_1 = decode_texels(match[0])[h * w * 4:][:(h >> 1) * (w >> 1) * 4]
+        assert match[0]["levels"] == len(chain) - 1
+        assert np.max(np.abs(level_1.reshape(h >> 1, w >> 1, 4) - chain[1]) - half_step) <= 1e-5
 
 
 def test_packed_data_round_trips_and_is_smaller():

@@ -131,6 +131,18 @@ DYES = {
     # natural flax (unbleached linen): an ecru that absorbs across the blue and a little of
     # the green (CIELAB a* ~ 1, b* ~ 8 on screen), less yellow than cream
     "flax": lambda wl: 0.90 - 0.30 * (1 - _sigmoid(wl, 520.0, 45.0)),
+    # fully bleached cotton without brightener: what peroxide bleaching leaves of the fibre's
+    # natural pigments is an absorption edge tailing from the UV into the blue (reflectance
+    # about 0.75 at 400 nm, 0.86 at 460 nm, flat 0.9 above 550 nm with an albedo of 0.9): CIE
+    # whiteness 75, ASTM E313 yellowness 5.3 (bleached cottons without brightener: 60-80)
+    "bleached-cotton": lambda wl: 1.0 - 0.25 * np.exp(-(wl - 380.0) / 48.0),
+    # a white nylon tulle's shading ("bluing") dye: a violet acid dye's weak absorption band
+    # round 565 nm takes the yellow-green the fibre's own yellowness would show, so the white
+    # reads cool beside an unshaded one
+    "violet-shading": lambda wl: 1.0 - 0.10 * _gauss(wl, 565.0, 45.0),
+    # a deeper ivory (a Raschel lace's heavier cotton-look yarn): the blue absorbed further into
+    # the cyan than the faint ivory
+    "ivory-deep": lambda wl: 0.97 - 0.40 * (1 - _sigmoid(wl, 470.0, 30.0)),
 }
 
 CATALOG: tuple[YarnFabric, ...] = (
@@ -160,14 +172,15 @@ CATALOG: tuple[YarnFabric, ...] = (
                crossings=3.0, albedo=0.95, sigma_x_deg=9.0, sigma_y_deg=9.0, dye="grey",
                seed=109, cloth={"areal_density_kg_m2": 0.035}),
     YarnFabric("raschel-ivory", "Ivory Raschel lace", "lace", 0.18, 0.40, 0.16, 0.38, 0.24,
-               crossings=3.2, albedo=0.94, sigma_x_deg=8.0, sigma_y_deg=7.0, dye="ivory",
+               crossings=3.2, albedo=0.94, sigma_x_deg=8.0, sigma_y_deg=7.0, dye="ivory-deep",
                seed=111, cloth={"areal_density_kg_m2": 0.07}),
     YarnFabric("tulle-embroidered", "White embroidered tulle", "lace", 0.10, 0.40, 0.10,
                0.40, 0.14, crossings=2.5, albedo=0.95, sigma_x_deg=8.0, sigma_y_deg=8.0,
-               seed=112, cloth={"areal_density_kg_m2": 0.04}),
+               dye="violet-shading", seed=112, cloth={"areal_density_kg_m2": 0.04}),
     YarnFabric("jacquard-white", "White jacquard", "satin", 0.30, 0.34, 0.28, 0.31, 0.45,
                crossings=6.0, albedo=0.93, sigma_x_deg=10.0, sigma_y_deg=7.0,
-               back_scale=3.5, seed=110, cloth={"areal_density_kg_m2": 0.26}),
+               back_scale=3.5, dye="bleached-cotton", seed=110,
+               cloth={"areal_density_kg_m2": 0.26}),
 )
 
 

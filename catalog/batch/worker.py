@@ -199,15 +199,17 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
 def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> None:
     from catalog.optics.lights import get_light  # noqa: PLC0415
     from catalog.presets import load_preset  # noqa: PLC0415
-    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.render.settings import FrameSettings  # noqa: PLC0415
     from catalog.render.snapshot import (FRAME_DT_S, SnapshotRequest,  # noqa: PLC0415
-                                         configure_renderer, curtain_on_rod, curtain_simulation,
-                                         image_metadata, ring_xs_m)
+                                         curtain_on_rod, curtain_simulation, image_metadata,
+                                         ring_xs_m, snapshot_settings)
 
     t0 = time.perf_counter()
     preset = load_preset(task.preset_path)
-    scene_lib.dye_transmittance(preset)
-    scene_lib.fluorescent_material(preset)
+    # the task's scene value, resolved once here (the edge): the fabric's tables read, its
+    # choices checked; each image draws it with its own light and camera
+    task_scene = FrameSettings(fabric=preset, fluorescence=task.fluorescence, bands=task.bands,
+                               exposure=task.exposure, room=task.room)
     lights = {name: get_light(name) for name in sorted({image.light for image in todo})}
     from catalog.render.placement import room_placement  # noqa: PLC0415
 
@@ -242,7 +244,7 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
                                       yaw_deg=image.yaw_deg, pitch_deg=task.pitch_deg,
                                       distance_m=task.distance_m, exposure=task.exposure,
                                       room=task.room)
-            configure_renderer(renderer, request, preset, lights[image.light])
+            renderer.update(snapshot_settings(request, preset, lights[image.light], base=task_scene))
             renderer.display.forget_white()   # each image adapts to its own view, as a snapshot
             if image is by_frame[frame][0]:
                 # once a frame: a new mesh makes the room's light be drawn again, which the

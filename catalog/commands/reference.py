@@ -42,20 +42,23 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> int:
+    import dataclasses  # noqa: PLC0415
     from pathlib import Path  # noqa: PLC0415
 
     from catalog.core.jsonout import print_json  # noqa: PLC0415
-    from catalog.pathtrace.render import ReferenceRequest, render_reference  # noqa: PLC0415
+    from catalog.pathtrace.render import (ReferenceRequest, check_options,  # noqa: PLC0415
+                                          reference_settings, render_reference)
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
-    # the camera is kept inside the room (its own inside: catalog.render.placement) as
-    # catalog snapshot keeps it, where the room is loaded (catalog.pathtrace.render.describe)
-    distance = args.distance
-    request = ReferenceRequest(
-        fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
-        spp=args.spp, frame=args.frame, distance_m=distance, yaw_deg=args.yaw,
-        pitch_deg=args.pitch, fluorescence="off" if args.no_fluorescence else args.mode,
-        variant=args.variant, seed=args.seed, max_depth=args.max_depth, room=args.room)
+    request = ReferenceRequest(scene=None, size=parse_size(args.size), out=Path(args.out),
+                               spp=args.spp, frame=args.frame, variant=args.variant,
+                               seed=args.seed, max_depth=args.max_depth)
+    check_options(request)   # the path tracer's options first, then the scene
+    # the scene value catalog snapshot draws (the camera kept inside the room, as its is),
+    # resolved once here: the fabric's tables, the light, the room loaded
+    request = dataclasses.replace(request, scene=reference_settings(
+        args.fabric, args.light, yaw_deg=args.yaw, pitch_deg=args.pitch, distance_m=args.distance,
+        fluorescence="off" if args.no_fluorescence else args.mode, room=args.room, inside=True))
     _, report = render_reference(request, progress=not args.json)
     if args.json:
         print_json(report)

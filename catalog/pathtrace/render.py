@@ -36,20 +36,48 @@ REFERENCE_BYTES_PER_PIXEL = 128
 
 @dataclass(frozen=True)
 class ReferenceRequest:
-    fabric: str
-    light: str
+    """A reference render: the scene the real-time frame draws (``scene``, a
+    :class:`catalog.render.settings.FrameSettings` whose room is resolved; built by
+    :func:`reference_settings`), at ``size``, with the path tracer's own choices."""
+
+    scene: object
     size: tuple[int, int]
     out: Path | None
     spp: int = 64
     frame: int = 0
-    distance_m: float = 2.6
-    yaw_deg: float = 0.0
-    pitch_deg: float = 0.0
-    fluorescence: str = "physical"
     variant: str = "llvm_ad_rgb"
     seed: int = 0
     max_depth: int = MAX_DEPTH
-    room: str = "box"
+
+
+def reference_settings(fabric, light, *, yaw_deg: float = 0.0, pitch_deg: float = 0.0,
+                       distance_m: float = 2.6, fluorescence: str = "physical", room="box",
+                       inside: bool = False, **fields):
+    """The scene value (:class:`catalog.render.settings.FrameSettings`) of ``fabric`` under
+    ``light`` in ``room``, everything resolved here, at the edge: the preset and its Fabric
+    tables, the light, the room loaded (a name, a .glb path or a Room) and the orbit camera
+    (looking at the curtain of the room's window; ``inside``: kept inside the room's own
+    interior, catalog.render.placement, as every command's is). ``fields``: any other
+    FrameSettings field (e.g. ``key_direction_deg``). Bad input: one line naming the option."""
+    from catalog.core import validate as checks  # noqa: PLC0415
+    from catalog.render.placement import placement_of_room  # noqa: PLC0415
+    from catalog.render.settings import FrameSettings, orbit  # noqa: PLC0415
+    from catalog.room.model import Room  # noqa: PLC0415
+
+    checks.check_camera({"--yaw": yaw_deg, "--pitch": pitch_deg})
+    if not (math.isfinite(distance_m) and distance_m > 0.05):
+        raise InputError(f"{distance_m!r} m: the camera distance must exceed 0.05 m",
+                         field="--distance")
+    settings = FrameSettings(fabric=fabric, light=light, fluorescence=fluorescence, **fields)
+    if not isinstance(room, Room):
+        from catalog.room.load import load_room  # noqa: PLC0415
+
+        room = load_room(room)   # a bad room is refused before Mitsuba loads
+    # the camera looks at the curtain of this room's window and (``inside``) stays in its own
+    # interior, as catalog snapshot's does (catalog.render.snapshot.snapshot_settings)
+    placement = placement_of_room(room)
+    return settings.replace(camera=orbit(yaw_deg, pitch_deg, distance_m, inside=inside,
+                                         placement=placement), room=room)
 
 
 def check_out(path) -> Path:
@@ -73,13 +101,19 @@ def check_out(path) -> Path:
     return path
 
 
-def validate(request: ReferenceRequest):
-    """Refuse bad input before Mitsuba is loaded; the scene's files are read here, once (the
-    edge). Returns (preset, light, room: a loaded catalog.room.model.Room)."""
-    from catalog.optics.lights import get_light  # noqa: PLC0415
+def validate(request: ReferenceRequest) -> None:
+    """Refuse bad input before Mitsuba is loaded (the scene was resolved when its value was
+    made: :func:`reference_settings`)."""
+    check_options(request)
+    if getattr(request.scene, "resolved_room", None) is None or request.scene.fabric is None \
+            or request.scene.key_light is None:
+        raise CatalogError("the reference draws a resolved scene: a FrameSettings with a "
+                           "fabric, a light and a loaded Room (reference_settings)")
+
+
+def check_options(request: ReferenceRequest) -> None:
+    """The path tracer's own options (all but the scene), each refused in one line."""
     from catalog.pathtrace.backend import check_variant  # noqa: PLC0415
-    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
-    from catalog.render import scene as scene_lib  # noqa: PLC0415
     from catalog.render.snapshot import parse_size  # noqa: PLC0415
 
     if request.out is not None:
@@ -95,37 +129,16 @@ def validate(request: ReferenceRequest):
     checks.frame_memory_check(width, height, REFERENCE_BYTES_PER_PIXEL, "--size")
     checks.check_frame(request.frame, "--frame")
     checks.check_seed(request.seed, "--seed")
-    checks.check_camera({"--yaw": request.yaw_deg, "--pitch": request.pitch_deg})
-    if not (math.isfinite(request.distance_m) and request.distance_m > 0.05):
-        raise InputError(f"{request.distance_m!r} m: the camera distance must exceed 0.05 m",
-                         field="--distance")
     if not 1 <= request.max_depth <= 256:
         raise InputError(f"{request.max_depth} must lie in 1..256", field="--max-depth")
-    preset = load_preset(find_preset(request.fabric))
-    scene_lib.dye_transmittance(preset)
-    scene_lib.fluorescent_material(preset)
-    light = get_light(request.light)
-    from catalog.room.load import load_room  # noqa: PLC0415
-
-    room = load_room(request.room)   # a bad room is refused before Mitsuba loads
-    return preset, light, room
 
 
 def describe(request: ReferenceRequest):
+    """The path tracer's :class:`catalog.pathtrace.scene.SceneDescription` of the request."""
     from catalog.pathtrace.scene import describe_scene  # noqa: PLC0415
 
-    from catalog.render.camera import OrbitCamera  # noqa: PLC0415
-    from catalog.render.placement import placement_of_room  # noqa: PLC0415
-
-    preset, light, room = validate(request)
-    placement = placement_of_room(room)   # the camera kept inside this room, as a snapshot's
-    distance = OrbitCamera(target=placement.curtain_middle, yaw_deg=request.yaw_deg,
-                           pitch_deg=request.pitch_deg, distance_m=request.distance_m,
-                           bounds=placement.interior).distance_m
-    return describe_scene(preset, light, size=request.size, frame=request.frame,
-                          yaw_deg=request.yaw_deg, pitch_deg=request.pitch_deg,
-                          distance_m=distance, fluorescence=request.fluorescence,
-                          room=room)
+    validate(request)
+    return describe_scene(request.scene, size=request.size, frame=request.frame)
 
 
 #: A spectral variant renders in this many passes (or one a sample when spp is smaller):

@@ -109,30 +109,32 @@ def key_light_for(light) -> tuple[np.ndarray, bool]:
     return scene_lib.key_direction(scene_lib.key_elevation_for(light)), light.is_sun
 
 
-def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: float = 0.0,
-                   pitch_deg: float = 0.0, distance_m: float = 2.6,
-                   fluorescence: str = "physical", curtain=None, room="box") -> SceneDescription:
-    """The snapshot scene for ``preset`` under ``light`` (a catalog.optics.lights.Light) in
-    ``room`` (a loaded catalog.room.model.Room, or a built-in name or .glb path)."""
+def describe_scene(settings, *, size=(256, 192), frame: int = 0, curtain=None) -> SceneDescription:
+    """The scene the real-time frame draws with ``settings`` (a
+    :class:`catalog.render.settings.FrameSettings`: its fabric and Fabric tables, key light
+    and direction, fluorescence mode, camera and room), at ``size``, for the path tracer.
+    The room must be resolved (``settings.room`` a loaded catalog.room.model.Room: the edge
+    loads it, :func:`catalog.pathtrace.render.reference_settings`); nothing is read here.
+    ``curtain``: the cloth's (positions, normals, uvs, tangents, indices[, fabric size]);
+    None: the settled drape after ``frame`` frames, as catalog snapshot draws it."""
+    from catalog.core.errors import CatalogError  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
-    from catalog.render.camera import OrbitCamera  # noqa: PLC0415
 
     from catalog.render.placement import placement_of_room  # noqa: PLC0415
 
-    if isinstance(room, (str, bytes)) or hasattr(room, "__fspath__"):
-        from catalog.room.load import load_room  # noqa: PLC0415
-
-        room = load_room(room)
-    placement = placement_of_room(room)   # the curtain, rod and camera target from its window
-    camera = OrbitCamera(target=placement.curtain_middle, yaw_deg=float(yaw_deg),
-                         pitch_deg=float(pitch_deg), distance_m=float(distance_m))
-    to_light, is_sun = key_light_for(light)
-    inside = bool(camera.position[2] > placement.window_z)
-    # as the frame builds them (FrameRenderer.shading_inputs): a ``sun:PATH_KM`` light is the
-    # paper's beam, whose sky and ground are that beam Rayleigh-scattered (paper_beam)
-    inputs, decision = scene_lib.build_shading_inputs(
-        preset, light.irradiance_w_m2_nm, to_light, is_sun=is_sun, fluorescence=fluorescence,
-        paper_beam=light.sun is not None and light.sun.model == "paper", viewer_inside=inside)
+    room = getattr(settings, "resolved_room", None)
+    if room is None:
+        raise CatalogError("describe_scene draws a resolved room: give FrameSettings whose room "
+                           "is a loaded Room (catalog.pathtrace.render.reference_settings)")
+    # the curtain and rod hung from this room's window, as the frame hangs them (its
+    # placement: catalog.render.placement); the camera is the value's (reference_settings
+    # aims it at this curtain and keeps it in this room's interior, as snapshot_settings does)
+    placement = placement_of_room(room)
+    preset, light, camera = settings.fabric, settings.key_light, settings.camera
+    is_sun = light.is_sun
+    # the frame's own shading inputs (FrameSettings.shading_inputs: passes/scene_terms.py),
+    # the viewer's side taken from this room's window plane
+    inputs, decision = settings.shading_inputs(placement)
     fabric_size = None
     rings: tuple = ()
     if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth
@@ -148,9 +150,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
         room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
                                          np.asarray(ring_positions).reshape(-1, 3)])
     pattern = None
-    from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
-
-    loaded = resolve_fabric(preset).pattern
+    loaded = settings.resolved_fabric.pattern
     if loaded is not None:
         cloth_m = fabric_size or (scene_lib.CURTAIN_WIDTH_M, scene_lib.CURTAIN_HEIGHT_M)
         pattern = {"coverage": np.asarray(loaded.coverage, dtype=np.float32),
@@ -175,7 +175,7 @@ def describe_scene(preset, light, *, size=(256, 192), frame: int = 0, yaw_deg: f
     if inputs.fluorescence_mode == "physical":
         from catalog.optics.fluorescence import absorbed_photon_irradiance  # noqa: PLC0415
 
-        material = scene_lib.fluorescent_material(preset)
+        material = scene_lib.fluorescent_material(settings.resolved_fabric)
         outside = math.pi * 0.5 * (inputs.sky_radiance + inputs.ground_radiance)
         fl = {"mode": "physical", "key_photons": float(inputs.absorbed_photons[0]),
               "outside_photons": absorbed_photon_irradiance(material, outside),
@@ -475,13 +475,16 @@ def _window_area_m2(desc: SceneDescription) -> float:
 
 
 def room_surface_bsdf(mi, surface) -> object:
-    """A room surface's Lambertian BSDF: its factor, times its texture (linear) where it has one."""
+    """A room surface's Lambertian BSDF: its factor, times its texture (linear) where it has one.
+    A spectral variant upsamples the texture's linear RGB to spectra (``raw`` off: a float
+    bitmap is linear, no transfer curve is applied); an RGB variant reads it as it is."""
     if surface.texture is None:
         return mi.load_dict({"type": "diffuse", "reflectance": {
             "type": "rgb", "value": [float(v) for v in surface.factor]}})
     albedo = np.ascontiguousarray(surface.texture * surface.factor[None, None, :], dtype=np.float32)
     return mi.load_dict({"type": "diffuse", "reflectance": {
-        "type": "bitmap", "bitmap": mi.Bitmap(albedo), "raw": True, "filter_type": "bilinear",
+        "type": "bitmap", "bitmap": mi.Bitmap(albedo), "raw": "spectral" not in mi.variant(),
+        "filter_type": "bilinear",
         "wrap_mode": "repeat"}})
 
 

@@ -142,7 +142,7 @@ class FrameRenderer:
     def _apply(self, new: FrameSettings, parts) -> None:
         """Act on the stale parts (see :data:`settings.STALE`), then keep ``new``."""
         if "room_transport" in parts:   # first: a bad room is refused before any change
-            self._set_room_transport(new.room)
+            self._set_room_transport(new.room_spec)
         if "fabric_tables" in parts and new.fabric is not None:
             self.fabric_pattern.set_fabric(new.fabric)   # its tables resolved with the settings
         if "msaa_targets" in parts:
@@ -217,7 +217,7 @@ class FrameRenderer:
     room_lamps = property(lambda self: list(self._settings.lamps))
     sky_model = property(lambda self: self._settings.sky_model)
     bloom = property(lambda self: self._settings.bloom)
-    room_spec = property(lambda self: self._settings.room,
+    room_spec = property(lambda self: self._settings.room_spec,
                          doc="The room drawn by its transport (a name or a path), or None.")
     room_update_every = property(lambda self: self._settings.room_update_every)
     patterned = property(lambda self: self._settings.patterned and not self.drawing_flat,
@@ -253,7 +253,7 @@ class FrameRenderer:
 
     @property
     def viewer_inside(self) -> bool:
-        return bool(self.camera.position[2] > self.placement.window_z)
+        return self._settings.viewer_inside(self.placement)   # the frame's room's window
 
     def _viewport_size(self, viewport) -> tuple[int, int]:
         if viewport is None:

@@ -29,6 +29,7 @@ from catalog.render import room_light
 from catalog.render.camera import OrbitCamera
 from catalog.render.passes.shadow import SHADOW_MAP_SIZES
 from catalog.render.passes.targets import ANTIALIASING_MODES
+from catalog.room.model import Room
 
 
 class SettingsError(InputError, ValueError):
@@ -110,9 +111,11 @@ class FrameSettings:
     bloom: bool = True
     #: while the cloth moves, the room's light is redrawn every this many frames
     room_update_every: int = 1
-    #: the room drawn and lit by its precomputed transport: a built-in name (catalog.room)
-    #: or a .glb path; None: the box's special-case room light (catalog/render/room_light)
-    room: str | None = None
+    #: the room drawn and lit by its precomputed transport: a built-in name (catalog.room),
+    #: a .glb path, or the loaded catalog.room.model.Room (what the path tracer needs: the
+    #: edge resolves it, catalog.pathtrace.render.reference_settings); None: the box's
+    #: special-case room light (catalog/render/room_light). Compared by :attr:`room_spec`.
+    room: object = None
 
     # resolved from the fields above when the value is made (not compared, not replaced):
     # the fabric's tables (catalog.presets.fabric.Fabric: dye, fluorescence, residual, pattern),
@@ -180,9 +183,10 @@ class FrameSettings:
             if not isinstance(value, (bool, np.bool_)):
                 raise _refuse(name, f"{value!r} must be True or False")
             object.__setattr__(self, name, bool(value))
-        if self.room is not None:
+        if self.room is not None and not isinstance(self.room, Room):
             if not isinstance(self.room, str) and not hasattr(self.room, "__fspath__"):
-                raise _refuse("room", f"{self.room!r}: give a built-in room name or a .glb path")
+                raise _refuse("room", f"{self.room!r}: give a built-in room name, a .glb path "
+                              "or a loaded Room")
             object.__setattr__(self, "room", str(self.room))
         if self.environment is not None:
             object.__setattr__(self, "environment", str(self.environment))
@@ -191,6 +195,46 @@ class FrameSettings:
     def replace(self, **changes) -> "FrameSettings":
         """``dataclasses.replace(self, **changes)``."""
         return dataclasses.replace(self, **changes)
+
+    @property
+    def room_spec(self) -> str | None:
+        """The room as the frame's transport names it: a built-in name or a .glb path (a
+        loaded Room by its name when built in, else by its file), or None."""
+        if not isinstance(self.room, Room):
+            return self.room
+        from pathlib import Path  # noqa: PLC0415
+
+        from catalog.room.load import BUILTIN_ROOMS, room_path  # noqa: PLC0415
+
+        builtin = self.room.name in BUILTIN_ROOMS and Path(self.room.source) == room_path(self.room.name)
+        return self.room.name if builtin else self.room.source
+
+    @property
+    def resolved_room(self):
+        """The loaded :class:`catalog.room.model.Room` when the edge gave one, else None."""
+        return self.room if isinstance(self.room, Room) else None
+
+    def viewer_inside(self, placement=None) -> bool:
+        """Whether the camera stands in the room: in front of the plane of the window of
+        ``placement`` (catalog.render.placement, the drawn room's; None: the box's)."""
+        window_z = scene_lib.WINDOW_Z if placement is None else placement.window_z
+        return bool(self.camera.position[2] > window_z)
+
+    def shading_inputs(self, placement=None):
+        """(the scene's :class:`catalog.optics.shading_reference.ShadingInputs`, the
+        fluorescence decision) for this value's fabric, key light and direction, mode and
+        side of the window (of ``placement``, the drawn room's: :meth:`viewer_inside`): what
+        the real-time frame (passes/scene_terms.py) and the path tracer
+        (catalog.pathtrace.scene.describe_scene) both shade with. No file is read."""
+        light = self.key_light
+        if self.fabric is None or light is None:
+            raise CatalogError("no fabric or no light: the scene is not complete")
+        # a ``sun:PATH_KM`` light is the paper's beam, whose sky and ground are that beam
+        # Rayleigh-scattered (paper_beam)
+        return scene_lib.build_shading_inputs(
+            self.fabric, light.irradiance_w_m2_nm, self.key_to_light, is_sun=light.is_sun,
+            fluorescence=self.fluorescence, viewer_inside=self.viewer_inside(placement),
+            paper_beam=light.sun is not None and light.sun.model == "paper")
 
     @property
     def sun_hour(self) -> dict | None:
@@ -219,17 +263,30 @@ def _resolve_light(light):
         return None, None, (scene_lib.LAMP_ELEVATION_DEG, scene_lib.KEY_AZIMUTH_DEG)
     if isinstance(light, SunHour):
         try:
-            sun = scene_lib.sun_at_hour(float(light.hour))
+            hour = float(light.hour)
         except (TypeError, ValueError) as exc:
             raise _refuse("light", f"SunHour({light.hour!r}): {exc}") from None
-        except InputError as exc:   # the hour's own field (--hour), as the CLI names it
-            raise SettingsError(exc.problem, field=exc.field or "light") from None
-        return get_light(sun.light_name), sun, (90.0 - sun.zenith_deg, sun.azimuth_deg)
+        return _sun_at(hour)
     if isinstance(light, str):
         light = get_light(light)
     if not isinstance(light, Light):
         raise _refuse("light", f"{light!r}: give a light name, a Light or SunHour(hour)")
     return light, None, (scene_lib.key_elevation_for(light), scene_lib.KEY_AZIMUTH_DEG)
+
+
+@functools.lru_cache(maxsize=64)
+def _sun_at(hour: float) -> tuple:
+    """SunHour(hour) resolved once (a value replaced keeps its sun: the web export draws
+    each hour's scene with eight switches): (its Light, the SunAtHour, (elevation, azimuth))."""
+    from catalog.optics.lights import get_light  # noqa: PLC0415
+
+    try:
+        sun = scene_lib.sun_at_hour(hour)
+    except (TypeError, ValueError) as exc:
+        raise _refuse("light", f"SunHour({hour!r}): {exc}") from None
+    except InputError as exc:   # the hour's own field (--hour), as the CLI names it
+        raise SettingsError(exc.problem, field=exc.field or "light") from None
+    return get_light(sun.light_name), sun, (90.0 - sun.zenith_deg, sun.azimuth_deg)
 
 
 def _environment(path: str) -> tuple:
@@ -295,6 +352,8 @@ def changed(old: FrameSettings, new: FrameSettings) -> frozenset[str]:
         if f.name == "lamps":
             a = tuple((id(light), position) for light, position in a)
             b = tuple((id(light), position) for light, position in b)
+        elif f.name == "room":
+            a, b = old.room_spec, new.room_spec
         elif f.name == "light":
             a, b = (old.key_light, tuple(old.key_to_light)), (new.key_light, tuple(new.key_to_light))
         if not _same(a, b):

@@ -257,11 +257,20 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
 def configure_renderer(renderer, request: SnapshotRequest, preset, light):
     """Every renderer setting a snapshot depends on but the mesh, from ``request`` (the
     preset and light already loaded). Returns the sun's report with ``request.hour``."""
+    renderer.update(snapshot_settings(request, preset, light, renderer.settings))
+    return renderer.settings.sun_hour
+
+
+def snapshot_settings(request: SnapshotRequest, preset, light, base=None):
+    """The scene value (:class:`catalog.render.settings.FrameSettings`) a snapshot draws:
+    ``base`` (None: the defaults) with every field ``request`` sets, the preset and light (or
+    ``request.hour``'s sun) as loaded; the camera looks at and stays inside the room's own
+    placement (catalog.render.placement: its window's curtain, its interior)."""
     from catalog.render.placement import room_placement  # noqa: PLC0415
-    from catalog.render.settings import SunHour, orbit  # noqa: PLC0415
+    from catalog.render.settings import FrameSettings, SunHour, orbit  # noqa: PLC0415
 
     placement = room_placement(request.room)   # where the camera may go: the room's inside
-    renderer.update(
+    return (base or FrameSettings()).replace(
         fabric=preset, light=light if request.hour is None else SunHour(request.hour),
         fluorescence=request.fluorescence, bands=request.bands,
         camera=orbit(request.yaw_deg, request.pitch_deg, request.distance_m,
@@ -271,7 +280,6 @@ def configure_renderer(renderer, request: SnapshotRequest, preset, light):
         curtain_open=request.curtain_open, room_lighting=request.room_light,
         bloom=request.bloom, environment=request.environment, lamps=request.lamps,
         room=request.room)
-    return renderer.settings.sun_hour
 
 
 def image_metadata(info: dict, frame: int, linear: bool) -> dict:

@@ -190,7 +190,8 @@ class ViewerApp:
         self._renderers: list = []
         self._scaled_fbos: list = []  # one per renderer when render_scale < 1
         self._layout_key = None
-        self._applied: dict[int, dict] = {}
+        #: per renderer slot, the fabric and light it refused (not tried again until they change)
+        self._refused: dict[int, dict] = {}
 
         if self.settings.show_panel:
             self._first_look(imgui)
@@ -328,7 +329,7 @@ class ViewerApp:
             and self.settings.compare_index < len(names) else None
         if not self.catalog.refresh():
             return
-        self._applied.clear()  # a preset file changed: apply the presets again
+        self._refused.clear()  # a preset file changed: try the presets again
         names = self.catalog.names
         if shown in names:
             self.settings.fabric_index = names.index(shown)
@@ -438,7 +439,7 @@ class ViewerApp:
         for small in self._scaled_fbos:
             small.release()
         self._renderers, self._scaled_fbos = [], []
-        self._applied = {}
+        self._refused = {}
         self._layout_key = key
         for viewport in self._viewports():
             size = (viewport[2], viewport[3])
@@ -500,7 +501,10 @@ class ViewerApp:
         self._fbo.use()
 
     def _sync_renderers(self) -> None:
-        """Pass the settings to each renderer, only what changed since the last frame."""
+        """Hand each renderer what the user chose: :meth:`FrameRenderer.update` compares it
+        with what the renderer draws and returns what it made stale (empty when nothing
+        changed), so the viewer keeps no copy of its own. A fabric or light the renderer
+        refused is remembered (``_refused``) and not tried again every frame."""
         from catalog.render.settings import SunHour  # noqa: PLC0415
 
         settings = self.settings
@@ -512,42 +516,34 @@ class ViewerApp:
         if settings.compare_index is not None:
             fabrics.append(settings.compare_index)
         for slot, (renderer, fabric_index) in enumerate(zip(self._renderers, fabrics)):
-            applied = self._applied.setdefault(slot, {})
+            refused = self._refused.setdefault(slot, {})
             entry = self.catalog.load(fabric_index)
-            if entry.preset is not None and applied.get("fabric") != (entry.name, id(entry.preset)):
+            fabric_key = (entry.name, id(entry.preset))
+            if entry.preset is not None and refused.get("fabric") != fabric_key:
                 try:
-                    renderer.update(fabric=entry.preset)
-                    if slot == 0:
+                    if "fabric_tables" in renderer.update(fabric=entry.preset) and slot == 0:
                         self.scene.set_fabric(entry.preset)
+                    refused.pop("fabric", None)
                     self.messages.pop(f"fabric{slot}", None)
                 except CatalogError as exc:
+                    refused["fabric"] = fabric_key
                     self.messages[f"fabric{slot}"] = str(exc)
                     self.frame_error = self.frame_error or exc
-                applied["fabric"] = (entry.name, id(entry.preset))
             light_key = (settings.light, settings.sun_hour if settings.light == SUN else None)
-            if applied.get("light") != light_key:
+            if refused.get("light") != light_key:
                 try:
-                    if settings.light == SUN:
-                        renderer.update(light=SunHour(settings.sun_hour))
-                        self._sun = renderer.settings.sun_hour
-                    else:
-                        self._sun = None
-                        renderer.update(light=settings.light)
+                    renderer.update(light=SunHour(settings.sun_hour) if settings.light == SUN
+                                    else settings.light)
+                    self._sun = renderer.settings.sun_hour   # None: not the sun by hour
+                    refused.pop("light", None)
                     self.messages.pop("light", None)
                 except CatalogError as exc:
+                    refused["light"] = light_key
                     self.messages["light"] = str(exc)
                     self.frame_error = self.frame_error or exc
-                applied["light"] = light_key
-            mode = settings.fluorescence if slot == 0 else settings.right_fluorescence
-            if applied.get("fluorescence") != mode:
-                renderer.update(fluorescence=mode)
-                applied["fluorescence"] = mode
-            if applied.get("white_balance") != settings.white_balance:
-                renderer.update(white_balance=settings.white_balance)
-                applied["white_balance"] = settings.white_balance
-            if applied.get("bands") != settings.bands:
-                renderer.update(bands=settings.bands)
-                applied["bands"] = settings.bands
+            renderer.update(fluorescence=settings.fluorescence if slot == 0
+                            else settings.right_fluorescence,
+                            white_balance=settings.white_balance, bands=settings.bands)
         if self.scene.preset_name is None:
             entry = self.catalog.load(settings.fabric_index)
             if entry.preset is not None:

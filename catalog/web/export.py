@@ -87,10 +87,11 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: pixels of 19 200 in the fluoro-pink D65 scene (182 with one layer), over the 1 % the
 #: browser test allows (web/browser.py); the peel's slope taken from the normal instead of
 #: depth derivatives gave 194 too. Not yet understood; the page keeps the one-layer shadow.
-#: ``pattern_prefilter``: off: the page builds the pattern's mips with
-#: generateMipmap (the box chain), not yet the desktop's prefiltered levels (level writes).
+#: The pattern's prefiltered mip levels (catalog.presets.patterns.mip_chain) travel with its
+#: texels (given_texels) and the page writes them over its generateMipmap chain, as the desktop
+#: writes them over its built one.
 DESKTOP_MODES = {"patterned": True, "room_lighting": True, "antialiasing": "fxaa",
-                 "key_second_layer": False, "pattern_prefilter": False}
+                 "key_second_layer": False}
 
 
 def configure_desktop_frame(renderer) -> None:
@@ -99,7 +100,6 @@ def configure_desktop_frame(renderer) -> None:
                     room_lighting=DESKTOP_MODES["room_lighting"],
                     antialiasing=DESKTOP_MODES["antialiasing"],
                     key_second_layer=DESKTOP_MODES["key_second_layer"])
-    renderer.fabric_pattern.set_prefilter(DESKTOP_MODES["pattern_prefilter"])
 #: The desktop frame meters its exposure from the HDR frame (auto exposure, CPU histogram);
 #: the page shows each scene at the EV100 a desktop frame of this size meters at the default
 #: camera (fixed while orbiting, like a photograph's), recorded as an ordinary uniform. The
@@ -269,8 +269,8 @@ def _b64(data: bytes) -> str:
 #: greatest value, so the error is at most (hi - lo) / (2 (2^bits - 1)) per texel. 8 bits:
 #: a quarter of the float32 bytes; the browser test's frames still match the EGL frame
 #: (fluoro-pink under D65: mean 0.046/255 against 0.025/255 at 16 bits, no pixel off but
-#: one-pixel edge shifts). The page decodes them to float32 and builds the mipmaps itself,
-#: as the desktop frame does.
+#: one-pixel edge shifts). The page decodes them to float32, builds the mipmaps and writes
+#: the prefiltered levels given over them, as the desktop frame does.
 TEXEL_BITS = 8
 
 
@@ -299,6 +299,23 @@ def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
     return {"data": _b64(encoded),
             "quantised": {"bits": bits, "lo": [float(v) for v in lo],
                           "hi": [float(v) for v in lo + span], "planar": True}}
+
+
+def given_texels(rec, rid: int) -> dict:
+    """The page's entry for the texels the frame gave texture ``rid`` (none: {}): level 0 and
+    the mip levels it wrote over its built chain (the pattern's prefiltered levels 1..n, each
+    w >> k by h >> k), in one quantised block, and ``levels``: n."""
+    if rid not in rec.texture_data:
+        return {}
+    given = rec.texture_levels.get(rid, {})
+    levels = 0
+    while levels + 1 in given:
+        levels += 1
+    if len(given) != levels:
+        raise CatalogError("the web page replays only mip levels 1..n given in order")
+    data = rec.texture_data[rid] + b"".join(given[k] for k in range(1, levels + 1))
+    entry = encode_texels(data, rec.textures[rid])
+    return {**entry, "levels": levels} if levels else entry
 
 
 def decode_texels(texture: dict) -> np.ndarray:
@@ -346,6 +363,11 @@ class SiteExporter:
         self._pool_of: dict[int, tuple] = {}    # id() of a cleaned value -> (index, value)
         self._clean = CleanCache()
         self._rings: tuple | None = None
+        #: recorded texels in the page's form (encode_texels), by texture id: encoded as soon
+        #: as a frame has given them, so that the catalog's patterns are held quantised (a
+        #: quarter of their float32 bytes: 92 MB -> 23 MB for the twelve built-in fabrics)
+        #: rather than as float32 until the end
+        self._texels: dict[int, dict] = {}
 
     # -- the curtain's buffers: found by their bytes after set_mesh
     def use_mesh(self, positions, normals, uvs, tangents, indices) -> None:
@@ -372,30 +394,40 @@ class SiteExporter:
                 renderer.set_rings(rings)
         self._rings = rings
 
-    def record(self, preset, light: LightChoice, fluorescence: str,
-               ev100: float | None = None, glare: str = "off", lamp: str = "none") -> dict:
-        """One scene's structure index and values (indices into :attr:`value_pool`); ``ev100``: its exposure (None: metered by
-        a METER_SIZE desktop frame at the default camera, with the glare and lamp asked)."""
-        for r in (self.meter, self.renderer):
-            r.update(fabric=preset)
-            if light.kind == "sun":
-                r.update(light=SunHour(light.hour))
-            else:
-                r.update(light=light.id)
-            r.update(fluorescence=FLUORESCENCE[fluorescence],
-                     bloom=GLARE[glare],
-                     lamps=room_lamps(lamp))
+    def scene(self, preset, light: LightChoice):
+        """The scene value (:class:`catalog.render.settings.FrameSettings`) of ``preset``
+        under ``light``, resolved once (the fabric's tables, the light or the sun at its
+        hour): the modes the page shows (:data:`DESKTOP_MODES`), the default camera, the
+        desktop's fluorescence, no glare, no lamp. :meth:`record` draws it with each switch."""
+        from catalog.render.settings import FrameSettings  # noqa: PLC0415
+
+        return FrameSettings(
+            fabric=preset, light=SunHour(light.hour) if light.kind == "sun" else light.id,
+            fluorescence=FLUORESCENCE["on"], bloom=GLARE["off"], lamps=room_lamps("none"),
+            patterned=DESKTOP_MODES["patterned"], room_lighting=DESKTOP_MODES["room_lighting"],
+            antialiasing=DESKTOP_MODES["antialiasing"],
+            key_second_layer=DESKTOP_MODES["key_second_layer"])
+
+    def record(self, scene, fluorescence: str, ev100: float | None = None, glare: str = "off",
+               lamp: str = "none") -> dict:
+        """One scene's structure index and values (indices into :attr:`value_pool`): the
+        value :meth:`scene` made, with the page's switches; ``ev100``: its exposure (None:
+        metered by a METER_SIZE desktop frame at the default camera, with the glare and lamp
+        asked)."""
+        scene = scene.replace(fluorescence=FLUORESCENCE[fluorescence], bloom=GLARE[glare],
+                              lamps=room_lamps(lamp))
         if ev100 is None:
-            self.meter.update(ev=None)
+            self.meter.update(scene)   # (the meter stays at the default camera)
             self.meter.render()
             ev100 = self.meter.current_ev100()
         r = self.renderer
-        r.update(ev=ev100)
+        r.update(scene.replace(camera=r.camera, ev=ev100))
         rec = self.ctx.recording
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
         rec.start(dry=True)  # only the commands are kept: no pixels drawn
         r.render()
         structure, values = split_commands(rec.stop(), self.camera_values(), clean=self._clean)
+        self._encode_given_texels()
         for command in structure:  # bytes written in a frame: shared by the scenes alike
             if command["op"] == "buffer_write":
                 values[command["slot"]] = {"blob": self._blob(values[command["slot"]])}
@@ -409,6 +441,26 @@ class SiteExporter:
                 "ev100": round(float(ev100), 6),
                 "fluorescence_variant": info["fluorescence_variant"],
                 "illuminance_lx": info["illuminance_lx"]}
+
+    def _encode_given_texels(self) -> None:
+        """Move the texels frames have given (Recording.texture_data) into :attr:`_texels` in
+        the page's form, with the mip levels written over them (:func:`given_texels`); the
+        recording keeps an empty :class:`_EncodedTexels` in their place (still "given": the
+        recording replays no mipmap command for it). A texture written again holds bytes again
+        and is encoded again; a level written after its texels were encoded is refused
+        (catalog.web.record)."""
+        rec = self.ctx.recording
+        for rid, data in rec.texture_data.items():
+            if not isinstance(data, _EncodedTexels):
+                # level 0 and the prefiltered levels the frame wrote after it (one block)
+                self._texels[rid] = given_texels(rec, rid)
+                rec.texture_data[rid] = _EncodedTexels()
+                rec.texture_levels.pop(rid, None)
+
+    def _page_texels(self, rid: int) -> dict:
+        """The texels of texture ``rid`` in the page's form ({} when no frame gave any)."""
+        self._encode_given_texels()
+        return self._texels.get(rid, {})
 
     def _pooled(self, value) -> int:
         """Index of ``value`` in :attr:`value_pool` (added once)."""
@@ -453,16 +505,16 @@ class SiteExporter:
                 "u_camera_position": [float(v) for v in r.camera.position],
                 "u_oit_depth_ref": float(r.curtain.oit_depth_reference_m())}
 
-    def check_camera_uniforms(self, preset, light: LightChoice) -> None:
+    def check_camera_uniforms(self, scene) -> None:
         """Refuse a desktop frame whose other uniforms depend on the camera: the page would
         not follow them (it computes only CAMERA_UNIFORMS)."""
         r = self.renderer
         saved = r.camera
         richest = {"glare": "on", "lamp": list(ROOM_LAMPS)[-1]}  # every pass the page has
-        ev100 = self.record(preset, light, "on", **richest)["ev100"]  # one exposure for both
-        first = self.record(preset, light, "on", ev100=ev100, **richest)
+        ev100 = self.record(scene, "on", **richest)["ev100"]  # one exposure for both
+        first = self.record(scene, "on", ev100=ev100, **richest)
         r.update(camera=orbit(saved.yaw_deg + 30.0, saved.pitch_deg + 20.0, saved.distance_m * 0.8))
-        second = self.record(preset, light, "on", ev100=ev100, **richest)
+        second = self.record(scene, "on", ev100=ev100, **richest)
         r.update(camera=saved)
         structure = self.structures[first["structure"]]
         if first["structure"] != second["structure"]:
@@ -527,9 +579,7 @@ class SiteExporter:
             "shaders": list(sources.values()),
             "programs": programs,
             "buffers": buffers,
-            "textures": {rid: _sized(dict(rec.textures[rid], **(encode_texels(rec.texture_data[rid],
-                                                                              rec.textures[rid])
-                                                                 if rid in rec.texture_data else {})))
+            "textures": {rid: _sized(dict(rec.textures[rid], **self._page_texels(rid)))
                          for rid in sorted(used_textures)},
             "renderbuffers": {rid: _sized(dict(rec.renderbuffers[rid])) for rid in
                               sorted({rec.framebuffers[f]["depth"] for f in used_fbos} - {None})},
@@ -540,6 +590,10 @@ class SiteExporter:
     def release(self) -> None:
         self.renderer.release()
         self.meter.release()
+
+
+class _EncodedTexels(bytes):
+    """Recording.texture_data's placeholder for texels the exporter holds encoded (empty)."""
 
 
 def _sized(entry: dict) -> dict:

@@ -32,6 +32,9 @@ class Recording:
     buffers: dict[int, bytes] = field(default_factory=dict)     # id -> current bytes
     textures: dict[int, dict] = field(default_factory=dict)     # id -> {size, components, dtype}
     texture_data: dict[int, bytes] = field(default_factory=dict)  # id -> texels given by the frame
+    #: id -> {level: texels}: the mip levels the frame gave over its built chain (the pattern's
+    #: prefiltered levels, catalog.presets.patterns.mip_chain)
+    texture_levels: dict[int, dict[int, bytes]] = field(default_factory=dict)
     renderbuffers: dict[int, dict] = field(default_factory=dict)
     framebuffers: dict[int, dict] = field(default_factory=dict)  # id -> {colour: [ids], depth}
     vertex_arrays: dict[int, dict] = field(default_factory=dict)
@@ -121,13 +124,17 @@ class _Texture(_Proxy):
 
     def write(self, data, **kw):
         if set(kw) == {"level"} and kw["level"] > 0 and self._rec.textures[self.rid].get("mipmaps"):
-            # a prefiltered mip level (catalog.presets.patterns.mip_chain): the page builds its
-            # own chain with generateMipmap; export.DESKTOP_MODES turns the prefilter off so
-            # that the desktop frame it is compared with has the same chain
+            # a prefiltered mip level (catalog.presets.patterns.mip_chain) over the built chain:
+            # the page writes it over its generateMipmap chain at the same level
+            if not self._rec.texture_data.get(self.rid):  # (empty: already encoded by the export)
+                raise CatalogError("the web page replays mip levels only of textures the frame "
+                                   "filled in the same frame")
+            self._rec.texture_levels.setdefault(self.rid, {})[int(kw["level"])] = bytes(data)
             return self._real.write(data, **kw)
         if kw:
             raise CatalogError("the web page replays only whole-texture writes")
         self._rec.texture_data[self.rid] = bytes(data)
+        self._rec.texture_levels.pop(self.rid, None)   # new texels: their levels come again
         return self._real.write(data)
 
     def build_mipmaps(self, base: int = 0, max_level: int = 1000):

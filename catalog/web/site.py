@@ -237,6 +237,24 @@ def _asset(name: str) -> bytes:
     return resources.files("catalog.web").joinpath("assets", name).read_bytes()
 
 
+def _return_large_blocks(threshold_bytes: int = 1 << 20) -> None:
+    """Let glibc's malloc give blocks of ``threshold_bytes`` or more back to the system when
+    they are freed (mallopt M_MMAP_THRESHOLD; elsewhere nothing). Its default threshold grows
+    to the largest block freed (up to 32 MB), after which the pattern's float64 temporaries
+    (catalog.presets.patterns.Pattern.normal_map, some 50 MB for the lace, made by each of
+    the build's renderers) came from the heap and stayed in the process after use: the
+    whole catalog's build peaked at 641 MB. A fixed threshold also keeps it from growing."""
+    import ctypes  # noqa: PLC0415
+    import ctypes.util  # noqa: PLC0415
+
+    m_mmap_threshold = -3   # malloc.h
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        libc.mallopt(m_mmap_threshold, int(threshold_bytes))
+    except (OSError, AttributeError):   # not glibc
+        pass
+
+
 def build_site(out: str | Path, fabrics: str | None = None, lights: str | None = None,
                ctx=None, progress: bool = False) -> dict:
     """Write the site into ``out``; returns a report (sizes, counts, seconds). ``progress``:
@@ -251,6 +269,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
     from catalog.web import export  # noqa: PLC0415
 
     start = time.perf_counter()
+    _return_large_blocks()
     out = Path(out)
     names = export.parse_fabrics(fabrics)
     choices = export.parse_lights(lights)
@@ -286,7 +305,8 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         timings["bake_s"] = time.perf_counter() - t
 
         t = time.perf_counter()
-        if ctx is None:
+        own_ctx = ctx is None
+        if own_ctx:
             from catalog.gl.context import create_headless_context  # noqa: PLC0415
             ctx = create_headless_context()
         # the swatches first, their renderer released before the recording's two are made
@@ -297,7 +317,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             positions, normals, tangents = bake_lib.decode_frame(first, 0)
             exporter.use_mesh(positions, normals, first.uv, tangents, first.indices)
             exporter.use_drape(fabric_animation[presets[0].name])
-            exporter.check_camera_uniforms(presets[0], choices[0])
+            exporter.check_camera_uniforms(exporter.scene(presets[0], choices[0]))
             scenes = {}
             variants = list(itertools.product(export.FLUORESCENCE, export.GLARE,
                                               export.ROOM_LAMPS))
@@ -306,7 +326,8 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                 for preset in presets:
                     exporter.use_drape(fabric_animation[preset.name])
                     for choice in choices:
-                        metered = exporter.record(preset, choice, "on")
+                        scene = exporter.scene(preset, choice)   # resolved once, drawn 8 ways
+                        metered = exporter.record(scene, "on")
                         # the switches keep the exposure metered with fluorescence on, no
                         # glare, no lamp: they show the brightener's, the glare's and the
                         # lamp's light
@@ -315,13 +336,15 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                                                    lamp)
                             scenes[key] = (
                                 metered if (fluorescence, glare, lamp) == ("on", "off", "none")
-                                else exporter.record(preset, choice, fluorescence,
+                                else exporter.record(scene, fluorescence,
                                                      ev100=metered["ev100"], glare=glare,
                                                      lamp=lamp))
                             bar.advance()
             objects = exporter.objects()
         finally:
             exporter.release()
+            if own_ctx:   # its programs, textures and the driver's compiled shaders go now,
+                ctx.release()   # before the data is packed
         timings["record_s"] = time.perf_counter() - t
         scenes, value_pool = exporter.pooled_scenes(scenes)
 

@@ -134,8 +134,8 @@ class CurtainPass(Pass):
                 self.frame.environment[1].use(location=ENVIRONMENT_UNIT)
                 set_uniform(program, "u_environment", ENVIRONMENT_UNIT)
                 set_uniform(program, "u_environment_scale", self.frame.background.environment_scale(self.frame.terms.shading_inputs()))
-            if "u_key_front" in program:
-                self.frame.shadow.key_shadow_uniforms(program, self.frame.terms.shading_inputs())
+            if "u_key_visibility" in program:
+                self.frame.shadow.key_shadow_uniforms(program, self.frame.terms.shading_inputs(), coarse)
             if "u_room_side" in program or "u_window_side_cloth" in program:   # (FOLDS_BEHIND: no room part)
                 self.frame.lightmap.room_side_uniforms(program)
             if "u_capture_thread" in program:

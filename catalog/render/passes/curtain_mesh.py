@@ -149,6 +149,11 @@ class CurtainMesh(Pass):
             buffer.release()
         self._own_buffers = []
 
+    @property
+    def has_coarse_grid(self) -> bool:
+        """Whether the mesh has the coarse grid the room's maps and captures draw."""
+        return self.buffers is not None and "coarse_index" in self.buffers
+
     def curtain_vao(self, program, coarse: bool = False):
         """The mesh drawn with ``program``; ``coarse``: the coarse grid's triangles (where the
         mesh has one), for the room's views of the aperture, a few texels a patch."""

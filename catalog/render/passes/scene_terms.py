@@ -46,10 +46,8 @@ class SceneTerms:
         key = (id(self.frame.preset), self.frame.light.name, id(self.frame.light), tuple(self.frame._key_to_light),
                self.frame.mode, self.frame.viewer_inside, self.frame._is_sun)
         if key != self.inputs_key:
-            self._inputs, self.decision = scene_lib.build_shading_inputs(
-                self.frame.preset, self.frame.light.irradiance_w_m2_nm, self.frame._key_to_light,
-                is_sun=self.frame._is_sun, fluorescence=self.frame.mode, viewer_inside=self.frame.viewer_inside,
-                paper_beam=self.frame.light.sun is not None and self.frame.light.sun.model == "paper")
+            # the settings' own (the path tracer's describe_scene takes the same)
+            self._inputs, self.decision = self.frame.settings.shading_inputs(self.frame.placement)
             self.inputs_key = key
             self._uniforms_key = None
         return self._inputs

@@ -54,6 +54,15 @@ OCCLUSION_BIAS_M = 0.01
 OCCLUSION_OFFSET_M = 0.03
 
 
+#: The key's visibility baked over the fabric's uv (curtain.frag KEY_SHADOW): a texel every
+#: this many metres of the rest fabric, finer than the front-layer map's texels on the cloth
+#: (room_light.shadow_texel_m: ~9 mm at 256), at most KEY_VISIBILITY_MAX_TEXELS a side.
+KEY_VISIBILITY_PITCH_M = 0.003
+
+
+KEY_VISIBILITY_MAX_TEXELS = 2048
+
+
 #: Texels a row of the per-vertex occlusion texture (curtain.vert reads texel index % width).
 VERTEX_OCCLUSION_WIDTH = 256
 
@@ -71,8 +80,19 @@ class ShadowPass(Pass):
     def __init__(self, frame):
         super().__init__(frame)
 
-    def key_shadow_uniforms(self, program, inputs) -> None:
-        """curtain.frag's KEY_SHADOW: the front-layer map, its frame and depth bias, the opening."""
+    def key_shadow_uniforms(self, program, inputs, coarse: bool = False) -> None:
+        """curtain.frag's KEY_SHADOW: the key's visibility baked over the fabric's uv, of the
+        mesh or (``coarse``) of the coarse grid the room's captures draw (its chords lie off
+        the cloth, so their shadow is their own)."""
+        name = "key_visibility_coarse" if coarse and self.frame.mesh.has_coarse_grid else "key_visibility"
+        texture = self.frame.room_targets.get().get(name)
+        if texture is None:   # not drawn yet (a mesh bound after the last update): none
+            texture = self._key_visibility_target(name)
+        texture.use(location=KEY_FRONT_UNIT)
+        set_uniform(program, "u_key_visibility", KEY_FRONT_UNIT)
+
+    def _key_lookup_uniforms(self, program, inputs) -> None:
+        """key_visibility.frag's inputs: the front-layer maps, their frame and depth bias, the opening."""
         gl = self.frame.room_targets.get()
         gl["key_front"].use(location=KEY_FRONT_UNIT)
         gl["key_second"].use(location=KEY_SECOND_UNIT)
@@ -82,10 +102,10 @@ class ShadowPass(Pass):
         matrix = room_light.light_view_projection(inputs.key_to_light, placement=self.frame.placement)
         s(program, "u_light_view_proj", gl_bytes(matrix))
         metre = self.frame.terms.key_depth_per_metre(inputs)
-        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels, placement=self.frame.placement)
+        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.frame.room_targets.key_texels, placement=self.frame.placement)
         s(program, "u_key_depth_bias", (KEY_SHADOW_BIAS_M * metre, slope_m * metre, KEY_SHADOW_SLOPE_CAP))
         s(program, "u_key_normal_offset", KEY_SHADOW_NORMAL_OFFSET_TEXELS
-          * room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels, placement=self.frame.placement))
+          * room_light.shadow_texel_m(inputs.key_to_light, self.frame.room_targets.key_texels, placement=self.frame.placement))
         wx0, wx1, wy0, wy1 = self.frame.placement.window_rect   # the frame's room's window
         z0 = self.frame.placement.window_z
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
@@ -210,6 +230,9 @@ class ShadowPass(Pass):
         patterned = (pattern is not None and self.frame.patterned
                      and self.frame.mesh.format != "interleaved")
         self._draw_key_front(inputs, patterned, self.frame.terms.room_colours(inputs))
+        self._draw_key_visibility(inputs, "key_visibility")
+        if self.frame.mesh.has_coarse_grid:
+            self._draw_key_visibility(inputs, "key_visibility_coarse", coarse=True)
         self._draw_occlusion_maps()
         self._draw_vertex_occlusion()
 
@@ -248,7 +271,7 @@ class ShadowPass(Pass):
         """The key light's front-layer map (curtain.frag KEY_SHADOW): per texel the layer of
         cloth nearest the light, its transmittance (as the room's map, one layer) and depth."""
         mgl, gl = self.mgl, self.frame.room_targets.get()
-        n = self.frame.shadow_texels
+        n = self.frame.room_targets.key_texels
         gl["key_front_fbo"].use()
         self.ctx.viewport = (0, 0, n, n)
         gl["key_front_fbo"].clear(1.0, 1.0, 1.0, 1.0, depth=1.0)
@@ -274,6 +297,46 @@ class ShadowPass(Pass):
             set_uniform(program, "u_peel_bias", KEY_SHADOW_BIAS_M * self.frame.terms.key_depth_per_metre(inputs))
             self.frame.mesh.shadow_vao(program, fine=True).render(mgl.TRIANGLES)
         self.ctx.disable(mgl.DEPTH_TEST)
+
+    def _key_visibility_target(self, name: str):
+        """The texture of the key's visibility over the fabric's uv (key_visibility.frag), one
+        texel every KEY_VISIBILITY_PITCH_M of the rest fabric (at most KEY_VISIBILITY_MAX_TEXELS a
+        side), made or remade when the fabric's size asks for another; cleared to fully lit."""
+        mgl, gl = self.mgl, self.frame.room_targets.get()
+        size = tuple(int(min(KEY_VISIBILITY_MAX_TEXELS, max(16, math.ceil(m / KEY_VISIBILITY_PITCH_M))))
+                     for m in self.frame.mesh.fabric_size_m)
+        texture = gl.get(name)
+        if texture is None or tuple(texture.size) != size:
+            if texture is not None:
+                gl[name + "_fbo"].release()
+                texture.release()
+            texture = self.ctx.texture(size, 4, dtype="f4")
+            texture.filter = (mgl.LINEAR, mgl.LINEAR)
+            texture.repeat_x = texture.repeat_y = False
+            gl[name] = texture
+            gl[name + "_fbo"] = self.ctx.framebuffer([texture])
+            gl[name + "_fbo"].clear(1.0, 0.0, 0.0, 1.0)
+        return texture
+
+    def _draw_key_visibility(self, inputs, name: str, coarse: bool = False) -> None:
+        """The key's visibility on the cloth (key_visibility.vert/.frag: the window's mask and
+        the two layers' coverage in front), baked over the fabric's uv from the front-layer
+        maps just drawn: none of it depends on the camera, so the frame reads it with one
+        lookup (curtain.frag KEY_SHADOW). ``coarse``: on the coarse grid's triangles."""
+        mgl = self.mgl
+        texture = self._key_visibility_target(name)
+        fbo = self.frame.room_targets.objects[name + "_fbo"]
+        fbo.use()
+        self.ctx.viewport = (0, 0, *texture.size)
+        fbo.clear(1.0, 0.0, 0.0, 1.0)
+        program = self.gl.program("key_visibility.vert", "key_visibility.frag")
+        self._key_lookup_uniforms(program, inputs)
+        set_uniform(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
+        set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
+        self.ctx.disable(mgl.DEPTH_TEST)
+        self.ctx.disable(mgl.BLEND)
+        self.ctx.disable(mgl.CULL_FACE)
+        self.frame.mesh.curtain_vao(program, coarse).render(mgl.TRIANGLES)
 
     def _front_layer_uniforms(self, program, inputs, patterned: bool, colours: dict) -> None:
         """room_shadow.frag's FRONT_LAYER and SECOND_LAYER inputs: the light's frame, the

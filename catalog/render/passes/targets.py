@@ -151,6 +151,11 @@ class FrameTargets:
         self.oit_fbo = ctx.framebuffer([self.oit_accum, self.oit_weight], self.depth)
         self.oit_fbo.depth_mask = False  # the layers are tested against the room, not each other
 
+    @property
+    def key_texels(self) -> int:
+        """The key's front-layer maps' side: the shadow map's, at most KEY_FRONT_TEXELS."""
+        return min(self.shadow_texels, KEY_FRONT_TEXELS)
+
     def framebuffers(self) -> list:
         """Every framebuffer of these targets (to leave none of them bound when released)."""
         fbos = [self.hdr_fbo, self.ldr_fbo, self.oit_fbo, self.pre_fbo]
@@ -200,10 +205,16 @@ class FrameTargets:
             self.gbuffer = None
 
 
+#: The key's front-layer maps' side at most (texels; curtain.frag KEY_SHADOW through
+#: key_visibility.frag). Finer, the strip along a fold's terminator (its flat triangles just
+#: behind their own layer, seen from the key) sharpens into one wedge per triangle row.
+KEY_FRONT_TEXELS = 256
+
+
 class RoomTargets:
     """The room light's maps (docs/room.md), made on first use by :meth:`get` as a dict of
     name -> GL object: the key light's transmittance map ``shadow`` and the cloth's
-    front-layer maps ``key_front`` / ``key_second`` (``shadow_texels`` a side), the occlusion
+    front-layer maps ``key_front`` / ``key_second`` (``key_texels`` a side), the occlusion
     maps, the window's captures (``luminaire``, ``luminaire_sides``, ``luminaire_walls``,
     ``luminaire_back``), the light map's parts (``direct``, ``beam``, ``lightmap``, ``ao``,
     ``window_near``), the radiosity's ``radiosity_operator`` and ``total``, the curtain's
@@ -259,6 +270,7 @@ class RoomTargets:
             ao = ctx.texture((aw, ah), 4, data=room_light.ao_and_mask_texture().tobytes(), dtype="f4")
             ao.filter = (mgl.NEAREST_MIPMAP_NEAREST, mgl.NEAREST)
             ao.build_mipmaps()
+            n = self.key_texels
             key_front = ctx.texture((n, n), 4, dtype="f4")
             key_front.filter = (mgl.NEAREST, mgl.NEAREST)
             key_front.repeat_x = key_front.repeat_y = False
@@ -305,6 +317,11 @@ class RoomTargets:
             self.operator_albedo = None
         return self.objects
 
+
+    @property
+    def key_texels(self) -> int:
+        """The key's front-layer maps' side: the shadow map's, at most KEY_FRONT_TEXELS."""
+        return min(self.shadow_texels, KEY_FRONT_TEXELS)
 
     def framebuffers(self) -> list:
         return [obj for name, obj in (self.objects or {}).items() if name.endswith("_fbo")]

@@ -53,8 +53,11 @@ BACK_LUMINAIRE_LEVEL = 3
 #: room_lightmap.frag's beam (the bounces' source): the mean over BEAM_SAMPLES x BEAM_SAMPLES
 #: points of a light-map texel (issue 11, sixth round; frame.py passes it to the shader as a define).
 BEAM_SAMPLES = 8
-#: The transmittance shadow map's side (texels).
-SHADOW_TEXELS = 256
+#: The transmittance shadow map's side (texels): 1024, about 2.5 mm a texel over the curtain's
+#: space. At 256 (1 cm) the folds' shadows on the floor stepped in one-texel stairs (issue 34:
+#: the hem's light patches at 1280x720); the room's lookups take the mip level of the sun's
+#: penumbra, whose texels a finer map has box-filtered (antialiased) instead of point-sampled.
+SHADOW_TEXELS = 1024
 #: Ambient occlusion: rays per texel and the distance within which geometry occludes.
 AO_RAYS = 96
 AO_RADIUS_M = 0.6

@@ -324,7 +324,9 @@
           texels = decodeTexels(t);
         }
         gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
-        gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], half ? gl.HALF_FLOAT : float ? gl.FLOAT : gl.UNSIGNED_BYTE, texels);
+        const type = half ? gl.HALF_FLOAT : float ? gl.FLOAT : gl.UNSIGNED_BYTE;
+        const level0 = texels && t.levels ? texels.subarray(0, s[0] * s[1] * t.components) : texels;
+        gl.texImage2D(gl.TEXTURE_2D, 0, internal[c], s[0], s[1], 0, formats[c], type, level0);
         // float textures filter linearly only with OES_texture_float_linear
         const linearOk = !float || half || this.floatLinear;  // half floats always filter
         const pick = (f) => (linearOk ? f : (f === gl.LINEAR || f === gl.LINEAR_MIPMAP_LINEAR || f === gl.LINEAR_MIPMAP_NEAREST || f === gl.NEAREST_MIPMAP_LINEAR ? gl.NEAREST : f));
@@ -335,6 +337,13 @@
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, t.repeat_x === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
         gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, t.repeat_y === false ? gl.CLAMP_TO_EDGE : gl.REPEAT);
         if (t.mipmaps) gl.generateMipmap(gl.TEXTURE_2D);
+        // the desktop's prefiltered levels 1..n (export.given_texels: after level 0, each
+        // w >> k by h >> k) written over generateMipmap's box chain, as the desktop does
+        for (let k = 1, at = s[0] * s[1] * t.components; k <= (t.levels || 0); k++) {
+          const w = Math.max(1, s[0] >> k), h = Math.max(1, s[1] >> k), n = w * h * t.components;
+          gl.texImage2D(gl.TEXTURE_2D, k, internal[c], w, h, 0, formats[c], type, texels.subarray(at, at + n));
+          at += n;
+        }
         if (t.anisotropy > 1 && this.aniso) {  // the desktop's anisotropic filter (record.py)
           gl.texParameterf(gl.TEXTURE_2D, this.aniso.TEXTURE_MAX_ANISOTROPY_EXT,
             Math.min(t.anisotropy, gl.getParameter(this.aniso.MAX_TEXTURE_MAX_ANISOTROPY_EXT)));
