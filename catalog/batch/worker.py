@@ -213,7 +213,10 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
     task_scene = FrameSettings(fabric=preset, fluorescence=task.fluorescence, bands=task.bands,
                                exposure=task.exposure, room=task.room)
     lights = {name: get_light(name) for name in sorted({image.light for image in todo})}
-    rings = ring_xs_m(preset)
+    from catalog.render.placement import room_placement  # noqa: PLC0415
+
+    placement = room_placement(task.room)   # the curtain on the rod of the room's own window
+    rings = ring_xs_m(preset, placement)
     timings["load_s"] += time.perf_counter() - t0
 
     renderer = pool.renderer_for(task.size)
@@ -225,14 +228,14 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
     for frame in sorted(by_frame):  # one simulation, stepped through the frames asked for
         t0 = time.perf_counter()
         if simulation is None:
-            simulation = curtain_simulation(preset)  # frame 0: the settled drape
+            simulation = curtain_simulation(preset, placement)  # frame 0: the settled drape
             timings["settle_s"] += time.perf_counter() - t0
         while stepped < frame:  # (its own frame counter includes the settling)
             simulation.step(FRAME_DT_S)
             stepped += 1
         if not simulation.finite:
             raise CatalogError(f"{task.fabric}: the cloth simulation diverged by frame {frame}")
-        *mesh, fabric_size = curtain_on_rod(simulation)
+        *mesh, fabric_size = curtain_on_rod(simulation, placement)
         timings["simulate_s"] += time.perf_counter() - t0
         for image in by_frame[frame]:
             t0 = time.perf_counter()

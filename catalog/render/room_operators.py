@@ -238,7 +238,10 @@ def build(room) -> RoomOperators:
     from catalog.room.cache import room_transport  # noqa: PLC0415
     from catalog.room.rays import ray_caster  # noqa: PLC0415
 
+    from catalog.room.build_progress import report  # noqa: PLC0415
+
     t = room_transport(room)
+    report("gathers")
     if t.window_basis is None or t.bounce_left is None:
         raise ValueError("the room's transport is not compressed")
     caster = ray_caster(room.triangles())
@@ -384,6 +387,12 @@ def main(argv=None) -> int:
 
     argv = sys.argv[1:] if argv is None else argv
     try:
+        if "--progress" in argv[1:]:   # lines on stdout while it builds (the viewer's first start)
+            from catalog.room.build_progress import LinePrinter, listening  # noqa: PLC0415
+
+            with listening(LinePrinter(Path(argv[0]).stem if argv[0].endswith(".glb") else argv[0])):
+                room_operators(argv[0])
+            return 0
         room_operators(argv[0])
     except CatalogError as exc:
         print(str(exc), file=sys.stderr)

@@ -49,6 +49,7 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 
 from catalog.room import sh
+from catalog.room.build_progress import report
 from catalog.room.model import Window
 from catalog.room.receivers import Receivers, build_receivers, cosine_directions, refine, subset
 
@@ -217,6 +218,7 @@ def direct_operator(rec: Receivers, window: Window, params: TransportParams, ray
     # stratified samples in each patch: s_count jittered points on a sqrt grid
     side = max(1, int(math.ceil(math.sqrt(s_count))))
     for start in range(0, rec.count, step):
+        report("direct light", start, rec.count)
         e = np.arange(start, min(rec.count, start + step))
         ee = np.repeat(e, per_receiver)
         patch = np.tile(np.repeat(np.arange(patches), s_count), e.size)
@@ -428,6 +430,7 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
     rng = np.random.default_rng(params.seed)
     timings = {}
     start = time.perf_counter()
+    report("receivers")
     rec_all = build_receivers(triangles, albedo_of, params.element_m)
     with_window = np.concatenate([np.asarray(triangles, dtype=np.float64), window.triangles()])
     rays_gather = ray_caster(with_window, backend)
@@ -443,6 +446,7 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
     timings["exposed_share"] = float(np.sum(rec.weld_weight_m2) / np.sum(rec.area_m2))
     timings["receivers_s"] = time.perf_counter() - start
     start = time.perf_counter()
+    report("form factors")
     hit, _ = gather(rec_all, rays_gather, len(triangles), params.gather_rays, rng,
                     receivers=np.flatnonzero(inside))
     f = form_factors(hit, new_index, rec.count)
@@ -458,6 +462,7 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
     lus = []
     dense = f.toarray()
     for ch in range(3):
+        report("solve", ch, 3)
         lu = scipy.linalg.lu_factor(np.eye(rec.count) - dense * rec.albedo[None, :, ch], overwrite_a=True)
         lus.append(lu)
         operator[ch] = scipy.linalg.lu_solve(lu, d)
@@ -467,6 +472,7 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
                           kept_index=new_index)
     if compress_operators:
         start = time.perf_counter()
+        report("compress")
         left, right, err = compress(operator.reshape(3 * rec.count, -1), params.rank_tolerance, params.max_rank)
         transport.window_basis = left.reshape(3, rec.count, -1)
         transport.window_modes = right

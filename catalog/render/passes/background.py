@@ -107,6 +107,7 @@ class BackgroundPass(Pass):
         if not sun_disc:
             set_uniform(program, "u_sun_disc_rgb", (0.0, 0.0, 0.0))
         if capture:
-            set_uniform(program, "u_capture_opening", scene_lib.WINDOW_RECT)
-            set_uniform(program, "u_capture_wall_z", scene_lib.ROOM_BOX[2][0])
+            placement = self.frame.placement   # the frame's room's window
+            set_uniform(program, "u_capture_opening", placement.window_rect)
+            set_uniform(program, "u_capture_wall_z", placement.window_z)
         self.gl.fullscreen_vao(program).render(self.mgl.TRIANGLES, vertices=3)

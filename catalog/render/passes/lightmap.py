@@ -38,7 +38,7 @@ class LightmapPass(Pass):
         z0 = scene_lib.ROOM_BOX[2][0]
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
         s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
-        s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+        s(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(inputs.key_to_light, placement=self.frame.placement)))
         s(program, "u_key_to_light", tuple(float(v) for v in inputs.key_to_light))
         s(program, "u_key_rgb", self.frame.terms.room_colours(inputs)["u_key_rgb"])
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
@@ -73,7 +73,7 @@ class LightmapPass(Pass):
         (x0, x1), _, _ = scene_lib.ROOM_BOX
         spacing_m = (x1 - x0) / room_light.FACE_TEXELS / room_light.BEAM_SAMPLES   # the beam's samples'
         set_uniform(program, "u_beam_shadow_lod",
-                  max(0.0, math.log2(spacing_m / room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))))
+                  max(0.0, math.log2(spacing_m / room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels, placement=self.frame.placement))))
         set_uniform(program, "u_key_on", 1.0)
         self.gl.fullscreen_vao(program).render(mgl.TRIANGLES, vertices=3)
         if self.frame.capture.window_near():   # the window wall beside the opening, finer (room_window_near.frag)

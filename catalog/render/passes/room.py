@@ -87,7 +87,7 @@ class RoomPass(Pass):
         set_uniform(program, "u_lightmap", 1)
         gl["shadow"].use(location=2)
         set_uniform(program, "u_shadow", 2)
-        set_uniform(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))
+        set_uniform(program, "u_shadow_texel_m", room_light.shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels, placement=self.frame.placement))
         set_uniform(program, "u_curtain_z", scene_lib.CURTAIN_Z)
         reveals = self.frame.terms.reveal_inputs(inputs)
         set_uniform(program, "u_reveal_sky", reveals["sky_half"])
@@ -111,9 +111,10 @@ class RoomPass(Pass):
                 program, [(self._room_vbo, "3f 3f", "in_position", "in_normal")])
         return self.gl.vaos[key]
 
-    def set_rings(self, xs_m) -> None:
-        """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
-        positions, normals = scene_lib.ring_mesh(xs_m)
+    def set_rings(self, xs_m, placement=None) -> None:
+        """Curtain rings on the rod (of ``placement``; None: the box's) at these x positions
+        (m, scene frame); empty: none."""
+        positions, normals = scene_lib.ring_mesh(xs_m, placement)
         self.ring_arrays = (positions, normals)   # the transport's room light draws them too
         if self._ring_vbo is not None:
             self._ring_vbo.release()
