@@ -405,6 +405,25 @@ def region_flip(flip: np.ndarray, masks: dict) -> dict:
     return out
 
 
+#: A fabric counts as dyed in the error split when its dye's CIELAB chroma (its transmittance
+#: under D65, against D65's white) is above this; the whites, ivories and the neutral grey are
+#: below (0-7.2), the cream batiste, dense linen and the three coloured cloths above (11.5-102).
+DYED_CHROMA = 10.0
+
+
+def dye_chroma(fabric: str) -> float:
+    """CIELAB chroma of ``fabric``'s dye transmittance T(l) under D65 (colour-science)."""
+    import colour  # noqa: PLC0415
+
+    from catalog.presets import find_preset, load_preset  # noqa: PLC0415
+    from catalog.render.scene import GRID_NM, dye_transmittance  # noqa: PLC0415
+
+    t = np.asarray(dye_transmittance(load_preset(find_preset(fabric))), dtype=np.float64)
+    sd = colour.SpectralDistribution(dict(zip(np.asarray(GRID_NM, dtype=np.float64), t)))
+    lab = colour.XYZ_to_Lab(colour.sd_to_XYZ(sd, illuminant=colour.SDS_ILLUMINANTS["D65"]) / 100.0)
+    return float(np.hypot(lab[1], lab[2]))
+
+
 def add_region_split(rows: list[dict], rows_out: Path) -> None:
     """Each row's FLIP split by region (``flip_by_region``), from its streamed FLIP map and the
     region masks of its scene (a ray per pixel centre through the reference's geometry)."""
@@ -421,6 +440,7 @@ def add_region_split(rows: list[dict], rows_out: Path) -> None:
     cache = json.loads(cache_path.read_text(encoding="utf-8")) if cache_path.is_file() else {}
     mi = load_mitsuba("llvm_ad_rgb")
     for number, row in enumerate(rows, 1):
+        row.setdefault("dye_chroma", dye_chroma(row["fabric"]))
         if row["label"] in cache:
             row["flip_by_region"] = cache[row["label"]]
         if "flip_by_region" in row:
@@ -466,17 +486,32 @@ def summarise(rows: list[dict]) -> dict:
         judged = [r for r in rows if sum(r["flip_by_region"][n]["flip_share"] for n in SPLIT_REGIONS) > 0] or rows
         split = {name: float(np.mean([r["flip_by_region"][name]["flip_share"] for r in judged]))
                  for name in SPLIT_REGIONS}
-    by_family, by_fabric = {}, {}
+    by_family, by_fabric, by_room, by_dye = {}, {}, {}, {}
     for r in rows:
         by_family.setdefault(r["light_family"], []).append(r["mean_flip"])
         by_fabric.setdefault(r["fabric"], []).append(r["mean_flip"])
+        by_room.setdefault(r.get("room", "box"), []).append(r["mean_flip"])
+        if "dye_chroma" in r:
+            by_dye.setdefault("dyed" if r["dye_chroma"] > DYED_CHROMA else "white", []).append(r)
+    causes = {
+        "by_room": {k: {"scenes": len(v), "median_mean_flip": float(np.median(v))} for k, v in sorted(by_room.items())},
+        "by_dye": {k: {"scenes": len(v), "median_mean_flip": float(np.median([r["mean_flip"] for r in v])),
+                       "median_curtain_delta_e": stats([r["curtain_delta_e_mean"] for r in v])["median"]}
+                   for k, v in sorted(by_dye.items())},
+    }
+    if split:   # each region's own mean FLIP (its pixels only), median over the scenes showing it
+        causes["region_mean_flip_median"] = {
+            name: float(np.median([m for m in (r["flip_by_region"][name]["mean_flip"] for r in rows
+                                                 if r["flip_by_region"][name]["pixel_share"] > 0.02)
+                                   if m is not None] or [0.0]))
+            for name in SPLIT_REGIONS}
     extra = {}
     if all("spp_rounds" in r for r in rows):
         extra = {"mean_flip_full_size": stats([r["mean_flip_full_size"] for r in rows]),
                  "spp_median": float(np.median([r["spp"] for r in rows])),
                  "measure_size": rows[0]["measure_size"]}
     return {**extra, "scenes": len(rows), "mean_flip": flip, "curtain_delta_e_mean": de,
-            "flip_share_by_region": split,
+            "flip_share_by_region": split, "causes": causes,
             "median_flip_by_light_family": {k: float(np.median(v)) for k, v in by_family.items()},
             "median_flip_by_fabric": {k: float(np.median(v)) for k, v in sorted(by_fabric.items())},
             "speedup": {"min": float(min(speed)), "median": float(np.median(speed))},
@@ -624,15 +659,29 @@ def markdown_tables(result: dict) -> dict[str, str]:
     planned = result.get("planned_scenes")
     if planned and planned > s["scenes"]:
         per_scene = float(np.mean([r["reference_s"] for r in result["rows"]]))
-        summary += (f"\n\nThe run measured {s['scenes']} of the {planned} planned scenes (the report seed's "
-                    f"first {s['scenes']}: the draw is seeded, so they are the start of the same list) in the "
-                    f"time the shared machine allowed; the {planned} scenes project to "
+        measured = sorted(int(r["label"].split()[0]) for r in result["rows"])
+        missing = [i for i in range(planned) if i not in measured]
+        summary += (f"\n\nThe run measured {s['scenes']} of the {planned} planned scenes in the time the "
+                    f"shared machine allowed (the draw is seeded: the missing ones are scenes "
+                    f"{', '.join(f'{i:02d}' for i in missing)} of the same list); the {planned} scenes project to "
                     f"{planned * per_scene / 3600:.1f} h of reference time at {cfg['spp']} spp "
                     f"(mean {per_scene:.0f} s a scene).")
     if s.get("flip_share_by_region"):
         share = s["flip_share_by_region"]
         summary += ("\n\nWhere the FLIP is (mean over the scenes of each region's share of the image's "
                     "summed FLIP): " + ", ".join(f"{k} {v:.0%}" for k, v in share.items()) + ".")
+    causes = s.get("causes", {})
+    if causes.get("region_mean_flip_median"):
+        summary += ("\n\nEach region's own mean FLIP (its pixels only; median over the scenes where it "
+                    "covers over 2 % of the image): " + ", ".join(
+                        f"{k} {v:.3f}" for k, v in causes["region_mean_flip_median"].items()) + ".")
+    if causes.get("by_room"):
+        summary += ("\n\nMedian mean FLIP by room: " + ", ".join(
+            f"{k} {v['median_mean_flip']:.3f} ({v['scenes']} scenes)" for k, v in causes["by_room"].items()) + ".")
+    if causes.get("by_dye"):
+        summary += (f"\n\nDyed cloths (dye chroma above {DYED_CHROMA:g}) against whites: " + "; ".join(
+            f"{k}: FLIP {v['median_mean_flip']:.3f}, curtain dE2000 {_cell(v['median_curtain_delta_e'])} "
+            f"({v['scenes']} scenes)" for k, v in causes["by_dye"].items()) + " (medians).")
     summary += ("\n\nMedian mean FLIP by light family: " + ", ".join(
         f"{k} {v:.3f}" for k, v in s["median_flip_by_light_family"].items())
         + "; by fabric: " + ", ".join(f"{k} {v:.3f}" for k, v in s.get("median_flip_by_fabric", {}).items()) + ".")

@@ -55,7 +55,10 @@ def run_once(workers: int, size: str) -> dict:
     return {"wall_s": round(wall, 3), "cpu_s": round(cpu, 3), "rendered": summary["rendered"],
             "startup_s": summary.get("startup_s", 0.0), "tasks_s": round(tasks_s, 3),
             "busy": round(tasks_s / (workers * wall), 3),
-            **{k: summary.get(k, 0.0) for k in PHASES}}
+            **{k: summary.get(k, 0.0) for k in PHASES},
+            # CPU seconds inside the tasks (the workers' processes, their GL and numba threads
+            # included); the rest of cpu_s is start-up, the scheduler and the driver
+            "task_cpu_s": summary.get("task_cpu_s", 0.0)}
 
 
 def run(rounds: int, size: str) -> dict:
@@ -79,7 +82,7 @@ def run(rounds: int, size: str) -> dict:
     rows = []
     for workers, worker_runs in runs.items():
         row = {"workers": workers, "runs": worker_runs}
-        for key in ("wall_s", "cpu_s", "startup_s", "tasks_s", "busy", *PHASES):
+        for key in ("wall_s", "cpu_s", "startup_s", "tasks_s", "busy", "task_cpu_s", *PHASES):
             row[key] = round(statistics.median(r[key] for r in worker_runs), 3)
         row["images_per_s"] = round(IMAGES / row["wall_s"], 3)
         rows.append(row)
@@ -98,12 +101,14 @@ def markdown_tables(result: dict) -> dict[str, str]:
              f"x frames {job['frames']} x yaws {job['yaw_deg']}, {job['size']} PNG), "
              f"{result['rounds']} interleaved rounds, medians:", "",
              "| workers | wall s | images/s | start s | settle s | simulate s | render s | "
-             "write s | tasks s | busy | CPU s |", "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "write s | tasks s | busy | CPU s | CPU s in tasks | CPU s outside tasks |",
+             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in result["rows"]:
         lines.append(f"| {r['workers']} | {r['wall_s']:.1f} | {r['images_per_s']:.2f} | "
                      f"{r['startup_s']:.1f} | {r['settle_s']:.1f} | {r['simulate_s']:.1f} | "
                      f"{r['render_s']:.1f} | {r['write_s']:.1f} | {r['tasks_s']:.1f} | "
-                     f"{r['busy']:.2f} | {r['cpu_s']:.1f} |")
+                     f"{r['busy']:.2f} | {r['cpu_s']:.1f} | {r.get('task_cpu_s', 0.0):.1f} | "
+                     f"{r['cpu_s'] - r.get('task_cpu_s', 0.0):.1f} |")
     lines += ["", f"Two workers against one: **{result['speedup_2_over_1']:.2f}x** (goal "
               f">= {result['goal']:g}x: {'met' if result['goal_met'] else 'NOT met'}); "
               f"{m['cpu_count']} cores shared with other engineers' jobs, load average "

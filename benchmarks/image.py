@@ -211,7 +211,7 @@ def frame_images(ctx, desc, preset, light, bands: int, mode: str, supersample: i
         if room is not None:
             renderer.update(room=room)
         cam = desc.info["camera"]
-        renderer.update(camera=orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"]))
+        renderer.update(camera=orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"], target=cam.get("target")))
         renderer.set_mesh(*desc.curtain, fabric_size_m=desc.fabric_size_m)
         renderer.set_rings(list(desc.ring_xs_m))
         wall, _cpu = median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=ctx.finish)

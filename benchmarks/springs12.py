@@ -123,8 +123,9 @@ def _make_kernels():
             dx = px[i2, j + dj] - px[i, j]
             dy = py[i2, j + dj] - py[i, j]
             dz = pz[i2, j + dj] - pz[i, j]
-            length = np.sqrt(dx * dx + dy * dy + dz * dz)
-            inv = np.float32(1.0) / length
+            d2 = dx * dx + dy * dy + dz * dz
+            inv = np.float32(1.0) / np.sqrt(d2)
+            length = d2 * inv
             along = ((vx[i2, j + dj] - vx[i, j]) * dx + (vy[i2, j + dj] - vy[i, j]) * dy
                      + (vz[i2, j + dj] - vz[i, j]) * dz) * inv
             s = (ke * (length - rest) + kd * along) * inv

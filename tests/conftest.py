@@ -90,14 +90,47 @@ def fabric_dir() -> Path:
 
 # --- GL (the renderer's tests; the only place a test creates a context) -----------------
 
+#: The session's one context once made (:func:`gl_context`); empty before.
+_SHARED_GL: list = []
+
+
 @pytest.fixture(scope="session")
 def gl_context():
     """One headless OpenGL 4.3 context (EGL, Mesa llvmpipe in CI) shared by the GL tests."""
     from catalog.gl.context import create_headless_context
 
     ctx = create_headless_context()
+    _SHARED_GL.append(ctx)
     yield ctx
+    _SHARED_GL.clear()
     ctx.release()
+
+
+def _share_gl_context(item) -> None:
+    """Make the shared context current again for a test that uses it. A command a test runs in
+    this process (``main(["snapshot", ..])``, ``render_sheet``, ``build_site`` without
+    ``ctx=``) creates its own EGL context, which becomes the thread's current one and stays
+    so (released or not): the shared context's calls then went to that one, and objects made
+    earlier in the shared context (a module fixture's renderer) gave GL_INVALID_OPERATION.
+    Serially a module's tests ran together, so it showed only when pytest-xdist interleaved
+    modules in one worker."""
+    if _SHARED_GL and "gl_context" in getattr(item, "fixturenames", ()):
+        _SHARED_GL[0].__enter__()   # eglMakeCurrent (moderngl: no matching exit needed)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtest_setup(item):
+    _share_gl_context(item)   # before the test's fixtures (a module's shared render) are made
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtest_call(item):
+    _share_gl_context(item)   # a fixture of the test may have made another context current
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtest_teardown(item):
+    _share_gl_context(item)   # the gl fixture's check and fixtures' releases
 
 
 @pytest.fixture
@@ -151,13 +184,14 @@ def make_preset(tmp_path):
 # --- the web catalog (tests/test_web*.py): one small site shared by its tests ----------
 
 @pytest.fixture(scope="session")
-def web_site(tmp_path_factory):
+def web_site(tmp_path_factory, gl_context):
     """(folder, report) of `catalog web` for two fabrics (one fluorescent, one dyed, with
-    different cloth) under D65, UV-A and the sun by hour."""
+    different cloth) under D65, UV-A and the sun by hour, recorded in the shared context."""
     from catalog.web.site import build_site
 
     out = tmp_path_factory.mktemp("web") / "site"
-    report = build_site(out, fabrics="fluoro-pink,linen-dense", lights="D65,UV-A,sun-by-hour")
+    report = build_site(out, fabrics="fluoro-pink,linen-dense", lights="D65,UV-A,sun-by-hour",
+                        ctx=gl_context)
     return out, report
 
 

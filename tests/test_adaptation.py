@@ -205,7 +205,7 @@ def test_voile_near_neutral_in_the_day(curtain_lab):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="issue 33 goal not met at 19 h: chroma 9.85 (a 2900 K light "
+@pytest.mark.xfail(strict=True, reason="issue 33 goal not met at 19 h: chroma 10.7 (a 2900 K light "
                                       "with D = 0.852 keeps 15 % of its warmth, what the sunset goal "
                                       "asks for; no single D meets both: docs/accuracy.md)")
 def test_voile_near_neutral_every_daylight_hour(curtain_lab):

@@ -145,8 +145,12 @@ def test_highlights_roll_off_and_desaturate_toward_white():
     grey and chroma falls toward zero (no channel clips on the way), at a constant hue."""
     red = np.array([1.0, 0.1, 0.05])
     scales = np.geomspace(0.3, 3000.0, 40)
-    shown = display.display_linear(red[None, :] * scales[:, None], 1.0, np.eye(3))
+    toned = display.tone_mapped(red[None, :] * scales[:, None], 1.0, np.eye(3))
+    shown = np.clip(display.gamut_compress(toned), 0.0, 1.0)
     lab = display.rgb_to_oklab(shown)
+    # the frame's table (display_lut) follows the exact path (tests/test_display_lut.py: bounds)
+    table_lab = display.rgb_to_oklab(display.display_linear(red[None, :] * scales[:, None], 1.0, np.eye(3)))
+    assert np.abs(table_lab[:, 0] - lab[:, 0]).max() < 0.01
     chroma = np.hypot(lab[:, 1], lab[:, 2])
     assert np.all(np.diff(lab[:, 0]) > -1e-12)        # up to the ceiling, then held there
     assert lab[-1, 0] == pytest.approx(display.lightness_ceiling(), abs=1e-9)

@@ -188,7 +188,8 @@ def test_transport_cache_follows_the_room_file(tmp_path, monkeypatch):
     assert changed.content_sha256 != room.content_sha256
     third = room_transport(changed, params, backend="numpy")
     assert third.timings_s["from_cache"] is False
-    assert not np.allclose(third.receivers.centre, first.receivers.centre)   # the deeper room
+    assert (third.receivers.count != first.receivers.count                    # the deeper room
+            or not np.allclose(third.receivers.centre, first.receivers.centre))
     def back_wall_mean(t):                                 # the far wall's mean direct light (unit DC patch)
         rec = t.receivers
         back = (rec.normal[:, 2] < -0.99) & (rec.centre[:, 2] > 0.5)      # the only inside face towards -z

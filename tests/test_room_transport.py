@@ -285,3 +285,47 @@ def test_web_pack_is_small_and_within_its_bound_of_the_full_operator():
     c[:, 0] = 1.0
     exact = t.irradiance(c, compressed=False)
     assert np.abs(tight.irradiance(c) - exact).max() < 5e-3 * np.abs(exact).max()
+
+
+# --------------------------------------------------------------------------- buried receivers
+
+@pytest.mark.slow
+def test_receivers_buried_under_furniture_are_measured_and_left_out_of_the_weld():
+    """A block standing on the floor buries the floor under its footprint: those points are
+    seen by no one. exposure = the share outside the footprint (closed form), and the
+    light map's corner between a buried and an exposed receiver takes the exposed one's value."""
+    from catalog.room import lightmap
+    from catalog.room.transport import buried, exposed_fraction
+
+    tris, _ = open_cube((0.3, 0.7, 0.35, 0.75))
+    block = box_triangles(0.35, 0.65, 0.0, 0.25, 0.45, 0.7)
+    tris = np.concatenate([tris, block])
+    rays = NumpyRays(tris)
+    # points on the floor (normal +y): inside the footprint buried, outside and on top not
+    pts = np.array([[0.5, 0.0, 0.6], [0.4, 0.0, 0.5], [0.2, 0.0, 0.6], [0.5, 0.0, 0.9], [0.5, 0.25, 0.6]])
+    up = np.tile([0.0, 1.0, 0.0], (5, 1))
+    assert buried(pts, up, rays, 1e-6, tris).tolist() == [True, True, False, False, False]
+    rec = build_receivers(tris, constant_albedo(0.5), 0.05)
+    exposed = exposed_fraction(rec, rays, 1e-6)
+    floor = (np.abs(rec.centre[:, 1]) < 1e-9) & (rec.normal[:, 1] > 0.99)
+    c = rec.centre
+    inside = (c[:, 0] > 0.35) & (c[:, 0] < 0.65) & (c[:, 2] > 0.45) & (c[:, 2] < 0.7)
+    lo, hi = rec.corners.min(axis=1), rec.corners.max(axis=1)
+    wholly_in = floor & (lo[:, 0] >= 0.35) & (hi[:, 0] <= 0.65) & (lo[:, 2] >= 0.45) & (hi[:, 2] <= 0.7)
+    wholly_out = floor & ((hi[:, 0] <= 0.35) | (lo[:, 0] >= 0.65) | (hi[:, 2] <= 0.45) | (lo[:, 2] >= 0.7))
+    assert wholly_in.sum() > 10 and np.all(exposed[wholly_in] == 0) and np.all(exposed[wholly_out] == 1)
+    area = float(np.sum(rec.area_m2[floor] * exposed[floor]))
+    assert area == pytest.approx(1.0 - 0.3 * 0.25, rel=0.02)               # floor minus the footprint
+    assert not np.any(inside & ~floor & (exposed < 1) & (rec.normal[:, 1] > 0.99) & (np.abs(c[:, 1] - 0.25) < 1e-9))
+    # the weld: buried receivers dark, exposed ones lit; no exposed corner is darkened
+    from dataclasses import replace
+
+    rec = replace(rec, exposed=exposed)
+
+    class T:
+        receivers = rec
+
+    value = np.where(exposed > 0, 1.0, 0.0)[:, None] * np.ones((1, 3))
+    corner = lightmap.corner_irradiance(T, value)
+    lit = floor & (exposed == 1)
+    assert np.allclose(corner[lit], 1.0, atol=1e-5)

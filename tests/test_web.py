@@ -82,8 +82,33 @@ def test_bake_codec_round_trip_within_its_quanta():
     assert len(payload) <= 0.6 * f * cols * rows * bake.BYTES_PER_VERTEX
 
 
+@pytest.fixture(scope="module")
+def voile_bake():
+    """bake() of voile-white in this process: one simulation of its loop for the module."""
+    from catalog.presets import find_preset, load_preset
+    from catalog.web import bake
+
+    return bake.bake(load_preset(find_preset("voile-white")))
+
+
+@pytest.fixture
+def baked_voile(monkeypatch, voile_bake):
+    """Site builds of voile-white take the module's bake instead of simulating the cloth again
+    in a child (the child's bake is tested on its own: test_a_bake_in_the_child_process_..):
+    for the tests about the site's files, which the bake does not change."""
+    from catalog.web import bake
+
+    def bake_apart(presets, on_baked=None):
+        assert [p.name for p in presets] == ["voile-white"]
+        if on_baked is not None:
+            on_baked()
+        return [voile_bake]
+
+    monkeypatch.setattr(bake, "bake_apart", bake_apart)
+
+
 @pytest.mark.slow
-def test_baked_loop_is_seamless_and_small():
+def test_baked_loop_is_seamless_and_small(voile_bake):
     """The last frame leads into the first: its step to frame 0 is no larger than the largest
     step inside the loop; and the encoding is at most 60 % of the raw 12 B per vertex."""
     from catalog.presets import find_preset, load_preset
@@ -92,7 +117,7 @@ def test_baked_loop_is_seamless_and_small():
     from catalog.render import snapshot
 
     preset = load_preset(find_preset("voile-white"))
-    animation = bake.bake(preset)
+    animation = voile_bake
     positions, _, _ = bake.decode_frames(animation)
     # hung where the snapshot hangs its settled drape: the same rod offset (the loop's grid
     # plus the offset = the snapshot's mesh, both from the settled drape's grid), fabric size
@@ -111,7 +136,7 @@ def test_baked_loop_is_seamless_and_small():
 
 
 @pytest.mark.slow
-def test_a_bake_in_the_child_process_is_the_bake_here():
+def test_a_bake_in_the_child_process_is_the_bake_here(voile_bake):
     """bake_apart (the site's bake, in a child Python) gives the animation bake() gives in
     this process, byte for byte, and counts it as it arrives."""
     from catalog.presets import find_preset, load_preset
@@ -120,7 +145,7 @@ def test_a_bake_in_the_child_process_is_the_bake_here():
     preset = load_preset(find_preset("voile-white"))
     arrived = []
     (apart,) = bake.bake_apart([preset], on_baked=lambda: arrived.append(1))
-    here = bake.bake(preset)
+    here = voile_bake
     assert arrived == [1] and apart.script() == here.script()
     assert bake.bake_apart([]) == []
 
@@ -292,7 +317,7 @@ def test_foreign_folder_is_not_replaced(tmp_path):
 
 @pytest.mark.gl
 @pytest.mark.slow
-def test_failure_midway_leaves_no_site_and_no_stage(tmp_path, monkeypatch):
+def test_failure_midway_leaves_no_site_and_no_stage(tmp_path, monkeypatch, baked_voile):
     """An error after the work began (here: while recording) leaves neither DIR, nor the
     staging folder beside it, nor the missing folders above DIR that the build made."""
     from catalog.core.errors import CatalogError
@@ -310,7 +335,7 @@ def test_failure_midway_leaves_no_site_and_no_stage(tmp_path, monkeypatch):
 
 @pytest.mark.gl
 @pytest.mark.slow
-def test_a_second_build_replaces_only_what_the_first_wrote(tmp_path):
+def test_a_second_build_replaces_only_what_the_first_wrote(tmp_path, baked_voile):
     """The second build replaces the first's files and removes those its manifest lists and
     the new site lacks; a file the user added (CNAME) survives."""
     from catalog.web import site
@@ -461,3 +486,23 @@ def test_packed_data_round_trips_and_is_smaller():
     assert text.startswith("window.CATALOG_PACKED = ")
     assert unpack_data(text) == data
     assert len(text) < 0.5 * plain
+
+
+def test_frame_comparison_reports_a_frame_wide_shift():
+    """compare_frames' signed mean per channel: a shift of the whole frame (another white
+    balance) reads as itself, sign included; a moved edge counts by its share of the frame
+    (a column of 200/255 lost from 40: -5/255 in each channel)."""
+    from catalog.web.browser import compare_frames, frames_match
+
+    rng = np.random.default_rng(3)
+    desktop = rng.integers(40, 200, size=(30, 40, 3), dtype=np.uint8)
+    shifted = desktop.astype(np.int16) + np.array([1, -1, 0], dtype=np.int16)
+    figures = compare_frames(shifted.astype(np.uint8), desktop)
+    assert figures["signed_mean_8bit"] == [1.0, -1.0, 0.0]
+    assert figures["unmatched"] == 0 and not frames_match(figures)  # mean 0.67 > 0.5
+    edge = np.zeros((30, 40, 3), dtype=np.uint8)
+    edge[:, 20:] = 200
+    moved = np.roll(edge, 1, axis=1)
+    moved[:, 0] = 0
+    figures = compare_frames(moved, edge)
+    assert figures["edge_shift"] == 30 and figures["signed_mean_8bit"] == [-5.0] * 3

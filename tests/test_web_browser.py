@@ -67,33 +67,35 @@ def test_page_loads_without_errors_and_renders(page, web_site):
     assert page.console_errors() == []
 
 
-#: Since the drape's heading pleats keep their rest length (longer folds): the page and the
-#: desktop frame differ on a few more edge pixels than the 1 % the rule allows (196 and 164 of
-#: 19 200, one off-edge pixel 11/255 apart) in these scenes; the cause is not yet isolated
-#: (SwiftShader's and llvmpipe's rasterisation of the new folds, or a term the page lacks).
-_EDGE_MISMATCH = pytest.mark.xfail(reason="page vs desktop: edge pixels just over the 1 % rule "
-                                          "since the longer heading pleats; not yet isolated",
-                                   strict=False)
 #: Since the display adapts to the light of the surfaces in view (measured from the frame's
 #: drawn HDR target and G-buffer): the export records its scenes dry (no pixels drawn), so the
-#: recorded white is measured from an undrawn target and the page's white balance differs from
-#: the desktop's under the sun (12 449 of 19 200 pixels over 3/255, mean 4.0/255); the lamp
-#: scenes, whose white is the light's own, still match. Found at the merge, not yet fixed.
-_WHITE_MISMATCH = pytest.mark.xfail(reason="page vs desktop under the sun: the export's dry "
-                                           "recording measures the visible white from an undrawn "
-                                           "target", strict=False)
+#: recorded white is measured from an undrawn target (it falls back to the light's own white:
+#: the identity under D65) and the page's white balance differs from the desktop's: under the
+#: sun 12 449 of 19 200 pixels over 3/255, mean 4.0/255; fluoro-pink under D65 (the room lit
+#: through the pink cloth) a frame-wide shift, page minus desktop R +1.32, G -0.73, B +0.21
+#: (mean 0.87/255, the edge clause met: 166 of 19 200). With a drawn frame's white put into the
+#: page's data the D65 cases pass: mean 0.25 (glare off, the desktop's own 160x120 white), 0.35
+#: and 0.34 (glare off, on: the white of a drawn frame at the recorder's 67x43); with issue 33's
+#: real frame before the dry one and the lamps in the white's key (test_white_lamps.py) the
+#: export gives mean 0.34, 147 edge pixels (glare off). Drop the marks once both are merged.
+#: linen-dense sun@18 with lamp A stays off (mean 4.9, page minus desktop B +9.7): the visible
+#: white depends on the frame's aspect (its field of view), and the recorder's 67x43 (1.56) is
+#: not the test's 4:3 (sun@18, lamp A: blue gain 1.40 at 67x43, 1.44 at 16:9, 1.22 at 4:3).
+_WHITE_MISMATCH = pytest.mark.xfail(reason="page vs desktop: the export's dry recording "
+                                           "measures the visible white from an undrawn target",
+                                    strict=False)
 
 
 @pytest.mark.parametrize("fabric, light, fluorescence, frame, camera, glare, lamp", [
-    pytest.param("fluoro-pink", "D65", "on", 0, None, "off", "none", marks=_EDGE_MISMATCH),
+    pytest.param("fluoro-pink", "D65", "on", 0, None, "off", "none", marks=_WHITE_MISMATCH),
     pytest.param("linen-dense", "sun@8", "on", 17, None, "off", "none", marks=_WHITE_MISMATCH),
     ("fluoro-pink", "UV-A", "off", 30, None, "off", "none"),
     pytest.param("fluoro-pink", "sun@15", "on", 5, (35.0, 20.0, 1.8), "off", "none",  # its camera
                  marks=_WHITE_MISMATCH),
     pytest.param("fluoro-pink", "D65", "on", 0, None, "on", "none",      # the glare's targets
-                 marks=_EDGE_MISMATCH),
+                 marks=_WHITE_MISMATCH),
     pytest.param("linen-dense", "sun@18", "on", 3, None, "on", "A",      # a room lamp
-                 marks=_EDGE_MISMATCH),
+                 marks=_WHITE_MISMATCH),  # measured: mean 3.1/255, 11 136 pixels unmatched
 ])
 def test_page_frame_matches_the_egl_frame(page, web_site, animations, gl, fabric, light,
                                           fluorescence, frame, camera, glare, lamp):

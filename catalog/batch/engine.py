@@ -105,7 +105,8 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
         left = sum(len(task.images) for task in tasks)
         counts = {"rendered": 0, "kept": 0}
         failed: dict[str, str] = {}
-        timings = {"settle_s": 0.0, "simulate_s": 0.0, "render_s": 0.0, "write_s": 0.0}
+        timings = {"settle_s": 0.0, "simulate_s": 0.0, "render_s": 0.0, "write_s": 0.0,
+                   "task_cpu_s": 0.0}
         seen: dict[str, int] = {}
         processes: dict[int, dict] = {}
         lock = threading.Lock()
@@ -134,6 +135,7 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
                     processes[result["worker"]["pid"]] = result["worker"]
                 for key in ("settle_s", "simulate_s", "write_s"):
                     timings[key] += result.get(key, 0.0)
+                timings["task_cpu_s"] += result.get("cpu_s", 0.0)
                 if not result["ok"]:
                     failed[task.fabric] = result["error"]
                     manifest.failed[task.fabric] = result["error"]

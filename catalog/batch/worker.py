@@ -166,7 +166,7 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
     ``on_image(record)`` is called after each image is on disk (progress). A CatalogError
     (bad preset, non-finite render) returns ``ok: False`` with the error; anything else
     is raised (an engine may retry it)."""
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     pool = pool or process_pool()
     out_dir = Path(task.out_dir)
     records: list[dict] = []
@@ -193,6 +193,8 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
                 "worker": pool.describe()}
     return {"fabric": task.fabric, "ok": True, "error": None, "records": records,
             "wall_s": round(time.perf_counter() - start, 4),
+            # CPU seconds of this process in the task, llvmpipe's and numba's threads included
+            "cpu_s": round(time.process_time() - cpu_start, 4),
             **{k: round(v, 4) for k, v in timings.items()}, "worker": pool.describe()}
 
 
@@ -211,7 +213,10 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
     task_scene = FrameSettings(fabric=preset, fluorescence=task.fluorescence, bands=task.bands,
                                exposure=task.exposure, room=task.room)
     lights = {name: get_light(name) for name in sorted({image.light for image in todo})}
-    rings = ring_xs_m(preset)
+    from catalog.render.placement import room_placement  # noqa: PLC0415
+
+    placement = room_placement(task.room)   # the curtain on the rod of the room's own window
+    rings = ring_xs_m(preset, placement)
     timings["load_s"] += time.perf_counter() - t0
 
     renderer = pool.renderer_for(task.size)
@@ -223,14 +228,14 @@ def _render_images(task, todo, pool, out_dir, records, timings, on_image) -> Non
     for frame in sorted(by_frame):  # one simulation, stepped through the frames asked for
         t0 = time.perf_counter()
         if simulation is None:
-            simulation = curtain_simulation(preset)  # frame 0: the settled drape
+            simulation = curtain_simulation(preset, placement)  # frame 0: the settled drape
             timings["settle_s"] += time.perf_counter() - t0
         while stepped < frame:  # (its own frame counter includes the settling)
             simulation.step(FRAME_DT_S)
             stepped += 1
         if not simulation.finite:
             raise CatalogError(f"{task.fabric}: the cloth simulation diverged by frame {frame}")
-        *mesh, fabric_size = curtain_on_rod(simulation)
+        *mesh, fabric_size = curtain_on_rod(simulation, placement)
         timings["simulate_s"] += time.perf_counter() - t0
         for image in by_frame[frame]:
             t0 = time.perf_counter()

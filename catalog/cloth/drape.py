@@ -53,13 +53,15 @@ def fullness_of(preset) -> float:
     return float(value)
 
 
-def drape_params(preset, grid: tuple[int, int] | None = None, **overrides) -> ClothParams:
-    """The cloth parameters of a preset hung on the scene's rod, closed: the fabric
-    ROD_SPAN_M x fullness wide, rings every RING_SPACING_M of fabric, spanning the rod."""
+def drape_params(preset, grid: tuple[int, int] | None = None, *, span_m: float = ROD_SPAN_M,
+                 length_m: float = LENGTH_M, **overrides) -> ClothParams:
+    """The cloth parameters of a preset hung on a rod, closed: the fabric ``span_m`` (the
+    rod's flat span, the room's window's: catalog.render.placement) x fullness wide and
+    ``length_m`` long, rings every RING_SPACING_M of fabric, spanning the rod."""
     fullness = fullness_of(preset)
     grid_w, grid_h = grid or GRID
-    values = {"grid_w": grid_w, "grid_h": grid_h, "width_m": ROD_SPAN_M * fullness,
-              "height_m": LENGTH_M, "opening": 1.0 / fullness, "ring_spacing_m": RING_SPACING_M}
+    values = {"grid_w": grid_w, "grid_h": grid_h, "width_m": span_m * fullness,
+              "height_m": length_m, "opening": 1.0 / fullness, "ring_spacing_m": RING_SPACING_M}
     values.update(overrides)
     table = preset.table("cloth") if hasattr(preset, "table") else dict(preset)
     table = {k: v for k, v in table.items() if k != "fullness"}

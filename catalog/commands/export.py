@@ -48,13 +48,17 @@ def run(args) -> int:
 
     # a built-in name or a room .glb (docs/formats.md, "Rooms"): one that breaks a rule
     # is refused in one line naming the node and the rule, before the simulation. The curtain
-    # hangs in the window as in every room; the file records the room's name
-    load_room(args.room)
+    # hangs on the rod of the room's own window (catalog.render.placement); the file records
+    # the room's name
+    from catalog.render.placement import placement_of_room
+
+    placement = placement_of_room(load_room(args.room))
     room = args.room if args.room in BUILTIN_ROOMS else Path(args.room).name
     get_light(args.light)                       # refused now, before the simulation
     preset = load_preset(find_preset(args.fabric))
     if suffix == ".glb":
-        report = write_glb(preset, out, light=args.light, frame=args.frame, room=room)
+        report = write_glb(preset, out, light=args.light, frame=args.frame, room=room,
+                           placement=placement)
     else:
         from catalog.exchange.u3m_export import write_u3m
 

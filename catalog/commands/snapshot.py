@@ -83,10 +83,10 @@ def run(args) -> int:
     from catalog.core.jsonout import print_json  # noqa: PLC0415
     from catalog.render.snapshot import SnapshotRequest, parse_size, render_snapshot  # noqa: PLC0415
 
-    from catalog.render.views import view_named  # noqa: PLC0415
+    from catalog.render.placement import room_placement  # noqa: PLC0415
 
     ev, white_balance = display_choices(args)
-    view = view_named(args.view)
+    view = room_placement(args.room).view(args.view)   # composed for the room's own window
     request = SnapshotRequest(
         fabric=args.fabric, light=args.light, size=parse_size(args.size), out=Path(args.out),
         frame=args.frame, fluorescence="off" if args.no_fluorescence else args.mode,

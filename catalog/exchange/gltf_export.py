@@ -74,12 +74,13 @@ def _plain(value):
     return str(value)
 
 
-def curtain_arrays(preset, frame: int):
-    """(positions, unit normals, uv in repeats, indices, fabric size m, repeat m)."""
+def curtain_arrays(preset, frame: int, placement=None):
+    """(positions, unit normals, uv in repeats, indices, fabric size m, repeat m), the curtain
+    on the rod of ``placement`` (catalog.render.placement; None: the box's)."""
     from catalog.presets.patterns import load_pattern  # noqa: PLC0415
     from catalog.render.snapshot import simulated_curtain  # noqa: PLC0415
 
-    positions, normals, uv, _tangents, indices, fabric_size = simulated_curtain(preset, frame)
+    positions, normals, uv, _tangents, indices, fabric_size = simulated_curtain(preset, frame, placement)
     pattern = load_pattern(preset)
     repeat = pattern.repeat_m if pattern is not None else fabric_size
     normals = np.asarray(normals, dtype=np.float64)
@@ -92,11 +93,11 @@ def curtain_arrays(preset, frame: int):
             fabric_size, repeat, pattern)
 
 
-def gltf_document(preset, light: str, frame: int, room: str):
+def gltf_document(preset, light: str, frame: int, room: str, placement=None):
     """(glTF JSON dict, binary buffer bytes)."""
     from catalog.exchange.u3m_export import base_colour_of  # noqa: PLC0415
 
-    positions, normals, uv, indices, fabric_size, repeat, pattern = curtain_arrays(preset, frame)
+    positions, normals, uv, indices, fabric_size, repeat, pattern = curtain_arrays(preset, frame, placement)
     colour = base_colour_of(preset)
     blobs, views, accessors = [], [], []
 
@@ -176,11 +177,12 @@ def glb_bytes(doc: dict, binary: bytes) -> bytes:
 
 
 def write_glb(preset, out: str | Path, light: str = "D65", frame: int = 0,
-              room: str = "box") -> dict:
-    """Write the curtain as ``out`` (.glb) atomically; a JSON report."""
+              room: str = "box", placement=None) -> dict:
+    """Write the curtain as ``out`` (.glb) atomically, hung on the rod of ``placement`` (the
+    room's window: catalog.render.placement; None: the box's); a JSON report."""
     from catalog.core.atomic import write_bytes_atomic  # noqa: PLC0415
 
-    doc, binary = gltf_document(preset, light, frame, room)
+    doc, binary = gltf_document(preset, light, frame, room, placement)
     data = glb_bytes(doc, binary)
     write_bytes_atomic(out, data, inputs=[preset.path] if preset.path else [])
     accessor = doc["accessors"][doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]]

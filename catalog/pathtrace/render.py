@@ -56,9 +56,11 @@ def reference_settings(fabric, light, *, yaw_deg: float = 0.0, pitch_deg: float 
     """The scene value (:class:`catalog.render.settings.FrameSettings`) of ``fabric`` under
     ``light`` in ``room``, everything resolved here, at the edge: the preset and its Fabric
     tables, the light, the room loaded (a name, a .glb path or a Room) and the orbit camera
-    (``inside``: kept inside the room, as every command's is). ``fields``: any other
+    (looking at the curtain of the room's window; ``inside``: kept inside the room's own
+    interior, catalog.render.placement, as every command's is). ``fields``: any other
     FrameSettings field (e.g. ``key_direction_deg``). Bad input: one line naming the option."""
     from catalog.core import validate as checks  # noqa: PLC0415
+    from catalog.render.placement import placement_of_room  # noqa: PLC0415
     from catalog.render.settings import FrameSettings, orbit  # noqa: PLC0415
     from catalog.room.model import Room  # noqa: PLC0415
 
@@ -66,14 +68,16 @@ def reference_settings(fabric, light, *, yaw_deg: float = 0.0, pitch_deg: float 
     if not (math.isfinite(distance_m) and distance_m > 0.05):
         raise InputError(f"{distance_m!r} m: the camera distance must exceed 0.05 m",
                          field="--distance")
-    settings = FrameSettings(fabric=fabric, light=light, fluorescence=fluorescence,
-                             camera=orbit(yaw_deg, pitch_deg, distance_m, inside=inside),
-                             **fields)
+    settings = FrameSettings(fabric=fabric, light=light, fluorescence=fluorescence, **fields)
     if not isinstance(room, Room):
         from catalog.room.load import load_room  # noqa: PLC0415
 
         room = load_room(room)   # a bad room is refused before Mitsuba loads
-    return settings.replace(room=room)
+    # the camera looks at the curtain of this room's window and (``inside``) stays in its own
+    # interior, as catalog snapshot's does (catalog.render.snapshot.snapshot_settings)
+    placement = placement_of_room(room)
+    return settings.replace(camera=orbit(yaw_deg, pitch_deg, distance_m, inside=inside,
+                                         placement=placement), room=room)
 
 
 def check_out(path) -> Path:

@@ -120,26 +120,33 @@ def describe_scene(settings, *, size=(256, 192), frame: int = 0, curtain=None) -
     from catalog.core.errors import CatalogError  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
+    from catalog.render.placement import placement_of_room  # noqa: PLC0415
+
     room = getattr(settings, "resolved_room", None)
     if room is None:
         raise CatalogError("describe_scene draws a resolved room: give FrameSettings whose room "
                            "is a loaded Room (catalog.pathtrace.render.reference_settings)")
+    # the curtain and rod hung from this room's window, as the frame hangs them (its
+    # placement: catalog.render.placement); the camera is the value's (reference_settings
+    # aims it at this curtain and keeps it in this room's interior, as snapshot_settings does)
+    placement = placement_of_room(room)
     preset, light, camera = settings.fabric, settings.key_light, settings.camera
     is_sun = light.is_sun
-    # the frame's own shading inputs (FrameSettings.shading_inputs: passes/scene_terms.py)
-    inputs, decision = settings.shading_inputs()
+    # the frame's own shading inputs (FrameSettings.shading_inputs: passes/scene_terms.py),
+    # the viewer's side taken from this room's window plane
+    inputs, decision = settings.shading_inputs(placement)
     fabric_size = None
     rings: tuple = ()
     if curtain is None:  # as catalog snapshot: the settled drape, then `frame` frames of cloth
         from catalog.render.snapshot import ring_xs_m, simulated_curtain  # noqa: PLC0415
 
-        *curtain, fabric_size = simulated_curtain(preset, frame)
-        rings = tuple(ring_xs_m(preset))
+        *curtain, fabric_size = simulated_curtain(preset, frame, placement)
+        rings = tuple(ring_xs_m(preset, placement))
     elif len(curtain) == 6:
         *curtain, fabric_size = curtain
-    room_positions, _ = scene_lib.rod_mesh()
+    room_positions, _ = scene_lib.rod_mesh(placement)
     if rings:
-        ring_positions, _ = scene_lib.ring_mesh(list(rings))
+        ring_positions, _ = scene_lib.ring_mesh(list(rings), placement)
         room_positions = np.concatenate([np.asarray(room_positions).reshape(-1, 3),
                                          np.asarray(ring_positions).reshape(-1, 3)])
     pattern = None
@@ -195,7 +202,7 @@ def describe_scene(settings, *, size=(256, 192), frame: int = 0, curtain=None) -
         info={"room": room.name, "fabric": preset.name, "light": light.name, "fluorescence_requested": decision.requested,
               "fluorescence_variant": inputs.fluorescence_mode, "frame": int(frame),
               "camera": {"yaw_deg": camera.yaw_deg, "pitch_deg": camera.pitch_deg,
-                         "distance_m": camera.distance_m}})
+                         "distance_m": camera.distance_m, "target": list(camera.target)}})
 
 
 # --------------------------------------------------------------------------- environment

@@ -33,15 +33,19 @@ CURTAIN_SIDE_TEXELS = (12, 12)
 COARSE_GRID_SIDE = 40
 
 
-def curtain_side_rect() -> tuple[float, float, float, float]:
-    """The room-side grid's extent (x from, y from, width, height; metres): the window's opening."""
-    x0, x1, y0, y1 = scene_lib.WINDOW_RECT
+def curtain_side_rect(placement=None) -> tuple[float, float, float, float]:
+    """The room-side grid's extent (x from, y from, width, height; metres): the window's opening
+    (of ``placement``, catalog.render.placement; None: the box's)."""
+    if placement is None:
+        from catalog.render.placement import BOX as placement  # noqa: PLC0415
+    x0, x1, y0, y1 = placement.window_rect
     return (x0, y0, x1 - x0, y1 - y0)
 
 
-def light_view_projection(to_light: np.ndarray, margin_m: float = 0.05) -> np.ndarray:
+def light_view_projection(to_light: np.ndarray, margin_m: float = 0.05, placement=None) -> np.ndarray:
     """Orthographic view-projection looking along the key light's travel (-to_light), framing
-    the window opening and the curtain's space in front of it (what can cast a shadow)."""
+    the window opening and the curtain's space in front of it (what can cast a shadow): the
+    room's window and curtain (``placement``, catalog.render.placement; None: the box's)."""
     to_light = np.asarray(to_light, dtype=np.float64)
     to_light = to_light / np.linalg.norm(to_light)
     forward = -to_light
@@ -49,12 +53,14 @@ def light_view_projection(to_light: np.ndarray, margin_m: float = 0.05) -> np.nd
     right = np.cross(forward, helper)
     right /= np.linalg.norm(right)
     up = np.cross(right, forward)
-    wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-    z0 = scene_lib.ROOM_BOX[2][0]
-    half_w = scene_lib.CURTAIN_WIDTH_M / 2 + 0.15
-    corners = np.array([[x, y, z] for x in (min(wx0, -half_w), max(wx1, half_w))
-                        for y in (wy0, max(wy1, scene_lib.CURTAIN_TOP_Y + 0.1))
-                        for z in (z0 - 0.1, scene_lib.CURTAIN_Z + 0.35)])
+    if placement is None:
+        from catalog.render.placement import BOX as placement  # noqa: PLC0415
+    wx0, wx1, wy0, wy1 = placement.window_rect
+    z0 = placement.window_z
+    cx, half_w = placement.window_centre_x, placement.rod_span_m / 2 + 0.15
+    corners = np.array([[x, y, z] for x in (min(wx0, cx - half_w), max(wx1, cx + half_w))
+                        for y in (wy0, max(wy1, placement.curtain_top_y + 0.1))
+                        for z in (z0 - 0.1, placement.curtain_z + 0.35)])
     view = np.eye(4)
     view[0, :3], view[1, :3], view[2, :3] = right, up, -forward
     local = corners @ view[:3, :3].T
@@ -68,9 +74,9 @@ def light_view_projection(to_light: np.ndarray, margin_m: float = 0.05) -> np.nd
     return proj @ view
 
 
-def shadow_texel_m(to_light: np.ndarray, texels: int = SHADOW_TEXELS) -> float:
+def shadow_texel_m(to_light: np.ndarray, texels: int = SHADOW_TEXELS, placement=None) -> float:
     """World size (m) of one texel of a ``texels``-wide key map (the larger of the two axes)."""
-    m = light_view_projection(to_light)
+    m = light_view_projection(to_light, placement=placement)
     return float(2.0 / min(m[0, :3] @ m[0, :3], m[1, :3] @ m[1, :3]) ** 0.5 / texels)
 
 

@@ -300,48 +300,67 @@ def compress_ratio(r: np.ndarray) -> np.ndarray:
     return np.where(r <= R_KNEE, r, R_KNEE + span * u / (1.0 + u))
 
 
-def gamut_compress(rgb: np.ndarray) -> np.ndarray:
+def gamut_compress(rgb: np.ndarray, steps: int = GAMUT_STEPS) -> np.ndarray:
     """Linear sRGB (luminance in [0, 1), channels anywhere) -> inside the cube, at constant
-    OKLab hue and L (L clamped to [0, :func:`lightness_ceiling`]; module docstring, step 4)."""
-    lab = rgb_to_oklab(rgb)
-    lightness = np.clip(lab[..., 0], 0.0, lightness_ceiling())
-    clamped = lightness != lab[..., 0]
-    lab[..., 0] = lightness
+    OKLab hue and L (L clamped to [0, :func:`lightness_ceiling`]; module docstring, step 4).
+
+    Walked in LMS' (OKLab's cube-rooted LMS): with g = M2^-1 (1, 0, 0) (about (1, 1, 1)), the
+    colour at lightness L and chroma scale t on this colour's hue is L g + t (lms' - L_own g).
+    ``steps``: bisection steps (the display's table is built with more)."""
+    m = matrices()
+    rgb = np.asarray(rgb, dtype=np.float64)
+    lms = _signed_cbrt(rgb @ m.rgb_to_lms.T)
+    own_l = lms @ m.lms_to_lab[0]
+    lightness = np.clip(own_l, 0.0, lightness_ceiling())
+    grey = m.lab_to_lms[:, 0]   # LMS' of (L, 0, 0) per unit L (1, 1, 1 to 1e-10)
+    offset = lms - own_l[..., None] * grey
+
+    def inside(lo_l, off, t):   # channel by channel: numpy's small matmuls are slow
+        cubes = [(lo_l * grey[k] + t * off[..., k]) ** 3 for k in range(3)]
+        ok = np.ones(lo_l.shape, dtype=bool)
+        for row in m.lms_to_rgb:
+            channel = row[0] * cubes[0] + row[1] * cubes[1] + row[2] * cubes[2]
+            ok &= (channel >= 0.0) & (channel <= CUBE_TOP)
+        return ok
+
     t_hi = 1.0 / R_KNEE
-    far = lab.copy()
-    far[..., 1:] *= t_hi
-    need = ~_in_gamut(far)  # in gamut at 1/R_KNEE times its chroma: r <= R_KNEE, kept
-    need |= clamped  # rebuilt from OKLab
-    out = np.array(rgb, dtype=np.float64, copy=True)
+    # in gamut at 1/R_KNEE times its chroma: r <= R_KNEE, kept; a clamped L is rebuilt
+    need = (lightness != own_l) | ~inside(lightness, offset, np.full(own_l.shape, t_hi))
+    out = np.array(rgb, copy=True)
     if not np.any(need):
         return out
-    sub = lab[need]
-    lo = np.zeros(sub.shape[:-1])
-    hi = np.full(sub.shape[:-1], t_hi)
-    for _ in range(GAMUT_STEPS):
+    sub_l, sub_off = lightness[need], offset[need]
+    lo = np.zeros(sub_l.shape)
+    hi = np.full(sub_l.shape, t_hi)
+    for _ in range(steps):
         mid = 0.5 * (lo + hi)
-        probe = sub.copy()
-        probe[..., 1:] *= mid[..., None]
-        inside = _in_gamut(probe)
-        lo = np.where(inside, mid, lo)
-        hi = np.where(inside, hi, mid)
+        ok = inside(sub_l, sub_off, mid)
+        lo = np.where(ok, mid, lo)
+        hi = np.where(ok, hi, mid)
     # lo: the largest multiple of the colour's chroma found inside (the boundary from below)
     r = 1.0 / np.maximum(lo, 1e-12)
     scale = compress_ratio(r) / r
-    sub[..., 1:] *= scale[..., None]
-    out[need] = oklab_to_rgb(sub)
+    out[need] = ((sub_l[..., None] * grey + scale[..., None] * sub_off) ** 3) @ m.lms_to_rgb.T
     return out
 
 
 def display_linear(hdr_rgb: np.ndarray, exposure: float, white_balance: np.ndarray) -> np.ndarray:
-    """Steps 1-4: radiance (linear sRGB, cd m^-2) -> display-linear sRGB in [0, 1)."""
+    """Steps 1-4: radiance (linear sRGB, cd m^-2) -> display-linear sRGB in [0, 1); step 4
+    with the boundary read from its table (catalog.render.display_lut), as tonemap.frag."""
+    from catalog.render import display_lut  # noqa: PLC0415
+
+    return np.clip(display_lut.gamut_compress(tone_mapped(hdr_rgb, exposure, white_balance)), 0.0, 1.0)
+
+
+def tone_mapped(hdr_rgb: np.ndarray, exposure: float, white_balance: np.ndarray) -> np.ndarray:
+    """Steps 1-3: radiance -> linear sRGB of luminance in [0, 1) (0 where Y <= 0), before the
+    gamut compression (:func:`gamut_compress` exactly, or its table)."""
     m = matrices()
     c = (np.asarray(hdr_rgb, dtype=np.float64) * exposure) @ np.asarray(white_balance).T
     y = c @ m.luminance
     positive = y > 0
     with np.errstate(divide="ignore", invalid="ignore"):
-        c = np.where(positive[..., None], c * (tone_curve(y) / np.where(positive, y, 1.0))[..., None], 0.0)
-    return np.clip(gamut_compress(c), 0.0, 1.0)
+        return np.where(positive[..., None], c * (tone_curve(y) / np.where(positive, y, 1.0))[..., None], 0.0)
 
 
 def display_transform(hdr_rgb: np.ndarray, exposure: float, white_balance: np.ndarray) -> np.ndarray:
@@ -359,9 +378,5 @@ def shader_uniforms(exposure: float, white_balance: np.ndarray) -> dict:
         return np.ascontiguousarray(np.asarray(a, dtype=np.float64).T, dtype="f4").tobytes()
 
     return {"u_exposure": float(exposure), "u_white_balance": mat3(white_balance),
-            "u_rgb_to_lms": mat3(m.rgb_to_lms), "u_lms_to_rgb": mat3(m.lms_to_rgb),
-            "u_lms_to_lab": mat3(m.lms_to_lab),
             "u_luminance": tuple(float(v) for v in m.luminance),
-            "u_tone": (float(TONE_S0), float(TONE_G)),
-            "u_gamut": (float(R_KNEE), float(R_LIMIT), float(CUBE_TOP)),
-            "u_lightness_ceiling": float(lightness_ceiling())}
+            "u_tone": (float(TONE_S0), float(TONE_G))}

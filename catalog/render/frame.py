@@ -233,8 +233,16 @@ class FrameRenderer:
                          doc="The pattern drawn (False: the flat cloth, or a capture's flat pass).")
 
     def set_rings(self, xs_m) -> None:
-        """Curtain rings on the rod at these x positions (m, scene frame); empty: none."""
-        self.ring_arrays = scene_lib.ring_mesh(xs_m)
+        """Curtain rings on the rod at these x positions (m, scene frame); empty: none. On the
+        rod of the frame's room (:attr:`placement`): after a room change, set the mesh and the
+        rings of that room again (catalog.render.snapshot.simulated_curtain, ring_xs_m)."""
+        self.ring_arrays = scene_lib.ring_mesh(xs_m, self.placement)
+
+    @property
+    def placement(self):
+        """Where the curtain, rod and camera go in the frame's room (catalog.render.placement),
+        from its window (the room transport's, loaded on first use)."""
+        return self.room_transport.placement
 
     def room_side_active(self) -> bool:
         """Whether the curtain's room side takes the room's solved light this frame: with the
@@ -250,7 +258,7 @@ class FrameRenderer:
 
     @property
     def viewer_inside(self) -> bool:
-        return self._settings.viewer_inside
+        return self._settings.viewer_inside(self.placement)   # the frame's room's window
 
     def _viewport_size(self, viewport) -> tuple[int, int]:
         if viewport is None:
@@ -505,6 +513,7 @@ class FrameRenderer:
         self.gl.release()
         self.room_targets.release()
         self.glare.release()
+        self.display.release()
         if self.environment is not None:
             self.environment[1].release()
             self.environment = None

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 #: Bumped when the bundle's content changes.
-BUNDLE_VERSION = 3
+BUNDLE_VERSION = 4
 #: Cosine-weighted rays from each receiver for its view of the outside (receivers outside
 #: the aperture: the reveals, a sill) and of the aperture from outside (the curtain's window side).
 OUTSIDE_RAYS = 64
@@ -61,7 +61,7 @@ class SurfaceData:
 
 @dataclass(frozen=True)
 class RoomOperators:
-    """A room's runtime bundle. Receivers: ``corners`` (E, 3, 3), ``normal``, ``area_m2``,
+    """A room's runtime bundle. Receivers: ``corners`` (E, 3, 3), ``normal``, ``area_m2`` (exposed),
     ``albedo`` (E, 3), ``surface`` (E,) and ``uvs`` (E, 3, 2); ``vertex`` (3 E,) the welded
     light-map vertex of each corner (catalog.room.lightmap's weld) and its weights."""
 
@@ -224,12 +224,24 @@ def _weld(transport) -> np.ndarray:
     return weld_vertices(transport.receivers)
 
 
-def side_grid() -> tuple:
-    """The cloth's room-side grid: (tw, th, x0, y0, w, h) of curtain.vert's ROOM_SIDE texture."""
+def side_grid(placement=None) -> tuple:
+    """The cloth's room-side grid: (tw, th, x0, y0, w, h) of curtain.vert's ROOM_SIDE texture,
+    over the window of ``placement`` (catalog.render.placement; None: the box's)."""
     from catalog.render.curtain_frames import CURTAIN_SIDE_TEXELS, curtain_side_rect  # noqa: PLC0415
 
     tw, th = CURTAIN_SIDE_TEXELS
-    return (int(tw), int(th), *(float(v) for v in curtain_side_rect()))
+    return (int(tw), int(th), *(float(v) for v in curtain_side_rect(placement)))
+
+
+def _room_side_grid(window_corners) -> tuple:
+    """:func:`side_grid` over the room's own window: its corners' bounds to the micrometre, the
+    window_rect catalog.render.placement.placement_of gives the frame (that module loads this
+    one's bundles, so the rule is restated here rather than imported)."""
+    from types import SimpleNamespace  # noqa: PLC0415
+
+    c = np.asarray(window_corners, dtype=np.float64)
+    rect = tuple(round(float(v), 6) for v in (c[:, 0].min(), c[:, 0].max(), c[:, 1].min(), c[:, 1].max()))
+    return side_grid(SimpleNamespace(window_rect=rect))
 
 
 def build(room) -> RoomOperators:
@@ -238,7 +250,10 @@ def build(room) -> RoomOperators:
     from catalog.room.cache import room_transport  # noqa: PLC0415
     from catalog.room.rays import ray_caster  # noqa: PLC0415
 
+    from catalog.room.build_progress import report  # noqa: PLC0415
+
     t = room_transport(room)
+    report("gathers")
     if t.window_basis is None or t.bounce_left is None:
         raise ValueError("the room's transport is not compressed")
     caster = ray_caster(room.triangles())
@@ -249,7 +264,7 @@ def build(room) -> RoomOperators:
     c = room.window.corners
     patch_points = (((1 - s) * (1 - tt))[:, None] * c[0] + (s * (1 - tt))[:, None] * c[1]
                     + (s * tt)[:, None] * c[2] + ((1 - s) * tt)[:, None] * c[3])
-    tw, th, x0, y0, w, h = side_grid()
+    tw, th, x0, y0, w, h = _room_side_grid(room.window.corners)
     n = room.window.normal
     plane = float(room.window.centre @ n)
     gx, gy = np.meshgrid(x0 + (np.arange(tw) + 0.5) / tw * w, y0 + (np.arange(th) + 0.5) / th * h)
@@ -264,7 +279,7 @@ def build(room) -> RoomOperators:
                        for s_ in room.surfaces),
         window_corners=room.window.corners, window_normal=room.window.normal, frame=t.frame,
         patches=tuple(t.params.patches), order=int(t.params.order),
-        corners=t.receivers.corners, normal=t.receivers.normal, area_m2=t.receivers.area_m2,
+        corners=t.receivers.corners, normal=t.receivers.normal, area_m2=t.receivers.weld_weight_m2,
         albedo=t.receivers.albedo, surface=surface, uvs=uvs, vertex=_weld(t),
         window_basis=t.window_basis, window_modes=t.window_modes,
         form_factors=Csr(f.data.astype(np.float64), f.indices.astype(np.int64),
@@ -284,7 +299,7 @@ def bundle_key(content_sha256: str) -> str:
 
     text = json.dumps({"room": content_sha256, "params": TransportParams().key(),
                        "version": BUNDLE_VERSION, "patch_rays": GATHER_RAYS_PATCH,
-                       "side_rays": GATHER_RAYS_SIDE, "side_grid": side_grid(),
+                       "side_rays": GATHER_RAYS_SIDE, "side_grid": side_grid(),   # (the box's; each room's lies over its own window)
                        "outside_rays": OUTSIDE_RAYS, "outside_order": OUTSIDE_ORDER,
                        "curtain_offset_m": CURTAIN_OFFSET_M}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()
@@ -358,8 +373,8 @@ def room_operators(spec) -> RoomOperators:
     process, or where scipy is marked absent (the viewer) in a child process."""
     path, key, _name = bundle_path(spec)
     bundle = load(path, key)
-    if bundle is not None:
-        return bundle
+    if bundle is not None and tuple(bundle.side_grid) == _room_side_grid(bundle.window_corners):
+        return bundle   # (a bundle whose grid is not over its own window is stale: rebuilt)
     if "scipy" in sys.modules and sys.modules["scipy"] is None:
         result = subprocess.run([sys.executable, "-m", "catalog.render.room_operators", str(spec)],
                                 capture_output=True, text=True)
@@ -384,6 +399,12 @@ def main(argv=None) -> int:
 
     argv = sys.argv[1:] if argv is None else argv
     try:
+        if "--progress" in argv[1:]:   # lines on stdout while it builds (the viewer's first start)
+            from catalog.room.build_progress import LinePrinter, listening  # noqa: PLC0415
+
+            with listening(LinePrinter(Path(argv[0]).stem if argv[0].endswith(".glb") else argv[0])):
+                room_operators(argv[0])
+            return 0
         room_operators(argv[0])
     except CatalogError as exc:
         print(str(exc), file=sys.stderr)

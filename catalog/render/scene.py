@@ -144,11 +144,13 @@ def rod_triangles(radius_m: float, length_m: float, centre, sections: int = 16) 
 RING_RADIUS_M = 0.03
 RING_WIRE_M = 0.004
 ROD_Y = CURTAIN_TOP_Y + 0.03
+ROD_RADIUS_M = 0.015
 
 
-def ring_triangles(xs_m, sections: int = 16, wire_sections: int = 6) -> np.ndarray:
-    """Rings (tori in the y-z plane around the rod) at the given x positions, as triangles
-    (T, 3, 3), counter-clockwise from outside."""
+def ring_triangles(xs_m, sections: int = 16, wire_sections: int = 6, rod_y: float = ROD_Y,
+                   curtain_z: float = CURTAIN_Z) -> np.ndarray:
+    """Rings (tori in the y-z plane around the rod at height ``rod_y``, in the curtain's plane
+    ``curtain_z``) at the given x positions, as triangles (T, 3, 3), counter-clockwise from outside."""
     xs_m = np.asarray(xs_m, dtype=np.float64).ravel()
     if xs_m.size == 0:
         return np.zeros((0, 3, 3))
@@ -156,7 +158,7 @@ def ring_triangles(xs_m, sections: int = 16, wire_sections: int = 6) -> np.ndarr
     b = np.linspace(0.0, 2 * math.pi, wire_sections + 1)       # around the wire
     aa, bb = np.meshgrid(a, b, indexing="ij")
     r = RING_RADIUS_M + RING_WIRE_M * np.cos(bb)
-    ring = np.stack([RING_WIRE_M * np.sin(bb), ROD_Y + r * np.cos(aa), CURTAIN_Z + r * np.sin(aa)], -1)
+    ring = np.stack([RING_WIRE_M * np.sin(bb), rod_y + r * np.cos(aa), curtain_z + r * np.sin(aa)], -1)
     quads = []
     for i in range(sections):
         for j in range(wire_sections):
@@ -167,9 +169,12 @@ def ring_triangles(xs_m, sections: int = 16, wire_sections: int = 6) -> np.ndarr
     return np.concatenate([one + [x, 0.0, 0.0] for x in xs_m])
 
 
-def ring_mesh(xs_m) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`ring_triangles` flat-shaded: (positions, normals) float32 (3T, 3)."""
-    return _flat_shaded(ring_triangles(xs_m))
+def ring_mesh(xs_m, placement=None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`ring_triangles` on the rod of ``placement`` (catalog.render.placement; None: the
+    box's), flat-shaded: (positions, normals) float32 (3T, 3)."""
+    if placement is None:
+        return _flat_shaded(ring_triangles(xs_m))
+    return _flat_shaded(ring_triangles(xs_m, rod_y=placement.rod_y, curtain_z=placement.curtain_z))
 
 
 def _room_parts() -> list[np.ndarray]:
@@ -187,7 +192,7 @@ def _room_parts() -> list[np.ndarray]:
         box_triangles(wx1, x1, y0, y1, z0 - t, z0),
         box_triangles(wx0, wx1, y0, wy0, z0 - t, z0),
         box_triangles(wx0, wx1, wy1, y1, z0 - t, z0),
-        rod_triangles(0.015, CURTAIN_WIDTH_M + 0.4, (0.0, ROD_Y, CURTAIN_Z)),
+        rod_triangles(ROD_RADIUS_M, CURTAIN_WIDTH_M + 0.4, (0.0, ROD_Y, CURTAIN_Z)),
     ]
 
 
@@ -203,9 +208,12 @@ def room_props() -> tuple[np.ndarray, np.ndarray]:
     return _flat_shaded(triangles)
 
 
-def rod_mesh() -> tuple[np.ndarray, np.ndarray]:
-    """The curtain rod alone (the last of the room's parts), flat-shaded like :func:`room_props`."""
-    return _flat_shaded(_room_parts()[-1])
+def rod_mesh(placement=None) -> tuple[np.ndarray, np.ndarray]:
+    """The curtain rod alone, on the window of ``placement`` (catalog.render.placement; None:
+    the box's, the last of the room's parts), flat-shaded like :func:`room_props`."""
+    if placement is None:
+        return _flat_shaded(_room_parts()[-1])
+    return _flat_shaded(rod_triangles(ROD_RADIUS_M, placement.rod_length_m, placement.rod_centre))
 
 
 def _flat_shaded(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

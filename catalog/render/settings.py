@@ -45,15 +45,19 @@ class SunHour:
 
 
 def orbit(yaw_deg: float, pitch_deg: float, distance_m: float, target=None,
-          fov_y_deg: float | None = None, inside: bool = False) -> OrbitCamera:
-    """The orbit camera (:class:`catalog.render.camera.OrbitCamera`); ``inside``: kept inside
-    the room's box (what every command asks for; the library also draws the room from outside)."""
+          fov_y_deg: float | None = None, inside: bool = False, placement=None) -> OrbitCamera:
+    """The orbit camera (:class:`catalog.render.camera.OrbitCamera`) in the room of
+    ``placement`` (catalog.render.placement; None: the box): ``target`` None looks at its
+    curtain's middle; ``inside``: kept inside its interior (what every command asks for; the
+    library also draws the room from outside)."""
     extra = {} if fov_y_deg is None else {"fov_y_deg": float(fov_y_deg)}
     if target is not None:
         extra["target"] = tuple(float(v) for v in target)
+    elif placement is not None:
+        extra["target"] = tuple(float(v) for v in placement.curtain_middle)
+    bounds = (placement.interior if placement is not None else scene_lib.ROOM_BOX) if inside else None
     return OrbitCamera(yaw_deg=float(yaw_deg), pitch_deg=float(pitch_deg),
-                       distance_m=float(distance_m),
-                       bounds=scene_lib.ROOM_BOX if inside else None, **extra)
+                       distance_m=float(distance_m), bounds=bounds, **extra)
 
 
 def _refuse(name: str, problem) -> SettingsError:
@@ -212,16 +216,18 @@ class FrameSettings:
         """The loaded :class:`catalog.room.model.Room` when the edge gave one, else None."""
         return self.room if isinstance(self.room, Room) else None
 
-    @property
-    def viewer_inside(self) -> bool:
-        """Whether the camera stands in the room (in front of the window plane)."""
-        return bool(self.camera.position[2] > scene_lib.WINDOW_Z)
+    def viewer_inside(self, placement=None) -> bool:
+        """Whether the camera stands in the room: in front of the plane of the window of
+        ``placement`` (catalog.render.placement, the drawn room's; None: the box's)."""
+        window_z = scene_lib.WINDOW_Z if placement is None else placement.window_z
+        return bool(self.camera.position[2] > window_z)
 
-    def shading_inputs(self):
+    def shading_inputs(self, placement=None):
         """(the scene's :class:`catalog.optics.shading_reference.ShadingInputs`, the
         fluorescence decision) for this value's fabric, key light and direction, mode and
-        side of the window: what the real-time frame (passes/scene_terms.py) and the path
-        tracer (catalog.pathtrace.scene.describe_scene) both shade with. No file is read."""
+        side of the window (of ``placement``, the drawn room's: :meth:`viewer_inside`): what
+        the real-time frame (passes/scene_terms.py) and the path tracer
+        (catalog.pathtrace.scene.describe_scene) both shade with. No file is read."""
         light = self.key_light
         if self.fabric is None or light is None:
             raise CatalogError("no fabric or no light: the scene is not complete")
@@ -229,7 +235,7 @@ class FrameSettings:
         # Rayleigh-scattered (paper_beam)
         return scene_lib.build_shading_inputs(
             self.fabric, light.irradiance_w_m2_nm, self.key_to_light, is_sun=light.is_sun,
-            fluorescence=self.fluorescence, viewer_inside=self.viewer_inside,
+            fluorescence=self.fluorescence, viewer_inside=self.viewer_inside(placement),
             paper_beam=light.sun is not None and light.sun.model == "paper")
 
     @property

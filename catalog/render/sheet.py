@@ -78,12 +78,12 @@ def close_up(renderer) -> np.ndarray:
     """The renderer's fabric and light seen from the close-up view (sRGB8), the camera put
     back as it was."""
     from catalog.render.settings import orbit  # noqa: PLC0415
-    from catalog.render.views import VIEWS  # noqa: PLC0415
 
     camera = renderer.camera
-    view = VIEWS["close"]
+    placement = renderer.placement        # the close-up of the room's own curtain
+    view = placement.view("close")
     renderer.update(camera=orbit(view.yaw_deg, view.pitch_deg, view.distance_m, target=view.target,
-                                 fov_y_deg=view.fov_y_deg, inside=True))
+                                 fov_y_deg=view.fov_y_deg, inside=True, placement=placement))
     try:
         renderer.render()
         return renderer.read_srgb8()
@@ -154,6 +154,12 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
     renderer = new_renderer(ctx, size)  # the size checked against the context first
     renderer.update(fluorescence=fluorescence, bands=bands, ev=ev, white_balance=white_balance,
                     room=room)
+    from catalog.render.settings import orbit  # noqa: PLC0415
+
+    placement = renderer.placement   # the room's curtain, its rod and the camera on it
+    base = renderer.camera           # the cells' camera: straight at the room's own curtain
+    renderer.update(camera=orbit(base.yaw_deg, base.pitch_deg, base.distance_m,
+                                 fov_y_deg=base.fov_y_deg, placement=placement))
     width, height = size
     grid = np.zeros((height * len(presets), width * len(light_objects), 3), dtype=np.uint8)
     images = []
@@ -166,9 +172,9 @@ def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluor
         shown = None
         for i, preset, j, light in pairs:
             if shown is not preset:   # the drape catalog snapshot shows (its fullness, rings)
-                *mesh, fabric_size = simulated_curtain(preset, 0)
+                *mesh, fabric_size = simulated_curtain(preset, 0, placement)
                 renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
-                renderer.set_rings(ring_xs_m(preset))
+                renderer.set_rings(ring_xs_m(preset, placement))
                 shown = preset
             renderer.update(fabric=preset, light=light)
             renderer.render()

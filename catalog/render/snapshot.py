@@ -108,45 +108,49 @@ class SnapshotRequest:
     room: str = "box"                 # a built-in room or FILE.glb (lit by its transport)
 
 
-def simulated_curtain(preset, frames: int):
+def simulated_curtain(preset, frames: int, placement=None):
     """The curtain after ``frames`` frames of the cloth simulation started from the settled
-    drape (frame 0: the settled drape itself; catalog.cloth.drape), moved onto the scene's
-    rod. Returns (positions, normals, uv, tangents, indices, fabric size (w, h) m)."""
-    simulation = curtain_simulation(preset)
+    drape (frame 0: the settled drape itself; catalog.cloth.drape), hung on the rod of
+    ``placement`` (catalog.render.placement; None: the box's). Returns (positions, normals,
+    uv, tangents, indices, fabric size (w, h) m)."""
+    simulation = curtain_simulation(preset, placement)
     simulation.run(frames, FRAME_DT_S)
-    return curtain_on_rod(simulation)
+    return curtain_on_rod(simulation, placement)
 
 
-def curtain_simulation(preset):
-    """The preset's cloth simulation at the settled drape (frame 0); step it by
-    ``FRAME_DT_S`` for the next frames (catalog render-catalog steps one through them all)."""
-    from catalog.cloth.drape import drape_params, settled_simulation  # noqa: PLC0415
+def curtain_simulation(preset, placement=None):
+    """The preset's cloth simulation at the settled drape (frame 0) for the rod of
+    ``placement``; step it by ``FRAME_DT_S`` for the next frames (catalog render-catalog
+    steps one through them all)."""
+    from catalog.cloth.drape import settled_simulation  # noqa: PLC0415
+    from catalog.render.placement import placed_drape_params  # noqa: PLC0415
 
-    return settled_simulation(drape_params(preset), backend="numpy")
+    return settled_simulation(placed_drape_params(preset, placement), backend="numpy")
 
 
-def curtain_on_rod(simulation):
-    """A running simulation's curtain moved onto the scene's rod: (positions, normals, uv,
-    tangents, indices, fabric size (w, h) m)."""
-    from catalog.cloth.drape import rod_centre_x_m  # noqa: PLC0415
+def curtain_on_rod(simulation, placement=None):
+    """A running simulation's curtain moved onto the rod of ``placement`` (None: the box's):
+    (positions, normals, uv, tangents, indices, fabric size (w, h) m)."""
     from catalog.cloth.mesh import CurtainMesh  # noqa: PLC0415
-    from catalog.render import scene as scene_lib  # noqa: PLC0415
+    from catalog.render.placement import BOX  # noqa: PLC0415
 
     params = simulation.params
     mesh = CurtainMesh.from_grid(simulation.positions(), params)
-    offset = np.array([-rod_centre_x_m(params), scene_lib.CURTAIN_TOP_Y - params.rod_y_m,
-                       scene_lib.CURTAIN_Z], dtype=np.float32)
+    offset = (placement or BOX).curtain_offset(params)
     return (mesh.positions + offset, mesh.normals, mesh.uv, mesh.tangents[:, :3], mesh.indices,
             (params.width_m, params.height_m))
 
 
-def ring_xs_m(preset) -> list[float]:
-    """x of the curtain's rings on the scene's rod (m): the settled drape's ring columns."""
-    from catalog.cloth.drape import drape_params, rod_centre_x_m  # noqa: PLC0415
+def ring_xs_m(preset, placement=None) -> list[float]:
+    """x of the curtain's rings on the rod of ``placement`` (m, world; None: the box's): the
+    settled drape's ring columns."""
+    from catalog.cloth.drape import rod_centre_x_m  # noqa: PLC0415
     from catalog.cloth.state import ring_positions  # noqa: PLC0415
+    from catalog.render.placement import BOX, placed_drape_params  # noqa: PLC0415
 
-    params = drape_params(preset)
-    return [float(x) - rod_centre_x_m(params) for x in ring_positions(params)[:, 0]]
+    params = placed_drape_params(preset, placement)
+    centre = (placement or BOX).window_centre_x
+    return [float(x) - rod_centre_x_m(params) + centre for x in ring_positions(params)[:, 0]]
 
 
 def check_display_choices(ev, white_balance, exposure=1.0) -> None:
@@ -221,9 +225,10 @@ def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
     renderer = new_renderer(ctx, request.size)
     try:
         sun = configure_renderer(renderer, request, preset, light)
-        *mesh, fabric_size = simulated_curtain(preset, request.frame)
+        placement = renderer.placement     # the room's window (catalog.render.placement)
+        *mesh, fabric_size = simulated_curtain(preset, request.frame, placement)
         renderer.set_mesh(*mesh, fabric_size_m=fabric_size)
-        renderer.set_rings(ring_xs_m(preset))
+        renderer.set_rings(ring_xs_m(preset, placement))
         mesh_source = ("settled drape" if request.frame == 0
                        else f"cloth simulation from the settled drape, frame {request.frame}")
         start = time.perf_counter()
@@ -258,14 +263,18 @@ def configure_renderer(renderer, request: SnapshotRequest, preset, light):
 def snapshot_settings(request: SnapshotRequest, preset, light, base=None):
     """The scene value (:class:`catalog.render.settings.FrameSettings`) a snapshot draws:
     ``base`` (None: the defaults) with every field ``request`` sets, the preset and light (or
-    ``request.hour``'s sun) as loaded."""
+    ``request.hour``'s sun) as loaded; the camera looks at and stays inside the room's own
+    placement (catalog.render.placement: its window's curtain, its interior)."""
+    from catalog.render.placement import room_placement  # noqa: PLC0415
     from catalog.render.settings import FrameSettings, SunHour, orbit  # noqa: PLC0415
 
+    placement = room_placement(request.room)   # where the camera may go: the room's inside
     return (base or FrameSettings()).replace(
         fabric=preset, light=light if request.hour is None else SunHour(request.hour),
         fluorescence=request.fluorescence, bands=request.bands,
         camera=orbit(request.yaw_deg, request.pitch_deg, request.distance_m,
-                     target=request.target, fov_y_deg=request.fov_y_deg, inside=True),
+                     target=request.target, fov_y_deg=request.fov_y_deg, inside=True,
+                     placement=placement),
         exposure=request.exposure, ev=request.ev, white_balance=request.white_balance,
         curtain_open=request.curtain_open, room_lighting=request.room_light,
         bloom=request.bloom, environment=request.environment, lamps=request.lamps,

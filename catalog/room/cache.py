@@ -20,11 +20,11 @@ from catalog.room.model import Window
 from catalog.room.receivers import Receivers
 from catalog.room.transport import Transport, TransportParams, precompute
 
-TRANSPORT_VERSION = 2
+TRANSPORT_VERSION = 3
 _ARRAYS = ("direct", "window_operator", "kept_index", "window_basis", "window_modes",
            "bounce_left", "bounce_right", "frame")
 _RECEIVERS = ("corners", "normal", "area_m2", "albedo", "triangle", "divisions", "first", "triangles")
-_RECEIVER_TREE = ("node_corners", "children", "leaf")      # present when refined
+_RECEIVER_TREE = ("node_corners", "children", "leaf", "exposed")      # present when refined / measured
 
 
 def cache_dir() -> Path:

@@ -1,6 +1,6 @@
 """The light map as the frame shows it, in numpy: each receiver corner's irradiance welded
-with the corners it shares on one plane (area-weighted mean of the receivers meeting
-there), interpolated linearly inside each receiver. The GL pass
+with the corners it shares on one plane (mean of the receivers meeting there weighted by
+their exposed area, Receivers.weld_weight_m2), interpolated linearly inside each receiver. The GL pass
 (catalog.render.passes.room_transport) draws exactly this; the benchmark measures it."""
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ def corner_irradiance(transport, irradiance: np.ndarray) -> np.ndarray:
     """(E, 3, 3) the irradiance at each receiver's three corners from receiver values (E, 3)."""
     rec = transport.receivers
     vertex = weld_vertices(rec)
-    weight = np.repeat(rec.area_m2, 3)
+    weight = np.repeat(rec.weld_weight_m2, 3)
     total = np.zeros((vertex.max() + 1, irradiance.shape[1]))
     np.add.at(total, vertex, weight[:, None] * np.repeat(irradiance, 3, axis=0))
     norm = np.bincount(vertex, weights=weight)

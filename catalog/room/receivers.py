@@ -20,7 +20,10 @@ class Receivers:
     ``first`` (T,) its first base element. After :func:`refine`, the tree: ``node_corners``
     (N, 3, 3) every node's corners (the base elements are nodes 0..B-1), ``children`` (N,)
     a node's first of four children (-1: a leaf) and ``leaf`` (N,) a leaf's receiver index
-    (-1: split); None when nothing is refined (the base elements are the receivers)."""
+    (-1: split); None when nothing is refined (the base elements are the receivers).
+    ``exposed`` (E,) the share of each receiver's area not buried inside other geometry (a
+    rug's or a sofa's base standing on the floor, a shelf against a wall: catalog.room.
+    transport.exposed_fraction), None before it is measured (all exposed)."""
 
     corners: np.ndarray
     normal: np.ndarray
@@ -33,6 +36,17 @@ class Receivers:
     node_corners: np.ndarray | None = None
     children: np.ndarray | None = None
     leaf: np.ndarray | None = None
+    exposed: np.ndarray | None = None
+
+    @property
+    def weld_weight_m2(self) -> np.ndarray:
+        """(E,) a receiver's weight in the light map's weld: its exposed area (m^2; a floor
+        at least 1e-6 of the area, so a vertex only buried receivers meet stays defined).
+        A buried part of a receiver is seen by no one: it must not darken its neighbours'
+        shared corners."""
+        if self.exposed is None:
+            return self.area_m2
+        return self.area_m2 * np.maximum(self.exposed, 1e-6)
 
     @property
     def count(self) -> int:
@@ -166,7 +180,8 @@ def subset(r: Receivers, keep: np.ndarray) -> tuple[Receivers, np.ndarray]:
     new[keep] = np.arange(int(keep.sum()))
     return Receivers(r.corners[keep], r.normal[keep], r.area_m2[keep], r.albedo[keep],
                      r.triangle[keep], r.divisions, r.first, r.triangles,
-                     r.node_corners, r.children, r.leaf), new
+                     r.node_corners, r.children, r.leaf,
+                     None if r.exposed is None else r.exposed[keep]), new
 
 
 def _element_albedo(albedo_of, triangles: np.ndarray, tri_index: np.ndarray, corners: np.ndarray) -> np.ndarray:

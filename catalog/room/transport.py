@@ -31,17 +31,25 @@ midpoints and centre (shadow rays to a fixed grid of window points), spans more 
 ``max_receivers`` receivers (the worst split first). Near the window and at the edges of
 its light patches (the sill's shadow, furniture) this halves the element size per level;
 where the light is smooth the elements stay large.
+
+Receivers are measured on their exposed part only (:func:`buried`, :func:`exposed_fraction`):
+furniture stands on the floor and against walls, so parts of those surfaces lie inside
+other geometry, seen by no one and lit by nothing. A receiver's sample points (the direct
+term's, the form factors', the refinement's) are drawn on its exposed part, and the light
+map welds corners by exposed area (Receivers.weld_weight_m2): a buried part neither darkens
+its receiver nor, through a shared corner, its visible neighbours.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
 from catalog.room import sh
+from catalog.room.build_progress import report
 from catalog.room.model import Window
 from catalog.room.receivers import Receivers, build_receivers, cosine_directions, refine, subset
 
@@ -125,6 +133,58 @@ class Transport:
         return out
 
 
+# --------------------------------------------------------------------------- exposure
+
+#: Redraws of a receiver's sample point found buried before it is kept as it is.
+EXPOSED_REDRAWS = 4
+def buried(points: np.ndarray, normals: np.ndarray, rays, eps: float, triangles: np.ndarray) -> np.ndarray:
+    """(N,) True where a surface point lies inside other geometry: the ray along its normal
+    first meets a back face (a floor under a rug or a sofa standing on it, a wall behind a
+    shelf's back). ``rays`` casts against ``triangles`` (T, 3, 3) first (any later ones,
+    the window's, face the room: never buried). Such a point is seen by no one and lit by nothing; counting it dark in a
+    receiver spreads a false contact shadow over the visible part and its neighbours."""
+    out = np.zeros(points.shape[0], dtype=bool)
+    if not points.shape[0]:
+        return out
+    dist, tri = rays.intersect(points + eps * normals, normals)
+    hit = (tri >= 0) & (tri < triangles.shape[0])
+    if hit.any():
+        t = triangles[tri[hit]]
+        n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        out[np.flatnonzero(hit)] = np.einsum("ni,ni->n", n, normals[hit]) > 0
+    return out
+
+
+def exposed_sample_points(rec: Receivers, index: np.ndarray, rng, rays, eps: float) -> np.ndarray:
+    """(N, 3) uniform random points of receivers ``index`` on their exposed part: a point
+    found :func:`buried` is drawn again (EXPOSED_REDRAWS times; a wholly buried receiver
+    keeps its last draw)."""
+    p = rec.sample_points(index, rng)
+    redo = np.flatnonzero(buried(p, rec.normal[index], rays, eps, rec.triangles))
+    for _ in range(EXPOSED_REDRAWS):
+        if not redo.size:
+            break
+        p[redo] = rec.sample_points(index[redo], rng)
+        redo = redo[buried(p[redo], rec.normal[index[redo]], rays, eps, rec.triangles)]
+    return p
+
+
+def exposed_fraction(rec: Receivers, rays, eps: float, side: int = 4) -> np.ndarray:
+    """(E,) the share of each receiver's area not :func:`buried`, by the centres of a
+    side x side barycentric grid (side^2 points, the same in every receiver)."""
+    from catalog.room.receivers import _grid  # noqa: PLC0415
+
+    g = _grid(side).mean(axis=1)                                   # (side^2, 2) cell centres
+    bary = np.concatenate([1 - g.sum(axis=1, keepdims=True), g], axis=1)
+    pts = np.einsum("qc,ecj->eqj", bary, rec.corners).reshape(-1, 3)
+    out = np.empty(pts.shape[0], dtype=bool)
+    normals = np.repeat(rec.normal, bary.shape[0], axis=0)
+    for start in range(0, pts.shape[0], CHUNK_RAYS):
+        sl = slice(start, start + CHUNK_RAYS)
+        out[sl] = buried(pts[sl], normals[sl], rays, eps, rec.triangles)
+    return 1.0 - out.reshape(rec.count, -1).mean(axis=1)
+
+
 # --------------------------------------------------------------------------- window
 
 def patch_points(window: Window, patches: tuple, s: np.ndarray, t: np.ndarray,
@@ -158,6 +218,7 @@ def direct_operator(rec: Receivers, window: Window, params: TransportParams, ray
     # stratified samples in each patch: s_count jittered points on a sqrt grid
     side = max(1, int(math.ceil(math.sqrt(s_count))))
     for start in range(0, rec.count, step):
+        report("direct light", start, rec.count)
         e = np.arange(start, min(rec.count, start + step))
         ee = np.repeat(e, per_receiver)
         patch = np.tile(np.repeat(np.arange(patches), s_count), e.size)
@@ -165,7 +226,7 @@ def direct_operator(rec: Receivers, window: Window, params: TransportParams, ray
         s = ((cell % side) + rng.random(ee.size)) / side
         t = (np.minimum(cell // side, side - 1) + rng.random(ee.size)) / max(1, int(math.ceil(s_count / side)))
         xw, jac = patch_points(window, params.patches, s, t, patch)
-        xe = rec.sample_points(ee, rng) + eps * rec.normal[ee]
+        xe = exposed_sample_points(rec, ee, rng, rays, eps) + eps * rec.normal[ee]
         d = xw - xe
         r = np.linalg.norm(d, axis=1)
         d /= r[:, None]
@@ -232,11 +293,20 @@ def refine_receivers(rec: Receivers, inside: np.ndarray, albedo_of, window: Wind
     factor 2 of the largest (the span times sqrt(area / base area): an element's share of
     the light map's L2 error) among those whose span exceeds the tolerance and whose
     level is below ``refine_levels``, as many as ``max_receivers`` leaves room for."""
+    eps = 1e-5 * float(np.linalg.norm(np.ptp(rec.triangles.reshape(-1, 3), axis=0)))
+
     def spans(r: Receivers, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pts = np.einsum("qc,ecj->eqj", _REFINE_POINTS, r.corners[which]).reshape(-1, 3)
         e = uniform_window_irradiance(pts, np.repeat(r.normal[which], len(_REFINE_POINTS), axis=0), window, rays)
         e = e.reshape(which.size, len(_REFINE_POINTS))
-        return e.max(axis=1) - e.min(axis=1), e.mean(axis=1)
+        # a buried point is seen by no one: its darkness is no error of the light map
+        hidden = buried(pts, np.repeat(r.normal[which], len(_REFINE_POINTS), axis=0), rays, eps,
+                        r.triangles).reshape(e.shape)
+        lo = np.where(hidden, np.inf, e).min(axis=1)
+        hi = np.where(hidden, -np.inf, e).max(axis=1)
+        span = np.where(hidden.all(axis=1), 0.0, hi - lo)
+        return span, np.where(hidden.all(axis=1), 0.0, np.where(hidden, 0.0, e).sum(axis=1)
+                              / np.maximum(1, (~hidden).sum(axis=1)))
 
     summary = {"base_receivers": int(inside.sum()), "splits": []}
     span = np.full(rec.count, np.nan)
@@ -286,7 +356,7 @@ def gather(rec: Receivers, rays_room, window_tris_first: int, count: int, rng,
         rows = np.arange(start, min(index.size, start + step))
         ee = np.repeat(index[rows], count)
         n = rec.normal[ee]
-        o = rec.sample_points(ee, rng) + eps * n
+        o = exposed_sample_points(rec, ee, rng, rays_room, eps) + eps * n
         d = cosine_directions(n, rng)
         dist, tri = rays_room.intersect(o, d)
         out = tri < 0
@@ -360,6 +430,7 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
     rng = np.random.default_rng(params.seed)
     timings = {}
     start = time.perf_counter()
+    report("receivers")
     rec_all = build_receivers(triangles, albedo_of, params.element_m)
     with_window = np.concatenate([np.asarray(triangles, dtype=np.float64), window.triangles()])
     rays_gather = ray_caster(with_window, backend)
@@ -369,9 +440,13 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
     if params.refine_levels > 0:
         rec_all, inside, refinement = refine_receivers(rec_all, inside, albedo_of, window, params, rays_room)
         timings["refinement"] = refinement
+    eps = 1e-5 * float(np.linalg.norm(np.ptp(np.asarray(triangles).reshape(-1, 3), axis=0)))
+    rec_all = replace(rec_all, exposed=exposed_fraction(rec_all, rays_room, eps))
     rec, new_index = subset(rec_all, inside)
+    timings["exposed_share"] = float(np.sum(rec.weld_weight_m2) / np.sum(rec.area_m2))
     timings["receivers_s"] = time.perf_counter() - start
     start = time.perf_counter()
+    report("form factors")
     hit, _ = gather(rec_all, rays_gather, len(triangles), params.gather_rays, rng,
                     receivers=np.flatnonzero(inside))
     f = form_factors(hit, new_index, rec.count)
@@ -387,6 +462,7 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
     lus = []
     dense = f.toarray()
     for ch in range(3):
+        report("solve", ch, 3)
         lu = scipy.linalg.lu_factor(np.eye(rec.count) - dense * rec.albedo[None, :, ch], overwrite_a=True)
         lus.append(lu)
         operator[ch] = scipy.linalg.lu_solve(lu, d)
@@ -396,6 +472,7 @@ def precompute_geometry(triangles: np.ndarray, albedo_of, window: Window,
                           kept_index=new_index)
     if compress_operators:
         start = time.perf_counter()
+        report("compress")
         left, right, err = compress(operator.reshape(3 * rec.count, -1), params.rank_tolerance, params.max_rank)
         transport.window_basis = left.reshape(3, rec.count, -1)
         transport.window_modes = right

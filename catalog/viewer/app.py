@@ -94,7 +94,12 @@ class ViewerApp:
         if options.wind_m_s is not None:
             self.settings.wind_m_s = options.wind_m_s
         self._choose_start(options)
-        self.camera = OrbitCamera(home_distance_m=options.distance_m)
+        from catalog.viewer.room_start import start_room  # noqa: PLC0415
+
+        #: the room's window and inside (catalog.render.placement): the curtain's rod and the
+        #: camera's views; its bundle built first (with progress) when not cached
+        self.placement = start_room(options.room if options.room_light else None)
+        self.camera = OrbitCamera(home_distance_m=options.distance_m, placement=self.placement)
         self.camera.reset()
         self.timer = FrameTimer()
         self._actions: list[Action] = []
@@ -179,7 +184,8 @@ class ViewerApp:
         self.panel_info.thumbnails = self.thumbnails
 
         self.scene = CurtainScene(self.options.grid, backend=self.cloth_backend,
-                                  wind_m_s=self.settings.wind_m_s, ctx=self.ctx)
+                                  wind_m_s=self.settings.wind_m_s, ctx=self.ctx,
+                                  placement=self.placement)
         self._fbo = None
         self._renderers: list = []
         self._scaled_fbos: list = []  # one per renderer when render_scale < 1
@@ -224,7 +230,8 @@ class ViewerApp:
                                                                 self._viewports())):
                     renderer.update(camera=orbit(
                         self.camera.yaw_deg, self.camera.pitch_deg, self.camera.distance_m,
-                        target=self.camera.target, fov_y_deg=self.camera.fov_y_deg, inside=True))
+                        target=self.camera.target, fov_y_deg=self.camera.fov_y_deg, inside=True,
+                        placement=self.placement))
                     try:
                         self._set_exposure(slot, renderer)
                         if self._scaled_fbos:

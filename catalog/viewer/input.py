@@ -89,10 +89,24 @@ class OrbitCamera:
     max_distance_m: float = 12.0
     home_distance_m: float | None = None   # None: the view's own distance
     view_name: str = DEFAULT_VIEW           # catalog.render.camera.VIEWS
+    #: the room's catalog.render.placement.Placement (its window and inside); None: the box
+    placement: object = None
 
     @property
     def view(self):
-        return VIEWS[self.view_name]
+        """The named view composed for the room's window (catalog.render.placement)."""
+        if self.placement is None:
+            return VIEWS[self.view_name]
+        return self.placement.view(self.view_name)
+
+    @property
+    def bounds(self):
+        """The room's inside, where the camera may go."""
+        if self.placement is None:
+            from catalog.render.scene import ROOM_BOX  # noqa: PLC0415
+
+            return ROOM_BOX
+        return self.placement.interior
 
     @property
     def target(self) -> tuple[float, float, float]:
@@ -117,7 +131,7 @@ class OrbitCamera:
         self.reset()
 
     def _keep_inside(self) -> None:
-        limit = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg, self.target))
+        limit = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg, self.target, self.bounds))
         self.distance_m = min(limit, max(self.min_distance_m, self.distance_m))
 
     def drag(self, dx_px: float, dy_px: float) -> None:
@@ -131,7 +145,7 @@ class OrbitCamera:
 
     def distance_limits_m(self) -> tuple[float, float]:
         """The nearest and farthest distance (m) allowed in the current direction."""
-        far = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg, self.target))
+        far = min(self.max_distance_m, room_limit_m(self.yaw_deg, self.pitch_deg, self.target, self.bounds))
         return self.min_distance_m, max(self.min_distance_m, far)
 
     def set_distance(self, distance_m: float) -> None:
@@ -149,12 +163,14 @@ class OrbitCamera:
         self._keep_inside()
 
 
-def room_limit_m(yaw_deg: float, pitch_deg: float, target=CURTAIN_TARGET) -> float:
+def room_limit_m(yaw_deg: float, pitch_deg: float, target=CURTAIN_TARGET, bounds=None) -> float:
     """How far the orbit camera may be from ``target`` in this direction and stay inside the
-    room's box less ROOM_MARGIN_M (catalog.render.camera.room_limit_m), at least 0.2 m."""
-    from catalog.render.scene import ROOM_BOX  # noqa: PLC0415
+    room's box (``bounds``; None: the box's) less ROOM_MARGIN_M
+    (catalog.render.camera.room_limit_m), at least 0.2 m."""
+    if bounds is None:
+        from catalog.render.scene import ROOM_BOX as bounds  # noqa: PLC0415,N811
 
-    return max(render_room_limit_m(target, yaw_deg, pitch_deg, ROOM_BOX), 0.2)
+    return max(render_room_limit_m(target, yaw_deg, pitch_deg, bounds), 0.2)
 
 
 class MouseOrbit:

@@ -27,8 +27,10 @@ class CurtainScene:
     """
 
     def __init__(self, grid: tuple[int, int], backend: str = "cpu", wind_m_s: float = 0.0,
-                 ctx=None):
+                 ctx=None, placement=None):
         self.grid = grid
+        #: the room's rod (catalog.render.placement; None: the box's)
+        self.placement = placement
         self.backend = backend
         self.ctx = ctx  # the window's context: the gpu backend computes in it
         self.wind_m_s = float(wind_m_s)
@@ -46,21 +48,20 @@ class CurtainScene:
 
         if preset.name == self.preset_name:
             return
-        from catalog.cloth.drape import drape_params, fullness_of  # noqa: PLC0415
+        from catalog.cloth.drape import fullness_of  # noqa: PLC0415
+        from catalog.render.placement import BOX, placed_drape_params  # noqa: PLC0415
 
         self.closed_opening = 1.0 / fullness_of(preset)
-        fabric = drape_params(preset, grid=self.grid, wind_speed_m_s=self.wind_m_s,
-                              opening=self.closed_opening * self.opening)
+        fabric = placed_drape_params(preset, self.placement, grid=self.grid, wind_speed_m_s=self.wind_m_s,
+                                     opening=self.closed_opening * self.opening)
         if self.simulation is None:
-            from catalog.cloth.drape import rod_centre_x_m, settled_simulation  # noqa: PLC0415
-            from catalog.render import scene as scene_lib  # noqa: PLC0415
+            from catalog.cloth.drape import settled_simulation  # noqa: PLC0415
 
             # the settled drape that catalog snapshot shows at frame 0
             options = {"ctx": self.ctx} if self.backend == "gpu" else {}
             self.simulation = settled_simulation(fabric, backend=self.backend, **options)
             closed = fabric.with_changes(opening=self.closed_opening)
-            self._offset = np.array([-rod_centre_x_m(closed), scene_lib.CURTAIN_TOP_Y - fabric.rod_y_m,
-                                     scene_lib.CURTAIN_Z], dtype=np.float32)
+            self._offset = (self.placement or BOX).curtain_offset(closed)
             self.mesh_version += 1
         else:
             self.simulation.set_params(areal_density_kg_m2=fabric.areal_density_kg_m2,

@@ -112,6 +112,14 @@ class Browser:
         self.driver.quit()
 
 
+def _mesh(animation, frame: int) -> tuple:
+    """The baked cloth's ``frame`` as set_mesh takes it."""
+    from catalog.web import bake as bake_lib  # noqa: PLC0415
+
+    positions, normals, tangents = bake_lib.decode_frame(animation, frame)
+    return positions, normals, animation.uv, tangents, animation.indices.astype(np.int32)
+
+
 def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tuple[int, int],
               animation, ctx=None, camera: tuple[float, float, float] | None = None,
               ev100: float | None = None, glare: str = "off", lamp: str = "none") -> np.ndarray:
@@ -121,11 +129,9 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
     from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.render.settings import SunHour, orbit  # noqa: PLC0415
-    from catalog.web import bake as bake_lib  # noqa: PLC0415
     from catalog.web.export import (FLUORESCENCE, GLARE, configure_desktop_frame,  # noqa: PLC0415
                                     room_lamps)
 
-    positions, normals, tangents = bake_lib.decode_frame(animation, frame)
     renderer = FrameRenderer(ctx or create_headless_context(), size)
     try:
         renderer.update(fabric=fabric)
@@ -136,15 +142,18 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
         renderer.update(fluorescence=FLUORESCENCE[fluorescence])
         configure_desktop_frame(renderer)
         renderer.update(bloom=GLARE[glare], lamps=room_lamps(lamp))
-        if camera is not None:
-            renderer.update(camera=orbit(*camera))
         if ev100 is not None:
             renderer.update(ev=ev100)
-        renderer.set_mesh(positions, normals, animation.uv, tangents,
-                          animation.indices.astype(np.int32),
-                          fabric_size_m=animation.fabric_size_m)
+        # the display's white measured as the export measures it (catalog.web.export.record:
+        # the default camera, the baked cloth's first frame), then kept while the camera and
+        # the cloth move, as the page keeps it
+        renderer.set_mesh(*_mesh(animation, 0), fabric_size_m=animation.fabric_size_m)
         renderer.set_mesh_offset((0.0, 0.0, 0.0))
         renderer.set_rings(animation.rings_x_m)
+        renderer.render()
+        if camera is not None:
+            renderer.update(camera=orbit(*camera))
+        renderer.set_mesh(*_mesh(animation, frame), fabric_size_m=animation.fabric_size_m)
         renderer.render()
         return renderer.read_srgb8()
     finally:
@@ -196,6 +205,9 @@ def compare_frames(page: np.ndarray, desktop: np.ndarray) -> dict:
     edge = ~close & shift
     unmatched = ~close & ~shift
     return {"mean_abs_8bit": float(diff.mean()), "max_abs_8bit": int(diff.max()),
+            # page minus desktop, per channel (R, G, B): a frame-wide shift (e.g. another
+            # white balance or exposure) shows here, where edges average out
+            "signed_mean_8bit": [round(float(v), 3) for v in (p - d).reshape(-1, 3).mean(axis=0)],
             "pixels": int(worst.size), "within_tolerance": int(close.sum()),
             "edge_shift": int(edge.sum()), "unmatched": int(unmatched.sum()),
             "max_abs_unmatched_8bit": int(worst[unmatched].max()) if unmatched.any() else 0}

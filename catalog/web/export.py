@@ -389,7 +389,16 @@ class SiteExporter:
 
     def use_drape(self, animation) -> None:
         """The fabric's drape (the desktop's settled drape, baked): the rest size its uv spans
-        (the pattern's scale) and the rings on the rod, as ``catalog snapshot`` sets them."""
+        (the pattern's scale) and the rings on the rod, as ``catalog snapshot`` sets them; the
+        meter draws the fabric's own cloth (its baked frame 0), so that a fabric's exposure does
+        not depend on which fabric the site lists first (the recorded frame's buffers keep the
+        first fabric's bytes: the page puts each fabric's own)."""
+        from catalog.web import bake as bake_lib  # noqa: PLC0415
+
+        positions, normals, tangents = bake_lib.decode_frame(animation, 0)
+        self.meter.set_mesh(positions, normals, animation.uv, tangents,
+                            animation.indices.astype(np.int32))
+        self.meter.set_mesh_offset((0.0, 0.0, 0.0))
         rings = tuple(animation.rings_x_m)
         for renderer in (self.renderer, self.meter):
             renderer.set_fabric_size(animation.fabric_size_m)
@@ -426,6 +435,11 @@ class SiteExporter:
         r = self.renderer
         r.update(scene.replace(camera=r.camera, ev=ev100))
         rec = self.ctx.recording
+        if not r.display.white_is_measured():
+            # the display's white is measured from the HDR target the frame draws, which a dry
+            # recording leaves undrawn: a real frame first (not recorded) when its key changes
+            # (the light, the fabric, the fluorescence: a few per fabric), kept by the one recorded
+            r.render()
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
         rec.start(dry=True)  # only the commands are kept: no pixels drawn
         r.render()

@@ -62,8 +62,10 @@ class CurtainPass(Pass):
             defines.update(self.frame.fabric_pattern.defines())
         return defines
 
-    def _curtain_program(self, gbuffer: bool, overrides: dict | None = None):
+    def _curtain_program(self, gbuffer: bool, overrides: dict | None = None, hem_band: bool = True):
         defines = self.variant_defines(gbuffer)
+        if not hem_band:
+            defines.pop("HEM_BORDER", None)   # triangles wholly above the hem's band
         if overrides:
             defines["ROOM_CAPTURE"] = True  # the transport's views of the window, not the frame's
             defines.pop("ROOM_SIDE", None)  # the transport reflects the room's light off the cloth
@@ -104,33 +106,60 @@ class CurtainPass(Pass):
             set_uniform(program, "u_camera_position", eye)
         else:
             program = self._curtain_program(gbuffer, overrides)
-            set_uniform(program, "u_view_proj", gl_bytes(view_proj))
-            set_uniform(program, "u_camera_position", eye)
-            set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
-            if "u_pattern" in program:
-                self.frame.fabric_pattern.bind(program, PATTERN_UNIT, self.frame.mesh.fabric_size_m)
-                set_uniform(program, "u_inv_mean_coverage", 1.0 / max(self.frame.fabric_pattern.mean_coverage, 1e-6))
-                set_uniform(program, "u_oit_depth_ref", self.oit_depth_reference_m())
-            if not self.frame.specialise:
-                for name, value in self.frame.terms.scene_values_with(overrides).items():
-                    set_uniform(program, name, value)
-            if self.frame.room_lamps:
-                for name, value in self.frame.terms.room_lamp_values().items():
-                    if overrides and name in overrides:
-                        value = overrides[name]
-                    set_uniform(program, name, value)
-            if "u_environment" in program:
-                self.frame.environment[1].use(location=ENVIRONMENT_UNIT)
-                set_uniform(program, "u_environment", ENVIRONMENT_UNIT)
-                set_uniform(program, "u_environment_scale", self.frame.background.environment_scale(self.frame.terms.shading_inputs()))
-            if "u_key_visibility" in program:
-                self.frame.shadow.key_shadow_uniforms(program, self.frame.terms.shading_inputs(), coarse)
-            if "u_room_side" in program:
-                self.frame.room_transport.cloth_uniforms(program)
-            if "u_vertex_occlusion" in program:
-                self.frame.shadow.vertex_occlusion_uniforms(program)
+            draws = [(program, None)]
+            split = self._hem_band_split(program, coarse)
+            if split is not None:
+                # the hem's band (a lace's scallops) sampled only by the triangles that reach
+                # it; the rest take the variant without it (one anisotropic lookup fewer a
+                # fragment over most of the cloth; the same picture: above the band the shader
+                # chose the all-over pattern's texel)
+                above = self._curtain_program(gbuffer, overrides, hem_band=False)
+                draws = [(program, split[0]), (above, split[1])]
+            for one, _index in draws:
+                self._bind_curtain(one, view_proj, eye, overrides, coarse)
         self.ctx.disable(self.mgl.CULL_FACE)  # two-sided cloth
-        self.frame.mesh.curtain_vao(program, coarse).render(self.mgl.TRIANGLES)
+        if fragment is not None:
+            self.frame.mesh.curtain_vao(program, coarse).render(self.mgl.TRIANGLES)
+            return
+        for one, index in draws:
+            self.frame.mesh.curtain_vao(one, coarse, index).render(self.mgl.TRIANGLES)
+
+    def _hem_band_split(self, program, coarse: bool):
+        """The index buffers' names (band, above) when ``program`` samples the hem's band and
+        the mesh can be split at its top; else None."""
+        pattern = self.frame.fabric_pattern
+        if coarse or "u_border" not in program or pattern.border_repeats is None:
+            return None
+        v_band = pattern.border_repeats * pattern.repeat_m[1] / self.frame.mesh.fabric_size_m[1]
+        return self.frame.mesh.hem_band_split(float(v_band))
+
+    def _bind_curtain(self, program, view_proj, eye, overrides, coarse: bool) -> None:
+        """The curtain program's inputs: the camera, the mesh, the pattern, the scene's values, the maps."""
+        set_uniform(program, "u_view_proj", gl_bytes(view_proj))
+        set_uniform(program, "u_camera_position", eye)
+        set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
+        if "u_pattern" in program:
+            self.frame.fabric_pattern.bind(program, PATTERN_UNIT, self.frame.mesh.fabric_size_m)
+            set_uniform(program, "u_inv_mean_coverage", 1.0 / max(self.frame.fabric_pattern.mean_coverage, 1e-6))
+            set_uniform(program, "u_oit_depth_ref", self.oit_depth_reference_m())
+        if not self.frame.specialise:
+            for name, value in self.frame.terms.scene_values_with(overrides).items():
+                set_uniform(program, name, value)
+        if self.frame.room_lamps:
+            for name, value in self.frame.terms.room_lamp_values().items():
+                if overrides and name in overrides:
+                    value = overrides[name]
+                set_uniform(program, name, value)
+        if "u_environment" in program:
+            self.frame.environment[1].use(location=ENVIRONMENT_UNIT)
+            set_uniform(program, "u_environment", ENVIRONMENT_UNIT)
+            set_uniform(program, "u_environment_scale", self.frame.background.environment_scale(self.frame.terms.shading_inputs()))
+        if "u_key_visibility" in program:
+            self.frame.shadow.key_shadow_uniforms(program, self.frame.terms.shading_inputs(), coarse)
+        if "u_room_side" in program:
+            self.frame.room_transport.cloth_uniforms(program)
+        if "u_vertex_occlusion" in program:
+            self.frame.shadow.vertex_occlusion_uniforms(program)
 
     def draw_flat(self, view_proj, eye, overrides: dict, coarse: bool = False) -> None:
         """The room's captures draw the flat cloth (the pattern averaged, model.md section 9):

@@ -78,7 +78,33 @@ class CurtainMesh(Pass):
         self.vertex_count = count
         self.gl.release_vaos()
         self.mesh_arrays = (positions, normals, tangents)
+        self._triangle_v_min = uvs[:, 1][indices.reshape(-1, 3)].min(axis=1)   # the hem band's split
+        self._band_split = None
         self.version += 1
+
+    def hem_band_split(self, v_band: float) -> tuple[str, str] | None:
+        """The names of two index buffers that split the triangles at the hem band's top,
+        ``v_band`` in uv (the band's rows from the hem at v = 0): those reaching below it, and
+        the rest, which lie wholly above it; None where the mesh's uvs are not known (the
+        cloth's own index buffer) or one side would be empty."""
+        v_min = getattr(self, "_triangle_v_min", None)
+        if v_min is None or self.buffers is None:
+            return None
+        if self._band_split is None or self._band_split[0] != v_band:
+            tri = np.frombuffer(self.buffers["index"].read(), dtype="i4").reshape(-1, 3)
+            low = v_min < v_band
+            if low.all() or not low.any():
+                self._band_split = (v_band, None)
+            else:
+                for name, rows in (("band_index", tri[low]), ("above_index", tri[~low])):
+                    if name in self.buffers:
+                        self.buffers[name].release()
+                        self._own_buffers.remove(self.buffers[name])
+                    self.buffers[name] = self.ctx.buffer(np.ascontiguousarray(rows).tobytes())
+                    self._own_buffers.append(self.buffers[name])
+                self.gl.release_vaos()
+                self._band_split = (v_band, ("band_index", "above_index"))
+        return self._band_split[1]
 
     def set_fabric_size(self, fabric_size_m) -> None:
         """The rest fabric's width and length (m) that uv 0..1 spans (the pattern's scale) for
@@ -132,6 +158,7 @@ class CurtainMesh(Pass):
         if index_buffer is not None:
             self.buffers["index"] = index_buffer
             self.buffers.pop("coarse_index", None)  # another mesh: no coarse grid
+            self._triangle_v_min = None               # nor the hem band's split
         self.vertex_count = count
         self.format = "interleaved"
         self.set_mesh_offset(offset_m)
@@ -154,10 +181,11 @@ class CurtainMesh(Pass):
         """Whether the mesh has the coarse grid the room's maps and captures draw."""
         return self.buffers is not None and "coarse_index" in self.buffers
 
-    def curtain_vao(self, program, coarse: bool = False):
+    def curtain_vao(self, program, coarse: bool = False, index_name: str | None = None):
         """The mesh drawn with ``program``; ``coarse``: the coarse grid's triangles (where the
-        mesh has one), for the room's views of the aperture, a few texels a patch."""
-        key = ("curtain", id(program), coarse)
+        mesh has one), for the room's views of the aperture, a few texels a patch;
+        ``index_name``: those of that index buffer (:meth:`hem_band_split`)."""
+        key = ("curtain", id(program), coarse, index_name)
         if key not in self.gl.vaos:
             b = self.buffers
             if self.format == "interleaved":
@@ -174,6 +202,8 @@ class CurtainMesh(Pass):
             if "in_uv" in program:
                 content.append((b["uv"], "2f", "in_uv"))
             index = b.get("coarse_index", b["index"]) if coarse else b["index"]
+            if index_name is not None:
+                index = b[index_name]
             self.gl.vaos[key] = self.ctx.vertex_array(
                 program, content, index_buffer=index, index_element_size=4)
         return self.gl.vaos[key]

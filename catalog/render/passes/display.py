@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from catalog.core.errors import CatalogError
-from catalog.render import adaptation as adaptation_lib, display as display_lib
+from catalog.render import adaptation as adaptation_lib, display as display_lib, display_lut
 from catalog.render.passes.gl_common import Pass, set_uniform
 
 #: Auto exposure meters a copy of the frame at most this many pixels wide (a mip level).
@@ -24,6 +24,24 @@ class DisplayPass(Pass):
     def __init__(self, frame):
         super().__init__(frame)
         self._wb_cache = None
+        self._gamut_lut = None
+
+    def gamut_boundary(self):
+        """The gamut boundary's table as a float texture (display_lut.boundary_table, made
+        once): linear, repeating along the hue, clamped along the lightness."""
+        if self._gamut_lut is None:
+            table = display_lut.boundary_table()
+            self._gamut_lut = self.ctx.texture((table.shape[1], table.shape[0]), 1,
+                                               table.tobytes(), dtype="f4")
+            self._gamut_lut.filter = (self.mgl.LINEAR, self.mgl.LINEAR)
+            self._gamut_lut.repeat_x = True
+            self._gamut_lut.repeat_y = False
+        return self._gamut_lut
+
+    def release(self) -> None:
+        if self._gamut_lut is not None:
+            self._gamut_lut.release()
+            self._gamut_lut = None
 
     def current_ev100(self) -> float:
         """The EV100 the next display pass uses (fixed, or the auto exposure's)."""
@@ -41,16 +59,28 @@ class DisplayPass(Pass):
         """Linear sRGB -> linear sRGB: CAT16 from the white of the light reaching the viewer to
         D65, with CAT16's degree of adaptation (catalog.render.adaptation), or the identity.
         The white is measured (a G-buffer draw) at the view of the first frame after the light,
-        the fabric or the size change, and kept while the camera moves (the web page replays
+        the fabric, the room's lamps or the size change, and kept while the camera moves (the web page replays
         camera-independent passes: catalog.web.export.check_camera_uniforms)."""
-        self.frame.terms.shading_inputs()
-        key = (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
-               self.frame.room_side_active())
+        key = self._white_key()
         if self._wb_cache is None or self._wb_cache[0] != key:
             self._wb_cache = (key, display_lib.white_balance_matrix(
                 adaptation_lib.visible_white_xyz(self.frame), self.frame.white_balance,
                 adaptation_lib.degree_of_adaptation()))
         return self._wb_cache[1]
+
+    def _white_key(self) -> tuple:
+        """What the measured white depends on: the light and fabric (the shading inputs), the
+        setting, the size, whether the room side is drawn and the room's lamps, which light
+        what is seen (not the camera)."""
+        self.frame.terms.shading_inputs()
+        return (self.frame.terms.inputs_key, self.frame.white_balance, tuple(self.frame.size),
+                self.frame.room_side_active(),
+                tuple((light.name, position) for light, position in self.frame.room_lamps))
+
+    def white_is_measured(self) -> bool:
+        """Whether the next frame keeps the white it has (False: it measures a new one from
+        the HDR target it draws, which a dry recording does not draw: catalog.web.export)."""
+        return self._wb_cache is not None and self._wb_cache[0] == self._white_key()
 
     def forget_white(self) -> None:
         """Measure the white again at the next frame, from its view (a still image adapts to
@@ -101,6 +131,11 @@ class DisplayPass(Pass):
             set_uniform(program, "u_glow_rect", glare.rect)
             set_uniform(program, "u_glare_strength", glare.strength)
         set_uniform(program, "u_hdr_rect", (0.0, 0.0, vw / self.frame.size[0], vh / self.frame.size[1]))
+        if stages >= 3:
+            self.gamut_boundary().use(location=2)
+            set_uniform(program, "u_gamut_boundary", 2)
+            for name, value in display_lut.shader_uniforms().items():
+                set_uniform(program, name, value)
         for name, value in self.display_uniforms().items():
             set_uniform(program, name, value)
         self.gl.fullscreen_vao(program).render(self.mgl.TRIANGLES, vertices=3)

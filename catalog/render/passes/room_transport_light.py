@@ -133,8 +133,12 @@ class RoomTransportLight(Pass):
         from catalog.render.passes.room_transport import RoomTransportPass  # noqa: PLC0415
         from catalog.render.room_operators import room_operators  # noqa: PLC0415
 
+        from catalog.render.placement import placement_of  # noqa: PLC0415
+
         self.ops = room_operators(room)
         ops = self.ops
+        #: the curtain, rod and camera of this room, from its window (catalog.render.placement)
+        self.placement = placement_of(ops.window_corners, ops.window_normal, ops.triangles, str(room))
         self.draw_pass = RoomTransportPass(self.ctx, ops)
         dirs, weights = sh.hemisphere_quadrature(CAPTURE_THETA, CAPTURE_PHI)
         self._weights = weights
@@ -372,7 +376,7 @@ class RoomTransportLight(Pass):
         its depth over the whole room."""
         from catalog.render.curtain_frames import light_view_projection  # noqa: PLC0415
 
-        m = light_view_projection(to_light).copy()
+        m = light_view_projection(to_light, placement=self.frame.placement).copy()
         to_light = np.asarray(to_light, dtype=np.float64) / np.linalg.norm(to_light)
         b = self.ops.bounds
         corners = np.array([[x, y, z] for x in b[:, 0] for y in b[:, 1] for z in b[:, 2]])
@@ -425,12 +429,12 @@ class RoomTransportLight(Pass):
         level = max(0, int(math.log2(n)) - 7)      # 128 texels a side at most
         side = max(n >> level, 1)
         t = np.frombuffer(shadow.read(level=level), dtype=np.float16).reshape(side, side, 4)[..., :3]
-        m = light_view_projection(inputs.key_to_light)
+        m = light_view_projection(inputs.key_to_light, placement=self.frame.placement)
         centre = self.ops.centre
         clip = np.c_[centre, np.ones(len(centre))] @ m.T
         uv = np.clip(clip[:, :2] * 0.5 + 0.5, 0.0, 1.0 - 1e-6)
         trans = t[(uv[:, 1] * side).astype(int), (uv[:, 0] * side).astype(int)].astype(np.float64)
-        before = (inputs.key_to_light[2] < 0) & (centre[:, 2] < scene_lib.WINDOW_Z - 1e-4)
+        before = (inputs.key_to_light[2] < 0) & (centre[:, 2] < self.placement.window_z - 1e-4)
         trans[before] = 1.0
         return vis[:, None] * key_rgb[None, :] * trans
 
@@ -572,11 +576,11 @@ class RoomTransportLight(Pass):
         s(program, "u_key_rgb", self.frame.terms.room_colours(inputs)["u_key_rgb"])
         gl["shadow"].use(location=2)
         s(program, "u_shadow", 2)
-        s(program, "u_light_view_proj", gl_bytes(light_view_projection(inputs.key_to_light)))
-        s(program, "u_shadow_texel_m", shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels))
-        s(program, "u_curtain_z", scene_lib.CURTAIN_Z)
+        s(program, "u_light_view_proj", gl_bytes(light_view_projection(inputs.key_to_light, placement=self.frame.placement)))
+        s(program, "u_shadow_texel_m", shadow_texel_m(inputs.key_to_light, self.frame.shadow_texels, placement=self.frame.placement))
+        s(program, "u_curtain_z", self.placement.curtain_z)
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
-        s(program, "u_window_z", scene_lib.WINDOW_Z)
+        s(program, "u_window_z", self.placement.window_z)
         self._room_depth[0].use(location=4)
         s(program, "u_room_depth", 4)
         s(program, "u_room_depth_view_proj", gl_bytes(self.room_depth_view_projection(inputs.key_to_light)))
@@ -597,7 +601,7 @@ class RoomTransportLight(Pass):
         return towards_room[:, None] * side[j, i] + (1.0 - towards_room)[:, None] * window[None, :]
 
     def _props(self):
-        rod_p, rod_n = scene_lib.rod_mesh()
+        rod_p, rod_n = scene_lib.rod_mesh(self.placement)   # on the room's own window
         ring_p, ring_n = self.frame.ring_arrays
         positions = np.concatenate([rod_p, np.asarray(ring_p, "f4").reshape(-1, 3)])
         normals = np.concatenate([rod_n, np.asarray(ring_n, "f4").reshape(-1, 3)])

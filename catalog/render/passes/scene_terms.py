@@ -47,7 +47,7 @@ class SceneTerms:
                self.frame.mode, self.frame.viewer_inside, self.frame._is_sun)
         if key != self.inputs_key:
             # the settings' own (the path tracer's describe_scene takes the same)
-            self._inputs, self.decision = self.frame.settings.shading_inputs()
+            self._inputs, self.decision = self.frame.settings.shading_inputs(self.frame.placement)
             self.inputs_key = key
             self._uniforms_key = None
         return self._inputs
@@ -208,11 +208,10 @@ class SceneTerms:
                 "u_thread_beam_rgb": tuple(float(v) for v in thread),
                 "u_lobe_rgb": tuple(float(v) for v in lobe)}
 
-    @staticmethod
-    def key_depth_per_metre(inputs) -> float:
+    def key_depth_per_metre(self, inputs) -> float:
         """The key's maps' depth (0..1) per metre along the key's travel: orthographic, window
         depth = 0.5 ndc z + 0.5 with ndc z = m[2, 2] z_view + .., so a metre is -m[2, 2] / 2."""
-        return abs(float(curtain_frames.light_view_projection(inputs.key_to_light)[2, 2])) / 2
+        return abs(float(curtain_frames.light_view_projection(inputs.key_to_light, placement=self.frame.placement)[2, 2])) / 2
 
     def window_albedo_rgb(self, inputs) -> tuple[float, float, float]:
         """The closed curtain's room-side reflectance under diffuse light (linear sRGB): the

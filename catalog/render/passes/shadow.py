@@ -57,9 +57,13 @@ OCCLUSION_OFFSET_M = 0.03
 
 
 #: The key's visibility baked over the fabric's uv (curtain.frag KEY_SHADOW): a texel every
-#: this many metres of the rest fabric, finer than the front-layer map's texels on the cloth
-#: (room_light.shadow_texel_m: ~9 mm at 256), at most KEY_VISIBILITY_MAX_TEXELS a side.
-KEY_VISIBILITY_PITCH_M = 0.003
+#: this many metres of the rest fabric, half the front-layer map's texel on the cloth
+#: (room_light.shadow_texel_m: ~1 cm at 256), at most KEY_VISIBILITY_MAX_TEXELS a side. The
+#: coarse grid's (the room's captures, a few texels a 16 cm patch) every COARSE_PITCH_M.
+KEY_VISIBILITY_PITCH_M = 0.005
+
+
+KEY_VISIBILITY_COARSE_PITCH_M = 0.02
 
 
 KEY_VISIBILITY_MAX_TEXELS = 2048
@@ -101,15 +105,15 @@ class ShadowPass(Pass):
         s = set_uniform
         s(program, "u_key_front", KEY_FRONT_UNIT)
         s(program, "u_key_second", KEY_SECOND_UNIT)
-        matrix = room_light.light_view_projection(inputs.key_to_light)
+        matrix = room_light.light_view_projection(inputs.key_to_light, placement=self.frame.placement)
         s(program, "u_light_view_proj", gl_bytes(matrix))
         metre = self.frame.terms.key_depth_per_metre(inputs)
-        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.frame.room_targets.key_texels)
+        slope_m = KEY_SHADOW_SLOPE_TEXELS * room_light.shadow_texel_m(inputs.key_to_light, self.frame.room_targets.key_texels, placement=self.frame.placement)
         s(program, "u_key_depth_bias", (KEY_SHADOW_BIAS_M * metre, slope_m * metre, KEY_SHADOW_SLOPE_CAP))
         s(program, "u_key_normal_offset", KEY_SHADOW_NORMAL_OFFSET_TEXELS
-          * room_light.shadow_texel_m(inputs.key_to_light, self.frame.room_targets.key_texels))
-        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-        z0 = scene_lib.ROOM_BOX[2][0]
+          * room_light.shadow_texel_m(inputs.key_to_light, self.frame.room_targets.key_texels, placement=self.frame.placement))
+        wx0, wx1, wy0, wy1 = self.frame.placement.window_rect   # the frame's room's window
+        z0 = self.frame.placement.window_z
         s(program, "u_window_rect", (wx0, wx1, wy0, wy1))
         s(program, "u_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
         s(program, "u_tan_sun_radius", math.tan(scene_lib.SUN_RADIUS_RAD))
@@ -173,15 +177,15 @@ class ShadowPass(Pass):
         s = set_uniform
         s(program, "u_occlusion_maps", unit)
         directions = room_light.occlusion_directions()
-        matrices = [room_light.light_view_projection(d) for d in directions]
+        matrices = [room_light.light_view_projection(d, placement=self.frame.placement) for d in directions]
         s(program, "u_occlusion_view_proj", b"".join(gl_bytes(m) for m in matrices))
         s(program, "u_occlusion_depth_bias",
           tuple(OCCLUSION_BIAS_M * abs(float(m[2, 2])) / 2 for m in matrices))
         s(program, "u_occlusion_direction", np.asarray(directions, dtype="f4"))
         s(program, "u_occlusion_grid", float(occlusion_grid()))
         s(program, "u_occlusion_offset_m", OCCLUSION_OFFSET_M)
-        wx0, wx1, wy0, wy1 = scene_lib.WINDOW_RECT
-        z0 = scene_lib.ROOM_BOX[2][0]
+        wx0, wx1, wy0, wy1 = self.frame.placement.window_rect   # the frame's room's window
+        z0 = self.frame.placement.window_z
         s(program, "u_occlusion_window", (wx0, wx1, wy0, wy1))
         s(program, "u_occlusion_wall_z", (z0, z0 - scene_lib.WALL_THICKNESS_M))
 
@@ -209,7 +213,7 @@ class ShadowPass(Pass):
                 self.frame.fabric_pattern.bind(program, 3, self.frame.mesh.fabric_size_m)
             colours = self.frame.terms.room_colours(inputs)
             set_uniform(program, "u_light_view_proj",
-                      gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+                      gl_bytes(room_light.light_view_projection(inputs.key_to_light, placement=self.frame.placement)))
             set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
             set_uniform(program, "u_mean_coverage", colours["u_mean_coverage"])
             set_uniform(program, "u_thread_beam_rgb", (0.0, 0.0, 0.0))
@@ -262,7 +266,7 @@ class ShadowPass(Pass):
         vao = self.frame.mesh.shadow_vao(program)   # the coarse grid: the occlusion is a fold's, not a pixel's
         for j, direction in enumerate(room_light.occlusion_directions()):
             self.ctx.viewport = ((j % grid) * n, (j // grid) * n, n, n)
-            set_uniform(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(direction)))
+            set_uniform(program, "u_light_view_proj", gl_bytes(room_light.light_view_projection(direction, placement=self.frame.placement)))
             vao.render(mgl.TRIANGLES)
         self.ctx.viewport = (0, 0, grid * n, grid * n)
         self.ctx.blend_equation = mgl.FUNC_ADD
@@ -301,11 +305,13 @@ class ShadowPass(Pass):
         self.ctx.disable(mgl.DEPTH_TEST)
 
     def _key_visibility_target(self, name: str):
-        """The texture of the key's visibility over the fabric's uv (key_visibility.frag), one
-        texel every KEY_VISIBILITY_PITCH_M of the rest fabric (at most KEY_VISIBILITY_MAX_TEXELS a
-        side), made or remade when the fabric's size asks for another; cleared to fully lit."""
+        """The texture ``name`` of the key's visibility over the fabric's uv (key_visibility.frag),
+        one texel every KEY_VISIBILITY_PITCH_M of the rest fabric (``*_coarse``: the coarse
+        grid's, every KEY_VISIBILITY_COARSE_PITCH_M; at most KEY_VISIBILITY_MAX_TEXELS a side),
+        made or remade when the fabric's size asks for another; cleared to fully lit."""
         mgl, gl = self.mgl, self.frame.room_targets.get()
-        size = tuple(int(min(KEY_VISIBILITY_MAX_TEXELS, max(16, math.ceil(m / KEY_VISIBILITY_PITCH_M))))
+        pitch = KEY_VISIBILITY_COARSE_PITCH_M if name.endswith("_coarse") else KEY_VISIBILITY_PITCH_M
+        size = tuple(int(min(KEY_VISIBILITY_MAX_TEXELS, max(16, math.ceil(m / pitch))))
                      for m in self.frame.mesh.fabric_size_m)
         texture = gl.get(name)
         if texture is None or tuple(texture.size) != size:
@@ -346,7 +352,7 @@ class ShadowPass(Pass):
         if patterned:
             self.frame.fabric_pattern.bind(program, 3, self.frame.mesh.fabric_size_m)
         set_uniform(program, "u_light_view_proj",
-                  gl_bytes(room_light.light_view_projection(inputs.key_to_light)))
+                  gl_bytes(room_light.light_view_projection(inputs.key_to_light, placement=self.frame.placement)))
         set_uniform(program, "u_mesh_offset", self.frame.mesh.offset_m)
         set_uniform(program, "u_mean_coverage", colours["u_mean_coverage"])
         set_uniform(program, "u_thread_beam_rgb", colours["u_thread_beam_rgb"])
