@@ -228,7 +228,7 @@ MAY_READ = {
     "catalog/render/imagefile.py": "image files written and read back (the commands' outputs)",
     "catalog/render/display.py": "the display's own tables (package data, not the scene)",
     "catalog/cloth/drape_cache.py": "the drape cache (results kept, not inputs)",
-    "catalog/render/room_operators.py": "the room's bundle: read from its cache (or built) when the settings name a room (not yet resolved at the edge)",
+    "catalog/render/room_operators.py": "the room's bundle, a cache of the resolved room: read from the cache (keyed by the loaded Room's hash); only the viewer, which keeps trimesh off its path, names a room and has its file hashed here",
 }
 #: What reads a file: a call of open(), np.load, json/tomllib/pickle/trimesh.load, an image
 #: input's open, a Path's read_text/read_bytes, an imread/read_image/loadtxt, or one of the

@@ -14,6 +14,17 @@ from catalog.core.errors import CatalogError
 SCENE_FIELDS = {"fabric", "light", "key_direction_deg", "fluorescence", "camera", "room"}
 
 
+
+def _assert_same_inputs(ours, theirs) -> None:
+    """Every field of two ShadingInputs equal (names and modes as such, arrays exactly)."""
+    for f in dataclasses.fields(ours):
+        a, b = getattr(ours, f.name), getattr(theirs, f.name)
+        if isinstance(a, (str, type(None))):
+            assert a == b, f.name
+        else:
+            np.testing.assert_array_equal(np.asarray(a, dtype=float), np.asarray(b, dtype=float),
+                                          err_msg=f.name)
+
 def _curtain():
     from catalog.render import scene as scene_lib
 
@@ -81,12 +92,7 @@ def test_describe_scene_draws_the_settings_value(light):
     assert desc.info["room"] == settings.room.name == "box"
     assert desc.info["fabric"] == settings.fabric.name
     inputs, _ = settings.shading_inputs()
-    for f in dataclasses.fields(inputs):
-        a, b = getattr(inputs, f.name), getattr(desc.inputs, f.name)
-        if isinstance(a, (str, type(None))):
-            assert a == b, f.name
-        else:
-            np.testing.assert_array_equal(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+    _assert_same_inputs(inputs, desc.inputs)
 
 
 def test_describe_scene_takes_a_resolved_room_only():
@@ -115,13 +121,7 @@ def test_the_frame_and_the_path_tracer_draw_one_value(gl):
     try:
         np.testing.assert_array_equal(r.camera.position, desc.camera_position)
         np.testing.assert_array_equal(r.shading_inputs().key_to_light, desc.key_to_light)
-        frame = r.shading_inputs()
-        for f in dataclasses.fields(frame):
-            a, b = getattr(frame, f.name), getattr(desc.inputs, f.name)
-            if isinstance(a, (str, type(None))):
-                assert a == b, f.name
-            else:
-                np.testing.assert_array_equal(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+        _assert_same_inputs(r.shading_inputs(), desc.inputs)
     finally:
         r.release()
 

@@ -140,7 +140,7 @@ class FrameRenderer:
     def _apply(self, new: FrameSettings, parts) -> None:
         """Act on the stale parts (see :data:`settings.STALE`), then keep ``new``."""
         if "room_transport" in parts:   # first: a bad room is refused before any change
-            self._set_room_transport(new.room_spec)
+            self._set_room_transport(new.resolved_room or new.room_spec)
         if "fabric_tables" in parts and new.fabric is not None:
             self.fabric_pattern.set_fabric(new.fabric)   # its tables resolved with the settings
         if "msaa_targets" in parts:
@@ -155,12 +155,13 @@ class FrameRenderer:
             self.schedule.invalidate()
 
     def _set_room_transport(self, room) -> None:
-        """The room (a built-in name or a .glb path) drawn and lit by its precomputed transport
+        """The room (a loaded catalog.room.model.Room where the edge resolved one, else a
+        built-in name or a .glb path) drawn and lit by its precomputed transport
         (catalog/render/passes/room_transport_light.py; its bundle from the cache, built on
         first use). A bad room is refused before any change."""
         from catalog.render.passes.room_transport_light import RoomTransportLight  # noqa: PLC0415
 
-        light = RoomTransportLight(self, str(room))
+        light = RoomTransportLight(self, room if hasattr(room, "content_sha256") else str(room))
         self._drop_room_transport()
         self._room_transport = light
 
@@ -175,7 +176,7 @@ class FrameRenderer:
     def room_transport(self):
         """The room's light by its precomputed transport (RoomTransportLight), loaded on first use."""
         if self._room_transport is None:
-            self._set_room_transport(self._settings.room_spec)
+            self._set_room_transport(self._settings.resolved_room or self._settings.room_spec)
         return self._room_transport
 
     def _resolve_antialiasing(self, mode: str) -> str:

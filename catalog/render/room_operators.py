@@ -306,10 +306,17 @@ def bundle_key(content_sha256: str) -> str:
 
 
 def bundle_path(spec) -> tuple[Path, str, str]:
-    """(path, key, name) of the bundle of ``spec`` (a built-in name or a .glb path)."""
+    """(path, key, name) of the bundle of ``spec``: a loaded Room (keyed by the hash its
+    loader took: nothing read here), or a built-in name or a .glb path (the viewer's, which
+    keeps trimesh off its path: keyed by the file's hash, the one read of it here)."""
     from catalog.room.cache import cache_dir  # noqa: PLC0415  (numpy only: no scipy at import)
     from catalog.room.load import BUILTIN_ROOMS, room_path  # noqa: PLC0415
 
+    if hasattr(spec, "content_sha256"):
+        key = bundle_key(spec.content_sha256)
+        builtin = spec.name in BUILTIN_ROOMS and Path(spec.source) == room_path(spec.name)
+        name = spec.name if builtin else Path(spec.source).stem
+        return cache_dir().parent / "room_frame" / f"{name}-{key[:24]}.npz", key, name
     path = room_path(spec)
     sha = hashlib.sha256(path.read_bytes()).hexdigest()
     key = bundle_key(sha)
@@ -368,15 +375,17 @@ def load(path: Path, key: str) -> RoomOperators | None:
 
 
 def room_operators(spec) -> RoomOperators:
-    """The bundle of ``spec`` (a built-in name or a .glb path) from the cache; built (the
-    room loaded and checked, its transport, the gathers) and stored when absent: in this
-    process, or where scipy is marked absent (the viewer) in a child process."""
+    """The bundle of ``spec`` (a loaded Room, a built-in name or a .glb path) from the cache;
+    built (the room loaded and checked unless given loaded, its transport, the gathers) and
+    stored when absent: in this process, or where scipy is marked absent (the viewer) in a
+    child process."""
     path, key, _name = bundle_path(spec)
     bundle = load(path, key)
     if bundle is not None and tuple(bundle.side_grid) == _room_side_grid(bundle.window_corners):
         return bundle   # (a bundle whose grid is not over its own window is stale: rebuilt)
     if "scipy" in sys.modules and sys.modules["scipy"] is None:
-        result = subprocess.run([sys.executable, "-m", "catalog.render.room_operators", str(spec)],
+        result = subprocess.run([sys.executable, "-m", "catalog.render.room_operators",
+                                 str(getattr(spec, "source", spec))],
                                 capture_output=True, text=True)
         if result.returncode != 0:
             from catalog.core.errors import InputError  # noqa: PLC0415
@@ -387,9 +396,12 @@ def room_operators(spec) -> RoomOperators:
         if bundle is None:
             raise RuntimeError(f"the room bundle {path} was not written")
         return bundle
-    from catalog.room.load import load_room  # noqa: PLC0415
+    if hasattr(spec, "content_sha256"):
+        bundle = build(spec)
+    else:
+        from catalog.room.load import load_room  # noqa: PLC0415
 
-    bundle = build(load_room(spec))
+        bundle = build(load_room(spec))
     save(bundle, path, key)
     return bundle
 

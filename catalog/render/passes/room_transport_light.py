@@ -128,7 +128,8 @@ class RoomTransportLight(Pass):
     grid ``room_side`` of frame.room_targets, the room into the HDR target."""
 
     def __init__(self, frame, room):
-        """``room``: a built-in name or a .glb path (its bundle from the cache, built when absent)."""
+        """``room``: a loaded Room, a built-in name or a .glb path (its bundle from the cache,
+        built when absent)."""
         super().__init__(frame)
         from catalog.render.passes.room_transport import RoomTransportPass  # noqa: PLC0415
         from catalog.render.room_operators import room_operators  # noqa: PLC0415
@@ -138,7 +139,8 @@ class RoomTransportLight(Pass):
         self.ops = room_operators(room)
         ops = self.ops
         #: the curtain, rod and camera of this room, from its window (catalog.render.placement)
-        self.placement = placement_of(ops.window_corners, ops.window_normal, ops.triangles, str(room))
+        self.placement = placement_of(ops.window_corners, ops.window_normal, ops.triangles,
+                                      str(getattr(room, "source", room)))
         self.draw_pass = RoomTransportPass(self.ctx, ops)
         dirs, weights = sh.hemisphere_quadrature(CAPTURE_THETA, CAPTURE_PHI)
         self._weights = weights
@@ -301,8 +303,19 @@ class RoomTransportLight(Pass):
         return out
 
     def draw_captures(self, inputs) -> None:
-        mgl = self.mgl
         texture, _depth, fbo = self._targets()
+        overrides = self.capture_overrides()
+        for view_proj, eye in self._aperture_views(fbo, self._world_dirs):
+            if not self.frame.curtain_open:
+                self.frame.curtain.draw_flat(view_proj, eye, overrides, coarse=CAPTURE_COARSE)
+            self.frame.background.draw(view_proj, inputs, camera_position=eye, sun_disc=False)
+        texture.build_mipmaps()
+
+    def _aperture_views(self, fbo, world_dirs):
+        """Into ``fbo``, one viewport a direction (side by side, CAPTURE_TEXELS_PER_PATCH texels
+        a patch): yields each parallel view of the aperture along -w as (view_proj, eye) with the
+        depth test on and blending off, and restores the frame's depth state after the last."""
+        mgl = self.mgl
         nu, nv = self._patches
         k = CAPTURE_TEXELS_PER_PATCH
         fbo.use()
@@ -310,18 +323,21 @@ class RoomTransportLight(Pass):
         self.ctx.enable(mgl.DEPTH_TEST)
         self.ctx.disable(mgl.BLEND)
         self.ctx.depth_func = "<="
-        overrides = self.capture_overrides()
         centre = self.ops.window_centre
-        for j, w in enumerate(self._world_dirs):
+        for j, w in enumerate(world_dirs):
             self.ctx.viewport = (j * nu * k, 0, nu * k, nv * k)
             view_proj = aperture_view_projection(self.ops.window_corners, self.ops.window_normal, w)
-            eye = tuple(float(v) for v in centre + 1e3 * w)   # the view's rays all ~ -w
-            if not self.frame.curtain_open:
-                self.frame.curtain.draw_flat(view_proj, eye, overrides, coarse=CAPTURE_COARSE)
-            self.frame.background.draw(view_proj, inputs, camera_position=eye, sun_disc=False)
+            yield view_proj, tuple(float(v) for v in centre + 1e3 * w)   # the rays all ~ -w
         self.ctx.depth_func = "<"
         self.ctx.disable(mgl.DEPTH_TEST)
-        texture.build_mipmaps()
+
+    def _patch_radiance(self, texture, count: int) -> np.ndarray:
+        """(count, nv, nu, 3) each view's mean radiance over each patch: the mip level where a
+        patch is one texel (row 0: the v edge's start)."""
+        nu, nv = self._patches
+        level = int(math.log2(CAPTURE_TEXELS_PER_PATCH))
+        data = np.frombuffer(texture.read(level=level), dtype="f4").reshape(nv, count * nu, 4)[..., :3]
+        return data.reshape(nv, count, nu, 3).transpose(1, 0, 2, 3).astype(np.float64)
 
     def draw_window_side(self) -> None:
         """The cloth's window side in parallel views of the aperture from outside (the
@@ -329,42 +345,21 @@ class RoomTransportLight(Pass):
         values (catalog.render.passes.scene_terms.back_capture_overrides: no see-through, the
         outside reflected), nothing where there is no cloth; its cosine-weighted mean radiance
         per patch (:attr:`_back_mean`, (nv, nu, 3))."""
-        mgl = self.mgl
         nu, nv = self._patches
         if self.frame.curtain_open:
             self._back_mean = np.zeros((nv, nu, 3))
             return
         texture, _depth, fbo = self._back_targets()
-        k = CAPTURE_TEXELS_PER_PATCH
-        fbo.use()
-        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        self.ctx.enable(mgl.DEPTH_TEST)
-        self.ctx.disable(mgl.BLEND)
-        self.ctx.depth_func = "<="
         overrides = self.frame.terms.back_capture_overrides()
-        centre = self.ops.window_centre
-        for j, w in enumerate(self._back_world_dirs):
-            self.ctx.viewport = (j * nu * k, 0, nu * k, nv * k)
-            view_proj = aperture_view_projection(self.ops.window_corners, self.ops.window_normal, w)
-            eye = tuple(float(v) for v in centre + 1e3 * w)
+        for view_proj, eye in self._aperture_views(fbo, self._back_world_dirs):
             self.frame.curtain.draw_flat(view_proj, eye, overrides, coarse=CAPTURE_COARSE)
-        self.ctx.depth_func = "<"
-        self.ctx.disable(mgl.DEPTH_TEST)
         texture.build_mipmaps()
-        level = int(math.log2(k))
-        count = len(self._back_weights)
-        data = np.frombuffer(texture.read(level=level), dtype="f4").reshape(nv, count * nu, 4)[..., :3]
-        radiance = data.reshape(nv, count, nu, 3).transpose(1, 0, 2, 3).astype(np.float64)
+        radiance = self._patch_radiance(texture, len(self._back_weights))
         self._back_mean = np.einsum("j,jvuc->vuc", self._back_weights, radiance)
 
     def read_captures(self) -> np.ndarray:
         """(J, nv, nu, 3) each direction's mean radiance over each patch (row 0: the v edge's start)."""
-        texture = self._capture[0]
-        nu, nv = self._patches
-        level = int(math.log2(CAPTURE_TEXELS_PER_PATCH))
-        count = len(self._weights)
-        data = np.frombuffer(texture.read(level=level), dtype="f4").reshape(nv, count * nu, 4)[..., :3]
-        return data.reshape(nv, count, nu, 3).transpose(1, 0, 2, 3).astype(np.float64)
+        return self._patch_radiance(self._capture[0], len(self._weights))
 
     def project(self, radiance: np.ndarray) -> np.ndarray:
         """(P, K, 3) coefficients of captures (J, nv, nu, 3) (:func:`project_captures`)."""
