@@ -1,7 +1,7 @@
 """The frame as passes (docs/architecture.md, "The frame"). One frame of the curtain scene,
 in the order :class:`catalog.render.frame.FrameRenderer` runs them:
 
-0. the room's light, when stale (:meth:`.room_schedule.RoomLightSchedule.stale`): ``shadow``
+0. the room's light, when stale (:meth:`catalog.render.passes.room_schedule.RoomLightSchedule.stale`): ``shadow``
    (the key light's maps, :mod:`.shadow`), then the room's precomputed transport
    (:mod:`.room_transport_light`: its views of the window, the light map, the curtain's two sides);
 1. the room (:mod:`.room_transport`): the room file's surfaces and the rod and rings, depth-tested;
