@@ -188,6 +188,9 @@ def test_glare_switch_spreads_light_from_bright_to_dark(page, web_site):
     assert change[bright].mean() <= 0.1
 
 
+@pytest.mark.xfail(strict=True, reason="issue 32: the page draws the room under the constant light "
+                                      "until it loads the room's transport pack, so a lamp no longer "
+                                      "lights the walls beside it (mean 0.157 against 2 x 0.146 asked)")
 def test_room_lamp_switch_lights_the_room_beside_it(page, web_site):
     """A room lamp (the select, then key M) stands right of the window: it only adds light
     (at most 0.5 % of the pixels darker by over 2/255: edge pixels; the exposure is the

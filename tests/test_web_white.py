@@ -27,7 +27,7 @@ def test_recorded_white_is_measured_from_a_drawn_frame(gl):
         whites = {}
         for hour in (8.0, 15.0):
             choice = export.LightChoice(id=f"sun@{hour:g}", label="sun", kind="sun", hour=hour)
-            exporter.record(preset, choice, "on")
+            exporter.record(exporter.scene(preset, choice), "on")
             whites[hour] = exporter.renderer.white_balance_matrix()
             export.configure_desktop_frame(desktop)
             desktop.update(fabric=preset, light=SunHour(hour), ev=exporter.renderer.ev100)

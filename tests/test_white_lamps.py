@@ -12,12 +12,12 @@ pytestmark = [pytest.mark.gl, pytest.mark.slow]
 
 def test_white_is_measured_again_when_a_lamp_is_switched(gl):
     from catalog.render.frame import FrameRenderer
-    from catalog.web.export import configure_desktop_frame, room_lamps
+    from catalog.web.export import room_lamps
 
     r = FrameRenderer(gl, (48, 32))
     try:
         r.update(fabric="fluoro-pink", light="D65")
-        configure_desktop_frame(r)
+        r.update(room_lighting=True)   # the desktop frame: the lamps light the room it sees
         whites = {}
         for lamp in ("none", "A", "LED-B4", "none"):
             r.update(lamps=room_lamps(lamp))
