@@ -21,8 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-#: Bumped when the bundle's content changes.
-BUNDLE_VERSION = 4
+#: Bumped when the bundle's content or the rules that make it (the cloth's room-side grid over
+#: the room's own window, :func:`_room_side_grid`) change.
+BUNDLE_VERSION = 5
 #: Cosine-weighted rays from each receiver for its view of the outside (receivers outside
 #: the aperture: the reveals, a sill) and of the aperture from outside (the curtain's window side).
 OUTSIDE_RAYS = 64
@@ -299,7 +300,7 @@ def bundle_key(content_sha256: str) -> str:
 
     text = json.dumps({"room": content_sha256, "params": TransportParams().key(),
                        "version": BUNDLE_VERSION, "patch_rays": GATHER_RAYS_PATCH,
-                       "side_rays": GATHER_RAYS_SIDE, "side_grid": side_grid(),   # (the box's; each room's lies over its own window)
+                       "side_rays": GATHER_RAYS_SIDE, "side_texels": side_grid()[:2],
                        "outside_rays": OUTSIDE_RAYS, "outside_order": OUTSIDE_ORDER,
                        "curtain_offset_m": CURTAIN_OFFSET_M}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()
@@ -381,8 +382,8 @@ def room_operators(spec) -> RoomOperators:
     child process."""
     path, key, _name = bundle_path(spec)
     bundle = load(path, key)
-    if bundle is not None and tuple(bundle.side_grid) == _room_side_grid(bundle.window_corners):
-        return bundle   # (a bundle whose grid is not over its own window is stale: rebuilt)
+    if bundle is not None:
+        return bundle
     if "scipy" in sys.modules and sys.modules["scipy"] is None:
         result = subprocess.run([sys.executable, "-m", "catalog.render.room_operators",
                                  str(getattr(spec, "source", spec))],
