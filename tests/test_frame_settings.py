@@ -15,7 +15,7 @@ from catalog.render.settings import FrameSettings, SettingsError, SunHour, orbit
 
 BAD = {
     "fluorescence": "bright", "bands": 5, "exposure": 0.0, "ev": 99.0, "white_balance": "warm",
-    "antialiasing": "ssaa", "shadow_map_size": 300, "lamps": [("A", (9.0, 9.0, 9.0))],
+    "antialiasing": "ssaa", "shadow_map_size": 300, "lamps": [("A", (9.0, 9.0))],
     "patterned": "no", "room_lighting": None, "bloom": 2, "camera": (0.0, 0.0, 2.6),
     "room_update_every": 0, "key_direction_deg": (10.0,), "light": 5, "fabric": 3.0,
 }
@@ -186,6 +186,23 @@ def test_the_renderer_redraws_what_the_table_says(gl):
         with pytest.raises(SettingsError, match="^bands: "):
             r.update(bands=7)
         assert r.settings is before
+        with pytest.raises(SettingsError, match="^lamps: .* must lie inside the room"):
+            r.update(lamps=[("A", (0.5, 0.3, 9.0))])   # behind the box's back wall (z 4.5 m)
+        assert r.settings is before
         assert r.update(before) == frozenset()
     finally:
         r.release()
+
+
+def test_a_lamp_is_checked_against_its_own_rooms_interior():
+    """The bedroom is shorter than the box (z to 3.6 m against 4.5) and wider (x to 2.3 m):
+    a lamp is refused or taken by the loaded room's interior, not the box's."""
+    from catalog.room.load import load_room
+
+    bedroom = load_room("bedroom")
+    FrameSettings(room=bedroom, lamps=[("A", (2.25, 0.3, 1.5))])          # outside the box, inside the bedroom
+    FrameSettings(lamps=[("A", (0.5, 0.3, 4.0))])                         # a named room: the frame checks it
+    with pytest.raises(SettingsError, match="^lamps: .* must lie inside the room x -1.8..2.3"):
+        FrameSettings(room=bedroom, lamps=[("A", (0.5, 0.3, 4.0))])
+    with pytest.raises(SettingsError, match="^lamps: .*give \\(x, y, z\\) in m, finite"):
+        FrameSettings(lamps=[("A", (0.5, float("nan"), 1.0))])

@@ -124,15 +124,24 @@ def coarse_grid_indices(uvs: np.ndarray, max_side: int = COARSE_GRID_SIDE) -> np
     return np.concatenate([np.stack([a, cc, b], 1), np.stack([b, cc, d], 1)]).astype(np.int32).ravel()
 
 
-def check_lamp_position(position_m) -> tuple[float, float, float]:
-    """A lamp's position (m) as a float triple, refused in one line outside the room's box."""
+def check_lamp_position(position_m, interior=None) -> tuple[float, float, float]:
+    """A lamp's position (m) as a finite float triple, refused in one line outside the
+    room's ``interior`` ((x0, x1), (y0, y1), (z0, z1)) m: catalog.render.placement's, the
+    drawn room's inside). ``interior`` None checks the triple alone (the room not yet
+    resolved: the frame checks it against its room's interior when it draws it)."""
     from catalog.core.errors import CatalogError  # noqa: PLC0415
 
-    p = tuple(float(v) for v in position_m)
-    (x0, x1), (y0, y1), (z0, z1) = scene_lib.ROOM_BOX
-    if len(p) != 3 or not (x0 < p[0] < x1 and y0 < p[1] < y1 and z0 < p[2] < z1):
-        raise CatalogError(f"room lamp position {position_m!r} must lie inside the room "
-                           f"x {x0}..{x1}, y {y0}..{y1}, z {z0}..{z1} m")
+    try:
+        p = tuple(float(v) for v in position_m)
+    except (TypeError, ValueError):
+        raise CatalogError(f"room lamp position {position_m!r}: give (x, y, z) in m") from None
+    if len(p) != 3 or not all(math.isfinite(v) for v in p):
+        raise CatalogError(f"room lamp position {position_m!r}: give (x, y, z) in m, finite")
+    if interior is not None:
+        (x0, x1), (y0, y1), (z0, z1) = interior
+        if not (x0 < p[0] < x1 and y0 < p[1] < y1 and z0 < p[2] < z1):
+            raise CatalogError(f"room lamp position {position_m!r} must lie inside the room "
+                               f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}, z {z0:g}..{z1:g} m")
     return p
 
 

@@ -139,8 +139,10 @@ class FrameRenderer:
 
     def _apply(self, new: FrameSettings, parts) -> None:
         """Act on the stale parts (see :data:`settings.STALE`), then keep ``new``."""
-        if "room_transport" in parts:   # first: a bad room is refused before any change
-            self._set_room_transport(new.resolved_room or new.room_spec)
+        if "room_transport" in parts:   # first: a bad room or lamp is refused before any change
+            self._set_room_transport(new.resolved_room or new.room_spec, new.lamps)
+        elif new.lamps and "room_light" in parts:
+            self._check_lamps(new.lamps, self.placement)
         if "fabric_tables" in parts and new.fabric is not None:
             self.fabric_pattern.set_fabric(new.fabric)   # its tables resolved with the settings
         if "msaa_targets" in parts:
@@ -154,14 +156,31 @@ class FrameRenderer:
         if "room_light" in parts:
             self.schedule.invalidate()
 
-    def _set_room_transport(self, room) -> None:
+    @staticmethod
+    def _check_lamps(lamps, placement) -> None:
+        """Each lamp inside the interior of the room of ``placement`` (catalog.render.placement)."""
+        from catalog.render.curtain_frames import check_lamp_position  # noqa: PLC0415
+
+        interior = placement.interior
+        for _light, position in lamps:
+            try:
+                check_lamp_position(position, interior)
+            except CatalogError as exc:
+                raise SettingsError(str(exc), field="lamps") from None
+
+    def _set_room_transport(self, room, lamps=()) -> None:
         """The room (a loaded catalog.room.model.Room where the edge resolved one, else a
         built-in name or a .glb path) drawn and lit by its precomputed transport
         (catalog/render/passes/room_transport_light.py; its bundle from the cache, built on
-        first use). A bad room is refused before any change."""
+        first use). A bad room, or a lamp outside it, is refused before any change."""
         from catalog.render.passes.room_transport_light import RoomTransportLight  # noqa: PLC0415
 
         light = RoomTransportLight(self, room if hasattr(room, "content_sha256") else str(room))
+        try:
+            self._check_lamps(lamps, light.placement)
+        except SettingsError:
+            light.release()
+            raise
         self._drop_room_transport()
         self._room_transport = light
 

@@ -151,7 +151,7 @@ class FrameSettings:
         set_(self, "sun", sun)
         set_(self, "key_to_light", scene_lib.key_direction(*elevation_azimuth))
         self._check_choices()
-        set_(self, "lamps", _resolve_lamps(self.lamps))
+        set_(self, "lamps", _resolve_lamps(self.lamps, self.room))
 
     def _check_choices(self) -> None:
         from catalog.render import bands as band_lib, display as display_lib  # noqa: PLC0415
@@ -312,7 +312,10 @@ def _environment_read(path: str, _stamp) -> tuple:
     return pixels, env.upper_illuminance(pixels)
 
 
-def _resolve_lamps(lamps) -> tuple:
+def _resolve_lamps(lamps, room) -> tuple:
+    """(Light, (x, y, z) m) pairs, each inside the interior of ``room`` where it is a loaded
+    Room (the path tracer's, catalog.render.placement); a named room's lamps are checked by
+    the frame that draws it (FrameRenderer.update)."""
     from catalog.optics.lights import get_light  # noqa: PLC0415
 
     try:
@@ -321,12 +324,17 @@ def _resolve_lamps(lamps) -> tuple:
         raise _refuse("lamps", f"{lamps!r}: give (light, (x, y, z) m) pairs") from None
     if len(lamps) > curtain_frames.MAX_ROOM_LAMPS:
         raise _refuse("lamps", f"at most {curtain_frames.MAX_ROOM_LAMPS} room lamps, got {len(lamps)}")
+    interior = None
+    if lamps and isinstance(room, Room):
+        from catalog.render.placement import placement_of_room  # noqa: PLC0415
+
+        interior = placement_of_room(room).interior
     resolved = []
     for lamp in lamps:
         try:
             light, position = lamp
             resolved.append((get_light(light) if isinstance(light, str) else light,
-                             curtain_frames.check_lamp_position(position)))
+                             curtain_frames.check_lamp_position(position, interior)))
         except InputError:
             raise
         except (CatalogError, TypeError, ValueError) as exc:
