@@ -69,22 +69,25 @@ def test_mip_chain_keeps_the_mean_and_removes_what_a_level_cannot_hold():
     assert all(c.min() >= 0.0 and c.max() <= 1.0 for c in chain)
 
 
-def _sweep(gl, fabric: str, prefilter: bool = True) -> list[float]:
-    """The share above the 1x Nyquist at each of 8 distances, 0.3-4 m (the quad face on)."""
-    renderer = FrameRenderer(gl, (96 * SUPERSAMPLE, 64 * SUPERSAMPLE))
+def _sweep(gl, fabric: str, prefilter: bool = True, yaw_deg: float = 0.0,
+           supersample: int = SUPERSAMPLE) -> list[float]:
+    """The share above the 1x Nyquist at each of 8 distances, 0.3-4 m (the quad face on, or
+    seen ``yaw_deg`` off its normal), measured ``supersample`` times finer."""
+    renderer = FrameRenderer(gl, (96 * supersample, 64 * supersample))
     renderer.fabric_pattern.set_prefilter(prefilter)
     renderer.update(fabric=fabric, light="D65")
     renderer.set_mesh(*_quad_mesh(), fabric_size_m=(1.8, 2.05))
     renderer.update(ev=12.0)
     # filtered for the pixel the supersampled frame is measured at
-    renderer.fabric_pattern.lod_bias = PATTERN_LOD_BIAS + math.log2(SUPERSAMPLE)
+    renderer.fabric_pattern.lod_bias = PATTERN_LOD_BIAS + math.log2(supersample)
     shares = []
     for distance in np.geomspace(0.3, 4.0, 8):
-        renderer.update(camera=orbit(0.0, 0.0, float(distance)))
+        renderer.update(camera=orbit(float(yaw_deg), 0.0, float(distance)))
         renderer.render()
-        shares.append(energy_above_nyquist(renderer.read_linear()))
+        shares.append(energy_above_nyquist(renderer.read_linear(), supersample))
     renderer.release()
-    print(fabric, "prefiltered" if prefilter else "box", " ".join(f"{s:.4f}" for s in shares))
+    print(fabric, "prefiltered" if prefilter else "box", f"{yaw_deg:g} deg {supersample}x",
+          " ".join(f"{s:.4f}" for s in shares))
     return shares
 
 
@@ -106,3 +109,17 @@ def test_the_measure_sees_the_box_chains_moire(gl):
     """The same sweep with the hardware's 2x2 box chain (the mips before): the net folds into
     stripes and the share rises over the bound (measured 4.2 % at 1.3-1.9 m; prefiltered 0.8 %)."""
     assert max(_sweep(gl, "lace-fwa", prefilter=False)) > MOIRE_BOUND
+
+
+@pytest.mark.gl
+@pytest.mark.slow
+def test_the_measure_converges_as_the_supersampling_rises_at_60_degrees(gl):
+    """Whether the 4x measure holds off the normal (issue 34): at 60 deg the lace's shares at
+    4x, 8x and 16x (measured: 4x at most 0.45 percentage points under 16x, 8x within 0.05; the
+    Raschel alike). It converges, so the oblique figures (lace 2.2-5.5 %, over MOIRE_BOUND) are
+    the frame's; they are not all the pattern's, though: the flat cloth alone gives 1.2-2.3 %
+    there and the rest is mostly the window's frame seen through the holes and the quad's
+    edge inside the measured middle half (docs/pattern.md), so no oblique bound is set yet."""
+    s4, s8, s16 = (np.array(_sweep(gl, "lace-fwa", yaw_deg=60.0, supersample=k)) for k in (4, 8, 16))
+    assert np.abs(s8 - s16).max() <= 0.002, (s8, s16)
+    assert np.abs(s4 - s16).max() <= 0.007, (s4, s16)
