@@ -262,14 +262,14 @@ def read_page_script(text: str, source: str = PAGE_FILE) -> tuple[dict, dict]:
     prefix = "window.CATALOG_ROOM_PACK = "
     body = text.strip()
     if not body.startswith(prefix) or not body.endswith(";"):
-        refuse("file", f"not a room pack (it must set window.CATALOG_ROOM_PACK)")
+        refuse("file", "not a room pack (it must set window.CATALOG_ROOM_PACK)")
     try:
         pack_obj = json.loads(body[len(prefix):-1])
         header, payload_text = pack_obj["header"], pack_obj["payload"]
     except (json.JSONDecodeError, KeyError, TypeError):
         refuse("file", "not a room pack's JSON (header and payload)")
     if header.get("format") != PAGE_FORMAT:
-        refuse("header.format", f"{header.get('format')!r}, expected {PAGE_FORMAT!r}")
+        refuse("header.format", f"{json.dumps(header.get('format'))}, expected {json.dumps(PAGE_FORMAT)}")
     try:
         payload = zlib.decompress(base64.b64decode(payload_text, validate=True))
     except (binascii.Error, zlib.error, TypeError):
