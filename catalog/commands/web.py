@@ -4,6 +4,7 @@ from __future__ import annotations
 
 #: Options read and written (checked before the work by catalog.commands.cli.check_outputs).
 OUTPUT_FOLDERS = ("out",)
+INPUT_FILES = ("room",)
 HELP = "write a static web catalog (WebGL2, same shaders and light) that opens from file://"
 
 
@@ -17,6 +18,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--lights", default=None, metavar="NAME[,NAME..]",
                         help="comma-separated lamps of the light library, and 'sun-by-hour' for "
                              "the sun slider (default: D65,A,FL2,LED-B4,LED-warm,UV-A,sun-by-hour)")
+    parser.add_argument("--room", default="box", metavar="NAME|FILE.glb",
+                        help="the room: a built-in name (box, living, bedroom) or a room .glb "
+                             "(docs/formats.md, Rooms; default box); its transport's web pack "
+                             "is written beside the page (room_pack.js)")
     parser.add_argument("--json", action="store_true", help="print the report as one JSON object")
 
 
@@ -28,7 +33,8 @@ def run(args) -> int:
     if args.lights is not None:
         parse_light_list(args.lights, "--lights")  # '' and a repeated light are refused
     fabrics = None if args.fabric is None else ",".join(args.fabric)
-    report = build_site(args.out, fabrics=fabrics, lights=args.lights, progress=not args.json)
+    report = build_site(args.out, fabrics=fabrics, lights=args.lights, progress=not args.json,
+                        room=args.room)
     if args.json:
         print_json(report)
     else:

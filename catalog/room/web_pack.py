@@ -178,3 +178,160 @@ def _bounced_iterative(transport, direct: np.ndarray, tolerance: float = 1e-10) 
         if np.abs(term).max() <= tolerance * np.abs(total).max():
             break
     return total
+
+
+# --------------------------------------------------------------------------- the page's file
+
+#: The page's pack file: ``window.CATALOG_ROOM_PACK = {"header": {...}, "payload": B}`` where B
+#: is base64 of zlib of the arrays laid end to end (each at an 8-byte boundary, little-endian).
+PAGE_FORMAT = "catalog-room-pack/1"
+#: The page's pack file name in a site.
+PAGE_FILE = "room_pack.js"
+_PAGE_DTYPES = ("float16", "float32", "uint8", "uint16", "uint32", "int32")
+
+
+def page_arrays(web: WebPack, ops) -> dict:
+    """What the page's host step needs of a room (ops: its
+    :class:`catalog.render.room_operators.RoomOperators`, from the same transport as ``web``):
+    the pack's operators; the light map's weld (each receiver corner's vertex, the receivers'
+    exposed areas); the gathers onto the window's patches, the cloth's room-side grid and the
+    wall's grid (CSR, float32); the outside's operator on the receivers outside the aperture
+    and the closed curtain's window side."""
+    if ops.count != web.count or not np.array_equal(np.asarray(ops.albedo, np.float32), web.albedo):
+        raise ValueError("the room's bundle and its web pack come from different transports")
+    out = dict(web.arrays())
+    out["vertex"] = np.asarray(ops.vertex, dtype=np.int32)
+    out["weld_weight_m2"] = np.asarray(ops.area_m2, dtype=np.float32)
+    small = np.uint16 if ops.count <= 65535 else np.uint32
+    for name in ("gather_patch", "gather_side", "gather_wall"):
+        m = getattr(ops, name)
+        out[f"{name}_data"] = np.asarray(m.data, dtype=np.float32)
+        out[f"{name}_indices"] = np.asarray(m.indices, dtype=small)
+        out[f"{name}_indptr"] = np.asarray(m.indptr, dtype=np.uint32)
+    out["outside"] = np.asarray(ops.outside, dtype=np.float32)
+    out["outside_frame"] = np.asarray(ops.outside_frame, dtype=np.float32)
+    out["window_back"] = np.asarray(ops.window_back, dtype=np.float32)
+    return out
+
+
+def page_script(web: WebPack, ops, room_name: str) -> str:
+    """The pack file's text (see :data:`PAGE_FORMAT`)."""
+    import base64  # noqa: PLC0415
+    import hashlib  # noqa: PLC0415
+    import json  # noqa: PLC0415
+    import zlib  # noqa: PLC0415
+
+    arrays = page_arrays(web, ops)
+    entries, chunks, offset = [], [], 0
+    for name, a in arrays.items():
+        a = np.ascontiguousarray(a)
+        if a.dtype.name not in _PAGE_DTYPES:
+            raise ValueError(f"{name}: {a.dtype} is not a page dtype")
+        raw = a.astype(a.dtype.newbyteorder("<"), copy=False).tobytes()
+        entries.append({"name": name, "dtype": a.dtype.name, "shape": list(a.shape), "offset": offset})
+        pad = (-len(raw)) % 8
+        chunks.append(raw + bytes(pad))
+        offset += len(raw) + pad
+    payload = b"".join(chunks)
+    nu, nv = ops.patches
+    header = {"format": PAGE_FORMAT, "room": room_name, "content_sha256": ops.content_sha256,
+              "receivers": int(web.count), "patches": [int(nu), int(nv)], "order": int(ops.order),
+              "gather_rays": int(web.gather_rays), "side_grid": [float(v) for v in ops.side_grid],
+              "payload_bytes": len(payload), "payload_sha256": hashlib.sha256(payload).hexdigest(),
+              "arrays": entries, "errors": {k: float(v) for k, v in web.errors.items()}}
+    body = base64.b64encode(zlib.compress(payload, 9)).decode("ascii")
+    return ("window.CATALOG_ROOM_PACK = " + json.dumps({"header": header, "payload": body},
+                                                        separators=(",", ":")) + ";\n")
+
+
+def read_page_script(text: str, source: str = PAGE_FILE) -> tuple[dict, dict]:
+    """(header, arrays) of a pack file, checked as the page checks it (assets/room_transport.js
+    ``checkPack``: the same rules); a bad one is refused in one line naming the file and the
+    field (:class:`catalog.core.errors.InputError`)."""
+    import base64  # noqa: PLC0415
+    import binascii  # noqa: PLC0415
+    import hashlib  # noqa: PLC0415
+    import json  # noqa: PLC0415
+    import zlib  # noqa: PLC0415
+
+    from catalog.core.errors import InputError  # noqa: PLC0415
+
+    def refuse(field_name: str, problem: str):
+        raise InputError(f"{field_name}: {problem}", path=source)
+
+    prefix = "window.CATALOG_ROOM_PACK = "
+    body = text.strip()
+    if not body.startswith(prefix) or not body.endswith(";"):
+        refuse("file", "not a room pack (it must set window.CATALOG_ROOM_PACK)")
+    try:
+        pack_obj = json.loads(body[len(prefix):-1])
+        header, payload_text = pack_obj["header"], pack_obj["payload"]
+    except (json.JSONDecodeError, KeyError, TypeError):
+        refuse("file", "not a room pack's JSON (header and payload)")
+    if header.get("format") != PAGE_FORMAT:
+        refuse("header.format", f"{json.dumps(header.get('format'))}, expected {json.dumps(PAGE_FORMAT)}")
+    try:
+        payload = zlib.decompress(base64.b64decode(payload_text, validate=True))
+    except (binascii.Error, zlib.error, TypeError):
+        refuse("payload", "not base64 of zlib data")
+    if len(payload) != header.get("payload_bytes"):
+        refuse("payload", f"{len(payload)} bytes, the header says {header.get('payload_bytes')}")
+    if hashlib.sha256(payload).hexdigest() != header.get("payload_sha256"):
+        refuse("payload", "its SHA-256 differs from the header's (the file is damaged)")
+    arrays = {}
+    for entry in header.get("arrays", []):
+        name = entry.get("name")
+        if entry.get("dtype") not in _PAGE_DTYPES:
+            refuse(f"arrays.{name}", f"dtype {entry.get('dtype')!r}")
+        dtype = np.dtype(entry["dtype"]).newbyteorder("<")
+        count = int(np.prod(entry["shape"])) if entry["shape"] else 1
+        start, end = entry["offset"], entry["offset"] + count * dtype.itemsize
+        if start % 8 or end > len(payload):
+            refuse(f"arrays.{name}", "outside the payload")
+        arrays[name] = np.frombuffer(payload[start:end], dtype=dtype).reshape(entry["shape"])
+    _check_arrays(header, arrays, refuse)
+    return header, arrays
+
+
+def _check_arrays(header: dict, a: dict, refuse) -> None:
+    """The pack's shapes agree with each other and its indices stay in range."""
+    need = ("window_left", "window_right", "albedo", "f_counts", "f_indices", "f_indptr",
+            "bounce_left", "bounce_right", "bounce_scale", "vertex", "weld_weight_m2",
+            "gather_patch_data", "gather_patch_indices", "gather_patch_indptr", "gather_side_data",
+            "gather_side_indices", "gather_side_indptr", "gather_wall_data", "gather_wall_indices",
+            "gather_wall_indptr", "outside", "outside_frame", "window_back")
+    for name in need:
+        if name not in a:
+            refuse(f"arrays.{name}", "missing")
+    e = header.get("receivers")
+    nu, nv = header.get("patches", (0, 0))
+    k = header.get("order", 0) * (header.get("order", 0) + 1) // 2
+    rank = a["window_left"].shape[-1]
+    shapes = {"window_left": (3, e, rank), "window_right": (rank, nu * nv * k), "albedo": (e, 3),
+              "vertex": (3 * e,), "weld_weight_m2": (e,), "window_back": (e,), "outside_frame": (3, 3),
+              "f_indptr": (e + 1,)}
+    for name, shape in shapes.items():
+        if tuple(a[name].shape) != tuple(shape):
+            refuse(f"arrays.{name}", f"shape {list(a[name].shape)}, expected {list(shape)}")
+    rb = a["bounce_scale"].shape[-1]
+    for name, shape in {"bounce_left": (3, e, rb), "bounce_right": (3, rb, e)}.items():
+        if tuple(a[name].shape) != shape:
+            refuse(f"arrays.{name}", f"shape {list(a[name].shape)}, expected {list(shape)}")
+    if a["outside"].shape[0] != e:
+        refuse("arrays.outside", f"{a['outside'].shape[0]} rows, expected {e}")
+    tw, th = (int(v) for v in header.get("side_grid", (0, 0))[:2])
+    for prefix, rows, data in (("f", e, "f_counts"), ("gather_patch", nu * nv, "gather_patch_data"),
+                               ("gather_side", tw * th, "gather_side_data"),
+                               ("gather_wall", tw * th, "gather_wall_data")):
+        ptr, idx = a[f"{prefix}_indptr"], a[f"{prefix}_indices"]
+        if ptr.shape != (rows + 1,) or ptr[0] != 0 or np.any(np.diff(ptr.astype(np.int64)) < 0) \
+                or ptr[-1] != idx.size or a[data].size != idx.size:
+            refuse(f"arrays.{prefix}_indptr", "not a CSR row index of its entries")
+        if idx.size and int(idx.max()) >= e:
+            refuse(f"arrays.{prefix}_indices", f"a column {int(idx.max())} >= {e} receivers")
+    if a["vertex"].size and (int(a["vertex"].min()) < 0 or int(a["vertex"].max()) >= 3 * e):
+        refuse("arrays.vertex", "a light-map vertex out of range")
+    for name in ("window_left", "window_right", "bounce_left", "bounce_right", "bounce_scale",
+                 "albedo", "outside", "window_back", "weld_weight_m2"):
+        if not np.all(np.isfinite(a[name])):
+            refuse(f"arrays.{name}", "a value is not finite")

@@ -343,7 +343,9 @@ def fabric_facts(preset) -> dict:
 class SiteExporter:
     """Records the desktop frame for each scene (see the module docstring)."""
 
-    def __init__(self, ctx=None):
+    def __init__(self, ctx=None, room="box"):
+        """``room``: the room the scenes are drawn in (a built-in name, a .glb path or a loaded
+        catalog.room.model.Room; FrameSettings.room)."""
         from catalog.gl.context import create_headless_context  # noqa: PLC0415
         from catalog.render.frame import FrameRenderer  # noqa: PLC0415
         from catalog.web.record import RecordingContext  # noqa: PLC0415
@@ -352,8 +354,10 @@ class SiteExporter:
         self.ctx = RecordingContext(real)
         self.renderer = FrameRenderer(self.ctx, RECORD_SIZE, specialise=False)
         self.meter = FrameRenderer(real, METER_SIZE)  # not recorded: meters the exposure
+        self.room = room
         for renderer in (self.renderer, self.meter):
             configure_desktop_frame(renderer)
+            renderer.update(room=room)
         self.structures: list[list[dict]] = []
         self._structure_index: dict[str, int] = {}
         self.curtain_tags: dict[int, str] = {}
@@ -418,7 +422,7 @@ class SiteExporter:
             fluorescence=FLUORESCENCE["on"], bloom=GLARE["off"], lamps=room_lamps("none"),
             patterned=DESKTOP_MODES["patterned"], room_lighting=DESKTOP_MODES["room_lighting"],
             antialiasing=DESKTOP_MODES["antialiasing"],
-            key_second_layer=DESKTOP_MODES["key_second_layer"])
+            key_second_layer=DESKTOP_MODES["key_second_layer"], room=self.room)
 
     def record(self, scene, fluorescence: str, ev100: float | None = None, glare: str = "off",
                lamp: str = "none") -> dict:
@@ -621,7 +625,23 @@ def _sized(entry: dict) -> dict:
     return entry
 
 
-def swatch_pngs(ctx, presets, size=SWATCH_SIZE) -> dict[str, bytes]:
+def room_pack_script(room) -> tuple[str, dict]:
+    """The page's pack of ``room`` (a loaded catalog.room.model.Room): its transport (from the
+    cache, computed when absent) in web size (catalog.room.web_pack: the default error bound)
+    with what the page's host step needs of its bundle; (the file's text, a report: receivers,
+    bytes per part, the pack's measured errors)."""
+    from catalog.render.room_operators import bundle_path, room_operators  # noqa: PLC0415
+    from catalog.room import web_pack  # noqa: PLC0415
+    from catalog.room.cache import room_transport  # noqa: PLC0415
+
+    ops = room_operators(room)
+    web = web_pack.pack(room_transport(room))
+    text = web_pack.page_script(web, ops, bundle_path(room)[2])
+    return text, {"name": bundle_path(room)[2], "receivers": web.count, "bytes": web.nbytes(),
+                  "file_bytes": len(text), "errors": web.errors}
+
+
+def swatch_pngs(ctx, presets, size=SWATCH_SIZE, room="box") -> dict[str, bytes]:
     """A small desktop frame of each fabric under D65 with the close-up inset (the grid's
     swatches, catalog/web/facts.py) in the modes the page shows (:data:`DESKTOP_MODES`), PNG
     bytes by fabric name; one renderer for them all (its programs compiled once)."""
@@ -636,7 +656,7 @@ def swatch_pngs(ctx, presets, size=SWATCH_SIZE) -> dict[str, bytes]:
     swatches = {}
     try:
         configure_desktop_frame(renderer)
-        renderer.update(light="D65", camera=orbit(0.0, 0.0, 1.9))
+        renderer.update(light="D65", camera=orbit(0.0, 0.0, 1.9), room=room)
         for preset in presets:
             renderer.update(fabric=preset)
             renderer.render()  # auto exposure: metered afresh (no dt), nothing carried over

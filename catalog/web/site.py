@@ -35,9 +35,11 @@ import numpy as np
 from catalog.core.errors import CatalogError, InputError
 
 #: The page's own files (catalog/web/assets), copied as they are.
-ASSET_FILES = ("index.html", "app.js", "style.css")
+ASSET_FILES = ("index.html", "app.js", "room_transport.js", "style.css")
 #: A file every site has: marks a folder as ours (safe to replace).
 MARKER = "catalog-web-site.json"
+#: The room's transport pack (catalog.room.web_pack.PAGE_FILE).
+ROOM_PACK_FILE = "room_pack.js"
 FORMAT_VERSION = 2  # 2: data.js packed (pack_data)
 
 
@@ -256,9 +258,11 @@ def _return_large_blocks(threshold_bytes: int = 1 << 20) -> None:
 
 
 def build_site(out: str | Path, fabrics: str | None = None, lights: str | None = None,
-               ctx=None, progress: bool = False) -> dict:
+               ctx=None, progress: bool = False, room="box") -> dict:
     """Write the site into ``out``; returns a report (sizes, counts, seconds). ``progress``:
-    the bake's and the recording's progress on stderr (catalog.core.progress)."""
+    the bake's and the recording's progress on stderr (catalog.core.progress). ``room``: a
+    built-in name or a .glb path (``--room``): the scenes are drawn in it and its transport's
+    web pack is written (export.room_pack_script)."""
     import base64  # noqa: PLC0415
 
     from catalog.core.progress import progress as progress_bar  # noqa: PLC0415
@@ -275,6 +279,9 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
     choices = export.parse_lights(lights)
     out = _check_out(out)
     presets = [load_preset(find_preset(n)) for n in names]
+    from catalog.room.load import load_room  # noqa: PLC0415
+
+    room = load_room(room)   # a bad room is refused in one line before any work
     for preset in presets:  # refuse a bad preset before any work
         scene_lib.dye_transmittance(preset)
         scene_lib.fluorescent_material(preset)
@@ -311,8 +318,8 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             ctx = create_headless_context()
         # the swatches first, their renderer released before the recording's two are made
         swatches = {name: base64.b64encode(png).decode("ascii")
-                    for name, png in export.swatch_pngs(ctx, presets).items()}
-        exporter = export.SiteExporter(ctx)
+                    for name, png in export.swatch_pngs(ctx, presets, room=room).items()}
+        exporter = export.SiteExporter(ctx, room=room)
         try:
             positions, normals, tangents = bake_lib.decode_frame(first, 0)
             exporter.use_mesh(positions, normals, first.uv, tangents, first.indices)
@@ -372,6 +379,11 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
             "room_lamps": [{"id": k, "label": v} for k, v in export.ROOM_LAMPS.items()],
             "animations": {k: a.manifest() for k, a in animations.items()},
         }
+        t = time.perf_counter()
+        room_text, room_report = export.room_pack_script(room)
+        (stage / ROOM_PACK_FILE).write_text(room_text, encoding="utf-8")
+        data["room"] = {"name": room_report["name"], "pack": ROOM_PACK_FILE}
+        timings["room_pack_s"] = time.perf_counter() - t
         packed, plain_bytes = pack_data(data)
         (stage / "data.js").write_text(packed, encoding="utf-8")
         (stage / "anim").mkdir()
@@ -386,9 +398,10 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                   "shader_programs": len(objects["shaders"]),
                   "animations": {k: a.manifest() for k, a in animations.items()},
                   "bytes": sizes, "total_bytes": sum(sizes.values()),
-                  "first_view_bytes": sum(v for k, v in sizes.items() if not k.startswith("anim/"))
+                  "first_view_bytes": sum(v for k, v in sizes.items()   # (the room pack: after it)
+                                          if not k.startswith("anim/") and k != ROOM_PACK_FILE)
                   + max(a.stat().st_size for a in (stage / "anim").iterdir()),
-                  "data_js_plain_bytes": plain_bytes,
+                  "data_js_plain_bytes": plain_bytes, "room": room_report,
                   **{k: round(v, 3) for k, v in timings.items()}}
         new_files.extend([*sizes, MARKER])
         (stage / MARKER).write_text(json.dumps({"format": FORMAT_VERSION, "fabrics": names,

@@ -734,6 +734,25 @@
     if (actions[k]) { e.preventDefault(); actions[k](); }
   }
 
+  // ---------------------------------------------------------------- the room's transport pack
+  // room_pack.js (catalog/room/web_pack.py), read after the grid is up and checked
+  // (room_transport.js): a bad pack is refused in one line. The page does not apply it yet:
+  // it draws the room under the constant light (docs/web.md, "The room").
+  let roomPack = null;
+  function loadRoomPack() {
+    if (!D.room) return Promise.resolve(null);
+    if (!roomPack) {
+      roomPack = loadScript(D.room.pack)
+        .then(() => CatalogRoom.load(window.CATALOG_ROOM_PACK, D.room.pack))
+        .catch((e) => {
+          const line = e instanceof CatalogRoom.PackError ? e.message : D.room.pack + ': ' + (e.message || e);
+          stats.roomPackError = line; $('status').textContent = line; console.error(line);
+          return null;
+        });
+    }
+    return roomPack;
+  }
+
   // ---------------------------------------------------------------- test and benchmark hooks
   // window.catalogApp: the browser tests and the benchmark drive the page through these.
   window.catalogApp = {
@@ -751,6 +770,8 @@
       const a = await animation(id);
       return [a.positions[frame], a.normals[frame], a.tangents[frame]].map(b64);
     },
+    // the room's pack (null: none, or refused: stats.roomPackError says why)
+    roomPack: loadRoomPack,
     // resolves when the current state has been drawn (animations loaded)
     settle() {
       return new Promise((resolve) => {
@@ -787,6 +808,7 @@
     set(readHash());
     stats.unpackMs = unpackMs; stats.gridReadyMs = performance.now();
     requestAnimationFrame(frame);
+    loadRoomPack();
   } catch (e) { fail(e); }
   }
 })();
