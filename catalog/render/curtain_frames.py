@@ -45,7 +45,15 @@ def curtain_side_rect(placement=None) -> tuple[float, float, float, float]:
 def light_view_projection(to_light: np.ndarray, margin_m: float = 0.05, placement=None) -> np.ndarray:
     """Orthographic view-projection looking along the key light's travel (-to_light), framing
     the window opening and the curtain's space in front of it (what can cast a shadow): the
-    room's window and curtain (``placement``, catalog.render.placement; None: the box's)."""
+    room's window and curtain (``placement``, catalog.render.placement; None: the box's).
+    A frame asks for it some 80 times with one light and room (every shadow and bake pass):
+    the matrix is kept per (direction, margin, placement) and a copy returned."""
+    direction = tuple(float(v) for v in np.asarray(to_light, dtype=np.float64).ravel())
+    return _light_view_projection(direction, float(margin_m), placement).copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _light_view_projection(to_light: tuple, margin_m: float, placement) -> np.ndarray:
     to_light = np.asarray(to_light, dtype=np.float64)
     to_light = to_light / np.linalg.norm(to_light)
     forward = -to_light

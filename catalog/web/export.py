@@ -355,6 +355,8 @@ class SiteExporter:
         self.renderer = FrameRenderer(self.ctx, RECORD_SIZE, specialise=False)
         self.meter = FrameRenderer(real, METER_SIZE)  # not recorded: meters the exposure
         self.room = room
+        #: the display's measured whites by key (DisplayPass.measured_white)
+        self._whites: dict = {}
         for renderer in (self.renderer, self.meter):
             configure_desktop_frame(renderer)
             renderer.update(room=room)
@@ -441,9 +443,16 @@ class SiteExporter:
         rec = self.ctx.recording
         if not r.display.white_is_measured():
             # the display's white is measured from the HDR target the frame draws, which a dry
-            # recording leaves undrawn: a real frame first (not recorded) when its key changes
-            # (the light, the fabric, the fluorescence: a few per fabric), kept by the one recorded
-            r.render()
+            # recording leaves undrawn: a real frame first (not recorded) for each key (the
+            # light, the fabric, the fluorescence, the lamp: a few per fabric); the whites are
+            # kept by key, as the variants (the lamp changing fastest) come back to each
+            kept = self._whites.get(r.display.white_key())
+            if kept is not None:
+                r.display.keep_white(kept)
+            else:
+                r.render()
+                measured = r.display.measured_white()
+                self._whites[measured[0]] = measured
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
         rec.start(dry=True)  # only the commands are kept: no pixels drawn
         r.render()

@@ -82,6 +82,19 @@ class DisplayPass(Pass):
         the HDR target it draws, which a dry recording does not draw: catalog.web.export)."""
         return self._wb_cache is not None and self._wb_cache[0] == self._white_key()
 
+    def white_key(self) -> tuple:
+        """The key of the white the next frame uses (:meth:`_white_key`)."""
+        return self._white_key()
+
+    def measured_white(self) -> tuple | None:
+        """(key, matrix) of the white measured last, or None: what :meth:`keep_white` takes."""
+        return self._wb_cache
+
+    def keep_white(self, measured: tuple) -> None:
+        """Use a white measured before (:meth:`measured_white`) while its key holds: the web
+        export keeps each scene's, whose variants come back to a light and fabric it measured."""
+        self._wb_cache = measured
+
     def forget_white(self) -> None:
         """Measure the white again at the next frame, from its view (a still image adapts to
         its own view, as ``catalog snapshot`` does; the viewer keeps the white while orbiting)."""
