@@ -3,16 +3,8 @@
 // No network: data.js and anim/*.js are loaded by <script> tags (works from file://).
 'use strict';
 (function () {
-  function b64bytes(text) {
-    const s = atob(text);
-    const out = new Uint8Array(s.length);
-    for (let i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
-    return out;
-  }
-  async function inflate(bytes) {
-    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
-    return new Uint8Array(await new Response(stream).arrayBuffer());
-  }
+  // base64 -> bytes and deflate -> bytes: room_transport.js's (loaded before this file)
+  const { b64bytes, inflate } = window.CatalogRoom;
   // data.js (catalog/web/site.py pack_data): the JSON and the bulky bytes, each deflated;
   // {"binary": i} in the JSON names the i-th bytes (bin() below)
   const unpackStart = performance.now();

@@ -6,7 +6,8 @@
 //   bounced(direct) E = direct + F rho direct + B2 direct  a direct light's bounces
 //   corners(E)      the light map's welded corner values (exposed-area weights)
 //   gather(name, x) a CSR gather (the window's patches, the cloth's room-side and wall grids)
-// window.CatalogRoom.load(window.CATALOG_ROOM_PACK, file) -> Promise of the pack.
+// window.CatalogRoom.load(window.CATALOG_ROOM_PACK, file) -> Promise of the pack; its byte
+// helpers b64bytes and inflate serve app.js too.
 'use strict';
 (function () {
   const FORMAT = 'catalog-room-pack/1';
@@ -178,5 +179,5 @@
     }
   }
 
-  window.CatalogRoom = { load, PackError, FORMAT };
+  window.CatalogRoom = { load, PackError, FORMAT, b64bytes, inflate };
 })();
