@@ -61,14 +61,14 @@ class DisplayPass(Pass):
         The white is measured (a G-buffer draw) at the view of the first frame after the light,
         the fabric, the room's lamps or the size change, and kept while the camera moves (the web page replays
         camera-independent passes: catalog.web.export.check_camera_uniforms)."""
-        key = self._white_key()
+        key = self.white_key()
         if self._wb_cache is None or self._wb_cache[0] != key:
             self._wb_cache = (key, display_lib.white_balance_matrix(
                 adaptation_lib.visible_white_xyz(self.frame), self.frame.white_balance,
                 adaptation_lib.degree_of_adaptation()))
         return self._wb_cache[1]
 
-    def _white_key(self) -> tuple:
+    def white_key(self) -> tuple:
         """What the measured white depends on: the light and fabric (the shading inputs), the
         setting, the size, whether the room side is drawn and the room's lamps, which light
         what is seen (not the camera)."""
@@ -80,11 +80,7 @@ class DisplayPass(Pass):
     def white_is_measured(self) -> bool:
         """Whether the next frame keeps the white it has (False: it measures a new one from
         the HDR target it draws, which a dry recording does not draw: catalog.web.export)."""
-        return self._wb_cache is not None and self._wb_cache[0] == self._white_key()
-
-    def white_key(self) -> tuple:
-        """The key of the white the next frame uses (:meth:`_white_key`)."""
-        return self._white_key()
+        return self._wb_cache is not None and self._wb_cache[0] == self.white_key()
 
     def measured_white(self) -> tuple | None:
         """(key, matrix) of the white measured last, or None: what :meth:`keep_white` takes."""
