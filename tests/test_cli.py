@@ -107,6 +107,20 @@ def test_bad_input_with_json_is_one_json_object(tmp_path, capsys):
     assert len(captured.err.strip().splitlines()) == 1
 
 
+def test_a_lamp_outside_the_room_is_refused_naming_the_option(tmp_path, capsys):
+    """The lamp's position is checked against the loaded room's interior (a frame setting),
+    but the user typed --lamp: the one line names the option, exit 2, nothing written."""
+    from catalog.commands.cli import main
+
+    out = tmp_path / "x.png"
+    code = main(["snapshot", "--fabric", "voile-white", "--size", "32x18",
+                 "--lamp", "A@0.5,0.3,9", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1
+    assert "--lamp: room lamp position (0.5, 0.3, 9.0) must lie inside the room" in err[0]
+    assert not out.exists()
+
+
 def test_user_fabric_folder_is_searched_before_the_built_in_catalog(tmp_path, monkeypatch,
                                                                     fabric_dir):
     """--fabrics DIR (and $CATALOG_FABRICS): a name found there wins over the built-in one;

@@ -10,6 +10,8 @@ RESOURCES = ("fabrics",)
 INPUT_FILES = ("fabric", "environment", "room")
 OUTPUT_FILES = ("out",)
 HELP = "render a fabric under a light, headless through EGL, to EXR (linear) or PNG (sRGB)"
+#: The frame settings refused after the room is loaded, by the option that gave them.
+OPTION_OF_FIELD = {"lamps": "--lamp"}
 
 
 def add_arguments(parser) -> None:
@@ -80,7 +82,9 @@ def parse_lamp(text: str) -> tuple[str, tuple[float, float, float]]:
 def run(args) -> int:
     from pathlib import Path  # noqa: PLC0415
 
+    from catalog.core.errors import InputError  # noqa: PLC0415
     from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.render.settings import SettingsError  # noqa: PLC0415
     from catalog.render.snapshot import SnapshotRequest, parse_size, render_snapshot  # noqa: PLC0415
 
     from catalog.render.placement import room_placement  # noqa: PLC0415
@@ -99,7 +103,12 @@ def run(args) -> int:
         curtain_open=args.curtain == "open", room_light=not args.no_room_light,
         bloom=not args.no_bloom, lamps=tuple(parse_lamp(text) for text in args.lamp),
         room=args.room)
-    report = render_snapshot(request)
+    try:
+        report = render_snapshot(request)
+    except SettingsError as exc:
+        if exc.field not in OPTION_OF_FIELD:
+            raise
+        raise InputError(exc.problem, field=OPTION_OF_FIELD[exc.field]) from None
     if args.json:
         print_json(report)
     else:

@@ -151,11 +151,6 @@ class FrameTargets:
         self.oit_fbo = ctx.framebuffer([self.oit_accum, self.oit_weight], self.depth)
         self.oit_fbo.depth_mask = False  # the layers are tested against the room, not each other
 
-    @property
-    def key_texels(self) -> int:
-        """The key's front-layer maps' side: the shadow map's, at most KEY_FRONT_TEXELS."""
-        return min(self.shadow_texels, KEY_FRONT_TEXELS)
-
     def framebuffers(self) -> list:
         """Every framebuffer of these targets (to leave none of them bound when released)."""
         fbos = [self.hdr_fbo, self.ldr_fbo, self.oit_fbo, self.pre_fbo]
