@@ -145,9 +145,12 @@ def check_room(room: str) -> str:
 def draw_scenes(count: int, seed: int, room: str | None = None) -> list[dict]:
     """``count`` scenes drawn from the scene space with ``numpy.random.default_rng(seed)``;
     ``room`` None draws among ROOMS. Each: label, fabric, light, camera, room, curtain."""
+    from catalog.render.camera import room_limit_m  # noqa: PLC0415
+    from catalog.render.placement import placement_of_room  # noqa: PLC0415
     from catalog.render.scene import sun_at_hour  # noqa: PLC0415
-    from catalog.viewer.input import room_limit_m  # noqa: PLC0415
+    from catalog.room.load import load_room  # noqa: PLC0415
 
+    placements = {}
     rng = np.random.default_rng(seed)
     fabrics = catalog_fabrics()
     families = list(LIGHT_FAMILIES)
@@ -165,9 +168,17 @@ def draw_scenes(count: int, seed: int, room: str | None = None) -> list[dict]:
             light_label = light
         yaw = float(rng.uniform(*YAW_RANGE_DEG))
         pitch = float(rng.uniform(*PITCH_RANGE_DEG))
-        far = max(DISTANCE_MIN_M * 1.5, room_limit_m(yaw, pitch))
-        distance = float(math.exp(rng.uniform(math.log(DISTANCE_MIN_M), math.log(far))))
+        # the distance's variate is drawn before the room (the draws' order of old) and
+        # scaled by that room's own limit: the camera stays inside the room it is drawn in
+        share = rng.random()
         chosen_room = room or ROOMS[rng.integers(len(ROOMS))]
+        if chosen_room not in placements:
+            placements[chosen_room] = placement_of_room(load_room(chosen_room))
+        placement = placements[chosen_room]
+        far = max(DISTANCE_MIN_M * 1.5, room_limit_m(placement.curtain_middle, yaw, pitch,
+                                                     placement.interior))
+        lo, hi = math.log(DISTANCE_MIN_M), math.log(far)
+        distance = float(math.exp(lo + (hi - lo) * share))
         scenes.append({"label": f"{index:02d} {fabric}, {light_label}, yaw {yaw:.0f} pitch {pitch:.0f} "
                                 f"at {distance:.2f} m",
                        "fabric": fabric, "light": light, "light_family": family,

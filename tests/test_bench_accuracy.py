@@ -43,6 +43,26 @@ def test_draw_is_seeded_and_covers_the_space():
     assert {s["room"] for s in first} == set(BUILTIN_ROOMS)
 
 
+@pytest.mark.slow  # three rooms loaded
+def test_every_drawn_camera_is_inside_the_room_it_is_drawn_in():
+    """The distance's limit is the drawn room's own interior (the bedroom is 0.9 m shorter
+    than the box): the camera never stands behind a wall, in the tune or the report seed."""
+    from catalog.render.placement import placement_of_room
+    from catalog.render.settings import orbit
+    from catalog.room.load import load_room
+
+    placements = {name: placement_of_room(load_room(name)) for name in accuracy.ROOMS}
+    for seed in (accuracy.TUNE_SEED, accuracy.REPORT_SEED):
+        for scene in accuracy.draw_scenes(48, seed):
+            cam, placement = scene["camera"], placements[scene["room"]]
+            free = orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"], placement=placement)
+            kept = orbit(cam["yaw_deg"], cam["pitch_deg"], cam["distance_m"], placement=placement,
+                         inside=True)
+            assert np.allclose(free.position, kept.position, atol=1e-3), scene["label"]   # not clamped
+            for axis, (lo, hi) in enumerate(placement.interior):
+                assert lo < free.position[axis] < hi, scene["label"]
+
+
 def test_the_image_benchs_scenes_are_named_cases():
     from benchmarks import image
 
