@@ -76,7 +76,7 @@ def _bad_packs(text: str) -> dict:
         "damaged": (_rewrite(text, damaged),
                     "payload: its SHA-256 differs from the header's (the file is damaged)"),
         "format": (_rewrite(text, wrong_format),
-                   "header.format: \"catalog-room-pack/0\", expected \"catalog-room-pack/1\""),
+                   "header.format: \"catalog-room-pack/0\", expected \"catalog-room-pack/2\""),
         "index": (_rewrite(text, out_of_range),
                   f"arrays.gather_side_indices: a column {e + 7} >= {e} receivers"),
         "shape": (_rewrite(text, short_window), "arrays.window_right: shape"),

@@ -23,7 +23,7 @@ import numpy as np
 
 #: Bumped when the bundle's content or the rules that make it (the cloth's room-side grid over
 #: the room's own window, :func:`_room_side_grid`) change.
-BUNDLE_VERSION = 5
+BUNDLE_VERSION = 6
 #: Cosine-weighted rays from each receiver for its view of the outside (receivers outside
 #: the aperture: the reveals, a sill) and of the aperture from outside (the curtain's window side).
 OUTSIDE_RAYS = 64
@@ -64,7 +64,9 @@ class SurfaceData:
 class RoomOperators:
     """A room's runtime bundle. Receivers: ``corners`` (E, 3, 3), ``normal``, ``area_m2`` (exposed),
     ``albedo`` (E, 3), ``surface`` (E,) and ``uvs`` (E, 3, 2); ``vertex`` (3 E,) the welded
-    light-map vertex of each corner (catalog.room.lightmap's weld) and its weights."""
+    light-map vertex of each corner (catalog.room.lightmap's weld, weighed by ``area_m2``);
+    ``hang_vertex`` (H,) the hanging vertices and ``hanging`` (H, V) their values from the
+    free ones (catalog.room.lightmap.hanging_vertices)."""
 
     name: str
     content_sha256: str
@@ -81,6 +83,8 @@ class RoomOperators:
     surface: np.ndarray
     uvs: np.ndarray
     vertex: np.ndarray
+    hang_vertex: np.ndarray
+    hanging: Csr
     window_basis: np.ndarray
     window_modes: np.ndarray
     form_factors: Csr
@@ -122,14 +126,13 @@ class RoomOperators:
 
     def corner_irradiance(self, irradiance: np.ndarray) -> np.ndarray:
         """(E, 3, 3) the light map at each receiver's corners (area-weighted over the welded
-        vertex, as catalog.room.lightmap.corner_irradiance)."""
-        weight = np.repeat(self.area_m2, 3)
-        count = int(self.vertex.max()) + 1
-        values = weight[:, None] * np.repeat(irradiance, 3, axis=0)
-        total = np.stack([np.bincount(self.vertex, weights=values[:, c], minlength=count)
-                          for c in range(3)], axis=1)
-        norm = np.bincount(self.vertex, weights=weight, minlength=count)
-        return (total / norm[:, None])[self.vertex].reshape(self.count, 3, 3)
+        vertex, hanging vertices from their edges: catalog.room.lightmap.corner_irradiance)."""
+        from catalog.room.lightmap import weld_values  # noqa: PLC0415  (numpy only)
+
+        h = self.hanging
+        corner = weld_values(self.vertex, self.area_m2, np.asarray(irradiance, dtype=np.float64),
+                             (self.hang_vertex, h.indptr, h.indices, h.data))
+        return corner.reshape(self.count, 3, 3)
 
 
 # --------------------------------------------------------------------------- building
@@ -219,10 +222,13 @@ def receiver_uvs(room, transport) -> tuple[np.ndarray, np.ndarray]:
     return surface, uvs
 
 
-def _weld(transport) -> np.ndarray:
-    from catalog.room.lightmap import weld_vertices  # noqa: PLC0415
+def _weld(transport) -> tuple:
+    """(vertex, hang_vertex, hanging Csr) of the transport's light map."""
+    from catalog.room.lightmap import hanging_vertices, weld_vertices  # noqa: PLC0415
 
-    return weld_vertices(transport.receivers)
+    vertex = weld_vertices(transport.receivers)
+    hang, indptr, indices, data = hanging_vertices(transport.receivers, vertex)
+    return vertex, hang, Csr(data, indices, indptr, (hang.size, int(vertex.max()) + 1))
 
 
 def side_grid(placement=None) -> tuple:
@@ -274,6 +280,7 @@ def build(room) -> RoomOperators:
     surface, uvs = receiver_uvs(room, t)
     f = t.form_factors.tocsr()
     outside_frame, outside, window_back = outside_operators(t, caster, room.window, rng)
+    vertex, hang_vertex, hanging = _weld(t)
     return RoomOperators(
         name=room.name, content_sha256=room.content_sha256,
         surfaces=tuple(SurfaceData(s_.name, np.asarray(s_.factor, dtype=np.float64), s_.texture)
@@ -281,7 +288,8 @@ def build(room) -> RoomOperators:
         window_corners=room.window.corners, window_normal=room.window.normal, frame=t.frame,
         patches=tuple(t.params.patches), order=int(t.params.order),
         corners=t.receivers.corners, normal=t.receivers.normal, area_m2=t.receivers.weld_weight_m2,
-        albedo=t.receivers.albedo, surface=surface, uvs=uvs, vertex=_weld(t),
+        albedo=t.receivers.albedo, surface=surface, uvs=uvs, vertex=vertex,
+        hang_vertex=hang_vertex, hanging=hanging,
         window_basis=t.window_basis, window_modes=t.window_modes,
         form_factors=Csr(f.data.astype(np.float64), f.indices.astype(np.int64),
                          f.indptr.astype(np.int64), f.shape),
@@ -328,10 +336,10 @@ def bundle_path(spec) -> tuple[Path, str, str]:
 def save(bundle: RoomOperators, path: Path, key: str) -> None:
     arrays = {}
     for name in ("window_corners", "window_normal", "frame", "corners", "normal", "area_m2", "albedo",
-                 "surface", "uvs", "vertex", "window_basis", "window_modes", "bounce_left",
+                 "surface", "uvs", "vertex", "hang_vertex", "window_basis", "window_modes", "bounce_left",
                  "bounce_right", "bounds", "triangles", "outside_frame", "outside", "window_back"):
         arrays[name] = getattr(bundle, name)
-    for name in ("form_factors", "gather_patch", "gather_side", "gather_wall"):
+    for name in ("form_factors", "gather_patch", "gather_side", "gather_wall", "hanging"):
         m = getattr(bundle, name)
         arrays.update({f"{name}_data": m.data, f"{name}_indices": m.indices, f"{name}_indptr": m.indptr,
                        f"{name}_shape": np.asarray(m.shape)})
@@ -366,13 +374,15 @@ def load(path: Path, key: str) -> RoomOperators | None:
     surfaces = tuple(SurfaceData(name, arrays[f"surface{k}_factor"], arrays.get(f"surface{k}_texture"))
                      for k, name in enumerate(meta["surfaces"]))
     plain = {name: arrays[name] for name in ("window_corners", "window_normal", "frame", "corners", "normal",
-                                             "area_m2", "albedo", "surface", "uvs", "vertex", "window_basis",
+                                             "area_m2", "albedo", "surface", "uvs", "vertex", "hang_vertex",
+                                             "window_basis",
                                              "window_modes", "bounce_left", "bounce_right", "bounds",
                                              "triangles", "outside_frame", "outside", "window_back")}
     return RoomOperators(name=meta["name"], content_sha256=meta["content_sha256"], surfaces=surfaces,
                          patches=tuple(meta["patches"]), order=int(meta["order"]),
                          form_factors=csr("form_factors"), gather_patch=csr("gather_patch"),
-                         gather_side=csr("gather_side"), gather_wall=csr("gather_wall"), side_grid=tuple(meta["side_grid"]), **plain)
+                         gather_side=csr("gather_side"), gather_wall=csr("gather_wall"), hanging=csr("hanging"),
+                         side_grid=tuple(meta["side_grid"]), **plain)
 
 
 def room_operators(spec) -> RoomOperators:

@@ -184,17 +184,18 @@ def _bounced_iterative(transport, direct: np.ndarray, tolerance: float = 1e-10) 
 
 #: The page's pack file: ``window.CATALOG_ROOM_PACK = {"header": {...}, "payload": B}`` where B
 #: is base64 of zlib of the arrays laid end to end (each at an 8-byte boundary, little-endian).
-PAGE_FORMAT = "catalog-room-pack/1"
+PAGE_FORMAT = "catalog-room-pack/2"
 #: The page's pack file name in a site.
 PAGE_FILE = "room_pack.js"
-_PAGE_DTYPES = ("float16", "float32", "uint8", "uint16", "uint32", "int32")
+_PAGE_DTYPES = ("float16", "float32", "float64", "uint8", "uint16", "uint32", "int32")
 
 
 def page_arrays(web: WebPack, ops) -> dict:
     """What the page's host step needs of a room (ops: its
     :class:`catalog.render.room_operators.RoomOperators`, from the same transport as ``web``):
     the pack's operators; the light map's weld (each receiver corner's vertex, the receivers'
-    exposed areas); the gathers onto the window's patches, the cloth's room-side grid and the
+    exposed areas, the hanging vertices and their free vertices' weights in float64: CSR
+    ``hang``); the gathers onto the window's patches, the cloth's room-side grid and the
     wall's grid (CSR, float32); the outside's operator on the receivers outside the aperture
     and the closed curtain's window side."""
     if ops.count != web.count or not np.array_equal(np.asarray(ops.albedo, np.float32), web.albedo):
@@ -202,6 +203,10 @@ def page_arrays(web: WebPack, ops) -> dict:
     out = dict(web.arrays())
     out["vertex"] = np.asarray(ops.vertex, dtype=np.int32)
     out["weld_weight_m2"] = np.asarray(ops.area_m2, dtype=np.float32)
+    out["hang_vertex"] = np.asarray(ops.hang_vertex, dtype=np.uint32)
+    out["hang_data"] = np.asarray(ops.hanging.data, dtype=np.float64)
+    out["hang_indices"] = np.asarray(ops.hanging.indices, dtype=np.uint32)
+    out["hang_indptr"] = np.asarray(ops.hanging.indptr, dtype=np.uint32)
     small = np.uint16 if ops.count <= 65535 else np.uint32
     for name in ("gather_patch", "gather_side", "gather_wall"):
         m = getattr(ops, name)
@@ -297,7 +302,7 @@ def _check_arrays(header: dict, a: dict, refuse) -> None:
     """The pack's shapes agree with each other and its indices stay in range."""
     need = ("window_left", "window_right", "albedo", "f_counts", "f_indices", "f_indptr",
             "bounce_left", "bounce_right", "bounce_scale", "vertex", "weld_weight_m2",
-            "gather_patch_data", "gather_patch_indices", "gather_patch_indptr", "gather_side_data",
+            "hang_vertex", "hang_data", "hang_indices", "hang_indptr", "gather_patch_data", "gather_patch_indices", "gather_patch_indptr", "gather_side_data",
             "gather_side_indices", "gather_side_indptr", "gather_wall_data", "gather_wall_indices",
             "gather_wall_indptr", "outside", "outside_frame", "window_back")
     for name in need:
@@ -331,7 +336,15 @@ def _check_arrays(header: dict, a: dict, refuse) -> None:
             refuse(f"arrays.{prefix}_indices", f"a column {int(idx.max())} >= {e} receivers")
     if a["vertex"].size and (int(a["vertex"].min()) < 0 or int(a["vertex"].max()) >= 3 * e):
         refuse("arrays.vertex", "a light-map vertex out of range")
+    vertices = int(a["vertex"].max()) + 1 if a["vertex"].size else 0
+    hang, ptr = a["hang_vertex"], a["hang_indptr"]
+    if ptr.shape != (hang.size + 1,) or ptr[0] != 0 or np.any(np.diff(ptr.astype(np.int64)) < 0) \
+            or ptr[-1] != a["hang_indices"].size or a["hang_data"].size != a["hang_indices"].size:
+        refuse("arrays.hang_indptr", "not a CSR row index of its entries")
+    for name in ("hang_vertex", "hang_indices"):
+        if a[name].size and int(a[name].max()) >= vertices:
+            refuse(f"arrays.{name}", f"a vertex {int(a[name].max())} >= {vertices} light-map vertices")
     for name in ("window_left", "window_right", "bounce_left", "bounce_right", "bounce_scale",
-                 "albedo", "outside", "window_back", "weld_weight_m2"):
+                 "albedo", "outside", "window_back", "weld_weight_m2", "hang_data"):
         if not np.all(np.isfinite(a[name])):
             refuse(f"arrays.{name}", "a value is not finite")

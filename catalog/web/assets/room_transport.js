@@ -10,12 +10,12 @@
 // helpers b64bytes and inflate serve app.js too.
 'use strict';
 (function () {
-  const FORMAT = 'catalog-room-pack/1';
-  const DTYPES = { float16: [2, Uint16Array], float32: [4, Float32Array], uint8: [1, Uint8Array],
+  const FORMAT = 'catalog-room-pack/2';
+  const DTYPES = { float16: [2, Uint16Array], float32: [4, Float32Array], float64: [8, Float64Array], uint8: [1, Uint8Array],
                    uint16: [2, Uint16Array], uint32: [4, Uint32Array], int32: [4, Int32Array] };
   const NEED = ['window_left', 'window_right', 'albedo', 'f_counts', 'f_indices', 'f_indptr',
                 'bounce_left', 'bounce_right', 'bounce_scale', 'vertex', 'weld_weight_m2',
-                'gather_patch_data', 'gather_patch_indices', 'gather_patch_indptr', 'gather_side_data',
+                'hang_vertex', 'hang_data', 'hang_indices', 'hang_indptr', 'gather_patch_data', 'gather_patch_indices', 'gather_patch_indptr', 'gather_side_data',
                 'gather_side_indices', 'gather_side_indptr', 'gather_wall_data', 'gather_wall_indices',
                 'gather_wall_indptr', 'outside', 'outside_frame', 'window_back'];
 
@@ -85,7 +85,20 @@
       if (top >= E) refuse('arrays.' + prefix + '_indices', 'a column ' + top + ' >= ' + E + ' receivers');
     }
     for (let i = 0; i < a.vertex.length; i++) if (a.vertex[i] < 0 || a.vertex[i] >= 3 * E) refuse('arrays.vertex', 'a light-map vertex out of range');
-    for (const name of ['window_left', 'window_right', 'bounce_left', 'bounce_right', 'bounce_scale', 'albedo', 'outside', 'window_back', 'weld_weight_m2']) {
+    let vertices = 0;
+    for (let i = 0; i < a.vertex.length; i++) if (a.vertex[i] + 1 > vertices) vertices = a.vertex[i] + 1;
+    {
+      const ptr = a.hang_indptr, H = a.hang_vertex.length;
+      let ok = ptr.length === H + 1 && ptr[0] === 0 && ptr[H] === a.hang_indices.length && a.hang_data.length === a.hang_indices.length;
+      for (let i = 0; ok && i < H; i++) ok = ptr[i + 1] >= ptr[i];
+      if (!ok) refuse('arrays.hang_indptr', 'not a CSR row index of its entries');
+      for (const name of ['hang_vertex', 'hang_indices']) {
+        let top = -1;
+        for (let i = 0; i < a[name].length; i++) if (a[name][i] > top) top = a[name][i];
+        if (top >= vertices) refuse('arrays.' + name, 'a vertex ' + top + ' >= ' + vertices + ' light-map vertices');
+      }
+    }
+    for (const name of ['window_left', 'window_right', 'bounce_left', 'bounce_right', 'bounce_scale', 'albedo', 'outside', 'window_back', 'weld_weight_m2', 'hang_data']) {
       const v = a[name];
       for (let i = 0; i < v.length; i++) if (!Number.isFinite(v[i])) refuse('arrays.' + name, 'a value is not finite');
     }
@@ -159,10 +172,18 @@
         total[3 * v] += w * irradiance[3 * e]; total[3 * v + 1] += w * irradiance[3 * e + 1]; total[3 * v + 2] += w * irradiance[3 * e + 2];
         norm[v] += w;
       }
+      const value = new Float64Array(V * 3);
+      for (let v = 0; v < V; v++) for (let ch = 0; ch < 3; ch++) value[3 * v + ch] = total[3 * v + ch] / norm[v];
+      // a hanging vertex takes its coarser neighbour's edge there (from free vertices only)
+      const hung = this.gather('hang', value);
+      for (let i = 0; i < a.hang_vertex.length; i++) {
+        const v = a.hang_vertex[i];
+        for (let ch = 0; ch < 3; ch++) value[3 * v + ch] = hung[3 * i + ch];
+      }
       const out = new Float64Array(E * 9);
       for (let q = 0; q < 3 * E; q++) {
         const v = a.vertex[q];
-        for (let ch = 0; ch < 3; ch++) out[3 * q + ch] = total[3 * v + ch] / norm[v];
+        for (let ch = 0; ch < 3; ch++) out[3 * q + ch] = value[3 * v + ch];
       }
       return out;
     }
