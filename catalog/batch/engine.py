@@ -107,6 +107,9 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
         failed: dict[str, str] = {}
         timings = {"settle_s": 0.0, "simulate_s": 0.0, "render_s": 0.0, "write_s": 0.0,
                    "task_cpu_s": 0.0}
+        #: per task, summed for the job and for each worker process: its wall and CPU, and
+        #: its thread's time on a CPU, waiting for one (run_wait) and asleep (worker.py)
+        per_task = ("wall_s", "cpu_s", "thread_cpu_s", "run_wait_s", "sleep_s")
         seen: dict[str, int] = {}
         processes: dict[int, dict] = {}
         lock = threading.Lock()
@@ -132,7 +135,12 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
                     counts[record.get("status", "rendered")] += 1
                     timings["render_s"] += record.get("render_s", 0.0)
                 if "worker" in result:
-                    processes[result["worker"]["pid"]] = result["worker"]
+                    pid = result["worker"]["pid"]
+                    tasks = processes.get(pid, {}).get("tasks", {k: 0.0 for k in per_task})
+                    for key in per_task:
+                        tasks[key] = round(tasks[key] + result.get(key, 0.0), 4)
+                    tasks["count"] = tasks.get("count", 0) + 1
+                    processes[pid] = {**result["worker"], "tasks": tasks}
                 for key in ("settle_s", "simulate_s", "write_s"):
                     timings[key] += result.get(key, 0.0)
                 timings["task_cpu_s"] += result.get("cpu_s", 0.0)
