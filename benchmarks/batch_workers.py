@@ -15,6 +15,15 @@ The split comes from the job's summary: per phase, the seconds summed over the t
 draw + read-back; write = encode + write) and the workers' start; ``busy`` = the tasks' seconds / (workers x
 wall), how much of the workers' time went into tasks.
 
+Where a task's wall time went, from the kernel (/proc/thread-self/schedstat of the task's
+thread, catalog.batch.worker): on a CPU, runnable but waiting for a core (``run_wait``: the
+cores were busy, with the other worker or other jobs) and asleep (a lock, llvmpipe's own
+threads, I/O). Per run, the load before it and the CPU seconds the rest of the machine used
+meanwhile (/proc/stat less the job's own: ``others_cpu_s``; ``free_cores`` = cores - that /
+wall); per worker, its tasks' CPU. From each one-worker run, ``bound_2_over_1``: the most two
+workers could gain on free cores with the same tasks dealt whole (the best deal's longer
+worker, every second outside the tasks unchanged).
+
     .venv/bin/python -m benchmarks.batch_workers [--rounds 2] [--out F.json]
 """
 
