@@ -360,6 +360,39 @@ def test_cost_model_by_hand():
 
 
 @needs_dask
+def test_task_thread_split_into_cpu_run_wait_and_sleep():
+    """A task's thread time, from the kernel's schedstat: a busy loop is on a CPU or waiting
+    for one, a sleep is asleep; the three add up to the wall time."""
+    import catalog.batch.worker as worker
+
+    if worker.thread_sched() is None:
+        pytest.skip("no /proc/thread-self/schedstat here")
+    before, start = worker.thread_sched(), time.perf_counter()
+    while time.perf_counter() - start < 0.2:
+        pass
+    busy = worker._sched_split(before, time.perf_counter() - start)
+    assert busy["thread_cpu_s"] + busy["run_wait_s"] == pytest.approx(0.2, abs=0.03)
+    assert busy["sleep_s"] < 0.03
+    before, start = worker.thread_sched(), time.perf_counter()
+    time.sleep(0.2)
+    asleep = worker._sched_split(before, time.perf_counter() - start)
+    assert asleep["sleep_s"] == pytest.approx(0.2, abs=0.03)
+    assert asleep["thread_cpu_s"] < 0.03
+
+
+def test_two_worker_bound_by_hand():
+    """The best whole-task deal, tried by hand: tasks 6, 3, 3, 3 s on two workers: 6 | 3+3+3
+    is 9, 6+3 | 3+3 is 9, so 9; with 1 s outside the tasks (wall 16) the bound is 16/10."""
+    from benchmarks.batch_workers import best_makespan, two_worker_bound
+
+    assert best_makespan([6, 3, 3, 3]) == 9
+    assert best_makespan([5, 4, 3, 3, 3]) == 9    # 5+4 | 3+3+3
+    assert best_makespan([1.0] * 20) == 10        # the greedy path (more than 12 tasks)
+    run = {"wall_s": 16.0, "tasks": [{"wall_s": w} for w in (6, 3, 3, 3)]}
+    assert two_worker_bound(run) == pytest.approx(1.6)
+    assert two_worker_bound({"wall_s": 1.0}) is None
+
+
 def test_worker_plugin_threads_and_device(monkeypatch):
     """Per worker: LP_NUM_THREADS = cores / workers on the host (unless set or forced), and
     the EGL device = the worker's rank on its host modulo the devices there."""

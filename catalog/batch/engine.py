@@ -87,7 +87,10 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
 
     Summary keys: ``images`` (in the job), ``rendered``, ``kept`` (found on disk from a run
     whose record was lost), ``skipped`` (done before), ``failed`` ({fabric: error}),
-    ``wall_s``, ``images_per_s`` (rendered / wall), ``engine``, ``workers``, ``manifest``."""
+    ``wall_s``, ``images_per_s`` (rendered / wall), ``engine``, ``workers``, ``manifest``;
+    ``processes`` (each worker: its context, and its tasks' seconds summed) and ``tasks``
+    (each task in the order it finished: fabric, worker pid, wall, CPU, its thread's time on
+    a CPU, waiting for one and asleep)."""
     check_engine(workers, scheduler)
     if retries < 0:
         raise InputError(f"{retries} must be >= 0", field="--retries")
@@ -107,8 +110,12 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
         failed: dict[str, str] = {}
         timings = {"settle_s": 0.0, "simulate_s": 0.0, "render_s": 0.0, "write_s": 0.0,
                    "task_cpu_s": 0.0}
+        #: per task, summed for the job and for each worker process: its wall and CPU, and
+        #: its thread's time on a CPU, waiting for one (run_wait) and asleep (worker.py)
+        per_task = ("wall_s", "cpu_s", "thread_cpu_s", "run_wait_s", "sleep_s")
         seen: dict[str, int] = {}
         processes: dict[int, dict] = {}
+        task_times: list[dict] = []
         lock = threading.Lock()
         last_write = [time.perf_counter()]
         use_dask = workers is not None or scheduler is not None
@@ -132,7 +139,14 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
                     counts[record.get("status", "rendered")] += 1
                     timings["render_s"] += record.get("render_s", 0.0)
                 if "worker" in result:
-                    processes[result["worker"]["pid"]] = result["worker"]
+                    pid = result["worker"]["pid"]
+                    tasks = processes.get(pid, {}).get("tasks", {k: 0.0 for k in per_task})
+                    for key in per_task:
+                        tasks[key] = round(tasks[key] + result.get(key, 0.0), 4)
+                    tasks["count"] = tasks.get("count", 0) + 1
+                    processes[pid] = {**result["worker"], "tasks": tasks}
+                    task_times.append({"fabric": task.fabric, "pid": pid, "images": len(records),
+                                       **{k: result[k] for k in per_task if k in result}})
                 for key in ("settle_s", "simulate_s", "write_s"):
                     timings[key] += result.get(key, 0.0)
                 timings["task_cpu_s"] += result.get("cpu_s", 0.0)
@@ -165,6 +179,7 @@ def render_catalog(spec: JobSpec, *, workers: int | None = None, scheduler: str 
                    "images_per_s": round(counts["rendered"] / wall_s, 3) if wall_s > 0 else None,
                    **{k: round(v, 3) for k, v in timings.items()}, **engine,
                    "processes": [processes[pid] for pid in sorted(processes)],
+                   "tasks": task_times,
                    "manifest": str(Path(spec.out_dir) / "manifest.json")}
         manifest.write(spec.describe(), summary)
     finally:

@@ -154,6 +154,28 @@ def existing_key(path: Path) -> str | None:
         return None
 
 
+def thread_sched() -> tuple[float, float] | None:
+    """The calling thread's (seconds on a CPU, seconds runnable but waiting for one) since it
+    started, from the kernel's /proc/thread-self/schedstat; None where there is none. Over a
+    task, its wall time less these two is the time the thread slept (a lock, llvmpipe's
+    threads, I/O): the wait that is not the cores being busy."""
+    try:
+        with open("/proc/thread-self/schedstat") as handle:
+            on_cpu_ns, waiting_ns = handle.read().split()[:2]
+    except (OSError, ValueError):
+        return None
+    return int(on_cpu_ns) * 1e-9, int(waiting_ns) * 1e-9
+
+
+def _sched_split(before, wall_s: float) -> dict:
+    after = thread_sched()
+    if before is None or after is None:
+        return {}
+    thread_cpu, run_wait = after[0] - before[0], after[1] - before[1]
+    return {"thread_cpu_s": round(thread_cpu, 4), "run_wait_s": round(run_wait, 4),
+            "sleep_s": round(max(wall_s - thread_cpu - run_wait, 0.0), 4)}
+
+
 def _record(image, status: str, digest: str, size: int, render_s: float) -> dict:
     return {"path": image.path, "fabric": image.fabric, "light": image.light,
             "frame": image.frame, "yaw_deg": image.yaw_deg, "key": image.key,
@@ -167,6 +189,7 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
     (bad preset, non-finite render) returns ``ok: False`` with the error; anything else
     is raised (an engine may retry it)."""
     start, cpu_start = time.perf_counter(), time.process_time()
+    sched_start = thread_sched()
     pool = pool or process_pool()
     out_dir = Path(task.out_dir)
     records: list[dict] = []
@@ -191,10 +214,13 @@ def render_fabric(task, pool: RendererPool | None = None, on_image=None) -> dict
         return {"fabric": task.fabric, "ok": False, "error": str(exc), "records": records,
                 "wall_s": round(time.perf_counter() - start, 4), **timings,
                 "worker": pool.describe()}
+    wall_s = time.perf_counter() - start
     return {"fabric": task.fabric, "ok": True, "error": None, "records": records,
-            "wall_s": round(time.perf_counter() - start, 4),
+            "wall_s": round(wall_s, 4),
             # CPU seconds of this process in the task, llvmpipe's and numba's threads included
             "cpu_s": round(time.process_time() - cpu_start, 4),
+            # the task's thread: on a CPU, runnable but waiting for one, asleep
+            **_sched_split(sched_start, wall_s),
             **{k: round(v, 4) for k, v in timings.items()}, "worker": pool.describe()}
 
 

@@ -28,14 +28,13 @@ import dataclasses
 import hashlib
 import io
 import json
-import os
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
-#: Environment variable: the cache folder (``off`` or empty: no disk cache).
-CACHE_ENV = "CATALOG_CACHE_DIR"
+from catalog.core.resources import CACHE_ENV, cache_folder  # noqa: F401 (CACHE_ENV: the tests')
+
 #: Bumped when the file's layout changes.
 FORMAT = 1
 #: The modules whose code decides the settled state: the numpy backend's whole path and
@@ -59,12 +58,7 @@ def windless(params):
 
 def cache_dir() -> Path | None:
     """The drape cache folder, or None when the cache is off."""
-    value = os.environ.get(CACHE_ENV)
-    if value is not None:
-        return None if value.strip() in ("", "off") else Path(value) / "drape"
-    from platformdirs import user_cache_dir  # noqa: PLC0415
-
-    return Path(user_cache_dir("fabric-catalog", appauthor=False)) / "drape"
+    return cache_folder("drape")
 
 
 _SOLVER_HASH: str | None = None

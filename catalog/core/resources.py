@@ -25,6 +25,10 @@ DATA_ENV = "CATALOG_DATA"
 #: Environment variable: the user's fabric folders, searched before the built-in catalog.
 FABRICS_ENV = "CATALOG_FABRICS"
 
+#: Environment variable: the folder of the computed results kept between processes (the
+#: settled drapes, the patterns' mip chains); ``off`` or empty: none kept.
+CACHE_ENV = "CATALOG_CACHE_DIR"
+
 _PACKAGE_DIR = Path(__file__).resolve().parent.parent
 #: The checkout's root (meaningful only in a checkout, see :data:`IN_CHECKOUT`).
 PROJECT_ROOT = _PACKAGE_DIR.parent
@@ -113,3 +117,15 @@ def data_dir(subfolder: str = "") -> Path:
         raise InputError(reason, field="--data")
     folder = data_dir_candidate()
     return folder / subfolder if subfolder else folder
+
+
+def cache_folder(kind: str) -> Path | None:
+    """The folder that keeps one ``kind`` of computed result (``drape``, ``mips``): under
+    ``$CATALOG_CACHE_DIR``, else the user's cache folder (platformdirs, ``fabric-catalog``);
+    None when the cache is off."""
+    value = os.environ.get(CACHE_ENV)
+    if value is not None:
+        return None if value.strip() in ("", "off") else Path(value) / kind
+    from platformdirs import user_cache_dir  # noqa: PLC0415
+
+    return Path(user_cache_dir("fabric-catalog", appauthor=False)) / kind

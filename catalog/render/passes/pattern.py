@@ -85,10 +85,11 @@ class PatternTexture(Pass):
         texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
         texture.build_mipmaps()   # allocates the levels; their texels are the prefiltered chain
         if self.prefilter:
-            from catalog.presets.patterns import mip_chain  # noqa: PLC0415
+            from catalog.presets.mip_cache import cached_mip_chain  # noqa: PLC0415
 
             source = texels if periodic_v else np.concatenate([texels, texels[::-1]])
-            for level, image in enumerate(mip_chain(source)[1:], start=1):
+            # mip_chain's levels, from the disk cache when this texture was filtered before
+            for level, image in enumerate(cached_mip_chain(source)[1:], start=1):
                 rows = max(1, h >> level)
                 image = image if periodic_v else image[:rows]
                 if image.shape[:2] != (rows, max(1, w >> level)):
