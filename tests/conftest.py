@@ -135,13 +135,15 @@ def gl_context():
 
 
 def _share_gl_context(item) -> None:
-    """Make the shared context current again for a test that uses it. A command a test runs in
-    this process (``main(["snapshot", ..])``, ``render_sheet``, ``build_site`` without
-    ``ctx=``) creates its own EGL context, which becomes the thread's current one and stays
-    so (released or not): the shared context's calls then went to that one, and objects made
-    earlier in the shared context (a module fixture's renderer) gave GL_INVALID_OPERATION.
-    Serially a module's tests ran together, so it showed only when pytest-xdist interleaved
-    modules in one worker."""
+    """Make the shared context current again for a test that uses it. A context made in this
+    process becomes the thread's current one and stays so (released or not): the shared
+    context's calls then go to it, and objects made earlier in the shared context (a module
+    fixture's renderer) give GL_INVALID_OPERATION. The commands (``main(["snapshot", ..])``,
+    ``render_sheet``, ``build_site``, ``egl_frame``, ``catalog bench`` without ``ctx=``) make
+    theirs through catalog.gl.context.headless_context, which makes the caller's current again
+    (tests/test_gl_context.py); this stays for what does not yet: the benchmarks' functions
+    called without ``ctx`` (``ctx or create_headless_context()``) and the cloth's GpuBackend
+    without ``ctx``, whose contexts stay current after a test that calls them."""
     if _SHARED_GL and "gl_context" in getattr(item, "fixturenames", ()):
         _SHARED_GL[0].__enter__()   # eglMakeCurrent (moderngl: no matching exit needed)
 
