@@ -141,9 +141,10 @@ def _share_gl_context(item) -> None:
     fixture's renderer) give GL_INVALID_OPERATION. The commands (``main(["snapshot", ..])``,
     ``render_sheet``, ``build_site``, ``egl_frame``, ``catalog bench`` without ``ctx=``) make
     theirs through catalog.gl.context.headless_context, which makes the caller's current again
-    (tests/test_gl_context.py); this stays for what does not yet: the benchmarks' functions
-    called without ``ctx`` (``ctx or create_headless_context()``) and the cloth's GpuBackend
-    without ``ctx``, whose contexts stay current after a test that calls them."""
+    (tests/test_gl_context.py), as do the benchmarks' ``run(ctx=None)`` functions
+    (own_context_unless_given); this stays for what does not yet: the cloth's GpuBackend and
+    benchmarks.springs12 without ``ctx``, benchmarks.room, benchmarks.results' sections and
+    the web benchmark's frames, whose contexts live as long as an object or a section."""
     if _SHARED_GL and "gl_context" in getattr(item, "fixturenames", ()):
         _SHARED_GL[0].__enter__()   # eglMakeCurrent (moderngl: no matching exit needed)
 

@@ -85,3 +85,14 @@ def test_a_given_context_is_used_and_kept(gl):
     with headless_context(gl) as same:
         assert same is gl
     assert gl.error == "GL_NO_ERROR"    # not released: it still answers
+
+
+def _benchmark_run(tmp_path):
+    from benchmarks import alpha_to_coverage
+
+    alpha_to_coverage.run()   # a benchmark's function without ctx (its own, as the others)
+
+
+@pytest.mark.slow   # the benchmark's renders
+def test_a_benchmark_without_ctx_leaves_the_callers_context_current(gl, tmp_path):
+    _assert_caller_current(gl, _benchmark_run, tmp_path)

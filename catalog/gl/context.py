@@ -4,6 +4,7 @@
   a GPU's EGL where there is one);
 - :func:`headless_context`: the caller's context, or one of its own made for a ``with`` block
   and released after it, the thread's current context before it current again;
+  :func:`own_context_unless_given`, the same around a function's call (its ``ctx`` argument);
 - :func:`wrap_window_context`: the context of a window the caller made current (glfw).
 
 Both require OpenGL 4.3 (compute shaders, std430). Failures are one-line EnvironmentFailures (exit 3).
@@ -11,6 +12,8 @@ Both require OpenGL 4.3 (compute shaders, std430). Failures are one-line Environ
 
 from __future__ import annotations
 
+import functools
+import inspect
 from contextlib import contextmanager
 
 from catalog.core.errors import EnvironmentFailure
@@ -58,6 +61,21 @@ def headless_context(ctx=None, device_index: int | None = None):
         own.release()
         if egl is not None:
             _make_current(egl, before, own_display)
+
+
+def own_context_unless_given(function):
+    """``function`` (which takes a ``ctx`` argument) called in :func:`headless_context`: with
+    the ``ctx`` it was given, or with one of its own for the call, released after it."""
+    signature = inspect.signature(function)
+
+    @functools.wraps(function)
+    def call(*args, **kwargs):
+        bound = signature.bind(*args, **kwargs)
+        with headless_context(bound.arguments.get("ctx")) as ctx:
+            bound.arguments["ctx"] = ctx
+            return function(*bound.args, **bound.kwargs)
+
+    return call
 
 
 #: EGL's names for the draw and read surfaces (eglGetCurrentSurface's argument).
