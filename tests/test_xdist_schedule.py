@@ -36,7 +36,8 @@ def test_the_shared_modules_are_one_scope_and_the_others_one_each(pytestconfig):
     scheduler = conftest.pytest_xdist_make_scheduler(LoadFile(), None)
     shared = {scheduler._split_scope(f"{m}::test_x")
               for m in conftest.SHARED_FIXTURE_MODULES["web_site"]}
-    others = {scheduler._split_scope(f"tests/{m}.py::test_x[1]") for m in ("test_a", "test_b")}
-    assert len(shared) == 1 and others == {"tests/test_a.py", "tests/test_b.py"}
+    modules = [f"tests/test_{name}.py" for name in ("a", "b")]   # made-up modules
+    others = {scheduler._split_scope(f"{m}::test_x[1]") for m in modules}
+    assert len(shared) == 1 and others == set(modules)
     assert conftest.pytest_xdist_make_scheduler(type("Load", (LoadFile,), {
         "getvalue": lambda self, name: "load"})(), None) is None   # other modes: xdist's own
