@@ -54,6 +54,8 @@ from pathlib import Path
 
 import numpy as np
 
+from catalog.gl.context import own_context_unless_given
+
 #: Seeds: choose on TUNE_SEED, report on REPORT_SEED (fixed before the report was run).
 TUNE_SEED = 1
 REPORT_SEED = 33033
@@ -537,16 +539,13 @@ def summarise(rows: list[dict]) -> dict:
             "goal": GOAL, "goal_met": met, "worst": [r["label"] for r in worst]}
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(quick: bool = False, ctx=None, scenes: int | None = None, seed: int | None = None,
         room: str | None = None, size=None, spp: int | None = None, cases: list[dict] | None = None,
         progress=None, rows_out: Path | None = None) -> dict:
     """The section: ``scenes`` drawn with ``seed`` (REPORT_SEED by default), or ``cases``.
     ``rows_out``: each row appended there as one JSON line as soon as it is measured (a long
     run's finished scenes survive it)."""
-    if ctx is None:
-        from catalog.gl.context import create_headless_context  # noqa: PLC0415
-
-        ctx = create_headless_context()
     if room is not None:
         check_room(room)
     seed = REPORT_SEED if seed is None else int(seed)

@@ -13,19 +13,21 @@ from __future__ import annotations
 
 import numpy as np
 
+from catalog.gl.context import own_context_unless_given
+
 GL_SAMPLE_ALPHA_TO_COVERAGE = 0x809E
 COVERAGES = (0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9)
 SIZE_PX = 32
 SAMPLES = 4
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(ctx=None) -> dict:
     import moderngl  # noqa: PLC0415
 
-    from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
+    from catalog.gl.context import describe  # noqa: PLC0415
     from catalog.gl.shaderlib import create_program  # noqa: PLC0415
 
-    ctx = ctx or create_headless_context()
     size = (SIZE_PX, SIZE_PX)
     colour = ctx.renderbuffer(size, 4, samples=SAMPLES, dtype="f4")
     depth = ctx.depth_renderbuffer(size, samples=SAMPLES)

@@ -29,6 +29,7 @@ import math
 import numpy as np
 
 from benchmarks.timing import median_wall_and_cpu, percentile
+from catalog.gl.context import own_context_unless_given
 
 LIGHTS = ("D65", "A", "FL2", "LED-B4", "UV-A", "sun:22", "sun:500")
 QUICK_LIGHTS = ("D65", "A", "UV-A", "sun:500")
@@ -113,6 +114,7 @@ def frame_seconds(renderer, mode: str, bands: int, repeats: int) -> tuple[float,
     return median_wall_and_cpu(renderer.render, repeats, warmup=1, finish=renderer.ctx.finish)
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(quick: bool = False, ctx=None, *, fabrics=None, lights=None, error_size=None,
         time_size=None, repeats=None) -> dict:
     """Rows: one per (fabric, light, variant); summary: per variant, and the default chosen.
@@ -121,10 +123,9 @@ def run(quick: bool = False, ctx=None, *, fabrics=None, lights=None, error_size=
     (width, height) and timing repeats.
     """
     from catalog.presets import find_preset, list_presets, load_preset  # noqa: PLC0415
-    from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
+    from catalog.gl.context import describe  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
-    ctx = ctx or create_headless_context()
     if fabrics is not None:
         presets = [load_preset(find_preset(name)) for name in fabrics]
     else:

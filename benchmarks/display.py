@@ -14,6 +14,8 @@ and under UV-A (the glow: most cloth pixels take the bisection), the pink under 
 
 from __future__ import annotations
 
+from catalog.gl.context import own_context_unless_given
+
 STAGES = ("exposure + sRGB curve", "+ white balance", "+ tone curve", "+ gamut compression")
 SCENES = (("lace-fwa", "D65"), ("lace-fwa", "UV-A"), ("fluoro-pink", "sun:500"))
 
@@ -22,13 +24,12 @@ SCENES = (("lace-fwa", "D65"), ("lace-fwa", "UV-A"), ("fluoro-pink", "sun:500"))
 RESULT_JSON = "benchmarks/bench_display.json"
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(quick: bool = False, ctx=None, size=(640, 360)) -> dict:
     from benchmarks.timing import median_seconds  # noqa: PLC0415
-    from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
 
     own = ctx is None
-    ctx = ctx or create_headless_context()
     repeats = 5 if quick else 15
     renderer = FrameRenderer(ctx, size)
     rows = []

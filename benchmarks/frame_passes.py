@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import statistics
 
+from catalog.gl.context import own_context_unless_given
+
 #: (fabric, light, camera (yaw deg, pitch deg, distance m)): the frame check's room view under
 #: the noon sun (the sun's disc and its glare), an even white under D65 and a fluorescent
 #: yellow under UV-A (most cloth pixels out of gamut: the gamut compression's bisection).
@@ -95,14 +97,13 @@ def run_scene(ctx, size, fabric, light, camera, repeats) -> dict:
     return row
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(quick: bool = False, sizes=DEFAULT_SIZES, ctx=None) -> dict:
     import os  # noqa: PLC0415
 
     from benchmarks.results import machine_info  # noqa: PLC0415
-    from catalog.gl.context import create_headless_context  # noqa: PLC0415
 
     own = ctx is None
-    ctx = ctx or create_headless_context()
     repeats = 3 if quick else 7
     load_before = os.getloadavg()[0]
     try:

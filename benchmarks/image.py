@@ -41,6 +41,7 @@ import numpy as np
 
 from benchmarks.timing import median_wall_and_cpu
 from catalog.render.settings import orbit
+from catalog.gl.context import own_context_unless_given
 
 #: The camera of each view: (yaw deg, pitch deg, distance m). The room view looks down
 #: across the room so that the floor by the window is in the picture.
@@ -274,6 +275,7 @@ def meets_goal(row: dict, mean_flip: float) -> bool:
                 and row["speedup"] >= GOAL["speedup_at_least"])
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
         out: Path | None = None, variant: str | None = None) -> dict:
     """The section. ``variant``: every reference in that Mitsuba variant; None (the default):
@@ -286,10 +288,6 @@ def run(quick: bool = False, ctx=None, scenes=None, size=None, spp=None,
     from catalog.pathtrace.render import MAX_DEPTH  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
 
-    if ctx is None:
-        from catalog.gl.context import create_headless_context  # noqa: PLC0415
-
-        ctx = create_headless_context()
     scenes = scenes or (QUICK_SCENES if quick else SCENES)
     size = tuple(size or (QUICK_SIZE if quick else SIZE))
     spp = int(spp or (QUICK_SPP if quick else SPP))

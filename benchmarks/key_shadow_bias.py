@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 from catalog.render.settings import orbit
+from catalog.gl.context import own_context_unless_given
 
 #: (base bias m, slope texels, tangent cap, normal offset texels); the first is the frame's
 #: earlier constant 2 cm.
@@ -62,6 +63,7 @@ def shadow_truth(points: np.ndarray, to_light: np.ndarray, mesh) -> tuple[np.nda
     return behind, clear
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(ctx=None, size=(96, 72), fabric: str = "voile-white") -> dict:
     from benchmarks.results import machine_info  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
@@ -69,10 +71,6 @@ def run(ctx=None, size=(96, 72), fabric: str = "voile-white") -> dict:
     from catalog.render.passes import shadow as shadow_lib  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
-    if ctx is None:
-        from catalog.gl.context import create_headless_context  # noqa: PLC0415
-
-        ctx = create_headless_context()
     preset = load_preset(find_preset(fabric))
     meshes = [scene_lib.draped_curtain(columns=60, rows=40, folds=f, depth_m=d) for f, d in DRAPES]
     saved = (shadow_lib.KEY_SHADOW_BIAS_M, shadow_lib.KEY_SHADOW_SLOPE_TEXELS, shadow_lib.KEY_SHADOW_SLOPE_CAP,

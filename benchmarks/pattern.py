@@ -27,6 +27,8 @@ from __future__ import annotations
 import statistics
 import time
 
+from catalog.gl.context import own_context_unless_given
+
 FABRIC = "lace-fwa"
 LIGHT = "D65"
 
@@ -42,15 +44,15 @@ def _clock(ctx, draw, repeats: int) -> list[float]:
     return times
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(quick: bool = False, ctx=None, size=(1280, 720), repeats: int | None = None) -> dict:
     from catalog.presets import find_preset, load_preset  # noqa: PLC0415
-    from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
+    from catalog.gl.context import describe  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.render.passes.targets import MSAA_SAMPLES, choose_antialiasing  # noqa: PLC0415
     from catalog.render.scene import draped_curtain  # noqa: PLC0415
     from catalog.render.snapshot import simulated_curtain  # noqa: PLC0415
 
-    ctx = ctx or create_headless_context()
     repeats = repeats or (3 if quick else 11)
     if quick:
         size = (320, 180)

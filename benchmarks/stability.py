@@ -30,6 +30,7 @@ from dataclasses import replace
 import numpy as np
 
 from catalog.core.constants import FRAME_DT_S
+from catalog.gl.context import own_context_unless_given
 
 G_EDGES = (-0.99999, -0.9999, -0.999, -0.9, -0.3, 0.0, 0.3, 0.9, 0.999, 0.9999, 0.99999)
 THETAS = np.concatenate([[0.0], np.geomspace(1e-7, 1e-2, 24), np.linspace(0.02, math.pi, 60)])
@@ -249,10 +250,9 @@ def cloth_sweep(quick: bool) -> list[dict]:
     return rows
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def run(quick: bool = False, ctx=None) -> dict:
-    from catalog.gl.context import create_headless_context  # noqa: PLC0415
 
-    ctx = ctx or create_headless_context()
     scales = QUICK_SCALES if quick else SCALES
     rows = hg_glsl(ctx) + hg_float64() + fluorescence_sweep(scales) \
         + render_sweep(ctx, scales, quick) + band_scaling(ctx, scales) + cloth_sweep(quick)

@@ -36,6 +36,8 @@ import math
 
 import numpy as np
 
+from catalog.gl.context import own_context_unless_given
+
 #: The issue's test lights (UV and violet, the reddened sun, the HP lamps, a 2000 K flame).
 TEST_LIGHTS = ("UV-A", "UV-385", "LED-405", "LED-violet-white", "sun:500", "HP1", "HP2",
                "planck:2000")
@@ -478,6 +480,7 @@ def near_diagonal_table(result: dict) -> str:
     return "\n".join(lines)
 
 
+@own_context_unless_given   # without ctx: its own, released after (the caller's current again)
 def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> dict:
     """Whole-frame time of a single-band fabric against the same fabric carrying the banded
     model, side by side in one run (rounds interleaved; medians), under LED-405, plus the
@@ -494,7 +497,7 @@ def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> d
     from catalog.optics.bispectral.matrix import bispectral_dir, find_bfc, read_bfc  # noqa: PLC0415
     from catalog.optics.bispectral.bands import fit_banded  # noqa: PLC0415
     from catalog.presets import find_preset, load_preset, preset_from_dict, preset_to_dict  # noqa: PLC0415
-    from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
+    from catalog.gl.context import describe  # noqa: PLC0415
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.render import scene as scene_lib  # noqa: PLC0415
 
@@ -520,7 +523,6 @@ def frame_cost(size=(640, 360), repeats: int = 7, draws: int = 3, ctx=None) -> d
         doc["fluorescence"] = fl
         banded = preset_from_dict(doc, None)
         what = "lace-fwa with its own spectra as two bands (measured matrices absent)"
-    ctx = ctx or create_headless_context()
     renderers = {}
     for label, preset in (("single band (today)", single), ("banded", banded)):
         renderer = FrameRenderer(ctx, tuple(size))

@@ -46,6 +46,34 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip)
 
 
+#: Test modules that share a session fixture costlier than splitting them is worth (web_site:
+#: the web catalog built, 80 s under load): under ``-n 2 --dist loadfile`` they run in one
+#: worker as if they were one file, so it is built once. (tests/test_xdist_schedule.py checks
+#: that every module using the fixture is listed.)
+SHARED_FIXTURE_MODULES = {"web_site": ("tests/test_web.py", "tests/test_web_browser.py",
+                                       "tests/test_web_facts.py", "tests/test_web_links.py")}
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile``, each module in one worker (its module fixtures made once, its tests
+    in their written order), the modules of SHARED_FIXTURE_MODULES together. Other --dist
+    modes are xdist's own. (Not --dist loadgroup: xdist 3.8's groups are lost under pytest 9.2,
+    which no longer reads the node id xdist rewrites.)"""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    scope_of = {module: name for name, modules in SHARED_FIXTURE_MODULES.items()
+                for module in modules}
+
+    class SharedFixtureScheduling(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            module = super()._split_scope(nodeid)
+            return scope_of.get(module, module)
+
+    return SharedFixtureScheduling(config, log)
+
+
 #: Set (e.g. by .ci/run) to a number of seconds: an unmarked test whose call phase takes
 #: longer FAILS, so the fast loop (-m "not slow") stays fast. The rule marks a test slow at
 #: 0.5 s; CI fails it at twice that, the margin for run-to-run noise on a 2-core machine
@@ -107,13 +135,16 @@ def gl_context():
 
 
 def _share_gl_context(item) -> None:
-    """Make the shared context current again for a test that uses it. A command a test runs in
-    this process (``main(["snapshot", ..])``, ``render_sheet``, ``build_site`` without
-    ``ctx=``) creates its own EGL context, which becomes the thread's current one and stays
-    so (released or not): the shared context's calls then went to that one, and objects made
-    earlier in the shared context (a module fixture's renderer) gave GL_INVALID_OPERATION.
-    Serially a module's tests ran together, so it showed only when pytest-xdist interleaved
-    modules in one worker."""
+    """Make the shared context current again for a test that uses it. A context made in this
+    process becomes the thread's current one and stays so (released or not): the shared
+    context's calls then go to it, and objects made earlier in the shared context (a module
+    fixture's renderer) give GL_INVALID_OPERATION. The commands (``main(["snapshot", ..])``,
+    ``render_sheet``, ``build_site``, ``egl_frame``, ``catalog bench`` without ``ctx=``) make
+    theirs through catalog.gl.context.headless_context, which makes the caller's current again
+    (tests/test_gl_context.py), as do the benchmarks' ``run(ctx=None)`` functions
+    (own_context_unless_given); this stays for what does not yet: the cloth's GpuBackend and
+    benchmarks.springs12 without ``ctx``, benchmarks.room, benchmarks.results' sections and
+    the web benchmark's frames, whose contexts live as long as an object or a section."""
     if _SHARED_GL and "gl_context" in getattr(item, "fixturenames", ()):
         _SHARED_GL[0].__enter__()   # eglMakeCurrent (moderngl: no matching exit needed)
 
@@ -215,12 +246,19 @@ def pytest_sessionfinish(session, exitstatus):
     target = os.environ.get("CATALOG_RECORD_FIGURES")
     if not target or not _FIGURES:
         return
+    import fcntl
     import json
 
     from catalog.core.atomic import write_text_atomic
 
     path = Path(target)
-    merged = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
-    merged.setdefault("figures", {}).update(_FIGURES)
-    merged["figures"] = dict(sorted(merged["figures"].items()))
-    write_text_atomic(path, json.dumps(merged, indent=1, default=float) + "\n")
+    # each pytest-xdist worker merges its own figures: one at a time (a lock on the folder)
+    folder = os.open(path.resolve().parent, os.O_RDONLY)
+    try:
+        fcntl.flock(folder, fcntl.LOCK_EX)
+        merged = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+        merged.setdefault("figures", {}).update(_FIGURES)
+        merged["figures"] = dict(sorted(merged["figures"].items()))
+        write_text_atomic(path, json.dumps(merged, indent=1, default=float) + "\n")
+    finally:
+        os.close(folder)   # and the lock with it

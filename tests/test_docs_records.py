@@ -76,6 +76,27 @@ def test_record_figure_merges_into_the_named_json_only_when_asked(tmp_path):
     assert json.loads(target.read_text()) == {"figures": {"earlier": 2, "probe.value": 1.5}}
 
 
+@pytest.mark.slow
+def test_record_figure_keeps_every_xdist_workers_figures(tmp_path):
+    """Under pytest-xdist each worker merges its own figures into the file, one at a time:
+    two modules in two workers, both figures and the earlier one are there."""
+    conftest = PROJECT_ROOT / "tests" / "conftest.py"
+    (tmp_path / "conftest.py").write_text(conftest.read_text())
+    for name in ("a", "b"):
+        (tmp_path / f"test_{name}.py").write_text(
+            f"def test_{name}(record_figure):\n    record_figure('probe.{name}', 1.0)\n")
+    target = tmp_path / "figures.json"
+    target.write_text(json.dumps({"figures": {"earlier": 2}}))
+    env = {"PATH": "/usr/bin:/bin", "CATALOG_RECORD_FIGURES": str(target)}
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                           "-n", "2", "--dist", "loadfile", "test_a.py", "test_b.py"],
+                          cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "2 passed" in proc.stdout
+    assert json.loads(target.read_text()) == {"figures": {"earlier": 2, "probe.a": 1.0,
+                                                          "probe.b": 1.0}}
+
+
 def test_the_refinement_study_folds_hold_every_training_light_once():
     """The cross-validation of docs/bispectral.md holds out every training light exactly
     once, and never a goal light."""

@@ -194,6 +194,7 @@ def test_the_renderer_redraws_what_the_table_says(gl):
         r.release()
 
 
+@pytest.mark.slow   # loads the bedroom's glTF (0.8 s at a load of 2.5 on 2 cores)
 def test_a_lamp_is_checked_against_its_own_rooms_interior():
     """The bedroom is shorter than the box (z to 3.6 m against 4.5) and wider (x to 2.3 m):
     a lamp is refused or taken by the loaded room's interior, not the box's."""

@@ -207,6 +207,7 @@ def test_environment_disc_integrates_to_the_key_irradiance():
     assert np.all(sky[:16] == 1) and np.all(sky[16:] == 2)  # sky above, ground below
 
 
+@pytest.mark.slow   # two Mitsuba renders, JIT-compiled (1.3 s at a load of 2 on 2 cores)
 def test_direct_light_matches_the_float64_reference_per_pixel(mi):
     """Curtain alone under the frame's key (behind) and fill (viewer side) as directional
     lights, each in its own render (one light: no light selection noise), direct light only,

@@ -79,15 +79,15 @@ def parse_sections(text: str | None) -> list[str]:
 
 
 def run(args) -> int:
+    import contextlib  # noqa: PLC0415
     import sys  # noqa: PLC0415
-    import time  # noqa: PLC0415
     from pathlib import Path  # noqa: PLC0415
 
     load_benchmarks()   # the suite (a checkout's benchmarks/), or one line saying it is absent
-    from benchmarks.report import write_report  # noqa: PLC0415
-    from benchmarks.results import GL_SECTIONS, machine_info  # noqa: PLC0415
+    from benchmarks.results import GL_SECTIONS  # noqa: PLC0415
     from catalog.core.errors import InputError  # noqa: PLC0415
     from catalog.core.jsonout import print_json  # noqa: PLC0415
+    from catalog.gl.context import headless_context  # noqa: PLC0415
 
     names = parse_sections(args.sections)
     if args.scenes is not None and not 1 <= args.scenes <= 1000:
@@ -110,11 +110,27 @@ def run(args) -> int:
     def say(text: str) -> None:
         print(f"catalog bench: {text}", file=sys.stderr, flush=True)
 
-    ctx = None
-    if any(n in GL_SECTIONS for n in names):
-        from catalog.gl.context import create_headless_context  # noqa: PLC0415
+    # the GL sections' context, released at the end (the caller's current context current again)
+    with (headless_context() if any(n in GL_SECTIONS for n in names)
+          else contextlib.nullcontext()) as ctx:
+        report, written = _run_sections(names, args, ctx, say)
+    say(f"wrote {', '.join(str(p) for p in written)}")
+    if args.json:
+        print_json(report)
+    else:
+        print((out / "bench.md").read_text(encoding="utf-8"))
+    return 1 if report["failed"] else 0
 
-        ctx = create_headless_context()
+
+def _run_sections(names, args, ctx, say) -> tuple[dict, list]:
+    """(report, files written) of the named sections, run in ``ctx`` (None: no GL section)."""
+    import time  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    from benchmarks.report import write_report  # noqa: PLC0415
+    from benchmarks.results import machine_info  # noqa: PLC0415
+
+    out = Path(args.out)
     machine = machine_info(ctx)
     report = {"benchmark": "catalog bench", "quick": bool(args.quick), "machine": machine,
               "sections": {}, "failed": {}}
@@ -130,14 +146,7 @@ def run(args) -> int:
     report["total_seconds"] = time.perf_counter() - start_all
     written = write_report(report, out, plotters)
     report["written"] = [str(p) for p in written]
-    if ctx is not None:
-        ctx.release()
-    say(f"wrote {', '.join(str(p) for p in written)}")
-    if args.json:
-        print_json(report)
-    else:
-        print((out / "bench.md").read_text(encoding="utf-8"))
-    return 1 if report["failed"] else 0
+    return report, written
 
 
 def _run_section(name, args, ctx, report, plotters, say) -> None:

@@ -137,7 +137,11 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
     width, height = size
     # an upper bound of what is written: every image and the grid, uncompressed
     estimate_bytes = 2 * len(presets) * len(light_objects) * width * height * 3
-    with staged_folder(out_dir, estimate_bytes=estimate_bytes) as stage:
+    from catalog.gl.context import headless_context  # noqa: PLC0415
+
+    # without ctx, a context of its own, released after (the caller's current one current again)
+    with staged_folder(out_dir, estimate_bytes=estimate_bytes) as stage, \
+            headless_context(ctx) as ctx:
         report = _render_into(stage, out_dir, presets, light_objects, size, fluorescence,
                               bands, progress, ctx, ev, white_balance, labels, room)
     return report
@@ -145,12 +149,10 @@ def render_sheet(lights: list[str], out_dir: Path, size: tuple[int, int], *, fab
 
 def _render_into(stage: Path, out_dir: Path, presets, light_objects, size, fluorescence,
                  bands, progress, ctx, ev, white_balance, labels, room=None) -> dict:
-    from catalog.gl.context import create_headless_context  # noqa: PLC0415
     from catalog.render.imagefile import write_image  # noqa: PLC0415
 
     from catalog.render.snapshot import new_renderer  # noqa: PLC0415
 
-    ctx = ctx or create_headless_context()
     renderer = new_renderer(ctx, size)  # the size checked against the context first
     renderer.update(fluorescence=fluorescence, bands=bands, ev=ev, white_balance=white_balance,
                     room=room)

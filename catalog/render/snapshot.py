@@ -215,13 +215,20 @@ def validate(request: SnapshotRequest):
 
 
 def render_snapshot(request: SnapshotRequest, ctx=None) -> dict:
-    """Render one image as asked and write it; returns a JSON-able report."""
-    import time  # noqa: PLC0415
-
-    from catalog.gl.context import create_headless_context, describe  # noqa: PLC0415
+    """Render one image as asked and write it; returns a JSON-able report. Without ``ctx``, in
+    a context of its own, released after (the caller's current context current again)."""
+    from catalog.gl.context import headless_context  # noqa: PLC0415
 
     preset, light = validate(request)
-    ctx = ctx or create_headless_context()
+    with headless_context(ctx) as ctx:
+        return _snapshot_in(ctx, request, preset, light)
+
+
+def _snapshot_in(ctx, request: SnapshotRequest, preset, light) -> dict:
+    import time  # noqa: PLC0415
+
+    from catalog.gl.context import describe  # noqa: PLC0415
+
     renderer = new_renderer(ctx, request.size)
     try:
         sun = configure_renderer(renderer, request, preset, light)

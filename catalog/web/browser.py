@@ -125,14 +125,23 @@ def egl_frame(fabric: str, light: str, fluorescence: str, frame: int, size: tupl
               ev100: float | None = None, glare: str = "off", lamp: str = "none") -> np.ndarray:
     """The desktop frame (EGL) of the same fabric, light, fluorescence, glare and room-lamp
     switches, baked cloth frame and camera (yaw deg, pitch deg, distance m; default the renderer's): uint8 (H, W, 3), row
-    0 = top. ``ev100``: the page's fixed exposure of the scene (None: the desktop meters)."""
-    from catalog.gl.context import create_headless_context  # noqa: PLC0415
+    0 = top. ``ev100``: the page's fixed exposure of the scene (None: the desktop meters).
+    Without ``ctx``, in a context of its own, released after (the caller's current again)."""
+    from catalog.gl.context import headless_context  # noqa: PLC0415
+
+    with headless_context(ctx) as own:
+        return _egl_frame_in(own, fabric, light, fluorescence, frame, size, animation, camera,
+                             ev100, glare, lamp)
+
+
+def _egl_frame_in(ctx, fabric, light, fluorescence, frame, size, animation, camera, ev100,
+                  glare, lamp) -> np.ndarray:
     from catalog.render.frame import FrameRenderer  # noqa: PLC0415
     from catalog.render.settings import SunHour, orbit  # noqa: PLC0415
     from catalog.web.export import (FLUORESCENCE, GLARE, configure_desktop_frame,  # noqa: PLC0415
                                     room_lamps)
 
-    renderer = FrameRenderer(ctx or create_headless_context(), size)
+    renderer = FrameRenderer(ctx, size)
     try:
         renderer.update(fabric=fabric)
         if light.startswith("sun@"):

@@ -343,17 +343,16 @@ def fabric_facts(preset) -> dict:
 class SiteExporter:
     """Records the desktop frame for each scene (see the module docstring)."""
 
-    def __init__(self, ctx=None, room="box"):
-        """``room``: the room the scenes are drawn in (a built-in name, a .glb path or a loaded
-        catalog.room.model.Room; FrameSettings.room)."""
-        from catalog.gl.context import create_headless_context  # noqa: PLC0415
+    def __init__(self, ctx, room="box"):
+        """``ctx``: the caller's context (catalog.gl.context.headless_context: build_site's own
+        when it is given none). ``room``: the room the scenes are drawn in (a built-in name, a
+        .glb path or a loaded catalog.room.model.Room; FrameSettings.room)."""
         from catalog.render.frame import FrameRenderer  # noqa: PLC0415
         from catalog.web.record import RecordingContext  # noqa: PLC0415
 
-        real = ctx or create_headless_context()
-        self.ctx = RecordingContext(real)
+        self.ctx = RecordingContext(ctx)
         self.renderer = FrameRenderer(self.ctx, RECORD_SIZE, specialise=False)
-        self.meter = FrameRenderer(real, METER_SIZE)  # not recorded: meters the exposure
+        self.meter = FrameRenderer(ctx, METER_SIZE)  # not recorded: meters the exposure
         self.room = room
         #: the display's measured whites by key (DisplayPass.measured_white)
         self._whites: dict = {}

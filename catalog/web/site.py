@@ -312,46 +312,46 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         timings["bake_s"] = time.perf_counter() - t
 
         t = time.perf_counter()
-        own_ctx = ctx is None
-        if own_ctx:
-            from catalog.gl.context import create_headless_context  # noqa: PLC0415
-            ctx = create_headless_context()
-        # the swatches first, their renderer released before the recording's two are made
-        swatches = {name: base64.b64encode(png).decode("ascii")
-                    for name, png in export.swatch_pngs(ctx, presets, room=room).items()}
-        exporter = export.SiteExporter(ctx, room=room)
-        try:
-            positions, normals, tangents = bake_lib.decode_frame(first, 0)
-            exporter.use_mesh(positions, normals, first.uv, tangents, first.indices)
-            exporter.use_drape(fabric_animation[presets[0].name])
-            exporter.check_camera_uniforms(exporter.scene(presets[0], choices[0]))
-            scenes = {}
-            variants = list(itertools.product(export.FLUORESCENCE, export.GLARE,
-                                              export.ROOM_LAMPS))
-            with progress_bar("catalog web: record", total=len(presets) * len(choices)
-                              * len(variants), unit="scenes", enabled=progress) as bar:
-                for preset in presets:
-                    exporter.use_drape(fabric_animation[preset.name])
-                    for choice in choices:
-                        scene = exporter.scene(preset, choice)   # resolved once, drawn 8 ways
-                        metered = exporter.record(scene, "on")
-                        # the switches keep the exposure metered with fluorescence on, no
-                        # glare, no lamp: they show the brightener's, the glare's and the
-                        # lamp's light
-                        for fluorescence, glare, lamp in variants:
-                            key = export.scene_key(preset.name, choice.id, fluorescence, glare,
-                                                   lamp)
-                            scenes[key] = (
-                                metered if (fluorescence, glare, lamp) == ("on", "off", "none")
-                                else exporter.record(scene, fluorescence,
-                                                     ev100=metered["ev100"], glare=glare,
-                                                     lamp=lamp))
-                            bar.advance()
-            objects = exporter.objects()
-        finally:
-            exporter.release()
-            if own_ctx:   # its programs, textures and the driver's compiled shaders go now,
-                ctx.release()   # before the data is packed
+        from catalog.gl.context import headless_context  # noqa: PLC0415
+
+        # without ctx, a context of its own, released at the end of the block (its programs,
+        # textures and the driver's compiled shaders go before the data is packed) and the
+        # caller's current context current again
+        with headless_context(ctx) as own:
+            # the swatches first, their renderer released before the recording's two are made
+            swatches = {name: base64.b64encode(png).decode("ascii")
+                        for name, png in export.swatch_pngs(own, presets, room=room).items()}
+            exporter = export.SiteExporter(own, room=room)
+            try:
+                positions, normals, tangents = bake_lib.decode_frame(first, 0)
+                exporter.use_mesh(positions, normals, first.uv, tangents, first.indices)
+                exporter.use_drape(fabric_animation[presets[0].name])
+                exporter.check_camera_uniforms(exporter.scene(presets[0], choices[0]))
+                scenes = {}
+                variants = list(itertools.product(export.FLUORESCENCE, export.GLARE,
+                                                  export.ROOM_LAMPS))
+                with progress_bar("catalog web: record", total=len(presets) * len(choices)
+                                  * len(variants), unit="scenes", enabled=progress) as bar:
+                    for preset in presets:
+                        exporter.use_drape(fabric_animation[preset.name])
+                        for choice in choices:
+                            scene = exporter.scene(preset, choice)   # resolved once, drawn 8 ways
+                            metered = exporter.record(scene, "on")
+                            # the switches keep the exposure metered with fluorescence on, no
+                            # glare, no lamp: they show the brightener's, the glare's and the
+                            # lamp's light
+                            for fluorescence, glare, lamp in variants:
+                                key = export.scene_key(preset.name, choice.id, fluorescence, glare,
+                                                       lamp)
+                                scenes[key] = (
+                                    metered if (fluorescence, glare, lamp) == ("on", "off", "none")
+                                    else exporter.record(scene, fluorescence,
+                                                         ev100=metered["ev100"], glare=glare,
+                                                         lamp=lamp))
+                                bar.advance()
+                objects = exporter.objects()
+            finally:
+                exporter.release()
         timings["record_s"] = time.perf_counter() - t
         scenes, value_pool = exporter.pooled_scenes(scenes)
 
