@@ -62,6 +62,10 @@ class HemBorder:
     depth_m: float
 
 
+#: Rows of a pattern made at a time in float64 (Pattern.slopes, normal_map).
+_ROW_BLOCK = 128
+
+
 @dataclass(frozen=True)
 class Pattern:
     """One repeat: coverage (H, W) float32 in [0, 1], row 0 = the top of the image (v = 0
@@ -89,25 +93,35 @@ class Pattern:
         the image's x and y (y down the image), periodic central differences. Zero when the
         pattern has no height."""
         h, w = self.coverage.shape
+        out = np.zeros((h, w, 2), dtype=np.float32)
         if self.height is None:
-            return np.zeros((h, w, 2), dtype=np.float32)
+            return out
         z = self.height.astype(np.float64) * self.height_m
         px_u = self.repeat_m[0] / w
         px_v = self.repeat_m[1] / h
-        du = (np.roll(z, -1, axis=1) - np.roll(z, 1, axis=1)) / (2 * px_u)
-        dv = (np.roll(z, -1, axis=0) - np.roll(z, 1, axis=0)) / (2 * px_v)
-        return np.stack([du, dv], axis=-1).astype(np.float32)
+        for r0 in range(0, h, _ROW_BLOCK):   # a block of rows at a time: float64 temporaries
+            rows = np.arange(r0, min(h, r0 + _ROW_BLOCK))   # of a block, not of the image
+            zb = z[rows]
+            out[rows, :, 0] = (np.roll(zb, -1, axis=1) - np.roll(zb, 1, axis=1)) / (2 * px_u)
+            out[rows, :, 1] = (z[(rows + 1) % h] - z[(rows - 1) % h]) / (2 * px_v)
+        return out
 
     def normal_map(self) -> np.ndarray:
         """(H, W, 4) float32 RGBA: the thread's unit normal in the cloth's tangent frame
         (x along u = weft, y along v, z = the cloth normal), alpha = the coverage. A mip chain
         of it averages the normals before they are renormalised (the first moment of LEAN
         mapping, Olano & Baker 2010): far away the slopes cancel and the geometric normal
-        remains, so highlights do not sparkle."""
-        s = self.slopes().astype(np.float64)
-        n = np.concatenate([-s, np.ones(s.shape[:2] + (1,))], axis=-1)
-        n /= np.linalg.norm(n, axis=-1, keepdims=True)
-        return np.concatenate([n, self.coverage[..., None]], axis=-1).astype(np.float32)
+        remains, so highlights do not sparkle. Made in float64 a block of rows at a time."""
+        s32 = self.slopes()
+        h, w = s32.shape[:2]
+        out = np.empty((h, w, 4), dtype=np.float32)
+        for r0 in range(0, h, _ROW_BLOCK):
+            s = s32[r0:r0 + _ROW_BLOCK].astype(np.float64)
+            n = np.concatenate([-s, np.ones(s.shape[:2] + (1,))], axis=-1)
+            n /= np.linalg.norm(n, axis=-1, keepdims=True)
+            out[r0:r0 + _ROW_BLOCK, :, :3] = n
+        out[..., 3] = self.coverage
+        return out
 
     def border_normal_map(self) -> np.ndarray | None:
         """The hem band's RGBA as :meth:`normal_map` (None without a border). The band does
