@@ -73,6 +73,11 @@ KEY_VISIBILITY_MAX_TEXELS = 2048
 VERTEX_OCCLUSION_WIDTH = 256
 
 
+#: The mesh's buffers the maps are drawn from (CurtainMesh.buffers; not the index buffers
+#: derived from them, e.g. the hem band's split, made during a frame).
+_MESH_BUFFERS = ("position", "normal", "tangent", "uv", "index", "coarse_index", "interleaved")
+
+
 class ShadowPass(Pass):
     """The key light's maps, drawn from the light (room_shadow.vert/.frag): the room's
     transmittance map through the curtain (the pattern's holes projected), the cloth's own
@@ -256,8 +261,8 @@ class ShadowPass(Pass):
         and the frame's placement."""
         mesh = self.frame.mesh
         return (mesh.version, mesh.format, mesh.vertex_count, mesh.offset_m,
-                tuple((name, id(b)) for name, b in (mesh.buffers or {}).items()),
-                self.frame.placement)
+                tuple((name, id(b)) for name, b in (mesh.buffers or {}).items()
+                      if name in _MESH_BUFFERS), self.frame.placement)
 
     def _pattern_key(self) -> tuple:
         """What the maps take of the pattern: its texture (the fabric's key, the texture
