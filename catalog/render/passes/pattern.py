@@ -193,3 +193,10 @@ def prepared_levels(pattern, prefilter: bool = True) -> tuple:
              None if band is None or not prefilter else _prefiltered(band, False))
     _PREPARED[0] = (weakref.ref(pattern), bool(prefilter), value)
     return value
+
+
+def forget_prepared() -> None:
+    """Let the kept pattern's arrays go (:func:`prepared_levels`): the renderers that share
+    them have loaded it (the web export's meter and recording renderer, at a fabric's first
+    scene), so that they are not held beside what the recording gathers."""
+    _PREPARED[0] = None
