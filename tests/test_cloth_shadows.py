@@ -344,3 +344,72 @@ def test_the_sill_is_lit_by_the_sun(gl, make_preset):
     expected = albedo / math.pi * key_y * to_light[1]
     assert (img[sill][open_] @ LUMA).min() > 0.9 * expected
     r.release()
+
+
+def _cloth_maps(r) -> dict:
+    """The cloth's shadow maps as drawn (bytes): the key's front layer, its visibility over
+    the uv, the occlusion atlas and each vertex's occlusion."""
+    gl = r.room_targets.get()
+    return {name: gl[name].read() for name in ("key_front", "key_visibility", "occlusion",
+                                              "vertex_occlusion") if name in gl}
+
+
+def test_cloth_shadow_maps_kept_while_their_inputs_do_not_change(gl, monkeypatch):
+    """The shadow pass keeps the maps whose inputs did not change (ShadowPass._kept): after a
+    change of fluorescence and room lamp (the key's direction, the mesh and the room the
+    same) the occlusion maps are not drawn again, after a change of the sun's hour the key's
+    are and the occlusion's are not; each frame's maps and image are bit for bit those of a
+    renderer that draws the same scene from nothing. A recording context (the web export's)
+    notes the maps' draws in every frame."""
+    from catalog.render.passes.shadow import ShadowPass
+    from catalog.render.settings import SunHour
+    from catalog.web.record import RecordingContext
+
+    calls = {"occlusion": 0, "key": 0}
+    draw_occlusion, draw_key = ShadowPass._draw_occlusion_maps, ShadowPass._draw_key_front
+    monkeypatch.setattr(ShadowPass, "_draw_occlusion_maps",
+                        lambda self: (calls.__setitem__("occlusion", calls["occlusion"] + 1),
+                                      draw_occlusion(self))[1])
+    monkeypatch.setattr(ShadowPass, "_draw_key_front",
+                        lambda self, *a: (calls.__setitem__("key", calls["key"] + 1),
+                                          draw_key(self, *a))[1])
+    scenes = [dict(light=SunHour(10.0), fluorescence="physical", lamps=[]),
+              dict(light=SunHour(10.0), fluorescence="off", lamps=[("A", (1.3, 0.2, 1.0))]),
+              dict(light=SunHour(15.0), fluorescence="off", lamps=[])]
+    common = dict(fabric="lace-fwa", patterned=True, room_lighting=False, camera=orbit(0.0, 0.0, 1.6))
+    kept = FrameRenderer(gl, SIZE)
+    counts = []
+    try:
+        for scene in scenes:
+            kept.update(**common, **scene)
+            kept.render()
+            counts.append(dict(calls))
+            fresh = FrameRenderer(gl, SIZE)
+            try:
+                fresh.update(**common, **scene)
+                fresh.render()
+                assert np.array_equal(kept.read_srgb8(), fresh.read_srgb8())
+                want = _cloth_maps(fresh)
+                assert _cloth_maps(kept) == want and len(want) == 4
+            finally:
+                fresh.release()
+            calls["occlusion"] -= 1   # the fresh renderer's own draws
+            calls["key"] -= 1
+    finally:
+        kept.release()
+    assert counts == [{"occlusion": 1, "key": 1}, {"occlusion": 1, "key": 1},
+                      {"occlusion": 1, "key": 2}], counts
+
+    rec = RecordingContext(gl)
+    recorder = FrameRenderer(rec, SIZE, specialise=False)
+    try:
+        recorder.update(**common, **scenes[0])
+        before = dict(calls)
+        for dry in (False, True, True):
+            recorder.invalidate_room_light()
+            rec.recording.start(dry=dry)
+            recorder.render()
+            rec.recording.stop()
+        assert calls["occlusion"] - before["occlusion"] == 3
+    finally:
+        recorder.release()

@@ -506,3 +506,26 @@ def test_frame_comparison_reports_a_frame_wide_shift():
     moved[:, 0] = 0
     figures = compare_frames(moved, edge)
     assert figures["edge_shift"] == 30 and figures["signed_mean_8bit"] == [-5.0] * 3
+
+
+def test_stage_peaks_reset_at_each_stage(tmp_path):
+    """StagePeaks (benchmarks/web_build's per-stage column): a stage that holds 200 MB for a
+    moment peaks at least 190 MB above the resident set before it; the stage after it, which
+    holds nothing more, peaks below that (the peak is reset at each stage's start). Linux
+    only (VmHWM, /proc/self/clear_refs); elsewhere nothing is measured."""
+    from catalog.web.site import StagePeaks
+
+    stages = StagePeaks(True)
+    if not stages._on:
+        assert stages.peaks == {}
+        pytest.skip("no /proc/self/clear_refs here")
+    stages.start("quiet")
+    stages.start("big")
+    block = np.ones(200 * 2 ** 20 // 8)   # written: resident
+    del block
+    stages.start("after")
+    stages.end()
+    assert set(stages.peaks) == {"quiet", "big", "after"}
+    assert stages.peaks["big"] >= stages.peaks["quiet"] + 190, stages.peaks
+    assert stages.peaks["after"] < stages.peaks["big"] - 150, stages.peaks
+    assert StagePeaks(False).peaks == {} and not StagePeaks(False)._on

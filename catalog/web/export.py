@@ -439,6 +439,9 @@ class SiteExporter:
             ev100 = self.meter.current_ev100()
         r = self.renderer
         r.update(scene.replace(camera=r.camera, ev=ev100))
+        from catalog.render.passes.pattern import forget_prepared  # noqa: PLC0415
+
+        forget_prepared()   # both renderers hold the fabric's pattern now
         rec = self.ctx.recording
         if not r.display.white_is_measured():
             # the display's white is measured from the HDR target the frame draws, which a dry
@@ -673,5 +676,8 @@ def swatch_pngs(ctx, presets, size=SWATCH_SIZE, room="box") -> dict[str, bytes]:
                 out, format="PNG", optimize=True)
             swatches[preset.name] = out.getvalue()
     finally:
+        from catalog.render.passes.pattern import forget_prepared  # noqa: PLC0415
+
         renderer.release()
+        forget_prepared()
     return swatches

@@ -257,12 +257,56 @@ def _return_large_blocks(threshold_bytes: int = 1 << 20) -> None:
         pass
 
 
+class StagePeaks:
+    """The peak resident set (MB) of each stage of a build (:data:`STAGES`): Linux's VmHWM,
+    reset at each stage's start (``/proc/self/clear_refs`` 5). Opt-in (build_site's
+    ``stage_peaks``): the reset also lowers what the process's own peak reads afterwards
+    (getrusage, /usr/bin/time), so the whole run's peak is then the largest stage's. Where
+    the files cannot be used (not Linux) nothing is measured ({})."""
+
+    def __init__(self, enabled: bool):
+        self.peaks: dict[str, int] = {}
+        self._stage = None
+        self._on = enabled and self._reset()
+
+    @staticmethod
+    def _reset() -> bool:
+        try:
+            Path("/proc/self/clear_refs").write_text("5")
+            return True
+        except OSError:
+            return False
+
+    def start(self, name: str) -> None:
+        """End the running stage (its peak noted) and start ``name``."""
+        self.end()
+        if self._on:
+            self._stage = name
+            self._reset()
+
+    def end(self) -> None:
+        if self._stage is not None:
+            with open("/proc/self/status", encoding="ascii") as status:
+                kb = next(int(line.split()[1]) for line in status if line.startswith("VmHWM:"))
+            self.peaks[self._stage] = round(kb / 1024)
+        self._stage = None
+
+
+#: The stages of a build, as StagePeaks names them: the cloths' bake (its child process's
+#: peak is the child's own), the swatches' renderer, the exporter's two renderers made and
+#: checked, the scenes recorded, the GL objects collected (and the renderers released), the
+#: data pooled, packed and written with the room's pack.
+STAGES = ("bake", "swatches", "exporter", "recording", "GL collect", "packing")
+
+
 def build_site(out: str | Path, fabrics: str | None = None, lights: str | None = None,
-               ctx=None, progress: bool = False, room="box") -> dict:
+               ctx=None, progress: bool = False, room="box",
+               stage_peaks: bool = False) -> dict:
     """Write the site into ``out``; returns a report (sizes, counts, seconds). ``progress``:
     the bake's and the recording's progress on stderr (catalog.core.progress). ``room``: a
     built-in name or a .glb path (``--room``): the scenes are drawn in it and its transport's
-    web pack is written (export.room_pack_script)."""
+    web pack is written (export.room_pack_script). ``stage_peaks``: measure each stage's
+    peak resident set (:class:`StagePeaks`; the report's ``stage_peak_mb``)."""
     import base64  # noqa: PLC0415
 
     from catalog.core.progress import progress as progress_bar  # noqa: PLC0415
@@ -274,6 +318,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
 
     start = time.perf_counter()
     _return_large_blocks()
+    stages = StagePeaks(stage_peaks)
     out = Path(out)
     names = export.parse_fabrics(fabrics)
     choices = export.parse_lights(lights)
@@ -292,6 +337,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
     with staged_folder(out, replace_listed=_replace_listed(new_files)) as stage:
         timings = {}
         t = time.perf_counter()
+        stages.start("bake")
         fabric_animation = {}
         keys = {preset.name: bake_lib.cloth_key(bake_lib.bake_params(preset)) for preset in presets}
         firsts = {}   # one preset per distinct cloth
@@ -317,10 +363,12 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         # without ctx, a context of its own, released at the end of the block (its programs,
         # textures and the driver's compiled shaders go before the data is packed) and the
         # caller's current context current again
+        stages.start("swatches")
         with headless_context(ctx) as own:
             # the swatches first, their renderer released before the recording's two are made
             swatches = {name: base64.b64encode(png).decode("ascii")
                         for name, png in export.swatch_pngs(own, presets, room=room).items()}
+            stages.start("exporter")
             exporter = export.SiteExporter(own, room=room)
             try:
                 positions, normals, tangents = bake_lib.decode_frame(first, 0)
@@ -328,6 +376,7 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                 exporter.use_drape(fabric_animation[presets[0].name])
                 exporter.check_camera_uniforms(exporter.scene(presets[0], choices[0]))
                 scenes = {}
+                stages.start("recording")
                 variants = list(itertools.product(export.FLUORESCENCE, export.GLARE,
                                                   export.ROOM_LAMPS))
                 with progress_bar("catalog web: record", total=len(presets) * len(choices)
@@ -349,10 +398,12 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                                                          ev100=metered["ev100"], glare=glare,
                                                          lamp=lamp))
                                 bar.advance()
+                stages.start("GL collect")
                 objects = exporter.objects()
             finally:
                 exporter.release()
         timings["record_s"] = time.perf_counter() - t
+        stages.start("packing")
         scenes, value_pool = exporter.pooled_scenes(scenes)
 
         camera = exporter.renderer.camera
@@ -403,6 +454,9 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
                   + max(a.stat().st_size for a in (stage / "anim").iterdir()),
                   "data_js_plain_bytes": plain_bytes, "room": room_report,
                   **{k: round(v, 3) for k, v in timings.items()}}
+        stages.end()
+        if stages.peaks:
+            report["stage_peak_mb"] = dict(stages.peaks)
         new_files.extend([*sizes, MARKER])
         (stage / MARKER).write_text(json.dumps({"format": FORMAT_VERSION, "fabrics": names,
                                                 "lights": report["lights"],

@@ -47,7 +47,9 @@ class PatternTexture(Pass):
 
     def set_fabric(self, preset) -> None:
         """The preset's pattern as a mipmapped RGBA32F texture (thread normal, coverage);
-        without a [pattern] a uniform coverage 1 - LD (one texel)."""
+        without a [pattern] a uniform coverage 1 - LD (one texel). The texels and their
+        prefiltered levels come from :func:`prepared_levels` (made once for the renderers
+        that load the same fabric one after another)."""
         from catalog.presets.fabric import resolve_fabric  # noqa: PLC0415
 
         table = preset.table("pattern")
@@ -58,25 +60,25 @@ class PatternTexture(Pass):
         if pattern is None:
             texels = np.array([[[0.0, 0.0, 1.0, 1.0 - preset.btdf.direct]]], dtype=np.float32)
             repeat = self.frame.mesh.fabric_size_m
+            levels, band, band_levels = ([] if self.prefilter else None), None, None
         else:
-            texels = pattern.normal_map()
+            texels, levels, band, band_levels = prepared_levels(pattern, self.prefilter)
             repeat = pattern.repeat_m
         self.release()
-        self.texture = self._mipmapped(texels, periodic_v=True)
-        band = None if pattern is None else pattern.border_normal_map()
+        self.texture = self._mipmapped(texels, levels, periodic_v=True)
         if band is not None:
-            self.border = self._mipmapped(band, periodic_v=False)
+            self.border = self._mipmapped(band, band_levels, periodic_v=False)
             self.border_repeats = pattern.border.depth_m / float(repeat[1])
         self._pattern = pattern
         self.repeat_m = tuple(float(v) for v in repeat)
         self.mean_coverage = float(np.mean(texels[..., 3], dtype=np.float64))
         self.key = key
 
-    def _mipmapped(self, texels: np.ndarray, periodic_v: bool):
+    def _mipmapped(self, texels: np.ndarray, levels, periodic_v: bool):
         """A trilinear, anisotropic RGBA32F texture of ``texels``, repeating across and, when
-        ``periodic_v``, down (else clamped: the hem's band). Its levels: the prefiltered chain
-        (mip_chain; a band is mirrored about its top row first, what the clamped edge continues
-        as, and each level keeps its first half) or the hardware's box chain."""
+        ``periodic_v``, down (else clamped: the hem's band). Its levels: ``levels`` (1..n, the
+        prefiltered chain, :func:`prepared_levels`) written over the built chain, or (None)
+        the hardware's box chain."""
         mgl = self.mgl
         h, w = texels.shape[:2]
         texture = self.ctx.texture((w, h), 4, np.ascontiguousarray(texels).tobytes(), dtype="f4")
@@ -84,17 +86,8 @@ class PatternTexture(Pass):
         texture.repeat_y = periodic_v
         texture.filter = (mgl.LINEAR_MIPMAP_LINEAR, mgl.LINEAR)
         texture.build_mipmaps()   # allocates the levels; their texels are the prefiltered chain
-        if self.prefilter:
-            from catalog.presets.mip_cache import cached_mip_chain  # noqa: PLC0415
-
-            source = texels if periodic_v else np.concatenate([texels, texels[::-1]])
-            # mip_chain's levels, from the disk cache when this texture was filtered before
-            for level, image in enumerate(cached_mip_chain(source)[1:], start=1):
-                rows = max(1, h >> level)
-                image = image if periodic_v else image[:rows]
-                if image.shape[:2] != (rows, max(1, w >> level)):
-                    break   # the mirrored chain ran out of rows (a band under 2^level rows)
-                texture.write(np.ascontiguousarray(image, dtype="f4").tobytes(), level=level)
+        for level, image in enumerate(levels or (), start=1):
+            texture.write(np.ascontiguousarray(image, dtype="f4").tobytes(), level=level)
         max_aniso = float(self.ctx.info.get("GL_MAX_TEXTURE_MAX_ANISOTROPY", 1.0) or 1.0)
         texture.anisotropy = min(PATTERN_ANISOTROPY, max_aniso)
         return texture
@@ -155,3 +148,57 @@ class PatternTexture(Pass):
             if texture is not None:
                 texture.release()
         self.texture = self.border = self.border_repeats = None
+
+
+#: The last pattern's texels and levels (:func:`prepared_levels`): (weak reference to the
+#: pattern, prefilter, value). One entry: the web export's swatch, meter and recording
+#: renderers load each fabric in turn.
+_PREPARED: list = [None]
+
+
+def _prefiltered(texels: np.ndarray, periodic_v: bool) -> list[np.ndarray]:
+    """Levels 1..n of ``texels``' prefiltered chain (catalog.presets.patterns.mip_chain, kept
+    on disk by catalog.presets.mip_cache) as
+    GL sizes them (w >> k by h >> k); a band (not ``periodic_v``) is mirrored about its top
+    row first, what the clamped edge continues as, each level keeping its first half, and
+    its chain stops where the mirrored chain runs out of rows (a band under 2^k rows)."""
+    from catalog.presets.mip_cache import cached_mip_chain  # noqa: PLC0415
+
+    h, w = texels.shape[:2]
+    source = texels if periodic_v else np.concatenate([texels, texels[::-1]])
+    levels = []
+    # mip_chain's levels, from the disk cache when this texture was filtered before
+    for level, image in enumerate(cached_mip_chain(source)[1:], start=1):
+        rows = max(1, h >> level)
+        image = image if periodic_v else image[:rows]
+        if image.shape[:2] != (rows, max(1, w >> level)):
+            break
+        levels.append(image)
+    return levels
+
+
+def prepared_levels(pattern, prefilter: bool = True) -> tuple:
+    """(texels, levels, band, band_levels) of a :class:`catalog.presets.patterns.Pattern`:
+    its normal map (H, W, 4) float32, its prefiltered levels 1..n (:func:`_prefiltered`;
+    None when not ``prefilter``: the hardware's box chain), the hem band's and its levels
+    (None without a band). Made once for the renderers that load the same pattern object
+    one after another (the last pattern is kept)."""
+    import weakref  # noqa: PLC0415
+
+    kept = _PREPARED[0]
+    if kept is not None and kept[0]() is pattern and kept[1] == bool(prefilter):
+        return kept[2]
+    _PREPARED[0] = None   # the last pattern's arrays go before this one's are made
+    texels = pattern.normal_map()
+    band = pattern.border_normal_map()
+    value = (texels, _prefiltered(texels, True) if prefilter else None, band,
+             None if band is None or not prefilter else _prefiltered(band, False))
+    _PREPARED[0] = (weakref.ref(pattern), bool(prefilter), value)
+    return value
+
+
+def forget_prepared() -> None:
+    """Let the kept pattern's arrays go (:func:`prepared_levels`): the renderers that share
+    them have loaded it (the web export's meter and recording renderer, at a fabric's first
+    scene), so that they are not held beside what the recording gathers."""
+    _PREPARED[0] = None

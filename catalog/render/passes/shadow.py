@@ -73,6 +73,11 @@ KEY_VISIBILITY_MAX_TEXELS = 2048
 VERTEX_OCCLUSION_WIDTH = 256
 
 
+#: The mesh's buffers the maps are drawn from (CurtainMesh.buffers; not the index buffers
+#: derived from them, e.g. the hem band's split, made during a frame).
+_MESH_BUFFERS = ("position", "normal", "tangent", "uv", "index", "coarse_index", "interleaved")
+
+
 class ShadowPass(Pass):
     """The key light's maps, drawn from the light (room_shadow.vert/.frag): the room's
     transmittance map through the curtain (the pattern's holes projected), the cloth's own
@@ -235,12 +240,54 @@ class ShadowPass(Pass):
         pattern = self.frame.fabric_pattern.texture
         patterned = (pattern is not None and self.frame.patterned
                      and self.frame.mesh.format != "interleaved")
-        self._draw_key_front(inputs, patterned, self.frame.terms.room_colours(inputs))
-        self._draw_key_visibility(inputs, "key_visibility")
-        if self.frame.mesh.has_coarse_grid:
-            self._draw_key_visibility(inputs, "key_visibility_coarse", coarse=True)
-        self._draw_occlusion_maps()
-        self._draw_vertex_occlusion()
+        colours = self.frame.terms.room_colours(inputs)
+        mesh = self._mesh_key()
+        key_maps = (mesh, self.frame.mesh.fabric_size_m, tuple(float(v) for v in inputs.key_to_light),
+                    patterned, self._pattern_key() if patterned else None,
+                    colours["u_mean_coverage"], colours["u_thread_beam_rgb"],
+                    bool(self.frame.key_second_layer), self.frame.room_targets.key_texels)
+        if not self._kept("key", key_maps):
+            self._draw_key_front(inputs, patterned, colours)
+            self._draw_key_visibility(inputs, "key_visibility")
+            if self.frame.mesh.has_coarse_grid:
+                self._draw_key_visibility(inputs, "key_visibility_coarse", coarse=True)
+        if not self._kept("occlusion", mesh):   # the outside's occlusion: the cloth's alone
+            self._draw_occlusion_maps()
+            self._draw_vertex_occlusion()
+
+    def _mesh_key(self) -> tuple:
+        """What the cloth's maps take of the mesh and the room: its buffers, their version
+        (bumped by set_mesh, update_positions and cloth_moved), format, count and offset,
+        and the frame's placement."""
+        mesh = self.frame.mesh
+        return (mesh.version, mesh.format, mesh.vertex_count, mesh.offset_m,
+                tuple((name, id(b)) for name, b in (mesh.buffers or {}).items()
+                      if name in _MESH_BUFFERS), self.frame.placement)
+
+    def _pattern_key(self) -> tuple:
+        """What the maps take of the pattern: its texture (the fabric's key, the texture
+        object and its filtering) and the hem's band."""
+        fp = self.frame.fabric_pattern
+        texture = fp.texture
+        return (fp.key, id(texture), tuple(texture.filter), float(texture.anisotropy),
+                id(fp.border), fp.border_repeats, fp.repeat_m)
+
+    def _kept(self, group: str, key) -> bool:
+        """Whether the maps of ``group`` hold what ``key`` draws (drawn for real with it since
+        the maps were made): then they are kept, not drawn again (a frame per light of the
+        web export's meter and whites drew the same occlusion maps each time). A context that
+        notes commands (catalog.web.record: the page replays the maps every frame) draws them
+        each time; a dry recording draws no pixels, so the maps hold what they held."""
+        drawn = self.frame.room_targets.drawn
+        recording = getattr(self.ctx, "recording", None)
+        if recording is not None and recording.commands is not None:
+            if not recording.skipping:
+                drawn[group] = key
+            return False
+        if drawn.get(group) == key:
+            return True
+        drawn[group] = key
+        return False
 
     def _draw_occlusion_maps(self) -> None:
         """SKY_OCCLUSION's maps: per direction of room_light.occlusion_directions, the depth

@@ -219,6 +219,9 @@ class RoomTargets:
         self.ctx, self.mgl = ctx, moderngl
         self.shadow_texels = int(shadow_texels)
         self.objects: dict | None = None
+        #: what the maps hold: map group -> the key of its last real drawing (the shadow pass
+        #: keeps a group whose inputs did not change); emptied with the maps
+        self.drawn: dict = {}
 
     def get(self) -> dict:
         """The maps, made on first use."""
@@ -274,3 +277,4 @@ class RoomTargets:
         for obj in self.objects.values():
             obj.release()
         self.objects = None
+        self.drawn = {}
