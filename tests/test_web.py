@@ -3,6 +3,7 @@ frame, the site command and its refusals. The page itself is tested in test_web_
 
 from __future__ import annotations
 
+import base64
 import json
 import os
 import stat
@@ -24,7 +25,9 @@ def test_es_variant_is_the_same_file_with_another_version_line():
     es = shaderlib.load_source("curtain.frag", defines, dialect="es300").splitlines()
     assert core[0].startswith("#version 430") and es[0] == "#version 300 es"
     added = [line for line in es[1:] if line not in core]
-    assert added == ["precision highp float;", "precision highp int;", "precision highp sampler2D;"]
+    # (sampler2DShadow has no default precision in ES 3.00: the room's depth map needs one)
+    assert added == ["precision highp float;", "precision highp int;", "precision highp sampler2D;",
+                     "precision highp sampler2DShadow;"]
     assert [line for line in es[1:] if line not in added] == core[1:]
     # the precision lines follow the defines (so a define can never be hidden by them)
     assert es.index("#define N_BANDS 3") < es.index("precision highp float;")
@@ -218,6 +221,107 @@ def test_recording_context_refuses_what_the_page_cannot_replay(gl):
         fbo.color_mask = (True, False, True, True)
     fbo.release()
     texture.release()
+
+
+@pytest.mark.gl
+def test_the_room_transport_is_recorded_as_a_host_step(gl):
+    """The lit room (room_lighting on) through the recorder: the frame and the receivers'
+    irradiance are bit-identical to the plain context's; the recording holds one host step
+    ``room_transport`` after the views it reads are drawn (the captures' framebuffer) and
+    before the room is drawn, whose commands are only writes to the outputs its inputs name
+    (the light map's buffer, the room-side, wall and cloth textures); the room's depth map is
+    a depth texture with its compare func; a dry recording of it is refused (it reads pixels)."""
+    from catalog.core.errors import CatalogError
+    from catalog.render.frame import FrameRenderer
+    from catalog.web.record import RecordingContext
+
+    images, irradiance = [], []
+    rec_ctx = RecordingContext(gl)
+    for ctx in (gl, rec_ctx):
+        renderer = FrameRenderer(ctx, (48, 36), specialise=False)
+        try:
+            renderer.update(fabric="linen-dense", light="D65", room_lighting=True)
+            if ctx is rec_ctx:
+                renderer.render()   # the programs and targets made before the recorded frame
+                renderer.invalidate_room_light()
+                with pytest.raises(CatalogError, match="host step 'room_transport' reads pixels"):
+                    ctx.recording.start(dry=True)
+                    renderer.render()
+                ctx.recording.stop()
+                renderer.invalidate_room_light()
+                ctx.recording.start(dry=False)
+            renderer.render()
+            if ctx is rec_ctx:
+                commands = ctx.recording.stop()
+            images.append(renderer.read_srgb8())
+            irradiance.append(renderer.room_transport.irradiance.copy())
+        finally:
+            renderer.release()
+    assert np.array_equal(images[0], images[1])
+    assert np.array_equal(irradiance[0], irradiance[1]) and irradiance[0].max() > 0
+    rec = rec_ctx.recording
+    ops = [c["op"] for c in commands]
+    assert ops.count("host") == 1 and ops.count("host_end") == 1
+    start, end = ops.index("host"), ops.index("host_end")
+    step = commands[start]
+    assert step["name"] == "room_transport"
+    inputs = step["inputs"]
+    outputs = inputs["outputs"]
+    written = {outputs["light_map"]["object"]} | {outputs[k]["object"] for k in ("room_side", "wall_grid")} \
+        | {t["object"] for t in outputs["cloth"]}
+    inside = commands[start + 1:end]
+    assert inside and {c["op"] for c in inside} <= {"buffer_write", "texture_write"}
+    assert {c.get("buffer", c.get("texture")) for c in inside} <= written
+    capture = inputs["captures"]["texture"]["object"]
+    capture_fbos = {rid for rid, f in rec.framebuffers.items() if capture in f["colour"]}
+    drawn_into = None
+    views = 0
+    for c in commands[:start]:
+        if c["op"] == "framebuffer":
+            drawn_into = c["framebuffer"]
+        elif c["op"] == "draw" and drawn_into in capture_fbos:
+            views += 1
+    assert views >= len(inputs["captures"]["weights"])   # a view a direction at least
+    room_program = {rid for rid, r in rec.programs.items() if r["vertex"] == "room_transport.vert"}
+    room_draws = [i for i, c in enumerate(commands) if c["op"] == "draw"
+                  and rec.vertex_arrays[c["vertex_array"]]["program"] in room_program
+                  and rec.vertex_arrays[c["vertex_array"]]["content"][0]["buffer"] == outputs["light_map"]["object"]]
+    assert room_draws and min(room_draws) > end
+    depth = rec.textures[inputs["room_depth"]["texture"]["object"]]
+    assert depth["dtype"] == "depth" and depth["compare_func"] == "<="
+
+
+@pytest.mark.gl
+def test_a_scene_with_the_room_transport_exports_its_host_step(gl):
+    """SiteExporter.record of a lit-room scene: its host step's in-frame writes carry their
+    bytes as the scene's blobs (slots, not in the shared structure); objects() gives the page
+    the room's depth map as a depth texture (with its compare func), not a renderbuffer, and
+    every texture a host step writes."""
+    from catalog.render import scene as scene_lib
+    from catalog.render import settings as settings_lib
+    from catalog.web import export
+
+    exporter = export.SiteExporter(gl)
+    try:
+        d = scene_lib.draped_curtain(12, 8)
+        exporter.use_mesh(d.positions, d.normals, d.uvs, d.tangents, d.indices)
+        choice = export.LightChoice(id="D65", label="D65", kind="lamp", hour=None)
+        scene = exporter.scene(settings_lib.FrameSettings(fabric="linen-dense").fabric, choice)
+        recorded = exporter.record(scene.replace(room_lighting=True), "on")
+        structure = exporter.structures[recorded["structure"]]
+        writes = [c for c in structure if c["op"] == "texture_write"]
+        assert writes and all("data" not in c for c in writes)
+        for c in writes:
+            blob = exporter.value_pool[recorded["values"][c["slot"]]]["blob"]
+            size = exporter.ctx.recording.textures[c["texture"]]["size"]
+            assert len(base64.b64decode(exporter.blobs[blob])) == size[0] * size[1] * 4 * 4
+        objects = exporter.objects()
+        depth = [rid for rid, t in objects["textures"].items() if t["dtype"] == "depth"]
+        assert len(depth) == 1 and objects["textures"][depth[0]]["compare_func"] == "<="
+        assert depth[0] not in objects["renderbuffers"]
+        assert {c["texture"] for c in writes} <= set(objects["textures"])
+    finally:
+        exporter.release()
 
 
 @pytest.mark.gl

@@ -87,7 +87,7 @@ def _define_lines(defines: Mapping[str, object]) -> list[str]:
 DIALECTS: dict[str, tuple[str | None, tuple[str, ...]]] = {
     "core": (None, ()),  # the file's own version line (430)
     "es300": ("300 es", ("precision highp float;", "precision highp int;",
-                                  "precision highp sampler2D;")),
+                                  "precision highp sampler2D;", "precision highp sampler2DShadow;")),
 }
 
 

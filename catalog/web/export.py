@@ -89,10 +89,10 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: The pattern's prefiltered mip levels (catalog.presets.patterns.mip_chain) travel with its
 #: texels (given_texels) and the page writes them over its generateMipmap chain, as the desktop
 #: writes them over its built one.
-#: ``room_lighting``: off (the constant room: the room file under the ambient and fill
-#: stand-ins) until the page applies the room's transport (its pack, catalog/room/web_pack.py):
-#: the transport's update reads its views of the window back and works on the host, which a
-#: replayed recording cannot do for a moving cloth.
+#: ``room_lighting``: on, the room by its transport as the desktop frame lights it: the
+#: transport's update is a host step (catalog.gl.host_step: its views of the window read back,
+#: worked on the host, the light map uploaded), recorded wet with the desktop's outputs for the
+#: scene's recorded cloth, which the page replays (assets/host_steps.js).
 DESKTOP_MODES = {"patterned": True, "room_lighting": False, "antialiasing": "fxaa",
                  "key_second_layer": False}
 
@@ -254,7 +254,7 @@ def split_commands(commands: list[dict], camera_values: dict | None = None,
         elif command["op"] == "viewport" and command["viewport"][:2] == [0, 0] \
                 and canvas_level(command["viewport"][2:]) is not None:
             structure.append(dict(command, canvas_level=canvas_level(command["viewport"][2:])))
-        elif command["op"] == "buffer_write":  # the bytes are the scene's, the place is not
+        elif command["op"] in ("buffer_write", "texture_write"):  # the scene's bytes, not the place
             structure.append({k: v for k, v in command.items() if k != "data"}
                              | {"slot": len(values)})
             values.append(_b64(command["data"]))
@@ -456,12 +456,14 @@ class SiteExporter:
                 measured = r.display.measured_white()
                 self._whites[measured[0]] = measured
         r.invalidate_room_light()  # the room's light passes are part of every recorded frame
-        rec.start(dry=True)  # only the commands are kept: no pixels drawn
+        # only the commands are kept, no pixels drawn, unless the frame has a host step (the
+        # room's transport reads its views back: catalog.gl.host_step)
+        rec.start(dry=not scene.room_lighting)
         r.render()
         structure, values = split_commands(rec.stop(), self.camera_values(), clean=self._clean)
         self._encode_given_texels()
         for command in structure:  # bytes written in a frame: shared by the scenes alike
-            if command["op"] == "buffer_write":
+            if command["op"] in ("buffer_write", "texture_write"):
                 values[command["slot"]] = {"blob": self._blob(values[command["slot"]])}
         values = [self._pooled(v) for v in values]
         key = hashlib.sha256(json.dumps(structure, sort_keys=True).encode()).hexdigest()
@@ -573,7 +575,7 @@ class SiteExporter:
                     used_programs.add(c["program"])
                 elif c["op"] in ("framebuffer", "clear"):
                     used_fbos.add(c["framebuffer"])
-                elif c["op"] == "texture":
+                elif c["op"] in ("texture", "texture_write"):
                     used_textures.add(c["texture"])
         vaos = {rid: rec.vertex_arrays[rid] for rid in sorted(used_vaos)}
         for vao in vaos.values():
@@ -589,6 +591,8 @@ class SiteExporter:
         for rid in used_fbos:
             fbo = rec.framebuffers[rid]
             used_textures |= set(fbo["colour"])
+            if fbo["depth"] in rec.textures:   # a depth texture (the room's depth map)
+                used_textures.add(fbo["depth"])
         sources: dict[str, dict] = {}
         programs = {}
         for rid in sorted(used_programs):
@@ -614,7 +618,8 @@ class SiteExporter:
             "textures": {rid: _sized(dict(rec.textures[rid], **self._page_texels(rid)))
                          for rid in sorted(used_textures)},
             "renderbuffers": {rid: _sized(dict(rec.renderbuffers[rid])) for rid in
-                              sorted({rec.framebuffers[f]["depth"] for f in used_fbos} - {None})},
+                              sorted({rec.framebuffers[f]["depth"] for f in used_fbos} - {None}
+                                     - set(rec.textures))},
             "framebuffers": {rid: rec.framebuffers[rid] for rid in sorted(used_fbos)},
             "vertex_arrays": vaos,
         }

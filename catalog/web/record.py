@@ -14,6 +14,7 @@ written twice.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -122,6 +123,22 @@ class _Texture(_Proxy):
         self._rec.textures[self.rid]["anisotropy"] = float(value)
         self._real.anisotropy = value
 
+    @property
+    def compare_func(self):
+        return self._real.compare_func
+
+    @compare_func.setter
+    def compare_func(self, value) -> None:
+        # a depth texture sampled by a shadow sampler (the room's depth map from the key)
+        self._rec.textures[self.rid]["compare_func"] = str(value)
+        self._real.compare_func = value
+
+    def read(self, *args, **kw):
+        if self._rec.skipping:
+            raise CatalogError("the desktop frame reads a texture back in a dry recording: "
+                               "record a frame with a host step wet (Recording.start(dry=False))")
+        return self._real.read(*args, **kw)
+
     def write(self, data, **kw):
         if set(kw) == {"level"} and kw["level"] > 0 and self._rec.textures[self.rid].get("mipmaps"):
             # a prefiltered mip level (catalog.presets.patterns.mip_chain) over the built chain:
@@ -133,6 +150,14 @@ class _Texture(_Proxy):
             return self._real.write(data, **kw)
         if kw:
             raise CatalogError("the web page replays only whole-texture writes")
+        if self._rec.commands is not None:
+            # written within a frame (a host step's output, e.g. the room's light on the
+            # cloth): a command the page replays with the scene's bytes, as a buffer write
+            if self._rec.textures[self.rid].get("mipmaps"):
+                raise CatalogError("the web page replays in-frame writes only of textures "
+                                   "without mipmaps")
+            self._rec.note({"op": "texture_write", "texture": self.rid, "data": bytes(data)})
+            return self._real.write(data)
         self._rec.texture_data[self.rid] = bytes(data)
         self._rec.texture_levels.pop(self.rid, None)   # new texels: their levels come again
         return self._real.write(data)
@@ -296,6 +321,19 @@ class RecordingContext:
         self.recording._pending_recipe = {"vertex": vertex, "fragment": fragment,
                                           "defines": defines}
 
+    # -- told by catalog.gl.host_step around a frame's host work
+    @contextlib.contextmanager
+    def host_step_sink(self, name: str, inputs: dict):
+        """Notes ``host`` (the step's name, its inputs with GL objects as ids) and, after the
+        step's own commands (its outputs), ``host_end``; the step reads pixels back, so a dry
+        recording is refused."""
+        rec = self.recording
+        if rec.skipping:
+            raise CatalogError(f"host step {name!r} reads pixels back: record its frame wet")
+        rec.note({"op": "host", "name": str(name), "inputs": _plain(inputs)})
+        yield
+        rec.note({"op": "host_end", "name": str(name)})
+
     def program(self, **kw):
         recipe = self.recording._pending_recipe
         self.recording._pending_recipe = None
@@ -320,6 +358,17 @@ class RecordingContext:
                                               "filter": [int(v) for v in real.filter]}
         if data is not None:
             self.recording.texture_data[proxy.rid] = bytes(data)
+        return proxy
+
+    def depth_texture(self, size, data=None, **kw):
+        """A depth texture (the room's depth map from the key), drawn by the frame, sampled
+        with its compare function (:attr:`_Texture.compare_func`)."""
+        if data is not None:
+            raise CatalogError("the web page replays only depth textures the frame draws")
+        real = self._ctx.depth_texture(size, **kw)
+        proxy = _Texture(real, self.recording, self.recording.new_id())
+        self.recording.textures[proxy.rid] = {"size": [int(v) for v in size], "components": 1,
+                                              "dtype": "depth", "filter": [int(v) for v in real.filter]}
         return proxy
 
     def depth_renderbuffer(self, size, **kw):
@@ -423,3 +472,25 @@ def _flag_names(flags: int) -> list[str]:
     if int(flags) & ~sum(_FLAGS):
         raise CatalogError(f"GL state flags {int(flags)} include some the web page cannot set")
     return names
+
+
+def _plain(value):
+    """A host step's inputs as JSON: GL objects by their recorded id ({"object": id}), numpy
+    arrays and tuples as lists."""
+    if isinstance(value, _Proxy):
+        return {"object": value.rid}
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value)
+    if value is None or isinstance(value, str):
+        return value
+    raise CatalogError(f"a host step's input of type {type(value).__name__} cannot be recorded")

@@ -35,7 +35,7 @@ import numpy as np
 from catalog.core.errors import CatalogError, InputError
 
 #: The page's own files (catalog/web/assets), copied as they are.
-ASSET_FILES = ("index.html", "app.js", "room_transport.js", "style.css")
+ASSET_FILES = ("index.html", "app.js", "room_transport.js", "host_steps.js", "style.css")
 #: A file every site has: marks a folder as ours (safe to replace).
 MARKER = "catalog-web-site.json"
 #: The room's transport pack (catalog.room.web_pack.PAGE_FILE).

@@ -97,6 +97,11 @@ class RoomTransportPass:
         self._white = white
         self.update(np.zeros((room.count, 3)))
 
+    @property
+    def buffer(self):
+        """The room's vertex buffer (positions, the light map, normals, uvs: :meth:`update`)."""
+        return self._buffer
+
     def program(self, defines: dict):
         key = tuple(sorted(defines.items()))
         if key not in self._programs:

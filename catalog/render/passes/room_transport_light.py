@@ -33,6 +33,7 @@ import math
 
 import numpy as np
 
+from catalog.gl.host_step import host_step
 from catalog.render import scene as scene_lib
 from catalog.render.camera import gl_bytes
 from catalog.render.passes.gl_common import Pass, set_uniform
@@ -240,16 +241,17 @@ class RoomTransportLight(Pass):
             self._wall_grid = texture
         return self._wall_grid
 
-    def outside_radiance(self, inputs) -> np.ndarray:
-        """(K, 3) the outside's radiance (the background without the sun's disc, which the
-        beam carries) in the outward hemispherical basis: one texel per quadrature direction."""
+    def draw_outside(self, inputs) -> None:
+        """The outside (the background without the sun's disc, which the beam carries) one
+        texel per direction of the outward hemisphere's quadrature (:meth:`outside_radiance`
+        reads them)."""
         from catalog.render.passes.room_transport import look_at_view_projection  # noqa: PLC0415
 
         count = len(self._outside_weights)
         if self._outside_target is None:
             texture = self.ctx.texture((count, 1), 4, dtype="f4")
             self._outside_target = (texture, self.ctx.framebuffer([texture]))
-        texture, fbo = self._outside_target
+        _texture, fbo = self._outside_target
         fbo.use()
         self.ctx.disable(self.mgl.DEPTH_TEST)
         for j, d in enumerate(self._outside_dirs):
@@ -257,14 +259,20 @@ class RoomTransportLight(Pass):
             self.ctx.viewport = (j, 0, 1, 1)
             view_proj = look_at_view_projection((0.0, 0.0, 0.0), d, up, 0.5, 1.0)
             self.frame.background.draw(view_proj, inputs, camera_position=(0.0, 0.0, 0.0), sun_disc=False)
+
+    def outside_radiance(self) -> np.ndarray:
+        """(K, 3) the outside's radiance in the outward hemispherical basis, from
+        :meth:`draw_outside`'s texels."""
+        count = len(self._outside_weights)
+        texture = self._outside_target[0]
         radiance = np.frombuffer(texture.read(), dtype="f4").reshape(count, 4)[:, :3].astype(np.float64)
         return np.einsum("jk,j,jc->kc", self._outside_basis, self._outside_weights, radiance)
 
-    def outside_irradiance(self, inputs) -> np.ndarray:
+    def outside_irradiance(self) -> np.ndarray:
         """(E, 3) what receivers outside the aperture (the reveals, a sill) take directly from
         the outside and from the closed curtain's window side (its capture's mean radiance)."""
         ops = self.ops
-        e = ops.outside @ self.outside_radiance(inputs)
+        e = ops.outside @ self.outside_radiance()
         if not self.frame.curtain_open and np.any(ops.window_back):
             e = e + ops.window_back[:, None] * self._back_mean.reshape(-1, 3).mean(axis=0)[None, :]
         return e
@@ -343,19 +351,23 @@ class RoomTransportLight(Pass):
         """The cloth's window side in parallel views of the aperture from outside (the
         outward quadrature's directions), as the room's light sees it there: its back capture's
         values (catalog.render.passes.scene_terms.back_capture_overrides: no see-through, the
-        outside reflected), nothing where there is no cloth; its cosine-weighted mean radiance
-        per patch (:attr:`_back_mean`, (nv, nu, 3))."""
-        nu, nv = self._patches
+        outside reflected), nothing where there is no cloth (:meth:`read_window_side`)."""
         if self.frame.curtain_open:
-            self._back_mean = np.zeros((nv, nu, 3))
             return
         texture, _depth, fbo = self._back_targets()
         overrides = self.frame.terms.back_capture_overrides()
         for view_proj, eye in self._aperture_views(fbo, self._back_world_dirs):
             self.frame.curtain.draw_flat(view_proj, eye, overrides, coarse=CAPTURE_COARSE)
         texture.build_mipmaps()
-        radiance = self._patch_radiance(texture, len(self._back_weights))
-        self._back_mean = np.einsum("j,jvuc->vuc", self._back_weights, radiance)
+
+    def read_window_side(self) -> np.ndarray:
+        """(nv, nu, 3) the cloth's window side's cosine-weighted mean radiance per patch
+        (:meth:`draw_window_side`'s views; zero with the curtain open)."""
+        nu, nv = self._patches
+        if self.frame.curtain_open:
+            return np.zeros((nv, nu, 3))
+        radiance = self._patch_radiance(self._back_targets()[0], len(self._back_weights))
+        return np.einsum("j,jvuc->vuc", self._back_weights, radiance)
 
     def read_captures(self) -> np.ndarray:
         """(J, nv, nu, 3) each direction's mean radiance over each patch (row 0: the v edge's start)."""
@@ -461,10 +473,37 @@ class RoomTransportLight(Pass):
 
     # ------------------------------------------------------------------ the whole update
     def update(self, inputs) -> None:
-        """Steps 1-4 (the shadow pass has drawn the transmittance map)."""
+        """Steps 1-4 (the shadow pass has drawn the transmittance map): the views drawn, then
+        the host step (catalog.gl.host_step: read back, computed, uploaded)."""
         self.draw_window_side()
         self.draw_captures(inputs)
         self.draw_room_depth(inputs)
+        self.draw_outside(inputs)
+        with host_step(self.ctx, "room_transport", self.host_inputs()):
+            self._host_update(inputs)
+
+    def host_inputs(self) -> dict:
+        """The host step's inputs (catalog.gl.host_step): the textures it reads back and the
+        ones it writes, the vertex buffer of the light map, and the quadratures' constants."""
+        nu, nv = self._patches
+        return {
+            "patches": [nu, nv], "capture_level": int(math.log2(CAPTURE_TEXELS_PER_PATCH)),
+            "captures": {"texture": self._capture[0], "basis": self._basis, "weights": self._weights},
+            "window_side": {"texture": None if self._back_capture is None else self._back_capture[0],
+                            "weights": self._back_weights},
+            "outside": {"texture": self._outside_target[0], "basis": self._outside_basis,
+                        "weights": self._outside_weights},
+            "room_depth": {"texture": self._room_depth[0], "offset_m": DEPTH_OFFSET_M},
+            "shadow": self.frame.room_targets.get()["shadow"],
+            "uniform_c0": self._uniform_c0, "exitance_basis": self._exitance_basis,
+            "reflection_iterations": REFLECTION_ITERATIONS,
+            "outputs": {"light_map": self.draw_pass.buffer, "room_side": self.frame.room_targets.get()["room_side"],
+                        "wall_grid": self.wall_grid_texture(),
+                        "cloth": list(self.cloth_textures())},
+        }
+
+    def _host_update(self, inputs) -> None:
+        self._back_mean = self.read_window_side()
         c_window = self.project(self.read_captures())
         t = self.ops
         rho = t.albedo
@@ -472,7 +511,7 @@ class RoomTransportLight(Pass):
         # the direct light the window's operator does not hold (the operator is linear: one
         # bounced() of their sum): the beam (drawn per pixel, so only its bounces are added),
         # the outside on the receivers outside the aperture, the lamps
-        direct = beam + self.outside_irradiance(inputs)
+        direct = beam + self.outside_irradiance()
         if self.frame.room_lamps:
             direct = direct + self.lamp_irradiance()
         beam_bounces = t.bounced(direct) - beam

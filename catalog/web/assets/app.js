@@ -306,6 +306,11 @@
       for (const [rid, t] of Object.entries(D.textures)) {
         const tex = gl.createTexture(), s = sized(t);
         gl.bindTexture(gl.TEXTURE_2D, tex);
+        if (t.dtype === 'depth') {  // a depth texture the frame draws (record.py), its compare func
+          CatalogHost.depthTexture(gl, t, s, DEPTH_FUNCS);
+          textures[rid] = { tex, depth: true };
+          continue;
+        }
         const half = t.dtype === 'f2', float = t.dtype === 'f4' || half, c = t.components - 1;
         if (t.data && half) throw new Error('half-float texels given by the frame: not replayed');
         const formats = [gl.RED, gl.RG, gl.RGB, gl.RGBA];
@@ -354,7 +359,8 @@
         gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
         f.colour.forEach((t, i) => gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + i, gl.TEXTURE_2D, textures[t].tex, 0));
         gl.drawBuffers(f.colour.map((_, i) => gl.COLOR_ATTACHMENT0 + i));
-        if (f.depth != null) gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, renderbuffers[f.depth].rb);
+        if (f.depth != null && textures[f.depth]) gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.TEXTURE_2D, textures[f.depth].tex, 0);
+        else if (f.depth != null) gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, renderbuffers[f.depth].rb);
         targets['fbo' + rid] = { fbo };
       }
       gl.bindFramebuffer(gl.FRAMEBUFFER, null);
@@ -385,9 +391,21 @@
       const cam = cameraUniforms(camera, w / h);
       let screen = null;
       for (const c of structure) if (c.op === 'framebuffer') screen = c.framebuffer;
-      let current = null;
+      let current = null, host = null;  // host: a host step the page ran itself (its recorded outputs skipped)
       for (const c of structure) {
+        if (host !== null && c.op !== 'host_end') continue;
         switch (c.op) {
+          case 'host':  // a host step (catalog/gl/host_step.py): run by host_steps.js where it knows it
+            if (CatalogHost.run(c.name, c.inputs, this, scene)) { host = c.name; current = null; }
+            break;
+          case 'host_end': host = null; break;
+          case 'texture_write': {  // texels a host step wrote this frame (record.py), on a spare unit
+            const units = gl.getParameter(gl.MAX_COMBINED_TEXTURE_IMAGE_UNITS);
+            gl.activeTexture(gl.TEXTURE0 + units - 1);
+            gl.bindTexture(gl.TEXTURE_2D, this.targets[c.texture].tex);
+            CatalogHost.writeTexture(gl, D.textures[c.texture], bin(D.blobs[value(scene, c.slot).blob]));
+            break;
+          }
           case 'framebuffer':  // moderngl's use(): the framebuffer's depth mask with it
             gl.bindFramebuffer(gl.FRAMEBUFFER, c.framebuffer === screen ? null : this.targets['fbo' + c.framebuffer].fbo);
             gl.depthMask(D.framebuffers[c.framebuffer].depth_mask !== false);
