@@ -216,3 +216,18 @@ def test_docs_files_are_read(tmp_path):
     """The checks above read something: the docs quote dozens of command lines."""
     assert sum(1 for _ in _quoted_command_lines()) > 40
     assert Path(PROJECT_ROOT / "docs" / "formats.md") in DOCS
+
+
+def test_every_room_option_names_every_built_in_room():
+    """--room reads alike in every command and lists the rooms the package ships (it said
+    "box, living" in five commands after the bedroom was added)."""
+    from catalog.room.load import BUILTIN_ROOMS
+
+    rooms = [name for name, parser in _commands().items()
+             if "--room" in _visible_options(parser) and name != "bench"]   # bench's: a filter
+    assert {"snapshot", "view", "sheet", "reference", "render-catalog", "web", "export"} <= set(rooms)
+    for name in rooms:
+        action = _visible_options(_commands()[name])["--room"]
+        assert action.metavar == "NAME|FILE.glb", name
+        assert f"a built-in name ({', '.join(BUILTIN_ROOMS)})" in action.help, (name, action.help)
+        assert f"default {action.default}" in action.help, name

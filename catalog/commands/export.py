@@ -19,14 +19,14 @@ MAX_FRAME = 10000
 
 
 def add_arguments(parser) -> None:
+    from catalog.commands.roomargs import add_room_argument  # noqa: PLC0415
     from catalog.core.cliargs import number_type  # noqa: PLC0415
 
     parser.add_argument("--fabric", required=True, help="a fabric name or a preset .toml")
     parser.add_argument("--light", default="D65", help="the light the file records (default D65)")
     parser.add_argument("--frame", type=number_type(0, MAX_FRAME, whole=True), default=0,
                         help="the cloth frame (0: the settled drape; default 0)")
-    parser.add_argument("--room", default="box", metavar="NAME|FILE.glb",
-                        help="the room the curtain hangs in: box, living or a room .glb (default box)")
+    add_room_argument(parser, "box", ": the curtain hangs in its window")
     parser.add_argument("--out", required=True, metavar="FILE.glb|FILE.u3m", help="file to write")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
 

@@ -12,6 +12,7 @@ HELP = "path-trace the snapshot scene (Mitsuba 3 on the CPU) to a linear EXR: th
 
 
 def add_arguments(parser) -> None:
+    from catalog.commands.roomargs import add_room_argument  # noqa: PLC0415
     from catalog.core import validate  # noqa: PLC0415
     from catalog.core.cliargs import number_type  # noqa: PLC0415
 
@@ -36,7 +37,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--no-fluorescence", action="store_true", help="without fluorescence")
     parser.add_argument("--mode", choices=FLUORESCENT_MODES, default="physical",
                         help="fluorescence model (default physical)")
-    parser.add_argument("--room", default="box", help="room: a built-in name (box, living) or a .glb file")
+    add_room_argument(parser, "box")
     parser.add_argument("--out", required=True, help="FILE.exr (linear radiance)")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 

@@ -19,6 +19,7 @@ EXIT_PARTIAL = 3
 
 
 def add_arguments(parser) -> None:
+    from catalog.commands.roomargs import add_room_argument  # noqa: PLC0415
     from catalog.core import validate  # noqa: PLC0415
     from catalog.core.cliargs import number_type  # noqa: PLC0415
     from catalog.core.fabricargs import CATALOG_LIGHTS, add_fabric_options  # noqa: PLC0415
@@ -51,9 +52,7 @@ def add_arguments(parser) -> None:
                         default=2.6, help="camera distance, m")
     parser.add_argument("--exposure", type=number_type(*validate.EXPOSURE), default=1.0,
                         help="exposure multiplier")
-    parser.add_argument("--room", default="box", metavar="NAME|FILE.glb",
-                        help="the room: a built-in name (box, living) or a room .glb "
-                             "(docs/formats.md, Rooms; default box)")
+    add_room_argument(parser, "box")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
 

@@ -12,6 +12,7 @@ HELP = "contact sheet: every fabric x light as PNG images and one grid image"
 
 
 def add_arguments(parser) -> None:
+    from catalog.commands.roomargs import add_room_argument  # noqa: PLC0415
     from catalog.core.fabricargs import CATALOG_LIGHTS, add_fabric_options  # noqa: PLC0415
 
     parser.add_argument("--lights", default=CATALOG_LIGHTS, metavar="NAME[,NAME..]",
@@ -26,9 +27,7 @@ def add_arguments(parser) -> None:
     add_display_arguments(parser)
     parser.add_argument("--no-labels", action="store_true",
                         help="grid without the fabric (row) and light (column) labels")
-    parser.add_argument("--room", default="living", metavar="NAME|FILE.glb",
-                        help="the room: a built-in name (box, living) or a room .glb "
-                             "(docs/formats.md, Rooms; default living)")
+    add_room_argument(parser, "living")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 

@@ -15,6 +15,7 @@ OPTION_OF_FIELD = {"lamps": "--lamp"}
 
 
 def add_arguments(parser) -> None:
+    from catalog.commands.roomargs import add_room_argument  # noqa: PLC0415
     from catalog.core import validate  # noqa: PLC0415
     from catalog.core.cliargs import number_type  # noqa: PLC0415
 
@@ -58,9 +59,7 @@ def add_arguments(parser) -> None:
                              "window at z = -0.2); up to 4")
     parser.add_argument("--no-room-light", action="store_true",
                         help="the earlier constant room instead of the room lit through the curtain")
-    parser.add_argument("--room", default="box", metavar="NAME|FILE.glb",
-                        help="the room: a built-in name (box, living) or a room .glb "
-                             "(docs/formats.md, Rooms; default box)")
+    add_room_argument(parser, "box")
     parser.add_argument("--no-bloom", action="store_true", help="no glare before the tone map")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 

@@ -46,6 +46,7 @@ def _render_scale(text: str) -> float | None:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from catalog.commands.roomargs import add_room_argument  # noqa: PLC0415
     parser.add_argument("--fabric", help="fabric to show first (preset name or .toml)")
     parser.add_argument("--light", help="light to start with: 'sun' (hour slider), a CIE "
                         "illuminant (D65, A, FL2, LED-B4, ...), UV-A, UV-385, LED-405, "
@@ -85,9 +86,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "0.5 on a software rasteriser such as llvmpipe, else 1)")
     parser.add_argument("--no-room-light", action="store_true",
                         help="the earlier constant room and flat sky, no glare (docs/room.md)")
-    parser.add_argument("--room", default="living", metavar="NAME|FILE.glb",
-                        help="the room: a built-in name (box, living) or a room .glb "
-                             "(docs/formats.md, Rooms; default living)")
+    add_room_argument(parser, "living")
     parser.add_argument("--no-panel", action="store_true", help="start with the panel hidden")
     parser.add_argument("--paused", action="store_true", help="start with the cloth paused")
     parser.add_argument("--compare-fluorescence", choices=FLUORESCENCE_CHOICES, default=None,

@@ -9,6 +9,7 @@ HELP = "write a static web catalog (WebGL2, same shaders and light) that opens f
 
 
 def add_arguments(parser) -> None:
+    from catalog.commands.roomargs import add_room_argument  # noqa: PLC0415
     parser.add_argument("--out", required=True,
                         help="folder of the site (DIR/index.html); built beside it and renamed "
                              "when complete; replaces only an earlier site or an empty folder")
@@ -18,10 +19,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--lights", default=None, metavar="NAME[,NAME..]",
                         help="comma-separated lamps of the light library, and 'sun-by-hour' for "
                              "the sun slider (default: D65,A,FL2,LED-B4,LED-warm,UV-A,sun-by-hour)")
-    parser.add_argument("--room", default="box", metavar="NAME|FILE.glb",
-                        help="the room: a built-in name (box, living, bedroom) or a room .glb "
-                             "(docs/formats.md, Rooms; default box); its transport's web pack "
-                             "is written beside the page (room_pack.js)")
+    add_room_argument(parser, "box", "; its transport's web pack is written beside the page "
+                                     "(room_pack.js)")
     parser.add_argument("--json", action="store_true", help="print the report as one JSON object")
 
 

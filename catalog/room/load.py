@@ -23,10 +23,9 @@ from pathlib import Path
 import numpy as np
 
 from catalog.core.errors import InputError
-from catalog.room import glb
+from catalog.room import BUILTIN_ROOMS, glb  # noqa: F401  (BUILTIN_ROOMS: named here too)
 from catalog.room.model import Camera, Room, Surface, Window
 
-BUILTIN_ROOMS = ("box", "living", "bedroom")
 DATA_DIR = Path(__file__).resolve().parent / "data"
 MAX_FILE_BYTES = 64 << 20
 MAX_TRIANGLES = 200_000
