@@ -23,6 +23,7 @@ from benchmarks import accuracy
 ROOT = Path(__file__).resolve().parent.parent
 
 
+@pytest.mark.slow   # the draw loads the built-in rooms (each camera's limit is its room's)
 def test_draw_is_seeded_and_covers_the_space():
     first = accuracy.draw_scenes(100, 7)
     assert first == accuracy.draw_scenes(100, 7)

@@ -224,6 +224,7 @@ def test_recording_context_refuses_what_the_page_cannot_replay(gl):
 
 
 @pytest.mark.gl
+@pytest.mark.slow   # a recorded lit frame (1.1-1.7 s under -n 2)
 def test_the_room_transport_is_recorded_as_a_host_step(gl):
     """The lit room (room_lighting on) through the recorder: the frame and the receivers'
     irradiance are bit-identical to the plain context's; the recording holds one host step
@@ -292,6 +293,7 @@ def test_the_room_transport_is_recorded_as_a_host_step(gl):
 
 
 @pytest.mark.gl
+@pytest.mark.slow   # a recorded lit frame (1.1-1.7 s under -n 2)
 def test_a_scene_with_the_room_transport_exports_its_host_step(gl):
     """SiteExporter.record of a lit-room scene: its host step's in-frame writes carry their
     bytes as the scene's blobs (slots, not in the shared structure); objects() gives the page
@@ -613,7 +615,7 @@ def test_frame_comparison_reports_a_frame_wide_shift():
 
 
 def test_stage_peaks_reset_at_each_stage(tmp_path):
-    """StagePeaks (benchmarks/web_build's per-stage column): a stage that holds 200 MB for a
+    """StagePeaks (the per-stage column of benchmarks/web_build.py): a stage that holds 200 MB for a
     moment peaks at least 190 MB above the resident set before it; the stage after it, which
     holds nothing more, peaks below that (the peak is reset at each stage's start). Linux
     only (VmHWM, /proc/self/clear_refs); elsewhere nothing is measured."""
