@@ -50,7 +50,7 @@ def test_simulate_numpy_backend_and_sequence(tmp_path, capsys):
     (["--grid", "4x4", "--stiffness", "-5"], "--stiffness"),
     (["--grid", "4x4", "--dt", "0"], "--dt"),
     (["--grid", "4x4", "--opening", "0"], "--opening"),
-    (["--grid", "4x4", "--out", "x.stl"], "x.stl"),
+    pytest.param(["--grid", "4x4", "--out", "x.stl"], "x.stl", marks=pytest.mark.slow),  # 0.8 s: a run
 ])
 def test_simulate_refuses_bad_options(argv, option, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

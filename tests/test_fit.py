@@ -337,6 +337,7 @@ def test_match_open_area_remaps_to_the_fitted_ld_and_keeps_holes():
         match_open_area(c, 0.05)     # 12.5 % of the image is holes
 
 
+@pytest.mark.slow   # a fit and its pattern written (0.75 s here)
 def test_fit_with_a_pattern_writes_a_self_contained_preset(tmp_path):
     """``catalog fit --pattern IMAGE --pattern-repeat W``: the preset gets a [pattern] whose
     image lies beside it and whose open area is the fit's LD within formats' 1 %."""

@@ -278,6 +278,7 @@ def test_an_output_naming_the_input_is_refused_and_the_input_kept(tmp_path, proj
     assert excitation.read_bytes() == before
 
 
+@pytest.mark.slow   # 0.6 s here
 def test_a_preset_cannot_name_a_file_outside_its_folder(tmp_path):
     secret = tmp_path / "secret.txt"
     secret.write_text("wavelength_nm,intensity\nTOP-SECRET-CONTENT\n")

@@ -614,6 +614,7 @@ def test_frame_comparison_reports_a_frame_wide_shift():
     assert figures["edge_shift"] == 30 and figures["signed_mean_8bit"] == [-5.0] * 3
 
 
+@pytest.mark.slow   # 200 MB held and let go (0.7 s here)
 def test_stage_peaks_reset_at_each_stage(tmp_path):
     """StagePeaks (the per-stage column of benchmarks/web_build.py): a stage that holds 200 MB for a
     moment peaks at least 190 MB above the resident set before it; the stage after it, which
