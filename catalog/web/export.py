@@ -89,10 +89,12 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: The pattern's prefiltered mip levels (catalog.presets.patterns.mip_chain) travel with its
 #: texels (given_texels) and the page writes them over its generateMipmap chain, as the desktop
 #: writes them over its built one.
-#: ``room_lighting``: on, the room by its transport as the desktop frame lights it: the
-#: transport's update is a host step (catalog.gl.host_step: its views of the window read back,
-#: worked on the host, the light map uploaded), recorded wet with the desktop's outputs for the
-#: scene's recorded cloth, which the page replays (assets/host_steps.js).
+#: ``room_lighting``: off (the constant room: the room file under the ambient and fill
+#: stand-ins). The transport's update is a host step (catalog.gl.host_step: its views of the
+#: window read back, worked on the host, the light map uploaded), which a recording with the
+#: room lit notes wet with the desktop's outputs and the page can replay
+#: (assets/host_steps.js); the page with it on fails the browser tests yet (not understood),
+#: and it would replay the recorded cloth's light, not the moving cloth's.
 DESKTOP_MODES = {"patterned": True, "room_lighting": False, "antialiasing": "fxaa",
                  "key_second_layer": False}
 

@@ -158,8 +158,7 @@ _PREPARED: list = [None]
 
 def _prefiltered(texels: np.ndarray, periodic_v: bool) -> list[np.ndarray]:
     """Levels 1..n of ``texels``' prefiltered chain (catalog.presets.patterns.mip_chain, kept
-    on disk by catalog.presets.mip_cache) as
-    GL sizes them (w >> k by h >> k); a band (not ``periodic_v``) is mirrored about its top
+    on disk by catalog.presets.mip_cache) as GL sizes them (w >> k by h >> k); a band (not ``periodic_v``) is mirrored about its top
     row first, what the clamped edge continues as, each level keeping its first half, and
     its chain stops where the mirrored chain runs out of rows (a band under 2^k rows)."""
     from catalog.presets.mip_cache import cached_mip_chain  # noqa: PLC0415
