@@ -29,6 +29,13 @@ class _Transport:
     receivers: _Receivers
 
 
+def _rows(hang, matrix) -> dict:
+    """{hanging vertex: {free vertex: weight}} of hanging_vertices' (hang, Csr)."""
+    p, i, d = matrix.indptr, matrix.indices, matrix.data
+    return {int(h): dict(zip(i[p[r]:p[r + 1]].tolist(), d[p[r]:p[r + 1]].tolist()))
+            for r, h in enumerate(hang)}
+
+
 def _mesh() -> _Transport:
     """A coarse triangle (a, b, c) beside (b, d, c) split into its four midpoint children,
     one child (b, e, g) split again. Hanging: g = (1, 1) on the coarse hypotenuse b-c (1/2,
@@ -49,9 +56,7 @@ def test_hanging_vertices_take_the_coarse_edge_in_closed_form():
     position = np.zeros((vertex.max() + 1, 3))
     position[vertex] = t.receivers.corners.reshape(-1, 3)
     at = {tuple(np.round(x[:2], 6)): k for k, x in enumerate(position)}
-    hang, indptr, indices, data = lightmap.hanging_vertices(t.receivers, vertex)
-    rows = {int(h): dict(zip(indices[indptr[i]:indptr[i + 1]].tolist(), data[indptr[i]:indptr[i + 1]].tolist()))
-            for i, h in enumerate(hang)}
+    rows = _rows(*lightmap.hanging_vertices(t.receivers, vertex))
     b, c, e = at[(2.0, 0.0)], at[(0.0, 2.0)], at[(2.0, 1.0)]
     g, h, j = at[(1.0, 1.0)], at[(1.5, 0.5)], at[(1.5, 1.0)]
     assert set(rows) == {g, h, j}                    # i = (2, 0.5) lies on the mesh's border
@@ -84,9 +89,7 @@ def test_interleaved_grids_along_one_line_are_solved_together():
     position = np.zeros((vertex.max() + 1, 3))
     position[vertex] = corners.reshape(-1, 3)
     at = {tuple(np.round(x[:2], 6)): k for k, x in enumerate(position)}
-    hang, indptr, indices, data = lightmap.hanging_vertices(rec, vertex)
-    rows = {int(h): dict(zip(indices[indptr[i]:indptr[i + 1]].tolist(), data[indptr[i]:indptr[i + 1]].tolist()))
-            for i, h in enumerate(hang)}
+    rows = _rows(*lightmap.hanging_vertices(rec, vertex))
     bottom, top = at[(0.0, 0.0)], at[(0.0, 4.0)]
     assert set(rows) == {at[(0.0, 1.0)], at[(0.0, 2.0)], at[(0.0, 3.0)]}
     for y in (1.0, 2.0, 3.0):

@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from catalog.room.lightmap import Csr, hanging_vertices, weld_values, weld_vertices  # numpy only
+
 #: Bumped when the bundle's content or the rules that make it (the cloth's room-side grid over
 #: the room's own window, :func:`_room_side_grid`) change.
 BUNDLE_VERSION = 6
@@ -35,22 +37,6 @@ OUTSIDE_ORDER = 3
 #: Cosine-weighted rays from each window patch centre and each point of the cloth's grid.
 GATHER_RAYS_PATCH = 512
 GATHER_RAYS_SIDE = 128
-
-
-@dataclass(frozen=True)
-class Csr:
-    """A sparse matrix (rows, cols) as CSR arrays; :meth:`dot` of (cols, C) -> (rows, C)."""
-
-    data: np.ndarray
-    indices: np.ndarray
-    indptr: np.ndarray
-    shape: tuple
-
-    def dot(self, x: np.ndarray) -> np.ndarray:
-        rows = np.repeat(np.arange(self.shape[0]), np.diff(self.indptr))
-        contrib = self.data[:, None] * x[self.indices]
-        return np.stack([np.bincount(rows, weights=contrib[:, c], minlength=self.shape[0])
-                         for c in range(x.shape[1])], axis=1)
 
 
 @dataclass(frozen=True)
@@ -127,11 +113,8 @@ class RoomOperators:
     def corner_irradiance(self, irradiance: np.ndarray) -> np.ndarray:
         """(E, 3, 3) the light map at each receiver's corners (area-weighted over the welded
         vertex, hanging vertices from their edges: catalog.room.lightmap.corner_irradiance)."""
-        from catalog.room.lightmap import weld_values  # noqa: PLC0415  (numpy only)
-
-        h = self.hanging
         corner = weld_values(self.vertex, self.area_m2, np.asarray(irradiance, dtype=np.float64),
-                             (self.hang_vertex, h.indptr, h.indices, h.data))
+                             (self.hang_vertex, self.hanging))
         return corner.reshape(self.count, 3, 3)
 
 
@@ -224,11 +207,8 @@ def receiver_uvs(room, transport) -> tuple[np.ndarray, np.ndarray]:
 
 def _weld(transport) -> tuple:
     """(vertex, hang_vertex, hanging Csr) of the transport's light map."""
-    from catalog.room.lightmap import hanging_vertices, weld_vertices  # noqa: PLC0415
-
     vertex = weld_vertices(transport.receivers)
-    hang, indptr, indices, data = hanging_vertices(transport.receivers, vertex)
-    return vertex, hang, Csr(data, indices, indptr, (hang.size, int(vertex.max()) + 1))
+    return (vertex, *hanging_vertices(transport.receivers, vertex))
 
 
 def side_grid(placement=None) -> tuple:

@@ -10,10 +10,28 @@ finite elements constrain hanging nodes, so the light map is continuous across e
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 #: Corner positions closer than this (m) on one plane are one vertex of the light map.
 WELD_M = 1e-5
+
+
+@dataclass(frozen=True)
+class Csr:
+    """A sparse matrix (rows, cols) as CSR arrays; :meth:`dot` of (cols, C) -> (rows, C)."""
+
+    data: np.ndarray
+    indices: np.ndarray
+    indptr: np.ndarray
+    shape: tuple
+
+    def dot(self, x: np.ndarray) -> np.ndarray:
+        rows = np.repeat(np.arange(self.shape[0]), np.diff(self.indptr))
+        contrib = self.data[:, None] * x[self.indices]
+        return np.stack([np.bincount(rows, weights=contrib[:, c], minlength=self.shape[0])
+                         for c in range(x.shape[1])], axis=1)
 
 
 def weld_vertices(receivers) -> np.ndarray:
@@ -30,7 +48,7 @@ def weld_vertices(receivers) -> np.ndarray:
 
 def hanging_vertices(receivers, vertex: np.ndarray | None = None) -> tuple:
     """The light map's hanging vertices and the free vertices their values come from:
-    ``(hang, indptr, indices, data)``, a CSR matrix whose row i gives vertex ``hang[i]`` as a
+    ``(hang, matrix)``, a :class:`Csr` (H, V) whose row i gives vertex ``hang[i]`` as a
     weighted sum of free vertices (``vertex``: :func:`weld_vertices`). A vertex is hanging
     when it lies inside an edge (farther than WELD_M from its ends and within WELD_M of the
     line) of a receiver on its plane; it takes the longest such edge's ends, linearly
@@ -75,7 +93,7 @@ def hanging_vertices(receivers, vertex: np.ndarray | None = None) -> tuple:
     indptr[1:] = np.cumsum([len(rows[h]) for h in hang])
     indices = np.array([k for h in hang for k in sorted(rows[h])], dtype=np.int64)
     data = np.array([rows[h][k] for h in hang for k in sorted(rows[h])], dtype=np.float64)
-    return hang, indptr, indices, data
+    return hang, Csr(data, indices, indptr, (hang.size, count))
 
 
 def _resolve_hanging(rows: dict) -> dict:
@@ -108,19 +126,16 @@ def _resolve_hanging(rows: dict) -> dict:
 def weld_values(vertex: np.ndarray, weight: np.ndarray, irradiance: np.ndarray, hanging: tuple) -> np.ndarray:
     """(3E, C) each receiver corner's light-map value: receiver values ``irradiance`` (E, C)
     averaged over each welded vertex by ``weight`` (E,), hanging vertices set from the free
-    ones (``hanging``: :func:`hanging_vertices`)."""
+    ones (``hanging``: :func:`hanging_vertices`'s pair)."""
     corner_weight = np.repeat(weight, 3)
     count = int(vertex.max()) + 1
     values = corner_weight[:, None] * np.repeat(irradiance, 3, axis=0)
     total = np.stack([np.bincount(vertex, weights=values[:, c], minlength=count)
                       for c in range(values.shape[1])], axis=1)
     welded = total / np.bincount(vertex, weights=corner_weight, minlength=count)[:, None]
-    hang, indptr, indices, data = hanging
+    hang, matrix = hanging
     if hang.size:
-        rows = np.repeat(np.arange(hang.size), np.diff(indptr))
-        contrib = data[:, None] * welded[indices]
-        welded[hang] = np.stack([np.bincount(rows, weights=contrib[:, c], minlength=hang.size)
-                                 for c in range(welded.shape[1])], axis=1)
+        welded[hang] = matrix.dot(welded)   # its rows read free vertices only
     return welded[vertex]
 
 
