@@ -26,13 +26,12 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import io
 import json
-import zipfile
 from pathlib import Path
 
 import numpy as np
 
+from catalog.core.keyed_npz import UNREADABLE, read_keyed, write_keyed
 from catalog.core.resources import CACHE_ENV, cache_folder  # noqa: F401 (CACHE_ENV: the tests')
 
 #: Bumped when the file's layout changes.
@@ -98,47 +97,34 @@ def load(key: str, params):
     """The cached :class:`~catalog.cloth.state.ClothState` of ``key``, or None."""
     from catalog.cloth.state import ClothState  # noqa: PLC0415
 
-    path = _path(key)
-    if path is None or not path.is_file():
+    data = read_keyed(_path(key), key)
+    if data is None:
         return None
     try:
-        with np.load(path, allow_pickle=False) as data:
-            if str(data["key"]) != key:
-                return None
-            shape = (params.grid_h, params.grid_w, 3)
-            positions = np.array(data["positions_m"], dtype=np.float64)
-            velocities = np.array(data["velocities_m_s"], dtype=np.float64)
-            if positions.shape != shape or velocities.shape != shape \
-                    or not np.isfinite(positions).all():
-                return None
-            scalars = json.loads(str(data["scalars"]))
-            return ClothState(positions_m=positions, velocities_m_s=velocities,
-                              ring_positions_m=np.array(data["ring_positions_m"], np.float64),
-                              ring_targets_m=np.array(data["ring_targets_m"], np.float64),
-                              time_s=float(scalars["time_s"]), frames=int(scalars["frames"]),
-                              finite=bool(scalars["finite"]),
-                              max_stretch_seen=float(scalars["max_stretch_seen"]),
-                              calm_s=float(scalars["calm_s"]))
-    except (OSError, ValueError, KeyError, EOFError, TypeError, zipfile.BadZipFile):  # torn, edited, foreign
+        shape = (params.grid_h, params.grid_w, 3)
+        positions = np.array(data["positions_m"], dtype=np.float64)
+        velocities = np.array(data["velocities_m_s"], dtype=np.float64)
+        if positions.shape != shape or velocities.shape != shape \
+                or not np.isfinite(positions).all():
+            return None
+        scalars = json.loads(str(data["scalars"]))
+        return ClothState(positions_m=positions, velocities_m_s=velocities,
+                          ring_positions_m=np.array(data["ring_positions_m"], np.float64),
+                          ring_targets_m=np.array(data["ring_targets_m"], np.float64),
+                          time_s=float(scalars["time_s"]), frames=int(scalars["frames"]),
+                          finite=bool(scalars["finite"]),
+                          max_stretch_seen=float(scalars["max_stretch_seen"]),
+                          calm_s=float(scalars["calm_s"]))
+    except UNREADABLE:  # torn, edited, foreign
         return None
 
 
 def store(key: str, state) -> Path | None:
-    """Publish ``state`` under ``key`` atomically; None (and nothing left) when it cannot."""
-    from catalog.core.atomic import write_bytes_atomic  # noqa: PLC0415
-    from catalog.core.errors import CatalogError  # noqa: PLC0415
-
-    path = _path(key)
-    if path is None:
-        return None
+    """Publish ``state`` under ``key`` atomically; None (and nothing left) when it cannot (a
+    read-only or full cache folder costs the settle next time, no more)."""
     scalars = {"time_s": state.time_s, "frames": state.frames, "finite": state.finite,
                "max_stretch_seen": state.max_stretch_seen, "calm_s": state.calm_s}
-    buffer = io.BytesIO()
-    np.savez(buffer, key=np.array(key), scalars=np.array(json.dumps(scalars)),
-             positions_m=state.positions_m, velocities_m_s=state.velocities_m_s,
-             ring_positions_m=state.ring_positions_m, ring_targets_m=state.ring_targets_m)
-    try:
-        write_bytes_atomic(path, buffer.getvalue())
-    except (CatalogError, OSError):
-        return None  # a read-only or full cache folder costs the settle next time, no more
-    return path
+    return write_keyed(_path(key), key, {
+        "scalars": np.array(json.dumps(scalars)), "positions_m": state.positions_m,
+        "velocities_m_s": state.velocities_m_s, "ring_positions_m": state.ring_positions_m,
+        "ring_targets_m": state.ring_targets_m})

@@ -17,8 +17,6 @@ and never fails a command.
 from __future__ import annotations
 
 import hashlib
-import io
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -58,15 +56,14 @@ def _path(key: str) -> Path | None:
 
 def load(key: str, shape: tuple[int, ...]) -> list[np.ndarray] | None:
     """The cached levels 1, 2, ... of ``key`` (texels of ``shape``), or None."""
-    path = _path(key)
-    if path is None or not path.is_file():
+    from catalog.core.keyed_npz import UNREADABLE, read_keyed  # noqa: PLC0415
+
+    data = read_keyed(_path(key), key)
+    if data is None:
         return None
     try:
-        with np.load(path, allow_pickle=False) as data:
-            if str(data["key"]) != key:
-                return None
-            chain = [np.array(data[f"level{k}"]) for k in range(1, int(data["count"]))]
-    except (OSError, ValueError, KeyError, EOFError, TypeError, zipfile.BadZipFile):
+        chain = [data[f"level{k}"] for k in range(1, int(data["count"]))]
+    except UNREADABLE:
         return None
     h, w = shape[:2]
     for k, level in enumerate(chain, start=1):
@@ -78,20 +75,10 @@ def load(key: str, shape: tuple[int, ...]) -> list[np.ndarray] | None:
 def store(key: str, chain: list[np.ndarray]) -> Path | None:
     """Publish ``chain``'s levels above 0 under ``key`` atomically; None (and nothing
     left) when it cannot."""
-    from catalog.core.atomic import write_bytes_atomic  # noqa: PLC0415
-    from catalog.core.errors import CatalogError  # noqa: PLC0415
+    from catalog.core.keyed_npz import write_keyed  # noqa: PLC0415
 
-    path = _path(key)
-    if path is None:
-        return None
-    buffer = io.BytesIO()
-    np.savez(buffer, key=np.array(key), count=np.array(len(chain)),
-             **{f"level{k}": level for k, level in enumerate(chain) if k > 0})
-    try:
-        write_bytes_atomic(path, buffer.getvalue())
-    except (CatalogError, OSError):
-        return None
-    return path
+    return write_keyed(_path(key), key, {"count": np.array(len(chain)),
+                                         **{f"level{k}": level for k, level in enumerate(chain) if k > 0}})
 
 
 def cached_mip_chain(texels: np.ndarray, levels: int | None = None) -> list[np.ndarray]:
