@@ -113,8 +113,8 @@ def run(args) -> int:
     # the GL sections' context, released at the end (the caller's current context current again)
     with (headless_context() if any(n in GL_SECTIONS for n in names)
           else contextlib.nullcontext()) as ctx:
-        report, written = _run_sections(names, args, ctx, say)
-    say(f"wrote {', '.join(str(p) for p in written)}")
+        report = _run_sections(names, args, out, ctx, say)
+    say(f"wrote {', '.join(report['written'])}")
     if args.json:
         print_json(report)
     else:
@@ -122,15 +122,14 @@ def run(args) -> int:
     return 1 if report["failed"] else 0
 
 
-def _run_sections(names, args, ctx, say) -> tuple[dict, list]:
-    """(report, files written) of the named sections, run in ``ctx`` (None: no GL section)."""
+def _run_sections(names, args, out, ctx, say) -> dict:
+    """The report of the named sections, run in ``ctx`` (None: no GL section) and written to
+    the folder ``out`` (the files in its ``written``)."""
     import time  # noqa: PLC0415
-    from pathlib import Path  # noqa: PLC0415
 
     from benchmarks.report import write_report  # noqa: PLC0415
     from benchmarks.results import machine_info  # noqa: PLC0415
 
-    out = Path(args.out)
     machine = machine_info(ctx)
     report = {"benchmark": "catalog bench", "quick": bool(args.quick), "machine": machine,
               "sections": {}, "failed": {}}
@@ -144,9 +143,8 @@ def _run_sections(names, args, ctx, say) -> tuple[dict, list]:
             _run_section(name, args, ctx, report, plotters, say)
             bar.advance()
     report["total_seconds"] = time.perf_counter() - start_all
-    written = write_report(report, out, plotters)
-    report["written"] = [str(p) for p in written]
-    return report, written
+    report["written"] = [str(p) for p in write_report(report, out, plotters)]
+    return report
 
 
 def _run_section(name, args, ctx, report, plotters, say) -> None:
