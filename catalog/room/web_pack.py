@@ -325,25 +325,23 @@ def _check_arrays(header: dict, a: dict, refuse) -> None:
     if a["outside"].shape[0] != e:
         refuse("arrays.outside", f"{a['outside'].shape[0]} rows, expected {e}")
     tw, th = (int(v) for v in header.get("side_grid", (0, 0))[:2])
-    for prefix, rows, data in (("f", e, "f_counts"), ("gather_patch", nu * nv, "gather_patch_data"),
-                               ("gather_side", tw * th, "gather_side_data"),
-                               ("gather_wall", tw * th, "gather_wall_data")):
+    if a["vertex"].size and (int(a["vertex"].min()) < 0 or int(a["vertex"].max()) >= 3 * e):
+        refuse("arrays.vertex", "a light-map vertex out of range")
+    vertices = int(a["vertex"].max()) + 1 if a["vertex"].size else 0
+    # each CSR operator: its rows, its values' array, and what its columns index
+    for prefix, rows, data, columns, what in (
+            ("f", e, "f_counts", e, "receivers"), ("gather_patch", nu * nv, "gather_patch_data", e, "receivers"),
+            ("gather_side", tw * th, "gather_side_data", e, "receivers"),
+            ("gather_wall", tw * th, "gather_wall_data", e, "receivers"),
+            ("hang", a["hang_vertex"].size, "hang_data", vertices, "light-map vertices")):
         ptr, idx = a[f"{prefix}_indptr"], a[f"{prefix}_indices"]
         if ptr.shape != (rows + 1,) or ptr[0] != 0 or np.any(np.diff(ptr.astype(np.int64)) < 0) \
                 or ptr[-1] != idx.size or a[data].size != idx.size:
             refuse(f"arrays.{prefix}_indptr", "not a CSR row index of its entries")
-        if idx.size and int(idx.max()) >= e:
-            refuse(f"arrays.{prefix}_indices", f"a column {int(idx.max())} >= {e} receivers")
-    if a["vertex"].size and (int(a["vertex"].min()) < 0 or int(a["vertex"].max()) >= 3 * e):
-        refuse("arrays.vertex", "a light-map vertex out of range")
-    vertices = int(a["vertex"].max()) + 1 if a["vertex"].size else 0
-    hang, ptr = a["hang_vertex"], a["hang_indptr"]
-    if ptr.shape != (hang.size + 1,) or ptr[0] != 0 or np.any(np.diff(ptr.astype(np.int64)) < 0) \
-            or ptr[-1] != a["hang_indices"].size or a["hang_data"].size != a["hang_indices"].size:
-        refuse("arrays.hang_indptr", "not a CSR row index of its entries")
-    for name in ("hang_vertex", "hang_indices"):
-        if a[name].size and int(a[name].max()) >= vertices:
-            refuse(f"arrays.{name}", f"a vertex {int(a[name].max())} >= {vertices} light-map vertices")
+        if idx.size and int(idx.max()) >= columns:
+            refuse(f"arrays.{prefix}_indices", f"a column {int(idx.max())} >= {columns} {what}")
+    if a["hang_vertex"].size and int(a["hang_vertex"].max()) >= vertices:
+        refuse("arrays.hang_vertex", f"a vertex {int(a['hang_vertex'].max())} >= {vertices} light-map vertices")
     for name in ("window_left", "window_right", "bounce_left", "bounce_right", "bounce_scale",
                  "albedo", "outside", "window_back", "weld_weight_m2", "hang_data"):
         if not np.all(np.isfinite(a[name])):

@@ -74,43 +74,34 @@
     }
     if (shapes.outside[0] !== E) refuse('arrays.outside', shapes.outside[0] + ' rows, expected ' + E);
     const [tw, th] = h.side_grid;
-    for (const [prefix, rows, data] of [['f', E, 'f_counts'], ['gather_patch', nu * nv, 'gather_patch_data'],
-                                        ['gather_side', tw * th, 'gather_side_data'], ['gather_wall', tw * th, 'gather_wall_data']]) {
+    for (let i = 0; i < a.vertex.length; i++) if (a.vertex[i] < 0 || a.vertex[i] >= 3 * E) refuse('arrays.vertex', 'a light-map vertex out of range');
+    let V = 0;
+    for (let i = 0; i < a.vertex.length; i++) if (a.vertex[i] + 1 > V) V = a.vertex[i] + 1;
+    // each CSR operator: its rows, its values' array, and what its columns index
+    for (const [prefix, rows, data, cols, what] of [['f', E, 'f_counts', E, 'receivers'], ['gather_patch', nu * nv, 'gather_patch_data', E, 'receivers'],
+                                                    ['gather_side', tw * th, 'gather_side_data', E, 'receivers'], ['gather_wall', tw * th, 'gather_wall_data', E, 'receivers'],
+                                                    ['hang', a.hang_vertex.length, 'hang_data', V, 'light-map vertices']]) {
       const ptr = a[prefix + '_indptr'], idx = a[prefix + '_indices'];
       let ok = ptr.length === rows + 1 && ptr[0] === 0 && ptr[rows] === idx.length && a[data].length === idx.length;
       for (let i = 0; ok && i < rows; i++) ok = ptr[i + 1] >= ptr[i];
       if (!ok) refuse('arrays.' + prefix + '_indptr', 'not a CSR row index of its entries');
       let top = -1;
       for (let i = 0; i < idx.length; i++) if (idx[i] > top) top = idx[i];
-      if (top >= E) refuse('arrays.' + prefix + '_indices', 'a column ' + top + ' >= ' + E + ' receivers');
+      if (top >= cols) refuse('arrays.' + prefix + '_indices', 'a column ' + top + ' >= ' + cols + ' ' + what);
     }
-    for (let i = 0; i < a.vertex.length; i++) if (a.vertex[i] < 0 || a.vertex[i] >= 3 * E) refuse('arrays.vertex', 'a light-map vertex out of range');
-    let vertices = 0;
-    for (let i = 0; i < a.vertex.length; i++) if (a.vertex[i] + 1 > vertices) vertices = a.vertex[i] + 1;
-    {
-      const ptr = a.hang_indptr, H = a.hang_vertex.length;
-      let ok = ptr.length === H + 1 && ptr[0] === 0 && ptr[H] === a.hang_indices.length && a.hang_data.length === a.hang_indices.length;
-      for (let i = 0; ok && i < H; i++) ok = ptr[i + 1] >= ptr[i];
-      if (!ok) refuse('arrays.hang_indptr', 'not a CSR row index of its entries');
-      for (const name of ['hang_vertex', 'hang_indices']) {
-        let top = -1;
-        for (let i = 0; i < a[name].length; i++) if (a[name][i] > top) top = a[name][i];
-        if (top >= vertices) refuse('arrays.' + name, 'a vertex ' + top + ' >= ' + vertices + ' light-map vertices');
-      }
-    }
+    let topHung = -1;
+    for (let i = 0; i < a.hang_vertex.length; i++) if (a.hang_vertex[i] > topHung) topHung = a.hang_vertex[i];
+    if (topHung >= V) refuse('arrays.hang_vertex', 'a vertex ' + topHung + ' >= ' + V + ' light-map vertices');
     for (const name of ['window_left', 'window_right', 'bounce_left', 'bounce_right', 'bounce_scale', 'albedo', 'outside', 'window_back', 'weld_weight_m2', 'hang_data']) {
       const v = a[name];
       for (let i = 0; i < v.length; i++) if (!Number.isFinite(v[i])) refuse('arrays.' + name, 'a value is not finite');
     }
-    return new RoomPack(h, a, { E, P: nu * nv, K, r, rb });
+    return new RoomPack(h, a, { E, P: nu * nv, K, r, rb, vertices: V });
   }
 
   class RoomPack {
     constructor(header, arrays, dims) {
       this.header = header; this.a = arrays; Object.assign(this, dims);
-      let vertices = 0;
-      for (let i = 0; i < arrays.vertex.length; i++) vertices = Math.max(vertices, arrays.vertex[i] + 1);
-      this.vertices = vertices;
     }
     // (E * 3) receivers' irradiance [e][ch] from window coefficients (P K * 3) [p][k][ch]
     irradiance(c) {
