@@ -54,22 +54,54 @@ SHARED_FIXTURE_MODULES = {"web_site": ("tests/test_web.py", "tests/test_web_brow
                                        "tests/test_web_facts.py", "tests/test_web_links.py")}
 
 
+#: Seconds the longest scopes (a module, or a name of SHARED_FIXTURE_MODULES) took in the
+#: full `-n 2 --dist loadfile` suite (the sums of their tests' --durations over 5 s, at
+#: 018e387 on the 2-core machine, load ~2.4; the SIGKILL test as polled since). Only an
+#: order: the scheduler starts the longest first, so that no hour-long module is left to
+#: start last while the other worker idles (longest-first on two workers). Scopes not listed
+#: follow in xdist's own order (most tests first). tests/test_xdist_schedule.py checks that
+#: every name here is still a scope.
+SCOPE_SECONDS = {"tests/test_display_gl.py": 230, "web_site": 180, "tests/test_viewer.py": 110,
+                 "tests/test_batch.py": 80, "tests/test_bench.py": 70, "tests/test_presets.py": 60,
+                 "tests/test_pathtrace.py": 60, "tests/test_room_transport.py": 55,
+                 "tests/test_patterns.py": 50, "tests/test_viewer_panel.py": 40,
+                 "tests/test_adaptation.py": 40, "tests/test_cloth_shadows.py": 35,
+                 "tests/test_output_layer.py": 30, "tests/test_cli_hostile.py": 30,
+                 "tests/test_bench_accuracy.py": 27, "tests/test_room_placement.py": 26,
+                 "tests/test_see_through.py": 24, "tests/test_render_frame.py": 21,
+                 "tests/test_render_pattern.py": 18}
+
+
 def pytest_xdist_make_scheduler(config, log):
     """``--dist loadfile``, each module in one worker (its module fixtures made once, its tests
-    in their written order), the modules of SHARED_FIXTURE_MODULES together. Other --dist
-    modes are xdist's own. (Not --dist loadgroup: xdist 3.8's groups are lost under pytest 9.2,
-    which no longer reads the node id xdist rewrites.)"""
+    in their written order), the modules of SHARED_FIXTURE_MODULES together, the scopes of
+    SCOPE_SECONDS first, longest first. Other --dist modes are xdist's own. (Not --dist
+    loadgroup: xdist 3.8's groups are lost under pytest 9.2, which no longer reads the node id
+    xdist rewrites.)"""
     if config.getvalue("dist") != "loadfile":
         return None
+    from collections import OrderedDict
+
     from xdist.scheduler import LoadFileScheduling
 
     scope_of = {module: name for name, modules in SHARED_FIXTURE_MODULES.items()
                 for module in modules}
 
     class SharedFixtureScheduling(LoadFileScheduling):
+        _longest_first = False
+
         def _split_scope(self, nodeid: str) -> str:
             module = super()._split_scope(nodeid)
             return scope_of.get(module, module)
+
+        def _assign_work_unit(self, node) -> None:
+            # the work queue is whole by the first assignment (xdist's schedule() fills it,
+            # then assigns); a stable sort keeps xdist's order among the scopes not listed
+            if not self._longest_first:
+                self._longest_first = True
+                order = sorted(self.workqueue, key=lambda scope: -SCOPE_SECONDS.get(scope, 0))
+                self.workqueue = OrderedDict((scope, self.workqueue[scope]) for scope in order)
+            super()._assign_work_unit(node)
 
     return SharedFixtureScheduling(config, log)
 

@@ -41,3 +41,36 @@ def test_the_shared_modules_are_one_scope_and_the_others_one_each(pytestconfig):
     assert len(shared) == 1 and others == set(modules)
     assert conftest.pytest_xdist_make_scheduler(type("Load", (LoadFile,), {
         "getvalue": lambda self, name: "load"})(), None) is None   # other modes: xdist's own
+
+
+def test_the_longest_scopes_start_first_and_each_listed_one_is_a_scope(pytestconfig,
+                                                                        monkeypatch):
+    pytest.importorskip("xdist")
+    from xdist.scheduler import LoadFileScheduling
+
+    shared = set(conftest.SHARED_FIXTURE_MODULES)
+    for scope in conftest.SCOPE_SECONDS:   # a renamed or deleted module would be a dead entry
+        assert scope in shared or (PROJECT_ROOT / scope).is_file(), scope
+
+    class LoadFile:
+        option = pytestconfig.option
+
+        def getvalue(self, name):
+            return {"dist": "loadfile", "tx": ["popen"] * 2}.get(name)
+
+        def getoption(self, name, default=None):
+            return {"dist": "loadfile", "numprocesses": 2, "tx": [],
+                    "maxschedchunk": None}.get(name, default)
+
+    scheduler = conftest.pytest_xdist_make_scheduler(LoadFile(), None)
+    longest = max(conftest.SCOPE_SECONDS, key=conftest.SCOPE_SECONDS.get)
+    second = sorted(conftest.SCOPE_SECONDS, key=conftest.SCOPE_SECONDS.get)[-2]
+    unlisted = ["tests/test_unlisted_a.py", "tests/test_unlisted_b.py"]   # made-up modules
+    scheduler.workqueue.update((scope, {f"{scope}::test_x": False})
+                               for scope in (unlisted[0], second, unlisted[1], longest))
+    given = []
+    monkeypatch.setattr(LoadFileScheduling, "_assign_work_unit", lambda self, node: given.append(
+        self.workqueue.popitem(last=False)[0]))   # xdist's own: sends the unit to a worker
+    for _ in range(4):
+        scheduler._assign_work_unit(None)
+    assert given == [longest, second, *unlisted]
