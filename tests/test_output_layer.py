@@ -126,6 +126,12 @@ def test_stale_temporaries_of_dead_processes_are_removed_and_live_ones_kept(tmp_
     look_alike = tmp_path / f".x.png{TEMP_MARK}-{dead}-abc.png"
     users_folder = tmp_path / f".out{TEMP_MARK}-{dead}-0123456789abcdef"
     unmarked_stage = tmp_path / temporary_name("old", int(dead))
+    # a stage killed between its mkdir and its marker: empty, so removed
+    empty_stage = tmp_path / temporary_name("killed", int(dead))
+    empty_stage.mkdir()
+    # a user's empty folder with a look-alike name (no valid token): never touched
+    empty_look_alike = tmp_path / f".out{TEMP_MARK}-{dead}-fedcba9876543210"
+    empty_look_alike.mkdir()
     for path in (stale, live, other, look_alike):
         path.write_text("x")
     for folder in (stale_stage, users_folder, unmarked_stage):
@@ -135,10 +141,35 @@ def test_stale_temporaries_of_dead_processes_are_removed_and_live_ones_kept(tmp_
     assert temporary_owner(stale.name) == int(dead)
     assert temporary_owner(other.name) is None and temporary_owner(look_alike.name) is None
     write_bytes_atomic(tmp_path / "x.png", b"new")
-    assert not stale.exists() and not stale_stage.exists()
+    assert not stale.exists() and not stale_stage.exists() and not empty_stage.exists()
+    assert empty_look_alike.is_dir()
     assert live.exists() and other.exists() and look_alike.exists()
     assert (users_folder / "a.png").exists() and (unmarked_stage / "a.png").exists()
     assert remove_stale_temporaries(tmp_path) == []
+
+
+def test_stage_keeps_its_marker_while_its_files_are_moved(tmp_path, monkeypatch):
+    """A SIGKILL during the moves must leave a stage the cleaner claims (its marker in it),
+    and the marker itself is never published."""
+    from catalog.core import atomic
+
+    out = tmp_path / "sheet"
+    marked_at_move = []
+    real_replace = os.replace
+
+    def watching_replace(source, goal):
+        source = Path(source)
+        if atomic.TEMP_MARK in str(source.parent):
+            marked_at_move.append((source.parent / STAGE_MARKER).is_file())
+        return real_replace(source, goal)
+
+    monkeypatch.setattr(atomic.os, "replace", watching_replace)
+    with staged_folder(out) as stage:
+        for name in ("a.png", "b.png"):
+            (stage / name).write_text(name)
+    assert marked_at_move == [True, True]
+    assert sorted(p.name for p in out.iterdir()) == ["a.png", "b.png"]
+    assert _litter(tmp_path) == []
 
 
 def test_staged_folder_publishes_all_or_nothing(tmp_path):

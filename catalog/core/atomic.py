@@ -45,7 +45,8 @@ from catalog.core.errors import CatalogError
 #: Marks every temporary name this layer makes:
 #: ``.{target name}{TEMP_MARK}-{pid}-{random}{token}{suffix}``, where ``token`` is a keyed
 #: hash of the rest (:func:`_token`): the cleaner removes only names whose token checks, and
-#: a staging folder only when it holds :data:`STAGE_MARKER` naming the same process, so a
+#: a staging folder only when it holds :data:`STAGE_MARKER` naming the same process (from
+#: its making to its removal) or is empty (killed before its marker was written), so a
 #: user's file or folder that merely looks like a temporary is never deleted.
 TEMP_MARK = ".catalog-tmp"
 _TEMP_NAME = re.compile(r"^\.(?P<target>.*)" + re.escape(TEMP_MARK)
@@ -283,8 +284,11 @@ def remove_stale_temporaries(folder: str | Path) -> list[Path]:
             with contextlib.suppress(OSError):
                 if entry.is_dir() and not entry.is_symlink():
                     if not _is_our_stage(entry, pid):
-                        continue  # a user's folder with a look-alike name: never deleted
-                    shutil.rmtree(entry)
+                        # a stage killed between its mkdir and its marker is empty; rmdir
+                        # removes only an empty folder, so a user's look-alike is never lost
+                        entry.rmdir()
+                    else:
+                        shutil.rmtree(entry)
                 else:
                     entry.unlink()
                 removed.append(entry)
@@ -477,16 +481,18 @@ def staged_folder(destination: str | Path, *, inputs: Iterable[str | Path] = (),
     marker = stage / STAGE_MARKER
     try:
         yield stage
-        marker.unlink()
+        # the marker stays until the stage is removed (it is not published): a SIGKILL
+        # during the moves leaves a stage the next run's cleaner still claims
+        staged = [source for source in sorted(stage.rglob("*")) if source != marker]
         with os_errors_as_output_errors(destination):
             destination.mkdir(parents=True, exist_ok=True)
             remove_stale_temporaries(destination)
-            for source in sorted(stage.rglob("*")):
+            for source in staged:
                 if source.is_dir():
                     continue
                 with open(source, "rb") as handle:
                     os.fsync(handle.fileno())
-            for source in sorted(stage.rglob("*")):
+            for source in staged:
                 relative = source.relative_to(stage)
                 goal = destination / relative
                 if source.is_dir():
@@ -504,7 +510,7 @@ def staged_folder(destination: str | Path, *, inputs: Iterable[str | Path] = (),
             with signals_deferred():
                 if replace_listed is not None:
                     replace_listed(destination)
-                for source in sorted(stage.rglob("*")):
+                for source in staged:
                     if source.is_file():
                         os.replace(source, destination / source.relative_to(stage))
             _fsync_folder(destination)
