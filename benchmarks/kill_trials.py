@@ -62,13 +62,13 @@ class Command:
 
 def commands() -> list[Command]:
     snap = ("snapshot", "--fabric", "voile-white", "--size", "96x72", "--out", "{dir}/s.png")
-    sheet = ("sheet", "--fabrics", "voile-white,net-grey", "--size", "48x36", "--out",
+    sheet = ("sheet", "--fabric", "voile-white,net-grey", "--size", "48x36", "--out",
              "{dir}/sheet")
     fit = ("fit", "--gonio", str(GONIO), "--name", "p", "--out", "{dir}/p.toml", "--plot",
            "{dir}/p.png")
     ref = ("reference", "--fabric", "voile-white", "--size", "48x36", "--out", "{dir}/r.exr")
-    web = ("web", "--fabrics", "voile-white", "--out", "{dir}/site")
-    batch = ("render-catalog", "--fabrics", "voile-white", "--lights", "D65", "--size", "48x36",
+    web = ("web", "--fabric", "voile-white", "--out", "{dir}/site")
+    batch = ("render-catalog", "--fabric", "voile-white", "--lights", "D65", "--size", "48x36",
              "--out", "{dir}/cat")
     return [
         Command("snapshot", snap + ("--light", "D65"), snap + ("--light", "A"), ("s.png",)),

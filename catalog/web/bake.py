@@ -252,6 +252,7 @@ def bake_apart(presets, on_baked=None) -> list[BakedAnimation]:
 def _bake_child() -> None:
     """The child of :func:`bake_apart`: presets (pickled) on stdin; ("ok", animation) or
     ("error", message) on stdout, one per preset as it is baked."""
+    import os  # noqa: PLC0415
     import pickle  # noqa: PLC0415
     import signal  # noqa: PLC0415
     import sys  # noqa: PLC0415
@@ -268,8 +269,14 @@ def _bake_child() -> None:
             result = ("ok", bake(preset))
         except CatalogError as error:
             result = ("error", str(error))
-        pickle.dump(result, out)
-        out.flush()
+        try:
+            pickle.dump(result, out)
+            out.flush()
+        except BrokenPipeError:
+            # the parent is gone (stopped by a signal): nobody reads the rest; end quietly,
+            # stdout pointed at devnull so the interpreter's own flush at exit cannot fail
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            sys.exit(1)
         if result[0] == "error":
             return
 
