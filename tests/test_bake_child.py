@@ -7,9 +7,11 @@ the kill trials count one as a crash), with a non-zero status, and write nothing
 
 import io
 import pickle
+import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -42,3 +44,47 @@ def test_bake_child_writes_every_result_to_a_reading_parent():
     assert child.returncode == 0 and child.stderr == b""
     stream = io.BytesIO(child.stdout)
     assert [pickle.load(stream), pickle.load(stream)] == [("ok", "a"), ("ok", "b")]
+
+
+@pytest.mark.slow
+def test_bake_child_ends_at_once_on_ctrl_c_mid_bake():
+    """Ctrl-C reaches the child with its parent (one process group): it ends by the default
+    action at once, mid-bake, not when the bake returns (the kill trials' one slow web run:
+    4.1 s, the parent's pipes held open by the child)."""
+    child = subprocess.Popen([sys.executable, "-c", CHILD.replace("0.5", "20")],
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    pickle.dump(["a"], child.stdin)
+    child.stdin.close()
+    time.sleep(1.0)   # inside the 20 s stand-in bake
+    signalled = time.monotonic()
+    child.send_signal(signal.SIGINT)
+    status = child.wait(timeout=10)
+    assert time.monotonic() - signalled < 1.0
+    assert status == -signal.SIGINT
+    assert child.stderr.read() == b"" and child.stdout.read() == b""
+
+
+def _ended(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/status").read_text()
+    except FileNotFoundError:
+        return True
+    return "\nState:\tZ" in state   # a zombie: ended, not yet reaped
+
+
+@pytest.mark.slow
+def test_hard_exit_kills_the_registered_child_process():
+    """os._exit leaves a subprocess running; hard_exit kills those in child_process."""
+    script = ("import subprocess, sys\n"
+              "from catalog.core import atomic\n"
+              "p = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(60)'])\n"
+              "print(p.pid, flush=True)\n"
+              "with atomic.child_process(p):\n"
+              "    atomic.hard_exit(130)\n")
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=30)
+    assert run.returncode == 130, run.stderr
+    pid = int(run.stdout.split()[0])
+    deadline = time.monotonic() + 5.0
+    while not _ended(pid) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert _ended(pid)

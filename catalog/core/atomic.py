@@ -535,6 +535,20 @@ SIGNAL_GRACE_S = 0.4
 _COMMIT_LOCK = threading.RLock()
 _DEFERRED = {"depth": 0, "pending": None}
 _WATCHDOG = {"installed": False, "signalled": None}
+#: Child processes started with subprocess (:func:`child_process`) that :func:`hard_exit`
+#: ends with this one: os._exit leaves them running, holding the caller's pipes open.
+_CHILDREN: set = set()
+
+
+@contextlib.contextmanager
+def child_process(process) -> Iterator:
+    """``process`` (a subprocess.Popen) ended by :func:`hard_exit` if this process is
+    signalled while the block runs; the caller still waits for or kills it itself."""
+    _CHILDREN.add(process)
+    try:
+        yield process
+    finally:
+        _CHILDREN.discard(process)
 
 
 def _cleanup_live() -> None:
@@ -574,7 +588,8 @@ def _on_signal(signum, _frame) -> None:
 def hard_exit(status: int) -> None:
     """End the process now with ``status``: this process's temporaries removed, its child
     processes (Dask workers) terminated, no interpreter teardown (an EGL context torn down
-    inside a signal has crashed; os._exit skips it)."""
+    inside a signal has crashed; os._exit skips it), the subprocesses of
+    :func:`child_process` killed."""
     acquired = _COMMIT_LOCK.acquire(timeout=2.0)
     try:
         _cleanup_live()
@@ -583,6 +598,9 @@ def hard_exit(status: int) -> None:
 
             for child in multiprocessing.active_children():
                 child.terminate()
+        for process in list(_CHILDREN):
+            with contextlib.suppress(Exception):
+                process.kill()
         with contextlib.suppress(Exception):
             sys.stderr.flush()
     finally:

@@ -216,6 +216,7 @@ def bake_apart(presets, on_baked=None) -> list[BakedAnimation]:
     import subprocess  # noqa: PLC0415
     import sys  # noqa: PLC0415
 
+    from catalog.core.atomic import child_process  # noqa: PLC0415
     from catalog.core.errors import CatalogError  # noqa: PLC0415
 
     if not presets:
@@ -224,29 +225,30 @@ def bake_apart(presets, on_baked=None) -> list[BakedAnimation]:
     child = subprocess.Popen([sys.executable, "-c", "from catalog.web.bake import _bake_child; "
                               "_bake_child()"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                              env=env)
-    try:
-        pickle.dump(list(presets), child.stdin)
-        child.stdin.close()
-        animations = []
-        for _ in presets:
-            try:
-                kind, value = pickle.load(child.stdout)
-            except EOFError:
-                raise CatalogError(f"the cloth bake's child process ended (exit "
-                                   f"{child.wait()})") from None
-            if kind == "error":
-                raise CatalogError(value)
-            animations.append(value)
-            if on_baked is not None:
-                on_baked()
-        child.stdout.close()
-        if child.wait() != 0:
-            raise CatalogError(f"the cloth bake's child process failed (exit {child.returncode})")
-        return animations
-    finally:
-        if child.poll() is None:
-            child.kill()
-            child.wait()
+    with child_process(child):
+        try:
+            pickle.dump(list(presets), child.stdin)
+            child.stdin.close()
+            animations = []
+            for _ in presets:
+                try:
+                    kind, value = pickle.load(child.stdout)
+                except EOFError:
+                    raise CatalogError(f"the cloth bake's child process ended (exit "
+                                       f"{child.wait()})") from None
+                if kind == "error":
+                    raise CatalogError(value)
+                animations.append(value)
+                if on_baked is not None:
+                    on_baked()
+            child.stdout.close()
+            if child.wait() != 0:
+                raise CatalogError(f"the cloth bake's child process failed (exit {child.returncode})")
+            return animations
+        finally:
+            if child.poll() is None:
+                child.kill()
+                child.wait()
 
 
 def _bake_child() -> None:
@@ -259,9 +261,10 @@ def _bake_child() -> None:
 
     from catalog.core.errors import CatalogError  # noqa: PLC0415
 
-    # Ctrl-C reaches the whole terminal's process group: the parent stops and ends this child
-    # (no second traceback from here)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # Ctrl-C reaches the whole terminal's process group: this child ends at once by the
+    # default action (no traceback, nothing of its own to clean up; a Python handler would
+    # wait for the bake's compiled loop to return), as it does on SIGTERM
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
     presets = pickle.load(sys.stdin.buffer)
     out = sys.stdout.buffer
     for preset in presets:
