@@ -12,7 +12,7 @@ and little of the other processes' load; wall beside it). Ratios from one run.
     PYTHONPATH=. .venv/bin/python -m benchmarks.curtain_terms [--quick] [--sizes 1280x720,1920x1080]
     (prints the table, writes benchmarks/bench_curtain_terms.json)
 
-The room terms (ROOM_SIDE, WALL_LIGHT; the window capture is another pass) are timed too,
+The room terms (ROOM_SIDE, WALL_GRID; the window capture is another pass) are timed too,
 so that their cost is known; this bench changes no shader.
 """
 
@@ -25,10 +25,9 @@ import time
 TERMS = {
     "key shadow (KEY_SHADOW)": ("KEY_SHADOW",),
     # the wall light reads the sky occlusion's per-vertex table, so the two go out together
-    "sky occlusion maps + wall light": ("SKY_OCCLUSION", "OCCLUSION_MAPS", "WALL_LIGHT",
-                                        "WALL_LOBE_SAMPLES"),
+    "sky occlusion maps + wall light": ("SKY_OCCLUSION", "OCCLUSION_MAPS", "WALL_GRID"),
     "room side (ROOM_SIDE)": ("ROOM_SIDE",),
-    "wall light (WALL_LIGHT)": ("WALL_LIGHT", "WALL_LOBE_SAMPLES"),
+    "wall light (WALL_GRID)": ("WALL_GRID",),
     "pattern + OIT (PATTERN, OIT)": ("PATTERN", "OIT", "PATTERN_LOD_BIAS"),
     "fluorescence (FLUORESCENCE_PHYSICAL)": ("FLUORESCENCE_PHYSICAL",),
     "anisotropic lobes (ANISOTROPIC)": ("ANISOTROPIC",),

@@ -17,8 +17,11 @@ INTERPOLATION in vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 INTERPOLATION in vec3 v_tangent;
 #endif
+#if defined(PATTERN) || defined(KEY_SHADOW)
+INTERPOLATION in vec2 v_uv;                      // the fabric's texture coordinates (curtain.vert)
+#endif
 #ifdef PATTERN
-INTERPOLATION in vec2 v_pattern_uv;              // in pattern repeats
+uniform vec2 u_uv_to_repeats;      // fabric size / pattern repeat: uv -> pattern repeats
 uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to the threads alone
 #endif
 #ifdef OIT
@@ -28,15 +31,8 @@ uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth w
 INTERPOLATION in vec3 v_position;
 #endif
 
-// The scene's values, fixed until the light, fabric, mode or band count changes. SPECIALISED:
-// compiled in as constants (catalog/render/frame.py injects S_<NAME> #defines with their
-// values), so the compiler folds them (HG's (1 - g)^2, the sign of g) and a CPU rasteriser
-// loads no uniforms per fragment; otherwise ordinary uniforms.
-#ifdef SPECIALISED
-#define SCENE_VALUE(type, name, value) const type name = value
-#else
-#define SCENE_VALUE(type, name, value) uniform type name
-#endif
+// The scene's values (common.glsl SCENE_VALUE), fixed until the light, fabric, mode or band
+// count changes.
 
 SCENE_VALUE(vec3, u_key_to_light, S_KEY_TO_LIGHT);
 SCENE_VALUE(vec3, u_fill_to_light, S_FILL_TO_LIGHT);
@@ -132,7 +128,6 @@ SCENE_VALUE(vec4, u_key_thread2[NV4], S_KEY_THREAD2);
 // over the fabric's uv when the light or the mesh changes (key_visibility.frag: r the mask,
 // g, b the first and second layers' coverage) and read here with one bilinear lookup.
 uniform sampler2D u_key_visibility;
-INTERPOLATION in vec2 v_key_uv;
 float g_key_beam = 1.0;            // the window's mask (set in main)
 float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
 float g_second_coverage = 0.0;     // coverage of a second layer in front (0: none; set in main)
@@ -143,34 +138,40 @@ const float g_second_coverage = 0.0;
 // The curtain's room side lit by the room's own light, not by the stand-ins (the fill light
 // and the room's share of the ambient term, which frame.py then leaves out:
 // scene.with_room_solved), and the cloth by its own folds, all from the room's transport
-// (catalog/render/passes/room_transport_light.py); curtain.vert reads the light per vertex:
-// v_room_side_light, the irradiance on the room side, scattered back towards the viewer by
-// the lobes' backward factors as the room's share of eq. 8's ambient term is
-// (u_room_side_reflectance: dye (a_diff backward(g_diff) + a_spec backward(g_spec)) in display
-// RGB) at the view's ratio g_view_room; and v_window_side_light, the mean radiance of the
-// cloth's window side, passed towards the viewer by both lobes over the hemisphere's share
-// the folds hide (g_occlusion), the share the outside's term takes away for both lobes. RGB
-// like the room's light, so added after the bands' conversion.
+// (catalog/render/passes/room_transport_light.py); curtain.vert reads the light per vertex
+// and sums it (v_room_term, v_outside_term): the irradiance on the room side, scattered back
+// towards the viewer by the lobes' backward factors as the room's share of eq. 8's ambient
+// term is (u_room_side_reflectance: dye (a_diff backward(g_diff) + a_spec backward(g_spec))
+// in display RGB) at the view's ratio g_view_room; and the mean radiance of the cloth's window
+// side, passed towards the viewer by both lobes over the hemisphere's share the folds hide,
+// the share the outside's term takes away for both lobes, with the wall's light (WALL_GRID),
+// at g_view_outside. RGB like the room's light, so added after the bands' conversion.
+INTERPOLATION in vec3 v_room_term;
+#ifdef GBUFFER   // the parts apart, for the G-buffer
 INTERPOLATION in vec3 v_room_side_light;
 INTERPOLATION in vec3 v_window_side_light;
 INTERPOLATION in float v_view_occlusion;
-uniform vec3 u_room_side_reflectance;
-uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
-uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
 #ifdef WALL_GRID
 INTERPOLATION in vec3 v_wall_light;   // curtain.vert: the wall and its reveals, both lobes' share passed
+#endif
 #endif
 #endif
 float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own folds (SKY_OCCLUSION)
 #ifdef SKY_OCCLUSION
 // The outside hidden by the cloth's own folds and by the window wall (issue 11, model.md
 // section 9), per vertex (curtain.vert) and interpolated: the ambient term loses that
-// fraction of what a layer of cloth does not pass (u_ambient_occluded: the float64 twin's
-// outside_occluded_radiance), and all of the outside where the wall hides it.
-SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
+// fraction of what a layer of cloth does not pass (the float64 twin's
+// outside_occluded_radiance), and all of the outside where the wall hides it; curtain.vert
+// sums that loss in display RGB into v_outside_term (it is linear in the occlusion).
+INTERPOLATION in float v_outside_open;   // 1 - the wall's share of the outside
+#ifdef GBUFFER
 INTERPOLATION in vec3 v_occlusion;  // the cloth's share, the window wall's, the cloth's towards the room
 #endif
-float g_occlusion = 0.0;            // set in main (SKY_OCCLUSION; ROOM_SIDE reads it too)
+#endif
+#if defined(SKY_OCCLUSION) || defined(ROOM_SIDE)
+INTERPOLATION in vec3 v_outside_term;   // curtain.vert: the outside's terms per g_view_outside
+#endif
+float g_occlusion = 0.0;            // set in main (GBUFFER)
 float g_wall_occlusion = 0.0;
 
 // A table of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes.
@@ -200,10 +201,6 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
 #endif
     vec4 constant = g_view_room * u_ambient[k] + (g_view_outside - g_view_room) * u_ambient_outside[k]
                   + g_sky_tilt * u_ambient_tilt[k];
-#ifdef SKY_OCCLUSION
-    constant -= g_view_outside * (g_occlusion * u_ambient_occluded[k]
-                                  + g_wall_occlusion * u_ambient_outside[k]);
-#endif
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
 #endif
@@ -234,7 +231,7 @@ void main() {
 #ifdef PATTERN
     // the fabric's own structure (model.md section 9): thread coverage and the thread's
     // normal, both mip-filtered (far away: c -> mean(c) = 1 - LD, the normal -> the cloth's)
-    vec4 thread = thread_texel(v_pattern_uv);
+    vec4 thread = thread_texel(v_uv * u_uv_to_repeats);
     n = thread_normal(n, v_tangent, thread.xyz);
 #endif
 #ifdef ANISOTROPIC
@@ -261,7 +258,7 @@ void main() {
     float key_uv = 1.0;   // the key's excitation reaching the fragment (KEY_SHADOW)
 #ifdef KEY_SHADOW
     {
-        vec3 visibility = texture(u_key_visibility, v_key_uv).rgb;
+        vec3 visibility = texture(u_key_visibility, v_uv).rgb;
         g_key_beam = visibility.r;
         g_front_coverage = visibility.g;
         g_second_coverage = visibility.b;
@@ -269,10 +266,12 @@ void main() {
     }
 #endif
 #ifdef SKY_OCCLUSION
+    g_sky_tilt *= v_outside_open;   // where the wall hides the outside, no sky or ground
+#ifdef GBUFFER
     g_occlusion = v_occlusion.x;
     g_wall_occlusion = v_occlusion.y;
     g_room_occlusion = v_occlusion.z;
-    g_sky_tilt *= 1.0 - g_wall_occlusion;   // where the wall hides the outside, no sky or ground
+#endif
 #endif
     float absorbed = 0.0;
     float saturation = 1.0;
@@ -324,12 +323,11 @@ void main() {
 #if defined(SEE_THROUGH) && defined(CURTAIN_ENVIRONMENT)
     rgb += (bg.x * u_direct) * environment_lookup(u_environment, u_environment_scale, ray);
 #endif
-#ifdef ROOM_SIDE
-    rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance * v_room_side_light;
-    rgb += (g_view_outside * g_occlusion) * (u_window_side_diffuse + u_window_side_directional) * v_window_side_light;
-#ifdef WALL_GRID
-    rgb += g_view_outside * v_wall_light;   // the wall and its reveals where the outside is walled
+#if defined(SKY_OCCLUSION) || defined(ROOM_SIDE)
+    rgb += g_view_outside * v_outside_term;   // the occlusion's loss, the window side's and wall's light
 #endif
+#ifdef ROOM_SIDE
+    rgb += g_view_room * v_room_term;
 #endif
 #ifdef PATTERN
     // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole

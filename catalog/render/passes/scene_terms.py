@@ -95,9 +95,21 @@ class SceneTerms:
         return self._lamp_values
 
     def scene_values_with(self, overrides: dict | None) -> dict:
+        """:meth:`scene_values` with ``overrides`` replaced, and what curtain.vert derives from
+        them: the occlusion's loss of the ambient term (the outside's share hidden by the
+        cloth, ``u_ambient_occluded``, and by the wall, ``u_ambient_outside``) summed over the
+        bands in display RGB, as curtain.frag's shade_chunk projects a band (N_BANDS 3: the
+        bands themselves)."""
         values = self.scene_values()
         if overrides:
             values = {**values, **overrides}
+        n = self.frame.n_bands
+        to_rgb = (np.eye(3) if n == 3 else
+                  np.stack([np.asarray(values[f"u_band_to_{c}"], dtype=np.float64).reshape(-1)[:n]
+                            for c in "rgb"]))
+        for name in ("u_ambient_occluded", "u_ambient_outside"):
+            banded = np.asarray(values[name], dtype=np.float64).reshape(-1)[:n]
+            values[name + "_rgb"] = tuple(float(v) for v in to_rgb @ banded)
         return values
 
     def capture_overrides(self) -> dict:
