@@ -4,7 +4,8 @@
 // Costed for a CPU rasteriser (llvmpipe), where every operation runs per fragment: the view
 // ray is interpolated (curtain.vert), the tangent frame is used in the scalar form the chord
 // needs, each light's two HG lobes come back as one ratio, and with SHARED_DIVISION (set by
-// frame.py when float32 cannot underflow) the key, the fill and the fluorescence saturation
+// frame.py when float32 cannot underflow) the key, the fill (FILL_LIGHT: where the scene has
+// one; curtain.py) and the fluorescence saturation
 // share one division; constants are summed at compile time (SPECIALISED). docs/render.md has
 // the measured cost of each step.
 #include "common.glsl"
@@ -51,13 +52,13 @@ SCENE_VALUE(vec4, u_fill_dyed[NV4], S_FILL_DYED);           // fill light (viewe
 SCENE_VALUE(vec4, u_ambient[NV4], S_AMBIENT);               // cloth radiance from the diffuse surroundings
 SCENE_VALUE(vec4, u_ambient_outside[NV4], S_AMBIENT_OUTSIDE); // the outside's share of it
 // the ambient by view (issue 11, model.md section 9): its ratio to the normal view's at
-// mu = |n . v| = i / (AMBIENT_VIEW_NODES - 1), the outside's share and the room's
-SCENE_VALUE(vec4, u_ambient_view_outside[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_OUTSIDE);
-SCENE_VALUE(vec4, u_ambient_view_room[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_ROOM);
+// mu = |n . v| = i / (AMBIENT_VIEW_NODES - 1), the outside's share and the room's, as segments
+// (view_segments: per segment i, the outside's node i and its step to the next, the room's)
+SCENE_VALUE(vec4, u_ambient_view[AMBIENT_VIEW_NODES - 1], S_AMBIENT_VIEW);
 // the outside through the lobes by the view's height (issue 11): the sky's share at
-// x = (ray_y + 1) / 2 = i / (AMBIENT_VIEW_NODES - 1), and the ambient's change per unit of
+// x = (ray_y + 1) / 2 = i / (AMBIENT_VIEW_NODES - 1) (segments, xy), and the ambient's change per unit of
 // it away from 1/2 (dye (a_diff fwd + a_spec fwd) (sky - ground); 0 with the viewer outside)
-SCENE_VALUE(vec4, u_outside_sky_share[AMBIENT_VIEW_VEC4], S_OUTSIDE_SKY_SHARE);
+SCENE_VALUE(vec4, u_outside_sky_share[AMBIENT_VIEW_NODES - 1], S_OUTSIDE_SKY_SHARE);
 SCENE_VALUE(vec4, u_ambient_tilt[NV4], S_AMBIENT_TILT);
 float g_view_outside = 1.0;   // set in main
 float g_view_room = 1.0;
@@ -174,13 +175,15 @@ INTERPOLATION in vec3 v_outside_term;   // curtain.vert: the outside's terms per
 float g_occlusion = 0.0;            // set in main (GBUFFER)
 float g_wall_occlusion = 0.0;
 
-// A table of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes.
-float ambient_view(vec4 table[AMBIENT_VIEW_VEC4], float mu) {
+// Tables of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes, as
+// segments (bands.py view_segments: per segment a vec4 of two tables' node and step): both
+// tables at mu, one indexed read (an indexed read is a gather per fragment on a CPU rasteriser).
+vec2 view_segments(vec4 segments[AMBIENT_VIEW_NODES - 1], float mu) {
     float x = clamp(mu, 0.0, 1.0) * float(AMBIENT_VIEW_NODES - 1);
     int i = min(int(x), AMBIENT_VIEW_NODES - 2);
-    float a = table[i / 4][i % 4];
-    float b = table[(i + 1) / 4][(i + 1) % 4];
-    return a + (x - float(i)) * (b - a);
+    vec4 s = segments[i];
+    float f = x - float(i);
+    return vec2(s.x + f * s.y, s.z + f * s.w);
 }
 
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
@@ -246,13 +249,20 @@ void main() {
     float cos_key = dot(n, u_key_to_light);
     float cos_fill = dot(n, u_fill_to_light);
     float mu_view = abs(dot(n, ray));
-    g_view_outside = ambient_view(u_ambient_view_outside, mu_view);
-    g_view_room = ambient_view(u_ambient_view_room, mu_view);
-    g_sky_tilt = g_view_outside * (ambient_view(u_outside_sky_share, 0.5 * (ray.y + 1.0)) - 0.5);
+    vec2 view_ratios = view_segments(u_ambient_view, mu_view);
+    g_view_outside = view_ratios.x;
+    g_view_room = view_ratios.y;
+    g_sky_tilt = g_view_outside * (view_segments(u_outside_sky_share, 0.5 * (ray.y + 1.0)).x - 0.5);
     vec2 key = woven_transmission_ratio(u_key_to_light, cos_key, tan_key, view,
                                         u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
+#ifdef FILL_LIGHT
     vec2 fill = woven_transmission_ratio(u_fill_to_light, cos_fill, tan_fill, view,
                                          u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
+#else
+    // no fill light (its irradiance 0: the room's own light on the room side, ROOM_SIDE):
+    // no lobes to evaluate; g_fill = 0 and the shared division's factor 1
+    vec2 fill = vec2(0.0, 1.0);
+#endif
     // eq. 8 fluorescence, physical: fluorescence_effective_photons, N / (1 + N / N_sat), with its
     // denominator kept apart so that SHARED_DIVISION can fold it into the one division
     float key_uv = 1.0;   // the key's excitation reaching the fragment (KEY_SHADOW)
