@@ -130,7 +130,7 @@ def run(quick: bool = False, sizes=DEFAULT_SIZES) -> dict:
     ctx = create_headless_context()
     load_before = os.getloadavg()[0]
     try:
-        rows = [run_scene(ctx, size, fabric, light, 3 if quick else 7)
+        rows = [run_scene(ctx, size, fabric, light, 3 if quick else 11)
                 for size in sizes for fabric, light in SCENES]
         machine = machine_info(ctx)
     finally:
