@@ -11,6 +11,16 @@
 
 const float PI = 3.14159265358979;
 
+// The curtain's scene values (curtain.vert/.frag), fixed until the light, fabric, mode or band
+// count changes. SPECIALISED: compiled in as constants (catalog/render/frame.py injects
+// S_<NAME> #defines with their values), so the compiler folds them (HG's (1 - g)^2, the sign
+// of g) and a CPU rasteriser loads no uniforms per fragment; otherwise ordinary uniforms.
+#ifdef SPECIALISED
+#define SCENE_VALUE(type, name, value) const type name = value
+#else
+#define SCENE_VALUE(type, name, value) uniform type name
+#endif
+
 // Henyey & Greenstein 1941, "Diffuse radiation in the galaxy"; model.md eq. 6 in the robust form of
 // catalog/optics/btdf.py (unchanged for g >= 0):
 // 1 + g^2 - 2 g cos(theta) = (1 - g)^2 + 2 g (1 - cos theta) with 1 - cos theta = chord2 / 2, and

@@ -4,7 +4,8 @@
 // Costed for a CPU rasteriser (llvmpipe), where every operation runs per fragment: the view
 // ray is interpolated (curtain.vert), the tangent frame is used in the scalar form the chord
 // needs, each light's two HG lobes come back as one ratio, and with SHARED_DIVISION (set by
-// frame.py when float32 cannot underflow) the key, the fill and the fluorescence saturation
+// frame.py when float32 cannot underflow) the key, the fill (FILL_LIGHT: where the scene has
+// one; curtain.py) and the fluorescence saturation
 // share one division; constants are summed at compile time (SPECIALISED). docs/render.md has
 // the measured cost of each step.
 #include "common.glsl"
@@ -17,8 +18,11 @@ INTERPOLATION in vec3 v_normal;
 #if defined(ANISOTROPIC) || defined(GBUFFER) || defined(PATTERN)
 INTERPOLATION in vec3 v_tangent;
 #endif
+#if defined(PATTERN) || defined(KEY_SHADOW)
+INTERPOLATION in vec2 v_uv;                      // the fabric's texture coordinates (curtain.vert)
+#endif
 #ifdef PATTERN
-INTERPOLATION in vec2 v_pattern_uv;              // in pattern repeats
+uniform vec2 u_uv_to_repeats;      // fabric size / pattern repeat: uv -> pattern repeats
 uniform float u_inv_mean_coverage; // 1 / mean(c): the fitted lobes belong to the threads alone
 #endif
 #ifdef OIT
@@ -28,15 +32,8 @@ uniform float u_oit_depth_ref;     // m: the view distance where the OIT depth w
 INTERPOLATION in vec3 v_position;
 #endif
 
-// The scene's values, fixed until the light, fabric, mode or band count changes. SPECIALISED:
-// compiled in as constants (catalog/render/frame.py injects S_<NAME> #defines with their
-// values), so the compiler folds them (HG's (1 - g)^2, the sign of g) and a CPU rasteriser
-// loads no uniforms per fragment; otherwise ordinary uniforms.
-#ifdef SPECIALISED
-#define SCENE_VALUE(type, name, value) const type name = value
-#else
-#define SCENE_VALUE(type, name, value) uniform type name
-#endif
+// The scene's values (common.glsl SCENE_VALUE), fixed until the light, fabric, mode or band
+// count changes.
 
 SCENE_VALUE(vec3, u_key_to_light, S_KEY_TO_LIGHT);
 SCENE_VALUE(vec3, u_fill_to_light, S_FILL_TO_LIGHT);
@@ -55,13 +52,13 @@ SCENE_VALUE(vec4, u_fill_dyed[NV4], S_FILL_DYED);           // fill light (viewe
 SCENE_VALUE(vec4, u_ambient[NV4], S_AMBIENT);               // cloth radiance from the diffuse surroundings
 SCENE_VALUE(vec4, u_ambient_outside[NV4], S_AMBIENT_OUTSIDE); // the outside's share of it
 // the ambient by view (issue 11, model.md section 9): its ratio to the normal view's at
-// mu = |n . v| = i / (AMBIENT_VIEW_NODES - 1), the outside's share and the room's
-SCENE_VALUE(vec4, u_ambient_view_outside[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_OUTSIDE);
-SCENE_VALUE(vec4, u_ambient_view_room[AMBIENT_VIEW_VEC4], S_AMBIENT_VIEW_ROOM);
+// mu = |n . v| = i / (AMBIENT_VIEW_NODES - 1), the outside's share and the room's, as segments
+// (view_segments: per segment i, the outside's node i and its step to the next, the room's)
+SCENE_VALUE(vec4, u_ambient_view[AMBIENT_VIEW_NODES - 1], S_AMBIENT_VIEW);
 // the outside through the lobes by the view's height (issue 11): the sky's share at
-// x = (ray_y + 1) / 2 = i / (AMBIENT_VIEW_NODES - 1), and the ambient's change per unit of
+// x = (ray_y + 1) / 2 = i / (AMBIENT_VIEW_NODES - 1) (segments, xy), and the ambient's change per unit of
 // it away from 1/2 (dye (a_diff fwd + a_spec fwd) (sky - ground); 0 with the viewer outside)
-SCENE_VALUE(vec4, u_outside_sky_share[AMBIENT_VIEW_VEC4], S_OUTSIDE_SKY_SHARE);
+SCENE_VALUE(vec4, u_outside_sky_share[AMBIENT_VIEW_NODES - 1], S_OUTSIDE_SKY_SHARE);
 SCENE_VALUE(vec4, u_ambient_tilt[NV4], S_AMBIENT_TILT);
 float g_view_outside = 1.0;   // set in main
 float g_view_room = 1.0;
@@ -132,7 +129,6 @@ SCENE_VALUE(vec4, u_key_thread2[NV4], S_KEY_THREAD2);
 // over the fabric's uv when the light or the mesh changes (key_visibility.frag: r the mask,
 // g, b the first and second layers' coverage) and read here with one bilinear lookup.
 uniform sampler2D u_key_visibility;
-INTERPOLATION in vec2 v_key_uv;
 float g_key_beam = 1.0;            // the window's mask (set in main)
 float g_front_coverage = 0.0;      // coverage of the layer in front (0: none; set in main)
 float g_second_coverage = 0.0;     // coverage of a second layer in front (0: none; set in main)
@@ -143,43 +139,51 @@ const float g_second_coverage = 0.0;
 // The curtain's room side lit by the room's own light, not by the stand-ins (the fill light
 // and the room's share of the ambient term, which frame.py then leaves out:
 // scene.with_room_solved), and the cloth by its own folds, all from the room's transport
-// (catalog/render/passes/room_transport_light.py); curtain.vert reads the light per vertex:
-// v_room_side_light, the irradiance on the room side, scattered back towards the viewer by
-// the lobes' backward factors as the room's share of eq. 8's ambient term is
-// (u_room_side_reflectance: dye (a_diff backward(g_diff) + a_spec backward(g_spec)) in display
-// RGB) at the view's ratio g_view_room; and v_window_side_light, the mean radiance of the
-// cloth's window side, passed towards the viewer by both lobes over the hemisphere's share
-// the folds hide (g_occlusion), the share the outside's term takes away for both lobes. RGB
-// like the room's light, so added after the bands' conversion.
+// (catalog/render/passes/room_transport_light.py); curtain.vert reads the light per vertex
+// and sums it (v_room_term, v_outside_term): the irradiance on the room side, scattered back
+// towards the viewer by the lobes' backward factors as the room's share of eq. 8's ambient
+// term is (u_room_side_reflectance: dye (a_diff backward(g_diff) + a_spec backward(g_spec))
+// in display RGB) at the view's ratio g_view_room; and the mean radiance of the cloth's window
+// side, passed towards the viewer by both lobes over the hemisphere's share the folds hide,
+// the share the outside's term takes away for both lobes, with the wall's light (WALL_GRID),
+// at g_view_outside. RGB like the room's light, so added after the bands' conversion.
+INTERPOLATION in vec3 v_room_term;
+#ifdef GBUFFER   // the parts apart, for the G-buffer
 INTERPOLATION in vec3 v_room_side_light;
 INTERPOLATION in vec3 v_window_side_light;
 INTERPOLATION in float v_view_occlusion;
-uniform vec3 u_room_side_reflectance;
-uniform vec3 u_window_side_diffuse;      // dye a_diff forward(g_diff)
-uniform vec3 u_window_side_directional;  // dye a_spec forward(g_spec)
 #ifdef WALL_GRID
 INTERPOLATION in vec3 v_wall_light;   // curtain.vert: the wall and its reveals, both lobes' share passed
+#endif
 #endif
 #endif
 float g_room_occlusion = 0.0;       // the room's side hidden by the cloth's own folds (SKY_OCCLUSION)
 #ifdef SKY_OCCLUSION
 // The outside hidden by the cloth's own folds and by the window wall (issue 11, model.md
 // section 9), per vertex (curtain.vert) and interpolated: the ambient term loses that
-// fraction of what a layer of cloth does not pass (u_ambient_occluded: the float64 twin's
-// outside_occluded_radiance), and all of the outside where the wall hides it.
-SCENE_VALUE(vec4, u_ambient_occluded[NV4], S_AMBIENT_OCCLUDED);
+// fraction of what a layer of cloth does not pass (the float64 twin's
+// outside_occluded_radiance), and all of the outside where the wall hides it; curtain.vert
+// sums that loss in display RGB into v_outside_term (it is linear in the occlusion).
+INTERPOLATION in float v_outside_open;   // 1 - the wall's share of the outside
+#ifdef GBUFFER
 INTERPOLATION in vec3 v_occlusion;  // the cloth's share, the window wall's, the cloth's towards the room
 #endif
-float g_occlusion = 0.0;            // set in main (SKY_OCCLUSION; ROOM_SIDE reads it too)
+#endif
+#if defined(SKY_OCCLUSION) || defined(ROOM_SIDE)
+INTERPOLATION in vec3 v_outside_term;   // curtain.vert: the outside's terms per g_view_outside
+#endif
+float g_occlusion = 0.0;            // set in main (GBUFFER)
 float g_wall_occlusion = 0.0;
 
-// A table of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes.
-float ambient_view(vec4 table[AMBIENT_VIEW_VEC4], float mu) {
+// Tables of AMBIENT_VIEW_NODES values at mu = i / (nodes - 1), linear between nodes, as
+// segments (bands.py view_segments: per segment a vec4 of two tables' node and step): both
+// tables at mu, one indexed read (an indexed read is a gather per fragment on a CPU rasteriser).
+vec2 view_segments(vec4 segments[AMBIENT_VIEW_NODES - 1], float mu) {
     float x = clamp(mu, 0.0, 1.0) * float(AMBIENT_VIEW_NODES - 1);
     int i = min(int(x), AMBIENT_VIEW_NODES - 2);
-    float a = table[i / 4][i % 4];
-    float b = table[(i + 1) / 4][(i + 1) % 4];
-    return a + (x - float(i)) * (b - a);
+    vec4 s = segments[i];
+    float f = x - float(i);
+    return vec2(s.x + f * s.y, s.z + f * s.w);
 }
 
 vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
@@ -200,10 +204,6 @@ vec3 shade_chunk(int k, float g_key, float g_fill, vec3 bg, float effective) {
 #endif
     vec4 constant = g_view_room * u_ambient[k] + (g_view_outside - g_view_room) * u_ambient_outside[k]
                   + g_sky_tilt * u_ambient_tilt[k];
-#ifdef SKY_OCCLUSION
-    constant -= g_view_outside * (g_occlusion * u_ambient_occluded[k]
-                                  + g_wall_occlusion * u_ambient_outside[k]);
-#endif
 #ifdef FLUORESCENCE_PAPER
     constant += fluorescence_paper(u_fluorescence[k]);
 #endif
@@ -234,7 +234,7 @@ void main() {
 #ifdef PATTERN
     // the fabric's own structure (model.md section 9): thread coverage and the thread's
     // normal, both mip-filtered (far away: c -> mean(c) = 1 - LD, the normal -> the cloth's)
-    vec4 thread = thread_texel(v_pattern_uv);
+    vec4 thread = thread_texel(v_uv * u_uv_to_repeats);
     n = thread_normal(n, v_tangent, thread.xyz);
 #endif
 #ifdef ANISOTROPIC
@@ -249,19 +249,26 @@ void main() {
     float cos_key = dot(n, u_key_to_light);
     float cos_fill = dot(n, u_fill_to_light);
     float mu_view = abs(dot(n, ray));
-    g_view_outside = ambient_view(u_ambient_view_outside, mu_view);
-    g_view_room = ambient_view(u_ambient_view_room, mu_view);
-    g_sky_tilt = g_view_outside * (ambient_view(u_outside_sky_share, 0.5 * (ray.y + 1.0)) - 0.5);
+    vec2 view_ratios = view_segments(u_ambient_view, mu_view);
+    g_view_outside = view_ratios.x;
+    g_view_room = view_ratios.y;
+    g_sky_tilt = g_view_outside * (view_segments(u_outside_sky_share, 0.5 * (ray.y + 1.0)).x - 0.5);
     vec2 key = woven_transmission_ratio(u_key_to_light, cos_key, tan_key, view,
                                         u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
+#ifdef FILL_LIGHT
     vec2 fill = woven_transmission_ratio(u_fill_to_light, cos_fill, tan_fill, view,
                                          u_a_diff, u_g_diff, u_a_spec, u_g_spec, u_anisotropy);
+#else
+    // no fill light (its irradiance 0: the room's own light on the room side, ROOM_SIDE):
+    // no lobes to evaluate; g_fill = 0 and the shared division's factor 1
+    vec2 fill = vec2(0.0, 1.0);
+#endif
     // eq. 8 fluorescence, physical: fluorescence_effective_photons, N / (1 + N / N_sat), with its
     // denominator kept apart so that SHARED_DIVISION can fold it into the one division
     float key_uv = 1.0;   // the key's excitation reaching the fragment (KEY_SHADOW)
 #ifdef KEY_SHADOW
     {
-        vec3 visibility = texture(u_key_visibility, v_key_uv).rgb;
+        vec3 visibility = texture(u_key_visibility, v_uv).rgb;
         g_key_beam = visibility.r;
         g_front_coverage = visibility.g;
         g_second_coverage = visibility.b;
@@ -269,10 +276,12 @@ void main() {
     }
 #endif
 #ifdef SKY_OCCLUSION
+    g_sky_tilt *= v_outside_open;   // where the wall hides the outside, no sky or ground
+#ifdef GBUFFER
     g_occlusion = v_occlusion.x;
     g_wall_occlusion = v_occlusion.y;
     g_room_occlusion = v_occlusion.z;
-    g_sky_tilt *= 1.0 - g_wall_occlusion;   // where the wall hides the outside, no sky or ground
+#endif
 #endif
     float absorbed = 0.0;
     float saturation = 1.0;
@@ -324,12 +333,11 @@ void main() {
 #if defined(SEE_THROUGH) && defined(CURTAIN_ENVIRONMENT)
     rgb += (bg.x * u_direct) * environment_lookup(u_environment, u_environment_scale, ray);
 #endif
-#ifdef ROOM_SIDE
-    rgb += (g_view_room * (1.0 / PI)) * u_room_side_reflectance * v_room_side_light;
-    rgb += (g_view_outside * g_occlusion) * (u_window_side_diffuse + u_window_side_directional) * v_window_side_light;
-#ifdef WALL_GRID
-    rgb += g_view_outside * v_wall_light;   // the wall and its reveals where the outside is walled
+#if defined(SKY_OCCLUSION) || defined(ROOM_SIDE)
+    rgb += g_view_outside * v_outside_term;   // the occlusion's loss, the window side's and wall's light
 #endif
+#ifdef ROOM_SIDE
+    rgb += g_view_room * v_room_term;
 #endif
 #ifdef PATTERN
     // threads: eq. 8 without LD, the lobes divided by mean(c) (the fit describes the whole

@@ -344,3 +344,37 @@ def test_room_side_term_is_part_of_the_per_pixel_comparison(gl, make_preset):
     renderer.release()
 
 
+
+
+@pytest.mark.slow
+def test_frame_variant_shades_as_the_gbuffer_variant(gl, make_preset):
+    """The frame's own curtain program takes the room side's, the window side's, the wall's
+    light and the occlusion's loss of the ambient term summed per vertex (curtain.vert
+    v_room_term, v_outside_term, v_outside_open); the G-buffer variant, which the float64
+    twin holds to 1e-3 above, also writes the parts apart. Both must shade each pixel alike
+    (1e-5 relative: the same float32 arithmetic, compiled twice), in a scene where those
+    terms carry weight: the folds hide part of the outside and the room side is lit. (The
+    flat cloth: the patterned one's OIT layers weigh the radiance by depth.)"""
+    import moderngl
+
+    renderer = _renderer(gl, make_preset(), "D65", "physical")
+    renderer.update(camera=orbit(yaw_deg=20.0, pitch_deg=-10.0, distance_m=2.2), patterned=False)
+    defines = renderer.curtain.variant_defines()
+    assert all(defines.get(name) for name in ("ROOM_SIDE", "SKY_OCCLUSION", "WALL_GRID", "KEY_SHADOW"))
+    gbuffer = renderer.render_gbuffer()
+    mask = gbuffer["mask"]
+    assert gbuffer["shadows"][mask][:, 2].max() > 0.05      # the folds hide part of the outside
+    assert np.abs(gbuffer["window_side_light"][mask]).max() > 0.0
+    w, h = renderer.size
+    targets = renderer.targets
+    targets.hdr_fbo.use()
+    gl.viewport = (0, 0, w, h)
+    targets.hdr_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+    gl.enable(moderngl.DEPTH_TEST)
+    renderer.curtain.draw_curtain(renderer.camera.view_projection(w / h))
+    gl.disable(moderngl.DEPTH_TEST)
+    data = targets.hdr_fbo.read(viewport=(0, 0, w, h), components=4, dtype="f4")
+    frame = np.frombuffer(data, dtype=np.float32).reshape(h, w, 4)[::-1, :, :3]
+    expected = gbuffer["radiance"][mask].astype(np.float64)
+    assert _relative_error(frame[mask].astype(np.float64), expected).max() < 1e-5
+    renderer.release()

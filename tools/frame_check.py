@@ -1,6 +1,7 @@
 """Before/after frames of the real-time renderer (issue 31: a refactor must not change a frame).
 
     PYTHONPATH=TREE python tools/frame_check.py render OUT.npz MESHES.npz
+    PYTHONPATH=TREE python tools/frame_check.py accuracy OUT.npz [WIDTHxHEIGHT]
     python tools/frame_check.py compare BEFORE.npz AFTER.npz
 
 ``render`` draws CASES (the image bench's six scenes and options a user changes; an option
@@ -11,6 +12,11 @@ written to MESHES.npz on the first run and read on the next, so both trees draw 
 vertices. ``compare`` prints per case the largest and mean relative difference of the linear
 frames (|a - b| / max(|a|, 1e-3 max |a|)), the largest sRGB8 step and the mean FLIP of the
 display images (catalog.pathtrace.metrics.flip_map), then the worst of each.
+
+``accuracy`` draws the accuracy bench's report scenes instead (benchmarks/accuracy.py:
+draw_scenes(DEFAULT_SCENES, REPORT_SEED), each as its ``measure_scene`` draws the frame:
+describe_scene's settled drape in the scene's room, benchmarks.image.frame_images), at
+ACCURACY_SIZE unless given; ``compare`` reads either file.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 SIZE = (320, 180)
+ACCURACY_SIZE = (640, 360)
 VIEWS = {"room": (20.0, 15.0, 2.6), "close-up": (0.0, 0.0, 0.8), "outside": (180.0, 5.0, 2.6)}
 
 
@@ -83,6 +90,29 @@ def render(out: Path, meshes_path: Path) -> None:
         np.savez(meshes_path, **meshes)
 
 
+def render_accuracy(out: Path, size=ACCURACY_SIZE) -> None:
+    from benchmarks import accuracy
+    from benchmarks.image import frame_images
+    from catalog.gl.context import create_headless_context
+    from catalog.optics.lights import get_light
+    from catalog.pathtrace.render import reference_settings
+    from catalog.pathtrace.scene import describe_scene
+    from catalog.presets import find_preset, load_preset
+
+    ctx = create_headless_context()
+    frames, srgb = {}, {}
+    for scene in accuracy.draw_scenes(accuracy.DEFAULT_SCENES, accuracy.REPORT_SEED):
+        t = time.perf_counter()
+        preset, light, cam = load_preset(find_preset(scene["fabric"])), get_light(scene["light"]), scene["camera"]
+        desc = describe_scene(reference_settings(preset, light, yaw_deg=cam["yaw_deg"], pitch_deg=cam["pitch_deg"],
+                                                 distance_m=cam["distance_m"], room=scene["room"]), size=tuple(size))
+        frame = frame_images(ctx, desc, preset, light, 3, "physical", repeats=1, room=scene["room"])
+        frames[scene["label"]] = frame["linear"]
+        srgb[scene["label"]] = np.round(255.0 * frame["display"]).astype(np.uint8)
+        print(f"{scene['label']}: {time.perf_counter() - t:.1f} s", file=sys.stderr)
+    np.savez_compressed(out, **{f"lin:{k}": v for k, v in frames.items()}, **{f"srgb:{k}": v for k, v in srgb.items()})
+
+
 def _renderer(FrameRenderer, ctx, preset, light, view, opts):
     """A FrameRenderer of the case: from its FrameSettings, or (a tree before the settings
     value, e.g. the tag before-31) through the setters the options name."""
@@ -128,6 +158,8 @@ def compare(before: Path, after: Path) -> float:
 if __name__ == "__main__":
     if len(sys.argv) == 4 and sys.argv[1] == "render":
         render(Path(sys.argv[2]), Path(sys.argv[3]))
+    elif len(sys.argv) in (3, 4) and sys.argv[1] == "accuracy":
+        render_accuracy(Path(sys.argv[2]), *([tuple(int(v) for v in sys.argv[3].split("x"))] if len(sys.argv) == 4 else []))
     elif len(sys.argv) == 4 and sys.argv[1] == "compare":
         compare(Path(sys.argv[2]), Path(sys.argv[3]))
     else:

@@ -21,7 +21,6 @@ import math
 
 import numpy as np
 
-from catalog.core.constants import SHADER_DEFINES
 from catalog.core.errors import CatalogError
 from catalog.optics.shading_reference import (LUMINOUS_EFFICACY_LM_W, PHOTON_UNIT, STEP_NM, ShadingInputs,
                                               AMBIENT_VIEW_NODES, layer_beam_transmittance,
@@ -78,17 +77,18 @@ def _pack(values: np.ndarray, n_chunks: int) -> np.ndarray:
     return out
 
 
-def _view_table(table) -> np.ndarray:
-    """An ambient-by-view table (AMBIENT_VIEW_NODES values; None: all 1) as AMBIENT_VIEW_VEC4
-    vec4s, padded with its last value (curtain.frag's ambient_view)."""
-    values = np.ones(AMBIENT_VIEW_NODES.size) if table is None else np.asarray(table, dtype=np.float64)
-    out = np.full(4 * AMBIENT_VIEW_VEC4, values[-1], dtype=np.float32)
-    out[:values.size] = values
-    return out
-
-
-#: vec4s holding an ambient-by-view table (the shaders' AMBIENT_VIEW_VEC4).
-AMBIENT_VIEW_VEC4 = SHADER_DEFINES["AMBIENT_VIEW_VEC4"]
+def view_segments(*tables) -> np.ndarray:
+    """Ambient-by-view tables (AMBIENT_VIEW_NODES values each; None: all 1), one or two, as
+    curtain.frag's view_segments: per segment i (AMBIENT_VIEW_NODES - 1 vec4s) each table's
+    node i and its step to node i + 1 (float32, the step as the shader's own float32
+    subtraction would round it), zeros where there is no second table: a fragment reads one
+    vec4 for both tables instead of four indexed values."""
+    out = np.zeros((AMBIENT_VIEW_NODES.size - 1, 4), dtype=np.float32)
+    for j, table in enumerate(tables):
+        values = (np.ones(AMBIENT_VIEW_NODES.size) if table is None else np.asarray(table, dtype=np.float64)).astype(np.float32)
+        out[:, 2 * j] = values[:-1]
+        out[:, 2 * j + 1] = values[1:] - values[:-1]
+    return out.reshape(-1)
 
 
 def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray | float | tuple]:
@@ -120,13 +120,12 @@ def band_uniforms(inputs: ShadingInputs, n_bands: int) -> dict[str, np.ndarray |
         "u_ambient_occluded": band(outside_occluded_radiance(inputs)),
         "u_ambient_outside": band(inputs.ambient_outside_radiance
                                   if inputs.ambient_outside_radiance is not None else zeros),
-        "u_ambient_view_outside": _view_table(inputs.ambient_view_outside),
-        "u_ambient_view_room": _view_table(inputs.ambient_view_room),
+        "u_ambient_view": view_segments(inputs.ambient_view_outside, inputs.ambient_view_room),
         "u_ambient_tilt": band(inputs.ambient_tilt_radiance
                                if inputs.ambient_tilt_radiance is not None else zeros),
-        "u_outside_sky_share": _view_table(inputs.outside_sky_share
-                                           if inputs.outside_sky_share is not None
-                                           else np.full(AMBIENT_VIEW_NODES.size, 0.5)),
+        "u_outside_sky_share": view_segments(inputs.outside_sky_share
+                                              if inputs.outside_sky_share is not None
+                                              else np.full(AMBIENT_VIEW_NODES.size, 0.5)),
         "u_sky": band(inputs.sky_radiance),
         "u_ground": band(inputs.ground_radiance),
         "u_sun_disc": band(inputs.sun_disc_radiance),

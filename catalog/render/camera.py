@@ -6,6 +6,7 @@ Matrices are float64 numpy in the usual column-vector convention (clip = P V p);
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -83,6 +84,11 @@ class OrbitCamera:
 
     @property
     def position(self) -> np.ndarray:
+        """The eye (m), a fresh array (the frame asks for it a dozen times a draw: formed once)."""
+        return self._position.copy()
+
+    @functools.cached_property
+    def _position(self) -> np.ndarray:
         yaw, pitch = math.radians(self.yaw_deg), math.radians(self.pitch_deg)
         offset = np.array([math.sin(yaw) * math.cos(pitch), math.sin(pitch),
                            math.cos(yaw) * math.cos(pitch)])

@@ -40,6 +40,9 @@ class CurtainPass(Pass):
                    "SEE_THROUGH": inputs.direct > 0, "ANISOTROPIC": inputs.anisotropy != 0.0,
                    "GBUFFER": gbuffer, "SPECIALISED": self.frame.specialise,
                    "SHARED_DIVISION": shared_division_safe(inputs.g_diff, inputs.g_spec)}
+        # the fill light's lobes where it lights the cloth (the room's solved light replaces
+        # it: SceneTerms.curtain_inputs)
+        defines["FILL_LIGHT"] = bool(np.any(self.frame.terms.curtain_inputs().fill_irradiance != 0))
         if self.frame.environment is not None and defines["SEE_THROUGH"]:
             defines["CURTAIN_ENVIRONMENT"] = True  # the see-through shows the image
         if self.frame.room_lamps:
@@ -72,8 +75,7 @@ class CurtainPass(Pass):
             defines.pop("OCCLUSION_MAPS", None)
             defines.pop("WALL_GRID", None)
         if self.frame.specialise:
-            for name, value in self.frame.terms.scene_values_with(overrides).items():
-                defines["S_" + name[2:].upper()] = glsl_literal(value)
+            defines.update(self.frame.terms.scene_defines(overrides))
         return self.gl.program("curtain.vert", "curtain.frag", defines)
 
     def scene_uniforms(self, program, view_proj, inputs, camera_position=None) -> None:

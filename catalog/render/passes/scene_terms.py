@@ -26,6 +26,7 @@ class SceneTerms:
         self._window_side_values = self._window_side_key = None
         self._display = self._display_key = None
         self._dyes = self._dye_key = None
+        self._scene_defines = self._scene_defines_key = None
 
     def curtain_inputs(self):
         """The :class:`ShadingInputs` the curtain program shades with: :meth:`shading_inputs`,
@@ -95,10 +96,39 @@ class SceneTerms:
         return self._lamp_values
 
     def scene_values_with(self, overrides: dict | None) -> dict:
+        """:meth:`scene_values` with ``overrides`` replaced, and what curtain.vert derives from
+        them: the occlusion's loss of the ambient term (the outside's share hidden by the
+        cloth, ``u_ambient_occluded``, and by the wall, ``u_ambient_outside``) summed over the
+        bands in display RGB, as curtain.frag's shade_chunk projects a band (N_BANDS 3: the
+        bands themselves)."""
         values = self.scene_values()
         if overrides:
             values = {**values, **overrides}
+        n = self.frame.n_bands
+        to_rgb = (np.eye(3) if n == 3 else
+                  np.stack([np.asarray(values[f"u_band_to_{c}"], dtype=np.float64).reshape(-1)[:n]
+                            for c in "rgb"]))
+        for name in ("u_ambient_occluded", "u_ambient_outside"):
+            banded = np.asarray(values[name], dtype=np.float64).reshape(-1)[:n]
+            values[name + "_rgb"] = tuple(float(v) for v in to_rgb @ banded)
         return values
+
+    def scene_defines(self, overrides: dict | None = None) -> dict[str, str]:
+        """:meth:`scene_values_with` as the specialised program's #defines (``S_<NAME>``: GLSL
+        literals); without overrides formatted once per change of the scene (the frame's own
+        draws ask for them every frame)."""
+        from catalog.gl.shaderlib import glsl_literal  # noqa: PLC0415
+
+        if overrides:
+            return {"S_" + name[2:].upper(): glsl_literal(value)
+                    for name, value in self.scene_values_with(overrides).items()}
+        self.shading_inputs()   # (its key follows the settings)
+        key = (self.inputs_key, self.frame.n_bands, self.frame.room_side_active())
+        if self._scene_defines_key != key:
+            self._scene_defines = {"S_" + name[2:].upper(): glsl_literal(value)
+                                   for name, value in self.scene_values_with(None).items()}
+            self._scene_defines_key = key
+        return self._scene_defines
 
     def capture_overrides(self) -> dict:
         """The curtain's values for the room transport's views of the window: without the sun's disc seen through
@@ -161,8 +191,7 @@ class SceneTerms:
                 "u_ambient": banded["u_ambient"], "u_ambient_outside": banded["u_ambient_outside"],
                 "u_ambient_occluded": banded["u_ambient_occluded"],
                 "u_ambient_tilt": np.zeros_like(values["u_ambient_tilt"]),
-                "u_ambient_view_outside": np.ones_like(values["u_ambient_view_outside"]),
-                "u_ambient_view_room": np.ones_like(values["u_ambient_view_room"])}
+                "u_ambient_view": band_lib.view_segments(None, None)}
             self._window_side_key = key
         return self._window_side_values
 
