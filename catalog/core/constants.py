@@ -28,10 +28,9 @@ HG_MIRROR_BELOW = -0.2
 
 #: The cloth's ambient term by view (issue 11, docs/model.md section 9) is tabulated at this
 #: many values of mu = |n . v|, evenly from 0 to 1 (linear between), held in
-#: ceil(count / 4) vec4s in the shaders.
+#: AMBIENT_VIEW_NODES - 1 vec4 segments in the shaders (catalog/render/bands.py view_segments).
 AMBIENT_VIEW_NODE_COUNT = 17
 
 #: What every shader program gets as #define (name -> value), from the constants above.
 SHADER_DEFINES = {"HG_MIRROR_BELOW": HG_MIRROR_BELOW,
-                  "AMBIENT_VIEW_NODES": AMBIENT_VIEW_NODE_COUNT,
-                  "AMBIENT_VIEW_VEC4": -(-AMBIENT_VIEW_NODE_COUNT // 4)}
+                  "AMBIENT_VIEW_NODES": AMBIENT_VIEW_NODE_COUNT}
