@@ -94,8 +94,9 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: stand-ins). The transport's update is a host step (catalog.gl.host_step: its views of the
 #: window read back, worked on the host, the light map uploaded), which a recording with the
 #: room lit notes wet with the desktop's outputs and the page can replay
-#: (assets/host_steps.js); the page with it on fails the browser tests yet (not understood),
-#: and it would replay the recorded cloth's light, not the moving cloth's.
+#: (assets/host_steps.js) and does at frame 0 (tests/test_web_lit.py); off because every scene
+#: would then be recorded wet, and the page replays the recorded cloth's light (its baked
+#: frame 0), not the moving cloth's.
 DESKTOP_MODES = {"patterned": True, "room_lighting": False, "antialiasing": "fxaa",
                  "key_second_layer": False}
 
