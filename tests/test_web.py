@@ -636,3 +636,52 @@ def test_stage_peaks_reset_at_each_stage(tmp_path):
     assert stages.peaks["big"] >= stages.peaks["quiet"] + 190, stages.peaks
     assert stages.peaks["after"] < stages.peaks["big"] - 150, stages.peaks
     assert StagePeaks(False).peaks == {} and not StagePeaks(False)._on
+
+
+def _grid_animation(amplitude_m: float, key: str):
+    """A one-frame BakedAnimation of a 9 x 7 grid hanging in a sine of ``amplitude_m`` (the
+    same grid, uv and triangles whatever the amplitude: two fabrics of one site)."""
+    from catalog.web import bake
+
+    cols, rows = 9, 7
+    u, v = np.meshgrid(np.linspace(0.0, 1.0, cols), np.linspace(0.0, 1.0, rows))
+    grid = np.stack([1.2 * u - 0.6, 1.6 * v, amplitude_m * np.sin(4 * np.pi * u)], axis=-1)
+    quads = [(r * cols + c, r * cols + c + 1, (r + 1) * cols + c, (r + 1) * cols + c + 1)
+             for r in range(rows - 1) for c in range(cols - 1)]
+    indices = np.array([[a, c, b, b, c, d] for a, b, c, d in quads], dtype=np.uint32).ravel()
+    lo, payload = bake.encode(grid.reshape(1, -1, 3))
+    return bake.BakedAnimation(key=key, frames=1, fps=12.0, vertex_count=cols * rows,
+                               indices=indices, uv=np.stack([u, v], -1).reshape(-1, 2).astype("f4"),
+                               offset_m=(0.0, 0.0, 0.1), lo_m=lo, payload=payload,
+                               fabric_size_m=(1.2, 1.6), rings_x_m=(-0.5, 0.0, 0.5),
+                               grid=(cols, rows))
+
+
+@pytest.mark.gl
+def test_use_drape_puts_each_fabrics_cloth_in_the_recorded_frame(gl):
+    """The site's exporter is given the first fabric's mesh once (use_mesh: the page's curtain
+    buffers); use_drape of another fabric then puts that fabric's own baked frame 0 into the
+    recorded renderer's buffers (what its host steps read back is drawn from it), in the same
+    buffers (the page's curtain tags still name them), as into the meter's."""
+    from catalog.web import bake, export
+
+    first, second = _grid_animation(0.02, "first"), _grid_animation(0.08, "second")
+    exporter = export.SiteExporter(gl)
+    try:
+        p, n, t = bake.decode_frame(first, 0)
+        exporter.use_mesh(p, n, first.uv, t, first.indices.astype(np.int32))
+        exporter.use_drape(first)
+        tags = dict(exporter.curtain_tags)
+        exporter.use_drape(second)
+        want = dict(zip(("position", "normal", "tangent"), bake.decode_frame(second, 0)))
+        assert not np.allclose(want["position"], p, atol=1e-3)   # the cloths differ
+        buffers = exporter.ctx.recording.buffers
+        for rid, tag in tags.items():
+            if tag in want:
+                assert buffers[rid] == np.ascontiguousarray(want[tag], dtype="f4").tobytes(), tag
+        for arrays in (exporter.renderer.mesh_arrays, exporter.meter.mesh_arrays):
+            for got, tag in zip(arrays, ("position", "normal", "tangent")):
+                np.testing.assert_array_equal(got, want[tag])
+        assert exporter.curtain_tags == tags
+    finally:
+        exporter.release()

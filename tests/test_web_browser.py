@@ -393,6 +393,33 @@ def test_plain_json_data_renders_the_same(page, web_site, tmp_path):
     assert page.console_errors() == [] and page.page_errors() == []
 
 
+def test_a_frame_that_fails_is_reported_not_waited_for(page, web_site, tmp_path):
+    """A frame that throws is tried again at each animation frame and never counts as drawn
+    (issue 32's lit room: a sampler2DShadow uniform the page refused, which looked like a hang
+    of the first frame until the selenium script timeout): settle gives up at once with the
+    page's error (CatalogError), well within the 60 s script timeout; the page's own copy of
+    the site, its replayer made to throw."""
+    import shutil
+    import time
+
+    from catalog.core.errors import CatalogError
+
+    out, _ = web_site
+    broken = tmp_path / "broken"
+    shutil.copytree(out, broken)
+    app = (broken / "app.js").read_text(encoding="utf-8")
+    marker = "    render(scene, camera) {\n"
+    assert app.count(marker) == 1
+    (broken / "app.js").write_text(app.replace(
+        marker, marker + "      throw new Error('a recorded command the page cannot replay');\n"),
+        encoding="utf-8")
+    start = time.monotonic()
+    with pytest.raises(CatalogError, match="did not draw: .*a recorded command the page cannot"):
+        page.open(broken, view="viewer", fabric="fluoro-pink", light="D65", frame=0)
+    assert time.monotonic() - start < 20.0
+    page.console_errors()   # (the thrown frames' messages: read, so later tests start clean)
+
+
 def test_frame_time_under_swiftshader_is_reported(page, web_site, record_property):
     """Reported, not asserted as a speed (BENCHMARKS.md has the benchmark's figures): the hook
     gives finite frame times, the CPU part no larger than the whole frame."""

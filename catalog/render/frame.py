@@ -460,8 +460,8 @@ class FrameRenderer:
     def set_fabric_size(self, fabric_size_m) -> None:
         self.mesh.set_fabric_size(fabric_size_m)
 
-    def update_positions(self, positions, normals) -> None:
-        self.mesh.update_positions(positions, normals)
+    def update_positions(self, positions, normals, tangents=None) -> None:
+        self.mesh.update_positions(positions, normals, tangents)
 
     def bind_cloth_buffers(self, position_buffer, normal_buffer) -> None:
         self.mesh.bind_cloth_buffers(position_buffer, normal_buffer)

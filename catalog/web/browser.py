@@ -72,11 +72,19 @@ class Browser:
         return None if first is None else first / 1000.0
 
     def settle(self) -> None:
+        """Wait until the page has drawn its state; a page that failed to start or whose frame
+        failed (it would try again each animation frame, never drawn) is refused at once
+        with its errors (CatalogError), rather than waited for until the script timeout."""
         # the page starts once its data is inflated: wait for its hooks first
-        self.driver.execute_async_script(
+        drawn = self.driver.execute_async_script(
             "const done = arguments[arguments.length - 1];"
-            "const poll = () => window.catalogApp ? window.catalogApp.settle().then(() => done(true))"
+            "const poll = () => window.catalogApp ? window.catalogApp.settle().then(done)"
             " : window.catalogStartError ? done(false) : setTimeout(poll, 20); poll();")
+        if drawn is not True:
+            errors = self.driver.execute_script(
+                "return window.catalogApp ? window.catalogApp.stats.errors"
+                " : [window.catalogStartError]")
+            raise CatalogError("the page did not draw: " + "; ".join(map(str, errors)))
 
     def set(self, **state) -> None:
         self.driver.execute_script("window.catalogApp.set(arguments[0])", state)

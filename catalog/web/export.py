@@ -28,6 +28,7 @@ import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
 from catalog.render.settings import SunHour, orbit
+from catalog.web.prune import prune_unread
 
 #: The lamps of the light switch when ``--lights`` is not given.
 DEFAULT_LAMPS = ("D65", "A", "FL2", "LED-B4", "LED-warm", "UV-A")
@@ -93,10 +94,17 @@ ORBIT_LIMITS = {"yaw_deg": [-70.0, 70.0], "pitch_deg": [-30.0, 60.0], "distance_
 #: stand-ins). The transport's update is a host step (catalog.gl.host_step: its views of the
 #: window read back, worked on the host, the light map uploaded), which a recording with the
 #: room lit notes wet with the desktop's outputs and the page can replay
-#: (assets/host_steps.js); the page with it on fails the browser tests yet (not understood),
-#: and it would replay the recorded cloth's light, not the moving cloth's.
+#: (assets/host_steps.js) and does at frame 0 (tests/test_web_lit.py); off because every scene
+#: would then be recorded wet, and the page replays the recorded cloth's light (its baked
+#: frame 0), not the moving cloth's.
 DESKTOP_MODES = {"patterned": True, "room_lighting": False, "antialiasing": "fxaa",
                  "key_second_layer": False}
+
+
+#: The host steps (catalog.gl.host_step) the page runs itself (CatalogHost.register in
+#: assets/): none yet. The others' outputs are replayed as recorded, and the views only they
+#: read are left out of the recorded structures (catalog.web.prune).
+PAGE_HOST_STEPS: tuple[str, ...] = ()
 
 
 def configure_desktop_frame(renderer) -> None:
@@ -396,16 +404,19 @@ class SiteExporter:
 
     def use_drape(self, animation) -> None:
         """The fabric's drape (the desktop's settled drape, baked): the rest size its uv spans
-        (the pattern's scale) and the rings on the rod, as ``catalog snapshot`` sets them; the
-        meter draws the fabric's own cloth (its baked frame 0), so that a fabric's exposure does
-        not depend on which fabric the site lists first (the recorded frame's buffers keep the
-        first fabric's bytes: the page puts each fabric's own)."""
+        (the pattern's scale) and the rings on the rod, as ``catalog snapshot`` sets them; both
+        renderers draw the fabric's own cloth (its baked frame 0), so that neither a fabric's
+        exposure nor what the frame computes from its cloth on the host (the room's transport
+        reads its views of the cloth back) depends on which fabric the site lists first. The
+        recorded renderer's mesh keeps its buffers (the page's curtain buffers, found by
+        :meth:`use_mesh`), their bytes the fabric's."""
         from catalog.web import bake as bake_lib  # noqa: PLC0415
 
         positions, normals, tangents = bake_lib.decode_frame(animation, 0)
         self.meter.set_mesh(positions, normals, animation.uv, tangents,
                             animation.indices.astype(np.int32))
         self.meter.set_mesh_offset((0.0, 0.0, 0.0))
+        self.renderer.update_positions(positions, normals, tangents)   # the grid is the same
         rings = tuple(animation.rings_x_m)
         for renderer in (self.renderer, self.meter):
             renderer.set_fabric_size(animation.fabric_size_m)
@@ -463,6 +474,9 @@ class SiteExporter:
         rec.start(dry=not scene.room_lighting)
         r.render()
         structure, values = split_commands(rec.stop(), self.camera_values(), clean=self._clean)
+        # the views only a host step the page does not run reads back (its outputs are
+        # recorded as writes): not drawn on the page
+        structure = prune_unread(structure, rec.framebuffers, PAGE_HOST_STEPS)
         self._encode_given_texels()
         for command in structure:  # bytes written in a frame: shared by the scenes alike
             if command["op"] in ("buffer_write", "texture_write"):

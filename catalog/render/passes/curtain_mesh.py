@@ -114,10 +114,16 @@ class CurtainMesh(Pass):
             raise CatalogError(f"fabric size {fabric_size_m!r} must be two positive lengths (m)")
         self.fabric_size_m = size
 
-    def update_positions(self, positions, normals) -> None:
-        """New positions and normals for the same vertices (a simulation frame)."""
+    def update_positions(self, positions, normals, tangents=None) -> None:
+        """New positions and normals (and tangents: another cloth on the same grid) for the
+        same vertices (a simulation frame), in the same buffers."""
         positions = np.ascontiguousarray(positions, dtype="f4").reshape(-1, 3)
         normals = np.ascontiguousarray(normals, dtype="f4").reshape(-1, 3)
+        if tangents is not None:
+            tangents = np.ascontiguousarray(tangents, dtype="f4").reshape(-1, 3)
+            if tangents.shape[0] != self.vertex_count:
+                raise CatalogError(f"update_positions: expected {self.vertex_count} tangents, "
+                                   f"got {tangents.shape[0]}")
         if positions.shape[0] != self.vertex_count or normals.shape[0] != self.vertex_count:
             raise CatalogError(f"update_positions: expected {self.vertex_count} vertices, "
                                f"got {positions.shape[0]}")
@@ -126,7 +132,10 @@ class CurtainMesh(Pass):
                                "the cloth owns the buffers")
         self.buffers["position"].write(positions.tobytes())
         self.buffers["normal"].write(normals.tobytes())
-        self.mesh_arrays = (positions, normals, self.mesh_arrays[2])
+        if tangents is not None:
+            self.buffers["tangent"].write(tangents.tobytes())
+        self.mesh_arrays = (positions, normals,
+                            self.mesh_arrays[2] if tangents is None else tangents)
         self.version += 1
 
     def bind_cloth_buffers(self, position_buffer, normal_buffer) -> None:

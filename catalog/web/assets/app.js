@@ -379,7 +379,11 @@
         case gl.INT_VEC2: gl.uniform2iv(u.loc, v.map(Math.round)); break;
         case gl.INT_VEC3: gl.uniform3iv(u.loc, v.map(Math.round)); break;
         case gl.INT_VEC4: gl.uniform4iv(u.loc, v.map(Math.round)); break;
-        case gl.INT: case gl.SAMPLER_2D: case gl.BOOL: gl.uniform1iv(u.loc, v.map(Math.round)); break;
+        // a sampler's unit, whatever it samples (the room's depth map from the key is a
+        // sampler2DShadow: room_transport.frag)
+        case gl.INT: case gl.BOOL: case gl.SAMPLER_2D: case gl.SAMPLER_2D_SHADOW: case gl.SAMPLER_3D:
+        case gl.SAMPLER_CUBE: case gl.SAMPLER_2D_ARRAY: case gl.SAMPLER_2D_ARRAY_SHADOW:
+        case gl.INT_SAMPLER_2D: case gl.UNSIGNED_INT_SAMPLER_2D: gl.uniform1iv(u.loc, v.map(Math.round)); break;
         default: throw new Error('uniform type ' + u.type + ' is not supported');
       }
     }
@@ -783,9 +787,13 @@
     // the room's pack (null: none, or refused: stats.roomPackError says why)
     roomPack: loadRoomPack,
     // resolves when the current state has been drawn (animations loaded)
+    // (false at once when a frame failed since: a frame that throws is tried again each
+    // animation frame and stays dirty, so waiting for it would wait for ever)
     settle() {
+      const failed = stats.errors.length;
       return new Promise((resolve) => {
-        const poll = () => (!dirty && pendingLoads === 0 ? resolve(true) : setTimeout(poll, 20));
+        const poll = () => (stats.errors.length > failed ? resolve(false)
+          : !dirty && pendingLoads === 0 ? resolve(true) : setTimeout(poll, 20));
         dirty = true; poll();
       });
     },
