@@ -63,7 +63,8 @@ SHARED_FIXTURE_MODULES = {"web_site": ("tests/test_web.py", "tests/test_web_brow
 #: every name here is still a scope.
 SCOPE_SECONDS = {"tests/test_display_gl.py": 230, "web_site": 180, "tests/test_viewer.py": 110,
                  "tests/test_batch.py": 80, "tests/test_bench.py": 70, "tests/test_presets.py": 60,
-                 "tests/test_pathtrace.py": 60, "tests/test_room_transport.py": 55,
+                 "tests/test_pathtrace.py": 60, "tests/test_web_lit.py": 60,
+                 "tests/test_room_transport.py": 55,
                  "tests/test_patterns.py": 50, "tests/test_viewer_panel.py": 40,
                  "tests/test_adaptation.py": 40, "tests/test_cloth_shadows.py": 35,
                  "tests/test_output_layer.py": 30, "tests/test_cli_hostile.py": 30,
