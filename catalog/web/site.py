@@ -44,8 +44,8 @@ ROOM_PACK_FILE = "room_pack.js"
 FORMAT_VERSION = 2  # 2: data.js packed (pack_data)
 
 
-#: The places in data.js that hold bytes (base64 in the recorded data): packed apart from the
-#: JSON (see :func:`pack_data`). (section, field); ``None``: every item of the list.
+#: The places in data.js that hold bytes (a Deflated, or base64, in the recorded data): packed
+#: apart from the JSON (see :func:`pack_data`). (section, field); ``None``: every item of the list.
 BINARY_FIELDS = (("textures", "data"), ("buffers", "data"), ("blobs", None))
 
 
