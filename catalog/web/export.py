@@ -443,11 +443,16 @@ class SiteExporter:
         asked)."""
         scene = scene.replace(fluorescence=FLUORESCENCE[fluorescence], bloom=GLARE[glare],
                               lamps=room_lamps(lamp))
+        r = self.renderer
         if ev100 is None:
+            # a new fabric: the recorder's pattern loaded and its texels encoded before the
+            # meter loads it, so that the recorder's float32 copy of the pattern is gone by
+            # then (the lace's 33 MB; the peak of the whole catalog's recording)
+            r.update(fabric=scene.fabric)
+            self._encode_given_texels()
             self.meter.update(scene)   # (the meter stays at the default camera)
             self.meter.render()
             ev100 = self.meter.current_ev100()
-        r = self.renderer
         r.update(scene.replace(camera=r.camera, ev=ev100))
         from catalog.render.passes.pattern import forget_prepared  # noqa: PLC0415
 
