@@ -316,7 +316,7 @@ def test_a_scene_with_the_room_transport_exports_its_host_step(gl):
         for c in writes:
             blob = exporter.value_pool[recorded["values"][c["slot"]]]["blob"]
             size = exporter.ctx.recording.textures[c["texture"]]["size"]
-            assert len(base64.b64decode(exporter.blobs[blob])) == size[0] * size[1] * 4 * 4
+            assert len(exporter.blobs[blob].raw()) == size[0] * size[1] * 4 * 4
         objects = exporter.objects()
         depth = [rid for rid, t in objects["textures"].items() if t["dtype"] == "depth"]
         assert len(depth) == 1 and objects["textures"][depth[0]]["compare_func"] == "<="
@@ -351,9 +351,8 @@ def test_split_commands_keeps_every_uniform_value_in_order(gl):
     for command, value in zip(scene, values):
         if command["op"] == "uniform":  # float32-exact: 9 significant digits give it back
             assert np.array_equal(np.float32(command["value"]), np.float32(value))
-        else:
-            import base64
-            assert base64.b64decode(value) == command["data"]
+        else:  # the bytes written, as they are
+            assert value == command["data"]
     # every other command kept as it was, in order (room, curtain, background, display ...)
     assert [c for c in structure if c["op"] not in moved] == \
         [c for c in commands if c["op"] not in moved]
@@ -507,8 +506,7 @@ def test_float_texels_quantised_within_half_a_step():
         err = np.abs(back.astype(np.float64) - texels)
         assert np.all(err <= step / 2 + 1e-6), (bits, err.max(axis=0), step)
         assert np.all(back[:, 2] == np.float32(0.25))
-        float_b64 = len(encode_texels(texels.tobytes(), {"dtype": "f1"})["data"])
-        assert len(enc["data"]) <= float_b64 * bits / 32 + 4
+        assert enc["data"].size == texels.nbytes * bits // 32
     raw = bytes(range(256))
     assert decode_texels({"dtype": "f1", "components": 4, **encode_texels(raw, {"dtype": "f1", "components": 4})}).tobytes() == raw
 
@@ -592,6 +590,54 @@ def test_packed_data_round_trips_and_is_smaller():
     assert text.startswith("window.CATALOG_PACKED = ")
     assert unpack_data(text) == data
     assert len(text) < 0.5 * plain
+
+
+def test_deflated_bytes_round_trip_and_count_as_their_base64():
+    """A Deflated gives its bytes back (zlib at DEFLATE_LEVEL: zlib.compress's own bytes) and
+    its base64 (lengths 0, 1, 2 and 3 mod 3); _json_length of data holding Deflated values in
+    dicts, in lists of lists and below its depth equals len(json.dumps) of the same data with
+    each as its base64 string; pack_data writes the same data.js from either form."""
+    import base64
+    import json
+    import zlib
+
+    from catalog.web.deflated import DEFLATE_LEVEL, Deflated
+    from catalog.web.site import _json_length, pack_data, plain_data_js
+
+    rng = np.random.default_rng(7)
+    raws = [b"", b"a", b"ab", b"abc", bytes(1000),
+            rng.integers(0, 256, 4099, dtype=np.uint8).tobytes()]
+    for raw in raws:
+        d = Deflated.of(raw)
+        assert d.raw() == raw and d.size == len(raw)
+        assert d.data == zlib.compress(raw, DEFLATE_LEVEL)
+        assert d.b64() == base64.b64encode(raw).decode("ascii") and d.b64_length() == len(d.b64())
+    # in pieces: zlib.compress's bytes of their concatenation; texels given in pieces (level
+    # 0, its mip levels) encode as their concatenation does
+    cuts = [0, 1, 700, 701, 4099]
+    pieces = [raws[5][i:j] for i, j in zip(cuts, cuts[1:])] + [b"", bytes(3000)]
+    assert Deflated.of_pieces(iter(pieces)) == Deflated.of(b"".join(pieces))
+    from catalog.web.export import encode_texels
+    levels = [rng.uniform(-1, 1, (n, 4)).astype("f4").tobytes() for n in (64, 16, 4, 1)]
+    levels[2] = np.full((4, 4), 9.0, dtype="f4").tobytes()   # the greatest texel in a level
+    desc = {"dtype": "f4", "components": 4}
+    assert encode_texels(levels, desc) == encode_texels(b"".join(levels), desc)
+    assert encode_texels(levels, desc)["quantised"]["hi"] == [9.0] * 4
+    as_b64 = lambda v: (v.b64() if isinstance(v, Deflated) else  # noqa: E731
+                        {k: as_b64(x) for k, x in v.items()} if isinstance(v, dict) else
+                        [as_b64(x) for x in v] if isinstance(v, list) else v)
+    blobs = [Deflated.of(r) for r in raws]
+    data = {"format": 2, "blobs": blobs, "nested": [[blobs[1], [blobs[5], 0.5, "é"]], []],
+            "textures": {1: {"size": [4, 4], "data": blobs[4], "deep": {"x": [{"y": blobs[3]}]}}},
+            "empty": {}, "scenes": {"s0": {"values": [0, 1]}}, "value_pool": [0.125, [1.0, 2.0]]}
+    plain = as_b64(data)
+    for depth in (0, 1, 2, 3, 6):
+        assert _json_length(data, depth) == len(json.dumps(plain, separators=(",", ":"))), depth
+    assert plain_data_js(data) == plain_data_js(plain)
+    packable = {k: v for k, v in data.items() if k not in ("nested",)}
+    packable["textures"] = {1: {"size": [4, 4], "data": blobs[4]}}
+    packable["buffers"] = {3: {"data": blobs[5]}, 4: {"curtain": "uv"}}
+    assert pack_data(packable) == pack_data(as_b64(packable))
 
 
 def test_frame_comparison_reports_a_frame_wide_shift():

@@ -28,6 +28,7 @@ import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
 from catalog.render.settings import SunHour, orbit
+from catalog.web.deflated import Deflated
 from catalog.web.prune import prune_unread
 
 #: The lamps of the light switch when ``--lights`` is not given.
@@ -243,7 +244,8 @@ def split_commands(commands: list[dict], camera_values: dict | None = None,
     ``camera_values``: the frame camera's value of each of CAMERA_UNIFORMS; a uniform of that
     name set to it is marked ``camera`` (the page computes it from its own camera); set to
     another (e.g. the room's window capture or the light's view) it is an ordinary value.
-    ``clean``: :func:`_clean` or a :class:`CleanCache`."""
+    ``clean``: :func:`_clean` or a :class:`CleanCache`. A buffer or texture write's value
+    is its bytes (raw: the exporter holds them deflated, :meth:`SiteExporter._blob`)."""
     structure, values = [], []
     camera_values = camera_values or {}
     inverse = [_f32(1.0 / RECORD_SIZE[0]), _f32(1.0 / RECORD_SIZE[1])]
@@ -267,14 +269,10 @@ def split_commands(commands: list[dict], camera_values: dict | None = None,
         elif command["op"] in ("buffer_write", "texture_write"):  # the scene's bytes, not the place
             structure.append({k: v for k, v in command.items() if k != "data"}
                              | {"slot": len(values)})
-            values.append(_b64(command["data"]))
+            values.append(bytes(command["data"]))
         else:
             structure.append(command)
     return structure, values
-
-
-def _b64(data: bytes) -> str:
-    return base64.b64encode(data).decode("ascii")
 
 
 #: Bits per channel of a float texture the frame filled (the fabrics' pattern textures:
@@ -287,29 +285,35 @@ def _b64(data: bytes) -> str:
 TEXEL_BITS = 8
 
 
-def encode_texels(data: bytes, texture: dict, bits: int = TEXEL_BITS) -> dict:
+def encode_texels(data, texture: dict, bits: int = TEXEL_BITS) -> dict:
     """The page's form of recorded texels: 8-bit textures as they are; float32 ones
     quantised to ``bits`` (8 or 16) per channel with a per-channel range (``lo``, ``hi``),
-    little-endian, in channel planes, base64."""
+    little-endian, in channel planes; the bytes held :class:`Deflated` (data.js carries them
+    so). ``data``: bytes, or a list of bytes encoded as their concatenation (level 0 and the
+    mip levels, :func:`given_texels`) without making it."""
+    pieces = [data] if isinstance(data, (bytes, bytearray, memoryview)) else list(data)
     if texture["dtype"] != "f4":
-        return {"data": _b64(data)}
+        return {"data": Deflated.of(b"".join(pieces))}
     if bits not in (8, 16):
         raise CatalogError(f"texel bits must be 8 or 16, not {bits}")
-    texels = np.frombuffer(data, dtype="<f4").reshape(-1, texture["components"])
-    if not np.all(np.isfinite(texels)):
+    arrays = [np.frombuffer(p, dtype="<f4").reshape(-1, texture["components"]) for p in pieces]
+    arrays = [a for a in arrays if a.size] or arrays[:1]
+    if not all(np.all(np.isfinite(a)) for a in arrays):
         raise CatalogError("a recorded float texture has non-finite texels")
-    lo = texels.min(axis=0).astype(np.float64)
-    hi = texels.max(axis=0).astype(np.float64)
+    lo = np.min([a.min(axis=0) for a in arrays], axis=0).astype(np.float64)
+    hi = np.max([a.max(axis=0) for a in arrays], axis=0).astype(np.float64)
     top = (1 << bits) - 1
     span = np.where(hi > lo, hi - lo, 1.0)
     # in planes (every texel's channel 0, then channel 1, ..): deflate (site.pack_data) then
     # finds each channel's own repetitions (a third of the interleaved bytes' deflated size
-    # on the lace's pattern); quantised in float64 a channel at a time (a pattern of 27 MB
-    # needs no float64 copy of all its channels at once)
-    encoded = b"".join(
-        np.rint((texels[:, c].astype(np.float64) - lo[c]) / span[c] * top)
-        .astype("<u2" if bits == 16 else "u1").tobytes() for c in range(texels.shape[1]))
-    return {"data": _b64(encoded),
+    # on the lace's pattern); quantised in float64 a channel of a piece at a time and
+    # deflated as it comes (a pattern of 33 MB needs no float64 copy of a whole channel, nor
+    # its quantised bytes whole)
+    encoded = Deflated.of_pieces(
+        np.rint((a[:, c].astype(np.float64) - lo[c]) / span[c] * top)
+        .astype("<u2" if bits == 16 else "u1").tobytes()
+        for c in range(arrays[0].shape[1]) for a in arrays)
+    return {"data": encoded,
             "quantised": {"bits": bits, "lo": [float(v) for v in lo],
                           "hi": [float(v) for v in lo + span], "planar": True}}
 
@@ -326,14 +330,16 @@ def given_texels(rec, rid: int) -> dict:
         levels += 1
     if len(given) != levels:
         raise CatalogError("the web page replays only mip levels 1..n given in order")
-    data = rec.texture_data[rid] + b"".join(given[k] for k in range(1, levels + 1))
+    data = [rec.texture_data[rid], *(given[k] for k in range(1, levels + 1))]
     entry = encode_texels(data, rec.textures[rid])
     return {**entry, "levels": levels} if levels else entry
 
 
 def decode_texels(texture: dict) -> np.ndarray:
-    """The page's decoding of :func:`encode_texels` (float32, flat), for the tests."""
-    raw = base64.b64decode(texture["data"])
+    """The page's decoding of :func:`encode_texels` (float32, flat), for the tests: its
+    ``data`` as encoded (Deflated) or as data.js gives it back (base64, site.unpack_data)."""
+    data = texture["data"]
+    raw = data.raw() if isinstance(data, Deflated) else base64.b64decode(data)
     quantised = texture.get("quantised")
     if quantised is None:
         return np.frombuffer(raw, dtype="u1")
@@ -372,8 +378,10 @@ class SiteExporter:
         self.structures: list[list[dict]] = []
         self._structure_index: dict[str, int] = {}
         self.curtain_tags: dict[int, str] = {}
-        self.blobs: list[str] = []   # base64 bytes the frames write into buffers (shared)
-        self._blob_index: dict[str, int] = {}
+        #: the bytes the frames write into buffers and textures, deflated (shared by the
+        #: scenes that write the same: the whole catalog's: 36 MB raw, 2.3 MB deflated)
+        self.blobs: list[Deflated] = []
+        self._blob_index: dict[bytes, int] = {}   # SHA-256 of the raw bytes -> index
         # every distinct uniform value once (site.pack_data's "value_pool"): a scene holds
         # indices into it from the start, so the catalog's scenes cost a list of ints each
         self.value_pool: list = []
@@ -382,9 +390,9 @@ class SiteExporter:
         self._clean = CleanCache()
         self._rings: tuple | None = None
         #: recorded texels in the page's form (encode_texels), by texture id: encoded as soon
-        #: as a frame has given them, so that the catalog's patterns are held quantised (a
-        #: quarter of their float32 bytes: 92 MB -> 23 MB for the twelve built-in fabrics)
-        #: rather than as float32 until the end
+        #: as a frame has given them, so that the catalog's patterns are held quantised and
+        #: deflated (their levels included: 32 MB quantised, 7 MB deflated for the twelve
+        #: built-in fabrics) rather than as float32 until the end
         self._texels: dict[int, dict] = {}
 
     # -- the curtain's buffers: found by their bytes after set_mesh
@@ -446,11 +454,16 @@ class SiteExporter:
         asked)."""
         scene = scene.replace(fluorescence=FLUORESCENCE[fluorescence], bloom=GLARE[glare],
                               lamps=room_lamps(lamp))
+        r = self.renderer
         if ev100 is None:
+            # a new fabric: the recorder's pattern loaded and its texels encoded before the
+            # meter loads it, so that the recorder's float32 copy of the pattern is gone by
+            # then (the lace's 33 MB; the peak of the whole catalog's recording)
+            r.update(fabric=scene.fabric)
+            self._encode_given_texels()
             self.meter.update(scene)   # (the meter stays at the default camera)
             self.meter.render()
             ev100 = self.meter.current_ev100()
-        r = self.renderer
         r.update(scene.replace(camera=r.camera, ev=ev100))
         from catalog.render.passes.pattern import forget_prepared  # noqa: PLC0415
 
@@ -536,12 +549,14 @@ class SiteExporter:
             pool[new] = self.value_pool[old]
         return out, pool
 
-    def _blob(self, text: str) -> int:
-        """Index of ``text`` in :attr:`blobs` (added once)."""
-        if text not in self._blob_index:
-            self._blob_index[text] = len(self.blobs)
-            self.blobs.append(text)
-        return self._blob_index[text]
+    def _blob(self, raw: bytes) -> int:
+        """Index of ``raw`` (deflated) in :attr:`blobs` (added once, by its SHA-256)."""
+        digest = hashlib.sha256(raw).digest()
+        index = self._blob_index.get(digest)
+        if index is None:
+            index = self._blob_index[digest] = len(self.blobs)
+            self.blobs.append(Deflated.of(raw))
+        return index
 
     def camera_values(self) -> dict:
         """The recorded frame's camera uniforms (CAMERA_UNIFORMS) as the frame sets them."""
@@ -624,7 +639,7 @@ class SiteExporter:
         buffers = {}
         for rid in sorted(used_buffers):
             tag = self.curtain_tags.get(rid)
-            buffers[rid] = {"curtain": tag} if tag else {"data": _b64(rec.buffers[rid])}
+            buffers[rid] = {"curtain": tag} if tag else {"data": Deflated.of(rec.buffers[rid])}
             if any(v["index_buffer"] == rid for v in vaos.values()):
                 buffers[rid]["index"] = True  # WebGL binds a buffer to one target for life
         return {

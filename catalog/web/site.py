@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from catalog.core.errors import CatalogError, InputError
+from catalog.web.deflated import DEFLATE_LEVEL, Deflated
 
 #: The page's own files (catalog/web/assets), copied as they are.
 ASSET_FILES = ("index.html", "app.js", "room_transport.js", "host_steps.js", "style.css")
@@ -43,19 +44,32 @@ ROOM_PACK_FILE = "room_pack.js"
 FORMAT_VERSION = 2  # 2: data.js packed (pack_data)
 
 
-#: The places in data.js that hold bytes (base64 in the recorded data): packed apart from the
-#: JSON (see :func:`pack_data`). (section, field); ``None``: every item of the list.
+#: The places in data.js that hold bytes (a Deflated, or base64, in the recorded data): packed
+#: apart from the JSON (see :func:`pack_data`). (section, field); ``None``: every item of the list.
 BINARY_FIELDS = (("textures", "data"), ("buffers", "data"), ("blobs", None))
 
 
 def _json_length(value, depth: int = 2) -> int:
-    """len(json.dumps(value, separators=(",", ":"))) without the whole text at once: the
-    top ``depth`` levels of dicts part by part (the scenes one at a time)."""
+    """len(json.dumps(value, separators=(",", ":"))) of ``value`` with each
+    :class:`~catalog.web.deflated.Deflated` as its bytes' base64 string (the plain form,
+    :func:`plain_data_js`), without the whole text at once: the top ``depth`` levels of dicts
+    and lists part by part (the scenes one at a time), a Deflated by its base64's length."""
+    if isinstance(value, Deflated):
+        return value.b64_length() + 2
     if depth and isinstance(value, dict) and value:
         return (2 + len(value) - 1
                 + sum(len(json.dumps(str(key))) + 1 + _json_length(item, depth - 1)
                       for key, item in value.items()))
-    return len(json.dumps(value, separators=(",", ":")))
+    if depth and isinstance(value, list) and value:
+        return 2 + len(value) - 1 + sum(_json_length(item, depth - 1) for item in value)
+    deeper: list[int] = []   # a Deflated below depth: "" in the text, its length added
+
+    def stand_in(item):
+        if not isinstance(item, Deflated):
+            raise TypeError(f"{type(item).__name__} is not JSON serialisable")
+        deeper.append(item.b64_length())
+        return ""
+    return len(json.dumps(value, separators=(",", ":"), default=stand_in)) + sum(deeper)
 
 
 def _json_pieces(value, depth: int = 3):
@@ -97,7 +111,16 @@ def _plain_length(data: dict) -> int:
 
 
 def pack_data(data: dict) -> tuple[str, int]:
-    """data.js's text, and the bytes a plain ``window.CATALOG_DATA = JSON`` would take.
+    """data.js's text, and the bytes a plain ``window.CATALOG_DATA = JSON`` would take
+    (:func:`packed_pieces`, joined)."""
+    pieces, plain = packed_pieces(data)
+    return "".join(pieces), plain
+
+
+def packed_pieces(data: dict):
+    """(data.js's text in pieces, the bytes a plain ``window.CATALOG_DATA = JSON`` would
+    take): the pieces an iterator that makes each binary item's base64 as it comes, so that
+    data.js is written without its whole text (or all its base64) in memory.
 
     data.js sets ``window.CATALOG_PACKED = {"json": Z, "binary": [Z, ..]}``: Z is base64 of zlib
     (the page inflates it with the browser's DecompressionStream; a script, not a fetch, so
@@ -115,7 +138,7 @@ def pack_data(data: dict) -> tuple[str, int]:
     # move out).
     plain = len(plain_data_js({})) - 2 + _plain_length(data)
     data = dict(data)
-    binary: list[str] = []
+    binary: list[bytes] = []   # deflated
     # every distinct uniform value once ("values": [0.5, ..] -> "values": [i, ..] into
     # "value_pool"): scenes of one fabric or light share most of theirs. Data that comes
     # pooled (the exporter pools as it records) is kept as it is.
@@ -126,8 +149,10 @@ def pack_data(data: dict) -> tuple[str, int]:
             for v in scene["values"]]} for key, scene in data["scenes"].items()}
         data["value_pool"] = [json.loads(text) for text in pool]
 
-    def move(text: str) -> dict:
-        binary.append(base64.b64encode(zlib.compress(base64.b64decode(text), 9)).decode("ascii"))
+    def move(value: str | Deflated) -> dict:
+        # a Deflated (as the exporter holds them) as it is; base64 deflated here
+        deflated = value if isinstance(value, Deflated) else Deflated.of(base64.b64decode(value))
+        binary.append(deflated.data)
         return {"binary": len(binary) - 1}
 
     for section, field in BINARY_FIELDS:
@@ -135,23 +160,33 @@ def pack_data(data: dict) -> tuple[str, int]:
             data[section] = [move(v) for v in data[section]]
             continue
         data[section] = {key: ({**entry, field: move(entry[field])}
-                               if isinstance(entry.get(field), str) else entry)
+                               if isinstance(entry.get(field), (str, Deflated)) else entry)
                          for key, entry in data[section].items()}
     # deflated part by part (the scenes and the pool an item at a time): the same bytes as
     # zlib.compress of the whole text, without the whole text in memory
-    deflate = zlib.compressobj(9)
+    deflate = zlib.compressobj(DEFLATE_LEVEL)
     deflated = [deflate.compress(piece.encode("utf-8")) for piece in _json_pieces(data)]
     deflated.append(deflate.flush())
-    packed = {"format": FORMAT_VERSION,
-              "json": base64.b64encode(b"".join(deflated)).decode("ascii"),
-              "binary": binary}
-    return "window.CATALOG_PACKED = " + json.dumps(packed, separators=(",", ":")) + ";\n", plain
+    del data
+    packed_json = base64.b64encode(b"".join(deflated)).decode("ascii")
+    del deflated
+
+    def pieces():
+        # json.dumps({"format": .., "json": .., "binary": [..]}, separators=(",", ":")), each
+        # binary item's base64 made as it is written
+        yield (f'window.CATALOG_PACKED = {{"format":{json.dumps(FORMAT_VERSION)},"json":'
+               f'{json.dumps(packed_json)},"binary":[')
+        for k, item in enumerate(binary):
+            yield ("," if k else "") + json.dumps(base64.b64encode(item).decode("ascii"))
+        yield "]};\n"
+    return pieces(), plain
 
 
 def plain_data_js(data: dict) -> str:
-    """data.js as plain JSON (``window.CATALOG_DATA``, bytes as base64): the form before
-    :func:`pack_data`, which the page still reads (the benchmark loads both)."""
-    return "window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":")) + ";\n"
+    """data.js as plain JSON (``window.CATALOG_DATA``, bytes as base64, a Deflated's too): the
+    form before :func:`pack_data`, which the page still reads (the benchmark loads both)."""
+    return "window.CATALOG_DATA = " + json.dumps(data, separators=(",", ":"),
+                                                 default=Deflated.b64) + ";\n"
 
 
 def unpack_data(text: str) -> dict:
@@ -433,10 +468,14 @@ def build_site(out: str | Path, fabrics: str | None = None, lights: str | None =
         t = time.perf_counter()
         room_text, room_report = export.room_pack_script(room)
         (stage / ROOM_PACK_FILE).write_text(room_text, encoding="utf-8")
+        del room_text
         data["room"] = {"name": room_report["name"], "pack": ROOM_PACK_FILE}
         timings["room_pack_s"] = time.perf_counter() - t
-        packed, plain_bytes = pack_data(data)
-        (stage / "data.js").write_text(packed, encoding="utf-8")
+        pieces, plain_bytes = packed_pieces(data)
+        del data
+        with open(stage / "data.js", "w", encoding="utf-8") as packed:
+            packed.writelines(pieces)
+        del pieces
         (stage / "anim").mkdir()
         for animation in animations.values():
             (stage / "anim" / f"{animation.key}.js").write_text(animation.script(), encoding="utf-8")
