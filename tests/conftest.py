@@ -198,6 +198,26 @@ def pytest_runtest_teardown(item):
 
 
 @pytest.fixture
+def lit_recording(gl):
+    """A lit-room scene (linen-dense under D65, on a 12x8 drape) recorded by a fresh
+    SiteExporter: (exporter, recorded, its structure); the exporter released after."""
+    from catalog.render import scene as scene_lib
+    from catalog.render import settings as settings_lib
+    from catalog.web import export
+
+    exporter = export.SiteExporter(gl)
+    try:
+        d = scene_lib.draped_curtain(12, 8)
+        exporter.use_mesh(d.positions, d.normals, d.uvs, d.tangents, d.indices)
+        choice = export.LightChoice(id="D65", label="D65", kind="lamp", hour=None)
+        scene = exporter.scene(settings_lib.FrameSettings(fabric="linen-dense").fabric, choice)
+        recorded = exporter.record(scene.replace(room_lighting=True), "on")
+        yield exporter, recorded, exporter.structures[recorded["structure"]]
+    finally:
+        exporter.release()
+
+
+@pytest.fixture
 def gl(gl_context):
     """The shared context, checked for no pending GL error before and after each test."""
     # read once: glGetError clears the flag, so a second read in the message would say "no error"

@@ -294,36 +294,23 @@ def test_the_room_transport_is_recorded_as_a_host_step(gl):
 
 @pytest.mark.gl
 @pytest.mark.slow   # a recorded lit frame (1.1-1.7 s under -n 2)
-def test_a_scene_with_the_room_transport_exports_its_host_step(gl):
+def test_a_scene_with_the_room_transport_exports_its_host_step(lit_recording):
     """SiteExporter.record of a lit-room scene: its host step's in-frame writes carry their
     bytes as the scene's blobs (slots, not in the shared structure); objects() gives the page
     the room's depth map as a depth texture (with its compare func), not a renderbuffer, and
     every texture a host step writes."""
-    from catalog.render import scene as scene_lib
-    from catalog.render import settings as settings_lib
-    from catalog.web import export
-
-    exporter = export.SiteExporter(gl)
-    try:
-        d = scene_lib.draped_curtain(12, 8)
-        exporter.use_mesh(d.positions, d.normals, d.uvs, d.tangents, d.indices)
-        choice = export.LightChoice(id="D65", label="D65", kind="lamp", hour=None)
-        scene = exporter.scene(settings_lib.FrameSettings(fabric="linen-dense").fabric, choice)
-        recorded = exporter.record(scene.replace(room_lighting=True), "on")
-        structure = exporter.structures[recorded["structure"]]
-        writes = [c for c in structure if c["op"] == "texture_write"]
-        assert writes and all("data" not in c for c in writes)
-        for c in writes:
-            blob = exporter.value_pool[recorded["values"][c["slot"]]]["blob"]
-            size = exporter.ctx.recording.textures[c["texture"]]["size"]
-            assert len(exporter.blobs[blob].raw()) == size[0] * size[1] * 4 * 4
-        objects = exporter.objects()
-        depth = [rid for rid, t in objects["textures"].items() if t["dtype"] == "depth"]
-        assert len(depth) == 1 and objects["textures"][depth[0]]["compare_func"] == "<="
-        assert depth[0] not in objects["renderbuffers"]
-        assert {c["texture"] for c in writes} <= set(objects["textures"])
-    finally:
-        exporter.release()
+    exporter, recorded, structure = lit_recording
+    writes = [c for c in structure if c["op"] == "texture_write"]
+    assert writes and all("data" not in c for c in writes)
+    for c in writes:
+        blob = exporter.value_pool[recorded["values"][c["slot"]]]["blob"]
+        size = exporter.ctx.recording.textures[c["texture"]]["size"]
+        assert len(exporter.blobs[blob].raw()) == size[0] * size[1] * 4 * 4
+    objects = exporter.objects()
+    depth = [rid for rid, t in objects["textures"].items() if t["dtype"] == "depth"]
+    assert len(depth) == 1 and objects["textures"][depth[0]]["compare_func"] == "<="
+    assert depth[0] not in objects["renderbuffers"]
+    assert {c["texture"] for c in writes} <= set(objects["textures"])
 
 
 @pytest.mark.gl

@@ -86,40 +86,27 @@ def test_the_page_registers_no_host_step_the_export_does_not_know():
 
 @pytest.mark.gl
 @pytest.mark.slow   # a recorded lit frame
-def test_the_lit_rooms_views_only_its_host_step_reads_are_not_exported(gl):
+def test_the_lit_rooms_views_only_its_host_step_reads_are_not_exported(lit_recording):
     """A lit-room scene through SiteExporter.record: no draw into the window's captures, the
     window side's view or the outside's, no mip chain of them (the host step's inputs, read
     by nothing on the page: the recorded writes stand for them); the room's depth map, which
     the room's pass samples, is still drawn; as many uniforms as the unpruned recording."""
-    from catalog.render import scene as scene_lib
-    from catalog.render import settings as settings_lib
-    from catalog.web import export
-
-    exporter = export.SiteExporter(gl)
-    try:
-        d = scene_lib.draped_curtain(12, 8)
-        exporter.use_mesh(d.positions, d.normals, d.uvs, d.tangents, d.indices)
-        choice = export.LightChoice(id="D65", label="D65", kind="lamp", hour=None)
-        scene = exporter.scene(settings_lib.FrameSettings(fabric="linen-dense").fabric, choice)
-        recorded = exporter.record(scene.replace(room_lighting=True), "on")
-        structure = exporter.structures[recorded["structure"]]
-        rec = exporter.ctx.recording
-        host = next(c for c in structure if c["op"] == "host")
-        inputs = host["inputs"]
-        views = {inputs[k]["texture"]["object"] for k in ("captures", "window_side", "outside")}
-        view_fbos = {rid for rid, f in rec.framebuffers.items() if set(f["colour"]) & views}
-        depth = inputs["room_depth"]["texture"]["object"]
-        depth_fbos = {rid for rid, f in rec.framebuffers.items() if f["depth"] == depth}
-        bound, drawn = None, set()
-        for c in structure:
-            if c["op"] == "framebuffer":
-                bound = c["framebuffer"]
-            elif c["op"] in ("draw", "clear"):
-                drawn.add(c.get("framebuffer", bound))
-        assert view_fbos and not drawn & view_fbos
-        assert not {c["texture"] for c in structure if c["op"] == "mipmaps"} & views
-        assert drawn & depth_fbos
-        assert len(recorded["values"]) == sum(c["op"] in ("uniform", "buffer_write",
-                                                          "texture_write") for c in structure)
-    finally:
-        exporter.release()
+    exporter, recorded, structure = lit_recording
+    rec = exporter.ctx.recording
+    host = next(c for c in structure if c["op"] == "host")
+    inputs = host["inputs"]
+    views = {inputs[k]["texture"]["object"] for k in ("captures", "window_side", "outside")}
+    view_fbos = {rid for rid, f in rec.framebuffers.items() if set(f["colour"]) & views}
+    depth = inputs["room_depth"]["texture"]["object"]
+    depth_fbos = {rid for rid, f in rec.framebuffers.items() if f["depth"] == depth}
+    bound, drawn = None, set()
+    for c in structure:
+        if c["op"] == "framebuffer":
+            bound = c["framebuffer"]
+        elif c["op"] in ("draw", "clear"):
+            drawn.add(c.get("framebuffer", bound))
+    assert view_fbos and not drawn & view_fbos
+    assert not {c["texture"] for c in structure if c["op"] == "mipmaps"} & views
+    assert drawn & depth_fbos
+    assert len(recorded["values"]) == sum(c["op"] in ("uniform", "buffer_write",
+                                                      "texture_write") for c in structure)
